@@ -1,0 +1,408 @@
+//! HDR lighting environments in latitude–longitude layout, with the USC ICT light-probe
+//! mapping (`../shared/data/README.md`): for a unit direction `(x, y, z)` with `y` up,
+//! `u = (1 + atan2(x, -z) / π) / 2`, `v = acos(y) / π`; the image centre looks toward
+//! `-z`. A yaw (rotation about `+y`, radians, right-handed) turns the whole map:
+//! the map's direction `d` lights the subject from `R_y(yaw) d`.
+//!
+//! Input rule: non-finite texels (NaN, infinity) make the file invalid and are refused
+//! with their position; negative texels (which some EXR writers produce from filtering)
+//! are clamped to zero and counted in [`EnvMap::clamped_texels`].
+//!
+//! [`EnvMap::median_cut`] reduces the map to `n` distant lights of nearly equal energy
+//! (Debevec, "A median cut algorithm for light probe sampling", SIGGRAPH 2005 poster),
+//! keeping the total light exactly: a small, very bright sun ends up alone in its region.
+
+use std::collections::BinaryHeap;
+use std::f32::consts::PI;
+use std::path::Path;
+
+use glam::{Mat3, Vec2, Vec3};
+
+use crate::error::{CoreError, Result};
+use crate::image::{Border, Image, Rgb, RgbImage, luminance};
+use crate::light::DirLight;
+
+/// A latitude–longitude HDR environment of radiance.
+#[derive(Debug, Clone)]
+pub struct EnvMap {
+    radiance: RgbImage,
+    yaw: f32,
+    clamped_texels: usize,
+}
+
+impl EnvMap {
+    /// Loads a `.hdr` (Radiance RGBE) or `.exr` map.
+    pub fn load(path: &Path) -> Result<Self> {
+        let img = crate::io::read_rgb(path)?;
+        Self::from_image(img).map_err(|e| match e {
+            CoreError::InvalidArgument { problem, .. } => CoreError::bad_file(path, problem),
+            other => other,
+        })
+    }
+
+    /// Wraps a radiance image (width should be twice the height, but any size of at least
+    /// 1x1 is accepted). Non-finite texels are refused, negative ones clamped to zero.
+    pub fn from_image(mut radiance: RgbImage) -> Result<Self> {
+        if radiance.width() == 0 || radiance.height() == 0 {
+            return Err(CoreError::invalid("environment", "empty image"));
+        }
+        let w = radiance.width();
+        if let Some(i) = radiance
+            .pixels()
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(CoreError::invalid(
+                "environment",
+                format!("texel ({}, {}) is not finite", i % w, i / w),
+            ));
+        }
+        let mut clamped_texels = 0;
+        for p in radiance.pixels_mut() {
+            if p.iter().any(|&c| c < 0.0) {
+                clamped_texels += 1;
+                *p = p.map(|c| c.max(0.0));
+            }
+        }
+        Ok(Self {
+            radiance,
+            yaw: 0.0,
+            clamped_texels,
+        })
+    }
+
+    /// A constant environment of radiance `value` on a `2n x n` grid.
+    pub fn uniform(value: Rgb, n: usize) -> Self {
+        Self {
+            radiance: Image::new(2 * n.max(1), n.max(1), value),
+            yaw: 0.0,
+            clamped_texels: 0,
+        }
+    }
+
+    /// The same environment turned by an extra `angle` radians about `+y`.
+    pub fn rotated(&self, angle: f32) -> Self {
+        Self {
+            yaw: self.yaw + angle,
+            ..self.clone()
+        }
+    }
+
+    /// The current yaw, radians.
+    pub fn yaw(&self) -> f32 {
+        self.yaw
+    }
+
+    /// Texels whose negative channels were clamped to zero on load.
+    pub fn clamped_texels(&self) -> usize {
+        self.clamped_texels
+    }
+
+    /// The radiance image (map frame, before yaw).
+    pub fn image(&self) -> &RgbImage {
+        &self.radiance
+    }
+
+    /// Unit direction (after yaw) of continuous texel coordinates (centres at integers).
+    pub fn direction_of(&self, x: f32, y: f32) -> Vec3 {
+        let (w, h) = self.radiance.size();
+        let u = (x + 0.5) / w as f32;
+        let v = (y + 0.5) / h as f32;
+        let phi = (2.0 * u - 1.0) * PI;
+        let theta = v * PI;
+        let d = Vec3::new(
+            theta.sin() * phi.sin(),
+            theta.cos(),
+            -theta.sin() * phi.cos(),
+        );
+        Mat3::from_rotation_y(self.yaw) * d
+    }
+
+    /// Continuous texel coordinates of a direction (after yaw).
+    pub fn texel_of(&self, direction: Vec3) -> Vec2 {
+        let d = (Mat3::from_rotation_y(-self.yaw) * direction).normalize_or_zero();
+        let (w, h) = self.radiance.size();
+        let u = (1.0 + d.x.atan2(-d.z) / PI) / 2.0;
+        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+        Vec2::new(u * w as f32 - 0.5, v * h as f32 - 0.5)
+    }
+
+    /// Radiance arriving from `direction` (bilinear, wrapping in azimuth).
+    pub fn radiance(&self, direction: Vec3) -> Rgb {
+        let t = self.texel_of(direction);
+        let w = self.radiance.width() as f32;
+        let x = t.x.rem_euclid(w);
+        // Wrap by sampling the two columns explicitly when between the last and first.
+        if x > w - 1.0 {
+            let f = x - (w - 1.0);
+            let a = self.radiance.sample_bilinear(w - 1.0, t.y, Border::Clamp);
+            let b = self.radiance.sample_bilinear(0.0, t.y, Border::Clamp);
+            return [0, 1, 2].map(|c| a[c] * (1.0 - f) + b[c] * f);
+        }
+        self.radiance.sample_bilinear(x, t.y, Border::Clamp)
+    }
+
+    /// Solid angle of one texel of row `row`, steradians.
+    pub fn texel_solid_angle(&self, row: usize) -> f32 {
+        let (w, h) = self.radiance.size();
+        let top = row as f32 * PI / h as f32;
+        let bottom = (row + 1) as f32 * PI / h as f32;
+        (2.0 * PI / w as f32) * (top.cos() - bottom.cos())
+    }
+
+    /// `∫ L dω` over the whole sphere, per channel.
+    pub fn total_light(&self) -> Rgb {
+        let mut sum = [0.0f64; 3];
+        for y in 0..self.radiance.height() {
+            let omega = self.texel_solid_angle(y) as f64;
+            for p in self.radiance.row(y) {
+                for c in 0..3 {
+                    sum[c] += p[c] as f64 * omega;
+                }
+            }
+        }
+        sum.map(|v| v as f32)
+    }
+
+    /// Reduces the map to at most `n` distant lights by median cut; the lights' total
+    /// irradiance equals [`EnvMap::total_light`] (up to float rounding).
+    pub fn median_cut(&self, n: usize) -> Vec<DirLight> {
+        MedianCut::new(self).lights(n.max(1))
+    }
+}
+
+/// Summed-area tables of the quantities median cut needs per region.
+struct MedianCut<'a> {
+    env: &'a EnvMap,
+    w: usize,
+    /// Per texel: energy (luminance × solid angle), RGB light, energy-weighted direction.
+    tables: [Vec<f64>; 7],
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Region {
+    x0: usize,
+    y0: usize,
+    x1: usize,
+    y1: usize,
+    energy: f64,
+}
+
+impl PartialEq for Region {
+    fn eq(&self, other: &Self) -> bool {
+        self.energy == other.energy
+    }
+}
+impl Eq for Region {}
+impl PartialOrd for Region {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Region {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.energy.total_cmp(&other.energy)
+    }
+}
+
+impl<'a> MedianCut<'a> {
+    fn new(env: &'a EnvMap) -> Self {
+        let (w, h) = env.radiance.size();
+        let stride = w + 1;
+        let mut tables: [Vec<f64>; 7] = std::array::from_fn(|_| vec![0.0; stride * (h + 1)]);
+        for y in 0..h {
+            let omega = env.texel_solid_angle(y) as f64;
+            for x in 0..w {
+                let p = env.radiance.get(x, y);
+                let e = luminance(p) as f64 * omega;
+                let d = env.direction_of(x as f32, y as f32);
+                let values = [
+                    e,
+                    p[0] as f64 * omega,
+                    p[1] as f64 * omega,
+                    p[2] as f64 * omega,
+                    e * d.x as f64,
+                    e * d.y as f64,
+                    e * d.z as f64,
+                ];
+                let i = (y + 1) * stride + x + 1;
+                for (t, v) in tables.iter_mut().zip(values) {
+                    t[i] = v + t[i - 1] + t[i - stride] - t[i - stride - 1];
+                }
+            }
+        }
+        Self { env, w, tables }
+    }
+
+    fn sum(&self, table: usize, x0: usize, y0: usize, x1: usize, y1: usize) -> f64 {
+        let s = self.w + 1;
+        let t = &self.tables[table];
+        t[y1 * s + x1] - t[y0 * s + x1] - t[y1 * s + x0] + t[y0 * s + x0]
+    }
+
+    fn region(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> Region {
+        Region {
+            x0,
+            y0,
+            x1,
+            y1,
+            energy: self.sum(0, x0, y0, x1, y1),
+        }
+    }
+
+    /// Splits a region in two halves of equal energy across its longer angular side.
+    fn split(&self, r: Region) -> Option<(Region, Region)> {
+        let (w, h) = self.env.radiance.size();
+        let rows_mid = (r.y0 + r.y1) as f32 / 2.0 * PI / h as f32;
+        let width_angle = (r.x1 - r.x0) as f32 * 2.0 * PI / w as f32 * rows_mid.sin();
+        let height_angle = (r.y1 - r.y0) as f32 * PI / h as f32;
+        let along_x = (width_angle >= height_angle && r.x1 - r.x0 > 1) || r.y1 - r.y0 <= 1;
+        let (lo, hi) = if along_x { (r.x0, r.x1) } else { (r.y0, r.y1) };
+        if hi - lo < 2 {
+            return None;
+        }
+        let energy_below = |k: usize| {
+            if along_x {
+                self.sum(0, r.x0, r.y0, k, r.y1)
+            } else {
+                self.sum(0, r.x0, r.y0, r.x1, k)
+            }
+        };
+        // Smallest k in (lo, hi) with at least half the energy below it.
+        let (mut a, mut b) = (lo + 1, hi - 1);
+        while a < b {
+            let m = (a + b) / 2;
+            if energy_below(m) * 2.0 >= r.energy {
+                b = m;
+            } else {
+                a = m + 1;
+            }
+        }
+        let k = a;
+        Some(if along_x {
+            (
+                self.region(r.x0, r.y0, k, r.y1),
+                self.region(k, r.y0, r.x1, r.y1),
+            )
+        } else {
+            (
+                self.region(r.x0, r.y0, r.x1, k),
+                self.region(r.x0, k, r.x1, r.y1),
+            )
+        })
+    }
+
+    fn lights(&self, n: usize) -> Vec<DirLight> {
+        let (w, h) = self.env.radiance.size();
+        let mut done = Vec::new();
+        let mut heap = BinaryHeap::from([self.region(0, 0, w, h)]);
+        while done.len() + heap.len() < n {
+            let Some(r) = heap.pop() else { break };
+            match self.split(r) {
+                Some((a, b)) => {
+                    heap.push(a);
+                    heap.push(b);
+                }
+                None => done.push(r),
+            }
+        }
+        done.extend(heap);
+        done.into_iter()
+            .filter_map(|r| {
+                let rgb = [1, 2, 3].map(|t| self.sum(t, r.x0, r.y0, r.x1, r.y1) as f32);
+                if rgb.iter().all(|&c| c <= 0.0) {
+                    return None;
+                }
+                let d = Vec3::new(
+                    self.sum(4, r.x0, r.y0, r.x1, r.y1) as f32,
+                    self.sum(5, r.x0, r.y0, r.x1, r.y1) as f32,
+                    self.sum(6, r.x0, r.y0, r.x1, r.y1) as f32,
+                );
+                // A coloured region with zero luminance has no energy centroid: use its centre.
+                let direction = if d.length() > 1e-12 {
+                    d.normalize()
+                } else {
+                    self.env.direction_of(
+                        (r.x0 + r.x1) as f32 / 2.0 - 0.5,
+                        (r.y0 + r.y1) as f32 / 2.0 - 0.5,
+                    )
+                };
+                Some(DirLight {
+                    direction,
+                    irradiance: rgb,
+                })
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mapping_matches_the_ict_convention() {
+        let env = EnvMap::uniform([1.0; 3], 64);
+        // Image centre looks toward -z; top row is the zenith.
+        let centre = env.direction_of(63.5, 31.5);
+        assert!((centre - Vec3::NEG_Z).length() < 1e-3, "{centre}");
+        assert!(env.direction_of(10.0, -0.5).y > 0.999);
+        for d in [Vec3::new(0.3, 0.5, -0.8), Vec3::new(-0.9, -0.1, 0.2)] {
+            let d = d.normalize();
+            let t = env.texel_of(d);
+            assert!((env.direction_of(t.x, t.y) - d).length() < 1e-4);
+        }
+        let yawed = env.rotated(0.7);
+        let d = Vec3::new(0.2, 0.1, 0.9).normalize();
+        let t = yawed.texel_of(d);
+        assert!((yawed.direction_of(t.x, t.y) - d).length() < 1e-4);
+    }
+
+    #[test]
+    fn solid_angles_sum_to_the_sphere() {
+        let env = EnvMap::uniform([2.0; 3], 32);
+        let total = env.total_light();
+        assert!((total[0] - 8.0 * PI).abs() < 1e-3, "{total:?}");
+    }
+
+    #[test]
+    fn median_cut_keeps_total_light_and_isolates_the_sun() {
+        let mut img = Image::new(128, 64, [0.05f32, 0.07, 0.1]);
+        img.set(40, 20, [5000.0, 4000.0, 3000.0]);
+        let env = EnvMap::from_image(img).unwrap();
+        let lights = env.median_cut(64);
+        assert!(lights.len() <= 64 && lights.len() > 32);
+        let total = env.total_light();
+        let sum = lights.iter().fold([0.0f32; 3], |acc, l| {
+            [0, 1, 2].map(|c| acc[c] + l.irradiance[c])
+        });
+        for c in 0..3 {
+            assert!(
+                (sum[c] - total[c]).abs() <= 1e-4 * total[c],
+                "{sum:?} vs {total:?}"
+            );
+        }
+        let sun_dir = env.direction_of(40.0, 20.0);
+        let sun_light = env.texel_solid_angle(20) * 5000.0;
+        let brightest = lights
+            .iter()
+            .max_by(|a, b| a.irradiance[0].total_cmp(&b.irradiance[0]))
+            .unwrap();
+        assert!((brightest.direction - sun_dir).length() < 1e-3);
+        // The sun's light is in one light, with at most a little sky mixed in.
+        assert!((brightest.irradiance[0] - sun_light).abs() < 0.01 * sun_light);
+    }
+
+    #[test]
+    fn bad_texels_follow_the_stated_rule() {
+        let mut img = Image::new(8, 4, [1.0f32; 3]);
+        img.set(3, 2, [f32::NAN, 0.0, 0.0]);
+        let err = EnvMap::from_image(img).unwrap_err().to_string();
+        assert!(err.contains("(3, 2)"), "{err}");
+        let mut img = Image::new(8, 4, [1.0f32; 3]);
+        img.set(1, 1, [-1.0, 0.5, 0.0]);
+        let env = EnvMap::from_image(img).unwrap();
+        assert_eq!(env.clamped_texels(), 1);
+        assert_eq!(env.image().get(1, 1), [0.0, 0.5, 0.0]);
+    }
+}

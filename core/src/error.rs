@@ -1,0 +1,95 @@
+//! The error type of `frf-core`, split by who is at fault: a bad file or manifest
+//! (the input), a limit the input exceeds, a bad argument (the caller), or I/O.
+
+use std::path::{Path, PathBuf};
+
+/// Result alias of this crate.
+pub type Result<T, E = CoreError> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in `frf-core`.
+#[derive(Debug, thiserror::Error)]
+pub enum CoreError {
+    /// Reading or writing a file failed at the operating-system level.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file exists but its contents are not what its format requires.
+    #[error("{}: {problem}", path.display())]
+    BadFile {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong, in words.
+        problem: String,
+    },
+    /// An image has other dimensions than the manifest or the caller requires.
+    #[error("{}: expected {expected_width}x{expected_height} pixels, got {got_width}x{got_height}", path.display())]
+    SizeMismatch {
+        /// The file.
+        path: PathBuf,
+        /// Required width.
+        expected_width: usize,
+        /// Required height.
+        expected_height: usize,
+        /// Width found.
+        got_width: usize,
+        /// Height found.
+        got_height: usize,
+    },
+    /// A manifest field is missing, malformed or inconsistent.
+    #[error("{}: {field}: {problem}", path.display())]
+    Manifest {
+        /// The manifest file.
+        path: PathBuf,
+        /// The field, as a path such as `cameras[1].world_from_camera[0][2]`.
+        field: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An input would make the program allocate or compute more than its limits allow.
+    #[error("{what}: {problem}")]
+    LimitExceeded {
+        /// What was too large (usually a file name).
+        what: String,
+        /// The size found and the limit.
+        problem: String,
+    },
+    /// A function was called with an argument it cannot accept.
+    #[error("invalid argument {what}: {problem}")]
+    InvalidArgument {
+        /// The argument.
+        what: String,
+        /// Why it is refused.
+        problem: String,
+    },
+}
+
+impl CoreError {
+    /// An [`CoreError::Io`] error for `path`.
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        Self::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// A [`CoreError::BadFile`] error for `path`.
+    pub fn bad_file(path: &Path, problem: impl Into<String>) -> Self {
+        Self::BadFile {
+            path: path.to_path_buf(),
+            problem: problem.into(),
+        }
+    }
+
+    /// An [`CoreError::InvalidArgument`] error.
+    pub fn invalid(what: impl Into<String>, problem: impl Into<String>) -> Self {
+        Self::InvalidArgument {
+            what: what.into(),
+            problem: problem.into(),
+        }
+    }
+}

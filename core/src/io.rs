@@ -1,0 +1,311 @@
+//! Image files: linear 16-bit PNG and EXR in, linear 16-bit PNG, EXR and 8-bit sRGB
+//! previews out. Reading enforces [`limits`] before decoding, so a hostile header cannot
+//! make the program allocate gigabytes; writing is atomic (see [`crate::atomic`]).
+//!
+//! Values are returned as stored, scaled to `[0, 1]` for integer formats
+//! (`value / 65535` for 16-bit, `value / 255` for 8-bit): no transfer function is undone,
+//! because captured frames are linear by convention ([`crate::conventions`]).
+
+use std::path::Path;
+
+use image::codecs::openexr::OpenExrEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use image::{DynamicImage, ImageBuffer, ImageReader};
+
+use crate::atomic::write_atomic;
+use crate::error::{CoreError, Result};
+use crate::image::{GrayImage, Image, Rgb, RgbImage, Rgba};
+
+/// Limits on what an image file may make the program allocate.
+pub mod limits {
+    /// Largest width or height accepted (the largest 2D texture of the GPUs we target).
+    pub const MAX_DIMENSION: u32 = 16384;
+    /// Largest decoded size in bytes.
+    pub const MAX_ALLOC_BYTES: u64 = 2 << 30;
+}
+
+fn reader(path: &Path) -> Result<ImageReader<std::io::BufReader<std::fs::File>>> {
+    let mut reader = ImageReader::open(path)
+        .map_err(|e| CoreError::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| CoreError::io(path, e))?;
+    let mut lim = image::Limits::default();
+    lim.max_image_width = Some(limits::MAX_DIMENSION);
+    lim.max_image_height = Some(limits::MAX_DIMENSION);
+    lim.max_alloc = Some(limits::MAX_ALLOC_BYTES);
+    reader.limits(lim);
+    Ok(reader)
+}
+
+fn decode(path: &Path) -> Result<DynamicImage> {
+    if !path.exists() {
+        return Err(CoreError::bad_file(path, "file not found"));
+    }
+    reader(path)?.decode().map_err(|e| match e {
+        image::ImageError::Limits(l) => CoreError::LimitExceeded {
+            what: path.display().to_string(),
+            problem: l.to_string(),
+        },
+        other => CoreError::bad_file(path, format!("cannot decode image: {other}")),
+    })
+}
+
+/// Width and height of an image file, read from its header only.
+pub fn image_dimensions(path: &Path) -> Result<(usize, usize)> {
+    if !path.exists() {
+        return Err(CoreError::bad_file(path, "file not found"));
+    }
+    let (w, h) = reader(path)?
+        .into_dimensions()
+        .map_err(|e| CoreError::bad_file(path, format!("cannot read image header: {e}")))?;
+    Ok((w as usize, h as usize))
+}
+
+fn check_finite<P: crate::image::Pixel>(path: &Path, img: &Image<P>) -> Result<()> {
+    if let Some(i) = img
+        .pixels()
+        .iter()
+        .position(|p| p.channels().iter().any(|c| !c.is_finite()))
+    {
+        let (x, y) = (i % img.width(), i / img.width());
+        return Err(CoreError::bad_file(
+            path,
+            format!("pixel ({x}, {y}) is not finite (NaN or infinity)"),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads an RGB image (PNG 8/16-bit gray, RGB or RGBA; EXR; Radiance HDR). Alpha is dropped.
+/// Non-finite values are refused.
+pub fn read_rgb(path: &Path) -> Result<RgbImage> {
+    let img = decode(path)?.into_rgb32f();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let pixels = img
+        .into_raw()
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    let img = Image::from_vec(w, h, pixels)?;
+    check_finite(path, &img)?;
+    Ok(img)
+}
+
+/// Reads an RGBA image (missing alpha reads as 1). Non-finite values are refused.
+pub fn read_rgba(path: &Path) -> Result<Image<Rgba>> {
+    let img = decode(path)?.into_rgba32f();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let pixels = img
+        .into_raw()
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    let img = Image::from_vec(w, h, pixels)?;
+    check_finite(path, &img)?;
+    Ok(img)
+}
+
+/// Reads a one-channel image; colour images are reduced to their Rec. 709 luminance.
+pub fn read_gray(path: &Path) -> Result<GrayImage> {
+    let rgb = read_rgb(path)?;
+    Ok(rgb.map(crate::image::luminance))
+}
+
+/// Reads an image and checks that it is `width x height`.
+pub fn read_rgb_sized(path: &Path, width: usize, height: usize) -> Result<RgbImage> {
+    let img = read_rgb(path)?;
+    if img.size() != (width, height) {
+        return Err(CoreError::SizeMismatch {
+            path: path.to_path_buf(),
+            expected_width: width,
+            expected_height: height,
+            got_width: img.width(),
+            got_height: img.height(),
+        });
+    }
+    Ok(img)
+}
+
+fn to_u16(v: f32) -> u16 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+fn to_u8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// The sRGB transfer function (linear to encoded), for 8-bit previews.
+pub fn linear_to_srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+fn write_dynamic(path: &Path, image: DynamicImage) -> Result<()> {
+    let is_exr = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    write_atomic(path, |w| {
+        let result = if is_exr {
+            image.write_with_encoder(OpenExrEncoder::new(&mut *w))
+        } else {
+            image.write_with_encoder(PngEncoder::new_with_quality(
+                &mut *w,
+                CompressionType::Fast,
+                FilterType::Adaptive,
+            ))
+        };
+        result.map_err(|e| CoreError::bad_file(path, format!("cannot encode image: {e}")))
+    })
+}
+
+/// Writes linear RGB as a 16-bit PNG (`value = round(clamp(v) * 65535)`).
+pub fn write_png16_rgb(path: &Path, img: &RgbImage) -> Result<()> {
+    let raw: Vec<u16> = img.pixels().iter().flatten().map(|&v| to_u16(v)).collect();
+    let buf =
+        ImageBuffer::<image::Rgb<u16>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageRgb16(buf))
+}
+
+/// Writes a one-channel image as a 16-bit gray PNG.
+pub fn write_png16_gray(path: &Path, img: &GrayImage) -> Result<()> {
+    let raw: Vec<u16> = img.pixels().iter().map(|&v| to_u16(v)).collect();
+    let buf =
+        ImageBuffer::<image::Luma<u16>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageLuma16(buf))
+}
+
+/// Writes a one-channel image as an 8-bit gray PNG (masks, no transfer function).
+pub fn write_png8_gray(path: &Path, img: &GrayImage) -> Result<()> {
+    let raw: Vec<u8> = img.pixels().iter().map(|&v| to_u8(v)).collect();
+    let buf =
+        ImageBuffer::<image::Luma<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageLuma8(buf))
+}
+
+/// Writes linear RGB as an 8-bit sRGB PNG preview, after multiplying by `exposure`.
+pub fn write_png8_srgb(path: &Path, img: &RgbImage, exposure: f32) -> Result<()> {
+    let raw: Vec<u8> = img
+        .pixels()
+        .iter()
+        .flatten()
+        .map(|&v| to_u8(linear_to_srgb(v * exposure)))
+        .collect();
+    let buf =
+        ImageBuffer::<image::Rgb<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageRgb8(buf))
+}
+
+/// Writes premultiplied linear RGBA as an 8-bit sRGB PNG with straight alpha (the PNG
+/// convention): colour is divided by alpha before encoding.
+pub fn write_png8_srgba(path: &Path, img: &Image<Rgba>, exposure: f32) -> Result<()> {
+    let mut raw = Vec::with_capacity(img.pixels().len() * 4);
+    for p in img.pixels() {
+        let a = p[3].clamp(0.0, 1.0);
+        let inv = if a > 0.0 { exposure / a } else { 0.0 };
+        for c in &p[..3] {
+            raw.push(to_u8(linear_to_srgb(c * inv)));
+        }
+        raw.push(to_u8(a));
+    }
+    let buf =
+        ImageBuffer::<image::Rgba<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageRgba8(buf))
+}
+
+/// Writes premultiplied linear RGBA as a float EXR.
+pub fn write_exr_rgba(path: &Path, img: &Image<Rgba>) -> Result<()> {
+    let raw: Vec<f32> = img.pixels().iter().flatten().copied().collect();
+    let buf =
+        ImageBuffer::<image::Rgba<f32>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageRgba32F(buf))
+}
+
+/// Writes linear RGB as a float EXR.
+pub fn write_exr_rgb(path: &Path, img: &RgbImage) -> Result<()> {
+    let raw: Vec<f32> = img.pixels().iter().flatten().copied().collect();
+    let buf =
+        ImageBuffer::<image::Rgb<f32>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
+            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    write_dynamic(path, DynamicImage::ImageRgb32F(buf))
+}
+
+/// Combines colour and alpha into premultiplied RGBA (colour is already premultiplied).
+pub fn rgba_from(rgb: &RgbImage, alpha: &GrayImage) -> Result<Image<Rgba>> {
+    if !rgb.same_size(alpha) {
+        return Err(CoreError::invalid("alpha", "colour and alpha sizes differ"));
+    }
+    let pixels = rgb
+        .pixels()
+        .iter()
+        .zip(alpha.pixels())
+        .map(|(c, &a): (&Rgb, &f32)| [c[0], c[1], c[2], a])
+        .collect();
+    Image::from_vec(rgb.width(), rgb.height(), pixels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png16_round_trip_is_exact_to_16_bits() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        let img = Image::from_fn(7, 5, |x, y| [x as f32 / 7.0, y as f32 / 5.0, 0.25]);
+        write_png16_rgb(&path, &img).unwrap();
+        let back = read_rgb_sized(&path, 7, 5).unwrap();
+        for (a, b) in img.pixels().iter().zip(back.pixels()) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() <= 0.5 / 65535.0 + 1e-7);
+            }
+        }
+        assert_eq!(image_dimensions(&path).unwrap(), (7, 5));
+    }
+
+    #[test]
+    fn exr_round_trip_keeps_hdr_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let img = Image::from_fn(3, 2, |x, y| [x as f32 * 100.0, y as f32, 0.5, 0.75]);
+        write_exr_rgba(&path, &img).unwrap();
+        let back = read_rgba(&path).unwrap();
+        assert_eq!(back.pixels(), img.pixels());
+    }
+
+    #[test]
+    fn wrong_size_missing_and_garbage_files_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        write_png16_gray(&path, &Image::new(4, 4, 0.5)).unwrap();
+        let err = read_rgb_sized(&path, 5, 4).unwrap_err().to_string();
+        assert!(
+            err.contains("a.png") && err.contains("expected 5x4"),
+            "{err}"
+        );
+        let missing = dir.path().join("missing.png");
+        assert!(
+            read_rgb(&missing)
+                .unwrap_err()
+                .to_string()
+                .contains("missing.png")
+        );
+        let garbage = dir.path().join("garbage.png");
+        std::fs::write(&garbage, b"\x89PNG\r\n\x1a\nnot really").unwrap();
+        assert!(
+            read_rgb(&garbage)
+                .unwrap_err()
+                .to_string()
+                .contains("garbage.png")
+        );
+    }
+}

@@ -1,0 +1,22 @@
+//! Shared conventions and data types of the flowed-reflectance-field pipeline.
+//!
+//! Every other crate of the workspace builds on these: [`image::Image`] buffers with
+//! bilinear sampling, linear 16-bit PNG / EXR / Middlebury `.flo` input and output that
+//! writes atomically, pinhole [`camera::Camera`]s, the capture [`manifest`] that
+//! declares a lighting-dome capture, and HDR [`env::EnvMap`] environments. The
+//! axes, units and coordinate conventions they all share are written once, in
+//! [`conventions`].
+
+pub mod atomic;
+pub mod camera;
+pub mod capture;
+pub mod conventions;
+pub mod env;
+pub mod error;
+pub mod flo;
+pub mod image;
+pub mod io;
+pub mod light;
+pub mod manifest;
+
+pub use error::{CoreError, Result};
