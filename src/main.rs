@@ -1,5 +1,44 @@
-//! `frf`: the command-line front end. It only parses arguments and wires the crates.
+//! `frf`: the command-line front end of the flowed-reflectance-field pipeline. It only
+//! parses arguments, shows progress and wires the crates; every computation lives in the
+//! library crates (`frf-stage`, `frf-flow`, `frf-reflectance`, `frf-ingest`, `frf-render`).
 
-fn main() {
-    println!("frf");
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cmd;
+
+/// Errors of the binary: any library error, printed with its chain of causes.
+pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
+
+#[derive(Parser)]
+#[command(name = "frf", version, about = "Flowed reflectance fields: capture, store, relight and render walking people")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a synthetic capture with the virtual light stage, or its ground truth.
+    Stage(cmd::stage::StageArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Stage(args) => cmd::stage::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            let mut source = e.source();
+            while let Some(s) = source {
+                eprintln!("  caused by: {s}");
+                source = s.source();
+            }
+            ExitCode::FAILURE
+        }
+    }
 }

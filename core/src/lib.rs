@@ -18,5 +18,6 @@ pub mod image;
 pub mod io;
 pub mod light;
 pub mod manifest;
+pub mod shared_data;
 
 pub use error::{CoreError, Result};
