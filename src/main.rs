@@ -12,7 +12,11 @@ mod cmd;
 pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
 
 #[derive(Parser)]
-#[command(name = "frf", version, about = "Flowed reflectance fields: capture, store, relight and render walking people")]
+#[command(
+    name = "frf",
+    version,
+    about = "Flowed reflectance fields: capture, store, relight and render walking people"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -1,3 +1,4 @@
-//! One module per subcommand.
+//! One module per subcommand, plus shared progress reporting.
 
+pub mod progress;
 pub mod stage;

@@ -1,14 +1,321 @@
-//! `frf stage`: the virtual light stage.
+//! `frf stage`: renders a synthetic capture with the virtual light stage, and
+//! `frf stage truth`: renders the ground-truth image of a capture's pose from any camera
+//! under any HDR environment or basis combination.
 
-use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, Subcommand, ValueEnum};
+use frf_core::camera::Camera;
+use frf_core::env::EnvMap;
+use frf_core::io::{rgba_from, write_exr_rgba, write_png8_srgba};
+use frf_stage::truth::{DEFAULT_ENVIRONMENT_LIGHTS, environment_lights};
+use frf_stage::{Gait, Preset, SetFlowTruth, StageConfig};
+use glam::Vec3;
 
 use crate::CliResult;
+use crate::cmd::progress::bar;
 
 /// Arguments of `frf stage`.
 #[derive(Args)]
-pub struct StageArgs {}
+#[command(args_conflicts_with_subcommands = true)]
+pub struct StageArgs {
+    #[command(subcommand)]
+    command: Option<StageCommand>,
+    #[command(flatten)]
+    capture: CaptureArgs,
+}
+
+#[derive(Subcommand)]
+enum StageCommand {
+    /// Render the true image and alpha of a pose from any camera under any lighting.
+    Truth(TruthArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PresetArg {
+    Tiny,
+    Small,
+    Paper,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum GaitArg {
+    Walk,
+    Run,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SetFlowArg {
+    All,
+    Track,
+    None,
+}
+
+#[derive(Args)]
+struct CaptureArgs {
+    /// Size preset: tiny (64x90, seconds), small (160x224, the demo), paper (320x448).
+    #[arg(long, value_enum, default_value = "tiny")]
+    preset: PresetArg,
+    /// Output capture directory (created; a rerun with the same settings resumes).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Seed of the cycle-to-cycle perturbations and sensor noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Walking or running.
+    #[arg(long, value_enum, default_value = "walk")]
+    gait: GaitArg,
+    /// Poses to render, e.g. `0,1` or `0..4` (default: the preset's).
+    #[arg(long)]
+    poses: Option<String>,
+    /// Which true flows from T1 to the other slots of each set to write.
+    #[arg(long, value_enum)]
+    set_flow: Option<SetFlowArg>,
+    /// Render without sensor noise (quantization remains).
+    #[arg(long)]
+    no_noise: bool,
+}
+
+#[derive(Args)]
+struct TruthArgs {
+    /// A capture directory written by `frf stage`.
+    #[arg(long)]
+    capture: PathBuf,
+    /// Pose to render (default: the capture's first).
+    #[arg(long)]
+    pose: Option<u32>,
+    /// Use the camera of capture view `U,V` (as seen from the subject).
+    #[arg(long, conflicts_with_all = ["eye", "look_at"])]
+    view: Option<String>,
+    /// Virtual camera centre `x,y,z`, metres, subject frame.
+    #[arg(long, requires = "look_at")]
+    eye: Option<String>,
+    /// Point the virtual camera looks at, `x,y,z`.
+    #[arg(long)]
+    look_at: Option<String>,
+    /// Vertical field of view, degrees.
+    #[arg(long, default_value_t = 27.5)]
+    fov: f32,
+    /// Output size `WxH` (default: the capture's).
+    #[arg(long)]
+    size: Option<String>,
+    /// HDR environment (latitude-longitude .hdr or .exr), subject frame.
+    #[arg(long, conflicts_with = "basis")]
+    env: Option<PathBuf>,
+    /// Yaw of the environment, degrees.
+    #[arg(long, default_value_t = 0.0)]
+    yaw: f32,
+    /// Median-cut lights the environment is reduced to.
+    #[arg(long, default_value_t = DEFAULT_ENVIRONMENT_LIGHTS)]
+    lights: usize,
+    /// Basis weights `condition=weight,...` (e.g. `0=1,5=0.5`).
+    #[arg(long)]
+    basis: Option<String>,
+    /// Turntable angle for basis lighting, degrees.
+    #[arg(long, default_value_t = 0.0)]
+    turntable: f32,
+    /// Output: `.exr` (linear premultiplied RGBA) or `.png` (8-bit sRGB with alpha).
+    #[arg(long)]
+    out: PathBuf,
+    /// Exposure multiplier for PNG output.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f32,
+}
 
 /// Runs `frf stage`.
-pub fn run(_args: StageArgs) -> CliResult {
-    Err("frf stage: not built yet".into())
+pub fn run(args: StageArgs) -> CliResult {
+    match args.command {
+        Some(StageCommand::Truth(t)) => truth(t),
+        None => capture(args.capture),
+    }
+}
+
+fn parse_poses(s: &str) -> CliResult<Vec<u32>> {
+    let bad = || format!("--poses {s:?}: expected e.g. 0,1 or 0..4");
+    if let Some((a, b)) = s.split_once("..") {
+        let (a, b): (u32, u32) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        );
+        if a >= b {
+            return Err(bad().into());
+        }
+        return Ok((a..b).collect());
+    }
+    s.split(',')
+        .map(|p| p.trim().parse().map_err(|_| bad().into()))
+        .collect()
+}
+
+fn capture(args: CaptureArgs) -> CliResult {
+    let out = args.out.ok_or("frf stage: --out DIR is required")?;
+    let mut config = StageConfig::preset(match args.preset {
+        PresetArg::Tiny => Preset::Tiny,
+        PresetArg::Small => Preset::Small,
+        PresetArg::Paper => Preset::Paper,
+    });
+    config.seed = args.seed;
+    config.gait = match args.gait {
+        GaitArg::Walk => Gait::Walk,
+        GaitArg::Run => Gait::Run,
+    };
+    if let Some(p) = &args.poses {
+        config.poses = parse_poses(p)?;
+    }
+    if let Some(s) = args.set_flow {
+        config.set_flow_truth = match s {
+            SetFlowArg::All => SetFlowTruth::All,
+            SetFlowArg::Track => SetFlowTruth::Track,
+            SetFlowArg::None => SetFlowTruth::None,
+        };
+    }
+    config.noise = !args.no_noise;
+    let stage = frf_stage::Stage::new(config)?;
+    let bar = bar("stage: views rendered");
+    let report = frf_stage::write_capture(&stage, &out, &|done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })?;
+    bar.finish_and_clear();
+    let c = stage.config();
+    println!(
+        "capture written to {}: {}x{} pixels, {} cycles x {} cameras, {} poses, 33 frames per set",
+        out.display(),
+        c.width,
+        c.height,
+        c.cycles,
+        stage.cameras().len(),
+        c.poses.len()
+    );
+    println!(
+        "work units (one view of one pose, or one camera's clean plates): {} rendered, {} already done",
+        report.units_rendered, report.units_skipped
+    );
+    println!("wall time of this run: {:.1} s", report.seconds);
+    println!("capture size on disk: {:.1} MB", report.bytes as f64 / 1e6);
+    Ok(())
+}
+
+fn parse_vec3(flag: &str, s: &str) -> CliResult<Vec3> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("{flag} {s:?}: expected x,y,z in metres"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("{flag} {s:?}: expected three finite numbers x,y,z").into()),
+    }
+}
+
+fn parse_size(s: &str) -> CliResult<(u32, u32)> {
+    let bad = || format!("--size {s:?}: expected WxH, e.g. 320x448, each 1..=8192");
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if !(1..=8192).contains(&w) || !(1..=8192).contains(&h) {
+        return Err(bad().into());
+    }
+    Ok((w, h))
+}
+
+fn parse_basis(s: &str, conditions: usize) -> CliResult<Vec<f32>> {
+    let mut weights = vec![0.0; conditions];
+    for item in s.split(',') {
+        let bad = || {
+            format!(
+                "--basis item {item:?}: expected condition=weight with condition < {conditions}"
+            )
+        };
+        let (c, w) = item.split_once('=').ok_or_else(bad)?;
+        let c: usize = c.trim().parse().map_err(|_| bad())?;
+        let w: f32 = w.trim().parse().map_err(|_| bad())?;
+        if c >= conditions || !w.is_finite() {
+            return Err(bad().into());
+        }
+        weights[c] = w;
+    }
+    Ok(weights)
+}
+
+fn truth(args: TruthArgs) -> CliResult {
+    let stage = frf_stage::open_stage(&args.capture)?;
+    let config = stage.config();
+    let pose = args.pose.unwrap_or(config.poses[0]);
+    if pose >= config.poses_per_cycle() {
+        return Err(format!(
+            "--pose {pose}: a cycle has {} poses",
+            config.poses_per_cycle()
+        )
+        .into());
+    }
+    let (w, h) = match &args.size {
+        Some(s) => parse_size(s)?,
+        None => (config.width, config.height),
+    };
+    let camera = if let Some(view) = &args.view {
+        let (u, v) = view
+            .split_once(',')
+            .and_then(|(u, v)| {
+                Some((
+                    u.trim().parse::<usize>().ok()?,
+                    v.trim().parse::<usize>().ok()?,
+                ))
+            })
+            .ok_or_else(|| format!("--view {view:?}: expected U,V"))?;
+        stage.subject_camera(pose, u, v)?
+    } else {
+        let eye = parse_vec3(
+            "--eye",
+            args.eye
+                .as_deref()
+                .ok_or("give --view U,V or --eye and --look-at")?,
+        )?;
+        let target = parse_vec3("--look-at", args.look_at.as_deref().unwrap_or("0,0.9,0"))?;
+        Camera::look_at(eye, target, Vec3::Y, args.fov.to_radians(), w, h)?
+    };
+    let start = Instant::now();
+    let (lights, what) = if let Some(env_path) = &args.env {
+        let env = EnvMap::load(env_path)?.rotated(args.yaw.to_radians());
+        if args.lights == 0 || args.lights > 65536 {
+            return Err(format!("--lights {}: expected 1..=65536", args.lights).into());
+        }
+        (
+            environment_lights(&env, args.lights),
+            format!("environment {}", env_path.display()),
+        )
+    } else {
+        let weights = parse_basis(
+            args.basis
+                .as_deref()
+                .ok_or("give --env FILE or --basis c=w,...")?,
+            stage.basis().len(),
+        )?;
+        (
+            stage.basis_lights(&weights, args.turntable.to_radians())?,
+            "basis combination".to_string(),
+        )
+    };
+    let image = stage.truth_image(pose, &camera, &lights);
+    let rgba = rgba_from(&image.color, &image.alpha)?;
+    let is_exr = args
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if is_exr {
+        write_exr_rgba(&args.out, &rgba)?;
+    } else {
+        write_png8_srgba(&args.out, &rgba, args.exposure)?;
+    }
+    let coverage = image.alpha.pixels().iter().sum::<f32>() / image.alpha.pixels().len() as f32;
+    println!(
+        "truth image of pose {pose}, {}x{}, under {what} ({} lights): {}",
+        camera.width,
+        camera.height,
+        lights.len(),
+        args.out.display()
+    );
+    println!("subject coverage (mean alpha): {coverage:.3}");
+    println!("render time: {:.2} s", start.elapsed().as_secs_f64());
+    Ok(())
 }
