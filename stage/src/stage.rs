@@ -46,8 +46,8 @@ impl Stage {
     pub fn new(config: StageConfig) -> Result<Self> {
         config.validate()?;
         let basis = rig::basis(config.lights_per_axis);
-        let track = rig::track_lights(&basis);
         let cameras = rig::cameras(config.width, config.height);
+        let track = rig::track_lights(&basis, &cameras);
         Ok(Self {
             basis,
             track,
