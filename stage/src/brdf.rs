@@ -7,17 +7,17 @@ use glam::Vec3;
 
 use crate::material::Surface;
 
-/// Reflected radiance per unit irradiance at normal incidence: `f(l, v) · max(n·l, 0)`,
-/// per channel, for unit normal `n`, light direction `l` and view direction `v` (both
-/// pointing away from the surface).
+/// The two terms of the reflectance for one light, per unit irradiance at normal
+/// incidence: the diffuse weight `max(n·l, 0) / π` (to be multiplied by the albedo) and
+/// the specular term `f_s(l, v) · max(n·l, 0)` (colourless). Splitting them lets the
+/// renderer shade once and apply a pixel-averaged albedo ([`crate::render`]).
 #[inline]
-pub fn reflect(s: &Surface, n: Vec3, l: Vec3, v: Vec3) -> Rgb {
+pub fn terms(s: &Surface, n: Vec3, l: Vec3, v: Vec3) -> (f32, f32) {
     let nl = n.dot(l);
     let nv = n.dot(v);
     if nl <= 0.0 || nv <= 0.0 {
-        return [0.0; 3];
+        return (0.0, 0.0);
     }
-    let diffuse = std::f32::consts::FRAC_1_PI;
     let h = (l + v).normalize();
     let nh = n.dot(h).max(1e-4);
     let vh = v.dot(h).max(1e-4);
@@ -27,8 +27,16 @@ pub fn reflect(s: &Surface, n: Vec3, l: Vec3, v: Vec3) -> Rgb {
     let d = (-(1.0 - nh2) / (nh2 * m2)).exp() / (std::f32::consts::PI * m2 * nh2 * nh2);
     let g = (2.0 * nh * nv / vh).min(2.0 * nh * nl / vh).min(1.0);
     let f = s.f0 + (1.0 - s.f0) * (1.0 - vh).powi(5);
-    let specular = f * d * g / (4.0 * nl * nv);
-    s.albedo.map(|a| (a * diffuse + specular) * nl)
+    (nl * std::f32::consts::FRAC_1_PI, f * d * g / (4.0 * nv))
+}
+
+/// Reflected radiance per unit irradiance at normal incidence: `f(l, v) · max(n·l, 0)`,
+/// per channel, for unit normal `n`, light direction `l` and view direction `v` (both
+/// pointing away from the surface).
+#[inline]
+pub fn reflect(s: &Surface, n: Vec3, l: Vec3, v: Vec3) -> Rgb {
+    let (diffuse, specular) = terms(s, n, l, v);
+    s.albedo.map(|a| a * diffuse + specular)
 }
 
 #[cfg(test)]

@@ -68,9 +68,33 @@ fn lit(actor: Option<&Actor>, point: Vec3, normal: Vec3, light: &DirLight) -> bo
     !actor.occludes(&ray, 0.0, f32::INFINITY)
 }
 
-/// Radiance of the actor at a hit, toward the eye; `pixel_angle` is the angle one pixel
-/// subtends (radians), which with the distance gives the pixel's footprint on the surface.
-fn shade_actor(scene: &Scene, actor: &Actor, ray: &Ray, hit: &ActorHit, pixel_angle: f32) -> Rgb {
+/// The albedo-independent part of the actor's shading at a hit: radiance toward the eye
+/// is `albedo ⊙ diffuse + specular`. `pixel_angle` is the angle one pixel subtends
+/// (radians), which with the distance gives the pixel's footprint on the surface.
+struct ActorShading {
+    diffuse: Rgb,
+    specular: Rgb,
+}
+
+fn actor_footprint(hit: &ActorHit, pixel_angle: f32) -> f32 {
+    hit.t * pixel_angle
+}
+
+fn actor_albedo(hit: &ActorHit, pixel_angle: f32) -> Rgb {
+    let footprint = actor_footprint(hit, pixel_angle);
+    hit.part
+        .material()
+        .surface(hit.local, hit.part as u64 + 1, footprint)
+        .albedo
+}
+
+fn shade_actor(
+    scene: &Scene,
+    actor: &Actor,
+    ray: &Ray,
+    hit: &ActorHit,
+    pixel_angle: f32,
+) -> ActorShading {
     let view = -ray.dir;
     // Silhouette hits can have the normal barely facing away through rounding.
     let n = if hit.normal.dot(view) < 0.0 {
@@ -78,36 +102,38 @@ fn shade_actor(scene: &Scene, actor: &Actor, ray: &Ray, hit: &ActorHit, pixel_an
     } else {
         hit.normal
     };
-    // The pixel's footprint on the surface at that distance.
-    let footprint = hit.t * pixel_angle;
-    let surface = hit
-        .part
-        .material()
-        .surface(hit.local, hit.part as u64 + 1, footprint);
+    let surface = hit.part.material().surface(
+        hit.local,
+        hit.part as u64 + 1,
+        actor_footprint(hit, pixel_angle),
+    );
     let p = ray.origin + ray.dir * hit.t;
-    let mut out = [0.0; 3];
+    let mut out = ActorShading {
+        diffuse: [0.0; 3],
+        specular: [0.0; 3],
+    };
+    let mut add = |light: &DirLight, l: Vec3| {
+        let (d, s) = brdf::terms(&surface, n, l, view);
+        add_scaled(&mut out.diffuse, light.irradiance, d);
+        add_scaled(&mut out.specular, light.irradiance, s);
+    };
     match scene.illumination {
         Illumination::Lights(lights) => {
             for light in lights {
-                if n.dot(light.direction) <= 0.0 || !lit(Some(actor), p, n, light) {
-                    continue;
-                }
-                let f = brdf::reflect(&surface, n, light.direction, view);
-                for c in 0..3 {
-                    out[c] += f[c] * light.irradiance[c];
+                if n.dot(light.direction) > 0.0 && lit(Some(actor), p, n, light) {
+                    add(light, light.direction);
                 }
             }
         }
-        Illumination::Matte { ring } => {
-            // The ring light sits on the lens: light arrives along the view direction.
-            let f = brdf::reflect(&surface, n, view, view);
-            for c in 0..3 {
-                out[c] += f[c] * ring.irradiance[c];
-            }
-        }
+        // The ring light sits on the lens: light arrives along the view direction.
+        Illumination::Matte { ring } => add(ring, view),
         Illumination::Dark => {}
     }
     out
+}
+
+fn combine(albedo: Rgb, shading: &ActorShading) -> Rgb {
+    [0, 1, 2].map(|c| albedo[c] * shading.diffuse[c] + shading.specular[c])
 }
 
 fn shade_studio(scene: &Scene, ray: &Ray, hit: &StudioHit) -> Rgb {
@@ -134,85 +160,139 @@ fn shade_studio(scene: &Scene, ray: &Ray, hit: &StudioHit) -> Rgb {
     }
 }
 
-/// Traces one ray: radiance and whether it hit the actor (and where).
-fn trace(scene: &Scene, ray: &Ray, pixel_angle: f32) -> (Rgb, Option<ActorHit>) {
-    let actor_hit = scene
+/// What a primary ray sees first.
+#[derive(Debug, Clone, Copy)]
+enum Visible {
+    Actor(ActorHit),
+    Studio(StudioHit),
+    Nothing,
+}
+
+impl Visible {
+    /// Whether two rays see the same smooth surface (one body part, the floor, the
+    /// backdrop or nothing), so that shading one stands for both.
+    fn same_surface(&self, other: &Visible) -> bool {
+        match (self, other) {
+            (Visible::Actor(a), Visible::Actor(b)) => a.part == b.part,
+            (Visible::Studio(StudioHit::Floor(_)), Visible::Studio(StudioHit::Floor(_)))
+            | (Visible::Studio(StudioHit::Backdrop(_)), Visible::Studio(StudioHit::Backdrop(_)))
+            | (Visible::Nothing, Visible::Nothing) => true,
+            _ => false,
+        }
+    }
+
+    fn surface_point(&self) -> Option<SurfacePoint> {
+        match self {
+            Visible::Actor(hit) => Some(SurfacePoint {
+                part: hit.part,
+                local: hit.local,
+            }),
+            _ => None,
+        }
+    }
+}
+
+fn visibility(scene: &Scene, ray: &Ray) -> Visible {
+    if let Some(hit) = scene
         .actor
-        .and_then(|a| a.intersect(ray, 0.0, f32::INFINITY));
-    if let (Some(actor), Some(hit)) = (scene.actor, actor_hit) {
-        return (shade_actor(scene, actor, ray, &hit, pixel_angle), Some(hit));
+        .and_then(|a| a.intersect(ray, 0.0, f32::INFINITY))
+    {
+        return Visible::Actor(hit);
     }
     if scene.studio
         && let Some((_, hit)) = studio::intersect(ray)
     {
-        return (shade_studio(scene, ray, &hit), None);
+        return Visible::Studio(hit);
     }
-    ([0.0; 3], None)
+    Visible::Nothing
+}
+
+fn shade(scene: &Scene, ray: &Ray, visible: &Visible, pixel_angle: f32) -> Rgb {
+    match (visible, scene.actor) {
+        (Visible::Actor(hit), Some(actor)) => combine(
+            actor_albedo(hit, pixel_angle),
+            &shade_actor(scene, actor, ray, hit, pixel_angle),
+        ),
+        (Visible::Studio(hit), _) => shade_studio(scene, ray, hit),
+        _ => [0.0; 3],
+    }
 }
 
 /// Renders `scene` through `camera` with `samples_per_axis²` samples per pixel.
+///
+/// Visibility and texture are sampled at every sub-sample; lighting, the expensive part
+/// (a shadow ray per light), is computed once at the pixel centre when every sub-sample
+/// sees the same smooth surface as the centre, and applied to the sub-samples' mean
+/// albedo, as multisample anti-aliasing does; at silhouettes and between surfaces every
+/// sub-sample is lit on its own. Lighting varies slowly within one surface; texture
+/// does not, hence its full sampling.
 pub fn render(camera: &Camera, scene: &Scene, samples_per_axis: u32) -> Rendered {
     let (w, h) = (camera.width as usize, camera.height as usize);
     let n = samples_per_axis.max(1);
     let inv = 1.0 / (n * n) as f32;
     let pixel_angle = 1.0 / camera.intrinsics.fx.min(camera.intrinsics.fy);
+    let ray_through = |pixel: Vec2| Ray {
+        origin: camera.centre(),
+        dir: camera.ray_direction(pixel),
+    };
     let rows: Vec<Vec<(Rgb, f32, Option<SurfacePoint>)>> = (0..h)
         .into_par_iter()
         .map(|y| {
+            let mut samples = Vec::with_capacity((n * n) as usize);
             (0..w)
                 .map(|x| {
-                    let mut color = [0.0; 3];
-                    let mut covered = 0u32;
-                    let mut nearest: Option<(f32, SurfacePoint)> = None;
+                    let centre = Vec2::new(x as f32, y as f32);
+                    let centre_ray = ray_through(centre);
+                    let centre_visible = visibility(scene, &centre_ray);
+                    samples.clear();
                     for sy in 0..n {
                         for sx in 0..n {
                             let offset = Vec2::new(
                                 (sx as f32 + 0.5) / n as f32 - 0.5,
                                 (sy as f32 + 0.5) / n as f32 - 0.5,
                             );
-                            let pixel = Vec2::new(x as f32, y as f32) + offset;
-                            let ray = Ray {
-                                origin: camera.centre(),
-                                dir: camera.ray_direction(pixel),
-                            };
-                            let (c, hit) = trace(scene, &ray, pixel_angle);
-                            add_scaled(&mut color, c, inv);
-                            if let Some(hit) = hit {
-                                covered += 1;
-                                let d = offset.length_squared();
-                                if nearest.is_none_or(|(best, _)| d < best) {
-                                    nearest = Some((
-                                        d,
-                                        SurfacePoint {
-                                            part: hit.part,
-                                            local: hit.local,
-                                        },
-                                    ));
+                            let ray = ray_through(centre + offset);
+                            samples.push((offset, ray, visibility(scene, &ray)));
+                        }
+                    }
+                    let covered = samples
+                        .iter()
+                        .filter(|s| matches!(s.2, Visible::Actor(_)))
+                        .count();
+                    let uniform = samples.iter().all(|s| s.2.same_surface(&centre_visible));
+                    let color = if uniform {
+                        match (&centre_visible, scene.actor) {
+                            (Visible::Actor(hit), Some(actor)) => {
+                                let mut albedo = [0.0; 3];
+                                for (_, _, v) in &samples {
+                                    if let Visible::Actor(h) = v {
+                                        add_scaled(&mut albedo, actor_albedo(h, pixel_angle), inv);
+                                    }
                                 }
+                                combine(
+                                    albedo,
+                                    &shade_actor(scene, actor, &centre_ray, hit, pixel_angle),
+                                )
                             }
+                            _ => shade(scene, &centre_ray, &centre_visible, pixel_angle),
                         }
-                    }
-                    // Samples are symmetric about the centre for even n: trace the
-                    // centre itself so the surface point is exactly the pixel's.
-                    if covered > 0 && n % 2 == 0 {
-                        let ray = Ray {
-                            origin: camera.centre(),
-                            dir: camera.ray_direction(Vec2::new(x as f32, y as f32)),
-                        };
-                        if let Some(hit) = scene
-                            .actor
-                            .and_then(|a| a.intersect(&ray, 0.0, f32::INFINITY))
-                        {
-                            nearest = Some((
-                                0.0,
-                                SurfacePoint {
-                                    part: hit.part,
-                                    local: hit.local,
-                                },
-                            ));
+                    } else {
+                        let mut color = [0.0; 3];
+                        for (_, ray, visible) in &samples {
+                            add_scaled(&mut color, shade(scene, ray, visible, pixel_angle), inv);
                         }
-                    }
-                    (color, covered as f32 * inv, nearest.map(|(_, s)| s))
+                        color
+                    };
+                    // The surface point through the centre, or at the silhouette the
+                    // covered sub-sample nearest to it.
+                    let surface = centre_visible.surface_point().or_else(|| {
+                        samples
+                            .iter()
+                            .filter(|s| matches!(s.2, Visible::Actor(_)))
+                            .min_by(|a, b| a.0.length_squared().total_cmp(&b.0.length_squared()))
+                            .and_then(|s| s.2.surface_point())
+                    });
+                    (color, covered as f32 * inv, surface)
                 })
                 .collect()
         })

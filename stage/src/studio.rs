@@ -100,9 +100,15 @@ pub fn reflect(hit: &StudioHit, light: &DirLight, view: Vec3) -> Rgb {
     let k = match hit {
         StudioHit::Backdrop(_) => BACKDROP_ALBEDO * std::f32::consts::FRAC_1_PI * cos,
         StudioHit::Floor(_) => {
-            let angle = light.direction.dot(view).clamp(-1.0, 1.0).acos();
-            FLOOR_ALBEDO * std::f32::consts::FRAC_1_PI * cos
-                + RETRO_GAIN * (-(angle / RETRO_WIDTH_RAD).powi(2)).exp()
+            let diffuse = FLOOR_ALBEDO * std::f32::consts::FRAC_1_PI * cos;
+            // Beyond 5 widths the lobe is below 1e-10 of its peak: skip acos and exp.
+            let cos_to_source = light.direction.dot(view);
+            if cos_to_source < (5.0 * RETRO_WIDTH_RAD).cos() {
+                diffuse
+            } else {
+                let angle = cos_to_source.clamp(-1.0, 1.0).acos();
+                diffuse + RETRO_GAIN * (-(angle / RETRO_WIDTH_RAD).powi(2)).exp()
+            }
         }
     };
     light.irradiance.map(|e| e * k)

@@ -101,7 +101,7 @@ fn matte_frames_separate_subject_and_background() {
             }
             let accuracy = right as f64 / total as f64;
             eprintln!("view ({cycle}, {camera}): matte separation {accuracy:.5}");
-            // Measured: 100.00 % on every view of this capture.
+            // Measured: at least 99.98 % on every view of this capture (one pixel).
             assert!(accuracy > 0.999, "view ({cycle}, {camera}): {accuracy}");
         }
     }
