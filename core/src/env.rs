@@ -80,6 +80,41 @@ impl EnvMap {
         }
     }
 
+    /// A built-in outdoor environment (no file needed): a sky brightening toward the
+    /// horizon, a small sun 40° high at azimuth 60° carrying about 70 % of the light (a
+    /// clear day's share), and a brown ground. 256x128 texels.
+    pub fn sky() -> Self {
+        let probe = Self::uniform([0.0; 3], 128);
+        let sun =
+            crate::light::direction_from_azimuth_elevation(60f32.to_radians(), 40f32.to_radians());
+        // Sun disc of 2° radius (wider than the real 0.27° so that the 1.4° texels resolve it).
+        let sun_cos = 2f32.to_radians().cos();
+        let radiance = Image::from_fn(256, 128, |x, y| {
+            let d = probe.direction_of(x as f32, y as f32);
+            if d.dot(sun) > sun_cos {
+                [3000.0, 2800.0, 2500.0]
+            } else if d.y >= 0.0 {
+                let t = 1.0 - d.y;
+                [0.35 + 0.5 * t, 0.55 + 0.4 * t, 1.0 + 0.1 * t]
+            } else {
+                [0.25, 0.18, 0.12]
+            }
+        });
+        Self {
+            radiance,
+            yaw: 0.0,
+            clamped_texels: 0,
+        }
+    }
+
+    /// Loads `name`: a file path, or `sky` for [`EnvMap::sky`].
+    pub fn load_or_builtin(name: &Path) -> Result<Self> {
+        if name.as_os_str() == "sky" && !name.exists() {
+            return Ok(Self::sky());
+        }
+        Self::load(name)
+    }
+
     /// The same environment turned by an extra `angle` radians about `+y`.
     pub fn rotated(&self, angle: f32) -> Self {
         Self {
@@ -391,6 +426,34 @@ mod tests {
         assert!((brightest.direction - sun_dir).length() < 1e-3);
         // The sun's light is in one light, with at most a little sky mixed in.
         assert!((brightest.irradiance[0] - sun_light).abs() < 0.01 * sun_light);
+    }
+
+    #[test]
+    fn built_in_sky_is_sun_dominated() {
+        let env = EnvMap::sky();
+        let sun =
+            crate::light::direction_from_azimuth_elevation(60f32.to_radians(), 40f32.to_radians());
+        let (mut near_sun, mut total) = (0.0, 0.0);
+        for y in 0..env.image().height() {
+            let omega = env.texel_solid_angle(y);
+            for x in 0..env.image().width() {
+                let e = luminance(env.image().get(x, y)) * omega;
+                total += e;
+                if env.direction_of(x as f32, y as f32).dot(sun) > 3f32.to_radians().cos() {
+                    near_sun += e;
+                }
+            }
+        }
+        let share = near_sun / total;
+        assert!(share > 0.5 && share < 0.9, "sun share {share}");
+        // Median cut puts the sun's light into lights pointing at it.
+        let lights = env.median_cut(64);
+        let toward_sun: f32 = lights
+            .iter()
+            .filter(|l| l.direction.dot(sun) > 3f32.to_radians().cos())
+            .map(|l| luminance(l.irradiance))
+            .sum();
+        assert!((toward_sun / total - share).abs() < 0.05);
     }
 
     #[test]

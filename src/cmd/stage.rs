@@ -100,7 +100,8 @@ struct TruthArgs {
     /// Output size `WxH` (default: the capture's).
     #[arg(long)]
     size: Option<String>,
-    /// HDR environment (latitude-longitude .hdr or .exr), subject frame.
+    /// HDR environment (latitude-longitude .hdr or .exr), subject frame; `sky` for the
+    /// built-in one.
     #[arg(long, conflicts_with = "basis")]
     env: Option<PathBuf>,
     /// Yaw of the environment, degrees.
@@ -276,7 +277,7 @@ fn truth(args: TruthArgs) -> CliResult {
     };
     let start = Instant::now();
     let (lights, what) = if let Some(env_path) = &args.env {
-        let env = EnvMap::load(env_path)?.rotated(args.yaw.to_radians());
+        let env = EnvMap::load_or_builtin(env_path)?.rotated(args.yaw.to_radians());
         if args.lights == 0 || args.lights > 65536 {
             return Err(format!("--lights {}: expected 1..=65536", args.lights).into());
         }

@@ -13,7 +13,7 @@ use crate::gait::Gait;
 pub enum Preset {
     /// About 64x90 pixels, all 36x3 views, 2 poses: for tests and CI, seconds.
     Tiny,
-    /// 160x224, all views, 4 poses: for the demo.
+    /// 160x224, all views, 2 poses: for the demo.
     Small,
     /// 320x448 as the original, all views, 2 poses by default.
     Paper,
@@ -80,7 +80,7 @@ impl StageConfig {
     pub fn preset(preset: Preset) -> Self {
         let (width, height, poses, lights_per_axis) = match preset {
             Preset::Tiny => (64, 90, vec![0, 1], 2),
-            Preset::Small => (160, 224, vec![0, 1, 2, 3], 3),
+            Preset::Small => (160, 224, vec![0, 1], 3),
             Preset::Paper => (320, 448, vec![0, 1], 4),
         };
         Self {

@@ -3,6 +3,8 @@
 //! lights, it resumes after an interruption, and broken manifests and frame files are
 //! refused with a message naming what is wrong.
 
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
 use std::path::Path;
 
 use frf_core::capture::Capture;

@@ -3,6 +3,8 @@
 //! novel-view truth share one turntable convention, and an environment equal to a basis
 //! condition renders like that condition.
 
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
 use frf_core::camera::{Camera, Rigid};
 use frf_core::env::EnvMap;
 use frf_core::flo::is_known;
