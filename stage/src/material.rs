@@ -173,8 +173,10 @@ fn skin(local: Vec3, salt: u64, footprint: f32) -> Surface {
 fn head(local: Vec3, salt: u64, footprint: f32) -> Surface {
     // Head frame: face toward +x, up +y, centre (0.01, 0.11, 0) with radii 0.10/0.12/0.085.
     let p = local - Vec3::new(0.01, 0.11, 0.0);
-    let hairline = 0.02 - 0.5 * p.x.max(0.0) + 0.015 * fbm(local, 25.0, 2, salt ^ 9, footprint);
-    let is_hair = p.y > hairline || (p.x < -0.02 && p.y > -0.06);
+    // The hairline rises from the temples (4 cm above the head's centre) to the forehead
+    // (7 cm), and the hair reaches down to the nape at the back.
+    let hairline = 0.04 + 0.3 * p.x.max(0.0) + 0.01 * fbm(local, 25.0, 2, salt ^ 9, footprint);
+    let is_hair = p.y > hairline || (p.x < -0.03 && p.y > -0.06);
     if is_hair {
         // Stretched 5x along y: its finest detail is 5x finer than `frequency` says.
         let strands = fbm(
