@@ -3,10 +3,9 @@
 //! float32 `(u, v)` pairs, row-major from the top-left. A component whose magnitude
 //! exceeds [`UNKNOWN_THRESHOLD`] marks unknown flow; the project writes [`UNKNOWN`].
 
-use std::io::Write;
 use std::path::Path;
 
-use crate::atomic::write_atomic;
+use crate::atomic::write_bytes_atomic;
 use crate::error::{CoreError, Result};
 use crate::image::{Flow, FlowImage, Image};
 use crate::io::limits::MAX_DIMENSION;
@@ -109,10 +108,7 @@ pub fn write_flo(path: &Path, flow: &FlowImage) -> Result<()> {
             "cannot write an empty flow field",
         ));
     }
-    let bytes = encode_flo(flow);
-    write_atomic(path, |w| {
-        w.write_all(&bytes).map_err(|e| CoreError::io(path, e))
-    })
+    write_bytes_atomic(path, &encode_flo(flow))
 }
 
 #[cfg(test)]

@@ -162,30 +162,33 @@ fn write_dynamic(path: &Path, image: DynamicImage) -> Result<()> {
     })
 }
 
+/// Wraps raw samples as an `image` buffer of `img`'s size.
+fn buffer<Q: image::Pixel, P: Copy>(
+    img: &Image<P>,
+    raw: Vec<Q::Subpixel>,
+) -> Result<ImageBuffer<Q, Vec<Q::Subpixel>>> {
+    ImageBuffer::from_raw(img.width() as u32, img.height() as u32, raw)
+        .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))
+}
+
 /// Writes linear RGB as a 16-bit PNG (`value = round(clamp(v) * 65535)`).
 pub fn write_png16_rgb(path: &Path, img: &RgbImage) -> Result<()> {
     let raw: Vec<u16> = img.pixels().iter().flatten().map(|&v| to_u16(v)).collect();
-    let buf =
-        ImageBuffer::<image::Rgb<u16>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Rgb<u16>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgb16(buf))
 }
 
 /// Writes a one-channel image as a 16-bit gray PNG.
 pub fn write_png16_gray(path: &Path, img: &GrayImage) -> Result<()> {
     let raw: Vec<u16> = img.pixels().iter().map(|&v| to_u16(v)).collect();
-    let buf =
-        ImageBuffer::<image::Luma<u16>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Luma<u16>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageLuma16(buf))
 }
 
 /// Writes a one-channel image as an 8-bit gray PNG (masks, no transfer function).
 pub fn write_png8_gray(path: &Path, img: &GrayImage) -> Result<()> {
     let raw: Vec<u8> = img.pixels().iter().map(|&v| to_u8(v)).collect();
-    let buf =
-        ImageBuffer::<image::Luma<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Luma<u8>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageLuma8(buf))
 }
 
@@ -197,9 +200,7 @@ pub fn write_png8_srgb(path: &Path, img: &RgbImage, exposure: f32) -> Result<()>
         .flatten()
         .map(|&v| to_u8(linear_to_srgb(v * exposure)))
         .collect();
-    let buf =
-        ImageBuffer::<image::Rgb<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Rgb<u8>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgb8(buf))
 }
 
@@ -215,27 +216,21 @@ pub fn write_png8_srgba(path: &Path, img: &Image<Rgba>, exposure: f32) -> Result
         }
         raw.push(to_u8(a));
     }
-    let buf =
-        ImageBuffer::<image::Rgba<u8>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Rgba<u8>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgba8(buf))
 }
 
 /// Writes premultiplied linear RGBA as a float EXR.
 pub fn write_exr_rgba(path: &Path, img: &Image<Rgba>) -> Result<()> {
     let raw: Vec<f32> = img.pixels().iter().flatten().copied().collect();
-    let buf =
-        ImageBuffer::<image::Rgba<f32>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Rgba<f32>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgba32F(buf))
 }
 
 /// Writes linear RGB as a float EXR.
 pub fn write_exr_rgb(path: &Path, img: &RgbImage) -> Result<()> {
     let raw: Vec<f32> = img.pixels().iter().flatten().copied().collect();
-    let buf =
-        ImageBuffer::<image::Rgb<f32>, _>::from_raw(img.width() as u32, img.height() as u32, raw)
-            .ok_or_else(|| CoreError::invalid("image", "buffer size mismatch"))?;
+    let buf = buffer::<image::Rgb<f32>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgb32F(buf))
 }
 

@@ -42,6 +42,10 @@ pub fn truth_alpha_path(dir: &Path, pose: u32, cycle: usize, camera: usize) -> P
     dir.join(format!("truth/alpha/p{pose:02}/v{camera}/u{cycle:02}.png"))
 }
 
+fn truth_flow_stem(pose: u32, cycle: usize, camera: usize, n: Neighbour) -> String {
+    format!("truth/flow/p{pose:02}/v{camera}/u{cycle:02}_{}", n.name())
+}
+
 /// Path of the true flow from a view to a neighbour.
 pub fn truth_flow_path(
     dir: &Path,
@@ -50,10 +54,7 @@ pub fn truth_flow_path(
     camera: usize,
     n: Neighbour,
 ) -> PathBuf {
-    dir.join(format!(
-        "truth/flow/p{pose:02}/v{camera}/u{cycle:02}_{}.flo",
-        n.name()
-    ))
+    dir.join(truth_flow_stem(pose, cycle, camera, n) + ".flo")
 }
 
 /// Path of the occlusion mask of a true neighbour flow.
@@ -64,10 +65,7 @@ pub fn truth_occlusion_path(
     camera: usize,
     n: Neighbour,
 ) -> PathBuf {
-    dir.join(format!(
-        "truth/flow/p{pose:02}/v{camera}/u{cycle:02}_{}_occ.png",
-        n.name()
-    ))
+    dir.join(truth_flow_stem(pose, cycle, camera, n) + "_occ.png")
 }
 
 /// Path of the true flow from T1 to slot `slot` of a set.
