@@ -14,6 +14,7 @@ pub mod conventions;
 pub mod env;
 pub mod error;
 pub mod flo;
+pub mod grid;
 pub mod image;
 pub mod io;
 pub mod light;

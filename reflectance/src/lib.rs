@@ -1,6 +1,15 @@
-//! The flowed reflectance field as data (to be built by the reflectance issue): per pose
-//! and view, 26 premultiplied linear basis images, alpha and flows to each grid
-//! neighbour, plus per-pose shadow attenuation maps; the signed-logarithmic 8-bit flow
-//! quantizer with canonical Huffman coding; the gamma-2.2 JPEG basis mosaic; the indexed,
-//! checksummed container; projection of HDR environments onto the basis; and CPU
-//! relighting. Conventions: [`frf_core::conventions`].
+//! The flowed reflectance field as data (BRIEF sections 4 and 5.1): per pose and view
+//! `(u, v)`, the basis images (premultiplied, linear), alpha and the flows to each grid
+//! neighbour, plus per-pose shadow attenuation maps; how it is stored compactly with
+//! random access, and how it is relit.
+//!
+//! - [`flowcodec`]: signed-logarithmic 8-bit flow quantization and canonical Huffman
+//!   coding, optionally left-predicted.
+//!
+//! Conventions: [`frf_core::conventions`].
+
+pub mod error;
+pub mod flowcodec;
+pub mod imagecodec;
+
+pub use error::{ReflectanceError, Result};

@@ -15,6 +15,7 @@
 use frf_core::camera::{Camera, Rigid};
 use frf_core::env::EnvMap;
 use frf_core::flo::UNKNOWN;
+pub use frf_core::grid::Neighbour;
 use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
 use frf_core::light::DirLight;
 use glam::Vec2;
@@ -35,56 +36,6 @@ const VISIBILITY_TOLERANCE_M: f32 = 0.002;
 /// Median-cut lights used for truth images under an environment by default: enough that
 /// a further doubling changes the image by less than 1 % (measured on the ICT probes).
 pub const DEFAULT_ENVIRONMENT_LIGHTS: usize = 512;
-
-/// A neighbour in the grid of views.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Neighbour {
-    /// `(u + 1, v)`.
-    Right,
-    /// `(u - 1, v)`.
-    Left,
-    /// `(u, v + 1)`.
-    Up,
-    /// `(u, v - 1)`.
-    Down,
-}
-
-impl Neighbour {
-    /// All four, in file-name order.
-    pub const ALL: [Neighbour; 4] = [
-        Neighbour::Right,
-        Neighbour::Left,
-        Neighbour::Up,
-        Neighbour::Down,
-    ];
-
-    /// The name used in file names.
-    pub fn name(self) -> &'static str {
-        match self {
-            Neighbour::Right => "right",
-            Neighbour::Left => "left",
-            Neighbour::Up => "up",
-            Neighbour::Down => "down",
-        }
-    }
-
-    /// The neighbour of view `(cycle, camera)` in a grid of `cycles x cameras`, if any
-    /// (cycles wrap around, cameras do not).
-    pub fn of(
-        self,
-        cycle: usize,
-        camera: usize,
-        cycles: usize,
-        cameras: usize,
-    ) -> Option<(usize, usize)> {
-        match self {
-            Neighbour::Right => Some(((cycle + 1) % cycles, camera)),
-            Neighbour::Left => Some(((cycle + cycles - 1) % cycles, camera)),
-            Neighbour::Up => (camera + 1 < cameras).then_some((cycle, camera + 1)),
-            Neighbour::Down => camera.checked_sub(1).map(|c| (cycle, c)),
-        }
-    }
-}
 
 /// A true flow field and where its correspondences are hidden.
 #[derive(Debug, Clone)]
@@ -177,7 +128,7 @@ impl Stage {
         camera: usize,
         neighbour: Neighbour,
     ) -> Result<Option<TrueFlow>> {
-        let Some((u2, v2)) = neighbour.of(cycle, camera, self.cycles(), self.cameras().len())
+        let Some((u2, v2)) = neighbour.of(cycle, camera, self.cycles(), self.cameras().len(), true)
         else {
             return Ok(None);
         };

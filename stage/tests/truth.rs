@@ -79,7 +79,7 @@ fn true_flow_warps_a_neighbour_onto_the_view() {
         .true_view_image(pose, cycle, camera, &lights_for_view(&stage, pose, cycle))
         .unwrap();
     for (n, bound) in [(Neighbour::Right, 0.045), (Neighbour::Up, 0.06)] {
-        let (u2, v2) = n.of(cycle, camera, 36, 3).unwrap();
+        let (u2, v2) = n.of(cycle, camera, 36, 3, true).unwrap();
         let b = stage
             .true_view_image(pose, u2, v2, &lights_for_view(&stage, pose, u2))
             .unwrap();
