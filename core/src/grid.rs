@@ -2,8 +2,11 @@
 //! (horizontal, wrapping around a turntable) and `v` the camera (vertical), and the
 //! neighbour relation that flows are stored for.
 
+use serde::{Deserialize, Serialize};
+
 /// A neighbour in the grid of views.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Neighbour {
     /// `(u + 1, v)`.
     Right,
@@ -51,7 +54,14 @@ impl Neighbour {
 
     /// The neighbour of view `(u, v)` in a grid of `columns x rows`, if it exists:
     /// columns wrap around when `wraps` (a full turntable circle), rows never do.
-    pub fn of(self, u: usize, v: usize, columns: usize, rows: usize, wraps: bool) -> Option<(usize, usize)> {
+    pub fn of(
+        self,
+        u: usize,
+        v: usize,
+        columns: usize,
+        rows: usize,
+        wraps: bool,
+    ) -> Option<(usize, usize)> {
         match self {
             Neighbour::Right if u + 1 < columns => Some((u + 1, v)),
             Neighbour::Right => (wraps && columns > 1).then_some((0, v)),
@@ -77,7 +87,10 @@ mod tests {
         assert_eq!(Neighbour::Down.of(4, 2, 36, 3, true), Some((4, 1)));
         // Top and bottom rows have 3 neighbours, the middle row 4.
         for (v, n) in [(0, 3), (1, 4), (2, 3)] {
-            let count = Neighbour::ALL.iter().filter(|d| d.of(7, v, 36, 3, true).is_some()).count();
+            let count = Neighbour::ALL
+                .iter()
+                .filter(|d| d.of(7, v, 36, 3, true).is_some())
+                .count();
             assert_eq!(count, n);
         }
         for d in Neighbour::ALL {

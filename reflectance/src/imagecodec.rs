@@ -48,7 +48,9 @@ fn le_u32(bytes: &[u8], at: usize) -> u32 {
 /// Layout: `[count u32][tile width u32][tile height u32][count x scale f32][JPEG]`.
 pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
     let Some(first) = images.first() else {
-        return Err(ReflectanceError::BadParameter("no basis images to encode".into()));
+        return Err(ReflectanceError::BadParameter(
+            "no basis images to encode".into(),
+        ));
     };
     if !(1..=100).contains(&quality) {
         return Err(ReflectanceError::BadParameter(format!(
@@ -88,7 +90,11 @@ pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
         for y in 0..ch {
             for x in 0..cw {
                 let p = img.get(x.min(tw - 1), y.min(th - 1)).map(|v| {
-                    let t = if v.is_finite() { (v / scale).clamp(0.0, 1.0) } else { 0.0 };
+                    let t = if v.is_finite() {
+                        (v / scale).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
                     (255.0 * t.powf(1.0 / GAMMA)).round() as u8
                 });
                 mosaic.put_pixel((x0 + x) as u32, (y0 + y) as u32, image::Rgb(p));
@@ -134,7 +140,9 @@ pub fn decode_basis(bytes: &[u8]) -> Result<Vec<RgbImage>> {
         .map(|i| f32::from_bits(le_u32(bytes, 12 + 4 * i)))
         .collect();
     if let Some(s) = scales.iter().find(|s| !(s.is_finite() && **s > 0.0)) {
-        return Err(corrupt(format!("basis mosaic tile scale {s} is not a positive number")));
+        return Err(corrupt(format!(
+            "basis mosaic tile scale {s} is not a positive number"
+        )));
     }
     let columns = MOSAIC_COLUMNS.min(count);
     let rows = count.div_ceil(columns);
@@ -190,7 +198,11 @@ pub fn encode_planes(planes: &[GrayImage]) -> Result<Vec<u8>> {
             });
         }
         for &v in p.pixels() {
-            let q = if v.is_finite() { (v.clamp(0.0, 1.0) * 65535.0).round() as u16 } else { 0 };
+            let q = if v.is_finite() {
+                (v.clamp(0.0, 1.0) * 65535.0).round() as u16
+            } else {
+                0
+            };
             raw.extend_from_slice(&q.to_le_bytes());
         }
     }
@@ -216,13 +228,18 @@ pub fn decode_planes(bytes: &[u8]) -> Result<Vec<GrayImage>> {
     );
     let max = frf_core::io::limits::MAX_DIMENSION as usize;
     if count == 0 || count > 1024 || w == 0 || h == 0 || w > max || h > max {
-        return Err(corrupt(format!("plane header claims {count} planes of {w}x{h}")));
+        return Err(corrupt(format!(
+            "plane header claims {count} planes of {w}x{h}"
+        )));
     }
     let expected = count * w * h * 2;
     let raw = zstd::bulk::decompress(&bytes[12..], expected)
         .map_err(|e| corrupt(format!("plane data: {e}")))?;
     if raw.len() != expected {
-        return Err(corrupt(format!("plane data holds {} bytes, expected {expected}", raw.len())));
+        return Err(corrupt(format!(
+            "plane data holds {} bytes, expected {expected}",
+            raw.len()
+        )));
     }
     Ok(raw
         .chunks_exact(w * h * 2)
@@ -249,7 +266,9 @@ mod tests {
 
     #[test]
     fn mosaic_round_trip_is_close_in_linear_light() {
-        let images: Vec<RgbImage> = (0..26).map(|i| gradient(40, 56, 0.05 + i as f32 * 0.3)).collect();
+        let images: Vec<RgbImage> = (0..26)
+            .map(|i| gradient(40, 56, 0.05 + i as f32 * 0.3))
+            .collect();
         let bytes = encode_basis(&images, 95).unwrap();
         let back = decode_basis(&bytes).unwrap();
         assert_eq!(back.len(), 26);

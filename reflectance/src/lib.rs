@@ -3,13 +3,26 @@
 //! neighbour, plus per-pose shadow attenuation maps; how it is stored compactly with
 //! random access, and how it is relit.
 //!
+//! - [`field`]: the data model: header (grid, per-view cameras and turntable angles,
+//!   lighting basis, codec parameters) and per-view data.
 //! - [`flowcodec`]: signed-logarithmic 8-bit flow quantization and canonical Huffman
 //!   coding, optionally left-predicted.
+//! - [`imagecodec`]: the basis images of a view as one gamma-2.2 JPEG mosaic; alpha and
+//!   shadow maps lossless to 16 bits with zstd.
+//! - [`container`], [`store`]: the field file, an indexed and checksummed container that
+//!   reads one view without the rest; [`stats`]: its contents and compression ratios.
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod container;
 pub mod error;
+pub mod field;
 pub mod flowcodec;
 pub mod imagecodec;
+pub mod stats;
+pub mod store;
+
+pub use container::{FieldFile, FieldWriter};
+pub use field::{FieldHeader, ViewData};
 
 pub use error::{ReflectanceError, Result};

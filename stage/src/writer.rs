@@ -190,7 +190,8 @@ fn write_view(
         &reference.alpha,
     )?;
     for n in Neighbour::ALL {
-        let Some((u2, v2)) = n.of(cycle, camera, stage.cycles(), stage.cameras().len(), true) else {
+        let Some((u2, v2)) = n.of(cycle, camera, stage.cycles(), stage.cameras().len(), true)
+        else {
             continue;
         };
         let to = stage.view_setup(pose, u2, v2, 0.0)?;

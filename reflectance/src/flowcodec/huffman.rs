@@ -136,7 +136,9 @@ impl HuffmanTable {
             .map(|&l| 1u64 << (MAX_CODE_LENGTH - l))
             .sum();
         if kraft > 1 << MAX_CODE_LENGTH {
-            return Err(corrupt("Huffman table is over-subscribed (not a prefix code)"));
+            return Err(corrupt(
+                "Huffman table is over-subscribed (not a prefix code)",
+            ));
         }
         Ok(Self { lengths })
     }
@@ -265,7 +267,11 @@ impl Decoder {
                 }
             }
         }
-        Self { fast, sorted, count }
+        Self {
+            fast,
+            sorted,
+            count,
+        }
     }
 
     #[inline]
@@ -339,7 +345,9 @@ mod tests {
         assert!(table.lengths().iter().all(|&l| l <= MAX_CODE_LENGTH));
         assert!(table.lengths()[..40].iter().all(|&l| l > 0));
         // A peaked source codes well below 8 bits per symbol.
-        let symbols: Vec<u8> = (0..10_000u32).map(|i| if i % 10 == 0 { (i % 7) as u8 } else { 0 }).collect();
+        let symbols: Vec<u8> = (0..10_000u32)
+            .map(|i| if i % 10 == 0 { (i % 7) as u8 } else { 0 })
+            .collect();
         let t = HuffmanTable::from_counts(&counts(&symbols));
         let bytes = t.encode(&symbols).unwrap();
         assert!(bytes.len() * 8 < symbols.len() * 2, "{} bytes", bytes.len());
@@ -356,7 +364,11 @@ mod tests {
         let symbols = vec![1u8, 2, 3, 1, 1, 1, 2];
         let table = HuffmanTable::from_counts(&counts(&symbols));
         let bits = table.encode(&symbols).unwrap();
-        assert!(table.decode(&bits[..bits.len() - 1], symbols.len()).is_err());
+        assert!(
+            table
+                .decode(&bits[..bits.len() - 1], symbols.len())
+                .is_err()
+        );
         assert!(table.decode(&bits, 1_000_000).is_err());
         assert!(table.encode(&[200]).is_err());
         // A one-symbol table whose stream holds the unassigned code.

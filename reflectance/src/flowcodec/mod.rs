@@ -41,7 +41,12 @@ pub fn quantize(flow: &FlowImage, q: &LogQuantizer) -> Vec<i8> {
 }
 
 /// The flow map of `codes` (as from [`quantize`]).
-pub fn dequantize(width: usize, height: usize, codes: &[i8], q: &LogQuantizer) -> Result<FlowImage> {
+pub fn dequantize(
+    width: usize,
+    height: usize,
+    codes: &[i8],
+    q: &LogQuantizer,
+) -> Result<FlowImage> {
     let n = width * height;
     if codes.len() != 2 * n {
         return Err(ReflectanceError::Corrupt(format!(
@@ -131,7 +136,9 @@ pub fn decode_codes(bytes: &[u8]) -> Result<(usize, usize, Vec<i8>)> {
     }
     let flags = bytes[0];
     if flags & !FLAG_PREDICT != 0 {
-        return Err(ReflectanceError::Corrupt(format!("unknown flow-map flags {flags:#x}")));
+        return Err(ReflectanceError::Corrupt(format!(
+            "unknown flow-map flags {flags:#x}"
+        )));
     }
     let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
     let (w, h) = (word(1), word(5));
@@ -193,7 +200,10 @@ mod tests {
         let plain = encode(&flow, &q, false).unwrap().len();
         let predicted = encode(&flow, &q, true).unwrap().len();
         assert!(plain < eight_bit / 2, "plain {plain} of {eight_bit}");
-        assert!(predicted < plain / 2, "predicted {predicted} vs plain {plain}");
+        assert!(
+            predicted < plain / 2,
+            "predicted {predicted} vs plain {plain}"
+        );
     }
 
     proptest! {

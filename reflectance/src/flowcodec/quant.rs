@@ -52,7 +52,9 @@ impl LogQuantizer {
         if !x.is_finite() || x.abs() > frf_core::flo::UNKNOWN_THRESHOLD {
             return UNKNOWN_CODE;
         }
-        let q = ((x.abs() / self.scale).ln_1p() / self.k()).round().min(MAX_CODE);
+        let q = ((x.abs() / self.scale).ln_1p() / self.k())
+            .round()
+            .min(MAX_CODE);
         (q.copysign(x)) as i8
     }
 
@@ -163,7 +165,13 @@ mod tests {
     fn fitted_scale_beats_fixed_choices() {
         // Mostly small flow with a few large displacements.
         let values: Vec<f32> = (0..10_000)
-            .map(|i| if i % 100 == 0 { 18.0 } else { (i % 37) as f32 * 0.05 - 0.9 })
+            .map(|i| {
+                if i % 100 == 0 {
+                    18.0
+                } else {
+                    (i % 37) as f32 * 0.05 - 0.9
+                }
+            })
             .collect();
         let fitted = LogQuantizer::fit(values.iter().copied());
         assert_eq!(fitted.range, 18.0);

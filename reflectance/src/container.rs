@@ -1,0 +1,446 @@
+//! The field file: one container with an index, so that one pose, or one view of one
+//! pose, is read without reading the rest (BRIEF section 4).
+//!
+//! ```text
+//! preamble  "FRFFIELD" | version u32 | 0 u32                         16 bytes
+//! chunks    basis mosaics, alpha planes, flow maps, shadow maps    any order
+//! index     zstd(JSON { header, chunks: [{ key, offset, length, crc32 }] })
+//! footer    index offset u64 | index length u64 | index crc32 u32 | version u32 | "FRFEND\0\0"
+//! ```
+//!
+//! Every chunk and the index carry a CRC-32; a damaged or truncated file is refused with
+//! an error naming the chunk. Reading trusts nothing in the file: offsets must lie inside
+//! it, and sizes are bounded before anything is allocated. Writing goes to a temporary
+//! file renamed into place by [`FieldWriter::finish`]; a writer dropped before that leaves
+//! nothing behind.
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use frf_core::grid::Neighbour;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ReflectanceError, Result};
+use crate::field::FieldHeader;
+use crate::imagecodec::ZSTD_LEVEL;
+
+/// Version of the file layout this code reads and writes.
+pub const VERSION: u32 = 1;
+const MAGIC: &[u8; 8] = b"FRFFIELD";
+const END_MAGIC: &[u8; 8] = b"FRFEND\0\0";
+const PREAMBLE_BYTES: u64 = 16;
+const FOOTER_BYTES: u64 = 32;
+/// Largest decompressed index accepted (a 36x3 grid of 30 poses needs ~2 MB).
+const MAX_INDEX_BYTES: usize = 256 << 20;
+/// Largest chunk accepted (a 4096x4096 mosaic of 26 tiles is far below).
+const MAX_CHUNK_BYTES: u64 = 1 << 30;
+
+/// What a chunk holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ChunkKind {
+    /// The basis images of a view (JPEG mosaic).
+    Basis,
+    /// The alpha of a view.
+    Alpha,
+    /// The flow from a view to a neighbour.
+    Flow(Neighbour),
+    /// The shadow attenuation maps of a pose (`u = v = 0`).
+    Shadows,
+}
+
+/// Which chunk: kind, pose and view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct ChunkKey {
+    /// Pose.
+    pub pose: u32,
+    /// Horizontal view index.
+    pub u: u32,
+    /// Vertical view index.
+    pub v: u32,
+    /// What it holds.
+    pub kind: ChunkKind,
+}
+
+impl std::fmt::Display for ChunkKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.kind {
+            ChunkKind::Basis => write!(
+                f,
+                "basis images of pose {} view ({}, {})",
+                self.pose, self.u, self.v
+            ),
+            ChunkKind::Alpha => write!(
+                f,
+                "alpha of pose {} view ({}, {})",
+                self.pose, self.u, self.v
+            ),
+            ChunkKind::Flow(n) => write!(
+                f,
+                "flow {} of pose {} view ({}, {})",
+                n.name(),
+                self.pose,
+                self.u,
+                self.v
+            ),
+            ChunkKind::Shadows => write!(f, "shadow maps of pose {}", self.pose),
+        }
+    }
+}
+
+/// Where a chunk is and its checksum.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ChunkEntry {
+    /// Which chunk.
+    pub key: ChunkKey,
+    /// Byte offset in the file.
+    pub offset: u64,
+    /// Length in bytes.
+    pub length: u64,
+    /// CRC-32 (IEEE) of the bytes.
+    pub crc32: u32,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Index {
+    header: FieldHeader,
+    chunks: Vec<ChunkEntry>,
+}
+
+/// Random-access reading of a field's bytes (a file, or memory in tests and fuzzing).
+pub trait ReadAt: Send + Sync {
+    /// Fills `buf` from `offset`.
+    fn read_exact_at(&self, offset: u64, buf: &mut [u8]) -> std::io::Result<()>;
+    /// Total length in bytes.
+    fn size(&self) -> u64;
+}
+
+/// A file opened for [`ReadAt`].
+pub struct FileSource {
+    file: Mutex<File>,
+    size: u64,
+}
+
+impl ReadAt for FileSource {
+    fn read_exact_at(&self, offset: u64, buf: &mut [u8]) -> std::io::Result<()> {
+        let mut f = self
+            .file
+            .lock()
+            .map_err(|_| std::io::Error::other("file lock poisoned"))?;
+        f.seek(SeekFrom::Start(offset))?;
+        f.read_exact(buf)
+    }
+    fn size(&self) -> u64 {
+        self.size
+    }
+}
+
+impl ReadAt for Vec<u8> {
+    fn read_exact_at(&self, offset: u64, buf: &mut [u8]) -> std::io::Result<()> {
+        let start = usize::try_from(offset).map_err(std::io::Error::other)?;
+        let src = start
+            .checked_add(buf.len())
+            .and_then(|end| self.get(start..end))
+            .ok_or_else(|| std::io::Error::from(std::io::ErrorKind::UnexpectedEof))?;
+        buf.copy_from_slice(src);
+        Ok(())
+    }
+    fn size(&self) -> u64 {
+        self.len() as u64
+    }
+}
+
+/// Writes a field file chunk by chunk.
+pub struct FieldWriter {
+    path: PathBuf,
+    tmp: PathBuf,
+    out: Option<BufWriter<File>>,
+    offset: u64,
+    header: FieldHeader,
+    chunks: BTreeMap<ChunkKey, ChunkEntry>,
+}
+
+impl FieldWriter {
+    /// Starts writing `path` (through a temporary file beside it).
+    pub fn create(path: &Path, header: FieldHeader) -> Result<Self> {
+        header.validate().map_err(ReflectanceError::BadParameter)?;
+        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
+        }
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+        let file = File::create(&tmp).map_err(|e| io(&tmp, e))?;
+        let mut out = BufWriter::new(file);
+        let mut preamble = Vec::with_capacity(PREAMBLE_BYTES as usize);
+        preamble.extend_from_slice(MAGIC);
+        preamble.extend_from_slice(&VERSION.to_le_bytes());
+        preamble.extend_from_slice(&0u32.to_le_bytes());
+        out.write_all(&preamble).map_err(|e| io(&tmp, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            tmp,
+            out: Some(out),
+            offset: PREAMBLE_BYTES,
+            header,
+            chunks: BTreeMap::new(),
+        })
+    }
+
+    /// The header being written.
+    pub fn header(&self) -> &FieldHeader {
+        &self.header
+    }
+
+    /// Appends a chunk; a key may be written once.
+    pub fn add_chunk(&mut self, key: ChunkKey, bytes: &[u8]) -> Result<()> {
+        if self.chunks.contains_key(&key) {
+            return Err(ReflectanceError::BadParameter(format!(
+                "{key} written twice"
+            )));
+        }
+        let out = self
+            .out
+            .as_mut()
+            .ok_or_else(|| ReflectanceError::BadParameter("writer finished".into()))?;
+        out.write_all(bytes).map_err(|e| io(&self.tmp, e))?;
+        self.chunks.insert(
+            key,
+            ChunkEntry {
+                key,
+                offset: self.offset,
+                length: bytes.len() as u64,
+                crc32: crc32fast::hash(bytes),
+            },
+        );
+        self.offset += bytes.len() as u64;
+        Ok(())
+    }
+
+    /// Writes the index and footer and renames the file into place.
+    pub fn finish(mut self) -> Result<()> {
+        let index = Index {
+            header: self.header.clone(),
+            chunks: self.chunks.values().copied().collect(),
+        };
+        let json = serde_json::to_vec(&index)
+            .map_err(|e| ReflectanceError::BadParameter(e.to_string()))?;
+        let packed = zstd::bulk::compress(&json, ZSTD_LEVEL).map_err(|e| io(&self.tmp, e))?;
+        let mut footer = Vec::with_capacity(FOOTER_BYTES as usize);
+        footer.extend_from_slice(&self.offset.to_le_bytes());
+        footer.extend_from_slice(&(packed.len() as u64).to_le_bytes());
+        footer.extend_from_slice(&crc32fast::hash(&packed).to_le_bytes());
+        footer.extend_from_slice(&VERSION.to_le_bytes());
+        footer.extend_from_slice(END_MAGIC);
+        let Some(mut out) = self.out.take() else {
+            return Err(ReflectanceError::BadParameter("writer finished".into()));
+        };
+        out.write_all(&packed).map_err(|e| io(&self.tmp, e))?;
+        out.write_all(&footer).map_err(|e| io(&self.tmp, e))?;
+        let file = out
+            .into_inner()
+            .map_err(|e| io(&self.tmp, e.into_error()))?;
+        file.sync_all().map_err(|e| io(&self.tmp, e))?;
+        drop(file);
+        std::fs::rename(&self.tmp, &self.path).map_err(|e| io(&self.path, e))
+    }
+}
+
+impl Drop for FieldWriter {
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+fn io(path: &Path, source: std::io::Error) -> ReflectanceError {
+    ReflectanceError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// A field file opened for reading: its header and index are read; chunks on demand.
+pub struct FieldFile<R: ReadAt = FileSource> {
+    path: PathBuf,
+    source: R,
+    header: FieldHeader,
+    chunks: BTreeMap<ChunkKey, ChunkEntry>,
+}
+
+impl FieldFile<FileSource> {
+    /// Opens a field file.
+    pub fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(|e| io(path, e))?;
+        let size = file.metadata().map_err(|e| io(path, e))?.len();
+        Self::from_source(
+            path,
+            FileSource {
+                file: Mutex::new(file),
+                size,
+            },
+        )
+    }
+}
+
+impl<R: ReadAt> FieldFile<R> {
+    /// Reads the header and index from `source`; `path` names it in errors.
+    pub fn from_source(path: &Path, source: R) -> Result<Self> {
+        let bad = |problem: String| ReflectanceError::BadFile {
+            path: path.to_path_buf(),
+            problem,
+        };
+        let size = source.size();
+        if size < PREAMBLE_BYTES + FOOTER_BYTES {
+            return Err(bad(format!(
+                "{size} bytes is too short for a field file (truncated?)"
+            )));
+        }
+        let mut preamble = [0u8; PREAMBLE_BYTES as usize];
+        source
+            .read_exact_at(0, &mut preamble)
+            .map_err(|e| io(path, e))?;
+        if &preamble[..8] != MAGIC {
+            return Err(bad("not a field file (bad magic)".into()));
+        }
+        let version = u32::from_le_bytes([preamble[8], preamble[9], preamble[10], preamble[11]]);
+        if version != VERSION {
+            return Err(bad(format!(
+                "format version {version}, this build reads {VERSION}"
+            )));
+        }
+        let mut footer = [0u8; FOOTER_BYTES as usize];
+        source
+            .read_exact_at(size - FOOTER_BYTES, &mut footer)
+            .map_err(|e| io(path, e))?;
+        if &footer[24..] != END_MAGIC {
+            return Err(bad(
+                "footer missing: the file is truncated or was not finished".into(),
+            ));
+        }
+        let u64_at = |i: usize| u64::from_le_bytes(footer[i..i + 8].try_into().unwrap_or([0; 8]));
+        let (index_offset, index_length) = (u64_at(0), u64_at(8));
+        let index_crc = u32::from_le_bytes([footer[16], footer[17], footer[18], footer[19]]);
+        if index_offset < PREAMBLE_BYTES
+            || index_offset.checked_add(index_length) != Some(size - FOOTER_BYTES)
+            || index_length as usize > MAX_INDEX_BYTES
+        {
+            return Err(bad(format!(
+                "index at {index_offset}+{index_length} does not end at the footer ({})",
+                size - FOOTER_BYTES
+            )));
+        }
+        let mut packed = vec![0u8; index_length as usize];
+        source
+            .read_exact_at(index_offset, &mut packed)
+            .map_err(|e| io(path, e))?;
+        if crc32fast::hash(&packed) != index_crc {
+            return Err(bad("index checksum mismatch (damaged file)".into()));
+        }
+        let json = zstd::bulk::decompress(&packed, MAX_INDEX_BYTES)
+            .map_err(|e| bad(format!("index: {e}")))?;
+        let index: Index = serde_json::from_slice(&json).map_err(|e| bad(format!("index: {e}")))?;
+        index
+            .header
+            .validate()
+            .map_err(|e| bad(format!("header: {e}")))?;
+        let mut chunks = BTreeMap::new();
+        for c in index.chunks {
+            if c.offset < PREAMBLE_BYTES
+                || c.length > MAX_CHUNK_BYTES
+                || c.offset
+                    .checked_add(c.length)
+                    .is_none_or(|end| end > index_offset)
+            {
+                return Err(ReflectanceError::BadChunk {
+                    path: path.to_path_buf(),
+                    chunk: c.key.to_string(),
+                    problem: format!("lies outside the data area ({}+{})", c.offset, c.length),
+                });
+            }
+            chunks.insert(c.key, c);
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            source,
+            header: index.header,
+            chunks,
+        })
+    }
+
+    /// The header.
+    pub fn header(&self) -> &FieldHeader {
+        &self.header
+    }
+
+    /// The byte source the file is read from.
+    pub fn source(&self) -> &R {
+        &self.source
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// All chunk entries, in key order.
+    pub fn chunks(&self) -> impl Iterator<Item = &ChunkEntry> {
+        self.chunks.values()
+    }
+
+    /// Total size of the file, bytes.
+    pub fn size(&self) -> u64 {
+        self.source.size()
+    }
+
+    /// Whether a chunk exists.
+    pub fn has(&self, key: &ChunkKey) -> bool {
+        self.chunks.contains_key(key)
+    }
+
+    /// The checked bytes of a chunk.
+    pub fn read_chunk(&self, key: &ChunkKey) -> Result<Vec<u8>> {
+        let entry = self.chunks.get(key).ok_or_else(|| {
+            ReflectanceError::BadParameter(format!(
+                "{}: no {key} in this field",
+                self.path.display()
+            ))
+        })?;
+        let mut bytes = vec![0u8; entry.length as usize];
+        self.source
+            .read_exact_at(entry.offset, &mut bytes)
+            .map_err(|e| self.chunk_error(key, format!("cannot read: {e}")))?;
+        if crc32fast::hash(&bytes) != entry.crc32 {
+            return Err(self.chunk_error(key, "checksum mismatch (damaged file)".into()));
+        }
+        Ok(bytes)
+    }
+
+    /// An error about chunk `key` of this file.
+    pub fn chunk_error(&self, key: &ChunkKey, problem: String) -> ReflectanceError {
+        ReflectanceError::BadChunk {
+            path: self.path.clone(),
+            chunk: key.to_string(),
+            problem,
+        }
+    }
+
+    /// Decodes chunk `key` with `decode`, naming the chunk if it fails.
+    pub fn decode_chunk<T>(
+        &self,
+        key: &ChunkKey,
+        decode: impl FnOnce(&[u8]) -> Result<T>,
+    ) -> Result<T> {
+        let bytes = self.read_chunk(key)?;
+        decode(&bytes).map_err(|e| match e {
+            ReflectanceError::Corrupt(problem) => self.chunk_error(key, problem),
+            other => other,
+        })
+    }
+}

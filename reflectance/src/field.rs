@@ -1,0 +1,339 @@
+//! The flowed reflectance field as data: a [`FieldHeader`] (the grid, every view's
+//! camera and turntable angle, the lighting basis, codec parameters) and, per pose and
+//! view, a [`ViewData`] (basis images, alpha, flows to the grid neighbours), plus per-pose
+//! shadow attenuation maps.
+//!
+//! The header's geometry is self-contained: each view of each pose carries its camera
+//! as seen from the subject frame and the turntable angle that relighting must rotate the
+//! environment by ([`frf_core::conventions`]). A turntable capture fills it from its
+//! manifest ([`FieldHeader::from_capture`]); a calibrated ring of photographs fills it from
+//! its calibration, with one "condition" (the photo) and no relighting.
+
+use frf_core::camera::{Camera, Intrinsics, Rigid};
+use frf_core::capture::Capture;
+use frf_core::grid::Neighbour;
+use frf_core::image::{FlowImage, GrayImage, RgbImage};
+use frf_core::light::DirLight;
+use glam::{Mat3, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ReflectanceError, Result};
+use crate::flowcodec::quant::LogQuantizer;
+
+/// A camera as stored: intrinsics and the rows of `[R | t]` (`world_from_camera`,
+/// subject frame).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CameraRecord {
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Focal lengths and principal point, pixels.
+    pub intrinsics: [f32; 4],
+    /// Rows of the 3x4 matrix `[R | t]`.
+    pub world_from_camera: [[f32; 4]; 3],
+}
+
+impl CameraRecord {
+    /// The record of a camera.
+    pub fn from_camera(c: &Camera) -> Self {
+        let r = c.world_from_camera.rotation;
+        let t = c.world_from_camera.translation;
+        let row = |k: usize| [r.col(0)[k], r.col(1)[k], r.col(2)[k], t[k]];
+        let k = &c.intrinsics;
+        Self {
+            width: c.width,
+            height: c.height,
+            intrinsics: [k.fx, k.fy, k.cx, k.cy],
+            world_from_camera: [row(0), row(1), row(2)],
+        }
+    }
+
+    /// The camera, checked (finite, positive focal lengths, a rotation).
+    pub fn to_camera(&self) -> std::result::Result<Camera, String> {
+        let [fx, fy, cx, cy] = self.intrinsics;
+        if !(fx > 0.0
+            && fy > 0.0
+            && fx.is_finite()
+            && fy.is_finite()
+            && cx.is_finite()
+            && cy.is_finite())
+        {
+            return Err(format!("bad intrinsics {:?}", self.intrinsics));
+        }
+        let m = &self.world_from_camera;
+        let col = |k: usize| Vec3::new(m[0][k], m[1][k], m[2][k]);
+        let pose = Rigid {
+            rotation: Mat3::from_cols(col(0), col(1), col(2)),
+            translation: col(3),
+        };
+        pose.validate(1e-3)?;
+        Ok(Camera {
+            width: self.width,
+            height: self.height,
+            intrinsics: Intrinsics { fx, fy, cx, cy },
+            world_from_camera: pose,
+        })
+    }
+}
+
+/// A light of a basis condition (dome frame).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LightRecord {
+    /// Unit direction toward the light.
+    pub direction: [f32; 3],
+    /// RGB irradiance at normal incidence.
+    pub intensity: [f32; 3],
+    /// Solid angle this light stands for, steradians.
+    pub solid_angle_sr: f32,
+}
+
+/// A basis condition.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConditionRecord {
+    /// Name.
+    pub name: String,
+    /// Floor condition (light from the ground)?
+    pub floor: bool,
+    /// Lights.
+    pub lights: Vec<LightRecord>,
+}
+
+impl ConditionRecord {
+    /// The lights as [`DirLight`]s.
+    pub fn dir_lights(&self) -> Vec<DirLight> {
+        self.lights
+            .iter()
+            .map(|l| DirLight {
+                direction: Vec3::from(l.direction),
+                irradiance: l.intensity,
+            })
+            .collect()
+    }
+}
+
+/// One view of one pose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ViewRecord {
+    /// The camera, as seen from the subject frame.
+    pub camera: CameraRecord,
+    /// Turntable angle of this view, degrees: the environment is rotated by it before
+    /// projection onto the basis.
+    pub turntable_deg: f32,
+}
+
+/// One pose: its time and the geometry of its views (`u`-major: index `u * rows + v`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseRecord {
+    /// Pose index within the cycle.
+    pub pose: u32,
+    /// Time of the pose within the cycle, seconds.
+    pub time_s: f64,
+    /// The views.
+    pub views: Vec<ViewRecord>,
+}
+
+/// The ground grid of the shadow maps (BRIEF section 5.5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShadowSpec {
+    /// Side of the square ground patch centred under the subject, metres (3 in the
+    /// original).
+    pub extent_m: f32,
+    /// Texels per side (128 in the original).
+    pub texels: u32,
+    /// The basis conditions with a map, in map order (the upper-hemisphere ones).
+    pub conditions: Vec<usize>,
+}
+
+/// Everything about a field except its images and flows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FieldHeader {
+    /// Where the field comes from.
+    pub description: String,
+    /// Horizontal views (cycles).
+    pub columns: usize,
+    /// Vertical views (cameras).
+    pub rows: usize,
+    /// Whether the columns close into a circle (a full turntable turn).
+    pub wraps: bool,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Duration of a cycle, seconds.
+    pub cycle_seconds: f64,
+    /// Poses per cycle.
+    pub poses_per_cycle: u32,
+    /// The lighting basis (dome frame).
+    pub conditions: Vec<ConditionRecord>,
+    /// The poses stored, with their view geometry.
+    pub poses: Vec<PoseRecord>,
+    /// The flow quantizer (fitted to this field's flows).
+    pub flow_quantizer: LogQuantizer,
+    /// Whether flow codes are left-predicted.
+    pub flow_predicted: bool,
+    /// JPEG quality of the basis mosaics.
+    pub jpeg_quality: u8,
+    /// The shadow maps' ground grid, if the field has shadows.
+    pub shadows: Option<ShadowSpec>,
+}
+
+impl FieldHeader {
+    /// The header of a field built from `capture`, for `poses` (each must be captured).
+    pub fn from_capture(
+        capture: &Capture,
+        poses: &[u32],
+        flow_quantizer: LogQuantizer,
+        jpeg_quality: u8,
+    ) -> Result<Self> {
+        let m = capture.manifest();
+        let conditions = capture
+            .conditions()
+            .iter()
+            .map(|c| ConditionRecord {
+                name: c.name.clone(),
+                floor: c.floor,
+                lights: c
+                    .lights
+                    .iter()
+                    .map(|l| LightRecord {
+                        direction: l.light.direction.to_array(),
+                        intensity: l.light.irradiance,
+                        solid_angle_sr: l.solid_angle_sr,
+                    })
+                    .collect(),
+            })
+            .collect();
+        let rows = capture.cameras().len();
+        let poses = poses
+            .iter()
+            .map(|&pose| {
+                if !capture.poses().contains(&pose) {
+                    return Err(ReflectanceError::BadParameter(format!(
+                        "pose {pose} is not in the capture (it has {:?})",
+                        capture.poses()
+                    )));
+                }
+                let views = (0..capture.cycles())
+                    .flat_map(|u| (0..rows).map(move |v| (u, v)))
+                    .map(|(u, v)| ViewRecord {
+                        camera: CameraRecord::from_camera(&capture.subject_camera(u, v, pose)),
+                        turntable_deg: capture.view_angle(u, pose).to_degrees(),
+                    })
+                    .collect();
+                Ok(PoseRecord {
+                    pose,
+                    time_s: capture.pose_time_s(pose),
+                    views,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let cam = &capture.cameras()[0];
+        let covered: f64 = m.turntable.degrees_per_cycle * capture.cycles() as f64;
+        Ok(Self {
+            description: m.description.clone(),
+            columns: capture.cycles(),
+            rows,
+            // The grid closes when the cycles cover the full circle.
+            wraps: (covered.abs() - 360.0).abs() < 1e-3,
+            width: cam.width,
+            height: cam.height,
+            cycle_seconds: m.timing.cycle_seconds,
+            poses_per_cycle: m.timing.poses_per_cycle,
+            conditions,
+            poses,
+            flow_quantizer,
+            flow_predicted: true,
+            jpeg_quality,
+            shadows: None,
+        })
+    }
+
+    /// Views per pose.
+    pub fn views_per_pose(&self) -> usize {
+        self.columns * self.rows
+    }
+
+    /// Index of view `(u, v)` in a pose's view list.
+    pub fn view_index(&self, u: usize, v: usize) -> usize {
+        u * self.rows + v
+    }
+
+    /// The record of pose `pose`.
+    pub fn pose(&self, pose: u32) -> Result<&PoseRecord> {
+        self.poses.iter().find(|p| p.pose == pose).ok_or_else(|| {
+            ReflectanceError::BadParameter(format!(
+                "pose {pose} is not in the field (it has {:?})",
+                self.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
+            ))
+        })
+    }
+
+    /// The neighbour of view `(u, v)` in direction `n`, if any.
+    pub fn neighbour(&self, u: usize, v: usize, n: Neighbour) -> Option<(usize, usize)> {
+        n.of(u, v, self.columns, self.rows, self.wraps)
+    }
+
+    /// Checks the header's consistency, saying what is wrong.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        let max = frf_core::io::limits::MAX_DIMENSION;
+        if self.columns == 0 || self.rows == 0 || self.columns * self.rows > 1 << 16 {
+            return Err(format!(
+                "grid {}x{} is empty or absurd",
+                self.columns, self.rows
+            ));
+        }
+        if self.width == 0 || self.height == 0 || self.width > max || self.height > max {
+            return Err(format!("image size {}x{}", self.width, self.height));
+        }
+        if self.conditions.is_empty() || self.conditions.iter().any(|c| c.lights.is_empty()) {
+            return Err("a field needs basis conditions with lights".into());
+        }
+        if !(1..=100).contains(&self.jpeg_quality) {
+            return Err(format!("JPEG quality {}", self.jpeg_quality));
+        }
+        LogQuantizer::new(self.flow_quantizer.scale, self.flow_quantizer.range)
+            .map_err(|e| e.to_string())?;
+        for p in &self.poses {
+            if p.views.len() != self.views_per_pose() {
+                return Err(format!(
+                    "pose {} has {} views, the grid {}",
+                    p.pose,
+                    p.views.len(),
+                    self.views_per_pose()
+                ));
+            }
+            for (i, v) in p.views.iter().enumerate() {
+                let cam = v
+                    .camera
+                    .to_camera()
+                    .map_err(|e| format!("pose {} view {i}: {e}", p.pose))?;
+                if (cam.width, cam.height) != (self.width, self.height)
+                    || !v.turntable_deg.is_finite()
+                {
+                    return Err(format!("pose {} view {i}: size or turntable angle", p.pose));
+                }
+            }
+        }
+        if let Some(s) = &self.shadows
+            && (s.texels == 0
+                || s.texels > 4096
+                || !(s.extent_m > 0.0)
+                || s.conditions.iter().any(|&c| c >= self.conditions.len()))
+        {
+            return Err("shadow grid is inconsistent".into());
+        }
+        Ok(())
+    }
+}
+
+/// The data of one view of one pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewData {
+    /// Basis images, one per condition: premultiplied linear RGB.
+    pub basis: Vec<RgbImage>,
+    /// Alpha.
+    pub alpha: GrayImage,
+    /// Flow to each neighbour, in [`Neighbour::ALL`] order (`None` where there is none).
+    pub flows: [Option<FlowImage>; 4],
+}

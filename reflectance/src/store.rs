@@ -1,0 +1,209 @@
+//! Whole views and poses in and out of a field file: encoding a [`ViewData`] into its
+//! chunks (basis mosaic, alpha, one flow map per neighbour; pure, so views can be
+//! encoded in parallel and written in order), and reading one view back from only its
+//! own chunks.
+
+use frf_core::grid::Neighbour;
+use frf_core::image::{FlowImage, GrayImage, RgbImage};
+
+use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt};
+use crate::error::{ReflectanceError, Result};
+use crate::field::{FieldHeader, ViewData};
+use crate::flowcodec;
+use crate::imagecodec::{decode_basis, decode_planes, encode_basis, encode_planes};
+
+/// The encoded chunks of one view.
+#[derive(Debug, Clone)]
+pub struct EncodedView(Vec<(ChunkKind, Vec<u8>)>);
+
+impl EncodedView {
+    /// Total encoded bytes.
+    pub fn bytes(&self) -> usize {
+        self.0.iter().map(|c| c.1.len()).sum()
+    }
+}
+
+fn check_size<P: Copy>(
+    header: &FieldHeader,
+    what: &str,
+    w: usize,
+    h: usize,
+    img: &frf_core::image::Image<P>,
+) -> Result<()> {
+    if img.size() != (w, h) {
+        return Err(ReflectanceError::Mismatch {
+            what: what.into(),
+            expected: format!("{}x{}", header.width, header.height),
+            got: format!("{}x{}", img.width(), img.height()),
+        });
+    }
+    Ok(())
+}
+
+/// Encodes one view with the header's codec parameters.
+pub fn encode_view(header: &FieldHeader, view: &ViewData) -> Result<EncodedView> {
+    let (w, h) = (header.width as usize, header.height as usize);
+    if view.basis.len() != header.conditions.len() {
+        return Err(ReflectanceError::Mismatch {
+            what: "basis images per view".into(),
+            expected: header.conditions.len().to_string(),
+            got: view.basis.len().to_string(),
+        });
+    }
+    for b in &view.basis {
+        check_size(header, "basis image", w, h, b)?;
+    }
+    check_size(header, "alpha", w, h, &view.alpha)?;
+    let mut chunks = vec![
+        (
+            ChunkKind::Basis,
+            encode_basis(&view.basis, header.jpeg_quality)?,
+        ),
+        (
+            ChunkKind::Alpha,
+            encode_planes(std::slice::from_ref(&view.alpha))?,
+        ),
+    ];
+    for (n, flow) in Neighbour::ALL.iter().zip(&view.flows) {
+        if let Some(flow) = flow {
+            check_size(header, "flow", w, h, flow)?;
+            chunks.push((
+                ChunkKind::Flow(*n),
+                flowcodec::encode(flow, &header.flow_quantizer, header.flow_predicted)?,
+            ));
+        }
+    }
+    Ok(EncodedView(chunks))
+}
+
+impl FieldWriter {
+    /// Writes an encoded view of pose `pose` at `(u, v)`.
+    pub fn add_view(&mut self, pose: u32, u: usize, v: usize, view: &EncodedView) -> Result<()> {
+        self.header().pose(pose)?;
+        for (kind, bytes) in &view.0 {
+            let key = ChunkKey {
+                pose,
+                u: u as u32,
+                v: v as u32,
+                kind: *kind,
+            };
+            self.add_chunk(key, bytes)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the shadow attenuation maps of a pose (one per condition of the header's
+    /// shadow spec).
+    pub fn add_shadows(&mut self, pose: u32, maps: &[GrayImage]) -> Result<()> {
+        let spec = self.header().shadows.clone().ok_or_else(|| {
+            ReflectanceError::BadParameter("the header declares no shadow maps".into())
+        })?;
+        if maps.len() != spec.conditions.len() {
+            return Err(ReflectanceError::Mismatch {
+                what: "shadow maps".into(),
+                expected: spec.conditions.len().to_string(),
+                got: maps.len().to_string(),
+            });
+        }
+        let key = ChunkKey {
+            pose,
+            u: 0,
+            v: 0,
+            kind: ChunkKind::Shadows,
+        };
+        self.add_chunk(key, &encode_planes(maps)?)
+    }
+}
+
+fn key(pose: u32, u: usize, v: usize, kind: ChunkKind) -> ChunkKey {
+    ChunkKey {
+        pose,
+        u: u as u32,
+        v: v as u32,
+        kind,
+    }
+}
+
+impl<R: ReadAt> FieldFile<R> {
+    /// The basis images of a view, linear.
+    pub fn basis(&self, pose: u32, u: usize, v: usize) -> Result<Vec<RgbImage>> {
+        let k = key(pose, u, v, ChunkKind::Basis);
+        let images = self.decode_chunk(&k, decode_basis)?;
+        let (w, h) = (self.header().width as usize, self.header().height as usize);
+        if images.len() != self.header().conditions.len()
+            || images.iter().any(|i| i.size() != (w, h))
+        {
+            return Err(self.chunk_error(&k, "images of the wrong size or count".into()));
+        }
+        Ok(images)
+    }
+
+    /// The alpha of a view.
+    pub fn alpha(&self, pose: u32, u: usize, v: usize) -> Result<GrayImage> {
+        let k = key(pose, u, v, ChunkKind::Alpha);
+        let mut planes = self.decode_chunk(&k, decode_planes)?;
+        let (w, h) = (self.header().width as usize, self.header().height as usize);
+        match planes.pop() {
+            Some(a) if planes.is_empty() && a.size() == (w, h) => Ok(a),
+            _ => Err(self.chunk_error(&k, "not one plane of the field's size".into())),
+        }
+    }
+
+    /// The 8-bit log codes (two planes, `u` then `v`) of the flow from a view to a
+    /// neighbour, `None` where the neighbour does not exist.
+    pub fn flow_codes(
+        &self,
+        pose: u32,
+        u: usize,
+        v: usize,
+        n: Neighbour,
+    ) -> Result<Option<Vec<i8>>> {
+        let k = key(pose, u, v, ChunkKind::Flow(n));
+        if !self.has(&k) {
+            return Ok(None);
+        }
+        let (w, h, codes) = self.decode_chunk(&k, flowcodec::decode_codes)?;
+        if (w, h) != (self.header().width as usize, self.header().height as usize) {
+            return Err(self.chunk_error(&k, format!("flow map is {w}x{h}")));
+        }
+        Ok(Some(codes))
+    }
+
+    /// The flow from a view to a neighbour, `None` where the neighbour does not exist.
+    pub fn flow(&self, pose: u32, u: usize, v: usize, n: Neighbour) -> Result<Option<FlowImage>> {
+        let (w, h) = (self.header().width as usize, self.header().height as usize);
+        self.flow_codes(pose, u, v, n)?
+            .map(|codes| flowcodec::dequantize(w, h, &codes, &self.header().flow_quantizer))
+            .transpose()
+    }
+
+    /// Everything of one view, read from that view's chunks only.
+    pub fn view(&self, pose: u32, u: usize, v: usize) -> Result<ViewData> {
+        self.header().pose(pose)?;
+        if u >= self.header().columns || v >= self.header().rows {
+            return Err(ReflectanceError::BadParameter(format!(
+                "view ({u}, {v}) is outside the {}x{} grid",
+                self.header().columns,
+                self.header().rows
+            )));
+        }
+        let mut flows: [Option<FlowImage>; 4] = Default::default();
+        for n in Neighbour::ALL {
+            flows[n.index()] = self.flow(pose, u, v, n)?;
+        }
+        Ok(ViewData {
+            basis: self.basis(pose, u, v)?,
+            alpha: self.alpha(pose, u, v)?,
+            flows,
+        })
+    }
+
+    /// The shadow maps of a pose, if stored.
+    pub fn shadows(&self, pose: u32) -> Result<Option<Vec<GrayImage>>> {
+        let k = key(pose, 0, 0, ChunkKind::Shadows);
+        if !self.has(&k) {
+            return Ok(None);
+        }
+        self.decode_chunk(&k, decode_planes).map(Some)
+    }
+}

@@ -1,0 +1,283 @@
+//! The field file: round trip, random access that touches only the view asked for, and
+//! refusal of truncated, corrupted and hostile files with errors naming the chunk.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::sync::Mutex;
+
+use frf_core::capture::Capture;
+use frf_core::grid::Neighbour;
+use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
+use frf_reflectance::container::{ChunkKey, ChunkKind, FieldFile, ReadAt};
+use frf_reflectance::flowcodec::{self, quant::LogQuantizer};
+use frf_reflectance::store::encode_view;
+use frf_reflectance::{FieldHeader, FieldWriter, ViewData};
+use frf_stage::{Preset, Stage, StageConfig};
+
+const COLUMNS: usize = 4;
+
+fn header() -> FieldHeader {
+    let mut c = StageConfig::preset(Preset::Tiny);
+    c.cycles = COLUMNS as u32;
+    c.width = 24;
+    c.height = 32;
+    let stage = Stage::new(c).unwrap();
+    let capture = Capture::from_manifest(std::path::Path::new("."), stage.manifest()).unwrap();
+    FieldHeader::from_capture(&capture, &[0, 1], LogQuantizer::new(0.2, 12.0).unwrap(), 90).unwrap()
+}
+
+fn view(h: &FieldHeader, pose: u32, u: usize, v: usize) -> ViewData {
+    let (w, hh) = (h.width as usize, h.height as usize);
+    let seed = (pose as usize * 31 + u * 7 + v) as f32;
+    let basis: Vec<RgbImage> = (0..h.conditions.len())
+        .map(|c| {
+            Image::from_fn(w, hh, |x, y| {
+                let t = (x as f32 * 0.3 + y as f32 * 0.2 + seed + c as f32).sin() * 0.5 + 0.5;
+                [t * 0.8, t * 0.5 + 0.1, 0.2 * (c as f32 + 1.0) / 26.0]
+            })
+        })
+        .collect();
+    let alpha: GrayImage = Image::from_fn(w, hh, |x, y| ((x + y) % 7) as f32 / 6.0);
+    let mut flows: [Option<FlowImage>; 4] = Default::default();
+    for n in Neighbour::ALL {
+        if h.neighbour(u, v, n).is_some() {
+            flows[n.index()] = Some(Image::from_fn(w, hh, |x, y| {
+                if x < 2 {
+                    [frf_core::flo::UNKNOWN; 2]
+                } else {
+                    [
+                        x as f32 * 0.1 - 1.0 + seed * 0.01,
+                        y as f32 * -0.05 + n.index() as f32,
+                    ]
+                }
+            }));
+        }
+    }
+    ViewData {
+        basis,
+        alpha,
+        flows,
+    }
+}
+
+fn write_field(path: &std::path::Path) -> FieldHeader {
+    let h = header();
+    let mut w = FieldWriter::create(path, h.clone()).unwrap();
+    for pose in [0, 1] {
+        for u in 0..h.columns {
+            for v in 0..h.rows {
+                w.add_view(pose, u, v, &encode_view(&h, &view(&h, pose, u, v)).unwrap())
+                    .unwrap();
+            }
+        }
+    }
+    w.finish().unwrap();
+    h
+}
+
+#[test]
+fn views_round_trip() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.frf");
+    let h = write_field(&path);
+    let field = FieldFile::open(&path).unwrap();
+    assert_eq!(field.header(), &h);
+    let original = view(&h, 1, 3, 2);
+    let back = field.view(1, 3, 2).unwrap();
+    // Flows decode to exactly the dequantized values.
+    for n in Neighbour::ALL {
+        match (&original.flows[n.index()], &back.flows[n.index()]) {
+            (Some(a), Some(b)) => {
+                let q = &h.flow_quantizer;
+                let expected =
+                    flowcodec::dequantize(a.width(), a.height(), &flowcodec::quantize(a, q), q)
+                        .unwrap();
+                assert_eq!(b, &expected);
+            }
+            (None, None) => {}
+            _ => panic!("flow {} present on one side only", n.name()),
+        }
+    }
+    // The top row (v = 2) has no upward flow.
+    assert!(back.flows[Neighbour::Up.index()].is_none());
+    // Alpha is lossless to 16 bits; basis images close.
+    for (a, b) in original.alpha.pixels().iter().zip(back.alpha.pixels()) {
+        assert!((a - b).abs() <= 0.5 / 65535.0 + 1e-7);
+    }
+    for (a, b) in original.basis.iter().zip(&back.basis) {
+        let err: f32 = a
+            .pixels()
+            .iter()
+            .flatten()
+            .zip(b.pixels().iter().flatten())
+            .map(|(x, y)| (x - y).abs())
+            .sum::<f32>()
+            / (a.pixels().len() * 3) as f32;
+        assert!(err < 0.01, "mean basis error {err}");
+    }
+    let stats = field.stats();
+    assert_eq!((stats.poses, stats.views), (2, COLUMNS * 3));
+    // 4 columns that wrap: 2 horizontal flows per view, and 4 vertical ones per column.
+    assert_eq!(stats.flow_maps, 2 * (COLUMNS * 3 * 2 + COLUMNS * 4));
+    assert_eq!(stats.basis_images, 2 * COLUMNS * 3 * 26);
+    assert!(stats.flow_ratio_vs_8bit > 0.0 && stats.flow_ratio_vs_8bit < 1.0);
+}
+
+/// A source that records which byte ranges were read.
+struct Recording {
+    bytes: Vec<u8>,
+    reads: Mutex<Vec<(u64, u64)>>,
+}
+
+impl ReadAt for Recording {
+    fn read_exact_at(&self, offset: u64, buf: &mut [u8]) -> std::io::Result<()> {
+        self.reads.lock().unwrap().push((offset, buf.len() as u64));
+        self.bytes.read_exact_at(offset, buf)
+    }
+    fn size(&self) -> u64 {
+        self.bytes.len() as u64
+    }
+}
+
+#[test]
+fn reading_one_view_touches_only_its_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.frf");
+    write_field(&path);
+    let bytes = std::fs::read(&path).unwrap();
+    let field = FieldFile::from_source(
+        &path,
+        Recording {
+            bytes,
+            reads: Mutex::new(Vec::new()),
+        },
+    )
+    .unwrap();
+    let index_start = field.chunks().map(|c| c.offset + c.length).max().unwrap();
+    let opening: Vec<(u64, u64)> = std::mem::take(&mut *field_reads(&field));
+    // Opening reads the preamble, the footer and the index: nothing of the chunks.
+    assert!(
+        opening
+            .iter()
+            .all(|&(o, l)| o + l <= 16 || o >= index_start),
+        "{opening:?}"
+    );
+    field.view(0, 2, 1).unwrap();
+    let reads: Vec<(u64, u64)> = std::mem::take(&mut *field_reads(&field));
+    let own: Vec<(u64, u64)> = field
+        .chunks()
+        .filter(|c| (c.key.pose, c.key.u, c.key.v) == (0, 2, 1) && c.key.kind != ChunkKind::Shadows)
+        .map(|c| (c.offset, c.length))
+        .collect();
+    assert_eq!(own.len(), 2 + 4, "basis, alpha and 4 flows");
+    for r in &reads {
+        assert!(
+            own.contains(r),
+            "read {r:?} is not one of the view's chunks {own:?}"
+        );
+    }
+    assert_eq!(reads.len(), own.len());
+}
+
+fn field_reads(field: &FieldFile<Recording>) -> std::sync::MutexGuard<'_, Vec<(u64, u64)>> {
+    field.source().reads.lock().unwrap()
+}
+
+#[test]
+fn truncated_and_corrupted_files_are_refused_naming_the_chunk() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.frf");
+    write_field(&path);
+    let good = std::fs::read(&path).unwrap();
+    let field = FieldFile::open(&path).unwrap();
+    let target = ChunkKey {
+        pose: 1,
+        u: 2,
+        v: 0,
+        kind: ChunkKind::Flow(Neighbour::Right),
+    };
+    let entry = *field.chunks().find(|c| c.key == target).unwrap();
+
+    // Truncated anywhere: the footer is gone.
+    for cut in [10, good.len() / 2, good.len() - 1] {
+        std::fs::write(&path, &good[..cut]).unwrap();
+        let err = FieldFile::open(&path).err().unwrap().to_string();
+        assert!(
+            err.contains("f.frf") && (err.contains("truncated") || err.contains("short")),
+            "{err}"
+        );
+    }
+    // One flipped bit inside a chunk: that chunk, and only it, is refused.
+    let mut bad = good.clone();
+    bad[(entry.offset + entry.length / 2) as usize] ^= 0x10;
+    std::fs::write(&path, &bad).unwrap();
+    let field = FieldFile::open(&path).unwrap();
+    let err = field.view(1, 2, 0).unwrap_err().to_string();
+    assert!(
+        err.contains("flow right of pose 1 view (2, 0)") && err.contains("checksum"),
+        "{err}"
+    );
+    field.view(1, 3, 0).unwrap();
+    // A damaged index.
+    let mut bad = good.clone();
+    let n = bad.len();
+    bad[n - 40] ^= 0xFF;
+    std::fs::write(&path, &bad).unwrap();
+    let err = FieldFile::open(&path).err().unwrap().to_string();
+    assert!(err.contains("index"), "{err}");
+    // Not a field at all.
+    std::fs::write(&path, vec![7u8; 100]).unwrap();
+    assert!(
+        FieldFile::open(&path)
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("magic")
+    );
+    // Asking for what is not there.
+    std::fs::write(&path, &good).unwrap();
+    let field = FieldFile::open(&path).unwrap();
+    assert!(field.view(5, 0, 0).is_err());
+    assert!(field.view(0, 9, 0).is_err());
+}
+
+#[test]
+fn an_unfinished_writer_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.frf");
+    let h = header();
+    {
+        let mut w = FieldWriter::create(&path, h.clone()).unwrap();
+        w.add_view(0, 0, 0, &encode_view(&h, &view(&h, 0, 0, 0)).unwrap())
+            .unwrap();
+        // Dropped without finish(), as when a run is interrupted.
+    }
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // Writing a view twice, or of a pose the header lacks, is refused.
+    let mut w = FieldWriter::create(&path, h.clone()).unwrap();
+    let enc = encode_view(&h, &view(&h, 0, 0, 0)).unwrap();
+    w.add_view(0, 0, 0, &enc).unwrap();
+    assert!(w.add_view(0, 0, 0, &enc).is_err());
+    assert!(w.add_view(7, 0, 0, &enc).is_err());
+    let mut wrong = view(&h, 0, 0, 0);
+    wrong.basis.pop();
+    assert!(encode_view(&h, &wrong).is_err());
+}
+
+#[test]
+fn garbage_never_panics() {
+    use proptest::prelude::*;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.frf");
+    write_field(&path);
+    let good = std::fs::read(&path).unwrap();
+    proptest!(ProptestConfig::with_cases(200), |(at in 0usize..good.len(), byte in any::<u8>(), cut in 0usize..64)| {
+        let mut bytes = good.clone();
+        bytes[at] = byte;
+        bytes.truncate(bytes.len() - cut);
+        if let Ok(field) = FieldFile::from_source(std::path::Path::new("fuzz.frf"), bytes) {
+            let _ = field.view(0, 1, 1);
+            let _ = field.stats();
+        }
+    });
+}
