@@ -9,6 +9,9 @@
 //!   coding, optionally left-predicted.
 //! - [`imagecodec`]: the basis images of a view as one gamma-2.2 JPEG mosaic; alpha and
 //!   shadow maps lossless to 16 bits with zstd.
+//! - [`project`], [`relight`]: HDR environments projected onto the basis (spherical
+//!   Voronoi regions of the lights, turntable rotation, two floor models) and CPU
+//!   relighting.
 //! - [`container`], [`store`]: the field file, an indexed and checksummed container that
 //!   reads one view without the rest; [`stats`]: its contents and compression ratios.
 //!
@@ -19,6 +22,8 @@ pub mod error;
 pub mod field;
 pub mod flowcodec;
 pub mod imagecodec;
+pub mod project;
+pub mod relight;
 pub mod stats;
 pub mod store;
 
