@@ -25,13 +25,16 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a synthetic capture with the virtual light stage, or its ground truth.
-    Stage(cmd::stage::StageArgs),
+    Stage(Box<cmd::stage::StageArgs>),
+    /// Show what a field file holds and how well it is compressed.
+    Info(cmd::info::InfoArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Stage(args) => cmd::stage::run(args),
+        Command::Stage(args) => cmd::stage::run(*args),
+        Command::Info(args) => cmd::info::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -318,7 +318,8 @@ impl FieldHeader {
         if let Some(s) = &self.shadows
             && (s.texels == 0
                 || s.texels > 4096
-                || !(s.extent_m > 0.0)
+                || s.extent_m.is_nan()
+                || s.extent_m <= 0.0
                 || s.conditions.iter().any(|&c| c >= self.conditions.len()))
         {
             return Err("shadow grid is inconsistent".into());

@@ -72,10 +72,16 @@ impl Projector {
         let lights: Vec<(Vec3, u16)> = conditions
             .iter()
             .enumerate()
-            .flat_map(|(k, c)| c.lights.iter().map(move |l| (Vec3::from(l.direction).normalize(), k as u16)))
+            .flat_map(|(k, c)| {
+                c.lights
+                    .iter()
+                    .map(move |l| (Vec3::from(l.direction).normalize(), k as u16))
+            })
             .collect();
         if lights.is_empty() || conditions.len() > u16::MAX as usize {
-            return Err(ReflectanceError::BadParameter("a basis needs 1..65535 conditions with lights".into()));
+            return Err(ReflectanceError::BadParameter(
+                "a basis needs 1..65535 conditions with lights".into(),
+            ));
         }
         let grid = (0..EL_CELLS * AZ_CELLS)
             .into_par_iter()
@@ -91,7 +97,9 @@ impl Projector {
         let delivered = conditions
             .iter()
             .map(|c| {
-                c.lights.iter().fold([0.0f32; 3], |acc, l| [0, 1, 2].map(|i| acc[i] + l.intensity[i]))
+                c.lights.iter().fold([0.0f32; 3], |acc, l| {
+                    [0, 1, 2].map(|i| acc[i] + l.intensity[i])
+                })
             })
             .collect();
         Ok(Self {

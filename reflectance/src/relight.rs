@@ -18,7 +18,9 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
         });
     }
     let Some(first) = basis.first() else {
-        return Err(ReflectanceError::BadParameter("no basis images to relight".into()));
+        return Err(ReflectanceError::BadParameter(
+            "no basis images to relight".into(),
+        ));
     };
     let (w, h) = first.size();
     if let Some(bad) = basis.iter().find(|b| b.size() != (w, h)) {
@@ -28,8 +30,13 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
             got: format!("{}x{}", bad.width(), bad.height()),
         });
     }
-    if let Some(c) = coefficients.iter().find(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(ReflectanceError::BadParameter(format!("coefficient {c:?} is not finite")));
+    if let Some(c) = coefficients
+        .iter()
+        .find(|c| c.iter().any(|v| !v.is_finite()))
+    {
+        return Err(ReflectanceError::BadParameter(format!(
+            "coefficient {c:?} is not finite"
+        )));
     }
     let active: Vec<(&RgbImage, Rgb)> = basis
         .iter()

@@ -9,11 +9,11 @@ use std::f32::consts::{PI, TAU};
 use frf_core::capture::Capture;
 use frf_core::env::EnvMap;
 use frf_core::image::{Image, Rgb, RgbImage};
+use frf_reflectance::FieldHeader;
 use frf_reflectance::field::ConditionRecord;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::project::{FloorModel, Projector};
 use frf_reflectance::relight::relight;
-use frf_reflectance::FieldHeader;
 use frf_stage::{Preset, Stage, StageConfig};
 use glam::Mat3;
 
@@ -36,9 +36,17 @@ fn textured_env(w: usize) -> EnvMap {
     let probe = EnvMap::uniform([0.0; 3], w / 2);
     let img = Image::from_fn(w, w / 2, |x, y| {
         let d = probe.direction_of(x as f32, y as f32);
-        let sun = d.dot(glam::Vec3::new(0.5, 0.6, -0.62).normalize()).max(0.0).powi(200) * 500.0;
+        let sun = d
+            .dot(glam::Vec3::new(0.5, 0.6, -0.62).normalize())
+            .max(0.0)
+            .powi(200)
+            * 500.0;
         if d.y >= 0.0 {
-            [0.4 + d.x * 0.2 + sun, 0.5 + sun * 0.9, 0.9 - d.z * 0.3 + sun * 0.7]
+            [
+                0.4 + d.x * 0.2 + sun,
+                0.5 + sun * 0.9,
+                0.9 - d.z * 0.3 + sun * 0.7,
+            ]
         } else {
             [0.2 + 0.05 * (x % 9) as f32, 0.15, 0.1]
         }
@@ -48,12 +56,20 @@ fn textured_env(w: usize) -> EnvMap {
 
 fn basis_images(n: usize) -> Vec<RgbImage> {
     (0..n)
-        .map(|k| Image::from_fn(8, 6, |x, y| [(x + k) as f32 * 0.1, (y * k) as f32 * 0.01, 0.5]))
+        .map(|k| {
+            Image::from_fn(8, 6, |x, y| {
+                [(x + k) as f32 * 0.1, (y * k) as f32 * 0.01, 0.5]
+            })
+        })
         .collect()
 }
 
 fn close(a: &[Rgb], b: &[Rgb], tol: f32) {
-    let scale = a.iter().flatten().fold(0.0f32, |m, v| m.max(v.abs())).max(1e-6);
+    let scale = a
+        .iter()
+        .flatten()
+        .fold(0.0f32, |m, v| m.max(v.abs()))
+        .max(1e-6);
     for (x, y) in a.iter().zip(b) {
         for c in 0..3 {
             assert!((x[c] - y[c]).abs() <= tol * scale, "{x:?} vs {y:?}");
@@ -70,7 +86,9 @@ fn an_environment_equal_to_one_condition_relights_to_its_image() {
     for k in [0, 9, 20, 24] {
         // Radiance such that the region's light equals what the condition delivers.
         let rot = Mat3::from_rotation_y(turntable);
-        let in_region = |x: usize, y: usize| projector.condition_of(rot * probe.direction_of(x as f32, y as f32)) == k;
+        let in_region = |x: usize, y: usize| {
+            projector.condition_of(rot * probe.direction_of(x as f32, y as f32)) == k
+        };
         let omega: f32 = (0..256)
             .flat_map(|y| (0..512).map(move |x| (x, y)))
             .filter(|&(x, y)| in_region(x, y))
@@ -85,7 +103,10 @@ fn an_environment_equal_to_one_condition_relights_to_its_image() {
         for (j, c) in coefficients.iter().enumerate() {
             let expected = if j == k { 1.0 } else { 0.0 };
             for v in c {
-                assert!((v - expected).abs() < 1e-4, "condition {k}: coefficient {j} = {c:?}");
+                assert!(
+                    (v - expected).abs() < 1e-4,
+                    "condition {k}: coefficient {j} = {c:?}"
+                );
             }
         }
         let basis = basis_images(conds.len());
@@ -131,13 +152,29 @@ fn a_full_turn_is_the_identity_and_turns_compose() {
     let projector = Projector::new(&conditions()).unwrap();
     let env = textured_env(512);
     let base = projector.project(&env, 0.4, FloorModel::Environment);
-    close(&projector.project(&env, 0.4 + TAU, FloorModel::Environment), &base, 1e-3);
-    close(&projector.project(&env.rotated(TAU), 0.4, FloorModel::Environment), &base, 1e-3);
+    close(
+        &projector.project(&env, 0.4 + TAU, FloorModel::Environment),
+        &base,
+        1e-3,
+    );
+    close(
+        &projector.project(&env.rotated(TAU), 0.4, FloorModel::Environment),
+        &base,
+        1e-3,
+    );
     // Turning the map by φ is turning the subject by φ.
-    close(&projector.project(&env.rotated(0.4), 0.0, FloorModel::Environment), &base, 1e-3);
+    close(
+        &projector.project(&env.rotated(0.4), 0.0, FloorModel::Environment),
+        &base,
+        1e-3,
+    );
     // And a quarter turn does change things (the sun moves to another region).
     let quarter = projector.project(&env, 0.4 + PI / 2.0, FloorModel::Environment);
-    let diff: f32 = quarter.iter().zip(&base).map(|(a, b)| (a[0] - b[0]).abs()).sum();
+    let diff: f32 = quarter
+        .iter()
+        .zip(&base)
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .sum();
     assert!(diff > 0.1, "{diff}");
 }
 
@@ -150,7 +187,11 @@ fn projection_conserves_light() {
     let total = env.total_light();
     for c in 0..3 {
         let sum: f32 = regions.iter().map(|r| r[c]).sum();
-        assert!((sum - total[c]).abs() < 1e-4 * total[c], "{sum} vs {}", total[c]);
+        assert!(
+            (sum - total[c]).abs() < 1e-4 * total[c],
+            "{sum} vs {}",
+            total[c]
+        );
     }
     // Coefficients times what each condition delivers give the regions' light back.
     let coefficients = projector.project(&env, 1.1, FloorModel::Environment);
@@ -173,7 +214,11 @@ fn lambertian_ground_of_albedo_one_under_a_uniform_sky_is_the_sky() {
     }))
     .unwrap();
     let reference = projector.project(&sphere, 0.0, FloorModel::Environment);
-    let modelled = projector.project(&sky_only, 0.0, FloorModel::LambertianGround { albedo: [1.0; 3] });
+    let modelled = projector.project(
+        &sky_only,
+        0.0,
+        FloorModel::LambertianGround { albedo: [1.0; 3] },
+    );
     close(&modelled, &reference, 2e-3);
     // With the environment's own (black) lower hemisphere the floor gets nothing.
     let dark = projector.project(&sky_only, 0.0, FloorModel::Environment);

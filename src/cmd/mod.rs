@@ -1,4 +1,6 @@
 //! One module per subcommand, plus shared progress reporting.
 
+pub mod info;
 pub mod progress;
 pub mod stage;
+pub mod stage_field;

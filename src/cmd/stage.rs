@@ -30,6 +30,12 @@ pub struct StageArgs {
 enum StageCommand {
     /// Render the true image and alpha of a pose from any camera under any lighting.
     Truth(TruthArgs),
+    /// Build the oracle field of a capture from its ground truth (a perfect ingest).
+    Field(crate::cmd::stage_field::FieldArgs),
+    /// Error of relighting through the 26-condition basis, per environment.
+    ProjectionError(crate::cmd::stage_field::ProjectionArgs),
+    /// Compression ratio and relit PSNR of the basis images over JPEG quality.
+    CodecCurve(crate::cmd::stage_field::CodecArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -128,6 +134,9 @@ struct TruthArgs {
 pub fn run(args: StageArgs) -> CliResult {
     match args.command {
         Some(StageCommand::Truth(t)) => truth(t),
+        Some(StageCommand::Field(a)) => crate::cmd::stage_field::field(a),
+        Some(StageCommand::ProjectionError(a)) => crate::cmd::stage_field::projection(a),
+        Some(StageCommand::CodecCurve(a)) => crate::cmd::stage_field::codec(a),
         None => capture(args.capture),
     }
 }

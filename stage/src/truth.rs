@@ -33,8 +33,9 @@ use crate::studio::Illumination;
 /// far below the thinnest part (a hand, 5 cm).
 const VISIBILITY_TOLERANCE_M: f32 = 0.002;
 
-/// Median-cut lights used for truth images under an environment by default: enough that
-/// a further doubling changes the image by less than 1 % (measured on the ICT probes).
+/// Median-cut lights used for truth images under an environment by default. Measured
+/// (160x224, against 8192 lights, mean absolute luminance): 0.43 % for a uniform sphere,
+/// 0.34 % for the built-in sky, 0.26 % for Grace Cathedral; each doubling halves it.
 pub const DEFAULT_ENVIRONMENT_LIGHTS: usize = 512;
 
 /// A true flow field and where its correspondences are hidden.

@@ -97,9 +97,9 @@ impl HuffmanTable {
         let mut codes = [(0u16, 0u8); 256];
         let mut code = 0u32;
         for len in 1..=MAX_CODE_LENGTH {
-            for s in 0..256 {
-                if self.lengths[s] == len {
-                    codes[s] = (code as u16, len);
+            for (c, &l) in codes.iter_mut().zip(&self.lengths) {
+                if l == len {
+                    *c = (code as u16, len);
                     code += 1;
                 }
             }

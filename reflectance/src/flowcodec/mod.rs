@@ -83,7 +83,7 @@ fn predict(codes: &[i8], width: usize) -> Vec<u8> {
 #[inline]
 fn neighbour(codes: &[i8], i: usize, width: usize, plane: usize) -> i8 {
     let j = i % plane.max(1);
-    if j % width != 0 {
+    if !j.is_multiple_of(width) {
         codes[i - 1]
     } else if j >= width {
         codes[i - width]

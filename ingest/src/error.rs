@@ -1,0 +1,21 @@
+//! The error type of ingest and evaluation.
+
+/// Result alias of this crate.
+pub type Result<T, E = IngestError> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in ingest and evaluation.
+#[derive(Debug, thiserror::Error)]
+pub enum IngestError {
+    /// A parameter is out of range or inconsistent with the capture.
+    #[error("{0}")]
+    BadParameter(String),
+    /// Reading the capture, images or environments.
+    #[error(transparent)]
+    Core(#[from] frf_core::CoreError),
+    /// The virtual stage (ground truth).
+    #[error(transparent)]
+    Stage(#[from] frf_stage::StageError),
+    /// The field file and codecs.
+    #[error(transparent)]
+    Reflectance(#[from] frf_reflectance::ReflectanceError),
+}

@@ -1,0 +1,179 @@
+//! Evaluations of the storage and relighting against the virtual stage's ground truth:
+//!
+//! - [`projection_error`]: how far relighting a view's (perfect) basis images with an
+//!   environment's projection is from the true image of that view under the environment
+//!   itself. This is the error of representing the environment by 26 conditions, before
+//!   any compression or interpolation.
+//! - [`codec_curve`]: compression ratio of the basis images against 16-bit linear RGB,
+//!   and the relit PSNR it costs, over JPEG quality.
+
+use std::time::Instant;
+
+use frf_core::env::EnvMap;
+use frf_core::image::RgbImage;
+use frf_core::light::DirLight;
+use frf_reflectance::imagecodec::{decode_basis, encode_basis};
+use frf_reflectance::project::{FloorModel, Projector};
+use frf_reflectance::relight::relight;
+use frf_stage::Stage;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::error::{IngestError, Result};
+use crate::metrics::{ImageError, compare};
+use crate::oracle::oracle_view;
+
+/// The stage's basis as field conditions (what a projector needs).
+pub fn stage_projector(stage: &Stage) -> Result<Projector> {
+    let capture =
+        frf_core::capture::Capture::from_manifest(std::path::Path::new("."), stage.manifest())?;
+    let header = frf_reflectance::FieldHeader::from_capture(
+        &capture,
+        &stage.config().poses[..1],
+        frf_reflectance::flowcodec::quant::LogQuantizer::new(1.0, 1.0)?,
+        90,
+    )?;
+    Ok(Projector::new(&header.conditions)?)
+}
+
+/// Turntable angle of view column `u` of `pose`.
+fn view_angle(stage: &Stage, pose: u32, u: usize) -> f32 {
+    stage.turntable_angle(u, stage.pose_time_s(pose))
+}
+
+/// The environment's lights (median cut, subject frame) as the dome frame of view column
+/// `u` sees them: turned by `+θ`.
+fn env_lights_for_view(stage: &Stage, lights: &[DirLight], pose: u32, u: usize) -> Vec<DirLight> {
+    let r = glam::Mat3::from_rotation_y(view_angle(stage, pose, u));
+    lights.iter().map(|l| l.rotated(r)).collect()
+}
+
+/// The basis-projection error of one view under one environment.
+#[derive(Debug, Clone, Serialize)]
+pub struct ProjectionError {
+    /// The view `(u, v)`.
+    pub view: (usize, usize),
+    /// PSNR over the subject (alpha ≥ 0.5), dB, peak = the truth's brightest value there.
+    pub psnr_subject_db: f64,
+    /// Mean absolute error over the subject relative to the truth's mean.
+    pub relative_mae: f64,
+}
+
+/// Relights the true basis images of view `(u, v)` of `pose` with the projection of
+/// `env` and compares with the true image under `env` (reduced to `lights` median-cut
+/// lights), over the subject.
+pub fn projection_error(
+    stage: &Stage,
+    projector: &Projector,
+    env: &EnvMap,
+    lights: usize,
+    floor: FloorModel,
+    pose: u32,
+    views: &[(usize, usize)],
+) -> Result<Vec<ProjectionError>> {
+    let env_lights = env.median_cut(lights);
+    views
+        .par_iter()
+        .map(|&(u, v)| {
+            let truth = stage.true_view_image(
+                pose,
+                u,
+                v,
+                &env_lights_for_view(stage, &env_lights, pose, u),
+            )?;
+            let basis = oracle_view(stage, pose, u, v)?.basis;
+            let coefficients = projector.project(env, view_angle(stage, pose, u), floor);
+            let relit = relight(&basis, &coefficients)?;
+            let e = compare(&truth.color, &relit, Some(&truth.alpha));
+            Ok(ProjectionError {
+                view: (u, v),
+                psnr_subject_db: e.psnr_db,
+                relative_mae: e.relative_mae,
+            })
+        })
+        .collect()
+}
+
+/// One point of the compression curve.
+#[derive(Debug, Clone, Serialize)]
+pub struct CodecPoint {
+    /// JPEG quality.
+    pub quality: u8,
+    /// 16-bit linear RGB size of the basis images divided by the coded size.
+    pub ratio_vs_16bit: f64,
+    /// Worst relit PSNR over the views (subject, dB), relit with the environment.
+    pub min_relit_psnr_db: f64,
+    /// Mean relit PSNR over the views (subject, dB).
+    pub mean_relit_psnr_db: f64,
+    /// Seconds to encode and decode one view's mosaic.
+    pub seconds_per_view: f64,
+}
+
+/// A view's uncompressed basis, its relit reference, alpha and coefficients.
+struct PreparedView {
+    basis: Vec<RgbImage>,
+    reference: RgbImage,
+    alpha: frf_core::image::GrayImage,
+    coefficients: Vec<[f32; 3]>,
+}
+
+/// Compression ratio and relit PSNR of the basis mosaic over JPEG `qualities`, on the
+/// oracle basis images of `views` of `pose`, relit with `env`.
+pub fn codec_curve(
+    stage: &Stage,
+    env: &EnvMap,
+    pose: u32,
+    views: &[(usize, usize)],
+    qualities: &[u8],
+) -> Result<Vec<CodecPoint>> {
+    if views.is_empty() || qualities.is_empty() {
+        return Err(IngestError::BadParameter(
+            "codec curve needs views and qualities".into(),
+        ));
+    }
+    let projector = stage_projector(stage)?;
+    let prepared: Vec<PreparedView> = views
+        .par_iter()
+        .map(|&(u, v)| {
+            let view = oracle_view(stage, pose, u, v)?;
+            let coefficients =
+                projector.project(env, view_angle(stage, pose, u), FloorModel::Environment);
+            let reference = relight(&view.basis, &coefficients)?;
+            Ok(PreparedView {
+                basis: view.basis,
+                reference,
+                alpha: view.alpha,
+                coefficients,
+            })
+        })
+        .collect::<Result<_>>()?;
+    qualities
+        .iter()
+        .map(|&quality| {
+            let start = Instant::now();
+            let results: Vec<(usize, ImageError)> = prepared
+                .iter()
+                .map(|p| {
+                    let bytes = encode_basis(&p.basis, quality)?;
+                    let decoded = decode_basis(&bytes)?;
+                    let relit = relight(&decoded, &p.coefficients)?;
+                    Ok((bytes.len(), compare(&p.reference, &relit, Some(&p.alpha))))
+                })
+                .collect::<Result<_>>()?;
+            let seconds = start.elapsed().as_secs_f64() / prepared.len() as f64;
+            let raw: usize = prepared
+                .iter()
+                .map(|p| p.basis.len() * p.basis[0].pixels().len() * 6)
+                .sum();
+            let coded: usize = results.iter().map(|r| r.0).sum();
+            let psnrs: Vec<f64> = results.iter().map(|r| r.1.psnr_db).collect();
+            Ok(CodecPoint {
+                quality,
+                ratio_vs_16bit: raw as f64 / coded as f64,
+                min_relit_psnr_db: psnrs.iter().copied().fold(f64::INFINITY, f64::min),
+                mean_relit_psnr_db: psnrs.iter().sum::<f64>() / psnrs.len() as f64,
+                seconds_per_view: seconds,
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,135 @@
+//! The oracle field: the flowed reflectance field that a perfect ingest would produce
+//! from a virtual-stage capture, built from the stage's ground truth instead of being
+//! estimated: noise-free basis images of each view at its reference instant (perfectly
+//! registered and matted onto black), the true alpha, and the true flows to every grid
+//! neighbour. It measures the storage on stage data before any estimation error, and
+//! lets the renderer be judged apart from ingest.
+
+use frf_core::capture::Capture;
+use frf_core::grid::Neighbour;
+use frf_core::image::FlowImage;
+use frf_reflectance::flowcodec::quant::LogQuantizer;
+use frf_reflectance::stats::FieldStats;
+use frf_reflectance::store::{EncodedView, encode_view};
+use frf_reflectance::{FieldFile, FieldHeader, FieldWriter, ViewData};
+use frf_stage::Stage;
+use frf_stage::render::{Scene, render};
+use frf_stage::studio::Illumination;
+use rayon::prelude::*;
+
+use crate::error::{IngestError, Result};
+
+/// The true flows of view `(u, v)` of `pose` to each neighbour ([`Neighbour::ALL`] order).
+pub fn true_flows(stage: &Stage, pose: u32, u: usize, v: usize) -> Result<[Option<FlowImage>; 4]> {
+    let (surface, _) = stage.reference_surface(pose, u, v)?;
+    let mut flows: [Option<FlowImage>; 4] = Default::default();
+    for n in Neighbour::ALL {
+        if let Some((u2, v2)) = n.of(u, v, stage.cycles(), stage.cameras().len(), true) {
+            let to = stage.view_setup(pose, u2, v2, 0.0)?;
+            flows[n.index()] = Some(frf_stage::truth::flow_between(&surface, &to).flow);
+        }
+    }
+    Ok(flows)
+}
+
+/// The oracle data of one view: true basis images, alpha and flows.
+pub fn oracle_view(stage: &Stage, pose: u32, u: usize, v: usize) -> Result<ViewData> {
+    let setup = stage.view_setup(pose, u, v, 0.0)?;
+    let basis = (0..stage.basis().len())
+        .map(|c| {
+            let illumination = Illumination::Lights(stage.condition_lights(c)?);
+            let scene = Scene {
+                actor: Some(&setup.actor),
+                studio: false,
+                illumination: &illumination,
+            };
+            Ok(render(&setup.camera, &scene, stage.config().samples_per_axis).color)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let (_, alpha) = stage.reference_surface(pose, u, v)?;
+    Ok(ViewData {
+        basis,
+        alpha,
+        flows: true_flows(stage, pose, u, v)?,
+    })
+}
+
+/// Options of [`write_oracle_field`].
+#[derive(Debug, Clone)]
+pub struct OracleOptions {
+    /// Poses to include (each must be in the stage's configuration).
+    pub poses: Vec<u32>,
+    /// JPEG quality of the basis mosaics.
+    pub jpeg_quality: u8,
+    /// Left-predict flow codes before Huffman coding.
+    pub predict_flow: bool,
+}
+
+/// Writes the oracle field of `stage` to `path`; `progress(done, total)` counts views.
+pub fn write_oracle_field(
+    stage: &Stage,
+    path: &std::path::Path,
+    options: &OracleOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<FieldStats> {
+    if let Some(p) = options
+        .poses
+        .iter()
+        .find(|p| !stage.config().poses.contains(p))
+    {
+        return Err(IngestError::BadParameter(format!(
+            "pose {p} is not rendered by this stage (it has {:?})",
+            stage.config().poses
+        )));
+    }
+    let capture = Capture::from_manifest(path.parent().unwrap_or(path), stage.manifest())?;
+    let (columns, rows) = (stage.cycles(), stage.cameras().len());
+    let views: Vec<(u32, usize, usize)> = options
+        .poses
+        .iter()
+        .flat_map(|&p| (0..columns).flat_map(move |u| (0..rows).map(move |v| (p, u, v))))
+        .collect();
+    let total = 2 * views.len();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let tick = || {
+        progress(
+            done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1,
+            total,
+        )
+    };
+    // Pass 1: every true flow, to fit the quantizer to the whole field.
+    let magnitudes: Vec<Vec<f32>> = views
+        .par_iter()
+        .map(|&(p, u, v)| {
+            let flows = true_flows(stage, p, u, v)?;
+            tick();
+            Ok(flows
+                .iter()
+                .flatten()
+                .flat_map(|f| f.pixels().iter().flatten().copied())
+                .collect())
+        })
+        .collect::<Result<_>>()?;
+    let quantizer = LogQuantizer::fit(magnitudes.into_iter().flatten());
+    let mut header =
+        FieldHeader::from_capture(&capture, &options.poses, quantizer, options.jpeg_quality)?;
+    header.flow_predicted = options.predict_flow;
+    header.description = format!("oracle field (stage ground truth): {}", header.description);
+    // Pass 2: render and encode views in parallel, write them in order.
+    let mut writer = FieldWriter::create(path, header.clone())?;
+    for chunk in views.chunks(rayon::current_num_threads().max(1) * 4) {
+        let encoded: Vec<EncodedView> = chunk
+            .par_iter()
+            .map(|&(p, u, v)| {
+                let e = encode_view(&header, &oracle_view(stage, p, u, v)?)?;
+                tick();
+                Ok(e)
+            })
+            .collect::<Result<_>>()?;
+        for (&(p, u, v), e) in chunk.iter().zip(&encoded) {
+            writer.add_view(p, u, v, e)?;
+        }
+    }
+    writer.finish()?;
+    Ok(FieldFile::open(path)?.stats())
+}

@@ -1,0 +1,78 @@
+//! `frf info FIELD [--json]`: what a field file holds, bytes by kind, and its
+//! compression ratios.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use frf_reflectance::FieldFile;
+
+use crate::CliResult;
+
+/// Arguments of `frf info`.
+#[derive(Args)]
+pub struct InfoArgs {
+    /// A field file.
+    field: PathBuf,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `frf info`.
+pub fn run(args: InfoArgs) -> CliResult {
+    let field = FieldFile::open(&args.field)?;
+    let s = field.stats();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&s)?);
+        return Ok(());
+    }
+    let h = field.header();
+    let mb = |b: u64| b as f64 / 1e6;
+    println!("{}", args.field.display());
+    println!("  source: {}", h.description);
+    println!(
+        "  grid: {} x {} views ({}), {}x{} pixels, {} basis conditions ({} floor)",
+        h.columns,
+        h.rows,
+        if h.wraps { "closed ring" } else { "open" },
+        h.width,
+        h.height,
+        h.conditions.len(),
+        h.conditions.iter().filter(|c| c.floor).count()
+    );
+    println!(
+        "  poses: {:?}",
+        h.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
+    );
+    println!(
+        "  flow: log quantizer s = {:.4} px, M = {:.2} px, {}",
+        h.flow_quantizer.scale,
+        h.flow_quantizer.range,
+        if h.flow_predicted {
+            "left-predicted"
+        } else {
+            "not predicted"
+        }
+    );
+    println!("  JPEG quality: {}", h.jpeg_quality);
+    println!("  bytes by kind (MB):");
+    for (kind, b) in [
+        ("basis images", s.bytes.images),
+        ("flow maps", s.bytes.flow),
+        ("alpha", s.bytes.alpha),
+        ("shadow maps", s.bytes.shadows),
+        ("index and framing", s.bytes.other),
+    ] {
+        println!("    {kind:<18} {:>10.3}", mb(b));
+    }
+    println!(
+        "  flow: {} maps, {:.1} % of their 8-bit quantized size",
+        s.flow_maps,
+        100.0 * s.flow_ratio_vs_8bit
+    );
+    println!(
+        "  basis images: {} images, {:.1}:1 against 16-bit linear RGB",
+        s.basis_images, s.image_ratio_vs_16bit
+    );
+    Ok(())
+}

@@ -1,0 +1,217 @@
+//! `frf stage field | projection-error | codec-curve`: the oracle field of a stage
+//! capture (built from its ground truth), and the storage and relighting errors measured
+//! against that truth.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use frf_core::env::EnvMap;
+use frf_ingest::eval::{codec_curve, projection_error, stage_projector};
+use frf_ingest::oracle::{OracleOptions, write_oracle_field};
+use frf_reflectance::project::FloorModel;
+
+use crate::CliResult;
+use crate::cmd::progress::bar;
+
+/// Arguments of `frf stage field`.
+#[derive(Args)]
+pub struct FieldArgs {
+    /// A capture directory written by `frf stage`.
+    #[arg(long)]
+    capture: PathBuf,
+    /// Output field file.
+    #[arg(long)]
+    out: PathBuf,
+    /// JPEG quality of the basis mosaics (1-100); 95 keeps relit PSNR above 40 dB on
+    /// the stage's data (see `frf stage codec-curve`).
+    #[arg(long, default_value_t = 95)]
+    jpeg_quality: u8,
+    /// Do not left-predict flow codes before Huffman coding.
+    #[arg(long)]
+    no_flow_prediction: bool,
+    /// Poses to include, e.g. `0,1` (default: all of the capture's).
+    #[arg(long, value_delimiter = ',')]
+    poses: Vec<u32>,
+}
+
+/// Runs `frf stage field`.
+pub fn field(args: FieldArgs) -> CliResult {
+    let stage = frf_stage::open_stage(&args.capture)?;
+    let poses = if args.poses.is_empty() {
+        stage.config().poses.clone()
+    } else {
+        args.poses
+    };
+    let start = Instant::now();
+    let bar = bar("oracle field: views (flows, then images)");
+    let stats = write_oracle_field(
+        &stage,
+        &args.out,
+        &OracleOptions {
+            poses,
+            jpeg_quality: args.jpeg_quality,
+            predict_flow: !args.no_flow_prediction,
+        },
+        &|done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+    )?;
+    bar.finish_and_clear();
+    println!(
+        "oracle field written to {} in {:.1} s (wall)",
+        args.out.display(),
+        start.elapsed().as_secs_f64()
+    );
+    println!(
+        "flow: {:.1} % of 8-bit quantized size; basis images: {:.1}:1 against 16-bit linear; total {:.2} MB",
+        100.0 * stats.flow_ratio_vs_8bit,
+        stats.image_ratio_vs_16bit,
+        std::fs::metadata(&args.out)?.len() as f64 / 1e6
+    );
+    Ok(())
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FloorArg {
+    /// The environment's own lower hemisphere.
+    Env,
+    /// A Lambertian ground of albedo 0.3 lit by the upper hemisphere.
+    Ground,
+}
+
+/// Arguments of `frf stage projection-error`.
+#[derive(Args)]
+pub struct ProjectionArgs {
+    /// A capture directory written by `frf stage`.
+    #[arg(long)]
+    capture: PathBuf,
+    /// Environments (lat-long .hdr/.exr, or `sky`); repeat for several.
+    #[arg(long, required = true)]
+    env: Vec<PathBuf>,
+    /// Median-cut lights of the true image under each environment.
+    #[arg(long, default_value_t = 512)]
+    lights: usize,
+    /// Where the floor conditions' light comes from.
+    #[arg(long, value_enum, default_value = "env")]
+    floor: FloorArg,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Views used by the evaluations: every ninth column, all cameras.
+fn sample_views(stage: &frf_stage::Stage) -> Vec<(usize, usize)> {
+    (0..stage.cycles())
+        .step_by(9)
+        .flat_map(|u| (0..stage.cameras().len()).map(move |v| (u, v)))
+        .collect()
+}
+
+/// Runs `frf stage projection-error`.
+pub fn projection(args: ProjectionArgs) -> CliResult {
+    let stage = frf_stage::open_stage(&args.capture)?;
+    let projector = stage_projector(&stage)?;
+    let floor = match args.floor {
+        FloorArg::Env => FloorModel::Environment,
+        FloorArg::Ground => FloorModel::LambertianGround { albedo: [0.3; 3] },
+    };
+    let views = sample_views(&stage);
+    let pose = stage.config().poses[0];
+    let mut rows = Vec::new();
+    for path in &args.env {
+        let env = EnvMap::load_or_builtin(path)?;
+        let start = Instant::now();
+        let errors = projection_error(&stage, &projector, &env, args.lights, floor, pose, &views)?;
+        let n = errors.len() as f64;
+        let mean_psnr = errors.iter().map(|e| e.psnr_subject_db).sum::<f64>() / n;
+        let min_psnr = errors
+            .iter()
+            .map(|e| e.psnr_subject_db)
+            .fold(f64::INFINITY, f64::min);
+        let mae = errors.iter().map(|e| e.relative_mae).sum::<f64>() / n;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        rows.push(serde_json::json!({
+            "env": name, "views": errors.len(), "mean_psnr_subject_db": mean_psnr,
+            "min_psnr_subject_db": min_psnr, "relative_mae": mae,
+            "seconds": start.elapsed().as_secs_f64(),
+        }));
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+        return Ok(());
+    }
+    println!(
+        "basis-projection error: relit true basis images vs true image under the environment ({} views of pose {pose}, subject pixels, peak = brightest true value)",
+        views.len()
+    );
+    println!(
+        "{:<24} {:>12} {:>12} {:>10} {:>9}",
+        "environment", "mean PSNR dB", "min PSNR dB", "rel. MAE", "seconds"
+    );
+    for r in rows {
+        println!(
+            "{:<24} {:>12.2} {:>12.2} {:>9.2}% {:>9.1}",
+            r["env"].as_str().unwrap_or(""),
+            r["mean_psnr_subject_db"].as_f64().unwrap_or(0.0),
+            r["min_psnr_subject_db"].as_f64().unwrap_or(0.0),
+            100.0 * r["relative_mae"].as_f64().unwrap_or(0.0),
+            r["seconds"].as_f64().unwrap_or(0.0)
+        );
+    }
+    Ok(())
+}
+
+/// Arguments of `frf stage codec-curve`.
+#[derive(Args)]
+pub struct CodecArgs {
+    /// A capture directory written by `frf stage`.
+    #[arg(long)]
+    capture: PathBuf,
+    /// Environment to relight with (lat-long .hdr/.exr, or `sky`).
+    #[arg(long, default_value = "sky")]
+    env: PathBuf,
+    /// JPEG qualities to measure.
+    #[arg(long, value_delimiter = ',', default_value = "50,60,70,80,85,90,95,98")]
+    qualities: Vec<u8>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `frf stage codec-curve`.
+pub fn codec(args: CodecArgs) -> CliResult {
+    let stage = frf_stage::open_stage(&args.capture)?;
+    let env = EnvMap::load_or_builtin(&args.env)?;
+    let views = sample_views(&stage);
+    let pose = stage.config().poses[0];
+    let curve = codec_curve(&stage, &env, pose, &views, &args.qualities)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&curve)?);
+        return Ok(());
+    }
+    println!(
+        "basis mosaic (gamma 2.2 JPEG) over quality: ratio against 16-bit linear RGB, and PSNR of the view relit under {} against the uncompressed basis ({} views, subject pixels)",
+        args.env.display(),
+        views.len()
+    );
+    println!(
+        "{:>8} {:>14} {:>16} {:>16} {:>14}",
+        "quality", "ratio (x:1)", "min PSNR (dB)", "mean PSNR (dB)", "ms per view"
+    );
+    for p in curve {
+        println!(
+            "{:>8} {:>14.1} {:>16.2} {:>16.2} {:>14.1}",
+            p.quality,
+            p.ratio_vs_16bit,
+            p.min_relit_psnr_db,
+            p.mean_relit_psnr_db,
+            1e3 * p.seconds_per_view
+        );
+    }
+    Ok(())
+}
