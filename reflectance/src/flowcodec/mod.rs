@@ -1,14 +1,17 @@
 //! The flow codec: each displacement component quantized to 8 bits on a signed
-//! logarithmic scale ([`quant`]), optionally predicted from its left neighbour, then
-//! entropy coded with a canonical Huffman code ([`huffman`]) built for the map.
+//! logarithmic scale ([`quant`]), optionally predicted from its neighbours, then entropy
+//! coded with a canonical Huffman code ([`huffman`]) built for the map.
 //!
-//! A coded map is `[flags u8][width u32][height u32][Huffman table, 128 bytes][bits]`,
-//! little-endian. The codes are laid out as two planes (all `u`, then all `v`), row-major.
-//! With prediction (flag bit 0) each code is replaced by its difference from the code to
-//! its left (the one above for the first column), modulo 256: flow is smooth inside the
-//! subject and constant (unknown) outside, so the differences cluster at zero and the
-//! Huffman code gets short. The original reached 34 % of the 8-bit size without
-//! prediction (BRIEF section 4).
+//! A coded map is, little-endian:
+//! `[flags u8][width u32][height u32][mask length u32][mask][Huffman table, 128 B][bits]`.
+//! The mask says which pixels have known flow (one byte per pixel, 0 or 1, zstd-coded:
+//! the unknown background is a few long runs, which cost next to nothing there, while
+//! Huffman coding cannot spend less than one bit per symbol on them). Only the known
+//! pixels' codes are Huffman-coded, as two planes (all `u`, then all `v`), row-major.
+//! With prediction (flag bit 0) each code is replaced by its difference, modulo 256, from
+//! the code of its left neighbour if that is known, else of the one above, else 0: flow is
+//! smooth inside the subject, so the differences cluster at zero. The original reached
+//! 34 % of the 8-bit size with Huffman coding alone (BRIEF section 4).
 
 pub mod huffman;
 pub mod quant;
@@ -21,7 +24,7 @@ use quant::LogQuantizer;
 
 /// Flag: codes are left-predicted.
 const FLAG_PREDICT: u8 = 1;
-const HEADER_BYTES: usize = 9;
+const HEADER_BYTES: usize = 13;
 /// Largest flow map accepted from a file, pixels per side.
 const MAX_SIDE: u32 = frf_core::io::limits::MAX_DIMENSION;
 
@@ -67,59 +70,59 @@ pub fn dequantize(
     Ok(Image::from_vec(width, height, pixels)?)
 }
 
-/// Replaces codes by their difference from the left (or, in the first column, upper)
-/// neighbour in the same plane, modulo 256; the inverse of [`unpredict`].
-fn predict(codes: &[i8], width: usize) -> Vec<u8> {
-    let plane = codes.len() / 2;
-    let mut out = Vec::with_capacity(codes.len());
-    for (i, &c) in codes.iter().enumerate() {
-        out.push((c as u8).wrapping_sub(neighbour(codes, i, width, plane) as u8));
-    }
-    out
-}
-
-/// The predicting neighbour of code `i` in planes of `plane` codes (0 for the first of
-/// each plane); only codes before `i` are read.
+/// The predicting code for pixel `i` of a `width`-wide plane (`plane` = the plane's
+/// codes, only those before `i` are read): the left neighbour if known, else the one
+/// above if known, else 0.
 #[inline]
-fn neighbour(codes: &[i8], i: usize, width: usize, plane: usize) -> i8 {
-    let j = i % plane.max(1);
-    if !j.is_multiple_of(width) {
-        codes[i - 1]
-    } else if j >= width {
-        codes[i - width]
-    } else {
-        0
-    }
+fn prediction(plane: &[i8], i: usize, width: usize) -> i8 {
+    let left = (!i.is_multiple_of(width)).then(|| plane[i - 1]);
+    let up = (i >= width).then(|| plane[i - width]);
+    [left, up]
+        .into_iter()
+        .flatten()
+        .find(|&c| c != quant::UNKNOWN_CODE)
+        .unwrap_or(0)
 }
 
-fn unpredict(residuals: &[u8], width: usize) -> Vec<i8> {
-    let plane = residuals.len() / 2;
-    let mut codes: Vec<i8> = Vec::with_capacity(residuals.len());
-    for (i, &r) in residuals.iter().enumerate() {
-        let pred = neighbour(&codes, i, width, plane);
-        codes.push(r.wrapping_add(pred as u8) as i8);
-    }
-    codes
+fn corrupt(what: impl Into<String>) -> ReflectanceError {
+    ReflectanceError::Corrupt(what.into())
 }
 
 /// Encodes a flow map.
 pub fn encode(flow: &FlowImage, q: &LogQuantizer, predicted: bool) -> Result<Vec<u8>> {
+    let (w, n) = (flow.width(), flow.pixels().len());
     let codes = quantize(flow, q);
-    let symbols: Vec<u8> = if predicted {
-        predict(&codes, flow.width())
-    } else {
-        codes.iter().map(|&c| c as u8).collect()
-    };
+    let known: Vec<u8> = codes[..n]
+        .iter()
+        .map(|&c| (c != quant::UNKNOWN_CODE) as u8)
+        .collect();
+    let mut symbols = Vec::with_capacity(2 * n);
+    for plane in codes.chunks_exact(n.max(1)) {
+        for (i, &c) in plane.iter().enumerate() {
+            if known[i] == 1 {
+                let pred = if predicted {
+                    prediction(plane, i, w)
+                } else {
+                    0
+                };
+                symbols.push((c as u8).wrapping_sub(pred as u8));
+            }
+        }
+    }
+    let mask = zstd::bulk::compress(&known, crate::imagecodec::ZSTD_LEVEL)
+        .map_err(|e| ReflectanceError::BadParameter(format!("zstd: {e}")))?;
     let mut counts = [0u64; 256];
     for &s in &symbols {
         counts[s as usize] += 1;
     }
     let table = HuffmanTable::from_counts(&counts);
     let bits = table.encode(&symbols)?;
-    let mut out = Vec::with_capacity(HEADER_BYTES + TABLE_BYTES + bits.len());
+    let mut out = Vec::with_capacity(HEADER_BYTES + mask.len() + TABLE_BYTES + bits.len());
     out.push(if predicted { FLAG_PREDICT } else { 0 });
-    out.extend_from_slice(&(flow.width() as u32).to_le_bytes());
-    out.extend_from_slice(&(flow.height() as u32).to_le_bytes());
+    for v in [flow.width() as u32, flow.height() as u32, mask.len() as u32] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&mask);
     out.extend_from_slice(&table.to_bytes());
     out.extend_from_slice(&bits);
     Ok(out)
@@ -127,34 +130,55 @@ pub fn encode(flow: &FlowImage, q: &LogQuantizer, predicted: bool) -> Result<Vec
 
 /// Decodes a flow map into its 8-bit codes (two planes), with its size.
 pub fn decode_codes(bytes: &[u8]) -> Result<(usize, usize, Vec<i8>)> {
-    if bytes.len() < HEADER_BYTES + TABLE_BYTES {
-        return Err(ReflectanceError::Corrupt(format!(
-            "flow map truncated: {} bytes, the header alone needs {}",
-            bytes.len(),
-            HEADER_BYTES + TABLE_BYTES
+    if bytes.len() < HEADER_BYTES {
+        return Err(corrupt(format!(
+            "flow map truncated: {} bytes, the header needs {HEADER_BYTES}",
+            bytes.len()
         )));
     }
     let flags = bytes[0];
     if flags & !FLAG_PREDICT != 0 {
-        return Err(ReflectanceError::Corrupt(format!(
-            "unknown flow-map flags {flags:#x}"
-        )));
+        return Err(corrupt(format!("unknown flow-map flags {flags:#x}")));
     }
     let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
-    let (w, h) = (word(1), word(5));
+    let (w, h, mask_len) = (word(1), word(5), word(9) as usize);
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(ReflectanceError::Corrupt(format!(
+        return Err(corrupt(format!(
             "flow map size {w}x{h} outside 1..={MAX_SIDE} per side"
         )));
     }
     let (w, h) = (w as usize, h as usize);
-    let table = HuffmanTable::from_bytes(&bytes[HEADER_BYTES..])?;
-    let symbols = table.decode(&bytes[HEADER_BYTES + TABLE_BYTES..], 2 * w * h)?;
-    let codes = if flags & FLAG_PREDICT != 0 {
-        unpredict(&symbols, w)
-    } else {
-        symbols.iter().map(|&s| s as i8).collect()
-    };
+    let n = w * h;
+    let table_at = HEADER_BYTES
+        .checked_add(mask_len)
+        .filter(|&t| t + TABLE_BYTES <= bytes.len())
+        .ok_or_else(|| corrupt("flow map truncated in its mask or table"))?;
+    let known = zstd::bulk::decompress(&bytes[HEADER_BYTES..table_at], n)
+        .map_err(|e| corrupt(format!("flow mask: {e}")))?;
+    if known.len() != n || known.iter().any(|&k| k > 1) {
+        return Err(corrupt(format!(
+            "flow mask holds {} entries, expected {n} of 0 or 1",
+            known.len()
+        )));
+    }
+    let count = known.iter().filter(|&&k| k == 1).count();
+    let table = HuffmanTable::from_bytes(&bytes[table_at..])?;
+    let symbols = table.decode(&bytes[table_at + TABLE_BYTES..], 2 * count)?;
+    let mut codes = vec![quant::UNKNOWN_CODE; 2 * n];
+    let mut next = symbols.iter();
+    for plane in codes.chunks_exact_mut(n) {
+        for i in 0..n {
+            if known[i] == 1 {
+                let pred = if flags & FLAG_PREDICT != 0 {
+                    prediction(plane, i, w)
+                } else {
+                    0
+                };
+                let s = next.next().copied().unwrap_or(0);
+                plane[i] = s.wrapping_add(pred as u8) as i8;
+            }
+        }
+    }
     Ok((w, h, codes))
 }
 
