@@ -121,7 +121,7 @@ pub fn write_oracle_field(
         let encoded: Vec<EncodedView> = chunk
             .par_iter()
             .map(|&(p, u, v)| {
-                let e = encode_view(&header, &oracle_view(stage, p, u, v)?)?;
+                let e = encode_view(&header, p, &oracle_view(stage, p, u, v)?)?;
                 tick();
                 Ok(e)
             })

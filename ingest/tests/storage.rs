@@ -51,7 +51,7 @@ fn the_oracle_field_meets_the_storage_targets_and_decodes_faithfully() {
     assert_eq!(stats.flow_maps, 36 * 10);
 
     let field = FieldFile::open(&path).unwrap();
-    let q = field.header().flow_quantizer;
+    let q = field.header().pose(1).unwrap().flow_quantizer;
     let (u, v) = (17, 1);
     let truth = true_flows(&stage, 1, u, v).unwrap();
     for n in Neighbour::ALL {

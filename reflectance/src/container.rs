@@ -444,3 +444,51 @@ impl<R: ReadAt> FieldFile<R> {
         })
     }
 }
+
+/// Merges field files that hold disjoint poses of the same grid, basis and codec
+/// settings into one file at `out`, copying chunks byte for byte (each pose keeps its
+/// own flow quantizer). Used to assemble a field ingested pose by pose.
+pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
+    let files = parts
+        .iter()
+        .map(|p| FieldFile::open(p))
+        .collect::<Result<Vec<_>>>()?;
+    let Some(first) = files.first() else {
+        return Err(ReflectanceError::BadParameter("nothing to merge".into()));
+    };
+    let shape = |h: &FieldHeader| FieldHeader {
+        poses: Vec::new(),
+        description: String::new(),
+        ..h.clone()
+    };
+    let mut header = first.header().clone();
+    header.poses.clear();
+    for f in &files {
+        if shape(f.header()) != shape(first.header()) {
+            return Err(ReflectanceError::BadParameter(format!(
+                "{}: grid, basis or codec settings differ from {}",
+                f.path().display(),
+                first.path().display()
+            )));
+        }
+        for p in &f.header().poses {
+            if header.poses.iter().any(|q| q.pose == p.pose) {
+                return Err(ReflectanceError::BadParameter(format!(
+                    "{}: pose {} is in two parts",
+                    f.path().display(),
+                    p.pose
+                )));
+            }
+            header.poses.push(p.clone());
+        }
+    }
+    header.poses.sort_by_key(|p| p.pose);
+    let mut writer = FieldWriter::create(out, header)?;
+    for f in &files {
+        let keys: Vec<ChunkKey> = f.chunks().map(|c| c.key).collect();
+        for key in keys {
+            writer.add_chunk(key, &f.read_chunk(&key)?)?;
+        }
+    }
+    writer.finish()
+}

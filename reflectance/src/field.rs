@@ -122,7 +122,9 @@ pub struct ViewRecord {
     pub turntable_deg: f32,
 }
 
-/// One pose: its time and the geometry of its views (`u`-major: index `u * rows + v`).
+/// One pose: its time, the geometry of its views (`u`-major: index `u * rows + v`) and
+/// the quantizer of its flows (fitted to them, so that each pose can be ingested, stored
+/// and merged on its own).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PoseRecord {
     /// Pose index within the cycle.
@@ -131,6 +133,8 @@ pub struct PoseRecord {
     pub time_s: f64,
     /// The views.
     pub views: Vec<ViewRecord>,
+    /// The quantizer of this pose's flows.
+    pub flow_quantizer: LogQuantizer,
 }
 
 /// The ground grid of the shadow maps (BRIEF section 5.5).
@@ -168,9 +172,7 @@ pub struct FieldHeader {
     pub conditions: Vec<ConditionRecord>,
     /// The poses stored, with their view geometry.
     pub poses: Vec<PoseRecord>,
-    /// The flow quantizer (fitted to this field's flows).
-    pub flow_quantizer: LogQuantizer,
-    /// Whether flow codes are left-predicted.
+    /// Whether flow codes are predicted from their neighbours.
     pub flow_predicted: bool,
     /// JPEG quality of the basis mosaics.
     pub jpeg_quality: u8,
@@ -225,6 +227,7 @@ impl FieldHeader {
                     pose,
                     time_s: capture.pose_time_s(pose),
                     views,
+                    flow_quantizer,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -242,7 +245,6 @@ impl FieldHeader {
             poses_per_cycle: m.timing.poses_per_cycle,
             conditions,
             poses,
-            flow_quantizer,
             flow_predicted: true,
             jpeg_quality,
             shadows: None,
@@ -257,6 +259,19 @@ impl FieldHeader {
     /// Index of view `(u, v)` in a pose's view list.
     pub fn view_index(&self, u: usize, v: usize) -> usize {
         u * self.rows + v
+    }
+
+    /// The record of pose `pose`, mutable.
+    pub fn pose_mut(&mut self, pose: u32) -> Result<&mut PoseRecord> {
+        let available: Vec<u32> = self.poses.iter().map(|p| p.pose).collect();
+        self.poses
+            .iter_mut()
+            .find(|p| p.pose == pose)
+            .ok_or_else(|| {
+                ReflectanceError::BadParameter(format!(
+                    "pose {pose} is not in the field (it has {available:?})"
+                ))
+            })
     }
 
     /// The record of pose `pose`.
@@ -292,9 +307,12 @@ impl FieldHeader {
         if !(1..=100).contains(&self.jpeg_quality) {
             return Err(format!("JPEG quality {}", self.jpeg_quality));
         }
-        LogQuantizer::new(self.flow_quantizer.scale, self.flow_quantizer.range)
-            .map_err(|e| e.to_string())?;
         for p in &self.poses {
+            LogQuantizer::new(p.flow_quantizer.scale, p.flow_quantizer.range)
+                .map_err(|e| format!("pose {}: {e}", p.pose))?;
+            if self.poses.iter().filter(|q| q.pose == p.pose).count() > 1 {
+                return Err(format!("pose {} listed twice", p.pose));
+            }
             if p.views.len() != self.views_per_pose() {
                 return Err(format!(
                     "pose {} has {} views, the grid {}",

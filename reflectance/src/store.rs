@@ -40,8 +40,9 @@ fn check_size<P: Copy>(
     Ok(())
 }
 
-/// Encodes one view with the header's codec parameters.
-pub fn encode_view(header: &FieldHeader, view: &ViewData) -> Result<EncodedView> {
+/// Encodes one view of pose `pose` with the header's codec parameters.
+pub fn encode_view(header: &FieldHeader, pose: u32, view: &ViewData) -> Result<EncodedView> {
+    let quantizer = header.pose(pose)?.flow_quantizer;
     let (w, h) = (header.width as usize, header.height as usize);
     if view.basis.len() != header.conditions.len() {
         return Err(ReflectanceError::Mismatch {
@@ -69,7 +70,7 @@ pub fn encode_view(header: &FieldHeader, view: &ViewData) -> Result<EncodedView>
             check_size(header, "flow", w, h, flow)?;
             chunks.push((
                 ChunkKind::Flow(*n),
-                flowcodec::encode(flow, &header.flow_quantizer, header.flow_predicted)?,
+                flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
             ));
         }
     }
@@ -172,8 +173,9 @@ impl<R: ReadAt> FieldFile<R> {
     /// The flow from a view to a neighbour, `None` where the neighbour does not exist.
     pub fn flow(&self, pose: u32, u: usize, v: usize, n: Neighbour) -> Result<Option<FlowImage>> {
         let (w, h) = (self.header().width as usize, self.header().height as usize);
+        let quantizer = self.header().pose(pose)?.flow_quantizer;
         self.flow_codes(pose, u, v, n)?
-            .map(|codes| flowcodec::dequantize(w, h, &codes, &self.header().flow_quantizer))
+            .map(|codes| flowcodec::dequantize(w, h, &codes, &quantizer))
             .transpose()
     }
 

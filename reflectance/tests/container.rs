@@ -66,8 +66,13 @@ fn write_field(path: &std::path::Path) -> FieldHeader {
     for pose in [0, 1] {
         for u in 0..h.columns {
             for v in 0..h.rows {
-                w.add_view(pose, u, v, &encode_view(&h, &view(&h, pose, u, v)).unwrap())
-                    .unwrap();
+                w.add_view(
+                    pose,
+                    u,
+                    v,
+                    &encode_view(&h, pose, &view(&h, pose, u, v)).unwrap(),
+                )
+                .unwrap();
             }
         }
     }
@@ -88,7 +93,7 @@ fn views_round_trip() {
     for n in Neighbour::ALL {
         match (&original.flows[n.index()], &back.flows[n.index()]) {
             (Some(a), Some(b)) => {
-                let q = &h.flow_quantizer;
+                let q = &h.pose(1).unwrap().flow_quantizer;
                 let expected =
                     flowcodec::dequantize(a.width(), a.height(), &flowcodec::quantize(a, q), q)
                         .unwrap();
@@ -248,20 +253,21 @@ fn an_unfinished_writer_leaves_nothing() {
     let h = header();
     {
         let mut w = FieldWriter::create(&path, h.clone()).unwrap();
-        w.add_view(0, 0, 0, &encode_view(&h, &view(&h, 0, 0, 0)).unwrap())
+        w.add_view(0, 0, 0, &encode_view(&h, 0, &view(&h, 0, 0, 0)).unwrap())
             .unwrap();
         // Dropped without finish(), as when a run is interrupted.
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     // Writing a view twice, or of a pose the header lacks, is refused.
     let mut w = FieldWriter::create(&path, h.clone()).unwrap();
-    let enc = encode_view(&h, &view(&h, 0, 0, 0)).unwrap();
+    let enc = encode_view(&h, 0, &view(&h, 0, 0, 0)).unwrap();
     w.add_view(0, 0, 0, &enc).unwrap();
     assert!(w.add_view(0, 0, 0, &enc).is_err());
     assert!(w.add_view(7, 0, 0, &enc).is_err());
     let mut wrong = view(&h, 0, 0, 0);
     wrong.basis.pop();
-    assert!(encode_view(&h, &wrong).is_err());
+    assert!(encode_view(&h, 0, &wrong).is_err());
+    assert!(encode_view(&h, 9, &view(&h, 0, 0, 0)).is_err());
 }
 
 #[test]
@@ -280,4 +286,51 @@ fn garbage_never_panics() {
             let _ = field.stats();
         }
     });
+}
+
+#[test]
+fn poses_written_apart_merge_into_one_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole.frf");
+    let h = write_field(&whole);
+    let mut parts = Vec::new();
+    for pose in [1u32, 0] {
+        let mut hp = h.clone();
+        hp.poses.retain(|p| p.pose == pose);
+        hp.pose_mut(pose).unwrap().flow_quantizer =
+            LogQuantizer::new(0.1 + pose as f32, 12.0).unwrap();
+        let path = dir.path().join(format!("p{pose}.frf"));
+        let mut w = FieldWriter::create(&path, hp.clone()).unwrap();
+        for u in 0..hp.columns {
+            for v in 0..hp.rows {
+                w.add_view(
+                    pose,
+                    u,
+                    v,
+                    &encode_view(&hp, pose, &view(&hp, pose, u, v)).unwrap(),
+                )
+                .unwrap();
+            }
+        }
+        w.finish().unwrap();
+        parts.push(path);
+    }
+    let merged = dir.path().join("merged.frf");
+    frf_reflectance::container::merge_fields(&parts, &merged).unwrap();
+    let m = FieldFile::open(&merged).unwrap();
+    assert_eq!(
+        m.header().poses.iter().map(|p| p.pose).collect::<Vec<_>>(),
+        vec![0, 1]
+    );
+    let single = FieldFile::open(&parts[0]).unwrap();
+    assert_eq!(m.view(1, 2, 1).unwrap(), single.view(1, 2, 1).unwrap());
+    assert_eq!(
+        m.header().pose(1).unwrap().flow_quantizer,
+        single.header().pose(1).unwrap().flow_quantizer
+    );
+    // The same pose twice is refused.
+    assert!(
+        frf_reflectance::container::merge_fields(&[parts[0].clone(), parts[0].clone()], &merged)
+            .is_err()
+    );
 }

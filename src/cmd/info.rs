@@ -44,16 +44,18 @@ pub fn run(args: InfoArgs) -> CliResult {
         "  poses: {:?}",
         h.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
     );
-    println!(
-        "  flow: log quantizer s = {:.4} px, M = {:.2} px, {}",
-        h.flow_quantizer.scale,
-        h.flow_quantizer.range,
-        if h.flow_predicted {
-            "left-predicted"
-        } else {
-            "not predicted"
-        }
-    );
+    for p in &h.poses {
+        println!(
+            "  pose {}: flow log quantizer s = {:.4} px, M = {:.2} px",
+            p.pose, p.flow_quantizer.scale, p.flow_quantizer.range
+        );
+    }
+    let predicted = if h.flow_predicted {
+        "predicted from neighbours"
+    } else {
+        "not predicted"
+    };
+    println!("  flow codes: {predicted}");
     println!("  JPEG quality: {}", h.jpeg_quality);
     println!("  bytes by kind (MB):");
     for (kind, b) in [
