@@ -13,6 +13,7 @@ pub mod capture;
 pub mod conventions;
 pub mod env;
 pub mod error;
+pub mod filter;
 pub mod flo;
 pub mod grid;
 pub mod image;

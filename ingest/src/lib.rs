@@ -13,7 +13,10 @@
 
 pub mod error;
 pub mod eval;
+pub mod matte;
 pub mod metrics;
 pub mod oracle;
+pub mod rectify;
+pub mod registration;
 
 pub use error::{IngestError, Result};

@@ -14,28 +14,7 @@ pub const PSF_SIGMA_PX: f32 = 0.5;
 
 use frf_core::image::{Image, Pixel};
 
-/// Separable Gaussian blur with standard deviation `sigma` pixels (clamped borders).
+/// The image after the point-spread function (a Gaussian of [`PSF_SIGMA_PX`]).
 pub fn blur<P: Pixel>(img: &Image<P>, sigma: f32) -> Image<P> {
-    if sigma <= 0.0 {
-        return img.clone();
-    }
-    let radius = (3.0 * sigma).ceil() as i64;
-    let weights: Vec<f32> = (-radius..=radius)
-        .map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp())
-        .collect();
-    let norm: f32 = weights.iter().sum();
-    let (w, h) = (img.width() as i64, img.height() as i64);
-    let pass = |src: &Image<P>, dx: i64, dy: i64| {
-        Image::from_fn(w as usize, h as usize, |x, y| {
-            let mut acc = P::zero();
-            for (k, wt) in weights.iter().enumerate() {
-                let o = k as i64 - radius;
-                let xs = (x as i64 + o * dx).clamp(0, w - 1) as usize;
-                let ys = (y as i64 + o * dy).clamp(0, h - 1) as usize;
-                acc = acc.add_scaled(src.get(xs, ys), wt / norm);
-            }
-            acc
-        })
-    };
-    pass(&pass(img, 1, 0), 0, 1)
+    frf_core::filter::gaussian_blur(img, sigma)
 }

@@ -1,0 +1,182 @@
+//! Mattes from track and matte frames (BRIEF section 3.1; Einarsson et al. section 5.1).
+//! In a matte frame the actor is dark and the retro-reflective floor and back-lit
+//! backdrop are bright, so the foreground is where the monochrome track frame is
+//! brighter than the matte frame that follows it. Stray foreground elsewhere is dropped
+//! by keeping only the largest connected component near the image centre, and the binary
+//! matte is blurred with a 1-pixel Gaussian, modelling the sensor's and the colour
+//! interpolation's filtering, to give alpha. The premultiplied foreground is
+//! `T' = T − (1 − α) C`, with `C` the clean plate lit like `T`.
+
+use frf_core::filter::gaussian_blur;
+use frf_core::image::{GrayImage, Image, RgbImage, luminance};
+
+use crate::error::{IngestError, Result};
+
+/// Standard deviation of the blur that turns the binary matte into alpha, pixels (the
+/// paper's 1-pixel Gaussian).
+pub const MATTE_BLUR_SIGMA_PX: f32 = 1.0;
+/// The central region a kept component must reach: the middle half of the width and
+/// the middle two thirds of the height (a walker framed as the capture cameras frame it).
+const CENTRE_X: (f32, f32) = (0.25, 0.75);
+const CENTRE_Y: (f32, f32) = (1.0 / 6.0, 5.0 / 6.0);
+
+fn check_same(what: &str, a: &RgbImage, b: &RgbImage) -> Result<()> {
+    if a.size() != b.size() {
+        return Err(IngestError::BadParameter(format!(
+            "{what}: {}x{} and {}x{} differ",
+            a.width(),
+            a.height(),
+            b.width(),
+            b.height()
+        )));
+    }
+    Ok(())
+}
+
+/// The binary foreground: track brighter than matte, restricted to the largest
+/// 4-connected component that reaches the central region (empty if none does).
+pub fn foreground(track: &RgbImage, matte: &RgbImage) -> Result<Image<bool>> {
+    check_same("track and matte frames", track, matte)?;
+    let (w, h) = track.size();
+    let raw: Vec<bool> = track
+        .pixels()
+        .iter()
+        .zip(matte.pixels())
+        .map(|(t, m)| luminance(*t) > luminance(*m))
+        .collect();
+    // Label components by flood fill.
+    let mut label = vec![u32::MAX; w * h];
+    let mut sizes: Vec<usize> = Vec::new();
+    let mut central: Vec<bool> = Vec::new();
+    let in_centre = |x: usize, y: usize| {
+        let (fx, fy) = (x as f32 / w as f32, y as f32 / h as f32);
+        fx >= CENTRE_X.0 && fx <= CENTRE_X.1 && fy >= CENTRE_Y.0 && fy <= CENTRE_Y.1
+    };
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if !raw[start] || label[start] != u32::MAX {
+            continue;
+        }
+        let id = sizes.len() as u32;
+        let (mut size, mut reaches) = (0usize, false);
+        label[start] = id;
+        stack.push(start);
+        while let Some(i) = stack.pop() {
+            let (x, y) = (i % w, i / w);
+            size += 1;
+            reaches |= in_centre(x, y);
+            let neighbours = [
+                (x > 0).then(|| i - 1),
+                (x + 1 < w).then(|| i + 1),
+                (y > 0).then(|| i - w),
+                (y + 1 < h).then(|| i + w),
+            ];
+            for j in neighbours.into_iter().flatten() {
+                if raw[j] && label[j] == u32::MAX {
+                    label[j] = id;
+                    stack.push(j);
+                }
+            }
+        }
+        sizes.push(size);
+        central.push(reaches);
+    }
+    let keep = (0..sizes.len())
+        .filter(|&k| central[k])
+        .max_by_key(|&k| sizes[k])
+        .map(|k| k as u32);
+    let mask = label.iter().map(|&l| Some(l) == keep).collect();
+    Ok(Image::from_vec(w, h, mask)?)
+}
+
+/// Alpha of a track frame: [`foreground`] blurred by [`MATTE_BLUR_SIGMA_PX`].
+pub fn alpha(track: &RgbImage, matte: &RgbImage) -> Result<GrayImage> {
+    let fg = foreground(track, matte)?;
+    Ok(gaussian_blur(
+        &fg.map(|b| if b { 1.0 } else { 0.0 }),
+        MATTE_BLUR_SIGMA_PX,
+    ))
+}
+
+/// The premultiplied foreground `T − (1 − α) C`, clamped at zero (noise and the
+/// actor's shadow, absent from the clean plate, would otherwise go negative).
+pub fn premultiply(frame: &RgbImage, alpha: &GrayImage, clean: &RgbImage) -> Result<RgbImage> {
+    check_same("frame and clean plate", frame, clean)?;
+    if !frame.same_size(alpha) {
+        return Err(IngestError::BadParameter(
+            "frame and alpha sizes differ".into(),
+        ));
+    }
+    let pixels = frame
+        .pixels()
+        .iter()
+        .zip(alpha.pixels())
+        .zip(clean.pixels())
+        .map(|((f, &a), c)| [0, 1, 2].map(|k| (f[k] - (1.0 - a) * c[k]).max(0.0)))
+        .collect();
+    Ok(Image::from_vec(frame.width(), frame.height(), pixels)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A dark disc on a bright background in the matte frame, lit in the track frame,
+    /// with a stray bright speck in a corner.
+    fn frames() -> (RgbImage, RgbImage) {
+        let disc =
+            |x: usize, y: usize| (x as f32 - 20.0).powi(2) + (y as f32 - 30.0).powi(2) < 100.0;
+        let track = Image::from_fn(40, 60, |x, y| {
+            if disc(x, y) || (x < 2 && y < 2) {
+                [0.5; 3]
+            } else {
+                [0.05; 3]
+            }
+        });
+        let matte = Image::from_fn(40, 60, |x, y| if disc(x, y) { [0.01; 3] } else { [0.7; 3] });
+        (track, matte)
+    }
+
+    #[test]
+    fn keeps_the_central_component_and_blurs_it() {
+        let (track, matte) = frames();
+        let fg = foreground(&track, &matte).unwrap();
+        assert!(fg.get(20, 30));
+        assert!(!fg.get(0, 0), "the stray corner speck must go");
+        let count = fg.pixels().iter().filter(|&&b| b).count();
+        assert!(
+            (count as f32 - std::f32::consts::PI * 100.0).abs() < 30.0,
+            "{count}"
+        );
+        let a = alpha(&track, &matte).unwrap();
+        assert!((a.get(20, 30) - 1.0).abs() < 1e-4);
+        assert!(a.get(0, 0) < 1e-4);
+        // The edge is soft: some pixels strictly between 0 and 1.
+        assert!(a.pixels().iter().any(|&v| v > 0.2 && v < 0.8));
+    }
+
+    #[test]
+    fn premultiplied_foreground_removes_the_background() {
+        let (track, matte) = frames();
+        let a = alpha(&track, &matte).unwrap();
+        let clean = Image::new(40, 60, [0.05f32; 3]);
+        let p = premultiply(&track, &a, &clean).unwrap();
+        assert!(p.get(39, 59)[0].abs() < 1e-6);
+        assert!((p.get(20, 30)[0] - 0.5).abs() < 1e-4);
+        assert!(p.pixels().iter().all(|c| c.iter().all(|&v| v >= 0.0)));
+    }
+
+    #[test]
+    fn nothing_in_the_centre_gives_an_empty_matte_and_sizes_must_agree() {
+        let track = Image::new(20, 20, [0.0f32; 3]);
+        let matte = Image::new(20, 20, [1.0f32; 3]);
+        assert!(
+            foreground(&track, &matte)
+                .unwrap()
+                .pixels()
+                .iter()
+                .all(|&b| !b)
+        );
+        assert!(foreground(&track, &Image::new(21, 20, [1.0f32; 3])).is_err());
+    }
+}
