@@ -233,14 +233,7 @@ pub fn decode_planes(bytes: &[u8]) -> Result<Vec<GrayImage>> {
         )));
     }
     let expected = count * w * h * 2;
-    let raw = zstd::bulk::decompress(&bytes[12..], expected)
-        .map_err(|e| corrupt(format!("plane data: {e}")))?;
-    if raw.len() != expected {
-        return Err(corrupt(format!(
-            "plane data holds {} bytes, expected {expected}",
-            raw.len()
-        )));
-    }
+    let raw = crate::unzstd::decompress_exact(&bytes[12..], expected, "plane data")?;
     Ok(raw
         .chunks_exact(w * h * 2)
         .map(|plane| {

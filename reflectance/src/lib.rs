@@ -26,6 +26,7 @@ pub mod project;
 pub mod relight;
 pub mod stats;
 pub mod store;
+pub mod unzstd;
 
 pub use container::{FieldFile, FieldWriter};
 pub use field::{FieldHeader, ViewData};

@@ -40,32 +40,43 @@ fn check_size<P: Copy>(
     Ok(())
 }
 
-/// Encodes one view of pose `pose` with the header's codec parameters.
-pub fn encode_view(header: &FieldHeader, pose: u32, view: &ViewData) -> Result<EncodedView> {
-    let quantizer = header.pose(pose)?.flow_quantizer;
+/// Encodes a view's basis images and alpha with the header's codec parameters.
+pub fn encode_images(
+    header: &FieldHeader,
+    basis: &[RgbImage],
+    alpha: &GrayImage,
+) -> Result<EncodedView> {
     let (w, h) = (header.width as usize, header.height as usize);
-    if view.basis.len() != header.conditions.len() {
+    if basis.len() != header.conditions.len() {
         return Err(ReflectanceError::Mismatch {
             what: "basis images per view".into(),
             expected: header.conditions.len().to_string(),
-            got: view.basis.len().to_string(),
+            got: basis.len().to_string(),
         });
     }
-    for b in &view.basis {
+    for b in basis {
         check_size(header, "basis image", w, h, b)?;
     }
-    check_size(header, "alpha", w, h, &view.alpha)?;
-    let mut chunks = vec![
-        (
-            ChunkKind::Basis,
-            encode_basis(&view.basis, header.jpeg_quality)?,
-        ),
+    check_size(header, "alpha", w, h, alpha)?;
+    Ok(EncodedView(vec![
+        (ChunkKind::Basis, encode_basis(basis, header.jpeg_quality)?),
         (
             ChunkKind::Alpha,
-            encode_planes(std::slice::from_ref(&view.alpha))?,
+            encode_planes(std::slice::from_ref(alpha))?,
         ),
-    ];
-    for (n, flow) in Neighbour::ALL.iter().zip(&view.flows) {
+    ]))
+}
+
+/// Encodes a view's flows (in [`Neighbour::ALL`] order) with pose `pose`'s quantizer.
+pub fn encode_flows(
+    header: &FieldHeader,
+    pose: u32,
+    flows: &[Option<FlowImage>; 4],
+) -> Result<EncodedView> {
+    let quantizer = header.pose(pose)?.flow_quantizer;
+    let (w, h) = (header.width as usize, header.height as usize);
+    let mut chunks = Vec::new();
+    for (n, flow) in Neighbour::ALL.iter().zip(flows) {
         if let Some(flow) = flow {
             check_size(header, "flow", w, h, flow)?;
             chunks.push((
@@ -75,6 +86,13 @@ pub fn encode_view(header: &FieldHeader, pose: u32, view: &ViewData) -> Result<E
         }
     }
     Ok(EncodedView(chunks))
+}
+
+/// Encodes one view of pose `pose` with the header's codec parameters.
+pub fn encode_view(header: &FieldHeader, pose: u32, view: &ViewData) -> Result<EncodedView> {
+    let mut e = encode_images(header, &view.basis, &view.alpha)?;
+    e.0.extend(encode_flows(header, pose, &view.flows)?.0);
+    Ok(e)
 }
 
 impl FieldWriter {

@@ -153,9 +153,8 @@ pub fn decode_codes(bytes: &[u8]) -> Result<(usize, usize, Vec<i8>)> {
         .checked_add(mask_len)
         .filter(|&t| t + TABLE_BYTES <= bytes.len())
         .ok_or_else(|| corrupt("flow map truncated in its mask or table"))?;
-    let known = zstd::bulk::decompress(&bytes[HEADER_BYTES..table_at], n)
-        .map_err(|e| corrupt(format!("flow mask: {e}")))?;
-    if known.len() != n || known.iter().any(|&k| k > 1) {
+    let known = crate::unzstd::decompress_exact(&bytes[HEADER_BYTES..table_at], n, "flow mask")?;
+    if known.iter().any(|&k| k > 1) {
         return Err(corrupt(format!(
             "flow mask holds {} entries, expected {n} of 0 or 1",
             known.len()
