@@ -12,7 +12,11 @@ mod cmd;
 pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
 
 #[derive(Parser)]
-#[command(name = "frf", version, about = "Flowed reflectance fields: capture, store, relight and render walking people")]
+#[command(
+    name = "frf",
+    version,
+    about = "Flowed reflectance fields: capture, store, relight and render walking people"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -22,12 +26,18 @@ struct Cli {
 enum Command {
     /// Render a synthetic capture with the virtual light stage, or its ground truth.
     Stage(cmd::stage::StageArgs),
+    /// Optical flow from image A to image B, written as a Middlebury .flo file.
+    Flow(cmd::flow::FlowArgs),
+    /// Error and time of the flow estimator on Middlebury or Sintel pairs with ground truth.
+    FlowBench(cmd::flow::FlowBenchArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(args),
+        Command::Flow(args) => cmd::flow::run(args),
+        Command::FlowBench(args) => cmd::flow::run_bench(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

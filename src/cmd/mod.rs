@@ -1,3 +1,4 @@
 //! One module per subcommand.
 
+pub mod flow;
 pub mod stage;

@@ -1,0 +1,278 @@
+//! The estimator's entry points: input checks, the image pyramid, coarse-to-fine
+//! refinement and graduated non-convexity (GNC).
+//!
+//! Coarse to fine (Black & Anandan 1996; Sun et al. 2010): the flow of each level,
+//! upsampled, starts the next finer one, so displacements of many pixels at full
+//! resolution are about one pixel at the coarsest level. GNC runs the whole pyramid
+//! with a quadratic penalty first (convex: no local minima to fall into), then re-runs
+//! the finest [`FlowParams::gnc_levels`] levels with the penalties blended half-way and
+//! then fully robust, each stage starting from the previous one's flow (Sun et al.'s
+//! three stages, α = 1, ½, 0).
+
+use frf_core::flo::is_known;
+use frf_core::image::{FlowImage, GrayImage, Image, Pixel};
+
+use crate::error::{FlowError, Result};
+use crate::gradient::derivatives;
+use crate::params::FlowParams;
+use crate::penalty::{GncPenalty, Penalty};
+use crate::pyramid::{downsample, level_sizes, resize_flow};
+use crate::solver::{LevelImages, SolverConfig, refine_level};
+use crate::texture::{normalise, split_channels, texture_planes};
+use crate::weighted_median::Guide;
+
+/// Dense optical flow from `a` to `b`: pixel `s` of `a` corresponds to `s + F(s)` of
+/// `b`. Gray (`f32`) or colour (`[f32; N]`) images of the same size, finite values of
+/// any brightness scale.
+pub fn estimate_flow<P: Pixel>(
+    a: &Image<P>,
+    b: &Image<P>,
+    params: &FlowParams,
+) -> Result<FlowImage> {
+    estimate_flow_from(a, b, None, params)
+}
+
+/// [`estimate_flow`] starting from `initial` flow instead of zero (same size as `a`;
+/// unknown pixels start at zero). The pyramid still runs from its coarsest level, so
+/// set [`FlowParams::max_displacement_px`] to the error expected of `initial`.
+pub fn estimate_flow_from<P: Pixel>(
+    a: &Image<P>,
+    b: &Image<P>,
+    initial: Option<&FlowImage>,
+    params: &FlowParams,
+) -> Result<FlowImage> {
+    params.validate()?;
+    check_image("first image", a)?;
+    check_image("second image", b)?;
+    if !a.same_size(b) {
+        return Err(FlowError::SizeMismatch {
+            what: "second image",
+            expected: a.size(),
+            got: b.size(),
+        });
+    }
+    if let Some(init) = initial {
+        if !init.same_size(a) {
+            return Err(FlowError::SizeMismatch {
+                what: "initial flow",
+                expected: a.size(),
+                got: init.size(),
+            });
+        }
+        if let Some(i) = init
+            .pixels()
+            .iter()
+            .position(|f| f[0].is_nan() || f[1].is_nan())
+        {
+            return Err(FlowError::NonFinite {
+                what: "initial flow",
+                x: i % a.width(),
+                y: i / a.width(),
+            });
+        }
+    }
+
+    let sizes = level_sizes(a.width(), a.height(), params);
+    let finest = params.finest_level.min(sizes.len() - 1);
+    let coarsest = sizes.len() - 1;
+    let pyr_a = image_pyramid(a, &sizes, finest, params);
+    let pyr_b = image_pyramid(b, &sizes, finest, params);
+
+    let (cw, ch) = sizes[coarsest];
+    let mut flow = match initial {
+        Some(init) => {
+            let cleaned = init.map(|f| if is_known(f) { f } else { [0.0, 0.0] });
+            resize_flow(&cleaned, cw, ch)
+        }
+        None => Image::new(cw, ch, [0.0f32, 0.0]),
+    };
+
+    let mut levels: Vec<Option<(LevelImages, Option<Guide>)>> =
+        (0..sizes.len()).map(|_| None).collect();
+    let stages = gnc_schedule(params);
+    for (stage, &alpha) in stages.iter().enumerate() {
+        let start = if stage == 0 {
+            coarsest
+        } else {
+            (finest + params.gnc_levels - 1).min(coarsest)
+        };
+        let config = solver_config(params, alpha);
+        for level in (finest..=start).rev() {
+            let (w, h) = sizes[level];
+            flow = resize_flow(&flow, w, h);
+            let (images, guide) = levels[level].get_or_insert_with(|| {
+                build_level(
+                    &pyr_a.texture[level],
+                    &pyr_b.texture[level],
+                    pyr_a.guide.get(level),
+                    params,
+                )
+            });
+            // The weighted median only pays off where the flow has settled: the robust
+            // stage of the finest levels.
+            let guide = if alpha == 0.0 && level <= finest + 1 {
+                guide.as_ref()
+            } else {
+                None
+            };
+            refine_level(images, &mut flow, &config, guide);
+        }
+    }
+    let flow = resize_flow(&flow, a.width(), a.height());
+    if let Some(i) = flow
+        .pixels()
+        .iter()
+        .position(|f| !(f[0].is_finite() && f[1].is_finite()))
+    {
+        // Cannot happen with validated parameters and finite input; refuse rather
+        // than return garbage if it ever does.
+        return Err(FlowError::NonFinite {
+            what: "estimated flow (solver diverged)",
+            x: i % a.width(),
+            y: i / a.width(),
+        });
+    }
+    Ok(flow)
+}
+
+fn check_image<P: Pixel>(what: &'static str, img: &Image<P>) -> Result<()> {
+    if img.width() == 0 || img.height() == 0 {
+        return Err(FlowError::EmptyImage {
+            what,
+            width: img.width(),
+            height: img.height(),
+        });
+    }
+    if let Some(i) = img
+        .pixels()
+        .iter()
+        .position(|p| p.channels().iter().any(|c| !c.is_finite()))
+    {
+        return Err(FlowError::NonFinite {
+            what,
+            x: i % img.width(),
+            y: i / img.width(),
+        });
+    }
+    Ok(())
+}
+
+/// GNC blend α per stage: 1 = quadratic, 0 = robust.
+fn gnc_schedule(params: &FlowParams) -> Vec<f32> {
+    match params.gnc_stages {
+        1 => vec![0.0],
+        2 => vec![1.0, 0.0],
+        _ => vec![1.0, 0.5, 0.0],
+    }
+}
+
+fn solver_config(params: &FlowParams, alpha: f32) -> SolverConfig {
+    // The quadratic stage's own balance is set by λ_quadratic: its smoothness weight is
+    // λ_q/λ times the quadratic data weight (both ψ = 2 for x²).
+    let quadratic = Penalty::Quadratic.weight_sq(0.0);
+    SolverConfig {
+        warps: params.warps,
+        irls_iterations: if alpha >= 1.0 {
+            1
+        } else {
+            params.irls_iterations
+        },
+        sor_iterations: params.sor_iterations,
+        omega: params.sor_omega,
+        data: GncPenalty {
+            robust: params.data_penalty,
+            alpha,
+            quadratic_weight: quadratic,
+        },
+        smoothness: GncPenalty {
+            robust: params.smoothness_penalty,
+            alpha,
+            quadratic_weight: quadratic * params.lambda_quadratic / params.lambda,
+        },
+        lambda: params.lambda,
+        median_radius: params.median_radius,
+        weighted_median_radius: params.weighted_median_radius,
+        interpolation: params.interpolation,
+    }
+}
+
+/// Matching planes (and weighted-median guides) per level; levels finer than the
+/// finest solved one are left empty.
+struct Pyramid {
+    texture: Vec<Vec<GrayImage>>,
+    guide: Vec<Vec<GrayImage>>,
+}
+
+fn image_pyramid<P: Pixel>(
+    img: &Image<P>,
+    sizes: &[(usize, usize)],
+    finest: usize,
+    params: &FlowParams,
+) -> Pyramid {
+    let ratio = params.pyramid_ratio;
+    let mut planes = split_channels(img, params.color);
+    for &(w, h) in &sizes[1..=finest] {
+        planes = planes.iter().map(|p| downsample(p, w, h, ratio)).collect();
+    }
+    normalise(&mut planes);
+    let want_guide = params.weighted_median_radius > 0;
+    let guide_base = if want_guide {
+        planes.clone()
+    } else {
+        Vec::new()
+    };
+    let base = texture_planes(planes, params);
+    let cascade = |base: Vec<GrayImage>| {
+        let mut out: Vec<Vec<GrayImage>> = vec![Vec::new(); finest];
+        out.push(base);
+        for &(w, h) in &sizes[finest + 1..] {
+            let prev = out.last().map_or(&[][..], |v| v.as_slice());
+            let next = prev.iter().map(|p| downsample(p, w, h, ratio)).collect();
+            out.push(next);
+        }
+        out
+    };
+    Pyramid {
+        texture: cascade(base),
+        guide: if want_guide {
+            cascade(guide_base)
+        } else {
+            Vec::new()
+        },
+    }
+}
+
+fn build_level(
+    a: &[GrayImage],
+    b: &[GrayImage],
+    guide: Option<&Vec<GrayImage>>,
+    _params: &FlowParams,
+) -> (LevelImages, Option<Guide>) {
+    let (w, h) = a[0].size();
+    let mut level = LevelImages {
+        width: w,
+        height: h,
+        i1: Vec::new(),
+        i1x: Vec::new(),
+        i1y: Vec::new(),
+        i2: Vec::new(),
+        i2x: Vec::new(),
+        i2y: Vec::new(),
+    };
+    for (pa, pb) in a.iter().zip(b) {
+        let (ax, ay) = derivatives(pa);
+        let (bx, by) = derivatives(pb);
+        level.i1.push(pa.pixels().to_vec());
+        level.i1x.push(ax.into_pixels());
+        level.i1y.push(ay.into_pixels());
+        level.i2.push(pb.pixels().to_vec());
+        level.i2x.push(bx.into_pixels());
+        level.i2y.push(by.into_pixels());
+    }
+    let guide = guide.map(|g| Guide {
+        width: w,
+        height: h,
+        planes: g.iter().map(|p| p.pixels().to_vec()).collect(),
+    });
+    (level, guide)
+}
