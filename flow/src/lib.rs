@@ -35,6 +35,7 @@ pub mod penalty;
 pub mod presets;
 mod pyramid;
 mod solver;
+mod sor;
 mod texture;
 pub mod viz;
 pub mod warp;

@@ -83,6 +83,9 @@ pub struct FlowParams {
     pub gnc_stages: usize,
     /// Finest pyramid levels re-run by GNC stages after the first (which runs them all).
     pub gnc_levels: usize,
+    /// Whether the quadratic GNC stage runs down to the finest level (Sun et al.) or
+    /// stops where the robust stages take over (cheaper).
+    pub quadratic_to_finest: bool,
     /// Radius of the median filter applied to the flow after every warp (0: off,
     /// 2: Sun et al.'s 5x5).
     pub median_radius: usize,
@@ -296,6 +299,9 @@ impl FlowParams {
             "lambda_quadratic" => self.lambda_quadratic = num(value)?,
             "gnc_stages" => self.gnc_stages = int(value)?,
             "gnc_levels" => self.gnc_levels = int(value)?,
+            "quadratic_to_finest" => {
+                self.quadratic_to_finest = value.parse().map_err(|_| bad("true or false"))?
+            }
             "median_radius" => self.median_radius = int(value)?,
             "weighted_median_radius" => self.weighted_median_radius = int(value)?,
             "gradient_weight" => self.gradient_weight = num(value)?,

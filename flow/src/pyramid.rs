@@ -8,7 +8,7 @@
 //! `w'` (pixel centres at integer coordinates, [`frf_core::conventions`]); flow
 //! components scale by `w'/w` and `h'/h`.
 
-use frf_core::image::{Border, FlowImage, GrayImage, Image, Pixel};
+use frf_core::image::{FlowImage, GrayImage, Image, Pixel};
 use rayon::prelude::*;
 
 use crate::params::FlowParams;
@@ -100,18 +100,40 @@ pub(crate) fn gaussian_blur(img: &GrayImage, sigma: f32) -> GrayImage {
     convolve_separable(img, &gaussian_kernel(sigma))
 }
 
+/// Bilinear taps `(i0, i1, t)` of every output position of a `from → to` resampling
+/// along one axis (pixel centres at integers, edges clamped).
+fn axis_taps(from: usize, to: usize) -> Vec<(usize, usize, f32)> {
+    let scale = from as f32 / to as f32;
+    (0..to)
+        .map(|i| {
+            let p = ((i as f32 + 0.5) * scale - 0.5).clamp(0.0, (from - 1) as f32);
+            let i0 = p as usize; // p ≥ 0: truncation is the floor.
+            let i1 = (i0 + 1).min(from - 1);
+            (i0, i1, p - i0 as f32)
+        })
+        .collect()
+}
+
 /// Bilinear resampling of `img` to `width x height` (edges clamped), no anti-aliasing.
+/// The taps are computed once per row and column (the per-pixel sampler of
+/// `frf-core` measured 6% of the fast preset's time here).
 pub(crate) fn resample<P: Pixel>(img: &Image<P>, width: usize, height: usize) -> Image<P> {
-    let sx = img.width() as f32 / width as f32;
-    let sy = img.height() as f32 / height as f32;
+    if img.pixels().is_empty() || width == 0 || height == 0 {
+        return Image::new(width, height, P::zero());
+    }
+    let xt = axis_taps(img.width(), width);
+    let yt = axis_taps(img.height(), height);
+    let src = img.pixels();
+    let sw = img.width();
     let mut out = vec![P::zero(); width * height];
-    out.par_chunks_mut(width.max(1))
-        .enumerate()
-        .for_each(|(y, row)| {
-            let ys = (y as f32 + 0.5) * sy - 0.5;
-            for (x, o) in row.iter_mut().enumerate() {
-                let xs = (x as f32 + 0.5) * sx - 0.5;
-                *o = img.sample_bilinear(xs, ys, Border::Clamp);
+    out.par_chunks_mut(width)
+        .zip(yt.par_iter())
+        .for_each(|(row, &(y0, y1, fy))| {
+            let (r0, r1) = (&src[y0 * sw..(y0 + 1) * sw], &src[y1 * sw..(y1 + 1) * sw]);
+            for (o, &(x0, x1, fx)) in row.iter_mut().zip(&xt) {
+                let top = r0[x0].add_scaled(r0[x1], fx).add_scaled(r0[x0], -fx);
+                let bottom = r1[x0].add_scaled(r1[x1], fx).add_scaled(r1[x0], -fx);
+                *o = top.add_scaled(bottom, fy).add_scaled(top, -fy);
             }
         });
     Image::from_vec(width, height, out).unwrap_or_else(|_| Image::new(width, height, P::zero()))
