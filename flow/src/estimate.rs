@@ -29,6 +29,12 @@ use crate::solver::{LevelImages, SolverConfig, refine_level};
 use crate::texture::{normalise, split_channels, texture_planes};
 use crate::weighted_median::Guide;
 
+/// Warps at least this many times at levels coarser than the two finest solved ones.
+/// They hold a sixteenth of the pixels or less, so this costs little, and one warp per
+/// level there missed a 20 px translation that three warps recover (measured on the
+/// synthetic translation test; Middlebury error unchanged).
+const COARSE_WARPS: usize = 3;
+
 /// Dense optical flow from `a` to `b`: pixel `s` of `a` corresponds to `s + F(s)` of
 /// `b`. Gray (`f32`) or colour (`[f32; N]`) images of the same size, finite values of
 /// any brightness scale.
@@ -126,6 +132,10 @@ pub fn estimate_flow_from<P: Pixel>(
             } else {
                 None
             };
+            let mut config = config;
+            if level > finest + 1 {
+                config.warps = config.warps.max(COARSE_WARPS);
+            }
             refine_level(images, &mut flow, &config, guide);
         }
     }

@@ -36,7 +36,6 @@ const ROF_THETA: f32 = 0.25;
 
 /// An image's planes, as [`FlowParams::color`] asks for.
 pub(crate) fn split_channels<P: Pixel>(img: &Image<P>, color: ColorMode) -> Vec<GrayImage> {
-    let (w, h) = img.size();
     match (color, P::CHANNELS) {
         (ColorMode::Color, _) | (ColorMode::Gray, 1) => (0..P::CHANNELS)
             .map(|c| img.map(|p| p.channels()[c]))
@@ -49,12 +48,6 @@ pub(crate) fn split_channels<P: Pixel>(img: &Image<P>, color: ColorMode) -> Vec<
         }
         (ColorMode::Gray, n) => vec![img.map(|p| p.channels().iter().sum::<f32>() / n as f32)],
     }
-    .into_iter()
-    .map(|plane| {
-        debug_assert_eq!(plane.size(), (w, h));
-        plane
-    })
-    .collect()
 }
 
 /// Subtracts each plane's mean and divides all by their pooled standard deviation

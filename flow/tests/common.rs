@@ -63,6 +63,10 @@ impl Texture {
 /// from the border (content that enters or leaves the frame has no correspondence).
 pub fn epe_constant(flow: &FlowImage, d: [f32; 2], margin: usize) -> f32 {
     let (w, h) = flow.size();
+    assert!(
+        2 * margin < w.min(h),
+        "margin {margin} leaves no pixel of {w}x{h}"
+    );
     let mut sum = 0.0;
     let mut n = 0;
     for y in margin..h - margin {
