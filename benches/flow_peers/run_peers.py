@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Our flow presets and OpenCV's flow methods, side by side, in one run.
 
-For every Middlebury pair (<Seq>/frame10.png, frame11.png, flow10.flo) under --data, runs
+For every Middlebury pair (<Seq>/frame10.png, frame11.png, flow10.flo) under --data (and,
+with --sintel DIR, every MPI-Sintel pair <scene>/{clean,final}/frame_NNNN.png with
+<scene>/flow/frame_NNNN.flo, pixels of <scene>/invalid/frame_NNNN.png excluded), runs
 each of our presets (through `frf flow-bench`, which times only the estimation) and
 OpenCV's Farneback, DIS (medium preset), DeepFlow and DualTVL1 (timed around `calc`
 only), interleaved sequence by sequence and in a rotating order, so that the load of a
@@ -46,8 +48,10 @@ def read_flo(path):
     return data.reshape(int(h), int(w), 2)
 
 
-def errors(flow, truth):
+def errors(flow, truth, valid=None):
     known = (np.abs(truth[..., 0]) <= UNKNOWN_THRESHOLD) & (np.abs(truth[..., 1]) <= UNKNOWN_THRESHOLD)
+    if valid is not None:
+        known &= valid
     f = flow[known].astype(np.float64)
     t = truth[known].astype(np.float64)
     epe = np.sqrt(((f - t) ** 2).sum(-1))
@@ -68,28 +72,60 @@ def opencv_methods():
     }
 
 
-def run_opencv(fn, seq_dir, repeat):
-    a = cv2.cvtColor(cv2.imread(str(seq_dir / "frame10.png")), cv2.COLOR_BGR2GRAY)
-    b = cv2.cvtColor(cv2.imread(str(seq_dir / "frame11.png")), cv2.COLOR_BGR2GRAY)
+class Pair:
+    """One image pair with ground truth; `group` is the directory `frf flow-bench` runs on."""
+
+    def __init__(self, name, group, a, b, truth, invalid=None):
+        self.name, self.group, self.a, self.b, self.truth, self.invalid = name, group, a, b, truth, invalid
+
+
+def middlebury_pairs(root):
+    return [Pair(d.name, d, d / "frame10.png", d / "frame11.png", d / "flow10.flo")
+            for d in sorted(root.iterdir()) if (d / "flow10.flo").is_file()]
+
+
+def sintel_pairs(root):
+    pairs = []
+    scenes = [root] if (root / "flow").is_dir() else sorted(d for d in root.iterdir() if (d / "flow").is_dir())
+    for scene in scenes:
+        for flo in sorted((scene / "flow").glob("frame_*.flo")):
+            n = int(flo.stem.split("_")[1])
+            for pass_ in ("clean", "final"):
+                a, b = scene / pass_ / f"frame_{n:04d}.png", scene / pass_ / f"frame_{n + 1:04d}.png"
+                if a.is_file() and b.is_file():
+                    inv = scene / "invalid" / f"frame_{n:04d}.png"
+                    pairs.append(Pair(f"{scene.name}/{pass_}/{n:04d}", scene, a, b, flo, inv if inv.is_file() else None))
+    return pairs
+
+
+def run_opencv(fn, pair, repeat):
+    a = cv2.cvtColor(cv2.imread(str(pair.a)), cv2.COLOR_BGR2GRAY)
+    b = cv2.cvtColor(cv2.imread(str(pair.b)), cv2.COLOR_BGR2GRAY)
     times, flow = [], None
     for _ in range(repeat):
         start = time.perf_counter()
         flow = fn(a, b)
         times.append(time.perf_counter() - start)
-    epe, aae = errors(flow, read_flo(seq_dir / "flow10.flo"))
+    valid = None
+    if pair.invalid is not None:
+        valid = cv2.imread(str(pair.invalid), cv2.IMREAD_GRAYSCALE) <= 127
+    epe, aae = errors(flow, read_flo(pair.truth), valid)
     return {"epe": epe, "aae": aae, "seconds": statistics.median(times)}
 
 
-def run_frf(frf, args, seq_dir, repeat, env):
-    # One sequence at a time (a directory holding only a link to it), so that our
-    # presets interleave with the OpenCV methods.
+def run_frf(frf, args, group, repeat, env):
+    # One sequence directory at a time (a directory holding only a link to it), so that
+    # our presets interleave with the OpenCV methods. Returns results by pair name.
     with tempfile.TemporaryDirectory() as tmp:
-        link = Path(tmp) / seq_dir.name
-        link.symlink_to(seq_dir.resolve())
+        link = Path(tmp) / group.name
+        link.symlink_to(group.resolve())
         cmd = [str(frf), "flow-bench", str(link), "--json", "--repeat", str(repeat)] + args
         out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
-    seq = json.loads(out)["sequences"][0]
-    return {"epe": seq["epe"], "aae": seq["aae"], "seconds": seq["seconds"]}
+    found = {}
+    for seq in json.loads(out)["sequences"]:
+        # Middlebury sequence names are the directory's; Sintel ones start with it.
+        found[seq["name"]] = {"epe": seq["epe"], "aae": seq["aae"], "seconds": seq["seconds"]}
+    return found
 
 
 def main():
@@ -99,6 +135,7 @@ def main():
         data_default = Path("/work/shared/data/middlebury_flow")
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--data", type=Path, default=data_default, help="Middlebury directory")
+    p.add_argument("--sintel", type=Path, default=None, help="also the MPI-Sintel pairs under this directory")
     p.add_argument("--frf", type=Path, default=root / "target" / "release" / "frf")
     p.add_argument("--presets", default="fast,balanced,accurate")
     p.add_argument("--extra", action="append", default=[],
@@ -113,7 +150,9 @@ def main():
 
     cv2.setNumThreads(opts.threads)
     env = dict(os.environ, RAYON_NUM_THREADS=str(opts.threads))
-    seqs = sorted(d for d in opts.data.iterdir() if (d / "flow10.flo").is_file())
+    seqs = middlebury_pairs(opts.data)
+    if opts.sintel:
+        seqs += sintel_pairs(opts.sintel)
     if not seqs:
         sys.exit(f"no Middlebury sequence under {opts.data}")
 
@@ -131,23 +170,39 @@ def main():
 
     results = {m: {} for m in methods}
     names = list(methods)
-    for i, seq in enumerate(seqs):
+    groups = []
+    for pair in seqs:
+        if not groups or groups[-1][0] != pair.group:
+            groups.append((pair.group, []))
+        groups[-1][1].append(pair)
+    for i, (group, pairs) in enumerate(groups):
         order = names[i % len(names):] + names[: i % len(names)]
         for m in order:
             kind, what = methods[m]
-            r = run_frf(opts.frf, what, seq, opts.repeat, env) if kind == "frf" else run_opencv(what, seq, opts.repeat)
-            results[m][seq.name] = r
-            print(f"{seq.name:12s} {m:22s} EPE {r['epe']:.3f} px  AAE {r['aae']:.2f} deg  {r['seconds']:.3f} s",
-                  file=sys.stderr, flush=True)
+            if kind == "frf":
+                found = run_frf(opts.frf, what, group, opts.repeat, env)
+                for pair in pairs:
+                    key = pair.name if pair.name in found else group.name
+                    results[m][pair.name] = found[key]
+            else:
+                for pair in pairs:
+                    results[m][pair.name] = run_opencv(what, pair, opts.repeat)
+            for pair in pairs:
+                r = results[m][pair.name]
+                print(f"{pair.name:22s} {m:22s} EPE {r['epe']:.3f} px  AAE {r['aae']:.2f} deg  {r['seconds']:.3f} s",
+                      file=sys.stderr, flush=True)
 
+    # Means over the Middlebury pairs only (the targets' reference); Sintel is listed apart.
+    midd = [s for s in seqs if "/" not in s.name]
     summary = {}
     for m in names:
-        rs = [results[m][s.name] for s in seqs]
+        rs = [results[m][s.name] for s in midd]
         summary[m] = {k: statistics.fmean(r[k] for r in rs) for k in ("epe", "aae", "seconds")}
 
     meta = {
         "data": str(opts.data),
         "sequences": [s.name for s in seqs],
+        "sintel": str(opts.sintel) if opts.sintel else None,
         "threads": opts.threads,
         "repeat": opts.repeat,
         "opencv": cv2.__version__,
@@ -157,13 +212,14 @@ def main():
     }
     lines = [
         f"Threads per method: {opts.threads}; seconds = wall time of one pair's estimation "
-        f"(median of {opts.repeat}); OpenCV {cv2.__version__} on 8-bit gray frames, ours on RGB.",
+        f"(median of {opts.repeat}); OpenCV {cv2.__version__} on 8-bit gray frames, ours on RGB. "
+        "Cells: EPE (px) / seconds; means over the Middlebury pairs.",
         "",
-        "| method | " + " | ".join(s.name for s in seqs) + " | mean EPE (px) | mean AAE (deg) | mean seconds |",
-        "|---|" + "---|" * len(seqs) + "---|---|---|",
+        "| method | " + " | ".join(s.name for s in midd) + " | mean EPE (px) | mean AAE (deg) | mean seconds |",
+        "|---|" + "---|" * len(midd) + "---|---|---|",
     ]
     for m in names:
-        cells = [f"{results[m][s.name]['epe']:.3f} / {results[m][s.name]['seconds']:.3f} s" for s in seqs]
+        cells = [f"{results[m][s.name]['epe']:.3f} / {results[m][s.name]['seconds']:.3f} s" for s in midd]
         sm = summary[m]
         lines.append(f"| {m} | " + " | ".join(cells) + f" | {sm['epe']:.3f} | {sm['aae']:.2f} | {sm['seconds']:.3f} |")
     lines += ["", "AAE (deg) per sequence:", "",
@@ -171,6 +227,14 @@ def main():
               "|---|" + "---|" * len(seqs)]
     for m in names:
         lines.append(f"| {m} | " + " | ".join(f"{results[m][s.name]['aae']:.2f}" for s in seqs) + " |")
+    other = [s for s in seqs if "/" in s.name]
+    if other:
+        lines += ["", "MPI-Sintel (invalid pixels excluded), EPE (px) / seconds:", "",
+                  "| method | " + " | ".join(s.name for s in other) + " |",
+                  "|---|" + "---|" * len(other)]
+        for m in names:
+            lines.append(f"| {m} | " + " | ".join(
+                f"{results[m][s.name]['epe']:.3f} / {results[m][s.name]['seconds']:.3f} s" for s in other) + " |")
     table = "\n".join(lines)
     print(table)
     if opts.out_md:

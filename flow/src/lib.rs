@@ -12,8 +12,8 @@
 //! - input normalisation, structure–texture decomposition, gradient constancy: `texture.rs`;
 //! - image pyramid and its anti-aliasing: `pyramid.rs`;
 //! - robust penalties (Lorentzian, generalized Charbonnier) and GNC: [`penalty`];
-//! - warping, IRLS and parallel SOR: `solver.rs` (bicubic sampling: `interp.rs`,
-//!   derivative filter: `gradient.rs`);
+//! - warping, linearisation and IRLS: `solver.rs` (bicubic sampling: `interp.rs`,
+//!   derivative filter: `gradient.rs`); red-black SOR in a vectorisable layout: `sor.rs`;
 //! - median filtering between warps and Classic+NL's weighted median: `median.rs`,
 //!   `weighted_median.rs`;
 //! - coarse-to-fine and GNC stages: [`estimate`];

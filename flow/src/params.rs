@@ -14,7 +14,7 @@ pub enum ColorMode {
 }
 
 /// How the input is filtered before matching, to make the data term insensitive to
-/// shading and brightness changes (see [`crate::texture`]).
+/// shading and brightness changes (see `texture.rs`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum TextureFilter {
     /// Match the normalised intensities themselves.

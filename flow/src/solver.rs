@@ -36,7 +36,7 @@ use crate::sor::{PixelSystem, RedBlack};
 const DERIVATIVE_BLEND: f32 = 0.5;
 /// Both images at one pyramid level, each pixel's values packed together —
 /// `[I, ∂I/∂x, ∂I/∂y]` for every channel — so that warping reads a few contiguous cache
-/// lines per tap instead of one per plane (measured 2–3x faster sampling).
+/// lines per tap instead of one per plane (measured 15% faster warping for RGB).
 pub(crate) struct LevelImages {
     pub width: usize,
     pub height: usize,

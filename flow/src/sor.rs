@@ -6,7 +6,8 @@
 //! independent of the others (rayon runs rows in parallel) and every pixel of a row
 //! independent of its neighbours (the compiler vectorises the row loop). A first
 //! version that updated the colours in place in the natural layout read every cache
-//! line twice per sweep and could not be vectorised; this layout measured 2–3x faster.
+//! line twice per sweep and could not be vectorised; this layout measured about 1.8x
+//! faster.
 //!
 //! Neighbours, for a pixel of colour `c` at position `k` of row `y` (`x = o + 2k`,
 //! `o = (y + c) mod 2`): the left and right neighbours are the other colour's entries

@@ -30,8 +30,8 @@ pub(crate) const DATA_SCALE: f32 = 255.0 / 4.0;
 
 /// ROF fidelity θ of the structure–texture decomposition, in units of the image's
 /// standard deviation: Wedel et al. (2009) use 1/8 on images min-max scaled to
-/// [−1, 1], whose standard deviation is typically about 0.5 (measured: 0.4–0.6 on the
-/// Middlebury frames), so 1/8 of that range is about 1/4 of a standard deviation.
+/// [−1, 1], whose standard deviation is 0.44 on average (measured: 0.27–0.56 on the
+/// five Middlebury first frames), so 1/8 there is about 1/4 of a standard deviation.
 const ROF_THETA: f32 = 0.25;
 
 /// An image's planes, as [`FlowParams::color`] asks for.
@@ -92,8 +92,9 @@ pub(crate) fn normalise(planes: &mut [GrayImage]) {
 /// The ROF (total-variation) denoised `f`: the minimiser of `TV(u) + |u − f|² / 2θ`,
 /// by the accelerated primal–dual algorithm of Chambolle & Pock (J. Math. Imaging
 /// Vis. 2011, Algorithm 2, using the 1/θ-strong convexity of the fidelity term), which
-/// reaches in 25 iterations what Chambolle's 2004 projection needs about 100 for
-/// (measured: same flow error on Middlebury). `theta` is in the units of `f`.
+/// converges as O(1/N²) where Chambolle's 2004 projection converges as O(1/N): the flow
+/// error on Middlebury is within 0.003 px of its 100-iteration value after 25 iterations
+/// (measured). `theta` is in the units of `f`.
 pub(crate) fn rof_structure(f: &GrayImage, theta: f32, iterations: usize) -> GrayImage {
     let (w, h) = f.size();
     let fp = f.pixels();
