@@ -28,6 +28,10 @@ enum Command {
     Stage(Box<cmd::stage::StageArgs>),
     /// Show what a field file holds and how well it is compressed.
     Info(cmd::info::InfoArgs),
+    /// Optical flow from image A to image B, written as a Middlebury .flo file.
+    Flow(cmd::flow::FlowArgs),
+    /// Error and time of the flow estimator on Middlebury or Sintel pairs with ground truth.
+    FlowBench(cmd::flow::FlowBenchArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +39,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(*args),
         Command::Info(args) => cmd::info::run(args),
+        Command::Flow(args) => cmd::flow::run(args),
+        Command::FlowBench(args) => cmd::flow::run_bench(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! One module per subcommand, plus shared progress reporting.
 
+pub mod flow;
 pub mod info;
 pub mod progress;
 pub mod stage;
