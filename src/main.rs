@@ -28,6 +28,10 @@ enum Command {
     Stage(Box<cmd::stage::StageArgs>),
     /// Show what a field file holds and how well it is compressed.
     Info(cmd::info::InfoArgs),
+    /// Turn a capture into a flowed reflectance field (mattes, registration, flow).
+    Ingest(cmd::ingest::IngestArgs),
+    /// Turn a calibrated ring of photographs (Middlebury multi-view) into a field.
+    IngestRing(cmd::ingest::RingArgs),
     /// Optical flow from image A to image B, written as a Middlebury .flo file.
     Flow(cmd::flow::FlowArgs),
     /// Error and time of the flow estimator on Middlebury or Sintel pairs with ground truth.
@@ -39,6 +43,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(*args),
         Command::Info(args) => cmd::info::run(args),
+        Command::Ingest(args) => cmd::ingest::run(args),
+        Command::IngestRing(args) => cmd::ingest::run_ring(args),
         Command::Flow(args) => cmd::flow::run(args),
         Command::FlowBench(args) => cmd::flow::run_bench(args),
     };

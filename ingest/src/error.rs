@@ -9,6 +9,9 @@ pub enum IngestError {
     /// A parameter is out of range or inconsistent with the capture.
     #[error("{0}")]
     BadParameter(String),
+    /// The user asked to stop; finished poses are kept and a rerun resumes.
+    #[error("interrupted: finished poses are kept, run the same command again to resume")]
+    Interrupted,
     /// Reading the capture, images or environments.
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
@@ -18,4 +21,7 @@ pub enum IngestError {
     /// The field file and codecs.
     #[error(transparent)]
     Reflectance(#[from] frf_reflectance::ReflectanceError),
+    /// Optical flow.
+    #[error(transparent)]
+    Flow(#[from] frf_flow::FlowError),
 }

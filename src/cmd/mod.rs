@@ -2,6 +2,7 @@
 
 pub mod flow;
 pub mod info;
+pub mod ingest;
 pub mod progress;
 pub mod stage;
 pub mod stage_field;

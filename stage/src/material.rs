@@ -129,7 +129,7 @@ impl Material {
                 let stripe = 0.5 + (stripe - 0.5) * detail(1.0 / STRIPE_PERIOD_M, footprint);
                 let c = mix(SHIRT_BASE, SHIRT_STRIPE, stripe);
                 Surface {
-                    albedo: scale(c, 1.0 + 0.25 * fbm(local, 30.0, 3, salt, footprint)),
+                    albedo: scale(c, 1.0 + 0.5 * fbm(local, 22.0, 3, salt, footprint)),
                     f0: 0.04,
                     roughness: 0.6,
                 }
@@ -138,7 +138,7 @@ impl Material {
                 let patch = smoothstep(0.05, 0.25, fbm(local, 11.0, 3, salt ^ 3, footprint));
                 let c = mix(TROUSERS, TROUSERS_PATCH, patch);
                 Surface {
-                    albedo: scale(c, 1.0 + 0.35 * fbm(local, 40.0, 3, salt, footprint)),
+                    albedo: scale(c, 1.0 + 0.5 * fbm(local, 22.0, 3, salt, footprint)),
                     f0: 0.04,
                     roughness: 0.7,
                 }
@@ -160,11 +160,11 @@ impl Material {
 
 fn skin(local: Vec3, salt: u64, footprint: f32) -> Surface {
     // Blotches and freckles: ±15 % over 2–6 cm, plus darker spots.
-    let blotch = fbm(local, 18.0, 3, salt, footprint);
+    let blotch = fbm(local, 25.0, 3, salt, footprint);
     let freckle =
         smoothstep(0.55, 0.75, fbm(local, 70.0, 1, salt ^ 5, footprint)) * detail(70.0, footprint);
     Surface {
-        albedo: scale(mix(SKIN, [0.4, 0.24, 0.17], freckle), 1.0 + 0.15 * blotch),
+        albedo: scale(mix(SKIN, [0.4, 0.24, 0.17], freckle), 1.0 + 0.35 * blotch),
         f0: 0.028, // skin's refractive index ~1.4 (Weyrich et al., SIGGRAPH 2006)
         roughness: 0.35,
     }
@@ -179,6 +179,8 @@ fn head(local: Vec3, salt: u64, footprint: f32) -> Surface {
     let is_hair = p.y > hairline || (p.x < -0.03 && p.y > -0.06);
     if is_hair {
         // Stretched 5x along y: its finest detail is 5x finer than `frequency` says.
+        // Fine strands, and (below) isotropic clumps that survive at low resolution
+        // where the strands fade out.
         let strands = fbm(
             local * Vec3::new(1.0, 5.0, 1.0),
             30.0,
@@ -187,7 +189,10 @@ fn head(local: Vec3, salt: u64, footprint: f32) -> Surface {
             footprint * 5.0,
         );
         return Surface {
-            albedo: scale(HAIR, 1.0 + 0.4 * strands),
+            albedo: scale(
+                HAIR,
+                1.0 + 0.6 * fbm(local, 20.0, 3, salt ^ 13, footprint) + 0.4 * strands,
+            ),
             f0: 0.046, // keratin, n ≈ 1.55
             roughness: 0.25,
         };

@@ -1,0 +1,533 @@
+//! The ingest pipeline: capture in, flowed reflectance field out, pose by pose.
+//!
+//! For each pose: load the clean plates; for every view (in parallel) matte, register and
+//! matte the basis frames ([`crate::views`]) and compress its images at once; measure
+//! the flow from every view to each grid neighbour ([`crate::interview`]); fit the pose's
+//! flow quantizer to its flows, compress them and write the pose to its own part file
+//! `FIELD.parts/pNN.frf` (atomically), with its report beside it. A rerun skips poses
+//! whose part is finished and made with the same settings, so an interrupted ingest
+//! resumes; the field itself appears only when every pose is done, merged from the parts.
+//! When the capture comes from the virtual stage, each pose is also measured against the
+//! ground truth ([`crate::evaluate`]).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use frf_core::capture::Capture;
+use frf_core::grid::Neighbour;
+use frf_core::image::{FlowImage, GrayImage, RgbImage};
+use frf_flow::{FlowParams, Preset};
+use frf_reflectance::container::merge_fields;
+use frf_reflectance::flowcodec::quant::LogQuantizer;
+use frf_reflectance::stats::FieldStats;
+use frf_reflectance::store::{EncodedView, encode_flows, encode_images};
+use frf_reflectance::{FieldFile, FieldHeader, FieldWriter};
+use frf_stage::Stage;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{IngestError, Result};
+use crate::evaluate::{PoseErrors, PoseEvidence, evaluate_pose};
+use crate::interview::{keep_near_subject, rectified_flow, symmetrize};
+use crate::matte::MatteRule;
+use crate::views::{ViewSeconds, ViewSettings, process_view};
+
+/// What to ingest and how.
+#[derive(Debug, Clone)]
+pub struct IngestOptions {
+    /// Poses to ingest (empty: every captured pose).
+    pub poses: Vec<u32>,
+    /// Optical-flow preset for registration and inter-view flow.
+    pub flow_preset: Preset,
+    /// Overrides of the preset's parameters, `(key, value)` as
+    /// [`FlowParams::with_setting`] takes them.
+    pub flow_settings: Vec<(String, String)>,
+    /// JPEG quality of the basis mosaics.
+    pub jpeg_quality: u8,
+    /// Predict flow codes from their neighbours before Huffman coding.
+    pub predict_flow: bool,
+    /// Measure against the virtual stage's truth when the capture has one.
+    pub evaluate: bool,
+    /// Which pixels are foreground in the mattes.
+    pub matte_rule: MatteRule,
+}
+
+/// Progress of long steps: `begin` a named step of `total` units, `advance` by one; and
+/// interruption: when `should_stop` turns true the ingest stops at the next view with
+/// [`IngestError::Interrupted`], leaving the poses already finished in their parts.
+pub trait Progress: Sync {
+    /// A step of pose `pose` starts.
+    fn begin(&self, pose: u32, step: &str, total: usize);
+    /// One unit of the current step is done.
+    fn advance(&self);
+    /// Whether the user asked to stop.
+    fn should_stop(&self) -> bool {
+        false
+    }
+}
+
+fn check_stop(progress: &dyn Progress) -> Result<()> {
+    if progress.should_stop() {
+        return Err(IngestError::Interrupted);
+    }
+    Ok(())
+}
+
+/// Reports nothing.
+pub struct Silent;
+
+impl Progress for Silent {
+    fn begin(&self, _: u32, _: &str, _: usize) {}
+    fn advance(&self) {}
+}
+
+/// Wall-clock seconds of one step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Step {
+    /// What the step does.
+    pub name: String,
+    /// Wall-clock seconds. Steps that run interleaved in one parallel phase share the
+    /// phase's wall time in proportion to the thread time each took.
+    pub seconds: f64,
+}
+
+/// The settings a part file was made with (a resumed pose must match them).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Flow preset name, with its overrides.
+    pub flow_preset: String,
+    /// JPEG quality.
+    pub jpeg_quality: u8,
+    /// Flow prediction.
+    pub predict_flow: bool,
+    /// Matte rule.
+    pub matte_rule: String,
+}
+
+/// What happened to one pose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseReport {
+    /// The pose.
+    pub pose: u32,
+    /// Settings it was ingested with.
+    pub settings: Settings,
+    /// Whether this run found it finished and skipped it.
+    #[serde(skip_deserializing)]
+    pub resumed: bool,
+    /// Time per step.
+    pub steps: Vec<Step>,
+    /// Errors against the truth, when there is one.
+    pub errors: Option<PoseErrors>,
+}
+
+/// The result of an ingest.
+#[derive(Debug, Clone, Serialize)]
+pub struct IngestReport {
+    /// The capture directory.
+    pub capture: String,
+    /// Settings.
+    pub settings: Settings,
+    /// Image size.
+    pub width: u32,
+    /// Image size.
+    pub height: u32,
+    /// Views per pose.
+    pub views: usize,
+    /// Time per step, summed over poses.
+    pub steps: Vec<Step>,
+    /// Mean over poses of the per-pose figures (null without truth).
+    pub alpha_iou: Option<f64>,
+    /// See [`PoseErrors::alpha_mae`].
+    pub alpha_mae: Option<f64>,
+    /// See [`PoseErrors::registration_psnr`].
+    pub registration_psnr: Option<f64>,
+    /// See [`PoseErrors::unregistered_psnr`].
+    pub unregistered_psnr: Option<f64>,
+    /// See [`PoseErrors::flow_epe_horizontal`].
+    pub flow_epe_horizontal: Option<f64>,
+    /// See [`PoseErrors::flow_epe_vertical`].
+    pub flow_epe_vertical: Option<f64>,
+    /// Per pose.
+    pub poses: Vec<PoseReport>,
+    /// The field's size and compression.
+    pub field: FieldStats,
+    /// Wall-clock seconds of this run.
+    pub seconds: f64,
+}
+
+/// The directory of per-pose parts of field `out`.
+pub fn parts_dir(out: &Path) -> PathBuf {
+    let mut name = out
+        .file_name()
+        .map(|n| n.to_os_string())
+        .unwrap_or_default();
+    name.push(".parts");
+    out.with_file_name(name)
+}
+
+fn part_paths(out: &Path, pose: u32) -> (PathBuf, PathBuf) {
+    let dir = parts_dir(out);
+    (
+        dir.join(format!("p{pose:02}.frf")),
+        dir.join(format!("p{pose:02}.json")),
+    )
+}
+
+fn settings(options: &IngestOptions) -> Settings {
+    Settings {
+        flow_preset: std::iter::once(options.flow_preset.name().to_string())
+            .chain(
+                options
+                    .flow_settings
+                    .iter()
+                    .map(|(k, v)| format!("{k}={v}")),
+            )
+            .collect::<Vec<_>>()
+            .join(" "),
+        jpeg_quality: options.jpeg_quality,
+        predict_flow: options.predict_flow,
+        matte_rule: format!("{:?}", options.matte_rule),
+    }
+}
+
+/// A finished part of this pose made with these settings, if there is one.
+fn finished_part(out: &Path, pose: u32, wanted: &Settings) -> Result<Option<PoseReport>> {
+    let (part, json) = part_paths(out, pose);
+    if !(part.exists() && json.exists()) {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&json).map_err(|e| frf_core::CoreError::io(&json, e))?;
+    let mut report: PoseReport = serde_json::from_str(&text)
+        .map_err(|e| frf_core::CoreError::bad_file(&json, format!("not a pose report: {e}")))?;
+    if &report.settings != wanted {
+        return Err(IngestError::BadParameter(format!(
+            "{}: pose {pose} was ingested with {:?}, this run asks for {wanted:?}; use the same settings or remove {}",
+            part.display(),
+            report.settings,
+            parts_dir(out).display()
+        )));
+    }
+    FieldFile::open(&part)?;
+    report.resumed = true;
+    Ok(Some(report))
+}
+
+/// Wall time of a parallel phase shared among its steps by thread time.
+fn share(phase_wall: f64, steps: &[(&str, f64)]) -> Vec<Step> {
+    let total: f64 = steps.iter().map(|s| s.1).sum();
+    steps
+        .iter()
+        .map(|(name, t)| Step {
+            name: name.to_string(),
+            seconds: if total > 0.0 {
+                phase_wall * t / total
+            } else {
+                0.0
+            },
+        })
+        .collect()
+}
+
+struct ViewOut {
+    images: EncodedView,
+    alpha: GrayImage,
+    summed: RgbImage,
+    seconds: ViewSeconds,
+    encode_seconds: f64,
+    registered: Option<(Vec<RgbImage>, Vec<RgbImage>)>,
+}
+
+/// Views whose registration is evaluated: four columns spread over the turn, all cameras.
+fn evaluated(u: usize, columns: usize) -> bool {
+    u.is_multiple_of((columns / 4).max(1))
+}
+
+fn ingest_pose(
+    capture: &Capture,
+    pose: u32,
+    out: &Path,
+    options: &IngestOptions,
+    stage: Option<&Stage>,
+    progress: &dyn Progress,
+) -> Result<PoseReport> {
+    let (columns, rows) = (capture.cycles(), capture.cameras().len());
+    let mut params = FlowParams::preset(options.flow_preset);
+    for (k, v) in &options.flow_settings {
+        params = params.with_setting(k, v)?;
+    }
+    let mut steps = Vec::new();
+
+    let start = Instant::now();
+    let clean: Vec<Vec<RgbImage>> = (0..rows)
+        .map(|v| {
+            (0..capture.slots().len())
+                .map(|s| capture.load_clean_plate(v, s))
+                .collect()
+        })
+        .collect::<frf_core::Result<_>>()?;
+    steps.push(Step {
+        name: "load clean plates".into(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+
+    let mut header = FieldHeader::from_capture(
+        capture,
+        &[pose],
+        LogQuantizer::new(1.0, 1.0)?,
+        options.jpeg_quality,
+    )?;
+    header.flow_predicted = options.predict_flow;
+    header.description = format!(
+        "ingested from {} with flow {}",
+        capture.dir().display(),
+        settings(options).flow_preset
+    );
+
+    progress.begin(pose, "mattes and registration", columns * rows);
+    let start = Instant::now();
+    let views: Vec<ViewOut> = (0..columns * rows)
+        .into_par_iter()
+        .map(|i| {
+            check_stop(progress)?;
+            let (u, v) = (i / rows, i % rows);
+            let settings = ViewSettings {
+                flow: params,
+                matte_rule: options.matte_rule,
+                keep_unregistered: stage.is_some() && options.evaluate && evaluated(u, columns),
+            };
+            let r = process_view(capture, pose, u, v, &clean[v], &settings)?;
+            let t = Instant::now();
+            let images = encode_images(&header, &r.basis, &r.alpha)?;
+            progress.advance();
+            Ok(ViewOut {
+                images,
+                encode_seconds: t.elapsed().as_secs_f64(),
+                registered: r.unregistered.map(|un| (r.basis, un)),
+                alpha: r.alpha,
+                summed: r.summed,
+                seconds: r.seconds,
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut seconds = ViewSeconds::default();
+    for v in &views {
+        seconds += v.seconds;
+    }
+    let encode: f64 = views.iter().map(|v| v.encode_seconds).sum();
+    steps.extend(share(
+        start.elapsed().as_secs_f64(),
+        &[
+            ("load frames", seconds.load),
+            ("mattes", seconds.matte),
+            ("registration flow", seconds.registration_flow),
+            ("registration warp and matte", seconds.registration_warp),
+            ("compress basis images", encode),
+        ],
+    ));
+
+    progress.begin(pose, "inter-view flow", columns * rows);
+    let start = Instant::now();
+    // Raw flow of every (view, neighbour) pair, then each averaged with its reverse.
+    let raw: Vec<([Option<FlowImage>; 4], f64, f64)> = (0..columns * rows)
+        .into_par_iter()
+        .map(|i| {
+            check_stop(progress)?;
+            let (u, v) = (i / rows, i % rows);
+            let mut flows: [Option<FlowImage>; 4] = Default::default();
+            let (mut horizontal, mut vertical) = (0.0, 0.0);
+            for n in Neighbour::ALL {
+                let Some((u2, v2)) = n.of(u, v, columns, rows, header.wraps) else {
+                    continue;
+                };
+                let t = Instant::now();
+                let j = u2 * rows + v2;
+                flows[n.index()] = Some(rectified_flow(
+                    &views[i].summed,
+                    &views[j].summed,
+                    &capture.subject_camera(u, v, pose),
+                    &capture.subject_camera(u2, v2, pose),
+                    &params,
+                )?);
+                let dt = t.elapsed().as_secs_f64();
+                if matches!(n, Neighbour::Left | Neighbour::Right) {
+                    horizontal += dt;
+                } else {
+                    vertical += dt;
+                }
+            }
+            progress.advance();
+            Ok((flows, horizontal, vertical))
+        })
+        .collect::<Result<_>>()?;
+    let flows: Vec<([Option<FlowImage>; 4], f64, f64)> = (0..columns * rows)
+        .into_par_iter()
+        .map(|i| {
+            let (u, v) = (i / rows, i % rows);
+            let mut out: [Option<FlowImage>; 4] = Default::default();
+            for n in Neighbour::ALL {
+                let (Some(f), Some((u2, v2))) = (
+                    &raw[i].0[n.index()],
+                    n.of(u, v, columns, rows, header.wraps),
+                ) else {
+                    continue;
+                };
+                let back = raw[u2 * rows + v2].0[n.opposite().index()].as_ref();
+                let f = back.map_or_else(|| f.clone(), |b| symmetrize(f, b));
+                out[n.index()] = Some(keep_near_subject(&f, &views[i].alpha));
+            }
+            (out, raw[i].1, raw[i].2)
+        })
+        .collect();
+    steps.extend(share(
+        start.elapsed().as_secs_f64(),
+        &[
+            (
+                "inter-view flow, horizontal pairs",
+                flows.iter().map(|f| f.1).sum(),
+            ),
+            (
+                "inter-view flow, vertical pairs",
+                flows.iter().map(|f| f.2).sum(),
+            ),
+        ],
+    ));
+
+    let start = Instant::now();
+    header.pose_mut(pose)?.flow_quantizer = LogQuantizer::fit(
+        flows
+            .iter()
+            .flat_map(|f| f.0.iter().flatten())
+            .flat_map(|f| f.pixels().iter().flatten().copied()),
+    );
+    let encoded: Vec<EncodedView> = flows
+        .par_iter()
+        .map(|f| Ok(encode_flows(&header, pose, &f.0)?))
+        .collect::<Result<_>>()?;
+    let (part, json) = part_paths(out, pose);
+    let mut writer = FieldWriter::create(&part, header)?;
+    for (i, (view, flow)) in views.iter().zip(&encoded).enumerate() {
+        writer.add_view(pose, i / rows, i % rows, &view.images)?;
+        writer.add_view(pose, i / rows, i % rows, flow)?;
+    }
+    writer.finish()?;
+    steps.push(Step {
+        name: "compress flows and write".into(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+
+    let errors = match stage.filter(|_| options.evaluate) {
+        Some(stage) => {
+            progress.begin(pose, "evaluation against the stage's truth", 1);
+            let alphas: Vec<GrayImage> = views.iter().map(|v| v.alpha.clone()).collect();
+            let flow_maps: Vec<[Option<FlowImage>; 4]> = flows.into_iter().map(|f| f.0).collect();
+            let registered: Vec<(usize, usize, Vec<RgbImage>, Vec<RgbImage>)> = views
+                .into_iter()
+                .enumerate()
+                .filter_map(|(i, v)| v.registered.map(|(r, u)| (i / rows, i % rows, r, u)))
+                .collect();
+            let e = evaluate_pose(
+                stage,
+                pose,
+                &PoseEvidence {
+                    alphas: &alphas,
+                    flows: &flow_maps,
+                    registered: &registered,
+                },
+            )?;
+            progress.advance();
+            Some(e)
+        }
+        None => None,
+    };
+    let report = PoseReport {
+        pose,
+        settings: settings(options),
+        resumed: false,
+        steps,
+        errors,
+    };
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| IngestError::BadParameter(e.to_string()))?;
+    frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
+    Ok(report)
+}
+
+/// Ingests the capture in `capture_dir` into the field file `out`.
+pub fn ingest(
+    capture_dir: &Path,
+    out: &Path,
+    options: &IngestOptions,
+    progress: &dyn Progress,
+) -> Result<IngestReport> {
+    let start = Instant::now();
+    let capture = Capture::open(capture_dir)?;
+    let poses = if options.poses.is_empty() {
+        capture.poses().to_vec()
+    } else {
+        options.poses.clone()
+    };
+    if let Some(p) = poses.iter().find(|p| !capture.poses().contains(p)) {
+        return Err(IngestError::BadParameter(format!(
+            "pose {p} is not in the capture (it has {:?})",
+            capture.poses()
+        )));
+    }
+    if !(1..=100).contains(&options.jpeg_quality) {
+        return Err(IngestError::BadParameter(format!(
+            "JPEG quality {} outside 1..=100",
+            options.jpeg_quality
+        )));
+    }
+    let stage = if options.evaluate && capture_dir.join(frf_stage::writer::STAGE_FILE).exists() {
+        Some(frf_stage::open_stage(capture_dir)?)
+    } else {
+        None
+    };
+    let wanted = settings(options);
+    let mut reports = Vec::new();
+    for &pose in &poses {
+        let report = match finished_part(out, pose, &wanted)? {
+            Some(r) => r,
+            None => ingest_pose(&capture, pose, out, options, stage.as_ref(), progress)?,
+        };
+        reports.push(report);
+    }
+    let parts: Vec<PathBuf> = poses.iter().map(|&p| part_paths(out, p).0).collect();
+    merge_fields(&parts, out)?;
+    let field = FieldFile::open(out)?.stats();
+    let _ = std::fs::remove_dir_all(parts_dir(out));
+
+    let mut steps: Vec<Step> = Vec::new();
+    for r in reports.iter().filter(|r| !r.resumed) {
+        for s in &r.steps {
+            match steps.iter_mut().find(|t| t.name == s.name) {
+                Some(t) => t.seconds += s.seconds,
+                None => steps.push(s.clone()),
+            }
+        }
+    }
+    let mean = |f: fn(&PoseErrors) -> f64| {
+        let values: Vec<f64> = reports
+            .iter()
+            .filter_map(|r| r.errors.as_ref().map(f))
+            .collect();
+        (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+    };
+    Ok(IngestReport {
+        capture: capture_dir.display().to_string(),
+        settings: wanted,
+        width: capture.cameras()[0].width,
+        height: capture.cameras()[0].height,
+        views: capture.cycles() * capture.cameras().len(),
+        steps,
+        alpha_iou: mean(|e| e.alpha_iou),
+        alpha_mae: mean(|e| e.alpha_mae),
+        registration_psnr: mean(|e| e.registration_psnr),
+        unregistered_psnr: mean(|e| e.unregistered_psnr),
+        flow_epe_horizontal: mean(|e| e.flow_epe_horizontal),
+        flow_epe_vertical: mean(|e| e.flow_epe_vertical),
+        poses: reports,
+        field,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
