@@ -116,8 +116,27 @@ pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// Decodes a mosaic written by [`encode_basis`] into linear RGB images.
-pub fn decode_basis(bytes: &[u8]) -> Result<Vec<RgbImage>> {
+/// A decoded mosaic before linearization: each tile's 8-bit gamma-2.2 codes and its
+/// scale (`linear = scale · (code / 255)^2.2`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasisCodes {
+    /// Tile width, pixels.
+    pub width: usize,
+    /// Tile height, pixels.
+    pub height: usize,
+    /// Per tile, row-major RGB codes.
+    pub tiles: Vec<Vec<[u8; 3]>>,
+    /// Per tile, the scale.
+    pub scales: Vec<f32>,
+}
+
+/// The lookup from an 8-bit code to its gamma-2.2-decoded value in `[0, 1]`.
+pub fn gamma_lut() -> [f32; 256] {
+    std::array::from_fn(|c| (c as f32 / 255.0).powf(GAMMA))
+}
+
+/// Decodes a mosaic written by [`encode_basis`] into its tiles' codes and scales.
+pub fn decode_basis_codes(bytes: &[u8]) -> Result<BasisCodes> {
     if bytes.len() < 12 {
         return Err(corrupt("basis mosaic header truncated"));
     }
@@ -165,17 +184,40 @@ pub fn decode_basis(bytes: &[u8]) -> Result<Vec<RgbImage>> {
             rows * ch
         )));
     }
-    // 256-entry lookup: code -> (code/255)^2.2.
-    let lut: Vec<f32> = (0..256).map(|c| (c as f32 / 255.0).powf(GAMMA)).collect();
-    Ok(scales
-        .iter()
-        .enumerate()
-        .map(|(i, &scale)| {
+    let tiles = (0..count)
+        .map(|i| {
             let (x0, y0) = ((i % columns) * cw, (i / columns) * ch);
-            Image::from_fn(tw, th, |x, y| {
-                let p = mosaic.get_pixel((x0 + x) as u32, (y0 + y) as u32).0;
-                p.map(|c| lut[c as usize] * scale)
-            })
+            let mut t = Vec::with_capacity(tw * th);
+            for y in 0..th {
+                for x in 0..tw {
+                    t.push(mosaic.get_pixel((x0 + x) as u32, (y0 + y) as u32).0);
+                }
+            }
+            t
+        })
+        .collect();
+    Ok(BasisCodes {
+        width: tw,
+        height: th,
+        tiles,
+        scales,
+    })
+}
+
+/// Decodes a mosaic written by [`encode_basis`] into linear RGB images.
+pub fn decode_basis(bytes: &[u8]) -> Result<Vec<RgbImage>> {
+    let codes = decode_basis_codes(bytes)?;
+    let lut = gamma_lut();
+    Ok(codes
+        .tiles
+        .iter()
+        .zip(&codes.scales)
+        .map(|(tile, &scale)| {
+            let px = tile
+                .iter()
+                .map(|p| p.map(|c| lut[c as usize] * scale))
+                .collect();
+            Image::from_vec(codes.width, codes.height, px).expect("w*h codes per tile")
         })
         .collect())
 }

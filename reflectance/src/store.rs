@@ -10,7 +10,9 @@ use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt};
 use crate::error::{ReflectanceError, Result};
 use crate::field::{FieldHeader, ViewData};
 use crate::flowcodec;
-use crate::imagecodec::{decode_basis, decode_planes, encode_basis, encode_planes};
+use crate::imagecodec::{
+    BasisCodes, decode_basis, decode_basis_codes, decode_planes, encode_basis, encode_planes,
+};
 
 /// The encoded chunks of one view.
 #[derive(Debug, Clone)]
@@ -155,6 +157,20 @@ impl<R: ReadAt> FieldFile<R> {
             return Err(self.chunk_error(&k, "images of the wrong size or count".into()));
         }
         Ok(images)
+    }
+
+    /// The basis images of a view as their mosaic's 8-bit codes and tile scales (what a
+    /// GPU relights from).
+    pub fn basis_codes(&self, pose: u32, u: usize, v: usize) -> Result<BasisCodes> {
+        let k = key(pose, u, v, ChunkKind::Basis);
+        let codes = self.decode_chunk(&k, decode_basis_codes)?;
+        let (w, h) = (self.header().width as usize, self.header().height as usize);
+        if codes.tiles.len() != self.header().conditions.len()
+            || (codes.width, codes.height) != (w, h)
+        {
+            return Err(self.chunk_error(&k, "images of the wrong size or count".into()));
+        }
+        Ok(codes)
     }
 
     /// The alpha of a view.

@@ -1,5 +1,18 @@
-//! Render (to be built by the render issue): the wgpu four-way flowed light-field
-//! renderer (relighting pass, light-field re-binning through the squashed cylinder of
-//! camera centres, four-way flowed morph, shadows and compositing, WGSL shaders in
-//! `shaders/`) and its CPU reference of the same mathematics.
+//! Render: the four-way flowed light-field renderer (BRIEF section 5), in wgpu with WGSL
+//! shaders (`shaders/`) and as a CPU reference of the same mathematics.
+//!
+//! - [`resident`]: a pose made ready to render: pre-lit views, alpha, flow codes, cropped.
+//! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres.
+//! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
+//!   nearest-view, linear-blend and two-way interpolations it is measured against.
+//! - [`cpu`]: the CPU reference renderer.
+//!
 //! Conventions: [`frf_core::conventions`].
+
+pub mod cpu;
+pub mod cylinder;
+pub mod error;
+pub mod morph;
+pub mod resident;
+
+pub use error::{RenderError, Result};

@@ -1,0 +1,132 @@
+//! The CPU reference renderer (rayon): for every pixel of the virtual camera, the ray
+//! through it is re-binned through the cylinder of camera centres ([`crate::cylinder`]),
+//! the camera interpolated at the hit, the pixel `s` of that camera through which the ray
+//! passes found, and the quad's images morphed there ([`crate::morph`]). The GPU renderer
+//! computes the same in `shaders/rebin.wgsl` and is tested against this one.
+
+use frf_core::camera::Camera;
+use frf_core::image::{Image, Rgba};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::cylinder::{Clamp, Cylinder, CylinderHit, interpolate_camera};
+use crate::morph::{Variant, morph, quad_views};
+use crate::resident::ResidentPose;
+
+/// What happened to the pixels of a frame.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FrameStats {
+    /// Pixels whose ray crossed the cylinder inside the grid.
+    pub inside: usize,
+    /// Pixels clamped to the top row (rays above the grid).
+    pub clamped_above: usize,
+    /// Pixels clamped to the bottom row.
+    pub clamped_below: usize,
+    /// Pixels whose ray meets no view (looking away from, or along the axis of, the grid).
+    pub missed: usize,
+}
+
+impl FrameStats {
+    fn count(&mut self, hit: Option<&CylinderHit>) {
+        match hit.map(|h| h.clamped) {
+            Some(Clamp::None) => self.inside += 1,
+            Some(Clamp::Above) => self.clamped_above += 1,
+            Some(Clamp::Below) => self.clamped_below += 1,
+            None => self.missed += 1,
+        }
+    }
+
+    fn merge(mut self, o: Self) -> Self {
+        self.inside += o.inside;
+        self.clamped_above += o.clamped_above;
+        self.clamped_below += o.clamped_below;
+        self.missed += o.missed;
+        self
+    }
+}
+
+/// The cylinder of a pose's cameras.
+pub fn pose_cylinder(pose: &ResidentPose) -> Cylinder {
+    let centres: Vec<Vec3> = pose.cameras.iter().map(|c| c.centre()).collect();
+    Cylinder::new(&centres, pose.columns, pose.rows, pose.wraps)
+}
+
+/// The pixel of the interpolated camera of `hit` through which the ray with direction
+/// `dir` passes, or `None` if it points behind that camera.
+pub fn source_pixel(pose: &ResidentPose, hit: &CylinderHit, dir: Vec3) -> Option<Vec2> {
+    let [a, b, c, d] = quad_views(pose, hit);
+    let cams = [
+        &pose.cameras[a],
+        &pose.cameras[b],
+        &pose.cameras[c],
+        &pose.cameras[d],
+    ];
+    let cam = interpolate_camera(cams, hit.beta, hit.gamma, hit.point);
+    let dc = cam.world_from_camera.rotation.transpose() * dir;
+    if dc.z <= 1e-6 {
+        return None;
+    }
+    let k = &cam.intrinsics;
+    Some(Vec2::new(
+        k.fx * dc.x / dc.z + k.cx,
+        k.fy * dc.y / dc.z + k.cy,
+    ))
+}
+
+/// One pixel: premultiplied RGBA and how its ray was re-binned.
+pub fn render_pixel(
+    pose: &ResidentPose,
+    cylinder: &Cylinder,
+    camera: &Camera,
+    pixel: Vec2,
+    variant: Variant,
+) -> (Rgba, Option<CylinderHit>) {
+    let dir = camera.ray_direction(pixel);
+    let Some(hit) = cylinder.intersect(camera.centre(), dir) else {
+        return ([0.0; 4], None);
+    };
+    let Some(s) = source_pixel(pose, &hit, dir) else {
+        return ([0.0; 4], None);
+    };
+    (morph(pose, &hit, s, variant), Some(hit))
+}
+
+/// Renders a frame of `camera` (subject frame) with `variant`.
+pub fn render_cpu(
+    pose: &ResidentPose,
+    camera: &Camera,
+    variant: Variant,
+) -> (Image<Rgba>, FrameStats) {
+    let cylinder = pose_cylinder(pose);
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let rows: Vec<(Vec<Rgba>, FrameStats)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut stats = FrameStats::default();
+            let row = (0..w)
+                .map(|x| {
+                    let (px, hit) = render_pixel(
+                        pose,
+                        &cylinder,
+                        camera,
+                        Vec2::new(x as f32, y as f32),
+                        variant,
+                    );
+                    stats.count(hit.as_ref());
+                    px
+                })
+                .collect();
+            (row, stats)
+        })
+        .collect();
+    let mut stats = FrameStats::default();
+    let mut pixels = Vec::with_capacity(w * h);
+    for (row, s) in rows {
+        pixels.extend(row);
+        stats = stats.merge(s);
+    }
+    (
+        Image::from_vec(w, h, pixels).expect("w*h pixels by construction"),
+        stats,
+    )
+}

@@ -1,0 +1,430 @@
+//! One pose of a field made ready to render: every view's pre-lit image (its basis images
+//! relit by the environment, BRIEF section 5.1), alpha and flows, in the compact form
+//! the GPU holds them in, so that the GPU and the CPU reference read identical data.
+//!
+//! - **Crop.** Everything is cropped to the union of the views' mattes (grown by
+//!   [`CROP_MARGIN_PX`], beyond the flows' margin): outside it every view is transparent
+//!   black, so nothing is lost, and at the original's size about half the pixels go.
+//! - **Pre-lit images**: RGBA8, colour as sRGB-encoded `linear / scale` with one scale per
+//!   view (its brightest value, so nothing clips), alpha linear. A GPU samples them through
+//!   an sRGB view, which decodes before it filters; the CPU decodes each texel the same way.
+//! - **Flows** stay as their 8-bit logarithmic codes, two per pixel, decoded when sampled
+//!   (unknown flow reads as zero displacement).
+//!
+//! Relighting skips conditions whose coefficient is zero for every view (none of its
+//! light reaches the subject, e.g. the floor conditions under a black lower
+//! hemisphere); [`LightingPlan`] says which and what that saved.
+
+use frf_core::camera::Camera;
+use frf_core::env::EnvMap;
+use frf_core::grid::Neighbour;
+use frf_core::image::{GrayImage, Rgb};
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
+use frf_reflectance::flowcodec::quant::LogQuantizer;
+use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
+use frf_reflectance::project::{FloorModel, Projector};
+use glam::Vec2;
+use rayon::prelude::*;
+
+use crate::error::{RenderError, Result};
+
+/// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
+pub const CROP_MARGIN_PX: u32 = 4;
+
+/// How the field is lit.
+#[derive(Debug, Clone)]
+pub enum Lighting {
+    /// An HDR environment (subject frame), with the floor conditions' model.
+    Environment {
+        /// The environment.
+        env: EnvMap,
+        /// Where the floor conditions' light comes from.
+        floor: FloorModel,
+    },
+    /// Every condition at coefficient 1 (for fields of photographs: no relighting).
+    Unlit,
+}
+
+/// A rectangle of the full image, pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Crop {
+    /// Left column.
+    pub x0: u32,
+    /// Top row.
+    pub y0: u32,
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+}
+
+/// What relighting left out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightingPlan {
+    /// Conditions whose coefficient is zero in every view: not relit at all.
+    pub skipped_conditions: Vec<String>,
+    /// Basis images decoded and combined.
+    pub images_combined: usize,
+    /// Basis images a plan without skipping would have combined.
+    pub images_total: usize,
+}
+
+/// One pose's geometry, flows and basis images as loaded from a field file, before
+/// relighting (what [`ResidentPose::relight_cpu`] and the GPU relighting pass start from).
+#[derive(Debug, Clone)]
+pub struct PoseSource {
+    /// Pose index.
+    pub pose: u32,
+    /// Grid columns.
+    pub columns: usize,
+    /// Grid rows.
+    pub rows: usize,
+    /// Whether columns close into a ring.
+    pub wraps: bool,
+    /// Full image size.
+    pub image_size: (u32, u32),
+    /// The crop.
+    pub crop: Crop,
+    /// Cameras (subject frame), `u`-major.
+    pub cameras: Vec<Camera>,
+    /// Per view: the basis mosaic's codes and scales, cropped.
+    pub basis: Vec<BasisCodes>,
+    /// Per view: alpha codes (`round(255 α)`), cropped.
+    pub alpha: Vec<Vec<u8>>,
+    /// Per view and neighbour: flow codes `(u, v)` per pixel, cropped.
+    pub flows: Vec<[Option<Vec<[i8; 2]>>; 4]>,
+    /// The pose's flow quantizer.
+    pub quantizer: LogQuantizer,
+    /// Per view and condition: relighting coefficients (RGB).
+    pub coefficients: Vec<Vec<Rgb>>,
+    /// What relighting leaves out.
+    pub plan: LightingPlan,
+}
+
+fn crop_of(alphas: &[GrayImage], size: (u32, u32)) -> Crop {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0u32, 0u32);
+    for a in alphas {
+        for (i, &v) in a.pixels().iter().enumerate() {
+            if v > 0.0 {
+                let (x, y) = ((i % a.width()) as u32, (i / a.width()) as u32);
+                x0 = x0.min(x);
+                y0 = y0.min(y);
+                x1 = x1.max(x);
+                y1 = y1.max(y);
+            }
+        }
+    }
+    if x0 > x1 {
+        return Crop {
+            x0: 0,
+            y0: 0,
+            width: 1,
+            height: 1,
+        };
+    }
+    let x0 = x0.saturating_sub(CROP_MARGIN_PX);
+    let y0 = y0.saturating_sub(CROP_MARGIN_PX);
+    let x1 = (x1 + CROP_MARGIN_PX).min(size.0 - 1);
+    let y1 = (y1 + CROP_MARGIN_PX).min(size.1 - 1);
+    Crop {
+        x0,
+        y0,
+        width: x1 - x0 + 1,
+        height: y1 - y0 + 1,
+    }
+}
+
+fn crop_rows<T: Copy>(data: &[T], full_width: usize, c: &Crop) -> Vec<T> {
+    let mut out = Vec::with_capacity((c.width * c.height) as usize);
+    for y in c.y0..c.y0 + c.height {
+        let row = y as usize * full_width;
+        out.extend_from_slice(&data[row + c.x0 as usize..row + (c.x0 + c.width) as usize]);
+    }
+    out
+}
+
+impl PoseSource {
+    /// Loads pose `pose` of a field and the relighting coefficients of `lighting`.
+    pub fn load<R: ReadAt>(field: &FieldFile<R>, pose: u32, lighting: &Lighting) -> Result<Self> {
+        let h = field.header();
+        let record = h.pose(pose)?;
+        let (columns, rows) = (h.columns, h.rows);
+        let views = columns * rows;
+        let cameras = record
+            .views
+            .iter()
+            .map(|v| v.camera.to_camera().map_err(RenderError::BadParameter))
+            .collect::<Result<Vec<_>>>()?;
+        let alphas: Vec<GrayImage> = (0..views)
+            .into_par_iter()
+            .map(|i| Ok(field.alpha(pose, i / rows, i % rows)?))
+            .collect::<Result<_>>()?;
+        let size = (h.width, h.height);
+        let crop = crop_of(&alphas, size);
+        let coefficients: Vec<Vec<Rgb>> = match lighting {
+            Lighting::Unlit => vec![vec![[1.0; 3]; h.conditions.len()]; views],
+            Lighting::Environment { env, floor } => {
+                let projector = Projector::new(&h.conditions)?;
+                record
+                    .views
+                    .iter()
+                    .map(|v| projector.project(env, v.turntable_deg.to_radians(), *floor))
+                    .collect()
+            }
+        };
+        let used: Vec<bool> = (0..h.conditions.len())
+            .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
+            .collect();
+        let plan = LightingPlan {
+            skipped_conditions: h
+                .conditions
+                .iter()
+                .zip(&used)
+                .filter(|(_, u)| !**u)
+                .map(|(c, _)| c.name.clone())
+                .collect(),
+            images_combined: views * used.iter().filter(|&&u| u).count(),
+            images_total: views * h.conditions.len(),
+        };
+        let full_w = h.width as usize;
+        let per_view: Vec<(BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4])> = (0..views)
+            .into_par_iter()
+            .map(|i| {
+                let (u, v) = (i / rows, i % rows);
+                let mut b = field.basis_codes(pose, u, v)?;
+                b.tiles = b
+                    .tiles
+                    .iter()
+                    .map(|t| crop_rows(t, full_w, &crop))
+                    .collect();
+                b.width = crop.width as usize;
+                b.height = crop.height as usize;
+                let a: Vec<u8> = alphas[i]
+                    .pixels()
+                    .iter()
+                    .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+                    .collect();
+                let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
+                for n in Neighbour::ALL {
+                    if let Some(codes) = field.flow_codes(pose, u, v, n)? {
+                        let plane = codes.len() / 2;
+                        let pairs: Vec<[i8; 2]> =
+                            (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
+                        flows[n.index()] = Some(crop_rows(&pairs, full_w, &crop));
+                    }
+                }
+                Ok((b, crop_rows(&a, full_w, &crop), flows))
+            })
+            .collect::<Result<_>>()?;
+        let mut basis = Vec::with_capacity(views);
+        let mut alpha = Vec::with_capacity(views);
+        let mut flows = Vec::with_capacity(views);
+        for (b, a, f) in per_view {
+            basis.push(b);
+            alpha.push(a);
+            flows.push(f);
+        }
+        Ok(Self {
+            pose,
+            columns,
+            rows,
+            wraps: h.wraps,
+            image_size: size,
+            crop,
+            cameras,
+            basis,
+            alpha,
+            flows,
+            quantizer: record.flow_quantizer,
+            coefficients,
+            plan,
+        })
+    }
+}
+
+/// A pose ready to render: pre-lit views, alpha and flow codes (see the module docs).
+#[derive(Debug, Clone)]
+pub struct ResidentPose {
+    /// Pose index.
+    pub pose: u32,
+    /// Grid columns.
+    pub columns: usize,
+    /// Grid rows.
+    pub rows: usize,
+    /// Whether columns close into a ring.
+    pub wraps: bool,
+    /// Full image size.
+    pub image_size: (u32, u32),
+    /// The crop.
+    pub crop: Crop,
+    /// Cameras (subject frame), `u`-major.
+    pub cameras: Vec<Camera>,
+    /// Per view: colour scale.
+    pub scales: Vec<f32>,
+    /// Per view: RGBA8 texels (sRGB colour / scale, linear alpha), cropped.
+    pub prelit: Vec<Vec<[u8; 4]>>,
+    /// Per view and neighbour: flow codes, cropped.
+    pub flows: Vec<[Option<Vec<[i8; 2]>>; 4]>,
+    /// The flow quantizer.
+    pub quantizer: LogQuantizer,
+    /// What relighting left out.
+    pub plan: LightingPlan,
+}
+
+/// The sRGB transfer function, linear to encoded (IEC 61966-2-1).
+#[inline]
+pub fn srgb_encode(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The sRGB transfer function, encoded to linear, as a GPU's `*-srgb` formats apply it.
+#[inline]
+pub fn srgb_decode(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The pre-lit colour of one pixel from a view's basis codes and coefficients.
+#[inline]
+pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i: usize) -> Rgb {
+    let mut out = [0.0f32; 3];
+    for ((tile, scale), c) in basis.tiles.iter().zip(&basis.scales).zip(coefficients) {
+        if c.iter().all(|&x| x == 0.0) {
+            continue;
+        }
+        let p = tile[i];
+        for k in 0..3 {
+            out[k] += c[k] * scale * lut[p[k] as usize];
+        }
+    }
+    out
+}
+
+impl ResidentPose {
+    /// Relights every view on the CPU and encodes it (the GPU's relighting pass computes
+    /// the same).
+    pub fn relight_cpu(source: &PoseSource) -> Self {
+        let lut = gamma_lut();
+        let views: Vec<(f32, Vec<[u8; 4]>)> = (0..source.basis.len())
+            .into_par_iter()
+            .map(|i| {
+                let b = &source.basis[i];
+                let n = b.width * b.height;
+                let relit: Vec<Rgb> = (0..n)
+                    .map(|p| relit_pixel(b, &source.coefficients[i], &lut, p))
+                    .collect();
+                let peak = relit.iter().flatten().copied().fold(0.0f32, f32::max);
+                let scale = if peak > 0.0 { peak } else { 1.0 };
+                let texels = relit
+                    .iter()
+                    .zip(&source.alpha[i])
+                    .map(|(c, &a)| {
+                        let e = |x: f32| (srgb_encode(x / scale) * 255.0).round() as u8;
+                        [e(c[0]), e(c[1]), e(c[2]), a]
+                    })
+                    .collect();
+                (scale, texels)
+            })
+            .collect();
+        let (scales, prelit) = views.into_iter().unzip();
+        Self {
+            pose: source.pose,
+            columns: source.columns,
+            rows: source.rows,
+            wraps: source.wraps,
+            image_size: source.image_size,
+            crop: source.crop,
+            cameras: source.cameras.clone(),
+            scales,
+            prelit,
+            flows: source.flows.clone(),
+            quantizer: source.quantizer,
+            plan: source.plan.clone(),
+        }
+    }
+
+    /// Bytes the pose takes on the GPU: pre-lit RGBA8 and flow RG8 texture arrays (one
+    /// layer per view and per stored flow), plus the per-view tables.
+    pub fn resident_bytes(&self) -> u64 {
+        let texels = self.crop.width as u64 * self.crop.height as u64;
+        let flow_layers = self.flows.iter().flatten().filter(|f| f.is_some()).count() as u64;
+        let tables = self.cameras.len() as u64 * 64;
+        texels * 4 * self.prelit.len() as u64 + texels * 2 * flow_layers + tables
+    }
+
+    /// Bilinear sample (premultiplied RGBA, linear) of view `view` at full-image pixel
+    /// coordinates `s`; the edge repeats beyond the crop (it is transparent there).
+    pub fn sample_prelit(&self, view: usize, s: Vec2) -> [f32; 4] {
+        let (w, h) = (self.crop.width as i64, self.crop.height as i64);
+        let x = s.x - self.crop.x0 as f32;
+        let y = s.y - self.crop.y0 as f32;
+        if !(x.is_finite() && y.is_finite()) {
+            return [0.0; 4];
+        }
+        let (x, y) = (x.clamp(-1.0, w as f32), y.clamp(-1.0, h as f32));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texels = &self.prelit[view];
+        let scale = self.scales[view];
+        let mut out = [0.0f32; 4];
+        for (dy, wy) in [(0i64, 1.0 - fy), (1, fy)] {
+            for (dx, wx) in [(0i64, 1.0 - fx), (1, fx)] {
+                let xi = (x0 as i64 + dx).clamp(0, w - 1);
+                let yi = (y0 as i64 + dy).clamp(0, h - 1);
+                let t = texels[(yi * w + xi) as usize];
+                let wt = wx * wy;
+                for k in 0..3 {
+                    out[k] += wt * scale * srgb_decode(t[k] as f32 / 255.0);
+                }
+                out[3] += wt * t[3] as f32 / 255.0;
+            }
+        }
+        out
+    }
+
+    /// Bilinear sample of the flow from view `view` toward `n` at full-image pixel
+    /// coordinates `s` (each texel decoded first; unknown or absent flow is zero).
+    pub fn sample_flow(&self, view: usize, n: Neighbour, s: Vec2) -> Vec2 {
+        let Some(codes) = &self.flows[view][n.index()] else {
+            return Vec2::ZERO;
+        };
+        let (w, h) = (self.crop.width as i64, self.crop.height as i64);
+        let x = s.x - self.crop.x0 as f32;
+        let y = s.y - self.crop.y0 as f32;
+        if !(x.is_finite() && y.is_finite()) {
+            return Vec2::ZERO;
+        }
+        let (x, y) = (x.clamp(-1.0, w as f32), y.clamp(-1.0, h as f32));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let mut out = Vec2::ZERO;
+        for (dy, wy) in [(0i64, 1.0 - fy), (1, fy)] {
+            for (dx, wx) in [(0i64, 1.0 - fx), (1, fx)] {
+                let xi = (x0 as i64 + dx).clamp(0, w - 1);
+                let yi = (y0 as i64 + dy).clamp(0, h - 1);
+                out += decode_flow(codes[(yi * w + xi) as usize], &self.quantizer) * (wx * wy);
+            }
+        }
+        out
+    }
+}
+
+/// One flow texel's displacement; unknown is zero.
+#[inline]
+pub fn decode_flow(c: [i8; 2], q: &LogQuantizer) -> Vec2 {
+    if c[0] == frf_reflectance::flowcodec::quant::UNKNOWN_CODE
+        || c[1] == frf_reflectance::flowcodec::quant::UNKNOWN_CODE
+    {
+        return Vec2::ZERO;
+    }
+    Vec2::new(q.decode(c[0]), q.decode(c[1]))
+}
