@@ -150,6 +150,31 @@ fn outside(bg: Vec2) -> f32 {
     d(bg.x) + d(bg.y)
 }
 
+/// One quad of the cylinder: `p = p00 + β e1 + γ e2 + βγ e3`, its plane's normal, its
+/// grid position, and for the walls above and below the grid (`wall` 1 and 2; 0 inside)
+/// the `γ` rays are clamped to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadData {
+    /// Column.
+    pub u: u32,
+    /// Row.
+    pub v: u32,
+    /// Corner `(u, v)`.
+    pub p00: Vec3,
+    /// Toward `(u + 1, v)`.
+    pub e1: Vec3,
+    /// Toward `(u, v + 1)`.
+    pub e2: Vec3,
+    /// The twist `P00 − P10 − P01 + P11`.
+    pub e3: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// 0 inside the grid, 1 above, 2 below.
+    pub wall: u32,
+    /// The clamped `γ` of a wall.
+    pub wall_gamma: f32,
+}
+
 /// The cylinder of a pose's camera centres.
 #[derive(Debug, Clone)]
 pub struct Cylinder {
@@ -246,6 +271,28 @@ impl Cylinder {
             return None;
         }
         hits.into_iter().min_by(|a, b| a.t.total_cmp(&b.t))
+    }
+
+    /// The quads and walls, as the GPU needs them.
+    pub fn quads(&self) -> Vec<QuadData> {
+        self.quads
+            .iter()
+            .map(|q| QuadData {
+                u: q.u as u32,
+                v: q.v as u32,
+                p00: q.p00,
+                e1: q.e1,
+                e2: q.e2,
+                e3: q.e3,
+                normal: q.normal,
+                wall: match q.wall {
+                    None => 0,
+                    Some((_, Clamp::Above)) => 1,
+                    Some(_) => 2,
+                },
+                wall_gamma: q.wall.map_or(0.0, |w| w.0),
+            })
+            .collect()
     }
 
     /// Index of view `(u, v)` (`u` taken modulo the columns).

@@ -5,13 +5,14 @@
 //! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres.
 //! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
 //!   nearest-view, linear-blend and two-way interpolations it is measured against.
-//! - [`cpu`]: the CPU reference renderer.
+//! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin.
 //!
 //! Conventions: [`frf_core::conventions`].
 
 pub mod cpu;
 pub mod cylinder;
 pub mod error;
+pub mod gpu;
 pub mod morph;
 pub mod resident;
 

@@ -46,6 +46,10 @@ pub enum Lighting {
     Unlit,
 }
 
+/// One view's codes as read from the field: basis tiles, 8-bit alpha, and the
+/// log-coded flow to each of its four neighbours (absent at the grid's edges).
+type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4]);
+
 /// A rectangle of the full image, pixels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Crop {
@@ -188,7 +192,7 @@ impl PoseSource {
             images_total: views * h.conditions.len(),
         };
         let full_w = h.width as usize;
-        let per_view: Vec<(BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4])> = (0..views)
+        let per_view: Vec<ViewCodes> = (0..views)
             .into_par_iter()
             .map(|i| {
                 let (u, v) = (i / rows, i % rows);
@@ -268,6 +272,10 @@ pub struct ResidentPose {
     pub flows: Vec<[Option<Vec<[i8; 2]>>; 4]>,
     /// The flow quantizer.
     pub quantizer: LogQuantizer,
+    /// Decoding table of the pre-lit texels ([`srgb_lut`]).
+    pub srgb_table: [f32; 256],
+    /// Decoding table of the flow texels ([`flow_lut`] of `quantizer`).
+    pub flow_table: [f32; 256],
     /// What relighting left out.
     pub plan: LightingPlan,
 }
@@ -291,6 +299,25 @@ pub fn srgb_decode(c: f32) -> f32 {
     } else {
         ((c + 0.055) / 1.055).powf(2.4)
     }
+}
+
+/// 8-bit sRGB code to linear: the table both the CPU and the GPU decode texels with, so
+/// that they read identical values.
+pub fn srgb_lut() -> [f32; 256] {
+    std::array::from_fn(|c| srgb_decode(c as f32 / 255.0))
+}
+
+/// Flow code (offset by 128) to displacement, unknown (−128) to zero: the table both the
+/// CPU and the GPU decode flow texels with.
+pub fn flow_lut(q: &LogQuantizer) -> [f32; 256] {
+    std::array::from_fn(|i| {
+        let code = (i as i32 - 128) as i8;
+        if code == frf_reflectance::flowcodec::quant::UNKNOWN_CODE {
+            0.0
+        } else {
+            q.decode(code)
+        }
+    })
 }
 
 /// The pre-lit colour of one pixel from a view's basis codes and coefficients.
@@ -348,6 +375,8 @@ impl ResidentPose {
             prelit,
             flows: source.flows.clone(),
             quantizer: source.quantizer,
+            srgb_table: srgb_lut(),
+            flow_table: flow_lut(&source.quantizer),
             plan: source.plan.clone(),
         }
     }
@@ -375,6 +404,7 @@ impl ResidentPose {
         let (fx, fy) = (x - x0, y - y0);
         let texels = &self.prelit[view];
         let scale = self.scales[view];
+        let lut = &self.srgb_table;
         let mut out = [0.0f32; 4];
         for (dy, wy) in [(0i64, 1.0 - fy), (1, fy)] {
             for (dx, wx) in [(0i64, 1.0 - fx), (1, fx)] {
@@ -383,7 +413,7 @@ impl ResidentPose {
                 let t = texels[(yi * w + xi) as usize];
                 let wt = wx * wy;
                 for k in 0..3 {
-                    out[k] += wt * scale * srgb_decode(t[k] as f32 / 255.0);
+                    out[k] += wt * (scale * lut[t[k] as usize]);
                 }
                 out[3] += wt * t[3] as f32 / 255.0;
             }
@@ -406,12 +436,21 @@ impl ResidentPose {
         let (x, y) = (x.clamp(-1.0, w as f32), y.clamp(-1.0, h as f32));
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
+        let lut = &self.flow_table;
         let mut out = Vec2::ZERO;
         for (dy, wy) in [(0i64, 1.0 - fy), (1, fy)] {
             for (dx, wx) in [(0i64, 1.0 - fx), (1, fx)] {
                 let xi = (x0 as i64 + dx).clamp(0, w - 1);
                 let yi = (y0 as i64 + dy).clamp(0, h - 1);
-                out += decode_flow(codes[(yi * w + xi) as usize], &self.quantizer) * (wx * wy);
+                let c = codes[(yi * w + xi) as usize];
+                let known = c[0] != i8::MIN && c[1] != i8::MIN;
+                if known {
+                    let d = Vec2::new(
+                        lut[(c[0] as i32 + 128) as usize],
+                        lut[(c[1] as i32 + 128) as usize],
+                    );
+                    out += d * (wx * wy);
+                }
             }
         }
         out

@@ -11,7 +11,7 @@ use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_render::cpu::{pose_cylinder, render_cpu, render_pixel, source_pixel};
 use frf_render::cylinder::{Clamp, CylinderHit};
 use frf_render::morph::{Variant, morph, quad_views};
-use frf_render::resident::{Crop, LightingPlan, ResidentPose, decode_flow};
+use frf_render::resident::{Crop, LightingPlan, ResidentPose, decode_flow, flow_lut, srgb_lut};
 use glam::{Vec2, Vec3};
 
 const W: u32 = 24;
@@ -78,6 +78,8 @@ fn pose() -> ResidentPose {
         prelit,
         flows,
         quantizer: q,
+        srgb_table: srgb_lut(),
+        flow_table: flow_lut(&q),
         plan: LightingPlan {
             skipped_conditions: vec![],
             images_combined: 0,

@@ -1,0 +1,92 @@
+//! `#[repr(C)]` Pod structs mirroring the WGSL structs of `shaders/`, padded explicitly;
+//! a test checks each size and field offset against naga's layout of the shader.
+
+use bytemuck::{Pod, Zeroable};
+
+/// `View` of `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuView {
+    /// Quaternion `(x, y, z, w)` of `world_from_camera`.
+    pub rotation: [f32; 4],
+    /// Camera centre.
+    pub centre: [f32; 3],
+    /// Pre-lit colour scale.
+    pub scale: f32,
+    /// fx, fy, cx, cy.
+    pub intrinsics: [f32; 4],
+    /// Flow layers toward right, left, up, down; -1 none.
+    pub flow_layers: [i32; 4],
+}
+
+/// `Quad` of `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuQuad {
+    /// Corner.
+    pub p00: [f32; 3],
+    /// Column.
+    pub u: u32,
+    /// Edge toward the next column.
+    pub e1: [f32; 3],
+    /// Row.
+    pub v: u32,
+    /// Edge toward the next row.
+    pub e2: [f32; 3],
+    /// 0 inside, 1 wall above, 2 wall below.
+    pub wall: u32,
+    /// Twist.
+    pub e3: [f32; 3],
+    /// Clamped γ of a wall.
+    pub wall_gamma: f32,
+    /// Normal.
+    pub normal: [f32; 3],
+    /// Padding to 16 bytes.
+    pub pad: f32,
+}
+
+/// `Frame` of `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuFrame {
+    /// Virtual camera's `world_from_camera` x column (w unused).
+    pub axis_x: [f32; 4],
+    /// y column.
+    pub axis_y: [f32; 4],
+    /// z column.
+    pub axis_z: [f32; 4],
+    /// Centre (w unused).
+    pub centre: [f32; 4],
+    /// fx, fy, cx, cy.
+    pub intrinsics: [f32; 4],
+    /// Output size.
+    pub size: [u32; 2],
+    /// [`crate::morph::Variant::index`].
+    pub variant: u32,
+    /// Number of quads.
+    pub quad_count: u32,
+    /// Grid columns.
+    pub columns: u32,
+    /// Grid rows.
+    pub rows: u32,
+    /// Crop origin in the full image.
+    pub crop_origin: [u32; 2],
+    /// Crop size.
+    pub crop_size: [u32; 2],
+    /// Padding to 16 bytes.
+    pub pad: [u32; 2],
+}
+
+/// `RelightParams` of `shaders/relight.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuRelightParams {
+    /// Texels per view.
+    pub texels: u32,
+    /// Basis images per view.
+    pub tiles: u32,
+    /// Row length.
+    pub width: u32,
+    /// View index.
+    pub view: u32,
+}
