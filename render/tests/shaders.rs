@@ -1,0 +1,136 @@
+//! The WGSL of `shaders/`: every file parses and validates with naga as compiled (the
+//! shared definitions of `common.wgsl`, then the pass), and every Pod struct of
+//! `frf_render::gpu::types` has the size and field offsets naga lays out for its WGSL
+//! twin. Needs no GPU.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::mem::{offset_of, size_of};
+
+use frf_render::gpu::shaders;
+use frf_render::gpu::types::{GpuFrame, GpuQuad, GpuRelightParams, GpuView};
+use naga::valid::{Capabilities, ValidationFlags, Validator};
+
+fn module(source: &str, name: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    Validator::new(ValidationFlags::all(), Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    module
+}
+
+#[test]
+fn every_wgsl_file_parses_and_validates_as_compiled() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    let mut passes = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "wgsl") {
+            continue;
+        }
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if name == "common.wgsl" {
+            module(&text, &name);
+            assert_eq!(text, shaders::COMMON, "{name} as compiled");
+        } else {
+            let m = module(&shaders::composed(&text), &name);
+            assert!(!m.entry_points.is_empty(), "{name} has no entry point");
+            passes += 1;
+        }
+    }
+    // The renderer's passes are exactly the files here.
+    assert_eq!(passes, 2, "passes in {}", dir.display());
+    for (name, pass) in [("relight", shaders::RELIGHT), ("rebin", shaders::REBIN)] {
+        module(&shaders::composed(pass), name);
+    }
+}
+
+#[test]
+fn a_broken_shader_is_refused() {
+    // The validation above can fail: a type error in an otherwise valid pass.
+    let broken = shaders::REBIN.replacen("fn ", "fn broken() -> f32 { return 1u; }\nfn ", 1);
+    let source = shaders::composed(&broken);
+    let parsed = naga::front::wgsl::parse_str(&source);
+    let refused = match parsed {
+        Err(_) => true,
+        Ok(m) => Validator::new(ValidationFlags::all(), Capabilities::default())
+            .validate(&m)
+            .is_err(),
+    };
+    assert!(refused);
+}
+
+/// Size and member offsets of the WGSL struct `name`, as naga lays it out.
+fn layout(module: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct");
+    };
+    let fields = members
+        .iter()
+        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+        .collect();
+    (layouter[handle].size, fields)
+}
+
+macro_rules! check_layout {
+    ($module:expr, $wgsl:literal, $rust:ty, [$($field:ident),* $(,)?]) => {{
+        let (size, fields) = layout($module, $wgsl);
+        assert_eq!(size as usize, size_of::<$rust>(), "size of {}", $wgsl);
+        let rust: Vec<(String, u32)> =
+            vec![$((stringify!($field).to_string(), offset_of!($rust, $field) as u32)),*];
+        assert_eq!(fields, rust, "fields of {}", $wgsl);
+    }};
+}
+
+#[test]
+fn pod_structs_match_naga_layouts() {
+    let rebin = module(&shaders::composed(shaders::REBIN), "rebin");
+    check_layout!(
+        &rebin,
+        "View",
+        GpuView,
+        [rotation, centre, scale, intrinsics, flow_layers]
+    );
+    check_layout!(
+        &rebin,
+        "Quad",
+        GpuQuad,
+        [p00, u, e1, v, e2, wall, e3, wall_gamma, normal, pad]
+    );
+    check_layout!(
+        &rebin,
+        "Frame",
+        GpuFrame,
+        [
+            axis_x,
+            axis_y,
+            axis_z,
+            centre,
+            intrinsics,
+            size,
+            variant,
+            quad_count,
+            columns,
+            rows,
+            crop_origin,
+            crop_size,
+            pad
+        ]
+    );
+    let relight = module(&shaders::composed(shaders::RELIGHT), "relight");
+    check_layout!(
+        &relight,
+        "RelightParams",
+        GpuRelightParams,
+        [texels, tiles, width, view]
+    );
+}
