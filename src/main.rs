@@ -32,6 +32,12 @@ enum Command {
     Ingest(cmd::ingest::IngestArgs),
     /// Turn a calibrated ring of photographs (Middlebury multi-view) into a field.
     IngestRing(cmd::ingest::RingArgs),
+    /// Render frames of a field, relit by an environment, along a camera path.
+    Render(Box<cmd::render::RenderArgs>),
+    /// Score renders between the grid's views against the virtual stage's truth.
+    Eval(Box<cmd::eval::EvalArgs>),
+    /// Score views held out of a ring of photographs, rendered from their neighbours.
+    EvalRing(cmd::eval::RingEvalArgs),
     /// Optical flow from image A to image B, written as a Middlebury .flo file.
     Flow(cmd::flow::FlowArgs),
     /// Error and time of the flow estimator on Middlebury or Sintel pairs with ground truth.
@@ -45,6 +51,9 @@ fn main() -> ExitCode {
         Command::Info(args) => cmd::info::run(args),
         Command::Ingest(args) => cmd::ingest::run(args),
         Command::IngestRing(args) => cmd::ingest::run_ring(args),
+        Command::Render(args) => cmd::render::run(*args),
+        Command::Eval(args) => cmd::eval::run(*args),
+        Command::EvalRing(args) => cmd::eval::run_ring(args),
         Command::Flow(args) => cmd::flow::run(args),
         Command::FlowBench(args) => cmd::flow::run_bench(args),
     };

@@ -295,17 +295,12 @@ pub struct RingReport {
     pub seconds: f64,
 }
 
-/// Ingests the ring described by `par` into the field file `out`.
-pub fn ingest_ring(
-    par: &Path,
-    out: &Path,
-    params: &FlowParams,
-    jpeg_quality: u8,
-) -> Result<RingReport> {
-    let start = Instant::now();
+/// The ring described by `par` in its subject frame: the views sorted by azimuth, their
+/// cameras (subject frame) and whether the ring closes.
+pub fn ring_views(par: &Path) -> Result<(Vec<RingView>, Vec<Camera>, bool)> {
     let all = read_par(par)?;
     let (subject_from_world, order, wraps) = ring_frame(&all)?;
-    let views: Vec<&RingView> = order.iter().map(|&i| &all[i]).collect();
+    let views: Vec<RingView> = order.iter().map(|&i| all[i].clone()).collect();
     let (w, h) = (views[0].camera.width, views[0].camera.height);
     if let Some(v) = views
         .iter()
@@ -319,10 +314,38 @@ pub fn ingest_ring(
             ),
         ));
     }
-    let cameras: Vec<Camera> = views
+    let cameras = views
         .iter()
         .map(|v| v.camera.transformed(&subject_from_world))
         .collect();
+    Ok((views, cameras, wraps))
+}
+
+/// Ingests the ring described by `par` into the field file `out`, keeping every
+/// `stride`-th view in azimuth order (1: all; 2, 4, 6: the views between them are held
+/// out for evaluation, in the subject frame of the whole ring).
+pub fn ingest_ring(
+    par: &Path,
+    out: &Path,
+    params: &FlowParams,
+    jpeg_quality: u8,
+    stride: usize,
+) -> Result<RingReport> {
+    let start = Instant::now();
+    let (all_views, all_cameras, all_wrap) = ring_views(par)?;
+    if stride == 0 || all_views.len() / stride.max(1) < 3 {
+        return Err(bad(
+            par,
+            format!(
+                "stride {stride} leaves fewer than 3 of the ring's {} views",
+                all_views.len()
+            ),
+        ));
+    }
+    let wraps = all_wrap && all_views.len() % stride == 0;
+    let views: Vec<&RingView> = all_views.iter().step_by(stride).collect();
+    let cameras: Vec<Camera> = all_cameras.iter().step_by(stride).copied().collect();
+    let (w, h) = (cameras[0].width, cameras[0].height);
     let images: Vec<(RgbImage, GrayImage)> = views
         .par_iter()
         .map(|v| photo_and_alpha(&v.path))

@@ -161,7 +161,7 @@ fn the_dino_ring_ingests_as_a_closed_one_row_field() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("dino.frf");
     let params = frf_flow::FlowParams::preset(Preset::Fast);
-    let r = frf_ingest::ring::ingest_ring(&par, &out, &params, 95).unwrap();
+    let r = frf_ingest::ring::ingest_ring(&par, &out, &params, 95, 1).unwrap();
     assert_eq!(r.views, 16);
     assert!(r.wraps, "16 views all around close the ring");
     // The dino fills about a third of each 640x480 frame (measured 0.36 on dinoRing).

@@ -5,15 +5,23 @@
 //! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres.
 //! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
 //!   nearest-view, linear-blend and two-way interpolations it is measured against.
-//! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin.
+//! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin;
+//!   [`renderer`]: one front for both.
+//! - [`path`]: virtual camera paths (keyframes, orbit).
+//! - [`eval`]: frames scored against the virtual stage's truth ([`metrics`]: PSNR, SSIM,
+//!   alpha error).
 //!
 //! Conventions: [`frf_core::conventions`].
 
 pub mod cpu;
 pub mod cylinder;
 pub mod error;
+pub mod eval;
 pub mod gpu;
+pub mod metrics;
 pub mod morph;
+pub mod path;
+pub mod renderer;
 pub mod resident;
 
 pub use error::{RenderError, Result};

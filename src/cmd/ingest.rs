@@ -232,6 +232,10 @@ pub struct RingArgs {
     /// JPEG quality of the images.
     #[arg(long, default_value_t = 95)]
     jpeg_quality: u8,
+    /// Keep every n-th view in azimuth order (the others are held out for
+    /// `frf eval-ring`).
+    #[arg(long, default_value_t = 1)]
+    stride: usize,
 }
 
 /// Runs `frf ingest-ring`.
@@ -246,6 +250,7 @@ pub fn run_ring(args: RingArgs) -> CliResult {
         &args.out,
         &frf_flow::FlowParams::preset(preset),
         args.jpeg_quality,
+        args.stride,
     )?;
     println!(
         "ring of {} photographs ({}) written to {} in {:.1} s (wall); mean matte coverage {:.1} % of the frame",

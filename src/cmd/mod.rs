@@ -1,8 +1,10 @@
 //! One module per subcommand, plus shared progress reporting.
 
+pub mod eval;
 pub mod flow;
 pub mod info;
 pub mod ingest;
 pub mod progress;
+pub mod render;
 pub mod stage;
 pub mod stage_field;

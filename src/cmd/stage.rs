@@ -81,6 +81,10 @@ struct CaptureArgs {
     /// Render without sensor noise (quantization remains).
     #[arg(long)]
     no_noise: bool,
+    /// Scale of the cycle-to-cycle perturbations of pose and position (1 = the documented
+    /// amounts; 0 = every cycle repeats exactly, which isolates interpolation error).
+    #[arg(long, default_value_t = 1.0)]
+    perturbation: f32,
 }
 
 #[derive(Args)]
@@ -181,6 +185,7 @@ fn capture(args: CaptureArgs) -> CliResult {
         };
     }
     config.noise = !args.no_noise;
+    config.perturbation = args.perturbation;
     let stage = frf_stage::Stage::new(config)?;
     let bar = bar("stage: views rendered");
     let report = frf_stage::write_capture(&stage, &out, &|done, total| {

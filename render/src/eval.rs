@@ -1,0 +1,210 @@
+//! Rendering judged against the virtual light stage's truth: for virtual cameras between
+//! the grid's views, the stage renders the true image and alpha of the pose under the
+//! same environment (median-cut lights, subject frame), and each interpolation variant
+//! is scored by PSNR and SSIM on the subject and on the whole frame, alpha error, and
+//! the seconds it took per frame.
+//!
+//! The cameras sit at the centre of grid quads (`β = γ = ½`): on the cylinder of camera
+//! centres, as far from every captured view as the grid allows, with orientation and
+//! intrinsics interpolated as the renderer does ([`crate::cylinder::interpolate_camera`]).
+//! The truth shows the unperturbed walker at the pose's instant, while each captured view
+//! shows that cycle's perturbed walker (BRIEF section 7): captures with perturbation 0
+//! isolate the interpolation error.
+
+use std::time::Instant;
+
+use frf_core::camera::Camera;
+use frf_core::image::{Image, Rgba};
+use frf_core::io::rgba_from;
+use frf_core::light::DirLight;
+use frf_stage::Stage;
+use serde::Serialize;
+
+use crate::cylinder::interpolate_camera;
+use crate::error::{RenderError, Result};
+use crate::metrics::{alpha_mae, psnr, ssim, subject_mask};
+use crate::morph::Variant;
+use crate::renderer::Renderer;
+
+/// The scores of one frame.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameScore {
+    /// Which camera.
+    pub camera: String,
+    /// PSNR (dB) where either alpha is at least ½.
+    pub psnr_subject: f64,
+    /// SSIM of luminance there.
+    pub ssim_subject: f64,
+    /// PSNR (dB) over the whole frame (premultiplied colour on black).
+    pub psnr_frame: f64,
+    /// SSIM over the whole frame.
+    pub ssim_frame: f64,
+    /// Mean absolute alpha error over the frame.
+    pub alpha_mae: f64,
+    /// Seconds to render the frame (after a warm-up frame).
+    pub seconds: f64,
+}
+
+/// One variant: means over the frames, and the frames.
+#[derive(Debug, Clone, Serialize)]
+pub struct VariantScore {
+    /// `nearest`, `linear`, `twoway` or `fourway`.
+    pub name: String,
+    /// Mean of the frames' subject PSNR, dB.
+    pub psnr_subject: f64,
+    /// Mean subject SSIM.
+    pub ssim_subject: f64,
+    /// Mean frame PSNR, dB.
+    pub psnr_frame: f64,
+    /// Mean frame SSIM.
+    pub ssim_frame: f64,
+    /// Mean alpha error.
+    pub alpha_mae: f64,
+    /// Mean seconds per frame.
+    pub seconds_per_frame: f64,
+    /// Each frame.
+    pub frames: Vec<FrameScore>,
+}
+
+/// A camera to evaluate at, named.
+#[derive(Debug, Clone)]
+pub struct EvalCamera {
+    /// Name in reports.
+    pub name: String,
+    /// The camera (subject frame).
+    pub camera: Camera,
+}
+
+/// `count` cameras at the centres of grid quads, spread over the columns and alternating
+/// over the row gaps; `cameras` are the grid's, `u`-major.
+pub fn between_view_cameras(
+    cameras: &[Camera],
+    columns: usize,
+    rows: usize,
+    wraps: bool,
+    count: usize,
+) -> Result<Vec<EvalCamera>> {
+    let quads_u = if wraps {
+        columns
+    } else {
+        columns.saturating_sub(1)
+    };
+    if quads_u == 0 || cameras.len() != columns * rows {
+        return Err(RenderError::BadParameter(format!(
+            "a {columns}x{rows} grid has no quad between views"
+        )));
+    }
+    if count == 0 || count > quads_u * rows.max(2) {
+        return Err(RenderError::BadParameter(format!(
+            "{count} cameras between views (1 to {})",
+            quads_u * rows.max(2)
+        )));
+    }
+    let gaps = rows.saturating_sub(1).max(1);
+    Ok((0..count)
+        .map(|k| {
+            let u = (k * quads_u) / count;
+            let v = k % gaps;
+            let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
+            let at = |u: usize, v: usize| &cameras[u * rows + v];
+            let quad = [at(u, v), at(u1, v), at(u, v1), at(u1, v1)];
+            let centre = quad.iter().map(|c| c.centre()).sum::<glam::Vec3>() / 4.0;
+            EvalCamera {
+                name: format!("u {u}.5, v {v}.5"),
+                camera: interpolate_camera(quad, 0.5, 0.5, centre),
+            }
+        })
+        .collect())
+}
+
+/// The captured cameras at the first corner of the quads of [`between_view_cameras`]:
+/// rendering there involves no interpolation, so their error is that of relighting
+/// through the basis and of storage alone, the floor under the variants' error.
+pub fn grid_view_cameras(
+    cameras: &[Camera],
+    columns: usize,
+    rows: usize,
+    wraps: bool,
+    count: usize,
+) -> Result<Vec<EvalCamera>> {
+    let between = between_view_cameras(cameras, columns, rows, wraps, count)?;
+    let quads_u = if wraps { columns } else { columns - 1 };
+    let gaps = rows.saturating_sub(1).max(1);
+    Ok((0..between.len())
+        .map(|k| {
+            let (u, v) = ((k * quads_u) / count, k % gaps);
+            EvalCamera {
+                name: format!("u {u}, v {v}"),
+                camera: cameras[u * rows + v],
+            }
+        })
+        .collect())
+}
+
+/// The stage's true frame of `pose` from `camera` under `lights`, as premultiplied RGBA.
+pub fn truth_frame(
+    stage: &Stage,
+    pose: u32,
+    camera: &Camera,
+    lights: &[DirLight],
+) -> Result<Image<Rgba>> {
+    let t = stage.truth_image(pose, camera, lights);
+    Ok(rgba_from(&t.color, &t.alpha)?)
+}
+
+/// Scores `test` against `truth`.
+pub fn score(camera: &str, truth: &Image<Rgba>, test: &Image<Rgba>, seconds: f64) -> FrameScore {
+    let mask = subject_mask(truth, test);
+    FrameScore {
+        camera: camera.to_string(),
+        psnr_subject: psnr(truth, test, Some(&mask)),
+        ssim_subject: ssim(truth, test, Some(&mask)),
+        psnr_frame: psnr(truth, test, None),
+        ssim_frame: ssim(truth, test, None),
+        alpha_mae: alpha_mae(truth, test),
+        seconds,
+    }
+}
+
+/// Renders every camera with every variant and scores them against `truths` (one per
+/// camera); `progress()` is called after each frame.
+pub fn evaluate(
+    renderer: &Renderer,
+    cameras: &[EvalCamera],
+    truths: &[Image<Rgba>],
+    variants: &[Variant],
+    progress: &dyn Fn(),
+) -> Result<Vec<VariantScore>> {
+    // One untimed frame first: pipeline compilation and caches.
+    if let Some(c) = cameras.first() {
+        renderer.render(&c.camera, Variant::FourWay)?;
+    }
+    variants
+        .iter()
+        .map(|&variant| {
+            let frames = cameras
+                .iter()
+                .zip(truths)
+                .map(|(c, truth)| {
+                    let t = Instant::now();
+                    let (img, _) = renderer.render(&c.camera, variant)?;
+                    let seconds = t.elapsed().as_secs_f64();
+                    progress();
+                    Ok(score(&c.name, truth, &img, seconds))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let n = frames.len().max(1) as f64;
+            let mean = |f: &dyn Fn(&FrameScore) -> f64| frames.iter().map(f).sum::<f64>() / n;
+            Ok(VariantScore {
+                name: variant.name().to_string(),
+                psnr_subject: mean(&|f| f.psnr_subject),
+                ssim_subject: mean(&|f| f.ssim_subject),
+                psnr_frame: mean(&|f| f.psnr_frame),
+                ssim_frame: mean(&|f| f.ssim_frame),
+                alpha_mae: mean(&|f| f.alpha_mae),
+                seconds_per_frame: mean(&|f| f.seconds),
+                frames,
+            })
+        })
+        .collect()
+}

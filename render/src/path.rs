@@ -1,0 +1,354 @@
+//! Virtual camera paths: keyframes of position, look-at point and vertical field of view
+//! at given times, interpolated smoothly (a Catmull–Rom spline with tangents from the
+//! neighbouring keys over their time spans, so that unevenly spaced keys keep a
+//! continuous velocity; clamped at the ends), and the orbit shortcut (exactly on its
+//! circle).
+//!
+//! A path file is TOML in the subject frame (metres, `+y` up; see the conventions):
+//!
+//! ```toml
+//! [[key]]
+//! time = 0.0                 # seconds, strictly increasing
+//! position = [2.5, 1.4, 3.0]
+//! look_at = [0.0, 0.9, 0.0]
+//! fov_deg = 30.0             # vertical field of view
+//!
+//! [[key]]
+//! time = 2.0
+//! position = [-2.5, 1.0, 3.0]
+//! look_at = [0.0, 0.9, 0.0]
+//! fov_deg = 35.0
+//! ```
+
+use std::path::Path;
+
+use frf_core::camera::Camera;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{RenderError, Result};
+
+/// One keyframe.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Key {
+    /// Time, seconds.
+    pub time: f32,
+    /// Camera centre, subject frame, metres.
+    pub position: [f32; 3],
+    /// Point the camera looks at.
+    pub look_at: [f32; 3],
+    /// Vertical field of view, degrees.
+    pub fov_deg: f32,
+}
+
+/// A validated camera path.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraPath {
+    /// Keyframes in increasing time.
+    #[serde(rename = "key")]
+    pub keys: Vec<Key>,
+}
+
+/// The orbit shortcut: a circle about the vertical axis through `look_at`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Orbit {
+    /// Horizontal distance from the axis, metres.
+    pub radius: f32,
+    /// Camera height, metres.
+    pub height: f32,
+    /// Azimuth of the first frame, degrees (0 on `+z`, increasing toward `+x`).
+    pub start_deg: f32,
+    /// Angle swept over the path, degrees (360 for a full turn).
+    pub sweep_deg: f32,
+    /// Point looked at.
+    pub look_at: Vec3,
+    /// Vertical field of view, degrees.
+    pub fov_deg: f32,
+}
+
+fn bad(what: impl Into<String>) -> RenderError {
+    RenderError::BadParameter(what.into())
+}
+
+impl Key {
+    /// The camera of this key.
+    pub fn camera(&self, width: u32, height: u32) -> Result<Camera> {
+        Ok(Camera::look_at(
+            Vec3::from(self.position),
+            Vec3::from(self.look_at),
+            Vec3::Y,
+            self.fov_deg.to_radians(),
+            width,
+            height,
+        )?)
+    }
+
+    fn check(&self, i: usize) -> Result<()> {
+        let finite = self.time.is_finite()
+            && self
+                .position
+                .iter()
+                .chain(&self.look_at)
+                .all(|c| c.is_finite())
+            && self.fov_deg.is_finite();
+        if !finite {
+            return Err(bad(format!("key {i}: a value is not finite")));
+        }
+        if !(self.fov_deg > 0.1 && self.fov_deg < 170.0) {
+            return Err(bad(format!(
+                "key {i}: fov_deg {} is outside (0.1, 170)",
+                self.fov_deg
+            )));
+        }
+        let forward = Vec3::from(self.look_at) - Vec3::from(self.position);
+        if forward.length() < 1e-4 || forward.normalize().cross(Vec3::Y).length() < 1e-4 {
+            return Err(bad(format!(
+                "key {i}: look_at equals position or lies straight above or below it"
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl CameraPath {
+    /// A path from keys; refuses an empty path, non-increasing times, non-finite values,
+    /// absurd fields of view and degenerate views.
+    pub fn new(keys: Vec<Key>) -> Result<Self> {
+        if keys.is_empty() {
+            return Err(bad("a camera path needs at least one key"));
+        }
+        for (i, k) in keys.iter().enumerate() {
+            k.check(i)?;
+            if i > 0 && k.time <= keys[i - 1].time {
+                return Err(bad(format!(
+                    "key {i}: time {} does not follow {}",
+                    k.time,
+                    keys[i - 1].time
+                )));
+            }
+        }
+        Ok(Self { keys })
+    }
+
+    /// Reads and validates a TOML path file; errors name the file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;
+        let raw: Self = toml::from_str(&text)
+            .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;
+        Self::new(raw.keys).map_err(|e| bad(format!("camera path {}: {e}", path.display())))
+    }
+
+    /// Time span `(first, last)`.
+    pub fn span(&self) -> (f32, f32) {
+        (self.keys[0].time, self.keys[self.keys.len() - 1].time)
+    }
+
+    /// The interpolated key at time `t` (clamped to the span).
+    pub fn at(&self, t: f32) -> Key {
+        let k = &self.keys;
+        let (t0, t1) = self.span();
+        let t = t.clamp(t0, t1);
+        if k.len() == 1 {
+            return k[0];
+        }
+        let i = k.partition_point(|key| key.time <= t).clamp(1, k.len() - 1) - 1;
+        let (a, b) = (&k[i], &k[i + 1]);
+        let h = b.time - a.time;
+        let s = (t - a.time) / h;
+        // Tangents (per second) from the neighbouring keys; one-sided at the ends.
+        let tangent = |j: usize, f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
+            let (l, r) = (j.saturating_sub(1), (j + 1).min(k.len() - 1));
+            (f(&k[r]) - f(&k[l])) / (k[r].time - k[l].time)
+        };
+        let hermite = |f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
+            let (p0, p1) = (f(a), f(b));
+            let (m0, m1) = (tangent(i, f) * h, tangent(i + 1, f) * h);
+            let (s2, s3) = (s * s, s * s * s);
+            p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+                + m0 * (s3 - 2.0 * s2 + s)
+                + p1 * (-2.0 * s3 + 3.0 * s2)
+                + m1 * (s3 - s2)
+        };
+        let position = hermite(&|key| Vec3::from(key.position));
+        let look_at = hermite(&|key| Vec3::from(key.look_at));
+        let fov = hermite(&|key| Vec3::splat(key.fov_deg)).x;
+        Key {
+            time: t,
+            position: position.to_array(),
+            look_at: look_at.to_array(),
+            fov_deg: fov.clamp(0.1, 170.0),
+        }
+    }
+
+    /// `frames` cameras of `width` x `height` evenly spaced in time over the span (the
+    /// first and last frames on the first and last keys).
+    pub fn cameras(&self, frames: usize, width: u32, height: u32) -> Result<Vec<Camera>> {
+        if frames == 0 || frames > 100_000 {
+            return Err(bad(format!("{frames} frames (1 to 100000)")));
+        }
+        let (t0, t1) = self.span();
+        (0..frames)
+            .map(|f| {
+                let s = if frames == 1 {
+                    0.0
+                } else {
+                    f as f32 / (frames - 1) as f32
+                };
+                self.at(t0 + s * (t1 - t0)).camera(width, height)
+            })
+            .collect()
+    }
+}
+
+impl Orbit {
+    /// Refuses non-finite or absurd parameters and a view straight down the axis.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.radius.is_finite() && self.radius > 1e-3 && self.radius < 1e4) {
+            return Err(bad(format!(
+                "orbit radius {} m is outside (0.001, 10000)",
+                self.radius
+            )));
+        }
+        if !(self.sweep_deg.is_finite() && self.sweep_deg.abs() <= 3600.0) {
+            return Err(bad(format!(
+                "orbit sweep {} degrees is outside [-3600, 3600]",
+                self.sweep_deg
+            )));
+        }
+        self.key(0.0).check(0)
+    }
+
+    /// The key at fraction `f` of the sweep: exactly on the circle.
+    pub fn key(&self, f: f32) -> Key {
+        let a = (self.start_deg + f * self.sweep_deg).to_radians();
+        Key {
+            time: f,
+            position: [
+                self.look_at.x + self.radius * a.sin(),
+                self.height,
+                self.look_at.z + self.radius * a.cos(),
+            ],
+            look_at: self.look_at.to_array(),
+            fov_deg: self.fov_deg,
+        }
+    }
+}
+
+/// Where the virtual camera goes: keyframes or an orbit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Trajectory {
+    /// A keyframed path.
+    Path(CameraPath),
+    /// The orbit shortcut.
+    Orbit(Orbit),
+}
+
+impl Trajectory {
+    /// `frames` cameras of `width` x `height`, evenly spaced in time. A full-turn orbit
+    /// does not repeat its first frame at the end, so that it loops.
+    pub fn cameras(&self, frames: usize, width: u32, height: u32) -> Result<Vec<Camera>> {
+        match self {
+            Self::Path(p) => p.cameras(frames, width, height),
+            Self::Orbit(o) => {
+                o.validate()?;
+                if frames == 0 || frames > 100_000 {
+                    return Err(bad(format!("{frames} frames (1 to 100000)")));
+                }
+                let closed = (o.sweep_deg.abs() % 360.0).abs() < 1e-3;
+                let steps = if closed || frames == 1 {
+                    frames
+                } else {
+                    frames - 1
+                };
+                (0..frames)
+                    .map(|f| o.key(f as f32 / steps as f32).camera(width, height))
+                    .collect()
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(time: f32, x: f32) -> Key {
+        Key {
+            time,
+            position: [x, 1.0, 3.0],
+            look_at: [0.0, 0.9, 0.0],
+            fov_deg: 30.0 + x,
+        }
+    }
+
+    #[test]
+    fn the_path_passes_through_its_keys_and_is_smooth() {
+        let p = CameraPath::new(vec![key(0.0, 0.0), key(1.0, 1.0), key(3.0, -2.0)]).unwrap();
+        for k in &p.keys {
+            let at = p.at(k.time);
+            assert!((Vec3::from(at.position) - Vec3::from(k.position)).length() < 1e-5);
+            assert!((at.fov_deg - k.fov_deg).abs() < 1e-4);
+        }
+        // Velocity is continuous across the middle key.
+        let x = |t: f32| p.at(t).position[0];
+        let (e, t) = (1e-3, 1.0);
+        let before = (x(t) - x(t - e)) / e;
+        let after = (x(t + e) - x(t)) / e;
+        assert!((before - after).abs() < 0.02, "{before} vs {after}");
+    }
+
+    #[test]
+    fn the_orbit_stays_on_its_circle() {
+        let o = Orbit {
+            radius: 3.0,
+            height: 1.2,
+            start_deg: 10.0,
+            sweep_deg: 360.0,
+            look_at: Vec3::new(0.0, 0.9, 0.0),
+            fov_deg: 30.0,
+        };
+        let cams = Trajectory::Orbit(o).cameras(36, 16, 24).unwrap();
+        for (i, c) in cams.iter().enumerate() {
+            let e = c.centre();
+            let r = (e.x * e.x + e.z * e.z).sqrt();
+            assert!((r - 3.0).abs() < 1e-5, "radius {r}");
+            assert!((e.y - 1.2).abs() < 1e-5);
+            // Ten degrees apart, the last one short of the first: the orbit loops.
+            let next = cams[(i + 1) % cams.len()].centre();
+            let step = (e - Vec3::new(0.0, 1.2, 0.0))
+                .angle_between(next - Vec3::new(0.0, 1.2, 0.0))
+                .to_degrees();
+            assert!((step - 10.0).abs() < 1e-2, "step {step}");
+        }
+        let mut bad = o;
+        bad.radius = f32::INFINITY;
+        assert!(Trajectory::Orbit(bad).cameras(4, 8, 8).is_err());
+    }
+
+    #[test]
+    fn bad_paths_are_refused_with_reasons() {
+        assert!(CameraPath::new(vec![]).is_err());
+        let e = CameraPath::new(vec![key(1.0, 0.0), key(1.0, 1.0)]).unwrap_err();
+        assert!(e.to_string().contains("key 1"), "{e}");
+        let mut k = key(0.0, 0.0);
+        k.fov_deg = 0.0;
+        assert!(CameraPath::new(vec![k]).is_err());
+        k = key(0.0, 0.0);
+        k.position[1] = f32::NAN;
+        assert!(CameraPath::new(vec![k]).is_err());
+        k = key(0.0, 0.0);
+        k.position = [0.0, 5.0, 0.0];
+        assert!(CameraPath::new(vec![k]).is_err());
+        let p = CameraPath::new(vec![key(0.0, 0.0)]).unwrap();
+        assert!(p.cameras(0, 8, 8).is_err());
+        let text = "[[key]]\ntime = 0.0\nposition = [1.0, 1.0, 3.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 30.0\nzoom = 2\n";
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("path.toml");
+        std::fs::write(&f, text).unwrap();
+        let e = CameraPath::load(&f).unwrap_err().to_string();
+        assert!(e.contains("path.toml") && e.contains("zoom"), "{e}");
+    }
+}

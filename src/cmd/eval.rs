@@ -1,0 +1,348 @@
+//! `frf eval FIELD --capture CAPTURE`: frames rendered between the grid's views scored
+//! against the virtual stage's truth, per interpolation variant (error against run time);
+//! `frf eval-ring FIELD --par PAR --stride S`: views held out of a ring of photographs
+//! rendered from their neighbours and scored against the photographs.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use frf_core::io::{rgba_from, write_png8_srgba};
+use frf_reflectance::FieldFile;
+use frf_render::eval::{
+    EvalCamera, between_view_cameras, evaluate, grid_view_cameras, truth_frame,
+};
+use frf_render::gpu::Gpu;
+use frf_render::metrics::{psnr, ssim};
+use frf_render::morph::Variant;
+use frf_render::renderer::Renderer;
+use frf_render::resident::{Lighting, PoseSource};
+use frf_stage::truth::environment_lights;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::CliResult;
+use crate::cmd::progress::bar;
+use crate::cmd::render::{LightingArgs, VariantArg};
+
+/// Arguments of `frf eval`.
+#[derive(Args)]
+pub struct EvalArgs {
+    /// A field of a virtual-stage capture (`frf stage field` or `frf ingest`).
+    field: PathBuf,
+    /// The capture the field was made from (its stage renders the truth).
+    #[arg(long)]
+    capture: PathBuf,
+    #[command(flatten)]
+    lighting: LightingArgs,
+    /// Pose (default: the field's first).
+    #[arg(long)]
+    pose: Option<u32>,
+    /// Cameras at the centres of grid quads, spread around the grid.
+    #[arg(long, default_value_t = 8)]
+    cameras: usize,
+    /// Median-cut lights of the environment in the truth renders.
+    #[arg(long, default_value_t = 512)]
+    lights: usize,
+    /// Variants to compare (default: all four).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    variants: Vec<VariantArg>,
+    /// Render with the CPU reference instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write each camera's truth and renders as PNGs here.
+    #[arg(long)]
+    images: Option<PathBuf>,
+}
+
+fn variants(args: &[VariantArg]) -> Vec<Variant> {
+    if args.is_empty() {
+        Variant::ALL.to_vec()
+    } else {
+        args.iter().map(|&v| v.into()).collect()
+    }
+}
+
+fn renderer(source: &PoseSource, cpu: bool) -> CliResult<Renderer> {
+    let gpu = if cpu { None } else { Some(Gpu::new()?) };
+    Ok(Renderer::new(source, gpu)?)
+}
+
+#[derive(Serialize)]
+struct EvalReport {
+    field: PathBuf,
+    capture: PathBuf,
+    env: PathBuf,
+    pose: u32,
+    device: String,
+    truth_lights: usize,
+    truth_seconds_per_frame: f64,
+    cameras: Vec<String>,
+    variants: Vec<frf_render::eval::VariantScore>,
+    /// The four-way renderer at captured cameras: the error of relighting and storage.
+    at_captured_views: frf_render::eval::VariantScore,
+}
+
+/// Runs `frf eval`.
+pub fn run(args: EvalArgs) -> CliResult {
+    let field = FieldFile::open(&args.field)?;
+    let h = field.header();
+    let pose = args
+        .pose
+        .or_else(|| h.poses.first().map(|p| p.pose))
+        .ok_or_else(|| format!("{}: the field holds no pose", args.field.display()))?;
+    let (lighting, env) = args.lighting.lighting(h.conditions.len())?;
+    let env = env.ok_or("frf eval needs an environment (the truth is relit by it)")?;
+    if !(1..=65536).contains(&args.lights) {
+        return Err(format!("--lights {} (1 to 65536)", args.lights).into());
+    }
+    let stage = frf_stage::open_stage(&args.capture)?;
+    if !stage.config().poses.contains(&pose) {
+        return Err(format!(
+            "{}: pose {pose} is not in the capture",
+            args.capture.display()
+        )
+        .into());
+    }
+    let source = PoseSource::load(&field, pose, &lighting)?;
+    let cameras = between_view_cameras(
+        &source.cameras,
+        source.columns,
+        source.rows,
+        source.wraps,
+        args.cameras,
+    )?;
+
+    let at_views = grid_view_cameras(
+        &source.cameras,
+        source.columns,
+        source.rows,
+        source.wraps,
+        args.cameras,
+    )?;
+    let lights = environment_lights(&env, args.lights);
+    let truth_bar = bar("truth frames");
+    truth_bar.set_length(cameras.len() as u64);
+    let start = Instant::now();
+    let all: Vec<&EvalCamera> = cameras.iter().chain(&at_views).collect();
+    truth_bar.set_length(all.len() as u64);
+    let mut truths = all
+        .par_iter()
+        .map(|c| {
+            let t = truth_frame(&stage, pose, &c.camera, &lights);
+            truth_bar.inc(1);
+            t
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let truth_seconds = start.elapsed().as_secs_f64() / all.len() as f64;
+    let truths_at_views = truths.split_off(cameras.len());
+    truth_bar.finish_and_clear();
+
+    let renderer = renderer(&source, args.cpu)?;
+    let variants = variants(&args.variants);
+    let bar = bar("rendered frames");
+    bar.set_length((cameras.len() * variants.len()) as u64);
+    let scores = evaluate(&renderer, &cameras, &truths, &variants, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let mut floor = evaluate(
+        &renderer,
+        &at_views,
+        &truths_at_views,
+        &[Variant::FourWay],
+        &|| {},
+    )?
+    .remove(0);
+    floor.name = "at the captured views".into();
+
+    if let Some(dir) = &args.images {
+        write_images(dir, &renderer, &cameras, &truths, &variants)?;
+    }
+    eprintln!(
+        "{} pose {pose} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
+         cameras at quad centres, {}:",
+        args.field.display(),
+        args.lighting.env.display(),
+        args.lights,
+        truth_seconds,
+        cameras.len(),
+        renderer.device()
+    );
+    eprintln!(
+        "{:<21} {:>13} {:>13} {:>11} {:>11} {:>10} {:>10}",
+        "variant",
+        "PSNR subject",
+        "SSIM subject",
+        "PSNR frame",
+        "SSIM frame",
+        "alpha MAE",
+        "s/frame"
+    );
+    for s in scores.iter().chain([&floor]) {
+        eprintln!(
+            "{:<21} {:>10.2} dB {:>13.4} {:>8.2} dB {:>11.4} {:>10.4} {:>10.4}",
+            s.name,
+            s.psnr_subject,
+            s.ssim_subject,
+            s.psnr_frame,
+            s.ssim_frame,
+            s.alpha_mae,
+            s.seconds_per_frame
+        );
+    }
+    if args.json {
+        let report = EvalReport {
+            field: args.field.clone(),
+            capture: args.capture.clone(),
+            env: args.lighting.env.clone(),
+            pose,
+            device: renderer.device().to_string(),
+            truth_lights: args.lights,
+            truth_seconds_per_frame: truth_seconds,
+            cameras: cameras.iter().map(|c| c.name.clone()).collect(),
+            variants: scores,
+            at_captured_views: floor,
+        };
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
+
+fn write_images(
+    dir: &std::path::Path,
+    renderer: &Renderer,
+    cameras: &[EvalCamera],
+    truths: &[frf_core::image::Image<frf_core::image::Rgba>],
+    variants: &[Variant],
+) -> CliResult {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for (i, (c, t)) in cameras.iter().zip(truths).enumerate() {
+        write_png8_srgba(&dir.join(format!("camera{i:02}_truth.png")), t, 1.0)?;
+        for &v in variants {
+            let (img, _) = renderer.render(&c.camera, v)?;
+            write_png8_srgba(
+                &dir.join(format!("camera{i:02}_{}.png", v.name())),
+                &img,
+                1.0,
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Arguments of `frf eval-ring`.
+#[derive(Args)]
+pub struct RingEvalArgs {
+    /// A field made by `frf ingest-ring --stride S` from the same ring.
+    field: PathBuf,
+    /// The ring's calibration (Middlebury `*_par.txt`).
+    #[arg(long)]
+    par: PathBuf,
+    /// The stride the field was ingested with: the view halfway between two kept views
+    /// is rendered (2: view i from i±1; 4: from i±2; 6: from i±3).
+    #[arg(long)]
+    stride: usize,
+    /// Variants to compare (default: all four).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    variants: Vec<VariantArg>,
+    /// Render with the CPU reference instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Serialize)]
+struct RingScore {
+    name: String,
+    psnr_silhouette: f64,
+    ssim_silhouette: f64,
+    seconds_per_frame: f64,
+    views: Vec<usize>,
+    psnr_per_view: Vec<f64>,
+}
+
+/// Runs `frf eval-ring`.
+pub fn run_ring(args: RingEvalArgs) -> CliResult {
+    let field = FieldFile::open(&args.field)?;
+    let (views, cameras, wraps) = frf_ingest::ring::ring_views(&args.par)?;
+    let s = args.stride;
+    if s < 2 || views.len() / s != field.header().columns {
+        return Err(format!(
+            "{}: {} views do not come from {} views at stride {s}",
+            args.field.display(),
+            field.header().columns,
+            views.len()
+        )
+        .into());
+    }
+    let held: Vec<usize> = (0..views.len() / s)
+        .map(|j| j * s + s / 2)
+        .filter(|&i| wraps || i + s / 2 < views.len())
+        .collect();
+    let source = PoseSource::load(&field, 0, &Lighting::Unlit)?;
+    let renderer = renderer(&source, args.cpu)?;
+    let photos = held
+        .par_iter()
+        .map(|&i| {
+            let (photo, alpha) = frf_ingest::ring::photo_and_alpha(&views[i].path)?;
+            let mask: Vec<bool> = alpha.pixels().iter().map(|&a| a >= 0.5).collect();
+            Ok((rgba_from(&photo, &alpha)?, mask))
+        })
+        .collect::<CliResult<Vec<_>>>()?;
+    renderer.render(&cameras[held[0]], Variant::FourWay)?;
+    let mut scores = Vec::new();
+    for v in variants(&args.variants) {
+        let (mut psnrs, mut ssims, mut seconds) = (Vec::new(), Vec::new(), 0.0);
+        for (&i, (photo, mask)) in held.iter().zip(&photos) {
+            let t = Instant::now();
+            let (img, _) = renderer.render(&cameras[i], v)?;
+            seconds += t.elapsed().as_secs_f64();
+            psnrs.push(psnr(photo, &img, Some(mask)));
+            ssims.push(ssim(photo, &img, Some(mask)));
+        }
+        let n = held.len() as f64;
+        scores.push(RingScore {
+            name: v.name().to_string(),
+            psnr_silhouette: psnrs.iter().sum::<f64>() / n,
+            ssim_silhouette: ssims.iter().sum::<f64>() / n,
+            seconds_per_frame: seconds / n,
+            views: held.clone(),
+            psnr_per_view: psnrs,
+        });
+    }
+    eprintln!(
+        "{}: {} held-out views, each rendered from views {} apart ({} each side), {}:",
+        args.field.display(),
+        held.len(),
+        s,
+        s / 2,
+        renderer.device()
+    );
+    eprintln!(
+        "{:<8} {:>17} {:>17} {:>9}",
+        "variant", "PSNR silhouette", "SSIM silhouette", "s/frame"
+    );
+    for r in &scores {
+        eprintln!(
+            "{:<8} {:>14.2} dB {:>17.4} {:>9.4}",
+            r.name, r.psnr_silhouette, r.ssim_silhouette, r.seconds_per_frame
+        );
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "field": args.field,
+                "par": args.par,
+                "stride": s,
+                "device": renderer.device(),
+                "variants": scores,
+            }))?
+        );
+    }
+    Ok(())
+}

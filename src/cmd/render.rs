@@ -1,0 +1,465 @@
+//! `frf render FIELD --env ENV --camera PATH.toml|--orbit R,H[,SWEEP] --out DIR`: frames
+//! of a pose of a field, relit by an environment, along a camera path, on the GPU (or the
+//! CPU reference with `--cpu`). Each frame is written as an 8-bit sRGB PNG with straight
+//! alpha and a linear premultiplied EXR, with a contact sheet of up to 12 frames over
+//! gray (`contact.png`); a rerun with the same settings resumes.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use frf_core::atomic::write_bytes_atomic;
+use frf_core::env::EnvMap;
+use frf_core::image::{Image, RgbImage, Rgba};
+use frf_core::io::{write_exr_rgba, write_png8_srgb, write_png8_srgba};
+use frf_reflectance::FieldFile;
+use frf_reflectance::project::FloorModel;
+use frf_render::cpu::FrameStats;
+use frf_render::gpu::Gpu;
+use frf_render::morph::Variant;
+use frf_render::path::{CameraPath, Orbit, Trajectory};
+use frf_render::renderer::Renderer;
+use frf_render::resident::{Lighting, PoseSource};
+use frf_stage::contact;
+use glam::Vec3;
+use serde::Serialize;
+
+use crate::CliResult;
+use crate::cmd::progress::bar;
+
+/// The interpolation (the ablations of `frf eval`).
+#[derive(Clone, Copy, ValueEnum, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum VariantArg {
+    /// Nearest view, unwarped.
+    Nearest,
+    /// Bilinear blend of the quad's views, unwarped.
+    Linear,
+    /// Two-way flowed morph along the nearer row.
+    Twoway,
+    /// Four-way flowed morph.
+    Fourway,
+}
+
+impl From<VariantArg> for Variant {
+    fn from(v: VariantArg) -> Self {
+        match v {
+            VariantArg::Nearest => Variant::Nearest,
+            VariantArg::Linear => Variant::Linear,
+            VariantArg::Twoway => Variant::TwoWay,
+            VariantArg::Fourway => Variant::FourWay,
+        }
+    }
+}
+
+/// Floor model of the relighting.
+#[derive(Clone, Copy, ValueEnum, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum FloorArg {
+    /// The environment's lower hemisphere lights the subject from below.
+    Env,
+    /// A grey Lambertian ground (albedo 0.3) lit by the upper hemisphere.
+    Ground,
+}
+
+/// How the field is lit: shared by `frf render` and `frf eval`.
+#[derive(Args, Clone, Serialize, PartialEq)]
+pub struct LightingArgs {
+    /// HDR environment (latitude-longitude .hdr or .exr, subject frame), `sky` for the
+    /// built-in sky, `uniform` for a white furnace, or `none` to show a field of
+    /// photographs as captured.
+    #[arg(long)]
+    pub env: PathBuf,
+    /// Yaw of the environment about the vertical axis, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub yaw: f32,
+    /// What lights the subject from below.
+    #[arg(long, value_enum, default_value = "env")]
+    pub floor: FloorArg,
+}
+
+impl LightingArgs {
+    /// The lighting, and the environment for truth renders (`None` for `none`).
+    pub fn lighting(&self, conditions: usize) -> CliResult<(Lighting, Option<EnvMap>)> {
+        let name = self.env.to_string_lossy();
+        if name == "none" && !self.env.exists() {
+            return Ok((Lighting::Unlit, None));
+        }
+        if conditions <= 1 {
+            return Err(format!(
+                "the field holds {conditions} lighting condition(s), photographs rather than \
+                 a reflectance basis: it cannot be relit; use --env none"
+            )
+            .into());
+        }
+        let env = if name == "uniform" && !self.env.exists() {
+            EnvMap::uniform([1.0, 1.0, 1.0], 64)
+        } else {
+            EnvMap::load_or_builtin(&self.env)
+                .map_err(|e| format!("environment {}: {e}", self.env.display()))?
+        }
+        .rotated(self.yaw.to_radians());
+        let floor = match self.floor {
+            FloorArg::Env => FloorModel::Environment,
+            FloorArg::Ground => FloorModel::LambertianGround {
+                albedo: [0.3, 0.3, 0.3],
+            },
+        };
+        Ok((
+            Lighting::Environment {
+                env: env.clone(),
+                floor,
+            },
+            Some(env),
+        ))
+    }
+}
+
+/// Where the camera goes: shared by `frf render` and `frf eval`.
+#[derive(Args, Clone, Serialize, PartialEq)]
+pub struct CameraArgs {
+    /// Keyframed camera path (TOML; see `frf_render::path`).
+    #[arg(long, conflicts_with = "orbit", required_unless_present = "orbit")]
+    pub camera: Option<PathBuf>,
+    /// Orbit about the vertical axis through --look-at: `RADIUS,HEIGHT[,SWEEP_DEG]`,
+    /// metres and degrees (default sweep 360, a loop).
+    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true)]
+    pub orbit: Option<OrbitSpec>,
+    /// Orbit: the point looked at, `x,y,z` metres.
+    #[arg(long, value_parser = parse_point, default_value = "0,0.9,0", allow_hyphen_values = true)]
+    pub look_at: [f32; 3],
+    /// Orbit: vertical field of view, degrees.
+    #[arg(long, default_value_t = 35.0)]
+    pub fov: f32,
+    /// Orbit: azimuth of the first frame, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub start: f32,
+}
+
+impl CameraArgs {
+    /// The trajectory.
+    pub fn trajectory(&self) -> CliResult<Trajectory> {
+        if let Some(path) = &self.camera {
+            return Ok(Trajectory::Path(CameraPath::load(path)?));
+        }
+        let o = self
+            .orbit
+            .ok_or("give --camera PATH.toml or --orbit RADIUS,HEIGHT")?;
+        let orbit = Orbit {
+            radius: o.radius,
+            height: o.height,
+            sweep_deg: o.sweep_deg,
+            start_deg: self.start,
+            look_at: Vec3::from(self.look_at),
+            fov_deg: self.fov,
+        };
+        orbit.validate()?;
+        Ok(Trajectory::Orbit(orbit))
+    }
+}
+
+fn numbers(s: &str, what: &str) -> Result<Vec<f32>, String> {
+    s.split(',')
+        .map(|t| match t.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(format!("{what} `{s}`: `{t}` is not a finite number")),
+        })
+        .collect()
+}
+
+/// `--orbit RADIUS,HEIGHT[,SWEEP_DEG]`.
+#[derive(Clone, Copy, Serialize, PartialEq)]
+pub struct OrbitSpec {
+    /// Metres from the axis.
+    pub radius: f32,
+    /// Camera height, metres.
+    pub height: f32,
+    /// Degrees swept.
+    pub sweep_deg: f32,
+}
+
+/// Parses `RADIUS,HEIGHT[,SWEEP_DEG]`.
+pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
+    let v = numbers(s, "orbit")?;
+    if !(2..=3).contains(&v.len()) {
+        return Err(format!("orbit `{s}`: expected RADIUS,HEIGHT[,SWEEP_DEG]"));
+    }
+    Ok(OrbitSpec {
+        radius: v[0],
+        height: v[1],
+        sweep_deg: v.get(2).copied().unwrap_or(360.0),
+    })
+}
+
+/// Parses `x,y,z`.
+pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
+    let v = numbers(s, "point")?;
+    <[f32; 3]>::try_from(v).map_err(|_| format!("point `{s}`: expected x,y,z"))
+}
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("size `{s}`: expected WxH"))?;
+    let parse = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|e| format!("size `{s}`: {e}"))
+    };
+    let (w, h) = (parse(w)?, parse(h)?);
+    if !(1..=8192).contains(&w) || !(1..=8192).contains(&h) {
+        return Err(format!("size `{s}`: each side must be 1 to 8192 pixels"));
+    }
+    Ok((w, h))
+}
+
+/// Arguments of `frf render`.
+#[derive(Args, Serialize, PartialEq)]
+pub struct RenderArgs {
+    /// A field file (`frf ingest`, `frf stage field` or `frf ingest-ring`).
+    pub field: PathBuf,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Output directory: frame_NNNN.png (8-bit sRGB, straight alpha) and frame_NNNN.exr
+    /// (linear, premultiplied), and render.json (the settings and the report).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Frame size `WxH` (default: the field's image size).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Number of frames along the path.
+    #[arg(long, default_value_t = 36)]
+    pub frames: usize,
+    /// Pose of the field (default: its first).
+    #[arg(long)]
+    pub pose: Option<u32>,
+    /// Interpolation.
+    #[arg(long, value_enum, default_value = "fourway")]
+    pub variant: VariantArg,
+    /// Render with the CPU reference instead of the GPU.
+    #[arg(long)]
+    pub cpu: bool,
+    /// Exposure of the PNG frames, stops (the EXR frames are not scaled).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Render every frame again even where the directory holds it.
+    #[arg(long)]
+    #[serde(skip)]
+    pub overwrite: bool,
+}
+
+/// The report written to `render.json`.
+#[derive(Serialize)]
+struct Report<'a> {
+    settings: &'a RenderArgs,
+    device: String,
+    pose: u32,
+    crop: [u32; 4],
+    lighting_skipped_conditions: Vec<String>,
+    images_combined: usize,
+    images_total: usize,
+    resident_bytes: u64,
+    resident_seconds: f64,
+    frames_rendered: usize,
+    frames_resumed: usize,
+    seconds_per_frame_mean: f64,
+    seconds_per_frame_median: f64,
+    seconds_first_frame: f64,
+    pixels_inside: usize,
+    pixels_clamped_above: usize,
+    pixels_clamped_below: usize,
+    pixels_missed: usize,
+}
+
+/// Frames on the contact sheet (evenly spaced).
+const SHEET_FRAMES: usize = 12;
+
+/// Premultiplied RGBA over a mid-gray backdrop, for the contact sheet.
+fn over_gray(img: &Image<Rgba>) -> RgbImage {
+    let gray = 0.18;
+    Image::from_fn(img.width(), img.height(), |x, y| {
+        let p = img.get(x, y);
+        let a = p[3].clamp(0.0, 1.0);
+        [0, 1, 2].map(|c| p[c] + (1.0 - a) * gray)
+    })
+}
+
+fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
+    dir.join(format!("frame_{i:04}.{ext}"))
+}
+
+/// Runs `frf render`.
+pub fn run(args: RenderArgs) -> CliResult {
+    let field = FieldFile::open(&args.field)?;
+    let h = field.header();
+    let pose = args
+        .pose
+        .or_else(|| h.poses.first().map(|p| p.pose))
+        .ok_or_else(|| format!("{}: the field holds no pose", args.field.display()))?;
+    let (lighting, _) = args.lighting.lighting(h.conditions.len())?;
+    let (width, height) = args.size.unwrap_or((h.width, h.height));
+    let cameras = args
+        .camera
+        .trajectory()?
+        .cameras(args.frames, width, height)?;
+    if !args.exposure.is_finite() || args.exposure.abs() > 30.0 {
+        return Err(format!("--exposure {} stops is outside [-30, 30]", args.exposure).into());
+    }
+
+    // A directory of a different render is not resumed into.
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("output directory {}: {e}", args.out.display()))?;
+    let settings_path = args.out.join("settings.json");
+    let settings = serde_json::to_string_pretty(&args)?;
+    let resume =
+        !args.overwrite && std::fs::read_to_string(&settings_path).is_ok_and(|s| s == settings);
+    if !resume && !args.overwrite && frame_path(&args.out, 0, "png").exists() {
+        return Err(format!(
+            "{} holds frames of a render with other settings; use --overwrite or another --out",
+            args.out.display()
+        )
+        .into());
+    }
+    write_bytes_atomic(&settings_path, settings.as_bytes())?;
+
+    let start = Instant::now();
+    let source = PoseSource::load(&field, pose, &lighting)?;
+    let gpu = if args.cpu { None } else { Some(Gpu::new()?) };
+    let renderer = Renderer::new(&source, gpu)?;
+    let resident_seconds = start.elapsed().as_secs_f64();
+    let c = source.crop;
+    eprintln!(
+        "{}: pose {pose}, {}x{} views, crop {}x{} at ({}, {}) of {}x{}",
+        args.field.display(),
+        h.columns,
+        h.rows,
+        c.width,
+        c.height,
+        c.x0,
+        c.y0,
+        h.width,
+        h.height
+    );
+    let plan = &source.plan;
+    eprintln!(
+        "lighting: {} of {} basis images combined; conditions left out (zero weight): {}",
+        plan.images_combined,
+        plan.images_total,
+        if plan.skipped_conditions.is_empty() {
+            "none".to_string()
+        } else {
+            plan.skipped_conditions.join(", ")
+        }
+    );
+    eprintln!(
+        "{}: pose resident in {:.2} MB, loaded and relit in {resident_seconds:.2} s",
+        renderer.device(),
+        renderer.resident_bytes() as f64 / 1e6
+    );
+
+    let scale = 2f32.powf(args.exposure);
+    let variant = Variant::from(args.variant);
+    let bar = bar("frames");
+    bar.set_length(cameras.len() as u64);
+    let mut times = Vec::new();
+    let mut totals = FrameStats::default();
+    let mut resumed = 0;
+    let sheet_every = cameras.len().div_ceil(SHEET_FRAMES).max(1);
+    let mut sheet = Vec::new();
+    for (i, cam) in cameras.iter().enumerate() {
+        let (png, exr) = (
+            frame_path(&args.out, i, "png"),
+            frame_path(&args.out, i, "exr"),
+        );
+        if resume && png.exists() && exr.exists() {
+            resumed += 1;
+            bar.inc(1);
+            continue;
+        }
+        let t = Instant::now();
+        let (img, stats) = renderer.render(cam, variant)?;
+        times.push(t.elapsed().as_secs_f64());
+        totals.inside += stats.inside;
+        totals.clamped_above += stats.clamped_above;
+        totals.clamped_below += stats.clamped_below;
+        totals.missed += stats.missed;
+        write_exr_rgba(&exr, &img)?;
+        write_png8_srgba(&png, &img, scale)?;
+        if i % sheet_every == 0 {
+            sheet.push(over_gray(&img));
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    let mean = times.iter().sum::<f64>() / times.len().max(1) as f64;
+    let mut sorted = times.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let report = Report {
+        settings: &args,
+        device: renderer.device().to_string(),
+        pose,
+        crop: [c.x0, c.y0, c.width, c.height],
+        lighting_skipped_conditions: plan.skipped_conditions.clone(),
+        images_combined: plan.images_combined,
+        images_total: plan.images_total,
+        resident_bytes: renderer.resident_bytes(),
+        resident_seconds,
+        frames_rendered: times.len(),
+        frames_resumed: resumed,
+        seconds_per_frame_mean: mean,
+        seconds_per_frame_median: median,
+        seconds_first_frame: times.first().copied().unwrap_or(0.0),
+        pixels_inside: totals.inside,
+        pixels_clamped_above: totals.clamped_above,
+        pixels_clamped_below: totals.clamped_below,
+        pixels_missed: totals.missed,
+    };
+    if !sheet.is_empty() {
+        let columns = sheet.len().min(SHEET_FRAMES / 2);
+        write_png8_srgb(
+            &args.out.join("contact.png"),
+            &contact::sheet(&sheet, columns),
+            scale,
+        )?;
+    }
+    write_bytes_atomic(
+        &args.out.join("render.json"),
+        serde_json::to_string_pretty(&report)?.as_bytes(),
+    )?;
+    eprintln!(
+        "{} frames of {width}x{height} ({}, {}) in {}: {median:.3} s/frame median, {mean:.3} \
+         mean, first {:.3} (includes pipeline set-up){}",
+        times.len(),
+        variant.name(),
+        args.env_name(),
+        args.out.display(),
+        report.seconds_first_frame,
+        if resumed > 0 {
+            format!("; {resumed} frames were already there (resumed)")
+        } else {
+            String::new()
+        }
+    );
+    let all = (totals.inside + totals.clamped_above + totals.clamped_below + totals.missed).max(1);
+    let pct = |n: usize| 100.0 * n as f64 / all as f64;
+    eprintln!(
+        "pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row (rays above \
+         the grid), {:.1} % clamped to the bottom row, {:.1} % missed (no view; transparent)",
+        pct(totals.inside),
+        pct(totals.clamped_above),
+        pct(totals.clamped_below),
+        pct(totals.missed)
+    );
+    Ok(())
+}
+
+impl RenderArgs {
+    fn env_name(&self) -> String {
+        format!("env {}", self.lighting.env.display())
+    }
+}

@@ -1,0 +1,267 @@
+//! `frf render` and `frf eval` end to end on the tiny stage's oracle field: an orbit
+//! under a real HDR environment written as PNG and EXR and resumed, the four-way morph
+//! beating the linear blend and the nearest view against the stage's truth between grid
+//! views, and bad arguments refused with messages that name them.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+
+use frf_ingest::oracle::{OracleOptions, write_oracle_field};
+use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
+
+fn frf(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_frf"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// A directory with the tiny stage's configuration (pose 0, no perturbation: every
+/// cycle repeats, so the truth between views is what interpolation should produce) and
+/// its oracle field, shared by the tests of this file.
+fn fixture() -> &'static (tempfile::TempDir, PathBuf) {
+    static FIXTURE: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    FIXTURE.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let mut c = StageConfig::preset(Preset::Tiny);
+        c.poses = vec![0];
+        c.perturbation = 0.0;
+        c.set_flow_truth = SetFlowTruth::None;
+        std::fs::write(dir.path().join("stage.toml"), toml::to_string(&c).unwrap()).unwrap();
+        let stage = Stage::new(c).unwrap();
+        let field = dir.path().join("tiny.frf");
+        let options = OracleOptions {
+            poses: vec![0],
+            jpeg_quality: 95,
+            predict_flow: true,
+        };
+        write_oracle_field(&stage, &field, &options, &|_, _| {}).unwrap();
+        (dir, field)
+    })
+}
+
+fn envmap(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/envmaps")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn gpu_flag() -> Option<&'static str> {
+    // The GPU path runs unless the machine has no adapter and says so.
+    std::env::var("FRF_SKIP_GPU")
+        .is_ok_and(|v| v == "1")
+        .then_some("--cpu")
+}
+
+#[test]
+fn render_writes_an_orbit_under_an_hdr_environment_and_resumes() {
+    let (dir, field) = fixture();
+    let out = dir.path().join("orbit");
+    let env = envmap("grace.hdr");
+    let mut args = vec![
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        &env,
+        "--orbit",
+        "3.2,1.3",
+        "--frames",
+        "4",
+        "--size",
+        "48x64",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for i in 0..4 {
+        let png = image::open(out.join(format!("frame_{i:04}.png"))).unwrap();
+        assert_eq!((png.width(), png.height()), (48, 64));
+        let rgba = png.to_rgba8();
+        let covered = rgba.pixels().filter(|p| p[3] > 128).count();
+        assert!(
+            covered > 200,
+            "frame {i}: the walker covers {covered} pixels"
+        );
+        let exr = image::open(out.join(format!("frame_{i:04}.exr"))).unwrap();
+        let exr = exr.to_rgba32f();
+        assert!(exr.pixels().all(|p| p.0.iter().all(|c| c.is_finite())));
+        assert!(exr.pixels().any(|p| p[3] > 0.99 && p[0] > 0.0));
+    }
+    assert!(out.join("contact.png").exists());
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+    assert_eq!(report["frames_rendered"], 4);
+    assert!(report["resident_bytes"].as_u64().unwrap() > 0);
+    assert!(stderr(&o).contains("pose resident in"), "{}", stderr(&o));
+
+    // The same command again renders nothing: every frame is there.
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+    assert_eq!(report["frames_resumed"], 4);
+    assert_eq!(report["frames_rendered"], 0);
+
+    // Other settings into the same directory are refused, not mixed in.
+    let mut other = args.clone();
+    other[7] = "5";
+    let o = frf(&other);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--overwrite"), "{}", stderr(&o));
+}
+
+#[test]
+fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
+    let (dir, field) = fixture();
+    let env = envmap("grace.hdr");
+    let mut args = vec![
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        dir.path().to_str().unwrap(),
+        "--env",
+        &env,
+        "--cameras",
+        "6",
+        "--lights",
+        "128",
+        "--json",
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let variants = report["variants"].as_array().unwrap();
+    let get = |name: &str, key: &str| {
+        variants.iter().find(|v| v["name"] == name).unwrap()[key]
+            .as_f64()
+            .unwrap()
+    };
+    for v in variants {
+        for key in [
+            "psnr_subject",
+            "ssim_subject",
+            "psnr_frame",
+            "alpha_mae",
+            "seconds_per_frame",
+        ] {
+            assert!(
+                v[key].as_f64().unwrap().is_finite(),
+                "{key} of {}",
+                v["name"]
+            );
+        }
+    }
+    let four = get("fourway", "psnr_subject");
+    assert!(four > get("linear", "psnr_subject") + 0.5, "{}", stderr(&o));
+    assert!(
+        four > get("nearest", "psnr_subject") + 2.0,
+        "{}",
+        stderr(&o)
+    );
+    assert!(get("fourway", "ssim_subject") > get("linear", "ssim_subject"));
+    // On a repeating walker the four-way morph should land close to the truth.
+    assert!(four > 22.0, "{}", stderr(&o));
+}
+
+#[test]
+fn bad_arguments_are_refused_naming_the_problem() {
+    let (dir, field) = fixture();
+    let field = field.to_str().unwrap();
+    let out = dir.path().join("bad");
+    let out = out.to_str().unwrap();
+    let path = dir.path().join("path.toml");
+    std::fs::write(
+        &path,
+        "[[key]]\ntime = 0.0\nposition = [1.0, nan, 3.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 30.0\n",
+    )
+    .unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "render",
+                "/nonexistent.frf",
+                "--env",
+                "sky",
+                "--orbit",
+                "3,1",
+                "--out",
+                out,
+            ],
+            "/nonexistent.frf",
+        ),
+        (
+            vec![
+                "render", field, "--env", "sky", "--orbit", "3,abc", "--out", out,
+            ],
+            "abc",
+        ),
+        (
+            vec![
+                "render", field, "--env", "sky", "--orbit", "-3,1", "--out", out,
+            ],
+            "radius",
+        ),
+        (
+            vec![
+                "render", field, "--env", "sky", "--orbit", "3,1", "--size", "0x10", "--out", out,
+            ],
+            "size",
+        ),
+        (
+            vec![
+                "render",
+                field,
+                "--env",
+                "/no/such.hdr",
+                "--orbit",
+                "3,1",
+                "--out",
+                out,
+            ],
+            "/no/such.hdr",
+        ),
+        (
+            vec![
+                "render",
+                field,
+                "--env",
+                "sky",
+                "--camera",
+                path.to_str().unwrap(),
+                "--out",
+                out,
+            ],
+            "path.toml",
+        ),
+        (
+            vec![
+                "render", field, "--env", "sky", "--orbit", "3,1", "--frames", "0", "--out", out,
+            ],
+            "frames",
+        ),
+        (
+            vec!["eval", field, "--capture", "/nonexistent", "--env", "sky"],
+            "/nonexistent",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = frf(&args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let e = stderr(&o);
+        assert!(e.contains(needle), "{args:?}: {e}");
+        assert!(!e.contains("panicked"), "{args:?}: {e}");
+    }
+}
