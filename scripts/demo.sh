@@ -2,10 +2,10 @@
 # The demo, end to end on built-in data: the virtual light stage films the walker
 # (small preset, 160x224, 36x3 views, 2 poses) with its ground truth, ingest turns the
 # capture into a flowed reflectance field (reporting each step's error against the
-# truth), then the stage renders the
-# true image of a novel camera under an HDR environment (a USC ICT light probe from
-# ../shared/data when present, else the built-in sky). Output in demo-out/ (resumable:
-# a rerun continues an interrupted one).
+# truth), the renderer draws an orbit of the walker relit by an HDR environment (a USC
+# ICT light probe from ../shared/data when present, else the built-in sky) on the GPU,
+# and the four-way morph is scored against its ablations on the stage's truth between
+# grid views. Output in demo-out/ (resumable: a rerun continues an interrupted one).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -17,6 +17,8 @@ $frf ingest "$out/capture" --out "$out/walker.frf" --report "$out/ingest_report.
 $frf info "$out/walker.frf"
 env=../shared/data/envmaps/grace.hdr
 [ -f "$env" ] || env=sky
-$frf stage truth --capture "$out/capture" --eye 2.5,1.6,3.0 --look-at 0,0.9,0 \
-  --env "$env" --out "$out/truth_novel_view.png"
-echo "demo: contact sheets in $out/capture/preview/, field $out/walker.frf with report $out/ingest_report.json, novel-view ground truth in $out/truth_novel_view.png"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
+$frf render "$out/walker.frf" --env "$env" --orbit 3.0,1.2 --frames 36 --out "$out/orbit"
+$frf eval "$out/walker.frf" --capture "$out/capture" --env "$env" --cameras 16 \
+  --json > "$out/eval.json"
+echo "demo: contact sheets in $out/capture/preview/, field $out/walker.frf with report $out/ingest_report.json, orbit frames in $out/orbit/ (contact.png), evaluation in $out/eval.json"

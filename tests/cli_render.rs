@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::OnceLock;
 
@@ -48,12 +48,15 @@ fn fixture() -> &'static (tempfile::TempDir, PathBuf) {
     })
 }
 
+/// A light probe of the shared data, or the built-in sky where the data is absent.
 fn envmap(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/envmaps")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
+    match frf_core::shared_data::shared_data(&format!("envmaps/{name}")) {
+        Some(p) => p.to_string_lossy().into_owned(),
+        None => {
+            eprintln!("envmaps/{name} is not in the shared data: the built-in sky instead");
+            "sky".into()
+        }
+    }
 }
 
 fn gpu_flag() -> Option<&'static str> {

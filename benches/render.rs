@@ -1,0 +1,85 @@
+//! Frame time of the renderer: the wgpu renderer (lavapipe on machines without a GPU)
+//! against the CPU reference in one run, per variant. The field is `FRF_BENCH_FIELD` (e.g. a paper-size field from
+//! `frf ingest`), or else the tiny stage's oracle field, built first (about 10 s).
+//! Frames are the field's image size, from a camera between grid views.
+//! Run: `cargo bench --bench render`.
+
+#![allow(clippy::unwrap_used)] // benchmarks: a failed unwrap is a failed run
+
+use std::path::PathBuf;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use frf_core::env::EnvMap;
+use frf_ingest::oracle::{OracleOptions, write_oracle_field};
+use frf_reflectance::FieldFile;
+use frf_reflectance::project::FloorModel;
+use frf_render::eval::between_view_cameras;
+use frf_render::gpu::Gpu;
+use frf_render::morph::Variant;
+use frf_render::renderer::Renderer;
+use frf_render::resident::{Lighting, PoseSource};
+use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
+
+fn field() -> (Option<tempfile::TempDir>, PathBuf) {
+    if let Ok(path) = std::env::var("FRF_BENCH_FIELD") {
+        return (None, PathBuf::from(path));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut c = StageConfig::preset(Preset::Tiny);
+    c.poses = vec![0];
+    c.set_flow_truth = SetFlowTruth::None;
+    let path = dir.path().join("tiny.frf");
+    let options = OracleOptions {
+        poses: vec![0],
+        jpeg_quality: 95,
+        predict_flow: true,
+    };
+    write_oracle_field(&Stage::new(c).unwrap(), &path, &options, &|_, _| {}).unwrap();
+    (Some(dir), path)
+}
+
+fn bench(c: &mut Criterion) {
+    let (_dir, path) = field();
+    let field = FieldFile::open(&path).unwrap();
+    let pose = field.header().poses[0].pose;
+    let lighting = Lighting::Environment {
+        env: EnvMap::sky(),
+        floor: FloorModel::Environment,
+    };
+    let source = PoseSource::load(&field, pose, &lighting).unwrap();
+    let camera = between_view_cameras(&source.cameras, source.columns, source.rows, true, 1)
+        .unwrap()
+        .remove(0)
+        .camera;
+    let mut group = c.benchmark_group("render");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(
+        camera.width as u64 * camera.height as u64,
+    ));
+    let renderers = [
+        (
+            "gpu",
+            Renderer::new(&source, Some(Gpu::new().unwrap())).unwrap(),
+        ),
+        ("cpu", Renderer::new(&source, None).unwrap()),
+    ];
+    eprintln!(
+        "{}: {}x{}, resident {:.1} MB; {}",
+        path.display(),
+        camera.width,
+        camera.height,
+        renderers[0].1.resident_bytes() as f64 / 1e6,
+        renderers[0].1.device()
+    );
+    for variant in [Variant::FourWay, Variant::Linear] {
+        for (name, r) in &renderers {
+            group.bench_function(format!("{}/{name}", variant.name()), |b| {
+                b.iter(|| r.render(&camera, variant).unwrap())
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
