@@ -23,7 +23,7 @@ use serde::Serialize;
 
 use crate::CliResult;
 use crate::cmd::progress::bar;
-use crate::cmd::render::{LightingArgs, VariantArg};
+use crate::cmd::render::{LightingArgs, VariantArg, pose_of};
 
 /// Arguments of `frf eval`.
 #[derive(Args)]
@@ -90,10 +90,7 @@ struct EvalReport {
 pub fn run(args: EvalArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
     let h = field.header();
-    let pose = args
-        .pose
-        .or_else(|| h.poses.first().map(|p| p.pose))
-        .ok_or_else(|| format!("{}: the field holds no pose", args.field.display()))?;
+    let pose = pose_of(h, args.pose, &args.field)?;
     let (lighting, env) = args.lighting.lighting(h.conditions.len())?;
     let env = env.ok_or("frf eval needs an environment (the truth is relit by it)")?;
     if !(1..=65536).contains(&args.lights) {

@@ -12,8 +12,8 @@ use frf_core::atomic::write_bytes_atomic;
 use frf_core::env::EnvMap;
 use frf_core::image::{Image, RgbImage, Rgba};
 use frf_core::io::{write_exr_rgba, write_png8_srgb, write_png8_srgba};
-use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
+use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::cpu::FrameStats;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
@@ -197,6 +197,14 @@ pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
     <[f32; 3]>::try_from(v).map_err(|_| format!("point `{s}`: expected x,y,z"))
 }
 
+/// The requested pose, or the field's first.
+pub fn pose_of(header: &FieldHeader, requested: Option<u32>, field: &Path) -> CliResult<u32> {
+    let pose = requested
+        .or_else(|| header.poses.first().map(|p| p.pose))
+        .ok_or_else(|| format!("{}: the field holds no pose", field.display()))?;
+    Ok(pose)
+}
+
 /// Parses `WxH`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -295,10 +303,7 @@ fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
 pub fn run(args: RenderArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
     let h = field.header();
-    let pose = args
-        .pose
-        .or_else(|| h.poses.first().map(|p| p.pose))
-        .ok_or_else(|| format!("{}: the field holds no pose", args.field.display()))?;
+    let pose = pose_of(h, args.pose, &args.field)?;
     let (lighting, _) = args.lighting.lighting(h.conditions.len())?;
     let (width, height) = args.size.unwrap_or((h.width, h.height));
     let cameras = args

@@ -120,6 +120,33 @@ fn texture_array(binding: u32, sample_type: wgpu::TextureSampleType) -> wgpu::Bi
     }
 }
 
+/// Copies `size = (width, height, layers)` of `texture` into `buffer`, rows `row` bytes
+/// apart.
+fn copy_to_buffer(
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    buffer: &wgpu::Buffer,
+    row: u32,
+    size: (u32, u32, u32),
+) {
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(size.1),
+            },
+        },
+        wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: size.2,
+        },
+    );
+}
+
 /// Pads `[f32; 256]` as `array<vec4<f32>, 64>`.
 fn table_bytes(tables: &[[f32; 256]]) -> Vec<u8> {
     tables
@@ -610,22 +637,7 @@ impl Gpu {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("prelit readback"),
             });
-        encoder.copy_texture_to_buffer(
-            pose.prelit.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: layers,
-            },
-        );
+        copy_to_buffer(&mut encoder, &pose.prelit, &buffer, row, (w, h, layers));
         self.queue.submit([encoder.finish()]);
         let bytes = self.read_buffer(&buffer)?;
         Ok((0..layers as usize)
@@ -752,22 +764,7 @@ impl Gpu {
             pass.set_bind_group(1, &pose.bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
-        encoder.copy_texture_to_buffer(
-            target.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
+        copy_to_buffer(&mut encoder, &target, &readback, row, (w, h, 1));
         encoder.copy_buffer_to_buffer(&stats, 0, &stats_readback, 0, 16);
         self.queue.submit([encoder.finish()]);
         let bytes = self.read_buffer(&readback)?;
