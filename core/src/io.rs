@@ -134,7 +134,19 @@ fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0).round() as u8
 }
 
-/// The sRGB transfer function (linear to encoded), for 8-bit previews.
+/// The sRGB transfer function, encoded to linear (IEC 61966-2-1), as a GPU's `*-srgb`
+/// formats apply it.
+#[inline]
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function, linear to encoded (IEC 61966-2-1), clamped to [0, 1].
+#[inline]
 pub fn linear_to_srgb(v: f32) -> f32 {
     let v = v.clamp(0.0, 1.0);
     if v <= 0.003_130_8 {

@@ -265,16 +265,9 @@ pub fn photo_and_alpha(path: &Path) -> Result<(RgbImage, GrayImage)> {
     let closed = dilate(&dilate(&raw, true), false);
     let fg = largest_central_component(&Image::from_vec(w, h, closed)?)?;
     let alpha = gaussian_blur(&fg.map(|b| if b { 1.0 } else { 0.0 }), MATTE_BLUR_SIGMA_PX);
-    let srgb_to_linear = |c: f32| {
-        if c <= 0.040_45 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
     let photo = Image::from_fn(w, h, |x, y| {
         if alpha.get(x, y) > 0.0 {
-            encoded.get(x, y).map(srgb_to_linear)
+            encoded.get(x, y).map(frf_core::io::srgb_to_linear)
         } else {
             [0.0; 3]
         }

@@ -75,15 +75,15 @@ pub struct EvalCamera {
     pub camera: Camera,
 }
 
-/// `count` cameras at the centres of grid quads, spread over the columns and alternating
-/// over the row gaps; `cameras` are the grid's, `u`-major.
-pub fn between_view_cameras(
+/// The first corners `(u, v)` of `count` grid quads, spread over the columns and
+/// alternating over the row gaps; refuses a grid without quads and absurd counts.
+fn quad_corners(
     cameras: &[Camera],
     columns: usize,
     rows: usize,
     wraps: bool,
     count: usize,
-) -> Result<Vec<EvalCamera>> {
+) -> Result<Vec<(usize, usize)>> {
     let quads_u = if wraps {
         columns
     } else {
@@ -102,9 +102,22 @@ pub fn between_view_cameras(
     }
     let gaps = rows.saturating_sub(1).max(1);
     Ok((0..count)
-        .map(|k| {
-            let u = (k * quads_u) / count;
-            let v = k % gaps;
+        .map(|k| ((k * quads_u) / count, k % gaps))
+        .collect())
+}
+
+/// `count` cameras at the centres of grid quads, spread over the columns and alternating
+/// over the row gaps; `cameras` are the grid's, `u`-major.
+pub fn between_view_cameras(
+    cameras: &[Camera],
+    columns: usize,
+    rows: usize,
+    wraps: bool,
+    count: usize,
+) -> Result<Vec<EvalCamera>> {
+    Ok(quad_corners(cameras, columns, rows, wraps, count)?
+        .into_iter()
+        .map(|(u, v)| {
             let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
             let at = |u: usize, v: usize| &cameras[u * rows + v];
             let quad = [at(u, v), at(u1, v), at(u, v1), at(u1, v1)];
@@ -127,16 +140,11 @@ pub fn grid_view_cameras(
     wraps: bool,
     count: usize,
 ) -> Result<Vec<EvalCamera>> {
-    let between = between_view_cameras(cameras, columns, rows, wraps, count)?;
-    let quads_u = if wraps { columns } else { columns - 1 };
-    let gaps = rows.saturating_sub(1).max(1);
-    Ok((0..between.len())
-        .map(|k| {
-            let (u, v) = ((k * quads_u) / count, k % gaps);
-            EvalCamera {
-                name: format!("u {u}, v {v}"),
-                camera: cameras[u * rows + v],
-            }
+    Ok(quad_corners(cameras, columns, rows, wraps, count)?
+        .into_iter()
+        .map(|(u, v)| EvalCamera {
+            name: format!("u {u}, v {v}"),
+            camera: cameras[u * rows + v],
         })
         .collect())
 }
@@ -166,14 +174,18 @@ pub fn score(camera: &str, truth: &Image<Rgba>, test: &Image<Rgba>, seconds: f64
     }
 }
 
+/// What [`evaluate`] calls with each frame: camera index, variant, the frame.
+pub type OnFrame<'a> = dyn FnMut(usize, Variant, &Image<Rgba>) -> Result<()> + 'a;
+
 /// Renders every camera with every variant and scores them against `truths` (one per
-/// camera); `progress()` is called after each frame.
+/// camera); `on_frame(camera index, variant, frame)` sees each frame once scored (to show
+/// progress or keep it).
 pub fn evaluate(
     renderer: &Renderer,
     cameras: &[EvalCamera],
     truths: &[Image<Rgba>],
     variants: &[Variant],
-    progress: &dyn Fn(),
+    on_frame: &mut OnFrame,
 ) -> Result<Vec<VariantScore>> {
     // One untimed frame first: pipeline compilation and caches.
     if let Some(c) = cameras.first() {
@@ -185,12 +197,14 @@ pub fn evaluate(
             let frames = cameras
                 .iter()
                 .zip(truths)
-                .map(|(c, truth)| {
+                .enumerate()
+                .map(|(i, (c, truth))| {
                     let t = Instant::now();
                     let (img, _) = renderer.render(&c.camera, variant)?;
                     let seconds = t.elapsed().as_secs_f64();
-                    progress();
-                    Ok(score(&c.name, truth, &img, seconds))
+                    let scored = score(&c.name, truth, &img, seconds);
+                    on_frame(i, variant, &img)?;
+                    Ok(scored)
                 })
                 .collect::<Result<Vec<_>>>()?;
             let n = frames.len().max(1) as f64;

@@ -4,6 +4,7 @@
 //! Rec. 709 luminance, and mean absolute alpha error. Regions are masks of pixels; the
 //! SSIM of a region is the mean of the SSIM map over it.
 
+use frf_core::filter::gaussian_blur;
 use frf_core::image::{GrayImage, Image, Rgba};
 
 /// Rec. 709 luminance of linear RGB.
@@ -33,30 +34,10 @@ pub fn psnr(reference: &Image<Rgba>, test: &Image<Rgba>, mask: Option<&[bool]>) 
     }
 }
 
-/// Separable Gaussian blur (σ = 1.5, radius 5) with clamped edges.
+/// The SSIM window: a Gaussian of σ = 1.5 px, truncated at radius 5 (11 x 11), edges
+/// clamped.
 fn blur(img: &GrayImage) -> GrayImage {
-    const RADIUS: i64 = 5;
-    let weights: Vec<f32> = (-RADIUS..=RADIUS)
-        .map(|d| (-(d * d) as f32 / (2.0 * 1.5 * 1.5)).exp())
-        .collect();
-    let total: f32 = weights.iter().sum();
-    let (w, h) = img.size();
-    let pass = |src: &GrayImage, horizontal: bool| {
-        Image::from_fn(w, h, |x, y| {
-            let mut acc = 0.0;
-            for (k, wk) in weights.iter().enumerate() {
-                let d = k as i64 - RADIUS;
-                let (sx, sy) = if horizontal {
-                    ((x as i64 + d).clamp(0, w as i64 - 1) as usize, y)
-                } else {
-                    (x, (y as i64 + d).clamp(0, h as i64 - 1) as usize)
-                };
-                acc += wk * src.get(sx, sy);
-            }
-            acc / total
-        })
-    };
-    pass(&pass(img, true), false)
+    gaussian_blur(img, 1.5)
 }
 
 /// Mean SSIM of the luminance of `test` against `reference` over `mask` (all pixels when

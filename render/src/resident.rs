@@ -19,6 +19,7 @@ use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
+use frf_core::io::{linear_to_srgb, srgb_to_linear};
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
@@ -280,31 +281,10 @@ pub struct ResidentPose {
     pub plan: LightingPlan,
 }
 
-/// The sRGB transfer function, linear to encoded (IEC 61966-2-1).
-#[inline]
-pub fn srgb_encode(v: f32) -> f32 {
-    let v = v.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// The sRGB transfer function, encoded to linear, as a GPU's `*-srgb` formats apply it.
-#[inline]
-pub fn srgb_decode(c: f32) -> f32 {
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 /// 8-bit sRGB code to linear: the table both the CPU and the GPU decode texels with, so
 /// that they read identical values.
 pub fn srgb_lut() -> [f32; 256] {
-    std::array::from_fn(|c| srgb_decode(c as f32 / 255.0))
+    std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0))
 }
 
 /// Flow code (offset by 128) to displacement, unknown (−128) to zero: the table both the
@@ -355,7 +335,7 @@ impl ResidentPose {
                     .iter()
                     .zip(&source.alpha[i])
                     .map(|(c, &a)| {
-                        let e = |x: f32| (srgb_encode(x / scale) * 255.0).round() as u8;
+                        let e = |x: f32| (linear_to_srgb(x / scale) * 255.0).round() as u8;
                         [e(c[0]), e(c[1]), e(c[2]), a]
                     })
                     .collect();

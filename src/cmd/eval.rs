@@ -12,10 +12,8 @@ use frf_reflectance::FieldFile;
 use frf_render::eval::{
     EvalCamera, between_view_cameras, evaluate, grid_view_cameras, truth_frame,
 };
-use frf_render::gpu::Gpu;
 use frf_render::metrics::{psnr, ssim};
 use frf_render::morph::Variant;
-use frf_render::renderer::Renderer;
 use frf_render::resident::{Lighting, PoseSource};
 use frf_stage::truth::environment_lights;
 use rayon::prelude::*;
@@ -23,7 +21,7 @@ use serde::Serialize;
 
 use crate::CliResult;
 use crate::cmd::progress::bar;
-use crate::cmd::render::{LightingArgs, VariantArg, pose_of};
+use crate::cmd::render::{LightingArgs, VariantArg, open_renderer, pose_of};
 
 /// Arguments of `frf eval`.
 #[derive(Args)]
@@ -44,6 +42,16 @@ pub struct EvalArgs {
     /// Median-cut lights of the environment in the truth renders.
     #[arg(long, default_value_t = 512)]
     lights: usize,
+    #[command(flatten)]
+    compare: CompareArgs,
+    /// Write each camera's truth and renders as PNGs here.
+    #[arg(long)]
+    images: Option<PathBuf>,
+}
+
+/// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.
+#[derive(Args)]
+struct CompareArgs {
     /// Variants to compare (default: all four).
     #[arg(long, value_enum, value_delimiter = ',')]
     variants: Vec<VariantArg>,
@@ -53,22 +61,16 @@ pub struct EvalArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
-    /// Write each camera's truth and renders as PNGs here.
-    #[arg(long)]
-    images: Option<PathBuf>,
 }
 
-fn variants(args: &[VariantArg]) -> Vec<Variant> {
-    if args.is_empty() {
-        Variant::ALL.to_vec()
-    } else {
-        args.iter().map(|&v| v.into()).collect()
+impl CompareArgs {
+    fn variants(&self) -> Vec<Variant> {
+        if self.variants.is_empty() {
+            Variant::ALL.to_vec()
+        } else {
+            self.variants.iter().map(|&v| v.into()).collect()
+        }
     }
-}
-
-fn renderer(source: &PoseSource, cpu: bool) -> CliResult<Renderer> {
-    let gpu = if cpu { None } else { Some(Gpu::new()?) };
-    Ok(Renderer::new(source, gpu)?)
 }
 
 #[derive(Serialize)]
@@ -122,7 +124,6 @@ pub fn run(args: EvalArgs) -> CliResult {
     )?;
     let lights = environment_lights(&env, args.lights);
     let truth_bar = bar("truth frames");
-    truth_bar.set_length(cameras.len() as u64);
     let start = Instant::now();
     let all: Vec<&EvalCamera> = cameras.iter().chain(&at_views).collect();
     truth_bar.set_length(all.len() as u64);
@@ -138,25 +139,37 @@ pub fn run(args: EvalArgs) -> CliResult {
     let truths_at_views = truths.split_off(cameras.len());
     truth_bar.finish_and_clear();
 
-    let renderer = renderer(&source, args.cpu)?;
-    let variants = variants(&args.variants);
+    let renderer = open_renderer(&source, args.compare.cpu)?;
+    let variants = args.compare.variants();
+    if let Some(dir) = &args.images {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        for (i, t) in truths.iter().enumerate() {
+            write_png8_srgba(&dir.join(format!("camera{i:02}_truth.png")), t, 1.0)?;
+        }
+    }
     let bar = bar("rendered frames");
     bar.set_length((cameras.len() * variants.len()) as u64);
-    let scores = evaluate(&renderer, &cameras, &truths, &variants, &|| bar.inc(1))?;
+    let scores = evaluate(&renderer, &cameras, &truths, &variants, &mut |i, v, img| {
+        bar.inc(1);
+        if let Some(dir) = &args.images {
+            write_png8_srgba(
+                &dir.join(format!("camera{i:02}_{}.png", v.name())),
+                img,
+                1.0,
+            )?;
+        }
+        Ok(())
+    })?;
     bar.finish_and_clear();
     let mut floor = evaluate(
         &renderer,
         &at_views,
         &truths_at_views,
         &[Variant::FourWay],
-        &|| {},
+        &mut |_, _, _| Ok(()),
     )?
     .remove(0);
     floor.name = "at the captured views".into();
-
-    if let Some(dir) = &args.images {
-        write_images(dir, &renderer, &cameras, &truths, &variants)?;
-    }
     eprintln!(
         "{} pose {pose} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
          cameras at quad centres, {}:",
@@ -189,7 +202,7 @@ pub fn run(args: EvalArgs) -> CliResult {
             s.seconds_per_frame
         );
     }
-    if args.json {
+    if args.compare.json {
         let report = EvalReport {
             field: args.field.clone(),
             capture: args.capture.clone(),
@@ -207,28 +220,6 @@ pub fn run(args: EvalArgs) -> CliResult {
     Ok(())
 }
 
-fn write_images(
-    dir: &std::path::Path,
-    renderer: &Renderer,
-    cameras: &[EvalCamera],
-    truths: &[frf_core::image::Image<frf_core::image::Rgba>],
-    variants: &[Variant],
-) -> CliResult {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    for (i, (c, t)) in cameras.iter().zip(truths).enumerate() {
-        write_png8_srgba(&dir.join(format!("camera{i:02}_truth.png")), t, 1.0)?;
-        for &v in variants {
-            let (img, _) = renderer.render(&c.camera, v)?;
-            write_png8_srgba(
-                &dir.join(format!("camera{i:02}_{}.png", v.name())),
-                &img,
-                1.0,
-            )?;
-        }
-    }
-    Ok(())
-}
-
 /// Arguments of `frf eval-ring`.
 #[derive(Args)]
 pub struct RingEvalArgs {
@@ -241,15 +232,8 @@ pub struct RingEvalArgs {
     /// is rendered (2: view i from i±1; 4: from i±2; 6: from i±3).
     #[arg(long)]
     stride: usize,
-    /// Variants to compare (default: all four).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    variants: Vec<VariantArg>,
-    /// Render with the CPU reference instead of the GPU.
-    #[arg(long)]
-    cpu: bool,
-    /// Print the report as JSON on stdout.
-    #[arg(long)]
-    json: bool,
+    #[command(flatten)]
+    compare: CompareArgs,
 }
 
 #[derive(Serialize)]
@@ -281,7 +265,7 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
         .filter(|&i| wraps || i + s / 2 < views.len())
         .collect();
     let source = PoseSource::load(&field, 0, &Lighting::Unlit)?;
-    let renderer = renderer(&source, args.cpu)?;
+    let renderer = open_renderer(&source, args.compare.cpu)?;
     let photos = held
         .par_iter()
         .map(|&i| {
@@ -292,7 +276,7 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
         .collect::<CliResult<Vec<_>>>()?;
     renderer.render(&cameras[held[0]], Variant::FourWay)?;
     let mut scores = Vec::new();
-    for v in variants(&args.variants) {
+    for v in args.compare.variants() {
         let (mut psnrs, mut ssims, mut seconds) = (Vec::new(), Vec::new(), 0.0);
         for (&i, (photo, mask)) in held.iter().zip(&photos) {
             let t = Instant::now();
@@ -329,7 +313,7 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
             r.name, r.psnr_silhouette, r.ssim_silhouette, r.seconds_per_frame
         );
     }
-    if args.json {
+    if args.compare.json {
         println!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({

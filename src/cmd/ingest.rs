@@ -10,6 +10,7 @@ use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
 use indicatif::ProgressBar;
 
 use crate::CliResult;
+use crate::cmd::parse_poses;
 use crate::cmd::progress::bar;
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -84,23 +85,6 @@ impl Progress for Bars {
             b.inc(1);
         }
     }
-}
-
-fn parse_poses(s: &str) -> CliResult<Vec<u32>> {
-    let bad = || format!("--poses {s:?}: expected e.g. 0,1 or 0..4");
-    if let Some((a, b)) = s.split_once("..") {
-        let (a, b): (u32, u32) = (
-            a.trim().parse().map_err(|_| bad())?,
-            b.trim().parse().map_err(|_| bad())?,
-        );
-        if a >= b {
-            return Err(bad().into());
-        }
-        return Ok((a..b).collect());
-    }
-    s.split(',')
-        .map(|p| p.trim().parse().map_err(|_| bad().into()))
-        .collect()
 }
 
 /// Runs `frf ingest`.

@@ -197,6 +197,12 @@ pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
     <[f32; 3]>::try_from(v).map_err(|_| format!("point `{s}`: expected x,y,z"))
 }
 
+/// Makes `source` resident on the GPU, or for the CPU reference when `cpu`.
+pub fn open_renderer(source: &PoseSource, cpu: bool) -> CliResult<Renderer> {
+    let gpu = if cpu { None } else { Some(Gpu::new()?) };
+    Ok(Renderer::new(source, gpu)?)
+}
+
 /// The requested pose, or the field's first.
 pub fn pose_of(header: &FieldHeader, requested: Option<u32>, field: &Path) -> CliResult<u32> {
     let pose = requested
@@ -332,8 +338,7 @@ pub fn run(args: RenderArgs) -> CliResult {
 
     let start = Instant::now();
     let source = PoseSource::load(&field, pose, &lighting)?;
-    let gpu = if args.cpu { None } else { Some(Gpu::new()?) };
-    let renderer = Renderer::new(&source, gpu)?;
+    let renderer = open_renderer(&source, args.cpu)?;
     let resident_seconds = start.elapsed().as_secs_f64();
     let c = source.crop;
     eprintln!(

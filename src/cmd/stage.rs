@@ -14,6 +14,7 @@ use frf_stage::{Gait, Preset, SetFlowTruth, StageConfig};
 use glam::Vec3;
 
 use crate::CliResult;
+use crate::cmd::parse_poses;
 use crate::cmd::progress::bar;
 
 /// Arguments of `frf stage`.
@@ -143,23 +144,6 @@ pub fn run(args: StageArgs) -> CliResult {
         Some(StageCommand::CodecCurve(a)) => crate::cmd::stage_field::codec(a),
         None => capture(args.capture),
     }
-}
-
-fn parse_poses(s: &str) -> CliResult<Vec<u32>> {
-    let bad = || format!("--poses {s:?}: expected e.g. 0,1 or 0..4");
-    if let Some((a, b)) = s.split_once("..") {
-        let (a, b): (u32, u32) = (
-            a.trim().parse().map_err(|_| bad())?,
-            b.trim().parse().map_err(|_| bad())?,
-        );
-        if a >= b {
-            return Err(bad().into());
-        }
-        return Ok((a..b).collect());
-    }
-    s.split(',')
-        .map(|p| p.trim().parse().map_err(|_| bad().into()))
-        .collect()
 }
 
 fn capture(args: CaptureArgs) -> CliResult {
