@@ -10,36 +10,23 @@ use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use frf_core::env::EnvMap;
-use frf_ingest::oracle::{OracleOptions, write_oracle_field};
+use frf_eval::views::between_view_cameras;
 use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
-use frf_render::eval::between_view_cameras;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
 use frf_render::resident::{Lighting, PoseSource};
-use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
 
-fn field() -> (Option<tempfile::TempDir>, PathBuf) {
-    if let Ok(path) = std::env::var("FRF_BENCH_FIELD") {
-        return (None, PathBuf::from(path));
+fn field() -> PathBuf {
+    match std::env::var("FRF_BENCH_FIELD") {
+        Ok(path) => PathBuf::from(path),
+        Err(_) => frf_testkit::tiny_field().field.clone(),
     }
-    let dir = tempfile::tempdir().unwrap();
-    let mut c = StageConfig::preset(Preset::Tiny);
-    c.poses = vec![0];
-    c.set_flow_truth = SetFlowTruth::None;
-    let path = dir.path().join("tiny.frf");
-    let options = OracleOptions {
-        poses: vec![0],
-        jpeg_quality: 95,
-        predict_flow: true,
-    };
-    write_oracle_field(&Stage::new(c).unwrap(), &path, &options, &|_, _| {}).unwrap();
-    (Some(dir), path)
 }
 
 fn bench(c: &mut Criterion) {
-    let (_dir, path) = field();
+    let path = field();
     let field = FieldFile::open(&path).unwrap();
     let pose = field.header().poses[0].pose;
     let lighting = Lighting::Environment {
@@ -47,7 +34,7 @@ fn bench(c: &mut Criterion) {
         floor: FloorModel::Environment,
     };
     let source = PoseSource::load(&field, pose, &lighting).unwrap();
-    let camera = between_view_cameras(&source.cameras, source.columns, source.rows, true, 1)
+    let camera = between_view_cameras(&source.geometry, 1)
         .unwrap()
         .remove(0)
         .camera;

@@ -1,4 +1,4 @@
-// The relighting pass (BRIEF section 5.1), one view at a time: the weighted sum of the
+// The relighting pass (docs/design.md section 4.1), one view at a time: the weighted sum of the
 // view's basis images (JPEG-decoded 8-bit gamma-2.2 codes, linearized through the table
 // the CPU uses), then its encoding into the pre-lit texture layer as sRGB codes of
 // colour / scale, the scale being the view's brightest value. Twin of

@@ -5,12 +5,8 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use std::sync::OnceLock;
-
-use frf_ingest::oracle::{OracleOptions, write_oracle_field};
-use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
 
 fn frf(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_frf"))
@@ -24,28 +20,11 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A directory with the tiny stage's configuration (pose 0, no perturbation: every
-/// cycle repeats, so the truth between views is what interpolation should produce) and
-/// its oracle field, shared by the tests of this file.
-fn fixture() -> &'static (tempfile::TempDir, PathBuf) {
-    static FIXTURE: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
-    FIXTURE.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let mut c = StageConfig::preset(Preset::Tiny);
-        c.poses = vec![0];
-        c.perturbation = 0.0;
-        c.set_flow_truth = SetFlowTruth::None;
-        std::fs::write(dir.path().join("stage.toml"), toml::to_string(&c).unwrap()).unwrap();
-        let stage = Stage::new(c).unwrap();
-        let field = dir.path().join("tiny.frf");
-        let options = OracleOptions {
-            poses: vec![0],
-            jpeg_quality: 95,
-            predict_flow: true,
-        };
-        write_oracle_field(&stage, &field, &options, &|_, _| {}).unwrap();
-        (dir, field)
-    })
+/// The tiny stage's oracle field and its capture directory, shared by the tests of this
+/// file; `(directory, field)`.
+fn fixture() -> (&'static Path, &'static PathBuf) {
+    let f = frf_testkit::tiny_field();
+    (f.capture(), &f.field)
 }
 
 /// A light probe of the shared data, or the built-in sky where the data is absent.
@@ -69,7 +48,7 @@ fn gpu_flag() -> Option<&'static str> {
 #[test]
 fn render_writes_an_orbit_under_an_hdr_environment_and_resumes() {
     let (dir, field) = fixture();
-    let out = dir.path().join("orbit");
+    let out = dir.join("orbit");
     let env = envmap("grace.hdr");
     let mut args = vec![
         "render",
@@ -133,7 +112,7 @@ fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
         "eval",
         field.to_str().unwrap(),
         "--capture",
-        dir.path().to_str().unwrap(),
+        dir.to_str().unwrap(),
         "--env",
         &env,
         "--cameras",
@@ -183,9 +162,9 @@ fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
 fn bad_arguments_are_refused_naming_the_problem() {
     let (dir, field) = fixture();
     let field = field.to_str().unwrap();
-    let out = dir.path().join("bad");
+    let out = dir.join("bad");
     let out = out.to_str().unwrap();
-    let path = dir.path().join("path.toml");
+    let path = dir.join("path.toml");
     std::fs::write(
         &path,
         "[[key]]\ntime = 0.0\nposition = [1.0, nan, 3.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 30.0\n",

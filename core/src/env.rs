@@ -1,5 +1,5 @@
 //! HDR lighting environments in latitude–longitude layout, with the USC ICT light-probe
-//! mapping (`../shared/data/README.md`): for a unit direction `(x, y, z)` with `y` up,
+//! mapping (`docs/data.md`): for a unit direction `(x, y, z)` with `y` up,
 //! `u = (1 + atan2(x, -z) / π) / 2`, `v = acos(y) / π`; the image centre looks toward
 //! `-z`. A yaw (rotation about `+y`, radians, right-handed) turns the whole map:
 //! the map's direction `d` lights the subject from `R_y(yaw) d`.
@@ -11,10 +11,15 @@
 //! [`EnvMap::median_cut`] reduces the map to `n` distant lights of nearly equal energy
 //! (Debevec, "A median cut algorithm for light probe sampling", SIGGRAPH 2005 poster),
 //! keeping the total light exactly: a small, very bright sun ends up alone in its region.
+//!
+//! [`EnvSource`] is what a user names as lighting (a file, the built-in sky, a uniform
+//! white furnace, or none), parsed once where it is read.
 
 use std::collections::BinaryHeap;
 use std::f32::consts::PI;
-use std::path::Path;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
 
 use glam::{Mat3, Vec2, Vec3};
 
@@ -105,14 +110,6 @@ impl EnvMap {
             yaw: 0.0,
             clamped_texels: 0,
         }
-    }
-
-    /// Loads `name`: a file path, or `sky` for [`EnvMap::sky`].
-    pub fn load_or_builtin(name: &Path) -> Result<Self> {
-        if name.as_os_str() == "sky" && !name.exists() {
-            return Ok(Self::sky());
-        }
-        Self::load(name)
     }
 
     /// The same environment turned by an extra `angle` radians about `+y`.
@@ -371,6 +368,86 @@ impl<'a> MedianCut<'a> {
     }
 }
 
+/// Where a render's lighting comes from, as a user names it: `sky`, `uniform`, `none`,
+/// or the path of a latitude–longitude `.hdr` / `.exr` file (a file literally named like
+/// one of the words is given as `./sky`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum EnvSource {
+    /// An HDR environment file.
+    File(PathBuf),
+    /// The built-in sky ([`EnvMap::sky`]).
+    Sky,
+    /// A uniform white environment of radiance 1 (a furnace).
+    Uniform,
+    /// No relighting: a field of photographs shown as captured.
+    None,
+}
+
+/// Resolution of the built-in uniform environment (texels per row); it is constant, so
+/// any size projects the same.
+const UNIFORM_SIZE: usize = 64;
+
+impl EnvSource {
+    /// The environment: `None` for [`EnvSource::None`].
+    pub fn load(&self) -> Result<Option<EnvMap>> {
+        Ok(match self {
+            EnvSource::File(path) => Some(EnvMap::load(path)?),
+            EnvSource::Sky => Some(EnvMap::sky()),
+            EnvSource::Uniform => Some(EnvMap::uniform([1.0; 3], UNIFORM_SIZE)),
+            EnvSource::None => None,
+        })
+    }
+
+    /// A short name for reports: the file's stem, or the word.
+    pub fn name(&self) -> String {
+        match self {
+            EnvSource::File(p) => p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| p.display().to_string()),
+            other => other.to_string(),
+        }
+    }
+}
+
+impl FromStr for EnvSource {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Ok(match s {
+            "" => return Err("an environment: a .hdr/.exr file, sky, uniform or none".into()),
+            "sky" => EnvSource::Sky,
+            "uniform" => EnvSource::Uniform,
+            "none" => EnvSource::None,
+            path => EnvSource::File(PathBuf::from(path)),
+        })
+    }
+}
+
+impl fmt::Display for EnvSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EnvSource::File(p) => write!(f, "{}", p.display()),
+            EnvSource::Sky => f.write_str("sky"),
+            EnvSource::Uniform => f.write_str("uniform"),
+            EnvSource::None => f.write_str("none"),
+        }
+    }
+}
+
+impl serde::Serialize for EnvSource {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for EnvSource {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -467,5 +544,30 @@ mod tests {
         let env = EnvMap::from_image(img).unwrap();
         assert_eq!(env.clamped_texels(), 1);
         assert_eq!(env.image().get(1, 1), [0.0, 0.5, 0.0]);
+    }
+
+    #[test]
+    fn environment_sources_parse_once_and_round_trip() {
+        for (text, source) in [
+            ("sky", EnvSource::Sky),
+            ("uniform", EnvSource::Uniform),
+            ("none", EnvSource::None),
+            ("./sky", EnvSource::File(PathBuf::from("./sky"))),
+            (
+                "maps/grace.hdr",
+                EnvSource::File(PathBuf::from("maps/grace.hdr")),
+            ),
+        ] {
+            assert_eq!(text.parse::<EnvSource>().unwrap(), source);
+            assert_eq!(source.to_string(), text);
+        }
+        assert!("".parse::<EnvSource>().is_err());
+        assert_eq!(EnvSource::File("a/grace.hdr".into()).name(), "grace");
+        assert!(EnvSource::None.load().unwrap().is_none());
+        let furnace = EnvSource::Uniform.load().unwrap().unwrap();
+        let total = furnace.total_light();
+        assert!((total[0] - 4.0 * PI).abs() < 1e-3, "{total:?}");
+        let missing = EnvSource::File("no/such.hdr".into()).load().unwrap_err();
+        assert!(missing.to_string().contains("no/such.hdr"), "{missing}");
     }
 }

@@ -1,5 +1,5 @@
 //! Where the real third-party data (Middlebury flow, Sintel, Middlebury multi-view rings,
-//! HDR light probes; see `../shared/data/README.md`) lives on this machine.
+//! HDR light probes; see `docs/data.md`) lives on this machine.
 //!
 //! Looked up in order: the `FRF_DATA_DIR` environment variable, then `shared/data` in the
 //! workspace's parent directory and its ancestors, then `/work/shared/data`. Tests on real

@@ -1,9 +1,9 @@
-//! The error type of ingest and evaluation.
+//! The error type of ingest.
 
 /// Result alias of this crate.
 pub type Result<T, E = IngestError> = std::result::Result<T, E>;
 
-/// Everything that can go wrong in ingest and evaluation.
+/// Everything that can go wrong in ingest.
 #[derive(Debug, thiserror::Error)]
 pub enum IngestError {
     /// A parameter is out of range or inconsistent with the capture.
@@ -15,9 +15,9 @@ pub enum IngestError {
     /// Reading the capture, images or environments.
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
-    /// The virtual stage (ground truth).
-    #[error(transparent)]
-    Stage(#[from] frf_stage::StageError),
+    /// The evaluator judging the ingest against a ground truth failed.
+    #[error("evaluation against the ground truth: {0}")]
+    Evaluation(crate::evidence::EvaluationError),
     /// The field file and codecs.
     #[error(transparent)]
     Reflectance(#[from] frf_reflectance::ReflectanceError),

@@ -1,4 +1,4 @@
-//! Flow between neighbouring views of a pose (BRIEF section 3.3), measured on each
+//! Flow between neighbouring views of a pose (docs/design.md section 2.3), measured on each
 //! view's registered basis images summed (the subject under the whole dome: evenly lit,
 //! so brightness constancy holds across views, and far less noisy than one track frame;
 //! measured on the small preset: 0.58 px instead of 0.73 px end-point error).
@@ -20,9 +20,13 @@
 //! Flow is stored only near the subject: inside its matte grown by [`FLOW_MARGIN_PX`]
 //! (the morph samples a little outside the silhouette); elsewhere it is unknown.
 
+use std::time::Instant;
+
 use frf_core::camera::Camera;
+use frf_core::grid::Neighbour;
 use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
 use frf_flow::FlowParams;
+use rayon::prelude::*;
 
 use crate::error::Result;
 use crate::rectify::{rectify, rectifying_homography, unrectify_flow};
@@ -98,5 +102,99 @@ pub fn keep_near_subject(flow: &FlowImage, alpha: &GrayImage) -> FlowImage {
         } else {
             [frf_core::flo::UNKNOWN; 2]
         }
+    })
+}
+
+/// The views of a grid, `u`-major (`index = u * rows + v`), as the flow step needs them:
+/// the image flow is measured on, its matte, and its camera seen from the subject frame.
+pub struct GridViews<'a> {
+    /// Columns.
+    pub columns: usize,
+    /// Rows.
+    pub rows: usize,
+    /// Whether the columns close into a ring.
+    pub wraps: bool,
+    /// Per view: the image flow is measured on.
+    pub images: &'a [&'a RgbImage],
+    /// Per view: its matte (flow is kept near it).
+    pub alphas: &'a [&'a GrayImage],
+    /// Per view: its camera, subject frame.
+    pub cameras: &'a [Camera],
+}
+
+/// The flows of a grid, and the thread time they took.
+pub struct GridFlows {
+    /// Per view, toward each neighbour ([`Neighbour::ALL`] order; `None` at the grid's
+    /// edges): rectified flow averaged with the reverse one ([`symmetrize`]), kept near
+    /// the subject ([`keep_near_subject`]).
+    pub flows: Vec<[Option<FlowImage>; 4]>,
+    /// Thread seconds spent on horizontal pairs.
+    pub horizontal_seconds: f64,
+    /// Thread seconds spent on vertical pairs.
+    pub vertical_seconds: f64,
+}
+
+/// The flow from every view of a grid to each of its neighbours, in parallel over views:
+/// each pair measured both ways through rectification ([`rectified_flow`]), then averaged
+/// with its reverse. `each_view` is called once per view when its raw flows are done (to
+/// show progress, and to stop: an error it returns ends the step).
+pub fn grid_flows(
+    grid: &GridViews,
+    params: &FlowParams,
+    each_view: &(dyn Fn() -> Result<()> + Sync),
+) -> Result<GridFlows> {
+    let (columns, rows, wraps) = (grid.columns, grid.rows, grid.wraps);
+    let raw: Vec<([Option<FlowImage>; 4], f64, f64)> = (0..columns * rows)
+        .into_par_iter()
+        .map(|i| {
+            let (u, v) = (i / rows, i % rows);
+            let mut flows: [Option<FlowImage>; 4] = Default::default();
+            let (mut horizontal, mut vertical) = (0.0, 0.0);
+            for n in Neighbour::ALL {
+                let Some((u2, v2)) = n.of(u, v, columns, rows, wraps) else {
+                    continue;
+                };
+                let t = Instant::now();
+                let j = u2 * rows + v2;
+                flows[n.index()] = Some(rectified_flow(
+                    grid.images[i],
+                    grid.images[j],
+                    &grid.cameras[i],
+                    &grid.cameras[j],
+                    params,
+                )?);
+                let dt = t.elapsed().as_secs_f64();
+                if matches!(n, Neighbour::Left | Neighbour::Right) {
+                    horizontal += dt;
+                } else {
+                    vertical += dt;
+                }
+            }
+            each_view()?;
+            Ok((flows, horizontal, vertical))
+        })
+        .collect::<Result<_>>()?;
+    let flows = (0..columns * rows)
+        .into_par_iter()
+        .map(|i| {
+            let (u, v) = (i / rows, i % rows);
+            let mut out: [Option<FlowImage>; 4] = Default::default();
+            for n in Neighbour::ALL {
+                let (Some(f), Some((u2, v2))) =
+                    (&raw[i].0[n.index()], n.of(u, v, columns, rows, wraps))
+                else {
+                    continue;
+                };
+                let back = raw[u2 * rows + v2].0[n.opposite().index()].as_ref();
+                let f = back.map_or_else(|| f.clone(), |b| symmetrize(f, b));
+                out[n.index()] = Some(keep_near_subject(&f, grid.alphas[i]));
+            }
+            out
+        })
+        .collect();
+    Ok(GridFlows {
+        flows,
+        horizontal_seconds: raw.iter().map(|r| r.1).sum(),
+        vertical_seconds: raw.iter().map(|r| r.2).sum(),
     })
 }

@@ -1,4 +1,4 @@
-//! Mattes from track and matte frames (BRIEF section 3.1; Einarsson et al. section 5.1).
+//! Mattes from track and matte frames (docs/design.md section 2.1; Einarsson et al. section 5.1).
 //! In a matte frame the actor is dark and the retro-reflective floor and back-lit
 //! backdrop are bright. Two rules say which pixels are foreground ([`MatteRule`]):
 //!

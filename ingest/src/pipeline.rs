@@ -7,28 +7,27 @@
 //! `FIELD.parts/pNN.frf` (atomically), with its report beside it. A rerun skips poses
 //! whose part is finished and made with the same settings, so an interrupted ingest
 //! resumes; the field itself appears only when every pose is done, merged from the parts.
-//! When the capture comes from the virtual stage, each pose is also measured against the
-//! ground truth ([`crate::evaluate`]).
+//! When the caller has a ground truth (the virtual stage's, in `frf-eval`), each pose is
+//! also handed to its [`Evaluator`] and its errors recorded in the report.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use frf_core::camera::Camera;
 use frf_core::capture::Capture;
-use frf_core::grid::Neighbour;
-use frf_core::image::{FlowImage, GrayImage, RgbImage};
+use frf_core::image::{GrayImage, RgbImage};
 use frf_flow::{FlowParams, Preset};
 use frf_reflectance::container::merge_fields;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::stats::FieldStats;
 use frf_reflectance::store::{EncodedView, encode_flows, encode_images};
 use frf_reflectance::{FieldFile, FieldHeader, FieldWriter};
-use frf_stage::Stage;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{IngestError, Result};
-use crate::evaluate::{PoseErrors, PoseEvidence, evaluate_pose};
-use crate::interview::{keep_near_subject, rectified_flow, symmetrize};
+use crate::evidence::{Evaluator, PoseErrors, PoseEvidence};
+use crate::interview::{GridViews, grid_flows};
 use crate::matte::MatteRule;
 use crate::views::{ViewSeconds, ViewSettings, process_view};
 
@@ -46,8 +45,6 @@ pub struct IngestOptions {
     pub jpeg_quality: u8,
     /// Predict flow codes from their neighbours before Huffman coding.
     pub predict_flow: bool,
-    /// Measure against the virtual stage's truth when the capture has one.
-    pub evaluate: bool,
     /// Which pixels are foreground in the mattes.
     pub matte_rule: MatteRule,
 }
@@ -237,17 +234,12 @@ struct ViewOut {
     registered: Option<(Vec<RgbImage>, Vec<RgbImage>)>,
 }
 
-/// Views whose registration is evaluated: four columns spread over the turn, all cameras.
-fn evaluated(u: usize, columns: usize) -> bool {
-    u.is_multiple_of((columns / 4).max(1))
-}
-
 fn ingest_pose(
     capture: &Capture,
     pose: u32,
     out: &Path,
     options: &IngestOptions,
-    stage: Option<&Stage>,
+    evaluator: Option<&dyn Evaluator>,
     progress: &dyn Progress,
 ) -> Result<PoseReport> {
     let (columns, rows) = (capture.cycles(), capture.cameras().len());
@@ -293,7 +285,7 @@ fn ingest_pose(
             let settings = ViewSettings {
                 flow: params,
                 matte_rule: options.matte_rule,
-                keep_unregistered: stage.is_some() && options.evaluate && evaluated(u, columns),
+                keep_unregistered: evaluator.is_some_and(|e| e.wants_unregistered(u, v)),
             };
             let r = process_view(capture, pose, u, v, &clean[v], &settings)?;
             let t = Instant::now();
@@ -327,81 +319,46 @@ fn ingest_pose(
 
     progress.begin(pose, "inter-view flow", columns * rows);
     let start = Instant::now();
-    // Raw flow of every (view, neighbour) pair, then each averaged with its reverse.
-    let raw: Vec<([Option<FlowImage>; 4], f64, f64)> = (0..columns * rows)
-        .into_par_iter()
-        .map(|i| {
-            check_stop(progress)?;
-            let (u, v) = (i / rows, i % rows);
-            let mut flows: [Option<FlowImage>; 4] = Default::default();
-            let (mut horizontal, mut vertical) = (0.0, 0.0);
-            for n in Neighbour::ALL {
-                let Some((u2, v2)) = n.of(u, v, columns, rows, header.wraps) else {
-                    continue;
-                };
-                let t = Instant::now();
-                let j = u2 * rows + v2;
-                flows[n.index()] = Some(rectified_flow(
-                    &views[i].summed,
-                    &views[j].summed,
-                    &capture.subject_camera(u, v, pose),
-                    &capture.subject_camera(u2, v2, pose),
-                    &params,
-                )?);
-                let dt = t.elapsed().as_secs_f64();
-                if matches!(n, Neighbour::Left | Neighbour::Right) {
-                    horizontal += dt;
-                } else {
-                    vertical += dt;
-                }
-            }
-            progress.advance();
-            Ok((flows, horizontal, vertical))
-        })
-        .collect::<Result<_>>()?;
-    let flows: Vec<([Option<FlowImage>; 4], f64, f64)> = (0..columns * rows)
-        .into_par_iter()
-        .map(|i| {
-            let (u, v) = (i / rows, i % rows);
-            let mut out: [Option<FlowImage>; 4] = Default::default();
-            for n in Neighbour::ALL {
-                let (Some(f), Some((u2, v2))) = (
-                    &raw[i].0[n.index()],
-                    n.of(u, v, columns, rows, header.wraps),
-                ) else {
-                    continue;
-                };
-                let back = raw[u2 * rows + v2].0[n.opposite().index()].as_ref();
-                let f = back.map_or_else(|| f.clone(), |b| symmetrize(f, b));
-                out[n.index()] = Some(keep_near_subject(&f, &views[i].alpha));
-            }
-            (out, raw[i].1, raw[i].2)
-        })
+    let images: Vec<&RgbImage> = views.iter().map(|v| &v.summed).collect();
+    let alphas: Vec<&GrayImage> = views.iter().map(|v| &v.alpha).collect();
+    let cameras: Vec<Camera> = (0..columns * rows)
+        .map(|i| capture.subject_camera(i / rows, i % rows, pose))
         .collect();
+    let grid = grid_flows(
+        &GridViews {
+            columns,
+            rows,
+            wraps: header.wraps,
+            images: &images,
+            alphas: &alphas,
+            cameras: &cameras,
+        },
+        &params,
+        &|| {
+            check_stop(progress)?;
+            progress.advance();
+            Ok(())
+        },
+    )?;
     steps.extend(share(
         start.elapsed().as_secs_f64(),
         &[
-            (
-                "inter-view flow, horizontal pairs",
-                flows.iter().map(|f| f.1).sum(),
-            ),
-            (
-                "inter-view flow, vertical pairs",
-                flows.iter().map(|f| f.2).sum(),
-            ),
+            ("inter-view flow, horizontal pairs", grid.horizontal_seconds),
+            ("inter-view flow, vertical pairs", grid.vertical_seconds),
         ],
     ));
+    let flows = grid.flows;
 
     let start = Instant::now();
     header.pose_mut(pose)?.flow_quantizer = LogQuantizer::fit(
         flows
             .iter()
-            .flat_map(|f| f.0.iter().flatten())
+            .flat_map(|f| f.iter().flatten())
             .flat_map(|f| f.pixels().iter().flatten().copied()),
     );
     let encoded: Vec<EncodedView> = flows
         .par_iter()
-        .map(|f| Ok(encode_flows(&header, pose, &f.0)?))
+        .map(|f| Ok(encode_flows(&header, pose, f)?))
         .collect::<Result<_>>()?;
     let (part, json) = part_paths(out, pose);
     let mut writer = FieldWriter::create(&part, header)?;
@@ -415,25 +372,25 @@ fn ingest_pose(
         seconds: start.elapsed().as_secs_f64(),
     });
 
-    let errors = match stage.filter(|_| options.evaluate) {
-        Some(stage) => {
-            progress.begin(pose, "evaluation against the stage's truth", 1);
+    let errors = match evaluator {
+        Some(evaluator) => {
+            progress.begin(pose, "evaluation against the ground truth", 1);
             let alphas: Vec<GrayImage> = views.iter().map(|v| v.alpha.clone()).collect();
-            let flow_maps: Vec<[Option<FlowImage>; 4]> = flows.into_iter().map(|f| f.0).collect();
             let registered: Vec<(usize, usize, Vec<RgbImage>, Vec<RgbImage>)> = views
                 .into_iter()
                 .enumerate()
                 .filter_map(|(i, v)| v.registered.map(|(r, u)| (i / rows, i % rows, r, u)))
                 .collect();
-            let e = evaluate_pose(
-                stage,
-                pose,
-                &PoseEvidence {
-                    alphas: &alphas,
-                    flows: &flow_maps,
-                    registered: &registered,
-                },
-            )?;
+            let e = evaluator
+                .evaluate(
+                    pose,
+                    &PoseEvidence {
+                        alphas: &alphas,
+                        flows: &flows,
+                        registered: &registered,
+                    },
+                )
+                .map_err(IngestError::Evaluation)?;
             progress.advance();
             Some(e)
         }
@@ -452,11 +409,13 @@ fn ingest_pose(
     Ok(report)
 }
 
-/// Ingests the capture in `capture_dir` into the field file `out`.
+/// Ingests the capture in `capture_dir` into the field file `out`; each pose is judged by
+/// `evaluator` when there is one (a capture with a ground truth).
 pub fn ingest(
     capture_dir: &Path,
     out: &Path,
     options: &IngestOptions,
+    evaluator: Option<&dyn Evaluator>,
     progress: &dyn Progress,
 ) -> Result<IngestReport> {
     let start = Instant::now();
@@ -478,17 +437,12 @@ pub fn ingest(
             options.jpeg_quality
         )));
     }
-    let stage = if options.evaluate && capture_dir.join(frf_stage::writer::STAGE_FILE).exists() {
-        Some(frf_stage::open_stage(capture_dir)?)
-    } else {
-        None
-    };
     let wanted = settings(options);
     let mut reports = Vec::new();
     for &pose in &poses {
         let report = match finished_part(out, pose, &wanted)? {
             Some(r) => r,
-            None => ingest_pose(&capture, pose, out, options, stage.as_ref(), progress)?,
+            None => ingest_pose(&capture, pose, out, options, evaluator, progress)?,
         };
         reports.push(report);
     }

@@ -1,4 +1,4 @@
-//! Rectification of vertical view pairs (BRIEF section 3.3): vertical neighbours come
+//! Rectification of vertical view pairs (docs/design.md section 2.3): vertical neighbours come
 //! from different cameras, so before flow is computed the neighbour is warped onto the
 //! plane fronto-parallel to the reference camera through the turntable axis (the plane
 //! through the point where the camera's optical axis passes closest to the axis, facing

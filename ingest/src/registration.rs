@@ -1,4 +1,4 @@
-//! Lighting-basis registration (BRIEF section 3.2; Wenger et al., SIGGRAPH 2005): the
+//! Lighting-basis registration (docs/design.md section 2.2; Wenger et al., SIGGRAPH 2005): the
 //! actor moves during the 1/30 s of a lighting set, so every frame of the set is warped
 //! onto the reference track frame T1 before the frames are combined.
 //!

@@ -1,5 +1,5 @@
 //! A real-data adapter: a calibrated ring of photographs in the Middlebury multi-view
-//! layout (Seitz et al., CVPR 2006; `../shared/data/mview`) ingested as a one-row field
+//! layout (Seitz et al., CVPR 2006; see `docs/data.md`) ingested as a one-row field
 //! with its own cameras and no relighting (one basis condition: the photograph), so that
 //! the renderer can be checked against real photographs.
 //!
@@ -21,8 +21,7 @@ use std::time::Instant;
 
 use frf_core::camera::{Camera, Intrinsics, Rigid};
 use frf_core::filter::gaussian_blur;
-use frf_core::grid::Neighbour;
-use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
+use frf_core::image::{GrayImage, Image, RgbImage};
 use frf_flow::FlowParams;
 use frf_reflectance::field::{CameraRecord, ConditionRecord, LightRecord, PoseRecord, ViewRecord};
 use frf_reflectance::flowcodec::quant::LogQuantizer;
@@ -32,7 +31,7 @@ use glam::{Mat3, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{IngestError, Result};
-use crate::interview::{keep_near_subject, rectified_flow, symmetrize};
+use crate::interview::{GridViews, grid_flows};
 use crate::matte::{MATTE_BLUR_SIGMA_PX, largest_central_component};
 
 /// The data set README's background threshold, on 0–1 encoded values.
@@ -344,40 +343,19 @@ pub fn ingest_ring(
         .map(|v| photo_and_alpha(&v.path))
         .collect::<Result<_>>()?;
     let columns = views.len();
-    let raw: Vec<[Option<FlowImage>; 4]> = (0..columns)
-        .into_par_iter()
-        .map(|u| {
-            let mut f: [Option<FlowImage>; 4] = Default::default();
-            for n in [Neighbour::Right, Neighbour::Left] {
-                if let Some((u2, _)) = n.of(u, 0, columns, 1, wraps) {
-                    f[n.index()] = Some(rectified_flow(
-                        &images[u].0,
-                        &images[u2].0,
-                        &cameras[u],
-                        &cameras[u2],
-                        params,
-                    )?);
-                }
-            }
-            Ok(f)
-        })
-        .collect::<Result<_>>()?;
-    let flows: Vec<[Option<FlowImage>; 4]> = (0..columns)
-        .map(|u| {
-            let mut f: [Option<FlowImage>; 4] = Default::default();
-            for n in [Neighbour::Right, Neighbour::Left] {
-                if let (Some(fwd), Some((u2, _))) =
-                    (&raw[u][n.index()], n.of(u, 0, columns, 1, wraps))
-                {
-                    let sym = raw[u2][n.opposite().index()]
-                        .as_ref()
-                        .map_or_else(|| fwd.clone(), |b| symmetrize(fwd, b));
-                    f[n.index()] = Some(keep_near_subject(&sym, &images[u].1));
-                }
-            }
-            f
-        })
-        .collect();
+    let flows = grid_flows(
+        &GridViews {
+            columns,
+            rows: 1,
+            wraps,
+            images: &images.iter().map(|i| &i.0).collect::<Vec<_>>(),
+            alphas: &images.iter().map(|i| &i.1).collect::<Vec<_>>(),
+            cameras: &cameras,
+        },
+        params,
+        &|| Ok(()),
+    )?
+    .flows;
     let header = FieldHeader {
         description: format!("calibrated ring of photographs {}", par.display()),
         columns,

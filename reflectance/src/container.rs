@@ -1,5 +1,5 @@
 //! The field file: one container with an index, so that one pose, or one view of one
-//! pose, is read without reading the rest (BRIEF section 4).
+//! pose, is read without reading the rest (docs/design.md section 3.5).
 //!
 //! ```text
 //! preamble  "FRFFIELD" | version u32 | 0 u32                         16 bytes

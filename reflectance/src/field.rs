@@ -137,7 +137,7 @@ pub struct PoseRecord {
     pub flow_quantizer: LogQuantizer,
 }
 
-/// The ground grid of the shadow maps (BRIEF section 5.5).
+/// The ground grid of the shadow maps (docs/design.md section 2.4).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ShadowSpec {
     /// Side of the square ground patch centred under the subject, metres (3 in the

@@ -1,4 +1,4 @@
-//! Image codecs of the field (BRIEF section 4).
+//! Image codecs of the field (docs/design.md section 3.3).
 //!
 //! **Basis images**: the basis images of one view are compressed together as one JPEG
 //! mosaic (tiles in rows of [`MOSAIC_COLUMNS`], each in a cell padded to whole 8x8 JPEG

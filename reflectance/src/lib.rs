@@ -1,4 +1,4 @@
-//! The flowed reflectance field as data (BRIEF sections 4 and 5.1): per pose and view
+//! The flowed reflectance field as data (docs/design.md sections 3 and 4.1): per pose and view
 //! `(u, v)`, the basis images (premultiplied, linear), alpha and the flows to each grid
 //! neighbour, plus per-pose shadow attenuation maps; how it is stored compactly with
 //! random access, and how it is relit.

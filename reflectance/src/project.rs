@@ -1,4 +1,4 @@
-//! Projection of an HDR environment onto the lighting basis (BRIEF section 5.1): the
+//! Projection of an HDR environment onto the lighting basis (docs/design.md section 4.1): the
 //! coefficient of condition `k` is the environment's light over the condition's region
 //! of the sphere, `∫_{Ω_k} L dω`, divided by the light the condition itself delivers,
 //! `Σ_{l ∈ k} E_l`. Relighting with these coefficients then reproduces the environment's

@@ -1,5 +1,5 @@
 //! What a field file holds and how well it is compressed: bytes by kind, and the ratios
-//! the original reported (BRIEF section 4): flow against its 8-bit quantized size
+//! the original reported (docs/design.md section 3.6): flow against its 8-bit quantized size
 //! (the original: 34 %), basis images against 16-bit linear RGB (the original: 16:1).
 
 use serde::Serialize;

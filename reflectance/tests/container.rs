@@ -3,26 +3,21 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+mod common;
+
 use std::sync::Mutex;
 
-use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
 use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
 use frf_reflectance::container::{ChunkKey, ChunkKind, FieldFile, ReadAt};
 use frf_reflectance::flowcodec::{self, quant::LogQuantizer};
 use frf_reflectance::store::encode_view;
 use frf_reflectance::{FieldHeader, FieldWriter, ViewData};
-use frf_stage::{Preset, Stage, StageConfig};
 
 const COLUMNS: usize = 4;
 
 fn header() -> FieldHeader {
-    let mut c = StageConfig::preset(Preset::Tiny);
-    c.cycles = COLUMNS as u32;
-    c.width = 24;
-    c.height = 32;
-    let stage = Stage::new(c).unwrap();
-    let capture = Capture::from_manifest(std::path::Path::new("."), stage.manifest()).unwrap();
+    let capture = common::tiny_capture(COLUMNS, 24, 32);
     FieldHeader::from_capture(&capture, &[0, 1], LogQuantizer::new(0.2, 12.0).unwrap(), 90).unwrap()
 }
 

@@ -4,9 +4,10 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+mod common;
+
 use std::f32::consts::{PI, TAU};
 
-use frf_core::capture::Capture;
 use frf_core::env::EnvMap;
 use frf_core::image::{Image, Rgb, RgbImage};
 use frf_reflectance::FieldHeader;
@@ -14,12 +15,10 @@ use frf_reflectance::field::ConditionRecord;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::project::{FloorModel, Projector};
 use frf_reflectance::relight::relight;
-use frf_stage::{Preset, Stage, StageConfig};
 use glam::Mat3;
 
 fn conditions() -> Vec<ConditionRecord> {
-    let stage = Stage::new(StageConfig::preset(Preset::Tiny)).unwrap();
-    let capture = Capture::from_manifest(std::path::Path::new("."), stage.manifest()).unwrap();
+    let capture = common::tiny_capture(36, 64, 90);
     FieldHeader::from_capture(&capture, &[0], LogQuantizer::new(0.2, 4.0).unwrap(), 90)
         .unwrap()
         .conditions

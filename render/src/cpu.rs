@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::cylinder::{Clamp, Cylinder, CylinderHit, interpolate_camera};
+use crate::geometry::PoseGeometry;
 use crate::morph::{Variant, morph, quad_views};
 use crate::resident::ResidentPose;
 
@@ -45,21 +46,15 @@ impl FrameStats {
     }
 }
 
-/// The cylinder of a pose's cameras.
-pub fn pose_cylinder(pose: &ResidentPose) -> Cylinder {
-    let centres: Vec<Vec3> = pose.cameras.iter().map(|c| c.centre()).collect();
-    Cylinder::new(&centres, pose.columns, pose.rows, pose.wraps)
-}
-
 /// The pixel of the interpolated camera of `hit` through which the ray with direction
 /// `dir` passes, or `None` if it points behind that camera.
-pub fn source_pixel(pose: &ResidentPose, hit: &CylinderHit, dir: Vec3) -> Option<Vec2> {
-    let [a, b, c, d] = quad_views(pose, hit);
+pub fn source_pixel(geometry: &PoseGeometry, hit: &CylinderHit, dir: Vec3) -> Option<Vec2> {
+    let [a, b, c, d] = quad_views(geometry, hit);
     let cams = [
-        &pose.cameras[a],
-        &pose.cameras[b],
-        &pose.cameras[c],
-        &pose.cameras[d],
+        &geometry.cameras[a],
+        &geometry.cameras[b],
+        &geometry.cameras[c],
+        &geometry.cameras[d],
     ];
     let cam = interpolate_camera(cams, hit.beta, hit.gamma, hit.point);
     let dc = cam.world_from_camera.rotation.transpose() * dir;
@@ -85,7 +80,7 @@ pub fn render_pixel(
     let Some(hit) = cylinder.intersect(camera.centre(), dir) else {
         return ([0.0; 4], None);
     };
-    let Some(s) = source_pixel(pose, &hit, dir) else {
+    let Some(s) = source_pixel(&pose.geometry, &hit, dir) else {
         return ([0.0; 4], None);
     };
     (morph(pose, &hit, s, variant), Some(hit))
@@ -97,7 +92,7 @@ pub fn render_cpu(
     camera: &Camera,
     variant: Variant,
 ) -> (Image<Rgba>, FrameStats) {
-    let cylinder = pose_cylinder(pose);
+    let cylinder = &pose.geometry.cylinder;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let rows: Vec<(Vec<Rgba>, FrameStats)> = (0..h)
         .into_par_iter()
@@ -107,7 +102,7 @@ pub fn render_cpu(
                 .map(|x| {
                     let (px, hit) = render_pixel(
                         pose,
-                        &cylinder,
+                        cylinder,
                         camera,
                         Vec2::new(x as f32, y as f32),
                         variant,

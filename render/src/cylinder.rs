@@ -1,4 +1,4 @@
-//! Light-field re-binning geometry (BRIEF section 5.4): the capture cameras' centres,
+//! Light-field re-binning geometry (docs/design.md section 4.3): the capture cameras' centres,
 //! seen from the subject frame, form a squashed cylinder of quads, `(u, v)` to
 //! `(u + 1, v + 1)`. A virtual camera's pixel ray is intersected with it; the quad hit
 //! and the bilinear position `(β, γ)` of the hit in it say which four images to morph and

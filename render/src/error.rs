@@ -9,9 +9,25 @@ pub enum RenderError {
     /// A parameter is out of range (camera path, size, frames, pose).
     #[error("{0}")]
     BadParameter(String),
-    /// No GPU adapter, or the GPU failed.
+    /// No GPU adapter or device, or waiting on the GPU failed.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// The GPU refused a request (a wgpu validation error).
+    #[error("GPU refused a request while {operation}: {message}")]
+    GpuValidation {
+        /// What the renderer was doing.
+        operation: &'static str,
+        /// wgpu's description.
+        message: String,
+    },
+    /// The GPU ran out of memory.
+    #[error("GPU out of memory while {operation}: {message}")]
+    GpuOutOfMemory {
+        /// What the renderer was doing.
+        operation: &'static str,
+        /// wgpu's description.
+        message: String,
+    },
     /// The field file.
     #[error(transparent)]
     Field(#[from] frf_reflectance::ReflectanceError),

@@ -1,6 +1,7 @@
-//! Render: the four-way flowed light-field renderer (BRIEF section 5), in wgpu with WGSL
+//! Render: the four-way flowed light-field renderer (docs/design.md section 4), in wgpu with WGSL
 //! shaders (`shaders/`) and as a CPU reference of the same mathematics.
 //!
+//! - [`geometry`]: a pose's grid, crop, cameras and cylinder, shared by both renderers;
 //! - [`resident`]: a pose made ready to render: pre-lit views, alpha, flow codes, cropped.
 //! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres.
 //! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
@@ -8,17 +9,14 @@
 //! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin;
 //!   [`renderer`]: one front for both.
 //! - [`path`]: virtual camera paths (keyframes, orbit).
-//! - [`eval`]: frames scored against the virtual stage's truth ([`metrics`]: PSNR, SSIM,
-//!   alpha error).
 //!
 //! Conventions: [`frf_core::conventions`].
 
 pub mod cpu;
 pub mod cylinder;
 pub mod error;
-pub mod eval;
+pub mod geometry;
 pub mod gpu;
-pub mod metrics;
 pub mod morph;
 pub mod path;
 pub mod renderer;

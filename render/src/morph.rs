@@ -1,4 +1,4 @@
-//! The flowed morph between the pre-lit images of a quad of the grid (BRIEF section 5),
+//! The flowed morph between the pre-lit images of a quad of the grid (docs/design.md section 4.2),
 //! and the simpler interpolations it is measured against.
 //!
 //! With vertices `A = (u, v)`, `B = (u+1, v)`, `C = (u, v+1)`, `D = (u+1, v+1)`, bilinear
@@ -38,6 +38,7 @@ use frf_core::grid::Neighbour;
 use glam::Vec2;
 
 use crate::cylinder::{CylinderHit, bilinear_weights};
+use crate::geometry::PoseGeometry;
 use crate::resident::ResidentPose;
 
 /// Which interpolation between views.
@@ -79,10 +80,10 @@ impl Variant {
 }
 
 /// The views `[A, B, C, D]` of the quad of a hit (`C = A`, `D = B` for a single row).
-pub fn quad_views(pose: &ResidentPose, hit: &CylinderHit) -> [usize; 4] {
-    let view = |u: usize, v: usize| (u % pose.columns) * pose.rows + v.min(pose.rows - 1);
+pub fn quad_views(geometry: &PoseGeometry, hit: &CylinderHit) -> [usize; 4] {
+    let view = |u: usize, v: usize| geometry.view(u, v);
     let (u, v) = (hit.u, hit.v);
-    let top = if pose.rows > 1 { v + 1 } else { v };
+    let top = if geometry.rows > 1 { v + 1 } else { v };
     [view(u, v), view(u + 1, v), view(u, top), view(u + 1, top)]
 }
 
@@ -95,7 +96,7 @@ fn add(acc: &mut [f32; 4], x: [f32; 4], w: f32) {
 /// The interpolated premultiplied RGBA at output pixel coordinates `s` inside the quad
 /// of `hit`.
 pub fn morph(pose: &ResidentPose, hit: &CylinderHit, s: Vec2, variant: Variant) -> [f32; 4] {
-    let [a, b_, c, d] = quad_views(pose, hit);
+    let [a, b_, c, d] = quad_views(&pose.geometry, hit);
     let (beta, gamma) = (hit.beta, hit.gamma);
     let (b, g) = (1.0 - beta, 1.0 - gamma);
     let w = bilinear_weights(beta, gamma);

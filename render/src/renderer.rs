@@ -55,7 +55,7 @@ impl Renderer {
     /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy).
     pub fn resident_bytes(&self) -> u64 {
         match &self.backend {
-            Backend::Gpu { pose, .. } => pose.resident_bytes,
+            Backend::Gpu { pose, .. } => pose.geometry.resident_bytes(),
             Backend::Cpu(pose) => pose.resident_bytes(),
         }
     }

@@ -1,10 +1,8 @@
 //! One pose of a field made ready to render: every view's pre-lit image (its basis images
-//! relit by the environment, BRIEF section 5.1), alpha and flows, in the compact form
+//! relit by the environment, docs/design.md section 4.1), alpha and flows, in the compact form
 //! the GPU holds them in, so that the GPU and the CPU reference read identical data.
+//! Everything is cropped to the pose's crop ([`crate::geometry`]).
 //!
-//! - **Crop.** Everything is cropped to the union of the views' mattes (grown by
-//!   [`CROP_MARGIN_PX`], beyond the flows' margin): outside it every view is transparent
-//!   black, so nothing is lost, and at the original's size about half the pixels go.
 //! - **Pre-lit images**: RGBA8, colour as sRGB-encoded `linear / scale` with one scale per
 //!   view (its brightest value, so nothing clips), alpha linear. A GPU samples them through
 //!   an sRGB view, which decodes before it filters; the CPU decodes each texel the same way.
@@ -15,23 +13,22 @@
 //! light reaches the subject, e.g. the floor conditions under a black lower
 //! hemisphere); [`LightingPlan`] says which and what that saved.
 
-use frf_core::camera::Camera;
+use std::sync::Arc;
+
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::io::{linear_to_srgb, srgb_to_linear};
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
-use frf_reflectance::flowcodec::quant::LogQuantizer;
+use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::project::{FloorModel, Projector};
 use glam::Vec2;
 use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
-
-/// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
-pub const CROP_MARGIN_PX: u32 = 4;
+use crate::geometry::{Crop, PoseGeometry};
 
 /// How the field is lit.
 #[derive(Debug, Clone)]
@@ -51,19 +48,6 @@ pub enum Lighting {
 /// log-coded flow to each of its four neighbours (absent at the grid's edges).
 type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4]);
 
-/// A rectangle of the full image, pixels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Crop {
-    /// Left column.
-    pub x0: u32,
-    /// Top row.
-    pub y0: u32,
-    /// Width.
-    pub width: u32,
-    /// Height.
-    pub height: u32,
-}
-
 /// What relighting left out.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightingPlan {
@@ -75,78 +59,35 @@ pub struct LightingPlan {
     pub images_total: usize,
 }
 
+/// One pose's flows as stored: 8-bit log codes `(u, v)` per pixel, cropped, per view and
+/// neighbour ([`Neighbour::ALL`] order; absent at the grid's edges), with the pose's
+/// quantizer and the table both renderers decode them with ([`flow_lut`]).
+#[derive(Debug, Clone)]
+pub struct PoseFlows {
+    /// Per view and neighbour: the codes.
+    pub codes: Vec<[Option<Vec<[i8; 2]>>; 4]>,
+    /// The pose's flow quantizer.
+    pub quantizer: LogQuantizer,
+    /// Code (offset by 128) to displacement.
+    pub table: [f32; 256],
+}
+
 /// One pose's geometry, flows and basis images as loaded from a field file, before
 /// relighting (what [`ResidentPose::relight_cpu`] and the GPU relighting pass start from).
 #[derive(Debug, Clone)]
 pub struct PoseSource {
-    /// Pose index.
-    pub pose: u32,
-    /// Grid columns.
-    pub columns: usize,
-    /// Grid rows.
-    pub rows: usize,
-    /// Whether columns close into a ring.
-    pub wraps: bool,
-    /// Full image size.
-    pub image_size: (u32, u32),
-    /// The crop.
-    pub crop: Crop,
-    /// Cameras (subject frame), `u`-major.
-    pub cameras: Vec<Camera>,
+    /// Grid, crop, cameras, cylinder.
+    pub geometry: Arc<PoseGeometry>,
+    /// The flows.
+    pub flows: Arc<PoseFlows>,
     /// Per view: the basis mosaic's codes and scales, cropped.
     pub basis: Vec<BasisCodes>,
     /// Per view: alpha codes (`round(255 α)`), cropped.
     pub alpha: Vec<Vec<u8>>,
-    /// Per view and neighbour: flow codes `(u, v)` per pixel, cropped.
-    pub flows: Vec<[Option<Vec<[i8; 2]>>; 4]>,
-    /// The pose's flow quantizer.
-    pub quantizer: LogQuantizer,
     /// Per view and condition: relighting coefficients (RGB).
     pub coefficients: Vec<Vec<Rgb>>,
     /// What relighting leaves out.
     pub plan: LightingPlan,
-}
-
-fn crop_of(alphas: &[GrayImage], size: (u32, u32)) -> Crop {
-    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0u32, 0u32);
-    for a in alphas {
-        for (i, &v) in a.pixels().iter().enumerate() {
-            if v > 0.0 {
-                let (x, y) = ((i % a.width()) as u32, (i / a.width()) as u32);
-                x0 = x0.min(x);
-                y0 = y0.min(y);
-                x1 = x1.max(x);
-                y1 = y1.max(y);
-            }
-        }
-    }
-    if x0 > x1 {
-        return Crop {
-            x0: 0,
-            y0: 0,
-            width: 1,
-            height: 1,
-        };
-    }
-    let x0 = x0.saturating_sub(CROP_MARGIN_PX);
-    let y0 = y0.saturating_sub(CROP_MARGIN_PX);
-    let x1 = (x1 + CROP_MARGIN_PX).min(size.0 - 1);
-    let y1 = (y1 + CROP_MARGIN_PX).min(size.1 - 1);
-    Crop {
-        x0,
-        y0,
-        width: x1 - x0 + 1,
-        height: y1 - y0 + 1,
-    }
-}
-
-fn crop_rows<T: Copy>(data: &[T], full_width: usize, c: &Crop) -> Vec<T> {
-    let mut out = Vec::with_capacity((c.width * c.height) as usize);
-    for y in c.y0..c.y0 + c.height {
-        let row = y as usize * full_width;
-        out.extend_from_slice(&data[row + c.x0 as usize..row + (c.x0 + c.width) as usize]);
-    }
-    out
 }
 
 impl PoseSource {
@@ -166,7 +107,7 @@ impl PoseSource {
             .map(|i| Ok(field.alpha(pose, i / rows, i % rows)?))
             .collect::<Result<_>>()?;
         let size = (h.width, h.height);
-        let crop = crop_of(&alphas, size);
+        let crop = Crop::of_mattes(&alphas, size);
         let coefficients: Vec<Vec<Rgb>> = match lighting {
             Lighting::Unlit => vec![vec![[1.0; 3]; h.conditions.len()]; views],
             Lighting::Environment { env, floor } => {
@@ -198,11 +139,7 @@ impl PoseSource {
             .map(|i| {
                 let (u, v) = (i / rows, i % rows);
                 let mut b = field.basis_codes(pose, u, v)?;
-                b.tiles = b
-                    .tiles
-                    .iter()
-                    .map(|t| crop_rows(t, full_w, &crop))
-                    .collect();
+                b.tiles = b.tiles.iter().map(|t| crop.rows_of(t, full_w)).collect();
                 b.width = crop.width as usize;
                 b.height = crop.height as usize;
                 let a: Vec<u8> = alphas[i]
@@ -216,10 +153,10 @@ impl PoseSource {
                         let plane = codes.len() / 2;
                         let pairs: Vec<[i8; 2]> =
                             (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
-                        flows[n.index()] = Some(crop_rows(&pairs, full_w, &crop));
+                        flows[n.index()] = Some(crop.rows_of(&pairs, full_w));
                     }
                 }
-                Ok((b, crop_rows(&a, full_w, &crop), flows))
+                Ok((b, crop.rows_of(&a, full_w), flows))
             })
             .collect::<Result<_>>()?;
         let mut basis = Vec::with_capacity(views);
@@ -230,18 +167,19 @@ impl PoseSource {
             alpha.push(a);
             flows.push(f);
         }
+        let geometry =
+            PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
+                flows[i][n.index()].is_some()
+            });
         Ok(Self {
-            pose,
-            columns,
-            rows,
-            wraps: h.wraps,
-            image_size: size,
-            crop,
-            cameras,
+            geometry: Arc::new(geometry),
+            flows: Arc::new(PoseFlows {
+                codes: flows,
+                quantizer: record.flow_quantizer,
+                table: flow_lut(&record.flow_quantizer),
+            }),
             basis,
             alpha,
-            flows,
-            quantizer: record.flow_quantizer,
             coefficients,
             plan,
         })
@@ -251,32 +189,16 @@ impl PoseSource {
 /// A pose ready to render: pre-lit views, alpha and flow codes (see the module docs).
 #[derive(Debug, Clone)]
 pub struct ResidentPose {
-    /// Pose index.
-    pub pose: u32,
-    /// Grid columns.
-    pub columns: usize,
-    /// Grid rows.
-    pub rows: usize,
-    /// Whether columns close into a ring.
-    pub wraps: bool,
-    /// Full image size.
-    pub image_size: (u32, u32),
-    /// The crop.
-    pub crop: Crop,
-    /// Cameras (subject frame), `u`-major.
-    pub cameras: Vec<Camera>,
+    /// Grid, crop, cameras, cylinder.
+    pub geometry: Arc<PoseGeometry>,
+    /// The flows.
+    pub flows: Arc<PoseFlows>,
     /// Per view: colour scale.
     pub scales: Vec<f32>,
     /// Per view: RGBA8 texels (sRGB colour / scale, linear alpha), cropped.
     pub prelit: Vec<Vec<[u8; 4]>>,
-    /// Per view and neighbour: flow codes, cropped.
-    pub flows: Vec<[Option<Vec<[i8; 2]>>; 4]>,
-    /// The flow quantizer.
-    pub quantizer: LogQuantizer,
     /// Decoding table of the pre-lit texels ([`srgb_lut`]).
     pub srgb_table: [f32; 256],
-    /// Decoding table of the flow texels ([`flow_lut`] of `quantizer`).
-    pub flow_table: [f32; 256],
     /// What relighting left out.
     pub plan: LightingPlan,
 }
@@ -292,7 +214,7 @@ pub fn srgb_lut() -> [f32; 256] {
 pub fn flow_lut(q: &LogQuantizer) -> [f32; 256] {
     std::array::from_fn(|i| {
         let code = (i as i32 - 128) as i8;
-        if code == frf_reflectance::flowcodec::quant::UNKNOWN_CODE {
+        if code == UNKNOWN_CODE {
             0.0
         } else {
             q.decode(code)
@@ -344,38 +266,27 @@ impl ResidentPose {
             .collect();
         let (scales, prelit) = views.into_iter().unzip();
         Self {
-            pose: source.pose,
-            columns: source.columns,
-            rows: source.rows,
-            wraps: source.wraps,
-            image_size: source.image_size,
-            crop: source.crop,
-            cameras: source.cameras.clone(),
+            geometry: source.geometry.clone(),
+            flows: source.flows.clone(),
             scales,
             prelit,
-            flows: source.flows.clone(),
-            quantizer: source.quantizer,
             srgb_table: srgb_lut(),
-            flow_table: flow_lut(&source.quantizer),
             plan: source.plan.clone(),
         }
     }
 
-    /// Bytes the pose takes on the GPU: pre-lit RGBA8 and flow RG8 texture arrays (one
-    /// layer per view and per stored flow), plus the per-view tables.
+    /// Bytes the pose holds ([`PoseGeometry::resident_bytes`]).
     pub fn resident_bytes(&self) -> u64 {
-        let texels = self.crop.width as u64 * self.crop.height as u64;
-        let flow_layers = self.flows.iter().flatten().filter(|f| f.is_some()).count() as u64;
-        let tables = self.cameras.len() as u64 * 64;
-        texels * 4 * self.prelit.len() as u64 + texels * 2 * flow_layers + tables
+        self.geometry.resident_bytes()
     }
 
     /// Bilinear sample (premultiplied RGBA, linear) of view `view` at full-image pixel
     /// coordinates `s`; the edge repeats beyond the crop (it is transparent there).
     pub fn sample_prelit(&self, view: usize, s: Vec2) -> [f32; 4] {
-        let (w, h) = (self.crop.width as i64, self.crop.height as i64);
-        let x = s.x - self.crop.x0 as f32;
-        let y = s.y - self.crop.y0 as f32;
+        let crop = &self.geometry.crop;
+        let (w, h) = (crop.width as i64, crop.height as i64);
+        let x = s.x - crop.x0 as f32;
+        let y = s.y - crop.y0 as f32;
         if !(x.is_finite() && y.is_finite()) {
             return [0.0; 4];
         }
@@ -404,19 +315,20 @@ impl ResidentPose {
     /// Bilinear sample of the flow from view `view` toward `n` at full-image pixel
     /// coordinates `s` (each texel decoded first; unknown or absent flow is zero).
     pub fn sample_flow(&self, view: usize, n: Neighbour, s: Vec2) -> Vec2 {
-        let Some(codes) = &self.flows[view][n.index()] else {
+        let Some(codes) = &self.flows.codes[view][n.index()] else {
             return Vec2::ZERO;
         };
-        let (w, h) = (self.crop.width as i64, self.crop.height as i64);
-        let x = s.x - self.crop.x0 as f32;
-        let y = s.y - self.crop.y0 as f32;
+        let crop = &self.geometry.crop;
+        let (w, h) = (crop.width as i64, crop.height as i64);
+        let x = s.x - crop.x0 as f32;
+        let y = s.y - crop.y0 as f32;
         if !(x.is_finite() && y.is_finite()) {
             return Vec2::ZERO;
         }
         let (x, y) = (x.clamp(-1.0, w as f32), y.clamp(-1.0, h as f32));
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let lut = &self.flow_table;
+        let lut = &self.flows.table;
         let mut out = Vec2::ZERO;
         for (dy, wy) in [(0i64, 1.0 - fy), (1, fy)] {
             for (dx, wx) in [(0i64, 1.0 - fx), (1, fx)] {
@@ -440,9 +352,7 @@ impl ResidentPose {
 /// One flow texel's displacement; unknown is zero.
 #[inline]
 pub fn decode_flow(c: [i8; 2], q: &LogQuantizer) -> Vec2 {
-    if c[0] == frf_reflectance::flowcodec::quant::UNKNOWN_CODE
-        || c[1] == frf_reflectance::flowcodec::quant::UNKNOWN_CODE
-    {
+    if c[0] == UNKNOWN_CODE || c[1] == UNKNOWN_CODE {
         return Vec2::ZERO;
     }
     Vec2::new(q.decode(c[0]), q.decode(c[1]))

@@ -8,10 +8,15 @@
 use frf_core::camera::Camera;
 use frf_core::grid::Neighbour;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
-use frf_render::cpu::{pose_cylinder, render_cpu, render_pixel, source_pixel};
+use frf_render::cpu::{render_cpu, render_pixel, source_pixel};
 use frf_render::cylinder::{Clamp, CylinderHit};
+use frf_render::geometry::{Crop, PoseGeometry};
 use frf_render::morph::{Variant, morph, quad_views};
-use frf_render::resident::{Crop, LightingPlan, ResidentPose, decode_flow, flow_lut, srgb_lut};
+use frf_render::resident::{
+    LightingPlan, PoseFlows, ResidentPose, decode_flow, flow_lut, srgb_lut,
+};
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 const W: u32 = 24;
@@ -61,25 +66,25 @@ fn pose() -> ResidentPose {
             flows.push(f);
         }
     }
+    let crop = Crop {
+        x0: 0,
+        y0: 0,
+        width: W,
+        height: H,
+    };
+    let geometry = PoseGeometry::new(0, columns, rows, true, (W, H), crop, cameras, |i, n| {
+        flows[i][n.index()].is_some()
+    });
     ResidentPose {
-        pose: 0,
-        columns,
-        rows,
-        wraps: true,
-        image_size: (W, H),
-        crop: Crop {
-            x0: 0,
-            y0: 0,
-            width: W,
-            height: H,
-        },
+        geometry: Arc::new(geometry),
+        flows: Arc::new(PoseFlows {
+            codes: flows,
+            quantizer: q,
+            table: flow_lut(&q),
+        }),
         scales: (0..columns * rows).map(|i| 1.0 + i as f32 * 0.1).collect(),
-        cameras,
         prelit,
-        flows,
-        quantizer: q,
         srgb_table: srgb_lut(),
-        flow_table: flow_lut(&q),
         plan: LightingPlan {
             skipped_conditions: vec![],
             images_combined: 0,
@@ -113,7 +118,7 @@ fn the_four_way_morph_returns_each_source_at_its_vertex() {
         .enumerate()
     {
         let h = hit(3, 0, b, g);
-        let view = quad_views(&p, &h)[k];
+        let view = quad_views(&p.geometry, &h)[k];
         assert!(
             close(morph(&p, &h, s, Variant::FourWay), p.sample_prelit(view, s)),
             "vertex {k}"
@@ -137,7 +142,7 @@ fn the_four_way_morph_reduces_to_the_two_way_morph_on_every_edge() {
         [0, 1, 2, 3].map(|k| b * x[k] + t * y[k])
     };
     for t in [0.0, 0.3, 0.71, 1.0] {
-        let [a, b, c, d] = quad_views(&p, &hit(6, 0, 0.0, 0.0));
+        let [a, b, c, d] = quad_views(&p.geometry, &hit(6, 0, 0.0, 0.0));
         assert!(
             close(
                 morph(&p, &hit(6, 0, t, 0.0), s, Variant::FourWay),
@@ -173,7 +178,7 @@ fn the_four_way_morph_reduces_to_the_two_way_morph_on_every_edge() {
         ));
     }
     // The wrapping quad uses column 0 as its right side.
-    let [a, b, _, _] = quad_views(&p, &hit(7, 0, 0.5, 0.0));
+    let [a, b, _, _] = quad_views(&p.geometry, &hit(7, 0, 0.5, 0.0));
     assert_eq!((a, b), (14, 0));
 }
 
@@ -189,7 +194,7 @@ fn flow_codes_decode_and_unknown_is_zero() {
 fn rendering_from_a_capture_camera_reproduces_its_view() {
     let p = pose();
     let view = 5 * 2 + 1;
-    let cam = p.cameras[view];
+    let cam = p.geometry.cameras[view];
     let (img, stats) = render_cpu(&p, &cam, Variant::FourWay);
     assert_eq!(stats.missed, 0);
     let mut worst = 0.0f32;
@@ -273,8 +278,8 @@ fn extreme_cameras_give_finite_bounded_output_and_say_what_happened() {
 #[test]
 fn the_source_pixel_of_a_vertex_ray_is_its_own_pixel() {
     let p = pose();
-    let cyl = pose_cylinder(&p);
-    let cam = p.cameras[4 * 2];
+    let cyl = &p.geometry.cylinder;
+    let cam = p.geometry.cameras[4 * 2];
     for pixel in [
         Vec2::new(0.0, 0.0),
         Vec2::new(11.5, 16.0),
@@ -282,9 +287,9 @@ fn the_source_pixel_of_a_vertex_ray_is_its_own_pixel() {
     ] {
         let dir = cam.ray_direction(pixel);
         let h = cyl.intersect(cam.centre(), dir).unwrap();
-        let s = source_pixel(&p, &h, dir).unwrap();
+        let s = source_pixel(&p.geometry, &h, dir).unwrap();
         assert!((s - pixel).length() < 1e-2, "{s} vs {pixel}");
-        let (px, _) = render_pixel(&p, &cyl, &cam, pixel, Variant::Linear);
+        let (px, _) = render_pixel(&p, cyl, &cam, pixel, Variant::Linear);
         assert!(px.iter().all(|c| c.is_finite()));
     }
 }

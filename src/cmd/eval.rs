@@ -7,12 +7,12 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use frf_core::io::{rgba_from, write_png8_srgba};
-use frf_reflectance::FieldFile;
-use frf_render::eval::{
-    EvalCamera, between_view_cameras, evaluate, grid_view_cameras, truth_frame,
+use frf_core::io::write_png8_srgba;
+use frf_eval::ring::{held_out_views, score_held_out};
+use frf_eval::views::{
+    EvalCamera, VariantScore, between_view_cameras, evaluate, grid_view_cameras, truth_frame,
 };
-use frf_render::metrics::{psnr, ssim};
+use frf_reflectance::FieldFile;
 use frf_render::morph::Variant;
 use frf_render::resident::{Lighting, PoseSource};
 use frf_stage::truth::environment_lights;
@@ -20,8 +20,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::CliResult;
+use crate::cmd::args::{LightingArgs, VariantArg};
 use crate::cmd::progress::bar;
-use crate::cmd::render::{LightingArgs, VariantArg, open_renderer, pose_of};
+use crate::cmd::render::{open_renderer, pose_of};
 
 /// Arguments of `frf eval`.
 #[derive(Args)]
@@ -77,15 +78,15 @@ impl CompareArgs {
 struct EvalReport {
     field: PathBuf,
     capture: PathBuf,
-    env: PathBuf,
+    env: String,
     pose: u32,
     device: String,
     truth_lights: usize,
     truth_seconds_per_frame: f64,
     cameras: Vec<String>,
-    variants: Vec<frf_render::eval::VariantScore>,
+    variants: Vec<VariantScore>,
     /// The four-way renderer at captured cameras: the error of relighting and storage.
-    at_captured_views: frf_render::eval::VariantScore,
+    at_captured_views: VariantScore,
 }
 
 /// Runs `frf eval`.
@@ -107,21 +108,8 @@ pub fn run(args: EvalArgs) -> CliResult {
         .into());
     }
     let source = PoseSource::load(&field, pose, &lighting)?;
-    let cameras = between_view_cameras(
-        &source.cameras,
-        source.columns,
-        source.rows,
-        source.wraps,
-        args.cameras,
-    )?;
-
-    let at_views = grid_view_cameras(
-        &source.cameras,
-        source.columns,
-        source.rows,
-        source.wraps,
-        args.cameras,
-    )?;
+    let cameras = between_view_cameras(&source.geometry, args.cameras)?;
+    let at_views = grid_view_cameras(&source.geometry, args.cameras)?;
     let lights = environment_lights(&env, args.lights);
     let truth_bar = bar("truth frames");
     let start = Instant::now();
@@ -174,7 +162,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         "{} pose {pose} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
          cameras at quad centres, {}:",
         args.field.display(),
-        args.lighting.env.display(),
+        args.lighting.env,
         args.lights,
         truth_seconds,
         cameras.len(),
@@ -206,7 +194,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         let report = EvalReport {
             field: args.field.clone(),
             capture: args.capture.clone(),
-            env: args.lighting.env.clone(),
+            env: args.lighting.env.to_string(),
             pose,
             device: renderer.device().to_string(),
             truth_lights: args.lights,
@@ -236,16 +224,6 @@ pub struct RingEvalArgs {
     compare: CompareArgs,
 }
 
-#[derive(Serialize)]
-struct RingScore {
-    name: String,
-    psnr_silhouette: f64,
-    ssim_silhouette: f64,
-    seconds_per_frame: f64,
-    views: Vec<usize>,
-    psnr_per_view: Vec<f64>,
-}
-
 /// Runs `frf eval-ring`.
 pub fn run_ring(args: RingEvalArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
@@ -260,41 +238,10 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
         )
         .into());
     }
-    let held: Vec<usize> = (0..views.len() / s)
-        .map(|j| j * s + s / 2)
-        .filter(|&i| wraps || i + s / 2 < views.len())
-        .collect();
+    let held = held_out_views(views.len(), s, wraps)?;
     let source = PoseSource::load(&field, 0, &Lighting::Unlit)?;
     let renderer = open_renderer(&source, args.compare.cpu)?;
-    let photos = held
-        .par_iter()
-        .map(|&i| {
-            let (photo, alpha) = frf_ingest::ring::photo_and_alpha(&views[i].path)?;
-            let mask: Vec<bool> = alpha.pixels().iter().map(|&a| a >= 0.5).collect();
-            Ok((rgba_from(&photo, &alpha)?, mask))
-        })
-        .collect::<CliResult<Vec<_>>>()?;
-    renderer.render(&cameras[held[0]], Variant::FourWay)?;
-    let mut scores = Vec::new();
-    for v in args.compare.variants() {
-        let (mut psnrs, mut ssims, mut seconds) = (Vec::new(), Vec::new(), 0.0);
-        for (&i, (photo, mask)) in held.iter().zip(&photos) {
-            let t = Instant::now();
-            let (img, _) = renderer.render(&cameras[i], v)?;
-            seconds += t.elapsed().as_secs_f64();
-            psnrs.push(psnr(photo, &img, Some(mask)));
-            ssims.push(ssim(photo, &img, Some(mask)));
-        }
-        let n = held.len() as f64;
-        scores.push(RingScore {
-            name: v.name().to_string(),
-            psnr_silhouette: psnrs.iter().sum::<f64>() / n,
-            ssim_silhouette: ssims.iter().sum::<f64>() / n,
-            seconds_per_frame: seconds / n,
-            views: held.clone(),
-            psnr_per_view: psnrs,
-        });
-    }
+    let scores = score_held_out(&renderer, &views, &cameras, &held, &args.compare.variants())?;
     eprintln!(
         "{}: {} held-out views, each rendered from views {} apart ({} each side), {}:",
         args.field.display(),

@@ -4,41 +4,21 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use frf_core::io::read_rgb;
 use frf_flow::bench::{find_pairs, run_pair, threads};
 use frf_flow::viz::write_flow_png;
 use frf_flow::{FlowParams, Preset, estimate_flow_from, read_flo, write_flo};
 
 use crate::CliResult;
-
-/// A preset of the estimator, as the command line names it.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum PresetArg {
-    /// Fastest: luminance, solved up to half resolution.
-    Fast,
-    /// Colour, full resolution, median filtering.
-    Balanced,
-    /// Classic+NL-style: texture decomposition, GNC, weighted median.
-    Accurate,
-}
-
-impl From<PresetArg> for Preset {
-    fn from(p: PresetArg) -> Self {
-        match p {
-            PresetArg::Fast => Preset::Fast,
-            PresetArg::Balanced => Preset::Balanced,
-            PresetArg::Accurate => Preset::Accurate,
-        }
-    }
-}
+use crate::cmd::args::FlowPresetArg;
 
 /// Options shared by both commands: which parameters to use.
 #[derive(Args)]
 pub struct ParamArgs {
     /// Preset of the estimator.
     #[arg(long, value_enum, default_value = "balanced")]
-    preset: PresetArg,
+    preset: FlowPresetArg,
     /// Reach larger displacements (horizontal view pairs: up to ~20 px at 320x448).
     #[arg(long)]
     wide_search: bool,

@@ -5,20 +5,14 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use clap::{Args, ValueEnum};
-use frf_flow::Preset;
+use frf_eval::ingest::StageEvaluator;
+use frf_ingest::evidence::Evaluator;
 use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
 use indicatif::ProgressBar;
 
 use crate::CliResult;
-use crate::cmd::parse_poses;
+use crate::cmd::args::{FlowPresetArg, parse_poses};
 use crate::cmd::progress::bar;
-
-#[derive(Clone, Copy, ValueEnum)]
-enum PresetArg {
-    Fast,
-    Balanced,
-    Accurate,
-}
 
 /// Arguments of `frf ingest`.
 #[derive(Args)]
@@ -33,7 +27,7 @@ pub struct IngestArgs {
     poses: Option<String>,
     /// Optical-flow preset for registration and inter-view flow.
     #[arg(long, value_enum, default_value = "balanced")]
-    flow_preset: PresetArg,
+    flow_preset: FlowPresetArg,
     /// Override a flow parameter, `key=value` (repeatable; keys as `frf flow --set`).
     #[arg(long = "flow-set", value_name = "KEY=VALUE")]
     flow_set: Vec<String>,
@@ -96,11 +90,7 @@ pub fn run(args: IngestArgs) -> CliResult {
             .map(parse_poses)
             .transpose()?
             .unwrap_or_default(),
-        flow_preset: match args.flow_preset {
-            PresetArg::Fast => Preset::Fast,
-            PresetArg::Balanced => Preset::Balanced,
-            PresetArg::Accurate => Preset::Accurate,
-        },
+        flow_preset: args.flow_preset.into(),
         flow_settings: args
             .flow_set
             .iter()
@@ -112,7 +102,6 @@ pub fn run(args: IngestArgs) -> CliResult {
             .collect::<Result<_, _>>()?,
         jpeg_quality: args.jpeg_quality,
         predict_flow: !args.no_flow_prediction,
-        evaluate: !args.no_eval,
         matte_rule: match args.matte_rule {
             MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
             MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
@@ -121,7 +110,13 @@ pub fn run(args: IngestArgs) -> CliResult {
     let bars = Bars {
         current: Mutex::new(None),
     };
-    let report = ingest(&args.capture, &args.out, &options, &bars)?;
+    let judge = if args.no_eval {
+        None
+    } else {
+        StageEvaluator::open_if_stage(&args.capture)?
+    };
+    let evaluator = judge.as_ref().map(|j| j as &dyn Evaluator);
+    let report = ingest(&args.capture, &args.out, &options, evaluator, &bars)?;
     if let Some(b) = bars
         .current
         .lock()
@@ -212,7 +207,7 @@ pub struct RingArgs {
     out: PathBuf,
     /// Optical-flow preset for the flow between neighbouring photographs.
     #[arg(long, value_enum, default_value = "accurate")]
-    flow_preset: PresetArg,
+    flow_preset: FlowPresetArg,
     /// JPEG quality of the images.
     #[arg(long, default_value_t = 95)]
     jpeg_quality: u8,
@@ -224,15 +219,10 @@ pub struct RingArgs {
 
 /// Runs `frf ingest-ring`.
 pub fn run_ring(args: RingArgs) -> CliResult {
-    let preset = match args.flow_preset {
-        PresetArg::Fast => Preset::Fast,
-        PresetArg::Balanced => Preset::Balanced,
-        PresetArg::Accurate => Preset::Accurate,
-    };
     let r = frf_ingest::ring::ingest_ring(
         &args.par,
         &args.out,
-        &frf_flow::FlowParams::preset(preset),
+        &frf_flow::FlowParams::preset(args.flow_preset.into()),
         args.jpeg_quality,
         args.stride,
     )?;

@@ -7,195 +7,22 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use frf_core::atomic::write_bytes_atomic;
-use frf_core::env::EnvMap;
+use frf_core::contact;
 use frf_core::image::{Image, RgbImage, Rgba};
 use frf_core::io::{write_exr_rgba, write_png8_srgb, write_png8_srgba};
-use frf_reflectance::project::FloorModel;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::cpu::FrameStats;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
-use frf_render::path::{CameraPath, Orbit, Trajectory};
 use frf_render::renderer::Renderer;
-use frf_render::resident::{Lighting, PoseSource};
-use frf_stage::contact;
-use glam::Vec3;
+use frf_render::resident::PoseSource;
 use serde::Serialize;
 
 use crate::CliResult;
+use crate::cmd::args::{CameraArgs, LightingArgs, VariantArg, parse_size};
 use crate::cmd::progress::bar;
-
-/// The interpolation (the ablations of `frf eval`).
-#[derive(Clone, Copy, ValueEnum, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum VariantArg {
-    /// Nearest view, unwarped.
-    Nearest,
-    /// Bilinear blend of the quad's views, unwarped.
-    Linear,
-    /// Two-way flowed morph along the nearer row.
-    Twoway,
-    /// Four-way flowed morph.
-    Fourway,
-}
-
-impl From<VariantArg> for Variant {
-    fn from(v: VariantArg) -> Self {
-        match v {
-            VariantArg::Nearest => Variant::Nearest,
-            VariantArg::Linear => Variant::Linear,
-            VariantArg::Twoway => Variant::TwoWay,
-            VariantArg::Fourway => Variant::FourWay,
-        }
-    }
-}
-
-/// Floor model of the relighting.
-#[derive(Clone, Copy, ValueEnum, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "lowercase")]
-pub enum FloorArg {
-    /// The environment's lower hemisphere lights the subject from below.
-    Env,
-    /// A grey Lambertian ground (albedo 0.3) lit by the upper hemisphere.
-    Ground,
-}
-
-/// How the field is lit: shared by `frf render` and `frf eval`.
-#[derive(Args, Clone, Serialize, PartialEq)]
-pub struct LightingArgs {
-    /// HDR environment (latitude-longitude .hdr or .exr, subject frame), `sky` for the
-    /// built-in sky, `uniform` for a white furnace, or `none` to show a field of
-    /// photographs as captured.
-    #[arg(long)]
-    pub env: PathBuf,
-    /// Yaw of the environment about the vertical axis, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub yaw: f32,
-    /// What lights the subject from below.
-    #[arg(long, value_enum, default_value = "env")]
-    pub floor: FloorArg,
-}
-
-impl LightingArgs {
-    /// The lighting, and the environment for truth renders (`None` for `none`).
-    pub fn lighting(&self, conditions: usize) -> CliResult<(Lighting, Option<EnvMap>)> {
-        let name = self.env.to_string_lossy();
-        if name == "none" && !self.env.exists() {
-            return Ok((Lighting::Unlit, None));
-        }
-        if conditions <= 1 {
-            return Err(format!(
-                "the field holds {conditions} lighting condition(s), photographs rather than \
-                 a reflectance basis: it cannot be relit; use --env none"
-            )
-            .into());
-        }
-        let env = if name == "uniform" && !self.env.exists() {
-            EnvMap::uniform([1.0, 1.0, 1.0], 64)
-        } else {
-            EnvMap::load_or_builtin(&self.env)
-                .map_err(|e| format!("environment {}: {e}", self.env.display()))?
-        }
-        .rotated(self.yaw.to_radians());
-        let floor = match self.floor {
-            FloorArg::Env => FloorModel::Environment,
-            FloorArg::Ground => FloorModel::LambertianGround {
-                albedo: [0.3, 0.3, 0.3],
-            },
-        };
-        Ok((
-            Lighting::Environment {
-                env: env.clone(),
-                floor,
-            },
-            Some(env),
-        ))
-    }
-}
-
-/// Where the camera goes: shared by `frf render` and `frf eval`.
-#[derive(Args, Clone, Serialize, PartialEq)]
-pub struct CameraArgs {
-    /// Keyframed camera path (TOML; see `frf_render::path`).
-    #[arg(long, conflicts_with = "orbit", required_unless_present = "orbit")]
-    pub camera: Option<PathBuf>,
-    /// Orbit about the vertical axis through --look-at: `RADIUS,HEIGHT[,SWEEP_DEG]`,
-    /// metres and degrees (default sweep 360, a loop).
-    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true)]
-    pub orbit: Option<OrbitSpec>,
-    /// Orbit: the point looked at, `x,y,z` metres.
-    #[arg(long, value_parser = parse_point, default_value = "0,0.9,0", allow_hyphen_values = true)]
-    pub look_at: [f32; 3],
-    /// Orbit: vertical field of view, degrees.
-    #[arg(long, default_value_t = 35.0)]
-    pub fov: f32,
-    /// Orbit: azimuth of the first frame, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub start: f32,
-}
-
-impl CameraArgs {
-    /// The trajectory.
-    pub fn trajectory(&self) -> CliResult<Trajectory> {
-        if let Some(path) = &self.camera {
-            return Ok(Trajectory::Path(CameraPath::load(path)?));
-        }
-        let o = self
-            .orbit
-            .ok_or("give --camera PATH.toml or --orbit RADIUS,HEIGHT")?;
-        let orbit = Orbit {
-            radius: o.radius,
-            height: o.height,
-            sweep_deg: o.sweep_deg,
-            start_deg: self.start,
-            look_at: Vec3::from(self.look_at),
-            fov_deg: self.fov,
-        };
-        orbit.validate()?;
-        Ok(Trajectory::Orbit(orbit))
-    }
-}
-
-fn numbers(s: &str, what: &str) -> Result<Vec<f32>, String> {
-    s.split(',')
-        .map(|t| match t.trim().parse::<f32>() {
-            Ok(v) if v.is_finite() => Ok(v),
-            _ => Err(format!("{what} `{s}`: `{t}` is not a finite number")),
-        })
-        .collect()
-}
-
-/// `--orbit RADIUS,HEIGHT[,SWEEP_DEG]`.
-#[derive(Clone, Copy, Serialize, PartialEq)]
-pub struct OrbitSpec {
-    /// Metres from the axis.
-    pub radius: f32,
-    /// Camera height, metres.
-    pub height: f32,
-    /// Degrees swept.
-    pub sweep_deg: f32,
-}
-
-/// Parses `RADIUS,HEIGHT[,SWEEP_DEG]`.
-pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
-    let v = numbers(s, "orbit")?;
-    if !(2..=3).contains(&v.len()) {
-        return Err(format!("orbit `{s}`: expected RADIUS,HEIGHT[,SWEEP_DEG]"));
-    }
-    Ok(OrbitSpec {
-        radius: v[0],
-        height: v[1],
-        sweep_deg: v.get(2).copied().unwrap_or(360.0),
-    })
-}
-
-/// Parses `x,y,z`.
-pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
-    let v = numbers(s, "point")?;
-    <[f32; 3]>::try_from(v).map_err(|_| format!("point `{s}`: expected x,y,z"))
-}
 
 /// Makes `source` resident on the GPU, or for the CPU reference when `cpu`.
 pub fn open_renderer(source: &PoseSource, cpu: bool) -> CliResult<Renderer> {
@@ -209,23 +36,6 @@ pub fn pose_of(header: &FieldHeader, requested: Option<u32>, field: &Path) -> Cl
         .or_else(|| header.poses.first().map(|p| p.pose))
         .ok_or_else(|| format!("{}: the field holds no pose", field.display()))?;
     Ok(pose)
-}
-
-/// Parses `WxH`.
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("size `{s}`: expected WxH"))?;
-    let parse = |t: &str| {
-        t.trim()
-            .parse::<u32>()
-            .map_err(|e| format!("size `{s}`: {e}"))
-    };
-    let (w, h) = (parse(w)?, parse(h)?);
-    if !(1..=8192).contains(&w) || !(1..=8192).contains(&h) {
-        return Err(format!("size `{s}`: each side must be 1 to 8192 pixels"));
-    }
-    Ok((w, h))
 }
 
 /// Arguments of `frf render`.
@@ -340,7 +150,7 @@ pub fn run(args: RenderArgs) -> CliResult {
     let source = PoseSource::load(&field, pose, &lighting)?;
     let renderer = open_renderer(&source, args.cpu)?;
     let resident_seconds = start.elapsed().as_secs_f64();
-    let c = source.crop;
+    let c = source.geometry.crop;
     eprintln!(
         "{}: pose {pose}, {}x{} views, crop {}x{} at ({}, {}) of {}x{}",
         args.field.display(),
@@ -470,6 +280,6 @@ pub fn run(args: RenderArgs) -> CliResult {
 
 impl RenderArgs {
     fn env_name(&self) -> String {
-        format!("env {}", self.lighting.env.display())
+        format!("env {}", self.lighting.env)
     }
 }

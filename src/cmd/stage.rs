@@ -7,14 +7,14 @@ use std::time::Instant;
 
 use clap::{Args, Subcommand, ValueEnum};
 use frf_core::camera::Camera;
-use frf_core::env::EnvMap;
+use frf_core::env::EnvSource;
 use frf_core::io::{rgba_from, write_exr_rgba, write_png8_srgba};
 use frf_stage::truth::{DEFAULT_ENVIRONMENT_LIGHTS, environment_lights};
 use frf_stage::{Gait, Preset, SetFlowTruth, StageConfig};
 use glam::Vec3;
 
 use crate::CliResult;
-use crate::cmd::parse_poses;
+use crate::cmd::args::{parse_env, parse_point, parse_poses, parse_size};
 use crate::cmd::progress::bar;
 
 /// Arguments of `frf stage`.
@@ -100,21 +100,21 @@ struct TruthArgs {
     #[arg(long, conflicts_with_all = ["eye", "look_at"])]
     view: Option<String>,
     /// Virtual camera centre `x,y,z`, metres, subject frame.
-    #[arg(long, requires = "look_at")]
-    eye: Option<String>,
+    #[arg(long, requires = "look_at", value_parser = parse_point, allow_hyphen_values = true)]
+    eye: Option<[f32; 3]>,
     /// Point the virtual camera looks at, `x,y,z`.
-    #[arg(long)]
-    look_at: Option<String>,
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    look_at: Option<[f32; 3]>,
     /// Vertical field of view, degrees.
     #[arg(long, default_value_t = 27.5)]
     fov: f32,
     /// Output size `WxH` (default: the capture's).
-    #[arg(long)]
-    size: Option<String>,
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
     /// HDR environment (latitude-longitude .hdr or .exr), subject frame; `sky` for the
-    /// built-in one.
-    #[arg(long, conflicts_with = "basis")]
-    env: Option<PathBuf>,
+    /// built-in one, `uniform` for a white furnace.
+    #[arg(long, conflicts_with = "basis", value_parser = parse_env)]
+    env: Option<EnvSource>,
     /// Yaw of the environment, degrees.
     #[arg(long, default_value_t = 0.0)]
     yaw: f32,
@@ -196,28 +196,6 @@ fn capture(args: CaptureArgs) -> CliResult {
     Ok(())
 }
 
-fn parse_vec3(flag: &str, s: &str) -> CliResult<Vec3> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("{flag} {s:?}: expected x,y,z in metres"))?;
-    match v[..] {
-        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
-        _ => Err(format!("{flag} {s:?}: expected three finite numbers x,y,z").into()),
-    }
-}
-
-fn parse_size(s: &str) -> CliResult<(u32, u32)> {
-    let bad = || format!("--size {s:?}: expected WxH, e.g. 320x448, each 1..=8192");
-    let (w, h) = s.split_once('x').ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
-    if !(1..=8192).contains(&w) || !(1..=8192).contains(&h) {
-        return Err(bad().into());
-    }
-    Ok((w, h))
-}
-
 fn parse_basis(s: &str, conditions: usize) -> CliResult<Vec<f32>> {
     let mut weights = vec![0.0; conditions];
     for item in s.split(',') {
@@ -248,10 +226,7 @@ fn truth(args: TruthArgs) -> CliResult {
         )
         .into());
     }
-    let (w, h) = match &args.size {
-        Some(s) => parse_size(s)?,
-        None => (config.width, config.height),
-    };
+    let (w, h) = args.size.unwrap_or((config.width, config.height));
     let camera = if let Some(view) = &args.view {
         let (u, v) = view
             .split_once(',')
@@ -264,24 +239,22 @@ fn truth(args: TruthArgs) -> CliResult {
             .ok_or_else(|| format!("--view {view:?}: expected U,V"))?;
         stage.subject_camera(pose, u, v)?
     } else {
-        let eye = parse_vec3(
-            "--eye",
-            args.eye
-                .as_deref()
-                .ok_or("give --view U,V or --eye and --look-at")?,
-        )?;
-        let target = parse_vec3("--look-at", args.look_at.as_deref().unwrap_or("0,0.9,0"))?;
+        let eye = Vec3::from(args.eye.ok_or("give --view U,V or --eye and --look-at")?);
+        let target = Vec3::from(args.look_at.unwrap_or([0.0, 0.9, 0.0]));
         Camera::look_at(eye, target, Vec3::Y, args.fov.to_radians(), w, h)?
     };
     let start = Instant::now();
-    let (lights, what) = if let Some(env_path) = &args.env {
-        let env = EnvMap::load_or_builtin(env_path)?.rotated(args.yaw.to_radians());
+    let (lights, what) = if let Some(source) = &args.env {
+        let env = source
+            .load()?
+            .ok_or("--env none: a truth image needs lighting (an environment or --basis)")?
+            .rotated(args.yaw.to_radians());
         if args.lights == 0 || args.lights > 65536 {
             return Err(format!("--lights {}: expected 1..=65536", args.lights).into());
         }
         (
             environment_lights(&env, args.lights),
-            format!("environment {}", env_path.display()),
+            format!("environment {source}"),
         )
     } else {
         let weights = parse_basis(

@@ -5,13 +5,14 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
-use frf_core::env::EnvMap;
-use frf_ingest::eval::{codec_curve, projection_error, stage_projector};
-use frf_ingest::oracle::{OracleOptions, write_oracle_field};
+use clap::Args;
+use frf_core::env::{EnvMap, EnvSource};
+use frf_eval::oracle::{OracleOptions, write_oracle_field};
+use frf_eval::storage::{codec_curve, projection_error, stage_projector};
 use frf_reflectance::project::FloorModel;
 
 use crate::CliResult;
+use crate::cmd::args::{FloorArg, parse_env};
 use crate::cmd::progress::bar;
 
 /// Arguments of `frf stage field`.
@@ -73,23 +74,15 @@ pub fn field(args: FieldArgs) -> CliResult {
     Ok(())
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum FloorArg {
-    /// The environment's own lower hemisphere.
-    Env,
-    /// A Lambertian ground of albedo 0.3 lit by the upper hemisphere.
-    Ground,
-}
-
 /// Arguments of `frf stage projection-error`.
 #[derive(Args)]
 pub struct ProjectionArgs {
     /// A capture directory written by `frf stage`.
     #[arg(long)]
     capture: PathBuf,
-    /// Environments (lat-long .hdr/.exr, or `sky`); repeat for several.
-    #[arg(long, required = true)]
-    env: Vec<PathBuf>,
+    /// Environments (lat-long .hdr/.exr, `sky` or `uniform`); repeat for several.
+    #[arg(long, required = true, value_parser = parse_env)]
+    env: Vec<EnvSource>,
     /// Median-cut lights of the true image under each environment.
     #[arg(long, default_value_t = 512)]
     lights: usize,
@@ -99,6 +92,13 @@ pub struct ProjectionArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+}
+
+/// The environment of `source`, which must be one (not `none`).
+fn environment(source: &EnvSource) -> CliResult<EnvMap> {
+    Ok(source
+        .load()?
+        .ok_or("--env none: these measures need an environment to relight with")?)
 }
 
 /// Views used by the evaluations: every ninth column, all cameras.
@@ -113,15 +113,12 @@ fn sample_views(stage: &frf_stage::Stage) -> Vec<(usize, usize)> {
 pub fn projection(args: ProjectionArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
     let projector = stage_projector(&stage)?;
-    let floor = match args.floor {
-        FloorArg::Env => FloorModel::Environment,
-        FloorArg::Ground => FloorModel::LambertianGround { albedo: [0.3; 3] },
-    };
+    let floor = FloorModel::from(args.floor);
     let views = sample_views(&stage);
     let pose = stage.config().poses[0];
     let mut rows = Vec::new();
-    for path in &args.env {
-        let env = EnvMap::load_or_builtin(path)?;
+    for source in &args.env {
+        let env = environment(source)?;
         let start = Instant::now();
         let errors = projection_error(&stage, &projector, &env, args.lights, floor, pose, &views)?;
         let n = errors.len() as f64;
@@ -131,10 +128,7 @@ pub fn projection(args: ProjectionArgs) -> CliResult {
             .map(|e| e.psnr_subject_db)
             .fold(f64::INFINITY, f64::min);
         let mae = errors.iter().map(|e| e.relative_mae).sum::<f64>() / n;
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let name = source.name();
         rows.push(serde_json::json!({
             "env": name, "views": errors.len(), "mean_psnr_subject_db": mean_psnr,
             "min_psnr_subject_db": min_psnr, "relative_mae": mae,
@@ -172,9 +166,9 @@ pub struct CodecArgs {
     /// A capture directory written by `frf stage`.
     #[arg(long)]
     capture: PathBuf,
-    /// Environment to relight with (lat-long .hdr/.exr, or `sky`).
-    #[arg(long, default_value = "sky")]
-    env: PathBuf,
+    /// Environment to relight with (lat-long .hdr/.exr, `sky` or `uniform`).
+    #[arg(long, default_value = "sky", value_parser = parse_env)]
+    env: EnvSource,
     /// JPEG qualities to measure.
     #[arg(long, value_delimiter = ',', default_value = "50,60,70,80,85,90,95,98")]
     qualities: Vec<u8>,
@@ -186,7 +180,7 @@ pub struct CodecArgs {
 /// Runs `frf stage codec-curve`.
 pub fn codec(args: CodecArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
-    let env = EnvMap::load_or_builtin(&args.env)?;
+    let env = environment(&args.env)?;
     let views = sample_views(&stage);
     let pose = stage.config().poses[0];
     let curve = codec_curve(&stage, &env, pose, &views, &args.qualities)?;
@@ -196,7 +190,7 @@ pub fn codec(args: CodecArgs) -> CliResult {
     }
     println!(
         "basis mosaic (gamma 2.2 JPEG) over quality: ratio against 16-bit linear RGB, and PSNR of the view relit under {} against the uncompressed basis ({} views, subject pixels)",
-        args.env.display(),
+        args.env,
         views.len()
     );
     println!(

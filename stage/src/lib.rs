@@ -1,6 +1,6 @@
 //! The virtual light stage: a CPU ray tracer that films an articulated, textured walker
 //! on a treadmill atop a turntable inside a lighting dome, as the original rig did
-//! (Einarsson et al., EGSR 2006; BRIEF sections 2 and 7), and that knows the exact
+//! (Einarsson et al., EGSR 2006; docs/design.md sections 1 and 5), and that knows the exact
 //! ground truth of everything it films.
 //!
 //! - [`rig`]: the dome's 26 basis conditions, track and matte lighting, the 3 cameras,

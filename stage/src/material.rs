@@ -5,7 +5,7 @@
 //!
 //! The textures are built from 3D value noise at several scales. Their features span
 //! 1.5–8 cm, i.e. 1–4 pixels at the tiny preset and 7–35 pixels at paper size, so that
-//! optical flow has texture to lock onto at every resolution (BRIEF section 7).
+//! optical flow has texture to lock onto at every resolution (docs/design.md section 5.3).
 
 use frf_core::image::Rgb;
 use glam::Vec3;

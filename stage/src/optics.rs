@@ -4,7 +4,7 @@
 //!
 //! Real footage is softer than a box-filtered ray tracing: lens blur and Bayer colour
 //! interpolation spread each point over about a pixel (the original's matting step
-//! blurs by 1 pixel for exactly this reason; BRIEF section 3). Without it, texture near
+//! blurs by 1 pixel for exactly this reason; docs/design.md section 2.1). Without it, texture near
 //! the pixel rate makes any two views differ by more than any resampling can undo:
 //! warping a true neighbour view with the true flow left 4.6 % error without a PSF,
 //! 3.5 % with σ = 0.5 px, and 2.7 % with 0.7 px (160x224, 10° apart, measured).

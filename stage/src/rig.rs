@@ -1,6 +1,6 @@
 //! The fixed hardware of the virtual light stage, in the world frame: the lighting dome's
 //! 26 basis conditions and its track lights, the three cameras, the turntable, and the
-//! 33-slot schedule of a lighting set (BRIEF sections 2 and 7).
+//! 33-slot schedule of a lighting set (docs/design.md section 5.1).
 //!
 //! **Basis.** The sphere is cut into 26 cells, symmetric about the vertical axis: a zenith
 //! cap and three rings of 6, 8 and 8 cells in the upper hemisphere (23 conditions, all of

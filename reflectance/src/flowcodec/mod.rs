@@ -11,7 +11,7 @@
 //! With prediction (flag bit 0) each code is replaced by its difference, modulo 256, from
 //! the code of its left neighbour if that is known, else of the one above, else 0: flow is
 //! smooth inside the subject, so the differences cluster at zero. The original reached
-//! 34 % of the 8-bit size with Huffman coding alone (BRIEF section 4).
+//! 34 % of the 8-bit size with Huffman coding alone (docs/design.md section 3.6).
 
 pub mod huffman;
 pub mod quant;

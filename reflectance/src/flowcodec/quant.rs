@@ -1,4 +1,4 @@
-//! Signed logarithmic 8-bit quantization of flow components (BRIEF section 4): fine steps
+//! Signed logarithmic 8-bit quantization of flow components (docs/design.md section 3.1): fine steps
 //! near zero, coarse ones for large displacements, saturating (never wrapping) beyond
 //! the largest flow of the data set.
 //!

@@ -11,20 +11,21 @@
 //! - [`Gpu::render`] draws a frame with a full-screen triangle into an RGBA32F target
 //!   and reads it back, rows padded to `COPY_BYTES_PER_ROW_ALIGNMENT`.
 
+pub mod scope;
 pub mod types;
 
 use std::sync::Arc;
 
 use frf_core::camera::Camera;
-use frf_core::grid::Neighbour;
 use frf_core::image::{Image, Rgba};
 use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use crate::cpu::FrameStats;
 use crate::error::{RenderError, Result};
+use crate::geometry::PoseGeometry;
 use crate::morph::Variant;
-use crate::resident::{Crop, PoseSource, flow_lut, srgb_lut};
+use crate::resident::{PoseSource, srgb_lut};
 use types::{GpuFrame, GpuQuad, GpuRelightParams, GpuView};
 
 /// The WGSL sources as compiled: each pass after the shared definitions.
@@ -54,6 +55,7 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     adapter: String,
+    uncaptured: scope::Uncaptured,
     relight_layout: wgpu::BindGroupLayout,
     relight: wgpu::ComputePipeline,
     encode: wgpu::ComputePipeline,
@@ -68,13 +70,10 @@ pub struct GpuPose {
     prelit: wgpu::Texture,
     /// Per view: the pre-lit colour scale found by the relighting pass.
     pub scales: Vec<f32>,
-    /// The crop.
-    pub crop: Crop,
-    columns: u32,
-    rows: u32,
+    /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
+    /// holds on the GPU.
+    pub geometry: Arc<PoseGeometry>,
     quad_count: u32,
-    /// Bytes held on the GPU for this pose (textures and tables).
-    pub resident_bytes: u64,
 }
 
 fn storage(
@@ -175,8 +174,26 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(gpu_err)?;
-        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| eprintln!("GPU error: {e:?}")));
+        let uncaptured = scope::Uncaptured::default();
+        uncaptured.install(&device);
+        let adapter = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        scope::scoped(&device, &uncaptured, "building the pipelines", || {
+            Ok(Self::build(
+                device.clone(),
+                queue,
+                adapter,
+                uncaptured.clone(),
+            ))
+        })
+    }
 
+    /// The pipelines and layouts of the renderer on `device`.
+    fn build(
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        adapter: String,
+        uncaptured: scope::Uncaptured,
+    ) -> Self {
         let relight_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("relight"),
             source: wgpu::ShaderSource::Wgsl(shaders::composed(shaders::RELIGHT).into()),
@@ -270,17 +287,28 @@ impl Gpu {
             multiview_mask: None,
             cache: None,
         });
-        Ok(Self {
+        Self {
             device,
             queue,
-            adapter: format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type),
+            adapter,
+            uncaptured,
             relight_layout,
             relight,
             encode,
             frame_layout,
             pose_layout,
             rebin,
-        })
+        }
+    }
+
+    /// Runs `f` inside error scopes ([`scope::scoped`]).
+    fn scoped<T>(&self, operation: &'static str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        scope::scoped(&self.device, &self.uncaptured, operation, f)
+    }
+
+    /// The largest texture side the device takes, pixels.
+    pub fn max_texture_side(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
     }
 
     /// The adapter, in words.
@@ -311,28 +339,27 @@ impl Gpu {
     /// Makes pose `source` resident: uploads its flows and tables and relights every view
     /// on the GPU.
     pub fn upload_pose(&self, source: &PoseSource) -> Result<GpuPose> {
-        let crop = source.crop;
-        let views = source.cameras.len();
-        let texels = (crop.width * crop.height) as usize;
+        self.scoped("making a pose resident", || {
+            self.upload_pose_unscoped(source)
+        })
+    }
+
+    fn upload_pose_unscoped(&self, source: &PoseSource) -> Result<GpuPose> {
+        let geometry = &source.geometry;
+        let crop = geometry.crop;
+        let views = geometry.views();
+        let texels = crop.texels();
         let extent = |layers: u32| wgpu::Extent3d {
             width: crop.width,
             height: crop.height,
             depth_or_array_layers: layers.max(1),
         };
-        // Flows: one layer per stored flow.
-        let mut layers = Vec::with_capacity(views);
-        let mut flow_data: Vec<u8> = Vec::new();
-        let mut next = 0i32;
-        for f in &source.flows {
-            let mut l = [-1i32; 4];
-            for n in Neighbour::ALL {
-                if let Some(codes) = &f[n.index()] {
-                    l[n.index()] = next;
-                    next += 1;
-                    flow_data.extend(codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]));
-                }
+        // Flows: one layer per stored flow, in the order of the geometry's flow layers.
+        let mut flow_data: Vec<u8> = Vec::with_capacity(geometry.flow_layer_count * texels * 2);
+        for f in &source.flows.codes {
+            for codes in f.iter().flatten() {
+                flow_data.extend(codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]));
             }
-            layers.push(l);
         }
         if flow_data.is_empty() {
             flow_data = vec![128u8; texels * 2];
@@ -341,7 +368,7 @@ impl Gpu {
             &self.queue,
             &wgpu::TextureDescriptor {
                 label: Some("flows"),
-                size: extent(next as u32),
+                size: extent(geometry.flow_layer_count as u32),
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -366,11 +393,11 @@ impl Gpu {
         });
         let scales = self.relight_views(source, &prelit)?;
 
-        let gpu_views: Vec<GpuView> = source
+        let gpu_views: Vec<GpuView> = geometry
             .cameras
             .iter()
             .zip(&scales)
-            .zip(&layers)
+            .zip(&geometry.flow_layers)
             .map(|((cam, &scale), l)| {
                 let q = Quat::from_mat3(&cam.world_from_camera.rotation);
                 let k = &cam.intrinsics;
@@ -383,7 +410,8 @@ impl Gpu {
                 }
             })
             .collect();
-        let quads: Vec<GpuQuad> = pose_cylinder_of(source)
+        let quads: Vec<GpuQuad> = geometry
+            .cylinder
             .quads()
             .iter()
             .map(|q| GpuQuad {
@@ -409,10 +437,7 @@ impl Gpu {
         };
         let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
-        let tables = buffer(
-            "tables",
-            &table_bytes(&[srgb_lut(), flow_lut(&source.quantizer)]),
-        );
+        let tables = buffer("tables", &table_bytes(&[srgb_lut(), source.flows.table]));
         let view_of = |t: &wgpu::Texture| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -445,26 +470,19 @@ impl Gpu {
                 },
             ],
         });
-        let resident_bytes = texels as u64 * (4 * views as u64 + 2 * next.max(1) as u64)
-            + (gpu_views.len() * std::mem::size_of::<GpuView>()
-                + quads.len() * std::mem::size_of::<GpuQuad>()
-                + 2048) as u64;
         Ok(GpuPose {
             bind_group,
             prelit,
             scales,
-            crop,
-            columns: source.columns as u32,
-            rows: source.rows as u32,
+            geometry: geometry.clone(),
             quad_count: quads.len() as u32,
-            resident_bytes,
         })
     }
 
     /// Relights every view into its layer of `prelit`; returns the views' scales.
     fn relight_views(&self, source: &PoseSource, prelit: &wgpu::Texture) -> Result<Vec<f32>> {
-        let crop = source.crop;
-        let texels = (crop.width * crop.height) as usize;
+        let crop = source.geometry.crop;
+        let texels = crop.texels();
         let tiles = source.basis.first().map_or(0, |b| b.tiles.len());
         let views = source.basis.len();
         let basis_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -622,7 +640,13 @@ impl Gpu {
 
     /// Reads back the pre-lit texels of every view (for tests and inspection).
     pub fn read_prelit(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
-        let (w, h) = (pose.crop.width, pose.crop.height);
+        self.scoped("reading pre-lit views back", || {
+            self.read_prelit_unscoped(pose)
+        })
+    }
+
+    fn read_prelit_unscoped(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
+        let (w, h) = (pose.geometry.crop.width, pose.geometry.crop.height);
         let layers = pose.scales.len() as u32;
         let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -662,6 +686,17 @@ impl Gpu {
         camera: &Camera,
         variant: Variant,
     ) -> Result<(Image<Rgba>, FrameStats)> {
+        self.scoped("rendering a frame", || {
+            self.render_unscoped(pose, camera, variant)
+        })
+    }
+
+    fn render_unscoped(
+        &self,
+        pose: &GpuPose,
+        camera: &Camera,
+        variant: Variant,
+    ) -> Result<(Image<Rgba>, FrameStats)> {
         let (w, h) = (camera.width, camera.height);
         let r = camera.world_from_camera.rotation;
         let k = &camera.intrinsics;
@@ -674,10 +709,10 @@ impl Gpu {
             size: [w, h],
             variant: variant.index(),
             quad_count: pose.quad_count,
-            columns: pose.columns,
-            rows: pose.rows,
-            crop_origin: [pose.crop.x0, pose.crop.y0],
-            crop_size: [pose.crop.width, pose.crop.height],
+            columns: pose.geometry.columns as u32,
+            rows: pose.geometry.rows as u32,
+            crop_origin: [pose.geometry.crop.x0, pose.geometry.crop.y0],
+            crop_size: [pose.geometry.crop.width, pose.geometry.crop.height],
             pad: [0; 2],
         };
         let frame_buffer = self
@@ -784,10 +819,4 @@ impl Gpu {
         };
         Ok((Image::from_vec(w as usize, h as usize, pixels)?, stats))
     }
-}
-
-/// The cylinder of a pose source's cameras.
-fn pose_cylinder_of(source: &PoseSource) -> crate::cylinder::Cylinder {
-    let centres: Vec<glam::Vec3> = source.cameras.iter().map(|c| c.centre()).collect();
-    crate::cylinder::Cylinder::new(&centres, source.columns, source.rows, source.wraps)
 }

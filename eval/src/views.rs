@@ -6,9 +6,9 @@
 //!
 //! The cameras sit at the centre of grid quads (`β = γ = ½`): on the cylinder of camera
 //! centres, as far from every captured view as the grid allows, with orientation and
-//! intrinsics interpolated as the renderer does ([`crate::cylinder::interpolate_camera`]).
+//! intrinsics interpolated as the renderer does ([`interpolate_camera`]).
 //! The truth shows the unperturbed walker at the pose's instant, while each captured view
-//! shows that cycle's perturbed walker (BRIEF section 7): captures with perturbation 0
+//! shows that cycle's perturbed walker (docs/design.md section 5.2): captures with perturbation 0
 //! isolate the interpolation error.
 
 use std::time::Instant;
@@ -17,14 +17,15 @@ use frf_core::camera::Camera;
 use frf_core::image::{Image, Rgba};
 use frf_core::io::rgba_from;
 use frf_core::light::DirLight;
+use frf_render::cylinder::interpolate_camera;
+use frf_render::geometry::PoseGeometry;
+use frf_render::morph::Variant;
+use frf_render::renderer::Renderer;
 use frf_stage::Stage;
 use serde::Serialize;
 
-use crate::cylinder::interpolate_camera;
-use crate::error::{RenderError, Result};
-use crate::metrics::{alpha_mae, psnr, ssim, subject_mask};
-use crate::morph::Variant;
-use crate::renderer::Renderer;
+use crate::error::{EvalError, Result};
+use crate::metrics::{alpha_mae, alpha_of, psnr, ssim, subject_mask};
 
 /// The scores of one frame.
 #[derive(Debug, Clone, Serialize)]
@@ -77,25 +78,20 @@ pub struct EvalCamera {
 
 /// The first corners `(u, v)` of `count` grid quads, spread over the columns and
 /// alternating over the row gaps; refuses a grid without quads and absurd counts.
-fn quad_corners(
-    cameras: &[Camera],
-    columns: usize,
-    rows: usize,
-    wraps: bool,
-    count: usize,
-) -> Result<Vec<(usize, usize)>> {
+fn quad_corners(geometry: &PoseGeometry, count: usize) -> Result<Vec<(usize, usize)>> {
+    let (columns, rows, wraps) = (geometry.columns, geometry.rows, geometry.wraps);
     let quads_u = if wraps {
         columns
     } else {
         columns.saturating_sub(1)
     };
-    if quads_u == 0 || cameras.len() != columns * rows {
-        return Err(RenderError::BadParameter(format!(
+    if quads_u == 0 || geometry.cameras.len() != columns * rows {
+        return Err(EvalError::BadParameter(format!(
             "a {columns}x{rows} grid has no quad between views"
         )));
     }
     if count == 0 || count > quads_u * rows.max(2) {
-        return Err(RenderError::BadParameter(format!(
+        return Err(EvalError::BadParameter(format!(
             "{count} cameras between views (1 to {})",
             quads_u * rows.max(2)
         )));
@@ -106,21 +102,14 @@ fn quad_corners(
         .collect())
 }
 
-/// `count` cameras at the centres of grid quads, spread over the columns and alternating
-/// over the row gaps; `cameras` are the grid's, `u`-major.
-pub fn between_view_cameras(
-    cameras: &[Camera],
-    columns: usize,
-    rows: usize,
-    wraps: bool,
-    count: usize,
-) -> Result<Vec<EvalCamera>> {
-    Ok(quad_corners(cameras, columns, rows, wraps, count)?
+/// `count` cameras at the centres of grid quads of a pose, spread over the columns and
+/// alternating over the row gaps.
+pub fn between_view_cameras(geometry: &PoseGeometry, count: usize) -> Result<Vec<EvalCamera>> {
+    Ok(quad_corners(geometry, count)?
         .into_iter()
         .map(|(u, v)| {
-            let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
-            let at = |u: usize, v: usize| &cameras[u * rows + v];
-            let quad = [at(u, v), at(u1, v), at(u, v1), at(u1, v1)];
+            let at = |u: usize, v: usize| &geometry.cameras[geometry.view(u, v)];
+            let quad = [at(u, v), at(u + 1, v), at(u, v + 1), at(u + 1, v + 1)];
             let centre = quad.iter().map(|c| c.centre()).sum::<glam::Vec3>() / 4.0;
             EvalCamera {
                 name: format!("u {u}.5, v {v}.5"),
@@ -133,18 +122,12 @@ pub fn between_view_cameras(
 /// The captured cameras at the first corner of the quads of [`between_view_cameras`]:
 /// rendering there involves no interpolation, so their error is that of relighting
 /// through the basis and of storage alone, the floor under the variants' error.
-pub fn grid_view_cameras(
-    cameras: &[Camera],
-    columns: usize,
-    rows: usize,
-    wraps: bool,
-    count: usize,
-) -> Result<Vec<EvalCamera>> {
-    Ok(quad_corners(cameras, columns, rows, wraps, count)?
+pub fn grid_view_cameras(geometry: &PoseGeometry, count: usize) -> Result<Vec<EvalCamera>> {
+    Ok(quad_corners(geometry, count)?
         .into_iter()
         .map(|(u, v)| EvalCamera {
             name: format!("u {u}, v {v}"),
-            camera: cameras[u * rows + v],
+            camera: geometry.cameras[geometry.view(u, v)],
         })
         .collect())
 }
@@ -169,7 +152,7 @@ pub fn score(camera: &str, truth: &Image<Rgba>, test: &Image<Rgba>, seconds: f64
         ssim_subject: ssim(truth, test, Some(&mask)),
         psnr_frame: psnr(truth, test, None),
         ssim_frame: ssim(truth, test, None),
-        alpha_mae: alpha_mae(truth, test),
+        alpha_mae: alpha_mae(&alpha_of(truth), &alpha_of(test)),
         seconds,
     }
 }

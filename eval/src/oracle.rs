@@ -17,7 +17,7 @@ use frf_stage::render::{Scene, render};
 use frf_stage::studio::Illumination;
 use rayon::prelude::*;
 
-use crate::error::{IngestError, Result};
+use crate::error::{EvalError, Result};
 
 /// The true flows of view `(u, v)` of `pose` to each neighbour ([`Neighbour::ALL`] order).
 pub fn true_flows(stage: &Stage, pose: u32, u: usize, v: usize) -> Result<[Option<FlowImage>; 4]> {
@@ -77,7 +77,7 @@ pub fn write_oracle_field(
         .iter()
         .find(|p| !stage.config().poses.contains(p))
     {
-        return Err(IngestError::BadParameter(format!(
+        return Err(EvalError::BadParameter(format!(
             "pose {p} is not rendered by this stage (it has {:?})",
             stage.config().poses
         )));

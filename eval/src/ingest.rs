@@ -1,64 +1,24 @@
-//! How good each ingest step is, against the virtual stage's ground truth (when the
-//! capture comes from it): alpha against the true coverage, registered basis images
-//! against the true images at the reference instant (and what registration gains over
-//! none), and inter-view flow against the true flow inside the matte, horizontal and
-//! vertical pairs apart.
+//! How good each ingest step is, against the virtual stage's ground truth: alpha
+//! against the true coverage, registered basis images against the true images at the
+//! reference instant (and what registration gains over none), and inter-view flow against
+//! the true flow inside the matte, horizontal and vertical pairs apart. [`StageEvaluator`]
+//! is the [`Evaluator`] that `frf ingest` hands to the ingest of a stage capture.
+
+use std::path::Path;
 
 use frf_core::grid::Neighbour;
-use frf_core::image::{FlowImage, GrayImage, RgbImage};
+use frf_core::image::FlowImage;
+use frf_ingest::evidence::{EvaluationError, Evaluator, PoseErrors, PoseEvidence};
 use frf_stage::Stage;
 use frf_stage::truth::flow_between;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
-use crate::metrics::compare;
+use crate::metrics::{alpha_iou, alpha_mae, alpha_mask, compare};
 
 /// True alpha at least this counts as inside the matte for flow errors: the flow of a
 /// pixel only partly covered is ill-defined.
 const INSIDE_MATTE: f32 = 0.99;
-/// Alpha threshold of the binary mattes compared by IoU.
-const IOU_THRESHOLD: f32 = 0.5;
-
-/// Errors of one pose against the truth.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct PoseErrors {
-    /// Intersection over union of estimated and true mattes (alpha ≥ 0.5), mean over views.
-    pub alpha_iou: f64,
-    /// Mean absolute alpha error over the image, mean over views.
-    pub alpha_mae: f64,
-    /// PSNR (dB, subject pixels, peak = the truth's brightest value) of the registered
-    /// basis images against the true images at the reference instant, mean over the
-    /// evaluated views and conditions.
-    pub registration_psnr: f64,
-    /// The same for the frames matted without registration.
-    pub unregistered_psnr: f64,
-    /// Mean end-point error (px) of horizontal-neighbour flow, inside the true matte where
-    /// the point is visible in the neighbour.
-    pub flow_epe_horizontal: f64,
-    /// The same for vertical neighbours.
-    pub flow_epe_vertical: f64,
-    /// Views whose registration was evaluated.
-    pub registration_views: usize,
-}
-
-/// Alpha IoU and MAE of one view.
-pub fn alpha_errors(estimated: &GrayImage, truth: &GrayImage) -> (f64, f64) {
-    let (mut inter, mut union, mut abs) = (0usize, 0usize, 0.0f64);
-    for (&e, &t) in estimated.pixels().iter().zip(truth.pixels()) {
-        let (a, b) = (e >= IOU_THRESHOLD, t >= IOU_THRESHOLD);
-        inter += (a && b) as usize;
-        union += (a || b) as usize;
-        abs += (e - t).abs() as f64;
-    }
-    let iou = if union > 0 {
-        inter as f64 / union as f64
-    } else {
-        1.0
-    };
-    (iou, abs / estimated.pixels().len().max(1) as f64)
-}
-
 /// Mean end-point error of `estimated` against the true flow of view `(u, v)` toward
 /// `n`, and the pixels compared.
 fn flow_epe(
@@ -90,16 +50,6 @@ fn flow_epe(
     Ok((sum, count))
 }
 
-/// Alpha, flow and (on the sampled views) registration errors of a pose.
-pub struct PoseEvidence<'a> {
-    /// Estimated alpha per view, `u`-major.
-    pub alphas: &'a [GrayImage],
-    /// Estimated flows per view.
-    pub flows: &'a [[Option<FlowImage>; 4]],
-    /// For some views: `(u, v, registered basis, unregistered basis)`.
-    pub registered: &'a [(usize, usize, Vec<RgbImage>, Vec<RgbImage>)],
-}
-
 /// Evaluates a pose against the stage's truth.
 pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Result<PoseErrors> {
     let rows = stage.cameras().len();
@@ -111,7 +61,10 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         .map(|i| {
             let (u, v) = (i / rows, i % rows);
             let (_, true_alpha) = stage.reference_surface(pose, u, v)?;
-            let alpha = alpha_errors(&evidence.alphas[i], &true_alpha);
+            let alpha = (
+                alpha_iou(&true_alpha, &evidence.alphas[i]),
+                alpha_mae(&true_alpha, &evidence.alphas[i]),
+            );
             let mut epe = [(0.0, 0usize); 2];
             for n in Neighbour::ALL {
                 if let Some(f) = &evidence.flows[i][n.index()] {
@@ -138,9 +91,10 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
             let mut out = Vec::new();
             for (c, (reg, unreg)) in registered.iter().zip(unregistered).enumerate() {
                 let truth = stage.true_view_image(pose, *u, *v, &stage.condition_lights(c)?)?;
+                let subject = alpha_mask(&truth.alpha);
                 out.push((
-                    compare(&truth.color, reg, Some(&truth.alpha)).psnr_db,
-                    compare(&truth.color, unreg, Some(&truth.alpha)).psnr_db,
+                    compare(&truth.color, reg, Some(&subject)).psnr_db,
+                    compare(&truth.color, unreg, Some(&subject)).psnr_db,
                 ));
             }
             Ok(out)
@@ -160,4 +114,41 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         flow_epe_vertical: sum_epe(1),
         registration_views: evidence.registered.len(),
     })
+}
+
+/// Views whose registration is evaluated: four columns spread over the turn, all cameras.
+fn evaluated(u: usize, columns: usize) -> bool {
+    u.is_multiple_of((columns / 4).max(1))
+}
+
+/// The judge of an ingest of a virtual-stage capture.
+pub struct StageEvaluator {
+    stage: Stage,
+}
+
+impl StageEvaluator {
+    /// The judge of the capture in `capture_dir`, if the virtual stage wrote it (it holds
+    /// the stage's configuration); `None` for any other capture.
+    pub fn open_if_stage(capture_dir: &Path) -> Result<Option<Self>> {
+        if !capture_dir.join(frf_stage::writer::STAGE_FILE).exists() {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            stage: frf_stage::open_stage(capture_dir)?,
+        }))
+    }
+}
+
+impl Evaluator for StageEvaluator {
+    fn wants_unregistered(&self, u: usize, _v: usize) -> bool {
+        evaluated(u, self.stage.cycles())
+    }
+
+    fn evaluate(
+        &self,
+        pose: u32,
+        evidence: &PoseEvidence,
+    ) -> std::result::Result<PoseErrors, EvaluationError> {
+        Ok(evaluate_pose(&self.stage, pose, evidence)?)
+    }
 }

@@ -7,6 +7,7 @@
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use frf_eval::ingest::StageEvaluator;
 use frf_flow::Preset;
 use frf_ingest::IngestError;
 use frf_ingest::matte::MatteRule;
@@ -30,7 +31,6 @@ fn options(poses: Vec<u32>) -> IngestOptions {
         flow_settings: Vec::new(),
         jpeg_quality: 95,
         predict_flow: true,
-        evaluate: true,
         matte_rule: MatteRule::MatteBelowHalfCleanPlate,
     }
 }
@@ -41,7 +41,9 @@ fn ingest_meets_its_bounds_against_the_truth() {
     let dir = tempfile::tempdir().unwrap();
     capture(&dir.path().join("cap"), 36);
     let out = dir.path().join("f.frf");
-    let report = ingest(&dir.path().join("cap"), &out, &options(vec![1]), &Silent).unwrap();
+    let cap = dir.path().join("cap");
+    let judge = StageEvaluator::open_if_stage(&cap).unwrap().unwrap();
+    let report = ingest(&cap, &out, &options(vec![1]), Some(&judge), &Silent).unwrap();
     eprintln!(
         "IoU {:?}, MAE {:?}, registration {:?} vs {:?} dB, EPE {:?} / {:?} px",
         report.alpha_iou,
@@ -93,19 +95,18 @@ fn an_interrupted_ingest_resumes_and_never_leaves_a_corrupt_field() {
     let cap = dir.path().join("cap");
     capture(&cap, 12);
     let out = dir.path().join("f.frf");
-    let mut opts = options(vec![0, 1]);
-    opts.evaluate = false;
+    let opts = options(vec![0, 1]);
     // Pose 0 takes 36 views twice (images, then flows); stop early in pose 1.
     let stop = StopLater {
         views: AtomicUsize::new(0),
         after: 72 + 10,
     };
-    let err = ingest(&cap, &out, &opts, &stop).unwrap_err();
+    let err = ingest(&cap, &out, &opts, None, &stop).unwrap_err();
     assert!(matches!(err, IngestError::Interrupted), "{err}");
     assert!(!out.exists(), "no field before every pose is done");
     assert!(parts_dir(&out).join("p00.frf").exists());
     assert!(!parts_dir(&out).join("p01.frf").exists());
-    let report = ingest(&cap, &out, &opts, &Silent).unwrap();
+    let report = ingest(&cap, &out, &opts, None, &Silent).unwrap();
     assert!(report.poses[0].resumed && !report.poses[1].resumed);
     let field = FieldFile::open(&out).unwrap();
     assert_eq!(field.header().poses.len(), 2);
@@ -115,10 +116,12 @@ fn an_interrupted_ingest_resumes_and_never_leaves_a_corrupt_field() {
         after: 72 + 10,
     };
     std::fs::remove_file(&out).unwrap();
-    assert!(ingest(&cap, &out, &opts, &stop).is_err());
+    assert!(ingest(&cap, &out, &opts, None, &stop).is_err());
     let mut other = opts.clone();
     other.jpeg_quality = 50;
-    let err = ingest(&cap, &out, &other, &Silent).unwrap_err().to_string();
+    let err = ingest(&cap, &out, &other, None, &Silent)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("p00.frf") && err.contains("settings"), "{err}");
 }
 
@@ -130,6 +133,7 @@ fn bad_requests_are_refused_by_name() {
         &missing,
         &dir.path().join("f.frf"),
         &options(vec![]),
+        None,
         &Silent,
     )
     .unwrap_err()
@@ -137,16 +141,22 @@ fn bad_requests_are_refused_by_name() {
     assert!(err.contains("nowhere"), "{err}");
     let cap = dir.path().join("cap");
     capture(&cap, 4);
-    let err = ingest(&cap, &dir.path().join("f.frf"), &options(vec![7]), &Silent)
-        .unwrap_err()
-        .to_string();
+    let err = ingest(
+        &cap,
+        &dir.path().join("f.frf"),
+        &options(vec![7]),
+        None,
+        &Silent,
+    )
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("pose 7"), "{err}");
     let mut bad = options(vec![0]);
     bad.jpeg_quality = 0;
-    assert!(ingest(&cap, &dir.path().join("f.frf"), &bad, &Silent).is_err());
+    assert!(ingest(&cap, &dir.path().join("f.frf"), &bad, None, &Silent).is_err());
     bad = options(vec![0]);
     bad.flow_settings = vec![("warps".into(), "many".into())];
-    let err = ingest(&cap, &dir.path().join("f.frf"), &bad, &Silent)
+    let err = ingest(&cap, &dir.path().join("f.frf"), &bad, None, &Silent)
         .unwrap_err()
         .to_string();
     assert!(err.contains("warps"), "{err}");

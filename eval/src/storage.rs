@@ -19,8 +19,8 @@ use frf_stage::Stage;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::error::{IngestError, Result};
-use crate::metrics::{ImageError, compare};
+use crate::error::{EvalError, Result};
+use crate::metrics::{ImageError, alpha_mask, compare};
 use crate::oracle::oracle_view;
 
 /// The stage's basis as field conditions (what a projector needs).
@@ -84,7 +84,7 @@ pub fn projection_error(
             let basis = oracle_view(stage, pose, u, v)?.basis;
             let coefficients = projector.project(env, view_angle(stage, pose, u), floor);
             let relit = relight(&basis, &coefficients)?;
-            let e = compare(&truth.color, &relit, Some(&truth.alpha));
+            let e = compare(&truth.color, &relit, Some(&alpha_mask(&truth.alpha)));
             Ok(ProjectionError {
                 view: (u, v),
                 psnr_subject_db: e.psnr_db,
@@ -113,7 +113,7 @@ pub struct CodecPoint {
 struct PreparedView {
     basis: Vec<RgbImage>,
     reference: RgbImage,
-    alpha: frf_core::image::GrayImage,
+    subject: Vec<bool>,
     coefficients: Vec<[f32; 3]>,
 }
 
@@ -127,7 +127,7 @@ pub fn codec_curve(
     qualities: &[u8],
 ) -> Result<Vec<CodecPoint>> {
     if views.is_empty() || qualities.is_empty() {
-        return Err(IngestError::BadParameter(
+        return Err(EvalError::BadParameter(
             "codec curve needs views and qualities".into(),
         ));
     }
@@ -142,7 +142,7 @@ pub fn codec_curve(
             Ok(PreparedView {
                 basis: view.basis,
                 reference,
-                alpha: view.alpha,
+                subject: alpha_mask(&view.alpha),
                 coefficients,
             })
         })
@@ -157,7 +157,7 @@ pub fn codec_curve(
                     let bytes = encode_basis(&p.basis, quality)?;
                     let decoded = decode_basis(&bytes)?;
                     let relit = relight(&decoded, &p.coefficients)?;
-                    Ok((bytes.len(), compare(&p.reference, &relit, Some(&p.alpha))))
+                    Ok((bytes.len(), compare(&p.reference, &relit, Some(&p.subject))))
                 })
                 .collect::<Result<_>>()?;
             let seconds = start.elapsed().as_secs_f64() / prepared.len() as f64;

@@ -1,7 +1,7 @@
 //! The GPU renderer against its CPU twin on the virtual stage's tiny oracle field, relit
 //! by the built-in sky: the relighting pass (per-view scales and pre-lit codes) and every
 //! variant of the morph from cameras between grid views, above the grid and inside the
-//! cylinder.
+//! cylinder; and a request the GPU refuses comes back as a typed error.
 //!
 //! Tolerances (measured on lavapipe: scales equal to 1e-7, codes differ by at most 1 on
 //! rounding ties, frames by at most 1e-4): scales 1e-5 relative, codes 1, frames 2e-3
@@ -14,14 +14,13 @@
 
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
-use frf_ingest::oracle::{OracleOptions, write_oracle_field};
 use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
+use frf_render::RenderError;
 use frf_render::cpu::render_cpu;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::resident::{Lighting, PoseSource, ResidentPose};
-use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
 use glam::Vec3;
 
 fn gpu() -> Option<Gpu> {
@@ -35,19 +34,8 @@ fn gpu() -> Option<Gpu> {
     }
 }
 
-fn tiny_source(dir: &std::path::Path) -> PoseSource {
-    let mut c = StageConfig::preset(Preset::Tiny);
-    c.poses = vec![0];
-    c.set_flow_truth = SetFlowTruth::None;
-    let stage = Stage::new(c).unwrap();
-    let path = dir.join("tiny.frf");
-    let options = OracleOptions {
-        poses: vec![0],
-        jpeg_quality: 95,
-        predict_flow: true,
-    };
-    write_oracle_field(&stage, &path, &options, &|_, _| {}).unwrap();
-    let field = FieldFile::open(&path).unwrap();
+fn tiny_source() -> PoseSource {
+    let field = FieldFile::open(&frf_testkit::tiny_field().field).unwrap();
     let lighting = Lighting::Environment {
         env: EnvMap::sky(),
         floor: FloorModel::Environment,
@@ -58,8 +46,7 @@ fn tiny_source(dir: &std::path::Path) -> PoseSource {
 #[test]
 fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let Some(gpu) = gpu() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    let source = tiny_source(dir.path());
+    let source = tiny_source();
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
 
@@ -113,4 +100,40 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
             }
         }
     }
+}
+
+#[test]
+fn a_request_the_gpu_refuses_is_returned_as_a_typed_error() {
+    let Some(gpu) = gpu() else { return };
+    let pose = gpu.upload_pose(&tiny_source()).unwrap();
+    // A frame one pixel wider than the largest texture the device takes.
+    let too_wide = gpu.max_texture_side() + 1;
+    let cam = Camera::look_at(
+        Vec3::new(2.2, 1.4, 3.0),
+        Vec3::new(0.0, 0.9, 0.0),
+        Vec3::Y,
+        0.6,
+        too_wide,
+        2,
+    )
+    .unwrap();
+    match gpu.render(&pose, &cam, Variant::FourWay) {
+        Err(RenderError::GpuValidation { operation, message }) => {
+            assert_eq!(operation, "rendering a frame");
+            assert!(!message.is_empty());
+        }
+        other => panic!("expected a validation error, got {:?}", other.map(|_| ())),
+    }
+    // The device is still usable, and the error was not left for the next request.
+    let cam = Camera::look_at(
+        Vec3::new(2.2, 1.4, 3.0),
+        Vec3::new(0.0, 0.9, 0.0),
+        Vec3::Y,
+        0.6,
+        64,
+        90,
+    )
+    .unwrap();
+    let (frame, stats) = gpu.render(&pose, &cam, Variant::FourWay).unwrap();
+    assert!(stats.inside > 0 && frame.pixels().iter().any(|p| p[3] > 0.5));
 }

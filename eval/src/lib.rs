@@ -1,0 +1,25 @@
+//! Evaluation against the virtual light stage's ground truth: everything that scores the
+//! product's results (ingest, storage, relighting, rendering) against what the stage
+//! knows exactly, kept out of the product's crates so that ingesting a real capture or
+//! rendering a field builds none of the ray tracer.
+//!
+//! - [`metrics`]: PSNR, SSIM, alpha error and IoU, with their mask rules, in one place;
+//! - [`oracle`]: the field a perfect ingest would produce, from the stage's truth;
+//! - [`ingest`]: each ingest step's error ([`ingest::StageEvaluator`], handed to
+//!   [`frf_ingest::pipeline::ingest`]);
+//! - [`storage`]: the error of the lighting basis and of the image codec;
+//! - [`views`]: rendered frames between the grid's views against the true frames;
+//! - [`ring`]: views held out of a ring of real photographs, rendered from their
+//!   neighbours, against the photographs.
+//!
+//! Conventions: [`frf_core::conventions`].
+
+pub mod error;
+pub mod ingest;
+pub mod metrics;
+pub mod oracle;
+pub mod ring;
+pub mod storage;
+pub mod views;
+
+pub use error::{EvalError, Result};

@@ -1,0 +1,232 @@
+//! Image error measures, in one place for every report of the project.
+//!
+//! **Regions.** Every measure takes an optional mask of pixels (`None`: the whole image).
+//! The masks used in reports are built here, with their rule in their name:
+//! - [`alpha_mask`]: pixels where one alpha image is at least [`SUBJECT_ALPHA`] (the
+//!   subject of a truth image: ingest and storage figures);
+//! - [`subject_mask`]: pixels where *either* of two RGBA images has alpha at least
+//!   [`SUBJECT_ALPHA`] (rendered frames: a renderer that drops or invents part of the
+//!   subject is charged for it).
+//!
+//! **PSNR** is over the colour channels (the first three), in linear light, with the
+//! peak stated: the reference's largest colour value inside the region, so that the
+//! figure does not depend on exposure. **SSIM** (Wang et al. 2004) is on Rec. 709
+//! luminance with a Gaussian window of σ = 1.5 px (11 x 11, edges clamped), K1 = 0.01,
+//! K2 = 0.03 and the reference's peak in the region as dynamic range; the SSIM of a
+//! region is the mean of the SSIM map over it.
+
+use frf_core::filter::gaussian_blur;
+use frf_core::image::{GrayImage, Image, Rgba, luminance};
+
+/// Alpha at least this much counts as subject in masked measures (half covered).
+pub const SUBJECT_ALPHA: f32 = 0.5;
+
+/// Colour error of a test image against a reference over a region.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageError {
+    /// Peak signal-to-noise ratio, dB, with the peak stated in `peak`; infinite when the
+    /// images are equal over the region.
+    pub psnr_db: f64,
+    /// Mean absolute error per channel, relative to the reference's mean.
+    pub relative_mae: f64,
+    /// The peak used: the reference's largest colour value inside the region.
+    pub peak: f64,
+    /// Pixels compared.
+    pub pixels: usize,
+}
+
+/// Compares the colour channels (the first three) of two equally sized images over the
+/// pixels where `mask` holds (all pixels when `None`).
+pub fn compare<P: Copy + AsRef<[f32]>>(
+    reference: &Image<P>,
+    test: &Image<P>,
+    mask: Option<&[bool]>,
+) -> ImageError {
+    let (mut se, mut ae, mut sum, mut peak, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0usize);
+    for (i, (r, t)) in reference.pixels().iter().zip(test.pixels()).enumerate() {
+        if mask.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        let (r, t) = (r.as_ref(), t.as_ref());
+        for c in 0..3 {
+            let (r, t) = (r[c] as f64, t[c] as f64);
+            se += (r - t).powi(2);
+            ae += (r - t).abs();
+            sum += r.abs();
+            peak = peak.max(r);
+        }
+        n += 1;
+    }
+    let mse = se / (3 * n).max(1) as f64;
+    ImageError {
+        psnr_db: if mse > 0.0 && peak > 0.0 {
+            10.0 * (peak * peak / mse).log10()
+        } else {
+            f64::INFINITY
+        },
+        relative_mae: if sum > 0.0 { ae / sum } else { 0.0 },
+        peak,
+        pixels: n,
+    }
+}
+
+/// PSNR (dB) of the colour of `test` against `reference` over `mask` ([`compare`]).
+pub fn psnr<P: Copy + AsRef<[f32]>>(
+    reference: &Image<P>,
+    test: &Image<P>,
+    mask: Option<&[bool]>,
+) -> f64 {
+    compare(reference, test, mask).psnr_db
+}
+
+/// Pixels where `alpha` is at least [`SUBJECT_ALPHA`].
+pub fn alpha_mask(alpha: &GrayImage) -> Vec<bool> {
+    alpha.pixels().iter().map(|&a| a >= SUBJECT_ALPHA).collect()
+}
+
+/// Pixels where either image's alpha is at least [`SUBJECT_ALPHA`].
+pub fn subject_mask(reference: &Image<Rgba>, test: &Image<Rgba>) -> Vec<bool> {
+    reference
+        .pixels()
+        .iter()
+        .zip(test.pixels())
+        .map(|(r, t)| r[3] >= SUBJECT_ALPHA || t[3] >= SUBJECT_ALPHA)
+        .collect()
+}
+
+/// Mean SSIM of the luminance of `test` against `reference` over `mask` (all pixels when
+/// `None`); 1 for identical images.
+pub fn ssim<P: Copy + AsRef<[f32]>>(
+    reference: &Image<P>,
+    test: &Image<P>,
+    mask: Option<&[bool]>,
+) -> f64 {
+    let (w, h) = reference.size();
+    let lum = |p: P| {
+        let c = p.as_ref();
+        luminance([c[0], c[1], c[2]])
+    };
+    let x = reference.map(lum);
+    let y = test.map(lum);
+    let peak = x
+        .pixels()
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| mask.is_none_or(|m| m[*i]))
+        .map(|(_, &v)| v)
+        .fold(0.0f32, f32::max)
+        .max(1e-6);
+    let (c1, c2) = ((0.01 * peak).powi(2), (0.03 * peak).powi(2));
+    let product =
+        |a: &GrayImage, b: &GrayImage| Image::from_fn(w, h, |i, j| a.get(i, j) * b.get(i, j));
+    let blur = |img: &GrayImage| gaussian_blur(img, 1.5);
+    let (mx, my) = (blur(&x), blur(&y));
+    let (sxx, syy, sxy) = (
+        blur(&product(&x, &x)),
+        blur(&product(&y, &y)),
+        blur(&product(&x, &y)),
+    );
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for i in 0..w * h {
+        if mask.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        let (a, b) = (mx.pixels()[i], my.pixels()[i]);
+        let var_x = (sxx.pixels()[i] - a * a).max(0.0);
+        let var_y = (syy.pixels()[i] - b * b).max(0.0);
+        let cov = sxy.pixels()[i] - a * b;
+        let s =
+            ((2.0 * a * b + c1) * (2.0 * cov + c2)) / ((a * a + b * b + c1) * (var_x + var_y + c2));
+        sum += s as f64;
+        n += 1;
+    }
+    if n == 0 { 1.0 } else { sum / n as f64 }
+}
+
+/// Mean absolute difference of two alpha images over the whole frame.
+pub fn alpha_mae(reference: &GrayImage, test: &GrayImage) -> f64 {
+    let n = reference.pixels().len().max(1) as f64;
+    reference
+        .pixels()
+        .iter()
+        .zip(test.pixels())
+        .map(|(r, t)| (r - t).abs() as f64)
+        .sum::<f64>()
+        / n
+}
+
+/// Intersection over union of the binary mattes `alpha ≥ SUBJECT_ALPHA` of two alpha
+/// images (1 when both are empty).
+pub fn alpha_iou(reference: &GrayImage, test: &GrayImage) -> f64 {
+    let (mut inter, mut union) = (0usize, 0usize);
+    for (&r, &t) in reference.pixels().iter().zip(test.pixels()) {
+        let (a, b) = (r >= SUBJECT_ALPHA, t >= SUBJECT_ALPHA);
+        inter += (a && b) as usize;
+        union += (a || b) as usize;
+    }
+    if union > 0 {
+        inter as f64 / union as f64
+    } else {
+        1.0
+    }
+}
+
+/// The alpha channel of an RGBA image.
+pub fn alpha_of(img: &Image<Rgba>) -> GrayImage {
+    img.map(|p| p[3])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pattern(seed: usize) -> Image<Rgba> {
+        Image::from_fn(40, 30, |x, y| {
+            let v = (((x * 7 + y * 13 + seed) % 17) as f32) / 17.0;
+            [v, 0.5 * v, 0.2, if x > 10 { 1.0 } else { 0.0 }]
+        })
+    }
+
+    #[test]
+    fn psnr_of_a_known_error_over_a_region() {
+        let a = Image::new(10, 10, [1.0f32, 0.5, 0.25]);
+        let b = a.map(|p| p.map(|v| v + 0.01));
+        let e = compare(&a, &b, None);
+        // MSE 1e-4 with peak 1: 40 dB.
+        assert!((e.psnr_db - 40.0).abs() < 1e-4, "{}", e.psnr_db);
+        assert_eq!(e.pixels, 100);
+        let half = alpha_mask(&Image::from_fn(
+            10,
+            10,
+            |x, _| if x < 5 { 1.0 } else { 0.0 },
+        ));
+        assert_eq!(compare(&a, &b, Some(&half)).pixels, 50);
+        assert!(compare(&a, &a, None).psnr_db.is_infinite());
+    }
+
+    #[test]
+    fn identical_images_score_perfectly_and_damage_lowers_the_scores() {
+        let a = pattern(0);
+        assert_eq!(psnr(&a, &a, None), f64::INFINITY);
+        assert!((ssim(&a, &a, None) - 1.0).abs() < 1e-6);
+        assert_eq!(alpha_mae(&alpha_of(&a), &alpha_of(&a)), 0.0);
+        let b = pattern(5);
+        let s = ssim(&a, &b, None);
+        assert!(s < 0.5, "a different texture: SSIM {s}");
+        // A uniform offset of 1 % of the peak on one of three channels: 10 log10(3 / 1e-4).
+        let mut c = a.clone();
+        c.pixels_mut()
+            .iter_mut()
+            .for_each(|p| p[0] += 0.01 * 16.0 / 17.0);
+        let p = psnr(&a, &c, None);
+        let expected = 10.0 * (3.0 / (0.01f64).powi(2)).log10();
+        assert!((p - expected).abs() < 0.05, "{p} vs {expected}");
+        let mask = subject_mask(&a, &a);
+        assert_eq!(mask.iter().filter(|&&m| m).count(), 29 * 30);
+        let mut d = a.clone();
+        d.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
+        assert!((alpha_mae(&alpha_of(&a), &alpha_of(&d)) - 11.0 / 40.0).abs() < 1e-6);
+        // 29 of 40 columns are subject in a, all of them in d.
+        assert!((alpha_iou(&alpha_of(&a), &alpha_of(&d)) - 29.0 / 40.0).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,109 @@
+//! Views held out of a ring of real photographs (Middlebury multi-view), rendered from
+//! their neighbours and scored against the photographs inside the photograph's
+//! silhouette: the renderer judged on real data. The field is ingested with
+//! `frf ingest-ring --stride S`, which keeps every `S`-th view; the view halfway between
+//! two kept views is the one held out.
+
+use std::time::Instant;
+
+use frf_core::camera::Camera;
+use frf_core::io::rgba_from;
+use frf_ingest::ring::{RingView, photo_and_alpha};
+use frf_render::morph::Variant;
+use frf_render::renderer::Renderer;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::error::{EvalError, Result};
+use crate::metrics::{alpha_mask, psnr, ssim};
+
+/// One variant's scores over the held-out views.
+#[derive(Debug, Clone, Serialize)]
+pub struct RingScore {
+    /// The variant.
+    pub name: String,
+    /// Mean PSNR (dB) inside the photographs' silhouettes.
+    pub psnr_silhouette: f64,
+    /// Mean SSIM there.
+    pub ssim_silhouette: f64,
+    /// Mean seconds per frame.
+    pub seconds_per_frame: f64,
+    /// The held-out views (indices in azimuth order).
+    pub views: Vec<usize>,
+    /// PSNR per held-out view.
+    pub psnr_per_view: Vec<f64>,
+}
+
+/// The views held out of a ring of `views` views ingested at `stride`: the view halfway
+/// between two kept views (on an open ring, only between kept views).
+pub fn held_out_views(views: usize, stride: usize, wraps: bool) -> Result<Vec<usize>> {
+    if stride < 2 || views / stride < 2 {
+        return Err(EvalError::BadParameter(format!(
+            "stride {stride} over {views} views holds no view out between two kept ones"
+        )));
+    }
+    Ok((0..views / stride)
+        .map(|j| j * stride + stride / 2)
+        .filter(|&i| wraps || i + stride / 2 < views)
+        .collect())
+}
+
+/// Renders each held-out view `held` (indices into `views` and `cameras`, the whole
+/// ring's) with every variant and scores it against its photograph.
+pub fn score_held_out(
+    renderer: &Renderer,
+    views: &[RingView],
+    cameras: &[Camera],
+    held: &[usize],
+    variants: &[Variant],
+) -> Result<Vec<RingScore>> {
+    let Some(&first) = held.first() else {
+        return Err(EvalError::BadParameter("no view is held out".into()));
+    };
+    let photos = held
+        .par_iter()
+        .map(|&i| {
+            let (photo, alpha) = photo_and_alpha(&views[i].path)?;
+            Ok((rgba_from(&photo, &alpha)?, alpha_mask(&alpha)))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    // One untimed frame first: pipeline compilation and caches.
+    renderer.render(&cameras[first], Variant::FourWay)?;
+    variants
+        .iter()
+        .map(|&v| {
+            let (mut psnrs, mut ssims, mut seconds) = (Vec::new(), Vec::new(), 0.0);
+            for (&i, (photo, mask)) in held.iter().zip(&photos) {
+                let t = Instant::now();
+                let (img, _) = renderer.render(&cameras[i], v)?;
+                seconds += t.elapsed().as_secs_f64();
+                psnrs.push(psnr(photo, &img, Some(mask)));
+                ssims.push(ssim(photo, &img, Some(mask)));
+            }
+            let n = held.len() as f64;
+            Ok(RingScore {
+                name: v.name().to_string(),
+                psnr_silhouette: psnrs.iter().sum::<f64>() / n,
+                ssim_silhouette: ssims.iter().sum::<f64>() / n,
+                seconds_per_frame: seconds / n,
+                views: held.to_vec(),
+                psnr_per_view: psnrs,
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn held_out_views_lie_halfway_between_kept_ones() {
+        assert_eq!(held_out_views(48, 2, true).unwrap().len(), 24);
+        assert_eq!(&held_out_views(48, 4, true).unwrap()[..3], &[2, 6, 10]);
+        // An open ring of 10 views at stride 4 keeps 0, 4, 8: 2 and 6 lie between them.
+        assert_eq!(held_out_views(10, 4, false).unwrap(), vec![2, 6]);
+        let e = held_out_views(48, 1, true).unwrap_err().to_string();
+        assert!(e.contains("stride 1"), "{e}");
+    }
+}
