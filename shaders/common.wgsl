@@ -55,6 +55,22 @@ struct Tables {
     flow: array<vec4<f32>, 64>,
 }
 
+// One triangle covering the viewport: the vertex stage of every full-screen pass.
+@vertex
+fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The unit direction (subject frame) of the ray through the pixel of a fragment at
+// `position`; pixel (x, y) has its centre at integer coordinates (docs/conventions.md).
+fn pixel_ray(f: Frame, position: vec4<f32>) -> vec3<f32> {
+    let pixel = floor(position.xy);
+    let k = f.intrinsics;
+    let dc = vec3<f32>((pixel.x - k.z) / k.x, (pixel.y - k.w) / k.y, 1.0);
+    return normalize(f.axis_x.xyz * dc.x + f.axis_y.xyz * dc.y + f.axis_z.xyz * dc.z);
+}
+
 fn normalize_or_zero(v: vec3<f32>) -> vec3<f32> {
     let l = length(v);
     if (l > 0.0) {

@@ -183,20 +183,9 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     return out;
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
-    // One triangle covering the viewport.
-    let uv = vec2<f32>(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
-
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    // Pixel (x, y) has its centre at integer coordinates (docs/conventions.md).
-    let pixel = floor(position.xy);
-    let k = frame.intrinsics;
-    let dc = vec3<f32>((pixel.x - k.z) / k.x, (pixel.y - k.w) / k.y, 1.0);
-    let dir = normalize(frame.axis_x.xyz * dc.x + frame.axis_y.xyz * dc.y + frame.axis_z.xyz * dc.z);
+    let dir = pixel_ray(frame, position);
     let hit = intersect(frame.centre.xyz, dir);
     if (hit.clamped == 3u) {
         atomicAdd(&stats[3], 1u);

@@ -28,6 +28,8 @@ enum Command {
     Stage(Box<cmd::stage::StageArgs>),
     /// Show what a field file holds and how well it is compressed.
     Info(cmd::info::InfoArgs),
+    /// Write a pose's visual hull as a mesh (PLY).
+    Hull(cmd::hull::HullArgs),
     /// Turn a capture into a flowed reflectance field (mattes, registration, flow).
     Ingest(cmd::ingest::IngestArgs),
     /// Turn a calibrated ring of photographs (Middlebury multi-view) into a field.
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(*args),
         Command::Info(args) => cmd::info::run(args),
+        Command::Hull(args) => cmd::hull::run(args),
         Command::Ingest(args) => cmd::ingest::run(args),
         Command::IngestRing(args) => cmd::ingest::run_ring(args),
         Command::Render(args) => cmd::render::run(*args),

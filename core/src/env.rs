@@ -196,6 +196,33 @@ impl EnvMap {
         sum.map(|v| v as f32)
     }
 
+    /// Irradiance on an unshadowed horizontal surface facing up, `∫_{upper} L cos θ dω`,
+    /// per channel.
+    pub fn upper_irradiance(&self) -> [f64; 3] {
+        let (w, h) = self.radiance.size();
+        let mut e = [0.0f64; 3];
+        for y in 0..h {
+            let omega = self.texel_solid_angle(y) as f64;
+            for x in 0..w {
+                let cos = self.direction_of(x as f32, y as f32).y as f64;
+                if cos > 0.0 {
+                    let l = self.radiance.get(x, y);
+                    for c in 0..3 {
+                        e[c] += l[c] as f64 * omega * cos;
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// Radiance of an unshadowed Lambertian ground of `albedo` lit by the map's upper
+    /// hemisphere: `ρ/π · ∫_{upper} L cos θ dω`.
+    pub fn lambertian_ground(&self, albedo: Rgb) -> Rgb {
+        let e = self.upper_irradiance();
+        [0, 1, 2].map(|c| albedo[c] * (e[c] / std::f64::consts::PI) as f32)
+    }
+
     /// Reduces the map to at most `n` distant lights by median cut; the lights' total
     /// irradiance equals [`EnvMap::total_light`] (up to float rounding).
     pub fn median_cut(&self, n: usize) -> Vec<DirLight> {

@@ -91,6 +91,33 @@ pub fn read_rgb(path: &Path) -> Result<RgbImage> {
     Ok(img)
 }
 
+/// Reads a photograph as linear RGB: 8-bit images (PNG, JPEG) are sRGB-encoded and are
+/// decoded; 16-bit PNG, EXR and HDR already hold linear values (as everywhere in the
+/// project). Non-finite values are refused.
+pub fn read_photo(path: &Path) -> Result<RgbImage> {
+    let img = decode(path)?;
+    let srgb = matches!(
+        img.color(),
+        image::ColorType::L8
+            | image::ColorType::La8
+            | image::ColorType::Rgb8
+            | image::ColorType::Rgba8
+    );
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let pixels = img
+        .into_rgb32f()
+        .into_raw()
+        .chunks_exact(3)
+        .map(|c| {
+            let p = [c[0], c[1], c[2]];
+            if srgb { p.map(srgb_to_linear) } else { p }
+        })
+        .collect();
+    let img = Image::from_vec(w, h, pixels)?;
+    check_finite(path, &img)?;
+    Ok(img)
+}
+
 /// Reads an RGBA image (missing alpha reads as 1). Non-finite values are refused.
 pub fn read_rgba(path: &Path) -> Result<Image<Rgba>> {
     let img = decode(path)?.into_rgba32f();

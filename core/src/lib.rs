@@ -22,5 +22,6 @@ pub mod io;
 pub mod light;
 pub mod manifest;
 pub mod shared_data;
+pub mod volume;
 
 pub use error::{CoreError, Result};

@@ -113,6 +113,9 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         flow_epe_horizontal: sum_epe(0),
         flow_epe_vertical: sum_epe(1),
         registration_views: evidence.registered.len(),
+        hull_iou: evidence
+            .hull
+            .map(|h| h.iou(&stage.true_occupancy(pose, h.grid()))),
     })
 }
 

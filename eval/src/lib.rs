@@ -9,6 +9,7 @@
 //!   [`frf_ingest::pipeline::ingest`]);
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
+//! - [`scene`]: the relit shadow, composites and matte edges against the truth;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
 //!   neighbours, against the photographs.
 //!
@@ -19,6 +20,7 @@ pub mod ingest;
 pub mod metrics;
 pub mod oracle;
 pub mod ring;
+pub mod scene;
 pub mod storage;
 pub mod views;
 

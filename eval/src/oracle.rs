@@ -5,9 +5,11 @@
 //! neighbour. It measures the storage on stage data before any estimation error, and
 //! lets the renderer be judged apart from ingest.
 
+use frf_core::camera::Camera;
 use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
-use frf_core::image::FlowImage;
+use frf_core::image::{FlowImage, GrayImage};
+use frf_ingest::shadows::{ShadowOptions, pose_shadows};
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::stats::FieldStats;
 use frf_reflectance::store::{EncodedView, encode_view};
@@ -63,6 +65,8 @@ pub struct OracleOptions {
     pub jpeg_quality: u8,
     /// Left-predict flow codes before Huffman coding.
     pub predict_flow: bool,
+    /// Visual hulls and shadow maps, carved from the true mattes (`None`: neither).
+    pub shadows: Option<ShadowOptions>,
 }
 
 /// Writes the oracle field of `stage` to `path`; `progress(done, total)` counts views.
@@ -114,20 +118,38 @@ pub fn write_oracle_field(
     let mut header =
         FieldHeader::from_capture(&capture, &options.poses, quantizer, options.jpeg_quality)?;
     header.flow_predicted = options.predict_flow;
+    header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
+    header.hulls = options.shadows.map(|s| s.hull);
     header.description = format!("oracle field (stage ground truth): {}", header.description);
-    // Pass 2: render and encode views in parallel, write them in order.
+    // Pass 2: render and encode views in parallel, write them in order, keeping the true
+    // mattes for the hulls.
     let mut writer = FieldWriter::create(path, header.clone())?;
+    let mut alphas = Vec::with_capacity(views.len());
     for chunk in views.chunks(rayon::current_num_threads().max(1) * 4) {
-        let encoded: Vec<EncodedView> = chunk
+        let encoded: Vec<(EncodedView, GrayImage)> = chunk
             .par_iter()
             .map(|&(p, u, v)| {
-                let e = encode_view(&header, p, &oracle_view(stage, p, u, v)?)?;
+                let view = oracle_view(stage, p, u, v)?;
+                let e = encode_view(&header, p, &view)?;
                 tick();
-                Ok(e)
+                Ok((e, view.alpha))
             })
             .collect::<Result<_>>()?;
-        for (&(p, u, v), e) in chunk.iter().zip(&encoded) {
-            writer.add_view(p, u, v, e)?;
+        for (&(p, u, v), (e, alpha)) in chunk.iter().zip(encoded) {
+            writer.add_view(p, u, v, &e)?;
+            alphas.push(alpha);
+        }
+    }
+    if let Some(s) = &options.shadows {
+        let per_pose = columns * rows;
+        for (i, &pose) in options.poses.iter().enumerate() {
+            let cameras: Vec<Camera> = (0..per_pose)
+                .map(|j| stage.subject_camera(pose, j / rows, j % rows))
+                .collect::<std::result::Result<_, _>>()?;
+            let mattes: Vec<&GrayImage> = alphas[i * per_pose..(i + 1) * per_pose].iter().collect();
+            let r = pose_shadows(&cameras, &mattes, &header.conditions, s)?;
+            writer.add_hull(pose, &r.hull)?;
+            writer.add_shadows(pose, &r.maps)?;
         }
     }
     writer.finish()?;

@@ -43,7 +43,12 @@ fn view_angle(stage: &Stage, pose: u32, u: usize) -> f32 {
 
 /// The environment's lights (median cut, subject frame) as the dome frame of view column
 /// `u` sees them: turned by `+θ`.
-fn env_lights_for_view(stage: &Stage, lights: &[DirLight], pose: u32, u: usize) -> Vec<DirLight> {
+pub fn env_lights_for_view(
+    stage: &Stage,
+    lights: &[DirLight],
+    pose: u32,
+    u: usize,
+) -> Vec<DirLight> {
     let r = glam::Mat3::from_rotation_y(view_angle(stage, pose, u));
     lights.iter().map(|l| l.rotated(r)).collect()
 }

@@ -74,6 +74,8 @@ pub struct EvalCamera {
     pub name: String,
     /// The camera (subject frame).
     pub camera: Camera,
+    /// The captured view `(u, v)` it is, if it is one.
+    pub view: Option<(usize, usize)>,
 }
 
 /// The first corners `(u, v)` of `count` grid quads, spread over the columns and
@@ -114,6 +116,7 @@ pub fn between_view_cameras(geometry: &PoseGeometry, count: usize) -> Result<Vec
             EvalCamera {
                 name: format!("u {u}.5, v {v}.5"),
                 camera: interpolate_camera(quad, 0.5, 0.5, centre),
+                view: None,
             }
         })
         .collect())
@@ -128,6 +131,7 @@ pub fn grid_view_cameras(geometry: &PoseGeometry, count: usize) -> Result<Vec<Ev
         .map(|(u, v)| EvalCamera {
             name: format!("u {u}, v {v}"),
             camera: geometry.cameras[geometry.view(u, v)],
+            view: Some((u, v)),
         })
         .collect())
 }

@@ -12,6 +12,7 @@ use frf_flow::Preset;
 use frf_ingest::IngestError;
 use frf_ingest::matte::MatteRule;
 use frf_ingest::pipeline::{IngestOptions, Progress, Silent, ingest, parts_dir};
+use frf_ingest::shadows::ShadowOptions;
 use frf_reflectance::FieldFile;
 use frf_stage::{Preset as StagePreset, SetFlowTruth, Stage, StageConfig, write_capture};
 
@@ -32,6 +33,7 @@ fn options(poses: Vec<u32>) -> IngestOptions {
         jpeg_quality: 95,
         predict_flow: true,
         matte_rule: MatteRule::MatteBelowHalfCleanPlate,
+        shadows: Some(ShadowOptions::default()),
     }
 }
 

@@ -3,6 +3,7 @@
 //! virtual stage's judge lives in `frf-eval`, and a real capture has none.
 
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
+use frf_reflectance::hull::VoxelHull;
 use serde::{Deserialize, Serialize};
 
 /// Errors of one pose against a ground truth.
@@ -25,6 +26,10 @@ pub struct PoseErrors {
     pub flow_epe_vertical: f64,
     /// Views whose registration was evaluated.
     pub registration_views: usize,
+    /// Intersection over union of the visual hull's voxels with the true occupancy of
+    /// the same grid (`None` without a hull).
+    #[serde(default)]
+    pub hull_iou: Option<f64>,
 }
 
 /// One pose's intermediate results, as ingest computed them.
@@ -36,6 +41,8 @@ pub struct PoseEvidence<'a> {
     /// For the views the evaluator asked for ([`Evaluator::wants_unregistered`]):
     /// `(u, v, registered basis, the same frames matted without registration)`.
     pub registered: &'a [(usize, usize, Vec<RgbImage>, Vec<RgbImage>)],
+    /// The pose's visual hull, when ingest carved one.
+    pub hull: Option<&'a VoxelHull>,
 }
 
 /// Errors an evaluator may return (its own error type, boxed).

@@ -7,6 +7,7 @@
 //! - [`pipeline`]: the ingest, pose by pose, parallel, resumable, with a report;
 //! - [`views`], [`matte`], [`registration`]: one view's mattes and registered basis images;
 //! - [`interview`], [`rectify`]: flow between grid neighbours, vertical pairs rectified;
+//! - [`shadows`]: the pose's visual hull and its shadow attenuation maps;
 //! - [`evidence`]: what ingest hands to an evaluator, and the errors it records;
 //! - [`ring`]: a calibrated ring of real photographs (Middlebury multi-view) as a field.
 //!
@@ -20,6 +21,7 @@ pub mod pipeline;
 pub mod rectify;
 pub mod registration;
 pub mod ring;
+pub mod shadows;
 pub mod views;
 
 pub use error::{IngestError, Result};

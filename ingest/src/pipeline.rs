@@ -29,6 +29,7 @@ use crate::error::{IngestError, Result};
 use crate::evidence::{Evaluator, PoseErrors, PoseEvidence};
 use crate::interview::{GridViews, grid_flows};
 use crate::matte::MatteRule;
+use crate::shadows::{ShadowOptions, pose_shadows};
 use crate::views::{ViewSeconds, ViewSettings, process_view};
 
 /// What to ingest and how.
@@ -47,6 +48,8 @@ pub struct IngestOptions {
     pub predict_flow: bool,
     /// Which pixels are foreground in the mattes.
     pub matte_rule: MatteRule,
+    /// The visual hull and shadow maps of every pose (`None`: neither).
+    pub shadows: Option<ShadowOptions>,
 }
 
 /// Progress of long steps: `begin` a named step of `total` units, `advance` by one; and
@@ -99,6 +102,9 @@ pub struct Settings {
     pub predict_flow: bool,
     /// Matte rule.
     pub matte_rule: String,
+    /// Hull and shadow maps.
+    #[serde(default)]
+    pub shadows: String,
 }
 
 /// What happened to one pose.
@@ -144,6 +150,8 @@ pub struct IngestReport {
     pub flow_epe_horizontal: Option<f64>,
     /// See [`PoseErrors::flow_epe_vertical`].
     pub flow_epe_vertical: Option<f64>,
+    /// See [`PoseErrors::hull_iou`].
+    pub hull_iou: Option<f64>,
     /// Per pose.
     pub poses: Vec<PoseReport>,
     /// The field's size and compression.
@@ -184,6 +192,19 @@ fn settings(options: &IngestOptions) -> Settings {
         jpeg_quality: options.jpeg_quality,
         predict_flow: options.predict_flow,
         matte_rule: format!("{:?}", options.matte_rule),
+        shadows: options.shadows.map_or_else(
+            || "none".to_string(),
+            |s| {
+                format!(
+                    "hull {} m, {} misses; ground {} texels over {} m, {} samples per light",
+                    s.hull.voxel_m,
+                    s.hull.misses,
+                    s.ground.texels,
+                    s.ground.extent_m,
+                    s.light_samples
+                )
+            },
+        ),
     }
 }
 
@@ -269,6 +290,8 @@ fn ingest_pose(
         options.jpeg_quality,
     )?;
     header.flow_predicted = options.predict_flow;
+    header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
+    header.hulls = options.shadows.map(|s| s.hull);
     header.description = format!(
         "ingested from {} with flow {}",
         capture.dir().display(),
@@ -349,6 +372,24 @@ fn ingest_pose(
     ));
     let flows = grid.flows;
 
+    let shadows = match &options.shadows {
+        Some(s) => {
+            progress.begin(pose, "visual hull and shadow maps", 1);
+            let r = pose_shadows(&cameras, &alphas, &header.conditions, s)?;
+            steps.push(Step {
+                name: "visual hull".into(),
+                seconds: r.hull_seconds,
+            });
+            steps.push(Step {
+                name: "shadow maps".into(),
+                seconds: r.map_seconds,
+            });
+            progress.advance();
+            Some(r)
+        }
+        None => None,
+    };
+
     let start = Instant::now();
     header.pose_mut(pose)?.flow_quantizer = LogQuantizer::fit(
         flows
@@ -365,6 +406,10 @@ fn ingest_pose(
     for (i, (view, flow)) in views.iter().zip(&encoded).enumerate() {
         writer.add_view(pose, i / rows, i % rows, &view.images)?;
         writer.add_view(pose, i / rows, i % rows, flow)?;
+    }
+    if let Some(s) = &shadows {
+        writer.add_hull(pose, &s.hull)?;
+        writer.add_shadows(pose, &s.maps)?;
     }
     writer.finish()?;
     steps.push(Step {
@@ -388,6 +433,7 @@ fn ingest_pose(
                         alphas: &alphas,
                         flows: &flows,
                         registered: &registered,
+                        hull: shadows.as_ref().map(|s| &s.hull),
                     },
                 )
                 .map_err(IngestError::Evaluation)?;
@@ -460,10 +506,10 @@ pub fn ingest(
             }
         }
     }
-    let mean = |f: fn(&PoseErrors) -> f64| {
+    let mean = |f: fn(&PoseErrors) -> Option<f64>| {
         let values: Vec<f64> = reports
             .iter()
-            .filter_map(|r| r.errors.as_ref().map(f))
+            .filter_map(|r| r.errors.as_ref().and_then(f))
             .collect();
         (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
     };
@@ -474,12 +520,13 @@ pub fn ingest(
         height: capture.cameras()[0].height,
         views: capture.cycles() * capture.cameras().len(),
         steps,
-        alpha_iou: mean(|e| e.alpha_iou),
-        alpha_mae: mean(|e| e.alpha_mae),
-        registration_psnr: mean(|e| e.registration_psnr),
-        unregistered_psnr: mean(|e| e.unregistered_psnr),
-        flow_epe_horizontal: mean(|e| e.flow_epe_horizontal),
-        flow_epe_vertical: mean(|e| e.flow_epe_vertical),
+        alpha_iou: mean(|e| Some(e.alpha_iou)),
+        alpha_mae: mean(|e| Some(e.alpha_mae)),
+        registration_psnr: mean(|e| Some(e.registration_psnr)),
+        unregistered_psnr: mean(|e| Some(e.unregistered_psnr)),
+        flow_epe_horizontal: mean(|e| Some(e.flow_epe_horizontal)),
+        flow_epe_vertical: mean(|e| Some(e.flow_epe_vertical)),
+        hull_iou: mean(|e| e.hull_iou),
         poses: reports,
         field,
         seconds: start.elapsed().as_secs_f64(),

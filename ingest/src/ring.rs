@@ -396,6 +396,7 @@ pub fn ingest_ring(
         flow_predicted: true,
         jpeg_quality,
         shadows: None,
+        hulls: None,
     };
     let mut writer = FieldWriter::create(out, header.clone())?;
     for u in 0..columns {

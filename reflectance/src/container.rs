@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! preamble  "FRFFIELD" | version u32 | 0 u32                         16 bytes
-//! chunks    basis mosaics, alpha planes, flow maps, shadow maps    any order
+//! chunks    basis mosaics, alpha planes, flow maps, shadow maps, hulls   any order
 //! index     zstd(JSON { header, chunks: [{ key, offset, length, crc32 }] })
 //! footer    index offset u64 | index length u64 | index crc32 u32 | version u32 | "FRFEND\0\0"
 //! ```
@@ -50,6 +50,8 @@ pub enum ChunkKind {
     Flow(Neighbour),
     /// The shadow attenuation maps of a pose (`u = v = 0`).
     Shadows,
+    /// The visual hull of a pose (`u = v = 0`).
+    Hull,
 }
 
 /// Which chunk: kind, pose and view.
@@ -87,6 +89,7 @@ impl std::fmt::Display for ChunkKey {
                 self.v
             ),
             ChunkKind::Shadows => write!(f, "shadow maps of pose {}", self.pose),
+            ChunkKind::Hull => write!(f, "visual hull of pose {}", self.pose),
         }
     }
 }

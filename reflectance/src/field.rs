@@ -14,6 +14,7 @@ use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 use frf_core::light::DirLight;
+use frf_core::volume::GroundGrid;
 use glam::{Mat3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -137,16 +138,31 @@ pub struct PoseRecord {
     pub flow_quantizer: LogQuantizer,
 }
 
-/// The ground grid of the shadow maps (docs/design.md section 2.4).
+/// The shadow maps of a field (docs/design.md section 2.4): their ground grid and the
+/// basis conditions they belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ShadowSpec {
-    /// Side of the square ground patch centred under the subject, metres (3 in the
+    /// The ground patch under the subject (128 x 128 texels over 3 m x 3 m in the
     /// original).
-    pub extent_m: f32,
-    /// Texels per side (128 in the original).
-    pub texels: u32,
+    pub ground: GroundGrid,
     /// The basis conditions with a map, in map order (the upper-hemisphere ones).
     pub conditions: Vec<usize>,
+    /// Directions traced per light ([`crate::shadow::attenuation_maps`]).
+    #[serde(default = "one")]
+    pub light_samples: usize,
+}
+
+fn one() -> usize {
+    1
+}
+
+/// The visual hulls of a field: one per pose, each in its own box.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HullSpec {
+    /// Voxel side, metres.
+    pub voxel_m: f32,
+    /// Views allowed to disagree when carving ([`crate::hull::VoxelHull::carve`]).
+    pub misses: usize,
 }
 
 /// Everything about a field except its images and flows.
@@ -178,6 +194,9 @@ pub struct FieldHeader {
     pub jpeg_quality: u8,
     /// The shadow maps' ground grid, if the field has shadows.
     pub shadows: Option<ShadowSpec>,
+    /// How the visual hulls were carved, if the field has them.
+    #[serde(default)]
+    pub hulls: Option<HullSpec>,
 }
 
 impl FieldHeader {
@@ -248,6 +267,7 @@ impl FieldHeader {
             flow_predicted: true,
             jpeg_quality,
             shadows: None,
+            hulls: None,
         })
     }
 
@@ -333,14 +353,21 @@ impl FieldHeader {
                 }
             }
         }
-        if let Some(s) = &self.shadows
-            && (s.texels == 0
-                || s.texels > 4096
-                || s.extent_m.is_nan()
-                || s.extent_m <= 0.0
-                || s.conditions.iter().any(|&c| c >= self.conditions.len()))
+        if let Some(s) = &self.shadows {
+            s.ground
+                .validate()
+                .map_err(|e| format!("shadow maps: {e}"))?;
+            if let Some(c) = s.conditions.iter().find(|&&c| c >= self.conditions.len()) {
+                return Err(format!(
+                    "shadow maps: condition {c} of {}",
+                    self.conditions.len()
+                ));
+            }
+        }
+        if let Some(h) = &self.hulls
+            && !(h.voxel_m.is_finite() && h.voxel_m > 0.0)
         {
-            return Err("shadow grid is inconsistent".into());
+            return Err(format!("visual hulls: voxel side {}", h.voxel_m));
         }
         Ok(())
     }

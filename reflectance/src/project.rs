@@ -134,22 +134,7 @@ impl Projector {
         let (w, h) = img.size();
         let ground = match floor {
             FloorModel::Environment => None,
-            FloorModel::LambertianGround { albedo } => {
-                let mut e = [0.0f64; 3];
-                for y in 0..h {
-                    let omega = env.texel_solid_angle(y) as f64;
-                    for x in 0..w {
-                        let cos = env.direction_of(x as f32, y as f32).y as f64;
-                        if cos > 0.0 {
-                            let l = img.get(x, y);
-                            for c in 0..3 {
-                                e[c] += l[c] as f64 * omega * cos;
-                            }
-                        }
-                    }
-                }
-                Some([0, 1, 2].map(|c| albedo[c] * (e[c] / std::f64::consts::PI) as f32))
-            }
+            FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
         };
         let per_row: Vec<Vec<[f64; 3]>> = (0..h)
             .into_par_iter()

@@ -17,6 +17,8 @@ pub struct Bytes {
     pub alpha: u64,
     /// Shadow maps.
     pub shadows: u64,
+    /// Visual hulls.
+    pub hulls: u64,
     /// Preamble, index and footer.
     pub other: u64,
 }
@@ -40,6 +42,10 @@ pub struct FieldStats {
     pub flow_maps: usize,
     /// Basis images stored.
     pub basis_images: usize,
+    /// Shadow attenuation maps stored (one per upper condition of each pose with maps).
+    pub shadow_maps: usize,
+    /// Visual hulls stored (one per pose).
+    pub hulls: usize,
 }
 
 impl<R: ReadAt> FieldFile<R> {
@@ -48,7 +54,8 @@ impl<R: ReadAt> FieldFile<R> {
         let h = self.header();
         let pixels = h.width as u64 * h.height as u64;
         let mut bytes = Bytes::default();
-        let (mut flow_maps, mut basis_views) = (0usize, 0usize);
+        let (mut flow_maps, mut basis_views, mut shadow_poses, mut hulls) =
+            (0usize, 0usize, 0usize, 0usize);
         for c in self.chunks() {
             match c.key.kind {
                 ChunkKind::Flow(_) => {
@@ -60,10 +67,19 @@ impl<R: ReadAt> FieldFile<R> {
                     basis_views += 1;
                 }
                 ChunkKind::Alpha => bytes.alpha += c.length,
-                ChunkKind::Shadows => bytes.shadows += c.length,
+                ChunkKind::Shadows => {
+                    bytes.shadows += c.length;
+                    shadow_poses += 1;
+                }
+                ChunkKind::Hull => {
+                    bytes.hulls += c.length;
+                    hulls += 1;
+                }
             }
         }
-        bytes.other = self.size() - (bytes.flow + bytes.images + bytes.alpha + bytes.shadows);
+        bytes.other =
+            self.size() - (bytes.flow + bytes.images + bytes.alpha + bytes.shadows + bytes.hulls);
+        let shadow_maps = shadow_poses * h.shadows.as_ref().map_or(0, |s| s.conditions.len());
         let basis_images = basis_views * h.conditions.len();
         let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
         FieldStats {
@@ -77,6 +93,8 @@ impl<R: ReadAt> FieldFile<R> {
             views: h.views_per_pose(),
             flow_maps,
             basis_images,
+            shadow_maps,
+            hulls,
         }
     }
 }

@@ -10,6 +10,7 @@ use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt};
 use crate::error::{ReflectanceError, Result};
 use crate::field::{FieldHeader, ViewData};
 use crate::flowcodec;
+use crate::hull::VoxelHull;
 use crate::imagecodec::{
     BasisCodes, decode_basis, decode_basis_codes, decode_planes, encode_basis, encode_planes,
 };
@@ -136,6 +137,19 @@ impl FieldWriter {
     }
 }
 
+impl FieldWriter {
+    /// Writes the visual hull of a pose.
+    pub fn add_hull(&mut self, pose: u32, hull: &VoxelHull) -> Result<()> {
+        self.header().pose(pose)?;
+        if self.header().hulls.is_none() {
+            return Err(ReflectanceError::BadParameter(
+                "the header declares no visual hulls".into(),
+            ));
+        }
+        self.add_chunk(key(pose, 0, 0, ChunkKind::Hull), &hull.encode()?)
+    }
+}
+
 fn key(pose: u32, u: usize, v: usize, kind: ChunkKind) -> ChunkKey {
     ChunkKey {
         pose,
@@ -241,5 +255,14 @@ impl<R: ReadAt> FieldFile<R> {
             return Ok(None);
         }
         self.decode_chunk(&k, decode_planes).map(Some)
+    }
+
+    /// The visual hull of a pose, if stored.
+    pub fn hull(&self, pose: u32) -> Result<Option<VoxelHull>> {
+        let k = key(pose, 0, 0, ChunkKind::Hull);
+        if !self.has(&k) {
+            return Ok(None);
+        }
+        self.decode_chunk(&k, VoxelHull::decode).map(Some)
     }
 }

@@ -8,10 +8,13 @@
 //!   nearest-view, linear-blend and two-way interpolations it is measured against.
 //! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin;
 //!   [`renderer`]: one front for both.
+//! - [`shadow`]: the subject's relit shadow on the ground; [`composite`]: backdrops and
+//!   Porter–Duff compositing of the subject over them.
 //! - [`path`]: virtual camera paths (keyframes, orbit).
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod composite;
 pub mod cpu;
 pub mod cylinder;
 pub mod error;
@@ -21,5 +24,6 @@ pub mod morph;
 pub mod path;
 pub mod renderer;
 pub mod resident;
+pub mod shadow;
 
 pub use error::{RenderError, Result};

@@ -86,6 +86,9 @@ pub struct PoseSource {
     pub alpha: Vec<Vec<u8>>,
     /// Per view and condition: relighting coefficients (RGB).
     pub coefficients: Vec<Vec<Rgb>>,
+    /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
+    /// relight the shadow maps; `None` without an environment.
+    pub ground_coefficients: Option<Vec<Rgb>>,
     /// What relighting leaves out.
     pub plan: LightingPlan,
 }
@@ -108,15 +111,18 @@ impl PoseSource {
             .collect::<Result<_>>()?;
         let size = (h.width, h.height);
         let crop = Crop::of_mattes(&alphas, size);
-        let coefficients: Vec<Vec<Rgb>> = match lighting {
-            Lighting::Unlit => vec![vec![[1.0; 3]; h.conditions.len()]; views],
+        let (coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
+            Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
             Lighting::Environment { env, floor } => {
                 let projector = Projector::new(&h.conditions)?;
-                record
-                    .views
-                    .iter()
-                    .map(|v| projector.project(env, v.turntable_deg.to_radians(), *floor))
-                    .collect()
+                (
+                    record
+                        .views
+                        .iter()
+                        .map(|v| projector.project(env, v.turntable_deg.to_radians(), *floor))
+                        .collect(),
+                    Some(projector.project(env, 0.0, *floor)),
+                )
             }
         };
         let used: Vec<bool> = (0..h.conditions.len())
@@ -181,6 +187,7 @@ impl PoseSource {
             basis,
             alpha,
             coefficients,
+            ground_coefficients,
             plan,
         })
     }

@@ -8,7 +8,9 @@
 use std::mem::{offset_of, size_of};
 
 use frf_render::gpu::shaders;
-use frf_render::gpu::types::{GpuFrame, GpuQuad, GpuRelightParams, GpuView};
+use frf_render::gpu::types::{
+    GpuComposite, GpuFrame, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
+};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
 fn module(source: &str, name: &str) -> naga::Module {
@@ -41,8 +43,8 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         }
     }
     // The renderer's passes are exactly the files here.
-    assert_eq!(passes, 2, "passes in {}", dir.display());
-    for (name, pass) in [("relight", shaders::RELIGHT), ("rebin", shaders::REBIN)] {
+    assert_eq!(passes, shaders::PASSES.len(), "passes in {}", dir.display());
+    for (name, pass) in shaders::PASSES {
         module(&shaders::composed(pass), name);
     }
 }
@@ -132,5 +134,28 @@ fn pod_structs_match_naga_layouts() {
         "RelightParams",
         GpuRelightParams,
         [texels, tiles, width, view]
+    );
+    let shadow = module(&shaders::composed(shaders::SHADOW), "shadow");
+    check_layout!(
+        &shadow,
+        "ShadowParams",
+        GpuShadowParams,
+        [texels, maps, pad]
+    );
+    let composite = module(&shaders::composed(shaders::COMPOSITE), "composite");
+    check_layout!(
+        &composite,
+        "Composite",
+        GpuComposite,
+        [
+            backdrop,
+            ground_look,
+            has_shadow,
+            shadow_texels,
+            ground_radiance,
+            env_size,
+            env_yaw,
+            shadow_extent
+        ]
     );
 }

@@ -7,11 +7,18 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use frf_core::env::{EnvMap, EnvSource};
+use frf_core::io::read_photo;
+use frf_core::volume::GroundGrid;
 use frf_flow::Preset;
+use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, DEFAULT_VOXEL_M, ShadowOptions};
+use frf_reflectance::FieldFile;
+use frf_reflectance::field::HullSpec;
 use frf_reflectance::project::FloorModel;
+use frf_render::composite::{Backdrop, GroundLook};
 use frf_render::morph::Variant;
 use frf_render::path::{CameraPath, Orbit, Trajectory};
 use frf_render::resident::Lighting;
+use frf_render::shadow::{RelitShadow, ShadowMaps, traced_shadow};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -260,6 +267,195 @@ impl CameraArgs {
     }
 }
 
+/// The visual hull and shadow maps made in ingest (`frf ingest`, `frf stage field`).
+#[derive(Args)]
+pub struct ShadowArgs {
+    /// Make neither visual hulls nor shadow maps.
+    #[arg(long)]
+    no_shadows: bool,
+    /// Voxel side of the visual hull, metres.
+    #[arg(long, default_value_t = DEFAULT_VOXEL_M)]
+    hull_voxel: f32,
+    /// Views allowed to disagree when carving the hull (its views come from different
+    /// walk cycles).
+    #[arg(long, default_value_t = DEFAULT_MISSES)]
+    hull_misses: usize,
+    /// Texels per side of the shadow maps.
+    #[arg(long, default_value_t = GroundGrid::ORIGINAL.texels)]
+    shadow_texels: u32,
+    /// Side of the ground patch under the subject the shadow maps cover, metres.
+    #[arg(long, default_value_t = GroundGrid::ORIGINAL.extent_m)]
+    shadow_extent: f32,
+    /// Directions traced per light of a condition, spread over the solid angle it stands
+    /// for (1: toward the light only).
+    #[arg(long, default_value_t = DEFAULT_LIGHT_SAMPLES)]
+    shadow_samples: usize,
+}
+
+impl ShadowArgs {
+    /// The options, checked; `None` with `--no-shadows`.
+    pub fn options(&self) -> CliResult<Option<ShadowOptions>> {
+        if self.no_shadows {
+            return Ok(None);
+        }
+        let o = ShadowOptions {
+            hull: HullSpec {
+                voxel_m: self.hull_voxel,
+                misses: self.hull_misses,
+            },
+            ground: GroundGrid {
+                extent_m: self.shadow_extent,
+                texels: self.shadow_texels,
+            },
+            light_samples: self.shadow_samples,
+        };
+        o.validate()?;
+        Ok(Some(o))
+    }
+}
+
+/// What a frame's subject is put over.
+#[derive(Clone, Copy, Debug, ValueEnum, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum BackdropArg {
+    /// Nothing: transparent, the shadow as a black layer of alpha 1 − S.
+    None,
+    /// The lighting environment, with a ground plane at y = 0.
+    Env,
+    /// A photograph taken by the camera (`--plate`), its ground at y = 0.
+    Plate,
+}
+
+/// The ground of an environment backdrop: `env` (the environment below the horizon) or
+/// a Lambertian albedo `A` or `R,G,B`.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub enum GroundArg {
+    /// The environment's lower hemisphere.
+    Env,
+    /// A Lambertian ground of this albedo.
+    Albedo([f32; 3]),
+}
+
+/// Parses `env`, `A` or `R,G,B` (albedos in 0..=1).
+pub fn parse_ground(s: &str) -> Result<GroundArg, String> {
+    if s == "env" {
+        return Ok(GroundArg::Env);
+    }
+    let v = numbers(s, "ground")?;
+    let albedo = match v[..] {
+        [a] => [a; 3],
+        [r, g, b] => [r, g, b],
+        _ => return Err(format!("ground `{s}`: expected env, an albedo A or R,G,B")),
+    };
+    if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
+        return Err(format!("ground `{s}`: albedos lie in 0 to 1"));
+    }
+    Ok(GroundArg::Albedo(albedo))
+}
+
+/// The scene a frame is composited into: shared by `frf render` and `frf eval`.
+#[derive(Args, Clone, Serialize, PartialEq)]
+pub struct BackdropArgs {
+    /// What the subject is put over (with its shadow on the ground when the field has
+    /// shadow maps).
+    #[arg(long, value_enum, default_value = "none")]
+    pub backdrop: BackdropArg,
+    /// The plate of `--backdrop plate`: a photograph (8-bit PNG/JPEG as sRGB; 16-bit PNG,
+    /// EXR, HDR linear) taken by the camera, which must then be a `--camera` path of one
+    /// key; frames take its size.
+    #[arg(long)]
+    pub plate: Option<PathBuf>,
+    /// Ground of `--backdrop env`: `env` (the environment below the horizon) or a
+    /// Lambertian albedo `A` or `R,G,B` lit by the environment's upper hemisphere.
+    #[arg(long, value_parser = parse_ground, default_value = "env")]
+    pub ground: GroundArg,
+    /// The subject's shadow on the ground: `maps` (the field's attenuation maps relit
+    /// with the environment), `traced` (the environment's median-cut lights traced
+    /// against the pose's visual hull) or `none`.
+    #[arg(long, value_enum, default_value = "maps")]
+    pub shadow: ShadowArg,
+    /// Median-cut lights of the environment for `--shadow traced`.
+    #[arg(long, default_value_t = 256)]
+    pub shadow_lights: usize,
+}
+
+/// Where the subject's shadow comes from.
+#[derive(Clone, Copy, Debug, ValueEnum, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum ShadowArg {
+    /// The field's attenuation maps, relit (the original's method).
+    Maps,
+    /// The environment's lights traced against the pose's visual hull.
+    Traced,
+    /// No shadow.
+    None,
+}
+
+impl BackdropArgs {
+    /// The backdrop, lit by `env` (the relighting's environment, if any).
+    pub fn backdrop(&self, env: Option<&EnvMap>) -> CliResult<Backdrop> {
+        Ok(match self.backdrop {
+            BackdropArg::None => Backdrop::None,
+            BackdropArg::Env => {
+                let env =
+                    env.ok_or("--backdrop env needs an environment (--env FILE|sky|uniform)")?;
+                let ground = match self.ground {
+                    GroundArg::Env => GroundLook::Environment,
+                    GroundArg::Albedo(a) => GroundLook::Albedo(a),
+                };
+                Backdrop::environment(env.clone(), ground)
+            }
+            BackdropArg::Plate => {
+                let path = self
+                    .plate
+                    .as_ref()
+                    .ok_or("--backdrop plate needs --plate IMAGE")?;
+                Backdrop::Plate(read_photo(path)?)
+            }
+        })
+    }
+
+    /// The shadow of pose `pose` of `field` the options ask for (`None`: no shadow),
+    /// as `(maps, traced)`: the maps to relight, or a shadow traced here under `env`.
+    pub fn shadow(
+        &self,
+        field: &FieldFile,
+        pose: u32,
+        env: Option<&EnvMap>,
+    ) -> CliResult<(Option<ShadowMaps>, Option<RelitShadow>)> {
+        Ok(match self.shadow {
+            ShadowArg::None => (None, None),
+            ShadowArg::Maps => (ShadowMaps::load(field, pose)?, None),
+            ShadowArg::Traced => {
+                let env = env.ok_or("--shadow traced needs an environment")?;
+                if !(1..=65536).contains(&self.shadow_lights) {
+                    return Err(
+                        format!("--shadow-lights {} (1 to 65536)", self.shadow_lights).into(),
+                    );
+                }
+                let hull = field
+                    .hull(pose)?
+                    .ok_or("--shadow traced: the field holds no visual hull")?;
+                let ground = field
+                    .header()
+                    .shadows
+                    .as_ref()
+                    .map_or(GroundGrid::ORIGINAL, |s| s.ground);
+                let lights = env.median_cut(self.shadow_lights);
+                (None, Some(traced_shadow(&hull, &lights, ground)))
+            }
+        })
+    }
+
+    /// The frame size a plate imposes.
+    pub fn plate_size(&self, backdrop: &Backdrop) -> Option<(u32, u32)> {
+        match backdrop {
+            Backdrop::Plate(p) => Some((p.width() as u32, p.height() as u32)),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,5 +478,9 @@ mod tests {
         let o = parse_orbit("3,1.2").unwrap();
         assert_eq!((o.radius, o.height, o.sweep_deg), (3.0, 1.2, 360.0));
         assert_eq!(parse_env("none"), Ok(EnvSource::None));
+        assert_eq!(parse_ground("env"), Ok(GroundArg::Env));
+        assert_eq!(parse_ground("0.3"), Ok(GroundArg::Albedo([0.3; 3])));
+        assert!(parse_ground("1.5").unwrap_err().contains("0 to 1"));
+        assert!(parse_ground("0.1,0.2").unwrap_err().contains("R,G,B"));
     }
 }

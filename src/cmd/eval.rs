@@ -7,8 +7,20 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use frf_core::io::write_png8_srgba;
+use frf_core::io::rgba_from;
+use frf_core::io::{write_png8_srgb, write_png8_srgba};
 use frf_eval::ring::{held_out_views, score_held_out};
+use frf_eval::scene::{
+    SceneScore, bright_background, composite_psnr, edge_band_error, mean_of, shadow_error,
+    true_composite,
+};
+use frf_eval::storage::env_lights_for_view;
+use frf_render::composite::{Backdrop, GroundLook};
+use frf_render::renderer::SceneShadow;
+use frf_render::shadow::{ShadowMaps, traced_shadow};
+
+/// Median-cut lights of the traced-shadow ablation (as `frf render --shadow traced`).
+const TRACED_LIGHTS: usize = 256;
 use frf_eval::views::{
     EvalCamera, VariantScore, between_view_cameras, evaluate, grid_view_cameras, truth_frame,
 };
@@ -20,7 +32,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::{LightingArgs, VariantArg};
+use crate::cmd::args::{GroundArg, LightingArgs, VariantArg, parse_ground};
 use crate::cmd::progress::bar;
 use crate::cmd::render::{open_renderer, pose_of};
 
@@ -45,9 +57,18 @@ pub struct EvalArgs {
     lights: usize,
     #[command(flatten)]
     compare: CompareArgs,
-    /// Write each camera's truth and renders as PNGs here.
+    /// Write each camera's truth and renders as PNGs here (with `--shadows`, also the
+    /// relit and the true shadow of the ground patch, seen from above, +x right, +z down).
     #[arg(long)]
     images: Option<PathBuf>,
+    /// Also score the subject in a scene: the relit shadow against the true one over the
+    /// ground patch, composites over the environment against true composites, and the
+    /// matte edges at the captured views.
+    #[arg(long)]
+    shadows: bool,
+    /// Ground of the composites' environment backdrop: `env` or an albedo `A` / `R,G,B`.
+    #[arg(long, value_parser = parse_ground, default_value = "env")]
+    ground: GroundArg,
 }
 
 /// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.
@@ -87,6 +108,9 @@ struct EvalReport {
     variants: Vec<VariantScore>,
     /// The four-way renderer at captured cameras: the error of relighting and storage.
     at_captured_views: VariantScore,
+    /// With `--shadows`: the scene's scores.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    scene: Option<SceneScore>,
 }
 
 /// Runs `frf eval`.
@@ -127,7 +151,7 @@ pub fn run(args: EvalArgs) -> CliResult {
     let truths_at_views = truths.split_off(cameras.len());
     truth_bar.finish_and_clear();
 
-    let renderer = open_renderer(&source, args.compare.cpu)?;
+    let mut renderer = open_renderer(&source, args.compare.cpu)?;
     let variants = args.compare.variants();
     if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -158,6 +182,76 @@ pub fn run(args: EvalArgs) -> CliResult {
     )?
     .remove(0);
     floor.name = "at the captured views".into();
+    let scene = if args.shadows {
+        let ground = match args.ground {
+            GroundArg::Env => GroundLook::Environment,
+            GroundArg::Albedo(a) => GroundLook::Albedo(a),
+        };
+        let backdrop = Backdrop::environment(env.clone(), ground);
+        let maps = ShadowMaps::load(&field, pose)?;
+        // The ablation first: the environment's lights traced against the hull.
+        let shadow_mae_traced = match (field.hull(pose)?, &maps) {
+            (Some(hull), Some(m)) => {
+                let traced = traced_shadow(&hull, &env.median_cut(TRACED_LIGHTS), m.spec.ground);
+                Some(shadow_error(&traced, &stage, pose, &lights))
+            }
+            _ => None,
+        };
+        renderer.set_scene(
+            backdrop.clone(),
+            maps.as_ref().map_or(SceneShadow::None, SceneShadow::Maps),
+        )?;
+        let relit = renderer.relit_shadow()?;
+        let shadow_mae = relit
+            .as_ref()
+            .map(|r| shadow_error(r, &stage, pose, &lights));
+        if let (Some(dir), Some(r)) = (&args.images, &relit) {
+            let truth = stage.true_ground_shadow(pose, &lights, &r.ground);
+            write_png8_srgb(&dir.join("shadow_relit.png"), &r.image, 1.0)?;
+            write_png8_srgb(&dir.join("shadow_truth.png"), &truth, 1.0)?;
+        }
+        let scene_bar = crate::cmd::progress::bar("composites");
+        scene_bar.set_length(cameras.len() as u64);
+        let psnrs = cameras
+            .iter()
+            .zip(&truths)
+            .map(|(c, truth)| {
+                let frame = renderer.render_frame(&c.camera, Variant::FourWay, false)?;
+                let t = true_composite(&stage, pose, &c.camera, truth.clone(), &lights, &backdrop)?;
+                scene_bar.inc(1);
+                Ok(composite_psnr(&t, &frame.composite))
+            })
+            .collect::<CliResult<Vec<f64>>>()?;
+        scene_bar.finish_and_clear();
+        let mut dark = Vec::new();
+        let mut bright = Vec::new();
+        for c in &at_views {
+            // The walker of that view's cycle as filmed, lit as the renderer relit it.
+            let (u, v) = c.view.ok_or("a captured-view camera without its view")?;
+            let t = stage.true_view_image(
+                pose,
+                u,
+                v,
+                &env_lights_for_view(&stage, &lights, pose, u),
+            )?;
+            let truth = &rgba_from(&t.color, &t.alpha)?;
+            let (img, _) = renderer.render(&c.camera, Variant::FourWay)?;
+            dark.push(edge_band_error(truth, &img, [0.0; 3]));
+            bright.push(edge_band_error(truth, &img, bright_background(truth)));
+        }
+        let (dark, bright) = (mean_of(dark.into_iter()), mean_of(bright.into_iter()));
+        Some(SceneScore {
+            shadow_mae,
+            shadow_mae_traced,
+            psnr_composite: psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64,
+            edge_band_mae_dark: dark,
+            edge_band_mae_bright: bright,
+            edge_band_mae: mean_of([dark, bright].into_iter()),
+            psnr_composite_per_camera: psnrs,
+        })
+    } else {
+        None
+    };
     eprintln!(
         "{} pose {pose} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
          cameras at quad centres, {}:",
@@ -190,6 +284,20 @@ pub fn run(args: EvalArgs) -> CliResult {
             s.seconds_per_frame
         );
     }
+    if let Some(s) = &scene {
+        let f = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+        eprintln!(
+            "scene: shadow MAE {} (relit maps against the true relative irradiance, {} m \
+             patch; traced against the hull instead: {}), composite PSNR {:.2} dB (four-way, over the environment), edge-band \
+             error {} over black / {} over bright (at the captured views)",
+            f(s.shadow_mae),
+            ShadowMaps::load(&field, pose)?.map_or(0.0, |m| m.spec.ground.extent_m),
+            f(s.shadow_mae_traced),
+            s.psnr_composite,
+            f(s.edge_band_mae_dark),
+            f(s.edge_band_mae_bright)
+        );
+    }
     if args.compare.json {
         let report = EvalReport {
             field: args.field.clone(),
@@ -202,6 +310,7 @@ pub fn run(args: EvalArgs) -> CliResult {
             cameras: cameras.iter().map(|c| c.name.clone()).collect(),
             variants: scores,
             at_captured_views: floor,
+            scene: scene.clone(),
         };
         println!("{}", serde_json::to_string_pretty(&report)?);
     }

@@ -63,6 +63,7 @@ pub fn run(args: InfoArgs) -> CliResult {
         ("flow maps", s.bytes.flow),
         ("alpha", s.bytes.alpha),
         ("shadow maps", s.bytes.shadows),
+        ("visual hulls", s.bytes.hulls),
         ("index and framing", s.bytes.other),
     ] {
         println!("    {kind:<18} {:>10.3}", mb(b));
@@ -76,5 +77,24 @@ pub fn run(args: InfoArgs) -> CliResult {
         "  basis images: {} images, {:.1}:1 against 16-bit linear RGB",
         s.basis_images, s.image_ratio_vs_16bit
     );
+    match &h.shadows {
+        Some(spec) => println!(
+            "  shadows: {} maps ({} conditions per pose), {} x {} texels over {} m x {} m",
+            s.shadow_maps,
+            spec.conditions.len(),
+            spec.ground.texels,
+            spec.ground.texels,
+            spec.ground.extent_m,
+            spec.ground.extent_m
+        ),
+        None => println!("  shadows: none"),
+    }
+    match &h.hulls {
+        Some(spec) => println!(
+            "  visual hulls: {} ({} m voxels, {} views may disagree)",
+            s.hulls, spec.voxel_m, spec.misses
+        ),
+        None => println!("  visual hulls: none"),
+    }
     Ok(())
 }

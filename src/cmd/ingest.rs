@@ -11,7 +11,7 @@ use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
 use indicatif::ProgressBar;
 
 use crate::CliResult;
-use crate::cmd::args::{FlowPresetArg, parse_poses};
+use crate::cmd::args::{FlowPresetArg, ShadowArgs, parse_poses};
 use crate::cmd::progress::bar;
 
 /// Arguments of `frf ingest`.
@@ -47,6 +47,8 @@ pub struct IngestArgs {
     /// Write the report as JSON here.
     #[arg(long)]
     report: Option<PathBuf>,
+    #[command(flatten)]
+    shadows: ShadowArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -102,6 +104,7 @@ pub fn run(args: IngestArgs) -> CliResult {
             .collect::<Result<_, _>>()?,
         jpeg_quality: args.jpeg_quality,
         predict_flow: !args.no_flow_prediction,
+        shadows: args.shadows.options()?,
         matte_rule: match args.matte_rule {
             MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
             MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
@@ -185,6 +188,10 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
         f(r.flow_epe_vertical, " px", 3)
     );
     println!(
+        "    visual hull IoU (voxels)            {}",
+        f(r.hull_iou, "", 4)
+    );
+    println!(
         "  field: flow {:.1} % of 8-bit codes, basis images {:.1}:1 vs 16-bit linear, {:.2} MB",
         100.0 * r.field.flow_ratio_vs_8bit,
         r.field.image_ratio_vs_16bit,
@@ -192,6 +199,7 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
             + r.field.bytes.images
             + r.field.bytes.alpha
             + r.field.bytes.shadows
+            + r.field.bytes.hulls
             + r.field.bytes.other) as f64
             / 1e6
     );

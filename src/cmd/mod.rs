@@ -3,6 +3,7 @@
 pub mod args;
 pub mod eval;
 pub mod flow;
+pub mod hull;
 pub mod info;
 pub mod ingest;
 pub mod progress;

@@ -11,17 +11,19 @@ use clap::Args;
 use frf_core::atomic::write_bytes_atomic;
 use frf_core::contact;
 use frf_core::image::{Image, RgbImage, Rgba};
-use frf_core::io::{write_exr_rgba, write_png8_srgb, write_png8_srgba};
+use frf_core::io::{write_exr_rgb, write_exr_rgba, write_png8_srgb, write_png8_srgba};
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::cpu::FrameStats;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
+use frf_render::path::Trajectory;
 use frf_render::renderer::Renderer;
+use frf_render::renderer::SceneShadow;
 use frf_render::resident::PoseSource;
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::{CameraArgs, LightingArgs, VariantArg, parse_size};
+use crate::cmd::args::{BackdropArgs, CameraArgs, LightingArgs, ShadowArg, VariantArg, parse_size};
 use crate::cmd::progress::bar;
 
 /// Makes `source` resident on the GPU, or for the CPU reference when `cpu`.
@@ -47,10 +49,17 @@ pub struct RenderArgs {
     pub lighting: LightingArgs,
     #[command(flatten)]
     pub camera: CameraArgs,
+    #[command(flatten)]
+    pub scene: BackdropArgs,
     /// Output directory: frame_NNNN.png (8-bit sRGB, straight alpha) and frame_NNNN.exr
     /// (linear, premultiplied), and render.json (the settings and the report).
     #[arg(long)]
     pub out: PathBuf,
+    /// Also write each frame's layers for compositing tools: frame_NNNN_subject.exr
+    /// (premultiplied RGBA), frame_NNNN_shadow.exr (relative irradiance of the ground, 1
+    /// unshadowed) and frame_NNNN_backdrop.exr.
+    #[arg(long)]
+    pub layers: bool,
     /// Frame size `WxH` (default: the field's image size).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -115,17 +124,31 @@ fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
     dir.join(format!("frame_{i:04}.{ext}"))
 }
 
+fn layer_path(dir: &Path, i: usize, layer: &str) -> PathBuf {
+    dir.join(format!("frame_{i:04}_{layer}.exr"))
+}
+
 /// Runs `frf render`.
 pub fn run(args: RenderArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
     let h = field.header();
     let pose = pose_of(h, args.pose, &args.field)?;
-    let (lighting, _) = args.lighting.lighting(h.conditions.len())?;
-    let (width, height) = args.size.unwrap_or((h.width, h.height));
-    let cameras = args
-        .camera
-        .trajectory()?
-        .cameras(args.frames, width, height)?;
+    let (lighting, env) = args.lighting.lighting(h.conditions.len())?;
+    let backdrop = args.scene.backdrop(env.as_ref())?;
+    let (shadow_maps, traced) = args.scene.shadow(&field, pose, env.as_ref())?;
+    let trajectory = args.camera.trajectory()?;
+    let (width, height) = match args.scene.plate_size(&backdrop) {
+        Some(size) => {
+            if !matches!(&trajectory, Trajectory::Path(p) if p.keys.len() == 1) {
+                return Err(
+                    "--backdrop plate: the plate's camera is a --camera path of one key".into(),
+                );
+            }
+            size
+        }
+        None => args.size.unwrap_or((h.width, h.height)),
+    };
+    let cameras = trajectory.cameras(args.frames, width, height)?;
     if !args.exposure.is_finite() || args.exposure.abs() > 30.0 {
         return Err(format!("--exposure {} stops is outside [-30, 30]", args.exposure).into());
     }
@@ -148,7 +171,14 @@ pub fn run(args: RenderArgs) -> CliResult {
 
     let start = Instant::now();
     let source = PoseSource::load(&field, pose, &lighting)?;
-    let renderer = open_renderer(&source, args.cpu)?;
+    let mut renderer = open_renderer(&source, args.cpu)?;
+    let had_maps = shadow_maps.is_some();
+    let shadow = match (&shadow_maps, traced) {
+        (Some(m), _) => SceneShadow::Maps(m),
+        (None, Some(t)) => SceneShadow::Relit(t),
+        (None, None) => SceneShadow::None,
+    };
+    renderer.set_scene(backdrop, shadow)?;
     let resident_seconds = start.elapsed().as_secs_f64();
     let c = source.geometry.crop;
     eprintln!(
@@ -179,6 +209,17 @@ pub fn run(args: RenderArgs) -> CliResult {
         renderer.device(),
         renderer.resident_bytes() as f64 / 1e6
     );
+    eprintln!(
+        "scene: backdrop {:?}, shadow {}",
+        args.scene.backdrop,
+        match (renderer.has_shadow(), args.scene.shadow) {
+            (true, ShadowArg::Maps) => "relit from the pose's maps",
+            (true, _) => "traced against the pose's visual hull",
+            (false, ShadowArg::None) => "left out (--shadow none)",
+            (false, _) if !had_maps => "none (the field holds no shadow maps)",
+            (false, _) => "none (no environment to relight it with)",
+        }
+    );
 
     let scale = 2f32.powf(args.exposure);
     let variant = Variant::from(args.variant);
@@ -200,12 +241,18 @@ pub fn run(args: RenderArgs) -> CliResult {
             continue;
         }
         let t = Instant::now();
-        let (img, stats) = renderer.render(cam, variant)?;
+        let frame = renderer.render_frame(cam, variant, args.layers)?;
         times.push(t.elapsed().as_secs_f64());
+        let (img, stats) = (frame.composite, frame.stats);
         totals.inside += stats.inside;
         totals.clamped_above += stats.clamped_above;
         totals.clamped_below += stats.clamped_below;
         totals.missed += stats.missed;
+        if let Some(l) = &frame.layers {
+            write_exr_rgba(&layer_path(&args.out, i, "subject"), &l.subject)?;
+            write_exr_rgb(&layer_path(&args.out, i, "shadow"), &l.shadow)?;
+            write_exr_rgba(&layer_path(&args.out, i, "backdrop"), &l.backdrop)?;
+        }
         write_exr_rgba(&exr, &img)?;
         write_png8_srgba(&png, &img, scale)?;
         if i % sheet_every == 0 {

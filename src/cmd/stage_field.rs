@@ -34,6 +34,8 @@ pub struct FieldArgs {
     /// Poses to include, e.g. `0,1` (default: all of the capture's).
     #[arg(long, value_delimiter = ',')]
     poses: Vec<u32>,
+    #[command(flatten)]
+    shadows: crate::cmd::args::ShadowArgs,
 }
 
 /// Runs `frf stage field`.
@@ -53,6 +55,7 @@ pub fn field(args: FieldArgs) -> CliResult {
             poses,
             jpeg_quality: args.jpeg_quality,
             predict_flow: !args.no_flow_prediction,
+            shadows: args.shadows.options()?,
         },
         &|done, total| {
             bar.set_length(total as u64);

@@ -330,6 +330,17 @@ impl Actor {
         best
     }
 
+    /// Whether the point `p` (actor frame) lies inside the body.
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.parts.iter().any(|part| {
+            (p - part.sphere_centre).length_squared() <= part.sphere_radius * part.sphere_radius
+                && part
+                    .part
+                    .shape()
+                    .contains(part.part_from_world.transform_point(p))
+        })
+    }
+
     /// Whether anything of the body lies on the ray within `(t_min, t_max)`.
     pub fn occludes(&self, ray: &Ray, t_min: f32, t_max: f32) -> bool {
         if !self.bounds.hit(ray, t_max) {

@@ -44,6 +44,19 @@ impl Shape {
         }
     }
 
+    /// Whether `p` (local frame) lies inside the shape or on its surface.
+    pub fn contains(&self, p: Vec3) -> bool {
+        match *self {
+            Shape::Capsule { a, b, radius } => {
+                let ab = b - a;
+                let t =
+                    ((p - a).dot(ab) / ab.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+                (p - (a + ab * t)).length_squared() <= radius * radius
+            }
+            Shape::Ellipsoid { centre, radii } => ((p - centre) / radii).length_squared() <= 1.0,
+        }
+    }
+
     /// A sphere (centre, radius) that contains the shape.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
         match *self {

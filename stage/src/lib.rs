@@ -24,6 +24,7 @@ pub mod contact;
 pub mod error;
 pub mod gait;
 pub mod geometry;
+pub mod ground;
 pub mod material;
 pub mod optics;
 pub mod render;

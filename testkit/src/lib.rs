@@ -3,7 +3,8 @@
 //! [`tiny_field`]: the virtual stage's tiny preset (64x90, 36x3 views), pose 0, without
 //! cycle-to-cycle perturbation (every cycle repeats, so the truth between views is what
 //! interpolation should reach), and its oracle field ([`frf_eval::oracle`]: true flows,
-//! noise-free basis images, JPEG quality 95, predicted flow codes). Its directory holds
+//! noise-free basis images, JPEG quality 95, predicted flow codes, visual hull and shadow
+//! maps carved from the true mattes with ingest's defaults). Its directory holds
 //! the stage's configuration, so it serves as the `--capture` of `frf eval`. Building it
 //! takes about 10 s on two cores.
 
@@ -11,6 +12,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use frf_eval::oracle::{OracleOptions, write_oracle_field};
+use frf_ingest::shadows::ShadowOptions;
 use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
 
 /// The tiny stage and its oracle field (see the crate docs).
@@ -66,6 +68,7 @@ pub fn tiny_field() -> &'static TinyField {
             poses: vec![0],
             jpeg_quality: 95,
             predict_flow: true,
+            shadows: Some(ShadowOptions::default()),
         };
         write_oracle_field(&stage, &field, &options, &|_, _| {})
             .expect("the tiny oracle field is written");

@@ -90,3 +90,37 @@ pub struct GpuRelightParams {
     /// View index.
     pub view: u32,
 }
+
+/// `ShadowParams` of `shaders/shadow.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuShadowParams {
+    /// Texels per side of the maps.
+    pub texels: u32,
+    /// Maps.
+    pub maps: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 2],
+}
+
+/// `Composite` of `shaders/composite.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuComposite {
+    /// 0 none, 1 environment, 2 plate.
+    pub backdrop: u32,
+    /// 0 the environment's lower hemisphere, 1 a Lambertian ground.
+    pub ground_look: u32,
+    /// 1 when the pose has a relit shadow.
+    pub has_shadow: u32,
+    /// Texels per side of the relit shadow.
+    pub shadow_texels: u32,
+    /// Radiance of the Lambertian ground (w unused).
+    pub ground_radiance: [f32; 4],
+    /// Size of the environment map.
+    pub env_size: [u32; 2],
+    /// Yaw of the environment, radians.
+    pub env_yaw: f32,
+    /// Side of the shadow's ground patch, metres.
+    pub shadow_extent: f32,
+}

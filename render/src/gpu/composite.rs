@@ -1,0 +1,270 @@
+//! The composite pass (`shaders/composite.wgsl`): after the frame pass has drawn the
+//! subject, a full-screen triangle puts it over the backdrop (environment, plate or
+//! nothing) whose ground is darkened by the pose's relit shadow, into three RGBA32F
+//! targets: the composite, the relative irradiance per pixel and the backdrop. Twin of
+//! [`crate::composite::compose`].
+
+use frf_core::camera::Camera;
+use frf_core::image::{Image, Rgba};
+use wgpu::util::DeviceExt;
+
+use super::bind::{FLOAT, cleared, full_screen_pipeline, rgba32f, texture_2d, uniform};
+use super::pose::GpuPose;
+use super::types::GpuComposite;
+use super::{Gpu, shaders};
+use crate::composite::{Backdrop, GroundLook, Layers};
+use crate::cpu::FrameStats;
+use crate::error::Result;
+use crate::morph::Variant;
+
+/// The pass's layouts and pipeline.
+pub struct CompositePass {
+    frame_layout: wgpu::BindGroupLayout,
+    image_layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl CompositePass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "composite", shaders::COMPOSITE);
+        let f = wgpu::ShaderStages::FRAGMENT;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite frame"),
+            entries: &[uniform(0, f), uniform(1, f)],
+        });
+        let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite images"),
+            entries: &[
+                texture_2d(0, FLOAT),
+                texture_2d(1, FLOAT),
+                texture_2d(2, FLOAT),
+                texture_2d(3, FLOAT),
+            ],
+        });
+        let pipeline = full_screen_pipeline(
+            device,
+            "composite",
+            &[&frame_layout, &image_layout],
+            &module,
+            "fs_composite",
+            3,
+        );
+        Self {
+            frame_layout,
+            image_layout,
+            pipeline,
+        }
+    }
+}
+
+/// A backdrop resident on the GPU.
+pub struct GpuBackdrop {
+    params: GpuComposite,
+    env: wgpu::Texture,
+    plate: wgpu::Texture,
+    plate_size: Option<(u32, u32)>,
+}
+
+/// Uploads linear RGB texels of `size` as an RGBA32F texture.
+fn upload_rgb(gpu: &Gpu, label: &str, size: (u32, u32), texels: &[[f32; 3]]) -> wgpu::Texture {
+    let data: Vec<f32> = texels
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2], 1.0])
+        .collect();
+    gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&data),
+    )
+}
+
+impl Gpu {
+    /// Makes `backdrop` resident.
+    pub fn upload_backdrop(&self, backdrop: &Backdrop) -> Result<GpuBackdrop> {
+        self.scoped("uploading the backdrop", || {
+            let one = |label| upload_rgb(self, label, (1, 1), &[[0.0; 3]]);
+            let mut params = GpuComposite {
+                backdrop: 0,
+                ground_look: 0,
+                has_shadow: 0,
+                shadow_texels: 1,
+                ground_radiance: [0.0; 4],
+                env_size: [1, 1],
+                env_yaw: 0.0,
+                shadow_extent: 1.0,
+            };
+            let (env, plate, plate_size) = match backdrop {
+                Backdrop::None => (one("no environment"), one("no plate"), None),
+                Backdrop::Environment {
+                    env,
+                    ground,
+                    ground_radiance,
+                } => {
+                    let img = env.image();
+                    let size = (img.width() as u32, img.height() as u32);
+                    params.backdrop = 1;
+                    params.ground_look = matches!(ground, GroundLook::Albedo(_)) as u32;
+                    params.ground_radiance = [
+                        ground_radiance[0],
+                        ground_radiance[1],
+                        ground_radiance[2],
+                        0.0,
+                    ];
+                    params.env_size = [size.0, size.1];
+                    params.env_yaw = env.yaw();
+                    (
+                        upload_rgb(self, "environment", size, img.pixels()),
+                        one("no plate"),
+                        None,
+                    )
+                }
+                Backdrop::Plate(img) => {
+                    let size = (img.width() as u32, img.height() as u32);
+                    params.backdrop = 2;
+                    (
+                        one("no environment"),
+                        upload_rgb(self, "plate", size, img.pixels()),
+                        Some(size),
+                    )
+                }
+            };
+            Ok(GpuBackdrop {
+                params,
+                env,
+                plate,
+                plate_size,
+            })
+        })
+    }
+
+    /// Renders a frame of `camera`: the subject with `variant`, composited over
+    /// `backdrop` with the pose's relit shadow (if any); with `layers`, the subject, the
+    /// relative irradiance and the backdrop too.
+    pub fn render_composite(
+        &self,
+        pose: &GpuPose,
+        backdrop: &GpuBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        layers: bool,
+    ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
+        if let Some((w, h)) = backdrop.plate_size
+            && (w, h) != (camera.width, camera.height)
+        {
+            return Err(crate::RenderError::BadParameter(format!(
+                "the plate is {w}x{h}, the camera {}x{}: a plate is seen by its own camera",
+                camera.width, camera.height
+            )));
+        }
+        self.scoped("compositing a frame", || {
+            let size = (camera.width, camera.height);
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("composite"),
+                });
+            let subject = self.draw_subject(&mut encoder, pose, camera, variant);
+            let mut params = backdrop.params;
+            let one = upload_rgb(self, "no shadow", (1, 1), &[[1.0; 3]]);
+            let shadow_texture = match &pose.shadow {
+                Some((texture, info)) => {
+                    params.has_shadow = 1;
+                    params.shadow_texels = info.texels;
+                    params.shadow_extent = info.extent_m;
+                    texture
+                }
+                None => &one,
+            };
+            let params = self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("composite params"),
+                    contents: bytemuck::bytes_of(&params),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+            let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("composite frame"),
+                layout: &self.composite.frame_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: subject.frame_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: params.as_entire_binding(),
+                    },
+                ],
+            });
+            let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+            let views = [
+                view(&subject.texture),
+                view(&backdrop.env),
+                view(&backdrop.plate),
+                view(shadow_texture),
+            ];
+            let image_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("composite images"),
+                layout: &self.composite.image_layout,
+                entries: &views
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| wgpu::BindGroupEntry {
+                        binding: i as u32,
+                        resource: wgpu::BindingResource::TextureView(v),
+                    })
+                    .collect::<Vec<_>>(),
+            });
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+            let targets = ["composite", "shadow layer", "backdrop layer"]
+                .map(|label| rgba32f(&self.device, label, size, usage));
+            let target_views = targets.each_ref().map(view);
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("composite"),
+                    color_attachments: &target_views.iter().map(cleared).collect::<Vec<_>>(),
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.composite.pipeline);
+                pass.set_bind_group(0, &frame_group, &[]);
+                pass.set_bind_group(1, &image_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            let composite = self.copy_rgba(&mut encoder, &targets[0], size);
+            let copied_layers = layers.then(|| {
+                [&subject.texture, &targets[1], &targets[2]]
+                    .map(|t| self.copy_rgba(&mut encoder, t, size))
+            });
+            let stats = self.copy_stats(&mut encoder, &subject);
+            self.queue.submit([encoder.finish()]);
+            let image = self.read_rgba(&composite, size)?;
+            let layers = match copied_layers {
+                Some([s, sh, b]) => Some(Layers {
+                    subject: self.read_rgba(&s, size)?,
+                    shadow: self.read_rgba(&sh, size)?.map(|p| [p[0], p[1], p[2]]),
+                    backdrop: self.read_rgba(&b, size)?,
+                }),
+                None => None,
+            };
+            Ok((image, layers, self.read_stats(&stats)?))
+        })
+    }
+}

@@ -1,0 +1,469 @@
+//! Making a pose resident on the GPU: its flows as RG8 integer texture arrays (the 8-bit
+//! log codes, decoded in the shader), the view and quad tables as storage buffers, and
+//! every view relit on the GPU into an RGBA8 texture array (`shaders/relight.wgsl`), one
+//! dispatch pair per view: the weighted sum of its basis images, then its encoding with
+//! the view's peak. Twin of [`crate::resident::ResidentPose::relight_cpu`].
+
+use std::sync::Arc;
+
+use frf_core::volume::GroundGrid;
+use glam::Quat;
+use wgpu::util::DeviceExt;
+
+use super::bind::{copy_to_buffer, storage, table_bytes, uniform};
+use super::types::{GpuQuad, GpuRelightParams, GpuView};
+use super::{Gpu, shaders};
+use crate::error::Result;
+use crate::geometry::PoseGeometry;
+use crate::resident::{PoseSource, srgb_lut};
+
+/// Workgroup size of the relighting pass (`@workgroup_size(64)`).
+const WORKGROUP: u32 = 64;
+
+/// The relighting pipelines.
+pub struct RelightPass {
+    layout: wgpu::BindGroupLayout,
+    relight: wgpu::ComputePipeline,
+    encode: wgpu::ComputePipeline,
+}
+
+impl RelightPass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let relight_module = shaders::module(device, "relight", shaders::RELIGHT);
+        let c = wgpu::ShaderStages::COMPUTE;
+        let relight_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("relight"),
+            entries: &[
+                uniform(0, c),
+                storage(1, true, c),
+                storage(2, true, c),
+                storage(3, true, c),
+                storage(4, false, c),
+                storage(5, false, c),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: c,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let relight_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("relight"),
+                bind_group_layouts: &[Some(&relight_layout)],
+                immediate_size: 0,
+            });
+        let compute = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&relight_pipeline_layout),
+                module: &relight_module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (relight, encode) = (compute("relight"), compute("encode"));
+
+        Self {
+            layout: relight_layout,
+            relight,
+            encode,
+        }
+    }
+}
+
+/// A pose resident on the GPU.
+pub struct GpuPose {
+    pub(super) bind_group: wgpu::BindGroup,
+    prelit: wgpu::Texture,
+    /// Per view: the pre-lit colour scale found by the relighting pass.
+    pub scales: Vec<f32>,
+    /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
+    /// holds on the GPU.
+    pub geometry: Arc<PoseGeometry>,
+    pub(super) quad_count: u32,
+    /// The relit shadow of the ground, when the pose has shadow maps and a lighting.
+    pub(super) shadow: Option<(wgpu::Texture, RelitShadowInfo)>,
+}
+
+/// What the composite pass needs to know of a relit shadow texture.
+#[derive(Debug, Clone, Copy)]
+pub struct RelitShadowInfo {
+    /// Texels per side.
+    pub texels: u32,
+    /// Side of the ground patch, metres.
+    pub extent_m: f32,
+}
+
+impl GpuPose {
+    /// Whether a relit shadow is resident.
+    pub fn has_shadow(&self) -> bool {
+        self.shadow.is_some()
+    }
+
+    /// The ground patch of the resident relit shadow.
+    pub fn shadow_ground(&self) -> Option<GroundGrid> {
+        self.shadow.as_ref().map(|(_, i)| GroundGrid {
+            extent_m: i.extent_m,
+            texels: i.texels,
+        })
+    }
+
+    /// Drops the relit shadow.
+    pub fn clear_shadow(&mut self) {
+        self.shadow = None;
+    }
+}
+
+impl Gpu {
+    /// Makes pose `source` resident: uploads its flows and tables and relights every view
+    /// on the GPU.
+    pub fn upload_pose(&self, source: &PoseSource) -> Result<GpuPose> {
+        self.scoped("making a pose resident", || {
+            self.upload_pose_unscoped(source)
+        })
+    }
+
+    fn upload_pose_unscoped(&self, source: &PoseSource) -> Result<GpuPose> {
+        let geometry = &source.geometry;
+        let crop = geometry.crop;
+        let views = geometry.views();
+        let texels = crop.texels();
+        let extent = |layers: u32| wgpu::Extent3d {
+            width: crop.width,
+            height: crop.height,
+            depth_or_array_layers: layers.max(1),
+        };
+        // Flows: one layer per stored flow, in the order of the geometry's flow layers.
+        let mut flow_data: Vec<u8> = Vec::with_capacity(geometry.flow_layer_count * texels * 2);
+        for f in &source.flows.codes {
+            for codes in f.iter().flatten() {
+                flow_data.extend(codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]));
+            }
+        }
+        if flow_data.is_empty() {
+            flow_data = vec![128u8; texels * 2];
+        }
+        let flows = self.device.create_texture_with_data(
+            &self.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("flows"),
+                size: extent(geometry.flow_layer_count as u32),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rg8Sint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &flow_data,
+        );
+        let prelit = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("prelit"),
+            size: extent(views as u32),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let scales = self.relight_views(source, &prelit)?;
+
+        let gpu_views: Vec<GpuView> = geometry
+            .cameras
+            .iter()
+            .zip(&scales)
+            .zip(&geometry.flow_layers)
+            .map(|((cam, &scale), l)| {
+                let q = Quat::from_mat3(&cam.world_from_camera.rotation);
+                let k = &cam.intrinsics;
+                GpuView {
+                    rotation: q.to_array(),
+                    centre: cam.centre().to_array(),
+                    scale,
+                    intrinsics: [k.fx, k.fy, k.cx, k.cy],
+                    flow_layers: *l,
+                }
+            })
+            .collect();
+        let quads: Vec<GpuQuad> = geometry
+            .cylinder
+            .quads()
+            .iter()
+            .map(|q| GpuQuad {
+                p00: q.p00.to_array(),
+                u: q.u,
+                e1: q.e1.to_array(),
+                v: q.v,
+                e2: q.e2.to_array(),
+                wall: q.wall,
+                e3: q.e3.to_array(),
+                wall_gamma: q.wall_gamma,
+                normal: q.normal.to_array(),
+                pad: 0.0,
+            })
+            .collect();
+        let buffer = |label: &str, contents: &[u8]| {
+            self.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage: wgpu::BufferUsages::STORAGE,
+                })
+        };
+        let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
+        let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
+        let tables = buffer("tables", &table_bytes(&[srgb_lut(), source.flows.table]));
+        let view_of = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pose"),
+            layout: &self.rebin.pose_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view_of(&prelit)),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view_of(&flows)),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: view_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: quad_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: tables.as_entire_binding(),
+                },
+            ],
+        });
+        Ok(GpuPose {
+            bind_group,
+            prelit,
+            scales,
+            geometry: geometry.clone(),
+            quad_count: quads.len() as u32,
+            shadow: None,
+        })
+    }
+
+    /// Relights every view into its layer of `prelit`; returns the views' scales.
+    fn relight_views(&self, source: &PoseSource, prelit: &wgpu::Texture) -> Result<Vec<f32>> {
+        let crop = source.geometry.crop;
+        let texels = crop.texels();
+        let tiles = source.basis.first().map_or(0, |b| b.tiles.len());
+        let views = source.basis.len();
+        let basis_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("basis"),
+            size: (tiles.max(1) * texels * 4) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let coefficient_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("coefficients"),
+            size: (tiles.max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let params = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("relight params"),
+            size: std::mem::size_of::<GpuRelightParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let gamma = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gamma"),
+                contents: &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("relit"),
+            size: (texels * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let peaks = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("peaks"),
+                contents: &vec![0u8; views.max(1) * 4],
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            });
+        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("peaks readback"),
+            size: (views.max(1) * 4) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let groups = (texels as u32).div_ceil(WORKGROUP);
+        for (i, basis) in source.basis.iter().enumerate() {
+            let mut packed = Vec::with_capacity(tiles * texels);
+            for (k, tile) in basis.tiles.iter().enumerate() {
+                packed.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
+                    let alpha = if k == 0 { a as u32 } else { 0 };
+                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
+                }));
+            }
+            let coefficients: Vec<[f32; 4]> = source.coefficients[i]
+                .iter()
+                .zip(&basis.scales)
+                .map(|(c, &s)| {
+                    let used = if c.iter().all(|&x| x == 0.0) {
+                        0.0
+                    } else {
+                        1.0
+                    };
+                    [c[0] * s, c[1] * s, c[2] * s, used]
+                })
+                .collect();
+            self.queue
+                .write_buffer(&basis_buffer, 0, bytemuck::cast_slice(&packed));
+            self.queue
+                .write_buffer(&coefficient_buffer, 0, bytemuck::cast_slice(&coefficients));
+            self.queue.write_buffer(
+                &params,
+                0,
+                bytemuck::bytes_of(&GpuRelightParams {
+                    texels: texels as u32,
+                    tiles: tiles as u32,
+                    width: crop.width,
+                    view: i as u32,
+                }),
+            );
+            let layer = prelit.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: i as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("relight"),
+                layout: &self.relight.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: basis_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: coefficient_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: gamma.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: relit.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: peaks.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: wgpu::BindingResource::TextureView(&layer),
+                    },
+                ],
+            });
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("relight"),
+                });
+            for pipeline in [&self.relight.relight, &self.relight.encode] {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("relight"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(groups, 1, 1);
+            }
+            // Each view's uploads must land before its dispatches and after the last ones.
+            self.queue.submit([encoder.finish()]);
+        }
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("peaks"),
+            });
+        encoder.copy_buffer_to_buffer(&peaks, 0, &readback, 0, (views.max(1) * 4) as u64);
+        self.queue.submit([encoder.finish()]);
+        let bytes = self.read_buffer(&readback)?;
+        Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[..views]
+            .iter()
+            .map(|&b| {
+                let p = f32::from_bits(b);
+                if p > 0.0 { p } else { 1.0 }
+            })
+            .collect())
+    }
+
+    /// Reads back the pre-lit texels of every view (for tests and inspection).
+    pub fn read_prelit(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
+        self.scoped("reading pre-lit views back", || {
+            self.read_prelit_unscoped(pose)
+        })
+    }
+
+    fn read_prelit_unscoped(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
+        let (w, h) = (pose.geometry.crop.width, pose.geometry.crop.height);
+        let layers = pose.scales.len() as u32;
+        let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("prelit readback"),
+            size: (row * h * layers) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("prelit readback"),
+            });
+        copy_to_buffer(&mut encoder, &pose.prelit, &buffer, row, (w, h, layers));
+        self.queue.submit([encoder.finish()]);
+        let bytes = self.read_buffer(&buffer)?;
+        Ok((0..layers as usize)
+            .map(|l| {
+                (0..h as usize)
+                    .flat_map(|y| {
+                        let start = (l * h as usize + y) * row as usize;
+                        bytes[start..start + w as usize * 4]
+                            .chunks_exact(4)
+                            .map(|c| [c[0], c[1], c[2], c[3]])
+                            .collect::<Vec<_>>()
+                    })
+                    .collect()
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,237 @@
+//! The relit-shadow pass (`shaders/shadow.wgsl`): once per pose and lighting, the pose's
+//! attenuation maps weighted by the light each condition brings to the ground, into an
+//! RGBA32F texture of the ground patch that the composite pass samples. Twin of
+//! [`crate::shadow::ShadowMaps::relight`].
+
+use frf_core::image::{Rgb, RgbImage};
+use wgpu::util::DeviceExt;
+
+use super::bind::{rgba32f, storage, storage_texture, uniform};
+use super::pose::{GpuPose, RelitShadowInfo};
+use super::types::GpuShadowParams;
+use super::{Gpu, shaders};
+use crate::error::{RenderError, Result};
+use crate::shadow::{RelitShadow, ShadowMaps};
+
+/// Workgroup side of the pass (`@workgroup_size(8, 8)`).
+const WORKGROUP: u32 = 8;
+
+/// The pass's layout and pipeline.
+pub struct ShadowPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl ShadowPass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "shadow", shaders::SHADOW);
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow"),
+            entries: &[
+                uniform(0, c),
+                storage(1, true, c),
+                storage(2, true, c),
+                storage_texture(3, wgpu::TextureFormat::Rgba32Float),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("shadow"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("relight_shadow"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { layout, pipeline }
+    }
+}
+
+impl Gpu {
+    /// Relights `maps` with the coefficients of every condition of the field (projected
+    /// for the ground's frame) and keeps the result resident with `pose`.
+    pub fn set_shadow(
+        &self,
+        pose: &mut GpuPose,
+        maps: &ShadowMaps,
+        coefficients: &[Rgb],
+    ) -> Result<()> {
+        self.scoped("relighting the shadow maps", || {
+            let n = maps.spec.ground.texels;
+            if maps
+                .maps
+                .iter()
+                .any(|m| m.size() != (n as usize, n as usize))
+            {
+                return Err(RenderError::BadParameter(format!(
+                    "shadow maps are not all {n}x{n}"
+                )));
+            }
+            let texels: Vec<f32> = maps
+                .maps
+                .iter()
+                .flat_map(|m| m.pixels().iter().copied())
+                .collect();
+            let weights: Vec<[f32; 4]> = maps
+                .weights(coefficients)
+                .iter()
+                .map(|w| [w[0], w[1], w[2], 0.0])
+                .collect();
+            let buffer = |label: &str, contents: &[u8], usage| {
+                self.device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(label),
+                        contents,
+                        usage,
+                    })
+            };
+            let params = GpuShadowParams {
+                texels: n,
+                maps: maps.maps.len() as u32,
+                pad: [0; 2],
+            };
+            let params = buffer(
+                "shadow params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            // Storage bindings may not be empty.
+            let texels = if texels.is_empty() { vec![0.0] } else { texels };
+            let weights = if weights.is_empty() {
+                vec![[0.0; 4]]
+            } else {
+                weights
+            };
+            let map_buffer = buffer(
+                "shadow maps",
+                bytemuck::cast_slice(&texels),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let weight_buffer = buffer(
+                "shadow weights",
+                bytemuck::cast_slice(&weights),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let relit = rgba32f(
+                &self.device,
+                "relit shadow",
+                (n, n),
+                wgpu::TextureUsages::STORAGE_BINDING
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+            );
+            let view = relit.create_view(&wgpu::TextureViewDescriptor::default());
+            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow"),
+                layout: &self.shadow.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: map_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: weight_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&view),
+                    },
+                ],
+            });
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("shadow"),
+                });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("shadow"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.shadow.pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                let groups = n.div_ceil(WORKGROUP);
+                pass.dispatch_workgroups(groups, groups, 1);
+            }
+            self.queue.submit([encoder.finish()]);
+            pose.shadow = Some((
+                relit,
+                RelitShadowInfo {
+                    texels: n,
+                    extent_m: maps.spec.ground.extent_m,
+                },
+            ));
+            Ok(())
+        })
+    }
+
+    /// Keeps a relit shadow computed on the CPU resident with `pose`.
+    pub fn upload_shadow(&self, pose: &mut GpuPose, relit: &RelitShadow) -> Result<()> {
+        self.scoped("uploading a relit shadow", || {
+            let n = relit.ground.texels;
+            let data: Vec<f32> = relit
+                .image
+                .pixels()
+                .iter()
+                .flat_map(|p| [p[0], p[1], p[2], 1.0])
+                .collect();
+            let texture = self.device.create_texture_with_data(
+                &self.queue,
+                &wgpu::TextureDescriptor {
+                    label: Some("relit shadow"),
+                    size: wgpu::Extent3d {
+                        width: n,
+                        height: n,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytemuck::cast_slice(&data),
+            );
+            pose.shadow = Some((
+                texture,
+                RelitShadowInfo {
+                    texels: n,
+                    extent_m: relit.ground.extent_m,
+                },
+            ));
+            Ok(())
+        })
+    }
+
+    /// Reads back the relit shadow of `pose` (for tests and inspection).
+    pub fn read_shadow(&self, pose: &GpuPose) -> Result<Option<RgbImage>> {
+        let Some((texture, info)) = &pose.shadow else {
+            return Ok(None);
+        };
+        self.scoped("reading the relit shadow back", || {
+            let size = (info.texels, info.texels);
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("shadow readback"),
+                });
+            let copied = self.copy_rgba(&mut encoder, texture, size);
+            self.queue.submit([encoder.finish()]);
+            let img = self.read_rgba(&copied, size)?;
+            Ok(Some(img.map(|p| [p[0], p[1], p[2]])))
+        })
+    }
+}

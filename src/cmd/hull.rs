@@ -1,0 +1,50 @@
+//! `frf hull FIELD [--pose P] --out HULL.ply`: a pose's visual hull as a mesh for other
+//! tools (the surface of its voxels, binary PLY, metres, subject frame, `+y` up), with
+//! its size.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use frf_reflectance::FieldFile;
+
+use crate::CliResult;
+use crate::cmd::render::pose_of;
+
+/// Arguments of `frf hull`.
+#[derive(Args)]
+pub struct HullArgs {
+    /// A field file with visual hulls (`frf ingest`, `frf stage field`).
+    field: PathBuf,
+    /// Pose (default: the field's first).
+    #[arg(long)]
+    pose: Option<u32>,
+    /// Output mesh (`.ply`).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Runs `frf hull`.
+pub fn run(args: HullArgs) -> CliResult {
+    let field = FieldFile::open(&args.field)?;
+    let pose = pose_of(field.header(), args.pose, &args.field)?;
+    let hull = field.hull(pose)?.ok_or_else(|| {
+        format!(
+            "{}: pose {pose} has no visual hull (ingest it without --no-shadows)",
+            args.field.display()
+        )
+    })?;
+    hull.write_ply(&args.out)?;
+    let g = hull.grid();
+    let bounds = hull.bounds().map_or("empty".to_string(), |(lo, hi)| {
+        format!("{lo:.3} to {hi:.3} m")
+    });
+    println!(
+        "visual hull of pose {pose}: {} voxels of {} m ({:.4} m³), {bounds}; grid {:?}; mesh written to {}",
+        hull.count(),
+        g.voxel_m,
+        hull.volume_m3(),
+        g.dims,
+        args.out.display()
+    );
+    Ok(())
+}
