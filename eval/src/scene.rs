@@ -115,6 +115,12 @@ pub struct SceneScore {
     pub shadow_mae_traced: Option<f64>,
     /// Mean [`composite_psnr`] over the cameras, dB.
     pub psnr_composite: f64,
+    /// Seconds to set the scene up: the backdrop made resident and the shadow relit.
+    pub scene_seconds: f64,
+    /// Seconds to trace the ablation's shadow against the hull (CPU).
+    pub traced_seconds: Option<f64>,
+    /// Mean seconds per composited frame (subject, shadow, backdrop, readback).
+    pub seconds_per_composite: f64,
     /// Mean edge-band error over black, at the captured views.
     pub edge_band_mae_dark: Option<f64>,
     /// Mean edge-band error over the bright background, at the captured views.

@@ -23,8 +23,10 @@ pub const DEFAULT_VOXEL_M: f32 = 0.02;
 /// 0.0435 / 0.0421 / 0.0425 (its small sun is a basis limit).
 pub const DEFAULT_LIGHT_SAMPLES: usize = 8;
 /// Views allowed to disagree when carving, by default (the views of a pose come from 36
-/// different walk cycles: see [`VoxelHull::carve`]).
-pub const DEFAULT_MISSES: usize = 2;
+/// different walk cycles: see [`VoxelHull::carve`]). Measured hull IoU against the true
+/// body on ingested captures (pose 0), with 2 / 5 / 6 / 8 misses: small preset 0.788 /
+/// 0.835 / 0.842 / 0.844, tiny 0.741 / 0.778 / 0.777 / 0.774.
+pub const DEFAULT_MISSES: usize = 6;
 
 /// How the hull and the shadow maps are made.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -190,17 +190,24 @@ pub fn run(args: EvalArgs) -> CliResult {
         let backdrop = Backdrop::environment(env.clone(), ground);
         let maps = ShadowMaps::load(&field, pose)?;
         // The ablation first: the environment's lights traced against the hull.
-        let shadow_mae_traced = match (field.hull(pose)?, &maps) {
+        let (shadow_mae_traced, traced_seconds) = match (field.hull(pose)?, &maps) {
             (Some(hull), Some(m)) => {
+                let t = Instant::now();
                 let traced = traced_shadow(&hull, &env.median_cut(TRACED_LIGHTS), m.spec.ground);
-                Some(shadow_error(&traced, &stage, pose, &lights))
+                let seconds = t.elapsed().as_secs_f64();
+                (
+                    Some(shadow_error(&traced, &stage, pose, &lights)),
+                    Some(seconds),
+                )
             }
-            _ => None,
+            _ => (None, None),
         };
+        let t = Instant::now();
         renderer.set_scene(
             backdrop.clone(),
             maps.as_ref().map_or(SceneShadow::None, SceneShadow::Maps),
         )?;
+        let scene_seconds = t.elapsed().as_secs_f64();
         let relit = renderer.relit_shadow()?;
         let shadow_mae = relit
             .as_ref()
@@ -212,11 +219,14 @@ pub fn run(args: EvalArgs) -> CliResult {
         }
         let scene_bar = crate::cmd::progress::bar("composites");
         scene_bar.set_length(cameras.len() as u64);
+        let mut composite_seconds = 0.0;
         let psnrs = cameras
             .iter()
             .zip(&truths)
             .map(|(c, truth)| {
+                let t = Instant::now();
                 let frame = renderer.render_frame(&c.camera, Variant::FourWay, false)?;
+                composite_seconds += t.elapsed().as_secs_f64();
                 let t = true_composite(&stage, pose, &c.camera, truth.clone(), &lights, &backdrop)?;
                 scene_bar.inc(1);
                 Ok(composite_psnr(&t, &frame.composite))
@@ -244,6 +254,9 @@ pub fn run(args: EvalArgs) -> CliResult {
             shadow_mae,
             shadow_mae_traced,
             psnr_composite: psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64,
+            scene_seconds,
+            traced_seconds,
+            seconds_per_composite: composite_seconds / psnrs.len().max(1) as f64,
             edge_band_mae_dark: dark,
             edge_band_mae_bright: bright,
             edge_band_mae: mean_of([dark, bright].into_iter()),
