@@ -6,12 +6,14 @@
 //!
 //! - [`pipeline`]: the ingest, pose by pose, parallel, resumable, with a report;
 //! - [`views`], [`matte`], [`registration`]: one view's mattes and registered basis images;
+//! - [`edges`]: keeping backdrop light out of the subject's edge pixels;
 //! - [`interview`], [`rectify`]: flow between grid neighbours, vertical pairs rectified;
 //! - [`evidence`]: what ingest hands to an evaluator, and the errors it records;
 //! - [`ring`]: a calibrated ring of real photographs (Middlebury multi-view) as a field.
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod edges;
 pub mod error;
 pub mod evidence;
 pub mod interview;
