@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Error against run time of ingest for each flow preset, on virtual-stage captures.
 # Usage: benches/ingest_presets.sh CAPTURE [CAPTURE...]   (writes one markdown table)
+#        EDGE=none|solve|extend picks the edge method (default: the ingest's, solve)
 # Example: ./target/release/frf stage --preset tiny --out /tmp/tiny
 #          ./target/release/frf stage --preset small --out /tmp/small
 #          benches/ingest_presets.sh /tmp/tiny /tmp/small
@@ -12,6 +13,7 @@ trap 'rm -rf "$work"' EXIT
 for cap in "$@"; do
   for preset in fast balanced accurate; do
     ./target/release/frf ingest "$cap" --out "$work/f.frf" --flow-preset "$preset" \
+      --edge "${EDGE:-solve}" \
       --report "$work/$(basename "$cap")_$preset.json" > /dev/null
     rm -f "$work/f.frf"
   done

@@ -1,6 +1,8 @@
 //! How good each ingest step is, against the virtual stage's ground truth: alpha
 //! against the true coverage, registered basis images against the true images at the
-//! reference instant (and what registration gains over none), and inter-view flow against
+//! reference instant (and what registration gains over none), their edge pixels
+//! composited over black and over a bright background (and what edge decontamination
+//! gains over none, [`crate::metrics::edge_band_error`]), and inter-view flow against
 //! the true flow inside the matte, horizontal and vertical pairs apart. [`StageEvaluator`]
 //! is the [`Evaluator`] that `frf ingest` hands to the ingest of a stage capture.
 
@@ -14,7 +16,7 @@ use frf_stage::truth::flow_between;
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::metrics::{alpha_iou, alpha_mae, alpha_mask, compare};
+use crate::metrics::{EdgeBandError, alpha_iou, alpha_mae, alpha_mask, compare, edge_band_error};
 
 /// True alpha at least this counts as inside the matte for flow errors: the flow of a
 /// pixel only partly covered is ill-defined.
@@ -84,17 +86,27 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
             .fold((0.0, 0), |acc, p| (acc.0 + p.1[k].0, acc.1 + p.1[k].1));
         if c > 0 { s / c as f64 } else { 0.0 }
     };
-    let registration: Vec<(f64, f64)> = evidence
+    // Per evaluated view and condition: registered and unregistered PSNR, and the edge
+    // band errors of the stored and the undecontaminated frames.
+    type ImageErrors = ((f64, f64), Option<(EdgeBandError, EdgeBandError)>);
+    let per_image: Vec<ImageErrors> = evidence
         .registered
         .par_iter()
-        .map(|(u, v, registered, unregistered)| {
+        .map(|s| {
+            let alpha = &evidence.alphas[s.u * rows + s.v];
             let mut out = Vec::new();
-            for (c, (reg, unreg)) in registered.iter().zip(unregistered).enumerate() {
-                let truth = stage.true_view_image(pose, *u, *v, &stage.condition_lights(c)?)?;
+            for (c, (reg, unreg)) in s.basis.iter().zip(&s.unregistered).enumerate() {
+                let truth = stage.true_view_image(pose, s.u, s.v, &stage.condition_lights(c)?)?;
                 let subject = alpha_mask(&truth.alpha);
+                let edges = edge_band_error(&truth.color, &truth.alpha, reg, alpha).zip(
+                    edge_band_error(&truth.color, &truth.alpha, &s.raw_basis[c], &s.raw_alpha),
+                );
                 out.push((
-                    compare(&truth.color, reg, Some(&subject)).psnr_db,
-                    compare(&truth.color, unreg, Some(&subject)).psnr_db,
+                    (
+                        compare(&truth.color, reg, Some(&subject)).psnr_db,
+                        compare(&truth.color, unreg, Some(&subject)).psnr_db,
+                    ),
+                    edges,
                 ));
             }
             Ok(out)
@@ -102,9 +114,17 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .flatten()
+        .collect();
+    let registration: Vec<(f64, f64)> = per_image
+        .iter()
+        .map(|p| p.0)
         .filter(|(a, b)| a.is_finite() && b.is_finite())
         .collect();
     let m = registration.len().max(1) as f64;
+    let edges: Vec<(EdgeBandError, EdgeBandError)> = per_image.iter().filter_map(|p| p.1).collect();
+    let edge_mean = |f: fn(&(EdgeBandError, EdgeBandError)) -> f64| {
+        (!edges.is_empty()).then(|| edges.iter().map(f).sum::<f64>() / edges.len() as f64)
+    };
     Ok(PoseErrors {
         alpha_iou: per_view.iter().map(|p| p.0.0).sum::<f64>() / n,
         alpha_mae: per_view.iter().map(|p| p.0.1).sum::<f64>() / n,
@@ -116,6 +136,10 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         hull_iou: evidence
             .hull
             .map(|h| h.iou(&stage.true_occupancy(pose, h.grid()))),
+        edge_band_error_dark: edge_mean(|e| e.0.dark),
+        edge_band_error_bright: edge_mean(|e| e.0.bright),
+        edge_band_error_dark_raw: edge_mean(|e| e.1.dark),
+        edge_band_error_bright_raw: edge_mean(|e| e.1.bright),
     })
 }
 

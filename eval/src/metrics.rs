@@ -6,7 +6,9 @@
 //!   subject of a truth image: ingest and storage figures);
 //! - [`subject_mask`]: pixels where *either* of two RGBA images has alpha at least
 //!   [`SUBJECT_ALPHA`] (rendered frames: a renderer that drops or invents part of the
-//!   subject is charged for it).
+//!   subject is charged for it);
+//! - the edge band of [`edge_band_error`]: pixels whose true alpha lies strictly inside
+//!   [`EDGE_BAND`] (partly covered silhouette pixels).
 //!
 //! **PSNR** is over the colour channels (the first three), in linear light, with the
 //! peak stated: the reference's largest colour value inside the region, so that the
@@ -16,10 +18,93 @@
 //! region is the mean of the SSIM map over it.
 
 use frf_core::filter::gaussian_blur;
-use frf_core::image::{GrayImage, Image, Rgba, luminance};
+use frf_core::image::{GrayImage, Image, RgbImage, Rgba, luminance};
 
 /// Alpha at least this much counts as subject in masked measures (half covered).
 pub const SUBJECT_ALPHA: f32 = 0.5;
+/// True alpha strictly between these bounds makes a pixel part of the edge band.
+pub const EDGE_BAND: (f32, f32) = (0.05, 0.95);
+/// The bright background of [`edge_band_error`] is this percentile of the truth's
+/// subject values.
+pub const BRIGHT_PERCENTILE: f64 = 0.99;
+
+/// Composite error over the edge band ([`edge_band_error`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeBandError {
+    /// Over black (the premultiplied colour itself), relative to the truth's mean subject
+    /// value.
+    pub dark: f64,
+    /// Over the bright level `bright`, relative to the same.
+    pub bright: f64,
+    /// The bright background's level: the truth's [`BRIGHT_PERCENTILE`] subject value.
+    pub bright_level: f64,
+    /// Pixels in the band.
+    pub pixels: usize,
+}
+
+/// The error of an estimated premultiplied image and its alpha, composited over black
+/// and over a bright background, against the truth composited the same way, over the
+/// pixels whose true alpha is strictly inside [`EDGE_BAND`]: over a background `b` the
+/// composite is `F + (1 − α) b`; over black only `F` counts, over a bright background
+/// the estimate's alpha error too. The bright level is the [`BRIGHT_PERCENTILE`] of the
+/// truth's colour values over its subject (true alpha ≥ [`SUBJECT_ALPHA`]). Both errors
+/// are the mean absolute error per channel relative to the truth's mean colour value
+/// over its subject, so that they do not depend on exposure. `None` when the band or the
+/// subject is empty, or the truth's subject is black.
+pub fn edge_band_error(
+    true_colour: &RgbImage,
+    true_alpha: &GrayImage,
+    colour: &RgbImage,
+    alpha: &GrayImage,
+) -> Option<EdgeBandError> {
+    let mut subject: Vec<f32> = true_colour
+        .pixels()
+        .iter()
+        .zip(true_alpha.pixels())
+        .filter(|(_, a)| **a >= SUBJECT_ALPHA)
+        .flat_map(|(c, _)| *c)
+        .collect();
+    if subject.is_empty() {
+        return None;
+    }
+    let mean = subject.iter().map(|&v| v as f64).sum::<f64>() / subject.len() as f64;
+    if !mean.is_finite() || mean <= 0.0 {
+        return None;
+    }
+    subject.sort_by(f32::total_cmp);
+    let b = subject[((subject.len() - 1) as f64 * BRIGHT_PERCENTILE).round() as usize] as f64;
+    let (mut dark, mut bright, mut pixels) = (0.0f64, 0.0f64, 0usize);
+    for i in 0..true_alpha.pixels().len() {
+        let ta = true_alpha.pixels()[i];
+        if !(ta > EDGE_BAND.0 && ta < EDGE_BAND.1) {
+            continue;
+        }
+        let (tc, c) = (true_colour.pixels()[i], colour.pixels()[i]);
+        let a = alpha.pixels()[i] as f64;
+        for k in 0..3 {
+            let (t, e) = (tc[k] as f64, c[k] as f64);
+            dark += (e - t).abs();
+            bright += ((e + (1.0 - a) * b) - (t + (1.0 - ta as f64) * b)).abs();
+        }
+        pixels += 1;
+    }
+    (pixels > 0).then(|| {
+        let n = (3 * pixels) as f64 * mean;
+        EdgeBandError {
+            dark: dark / n,
+            bright: bright / n,
+            bright_level: b,
+            pixels,
+        }
+    })
+}
+
+/// [`edge_band_error`] of premultiplied RGBA images (a rendered subject against the true
+/// one).
+pub fn edge_band_error_rgba(truth: &Image<Rgba>, test: &Image<Rgba>) -> Option<EdgeBandError> {
+    let rgb = |i: &Image<Rgba>| i.map(|p| [p[0], p[1], p[2]]);
+    edge_band_error(&rgb(truth), &alpha_of(truth), &rgb(test), &alpha_of(test))
+}
 
 /// Colour error of a test image against a reference over a region.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -185,6 +270,43 @@ mod tests {
             let v = (((x * 7 + y * 13 + seed) % 17) as f32) / 17.0;
             [v, 0.5 * v, 0.2, if x > 10 { 1.0 } else { 0.0 }]
         })
+    }
+
+    #[test]
+    fn edge_band_error_of_a_known_fringe() {
+        // A subject of colour 0.2 in columns 0-4 whose column 5 is half covered (the
+        // band), with one bright pixel of 1.0: its three values are the top 1 % of the
+        // 3 x 60 subject values (alpha >= 0.5: columns 0-5).
+        let true_alpha = Image::from_fn(10, 10, |x, _| match x {
+            0..5 => 1.0,
+            5 => 0.5,
+            _ => 0.0,
+        });
+        let true_colour = Image::from_fn(10, 10, |x, y| {
+            if x == 0 && y == 0 {
+                [1.0; 3]
+            } else {
+                [0.2 * true_alpha.get(x, y); 3]
+            }
+        });
+        assert!(
+            edge_band_error(&true_colour, &true_alpha, &true_colour, &true_alpha)
+                .is_some_and(|e| e.dark == 0.0 && e.bright == 0.0 && e.pixels == 10)
+        );
+        // The estimate's band pixels carry 0.1 of backdrop light and alpha 0.7.
+        let mut colour = true_colour.clone();
+        let mut alpha = true_alpha.clone();
+        for y in 0..10 {
+            colour.set(5, y, [0.2; 3]);
+            alpha.set(5, y, 0.7);
+        }
+        let e = edge_band_error(&true_colour, &true_alpha, &colour, &alpha).unwrap();
+        let mean = (49.0 * 0.2 + 1.0 + 10.0 * 0.1) / 60.0;
+        assert_eq!(e.bright_level, 1.0);
+        assert!((e.dark - 0.1 / mean).abs() < 1e-6, "{e:?}");
+        // Over 1.0: 0.2 + 0.3 against 0.1 + 0.5.
+        assert!((e.bright - 0.1 / mean).abs() < 1e-6, "{e:?}");
+        assert!(edge_band_error(&true_colour, &true_alpha.map(|_| 0.0), &colour, &alpha).is_none());
     }
 
     #[test]

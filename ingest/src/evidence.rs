@@ -30,6 +30,42 @@ pub struct PoseErrors {
     /// the same grid (`None` without a hull).
     #[serde(default)]
     pub hull_iou: Option<f64>,
+    /// Error over the edge band (true alpha strictly between 0.05 and 0.95) of the
+    /// registered basis images composited over black, against the truth composited the
+    /// same way: mean absolute error per channel relative to the truth's mean subject
+    /// value, mean over the evaluated views and conditions. `None` where not measured
+    /// (no evaluated view, or a part written before the figure existed).
+    #[serde(default)]
+    pub edge_band_error_dark: Option<f64>,
+    /// The same composited over a bright background (the truth's 99th-percentile subject
+    /// value), which also shows the error of alpha: `F + (1 − α) b`.
+    #[serde(default)]
+    pub edge_band_error_bright: Option<f64>,
+    /// [`Self::edge_band_error_dark`] of the frames before edge decontamination (matted
+    /// with the blurred binary matte).
+    #[serde(default)]
+    pub edge_band_error_dark_raw: Option<f64>,
+    /// [`Self::edge_band_error_bright`] of the frames before edge decontamination.
+    #[serde(default)]
+    pub edge_band_error_bright_raw: Option<f64>,
+}
+
+/// A view whose registration and edges the evaluator asked to see
+/// ([`Evaluator::wants_unregistered`]).
+pub struct SampledView {
+    /// Column.
+    pub u: usize,
+    /// Camera.
+    pub v: usize,
+    /// Registered basis images as stored (their alpha is the view's in
+    /// [`PoseEvidence::alphas`]).
+    pub basis: Vec<RgbImage>,
+    /// The same frames matted without registration (same edge treatment).
+    pub unregistered: Vec<RgbImage>,
+    /// The registered frames before edge decontamination.
+    pub raw_basis: Vec<RgbImage>,
+    /// The alpha they were matted with (the blurred binary matte).
+    pub raw_alpha: GrayImage,
 }
 
 /// One pose's intermediate results, as ingest computed them.
@@ -38,9 +74,8 @@ pub struct PoseEvidence<'a> {
     pub alphas: &'a [GrayImage],
     /// Estimated flows per view, in [`frf_core::grid::Neighbour::ALL`] order.
     pub flows: &'a [[Option<FlowImage>; 4]],
-    /// For the views the evaluator asked for ([`Evaluator::wants_unregistered`]):
-    /// `(u, v, registered basis, the same frames matted without registration)`.
-    pub registered: &'a [(usize, usize, Vec<RgbImage>, Vec<RgbImage>)],
+    /// The views the evaluator asked for ([`Evaluator::wants_unregistered`]).
+    pub registered: &'a [SampledView],
     /// The pose's visual hull, when ingest carved one.
     pub hull: Option<&'a VoxelHull>,
 }
@@ -51,7 +86,8 @@ pub type EvaluationError = Box<dyn std::error::Error + Send + Sync>;
 /// Someone who can judge an ingest against a ground truth.
 pub trait Evaluator: Sync {
     /// Whether ingest should keep view `(u, v)`'s basis frames matted without
-    /// registration, to measure what registration gains.
+    /// registration and without edge decontamination ([`SampledView`]), to measure what
+    /// each gains.
     fn wants_unregistered(&self, u: usize, v: usize) -> bool;
     /// The errors of pose `pose` from its evidence.
     fn evaluate(

@@ -6,6 +6,7 @@
 //!
 //! - [`pipeline`]: the ingest, pose by pose, parallel, resumable, with a report;
 //! - [`views`], [`matte`], [`registration`]: one view's mattes and registered basis images;
+//! - [`edges`]: keeping backdrop light out of the subject's edge pixels;
 //! - [`interview`], [`rectify`]: flow between grid neighbours, vertical pairs rectified;
 //! - [`shadows`]: the pose's visual hull and its shadow attenuation maps;
 //! - [`evidence`]: what ingest hands to an evaluator, and the errors it records;
@@ -13,6 +14,7 @@
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod edges;
 pub mod error;
 pub mod evidence;
 pub mod interview;

@@ -25,8 +25,9 @@ use frf_reflectance::{FieldFile, FieldHeader, FieldWriter};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::edges::EdgeMethod;
 use crate::error::{IngestError, Result};
-use crate::evidence::{Evaluator, PoseErrors, PoseEvidence};
+use crate::evidence::{Evaluator, PoseErrors, PoseEvidence, SampledView};
 use crate::interview::{GridViews, grid_flows};
 use crate::matte::MatteRule;
 use crate::shadows::{ShadowOptions, pose_shadows};
@@ -50,6 +51,8 @@ pub struct IngestOptions {
     pub matte_rule: MatteRule,
     /// The visual hull and shadow maps of every pose (`None`: neither).
     pub shadows: Option<ShadowOptions>,
+    /// What to do about backdrop light at the subject's edges.
+    pub edge: EdgeMethod,
 }
 
 /// Progress of long steps: `begin` a named step of `total` units, `advance` by one; and
@@ -105,6 +108,14 @@ pub struct Settings {
     /// Hull and shadow maps.
     #[serde(default)]
     pub shadows: String,
+    /// Edge decontamination ([`EdgeMethod::name`]); parts written before it existed
+    /// were made without.
+    #[serde(default = "no_edge_method")]
+    pub edge: String,
+}
+
+fn no_edge_method() -> String {
+    EdgeMethod::None.name().into()
 }
 
 /// What happened to one pose.
@@ -152,6 +163,14 @@ pub struct IngestReport {
     pub flow_epe_vertical: Option<f64>,
     /// See [`PoseErrors::hull_iou`].
     pub hull_iou: Option<f64>,
+    /// See [`PoseErrors::edge_band_error_dark`].
+    pub edge_band_error_dark: Option<f64>,
+    /// See [`PoseErrors::edge_band_error_bright`].
+    pub edge_band_error_bright: Option<f64>,
+    /// See [`PoseErrors::edge_band_error_dark_raw`].
+    pub edge_band_error_dark_raw: Option<f64>,
+    /// See [`PoseErrors::edge_band_error_bright_raw`].
+    pub edge_band_error_bright_raw: Option<f64>,
     /// Per pose.
     pub poses: Vec<PoseReport>,
     /// The field's size and compression.
@@ -205,6 +224,7 @@ fn settings(options: &IngestOptions) -> Settings {
                 )
             },
         ),
+        edge: options.edge.name().into(),
     }
 }
 
@@ -252,7 +272,7 @@ struct ViewOut {
     summed: RgbImage,
     seconds: ViewSeconds,
     encode_seconds: f64,
-    registered: Option<(Vec<RgbImage>, Vec<RgbImage>)>,
+    registered: Option<SampledView>,
 }
 
 fn ingest_pose(
@@ -309,6 +329,7 @@ fn ingest_pose(
                 flow: params,
                 matte_rule: options.matte_rule,
                 keep_unregistered: evaluator.is_some_and(|e| e.wants_unregistered(u, v)),
+                edge: options.edge,
             };
             let r = process_view(capture, pose, u, v, &clean[v], &settings)?;
             let t = Instant::now();
@@ -317,7 +338,14 @@ fn ingest_pose(
             Ok(ViewOut {
                 images,
                 encode_seconds: t.elapsed().as_secs_f64(),
-                registered: r.unregistered.map(|un| (r.basis, un)),
+                registered: r.kept.map(|k| SampledView {
+                    u,
+                    v,
+                    basis: r.basis,
+                    unregistered: k.unregistered,
+                    raw_basis: k.raw_basis,
+                    raw_alpha: k.raw_alpha,
+                }),
                 alpha: r.alpha,
                 summed: r.summed,
                 seconds: r.seconds,
@@ -421,11 +449,8 @@ fn ingest_pose(
         Some(evaluator) => {
             progress.begin(pose, "evaluation against the ground truth", 1);
             let alphas: Vec<GrayImage> = views.iter().map(|v| v.alpha.clone()).collect();
-            let registered: Vec<(usize, usize, Vec<RgbImage>, Vec<RgbImage>)> = views
-                .into_iter()
-                .enumerate()
-                .filter_map(|(i, v)| v.registered.map(|(r, u)| (i / rows, i % rows, r, u)))
-                .collect();
+            let registered: Vec<SampledView> =
+                views.into_iter().filter_map(|v| v.registered).collect();
             let e = evaluator
                 .evaluate(
                     pose,
@@ -527,6 +552,10 @@ pub fn ingest(
         flow_epe_horizontal: mean(|e| Some(e.flow_epe_horizontal)),
         flow_epe_vertical: mean(|e| Some(e.flow_epe_vertical)),
         hull_iou: mean(|e| e.hull_iou),
+        edge_band_error_dark: mean(|e| e.edge_band_error_dark),
+        edge_band_error_bright: mean(|e| e.edge_band_error_bright),
+        edge_band_error_dark_raw: mean(|e| e.edge_band_error_dark_raw),
+        edge_band_error_bright_raw: mean(|e| e.edge_band_error_bright_raw),
         poses: reports,
         field,
         seconds: start.elapsed().as_secs_f64(),

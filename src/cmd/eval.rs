@@ -9,11 +9,9 @@ use std::time::Instant;
 use clap::Args;
 use frf_core::io::rgba_from;
 use frf_core::io::{write_png8_srgb, write_png8_srgba};
+use frf_eval::metrics::edge_band_error_rgba;
 use frf_eval::ring::{held_out_views, score_held_out};
-use frf_eval::scene::{
-    SceneScore, bright_background, composite_psnr, edge_band_error, mean_of, shadow_error,
-    true_composite,
-};
+use frf_eval::scene::{SceneScore, composite_psnr, mean_of, shadow_error, true_composite};
 use frf_eval::storage::env_lights_for_view;
 use frf_render::composite::{Backdrop, GroundLook};
 use frf_render::renderer::SceneShadow;
@@ -246,8 +244,9 @@ pub fn run(args: EvalArgs) -> CliResult {
             )?;
             let truth = &rgba_from(&t.color, &t.alpha)?;
             let (img, _) = renderer.render(&c.camera, Variant::FourWay)?;
-            dark.push(edge_band_error(truth, &img, [0.0; 3]));
-            bright.push(edge_band_error(truth, &img, bright_background(truth)));
+            let e = edge_band_error_rgba(truth, &img);
+            dark.push(e.map(|e| e.dark));
+            bright.push(e.map(|e| e.bright));
         }
         let (dark, bright) = (mean_of(dark.into_iter()), mean_of(bright.into_iter()));
         Some(SceneScore {

@@ -6,6 +6,7 @@ use std::sync::Mutex;
 
 use clap::{Args, ValueEnum};
 use frf_eval::ingest::StageEvaluator;
+use frf_ingest::edges::EdgeMethod;
 use frf_ingest::evidence::Evaluator;
 use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
 use indicatif::ProgressBar;
@@ -44,6 +45,11 @@ pub struct IngestArgs {
     /// unbiased at silhouettes) or `paper` (the track frame brighter than the matte frame).
     #[arg(long, value_enum, default_value = "half-clean")]
     matte_rule: MatteArg,
+    /// Backdrop light at the subject's edges: `solve` (alpha of edge pixels solved from
+    /// the matte frame, then matted with it), `extend` (the interior's colour extended
+    /// under the edge) or `none` (the blurred binary matte, as the original).
+    #[arg(long, value_enum, default_value = "solve")]
+    edge: EdgeArg,
     /// Write the report as JSON here.
     #[arg(long)]
     report: Option<PathBuf>,
@@ -55,6 +61,23 @@ pub struct IngestArgs {
 enum MatteArg {
     HalfClean,
     Paper,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum EdgeArg {
+    Solve,
+    Extend,
+    None,
+}
+
+impl From<EdgeArg> for EdgeMethod {
+    fn from(e: EdgeArg) -> Self {
+        match e {
+            EdgeArg::Solve => EdgeMethod::Solve,
+            EdgeArg::Extend => EdgeMethod::Extend,
+            EdgeArg::None => EdgeMethod::None,
+        }
+    }
 }
 
 struct Bars {
@@ -109,6 +132,7 @@ pub fn run(args: IngestArgs) -> CliResult {
             MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
             MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
         },
+        edge: args.edge.into(),
     };
     let bars = Bars {
         current: Mutex::new(None),
@@ -139,13 +163,14 @@ pub fn run(args: IngestArgs) -> CliResult {
 
 fn print_report(r: &IngestReport, out: &std::path::Path) {
     println!(
-        "field written to {}: {} poses of {} views, {}x{} pixels, flow {}",
+        "field written to {}: {} poses of {} views, {}x{} pixels, flow {}, edges {}",
         out.display(),
         r.poses.len(),
         r.views,
         r.width,
         r.height,
-        r.settings.flow_preset
+        r.settings.flow_preset,
+        r.settings.edge
     );
     let resumed = r.poses.iter().filter(|p| p.resumed).count();
     if resumed > 0 {
@@ -178,6 +203,18 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
     println!(
         "    same frames unregistered            {}",
         f(r.unregistered_psnr, " dB", 2)
+    );
+    let pair = |after: Option<f64>, before: Option<f64>| match (after, before) {
+        (Some(a), Some(b)) => format!("{a:.4} ({b:.4} before edge decontamination)"),
+        _ => f(after, "", 4),
+    };
+    println!(
+        "    edge band error over black          {}",
+        pair(r.edge_band_error_dark, r.edge_band_error_dark_raw)
+    );
+    println!(
+        "    edge band error over bright         {}",
+        pair(r.edge_band_error_bright, r.edge_band_error_bright_raw)
     );
     println!(
         "    flow EPE inside matte, horizontal   {}",
