@@ -1,9 +1,11 @@
-// The composite pass (docs/design.md section 4.4): per pixel, the backdrop seen along the
-// ray (environment, plate or nothing), the relative irradiance S of the ground where the
-// ray meets the plane y = 0 (the relit shadow, bilinear, 1 off its patch), and the
-// rendered subject over the shadowed backdrop (Porter–Duff over, premultiplied). Writes
-// the composite and, as layers, S and the backdrop without shadow. Twin of `compose` in
-// `render/src/composite.rs`. Compiled after `common.wgsl`.
+// The composite pass (docs/design.md section 4.4): per pixel, the rendered walkers each
+// over the ones behind it, the backdrop seen along the ray (environment, plate or
+// nothing), the relative irradiance S of the ground where the ray meets the plane y = 0
+// (the product of every walker's relit shadow, each in its own subject frame, bilinear,
+// 1 off its patch), and the walkers over the shadowed backdrop (Porter–Duff over,
+// premultiplied). Writes the composite and, as layers, S, the backdrop without shadow and
+// the walkers alone. Twin of `compose` in `render/src/composite.rs`. Compiled after
+// `common.wgsl`.
 //
 // Bind group 0 holds per-frame data (the camera and these settings), group 1 the images.
 
@@ -24,42 +26,82 @@ struct Composite {
     env_yaw: f32,
     // Side of the shadow's ground patch, metres.
     shadow_extent: f32,
+    // Walkers drawn (layers of `subjects` and `shadows`, back to front).
+    instances: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// A walker's subject frame: `subject_from_world`, as columns and translation; the
+// translation's w is 1 when the walker has a relit shadow.
+struct Instance {
+    col_x: vec4<f32>,
+    col_y: vec4<f32>,
+    col_z: vec4<f32>,
+    translation: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> params: Composite;
+@group(0) @binding(2) var<storage, read> instances: array<Instance>;
 
-// The rendered subject, premultiplied linear RGBA, one texel per pixel.
-@group(1) @binding(0) var subject: texture_2d<f32>;
+// The rendered walkers, premultiplied linear RGBA, one texel per pixel, one layer each.
+@group(1) @binding(0) var subjects: texture_2d_array<f32>;
 // The environment, latitude-longitude radiance (rgb).
 @group(1) @binding(1) var env: texture_2d<f32>;
 // The plate, linear rgb, one texel per pixel.
 @group(1) @binding(2) var plate: texture_2d<f32>;
-// The relit shadow (rgb), rows along +z.
-@group(1) @binding(3) var shadow: texture_2d<f32>;
+// The walkers' relit shadows (rgb), rows along +z, one layer each.
+@group(1) @binding(3) var shadows: texture_2d_array<f32>;
 
 struct Layers {
     @location(0) composite: vec4<f32>,
     @location(1) shadow: vec4<f32>,
     @location(2) backdrop: vec4<f32>,
+    @location(3) subject: vec4<f32>,
 }
 
 const PI: f32 = 3.14159265358979;
 
-// Bilinear sample of a texture at continuous texel coordinates (centres at integers),
-// edges clamped.
+// Bilinear weights and corner of continuous texel coordinates p (centres at integers).
+struct Footprint {
+    i0: vec2<i32>,
+    f: vec2<f32>,
+}
+
+fn footprint(p: vec2<f32>) -> Footprint {
+    let p0 = floor(p);
+    return Footprint(vec2<i32>(p0), p - p0);
+}
+
+// Bilinear sample of a texture, edges clamped.
 fn bilinear(t: texture_2d<f32>, p: vec2<f32>) -> vec4<f32> {
     let size = vec2<i32>(textureDimensions(t));
-    let p0 = floor(p);
-    let f = p - p0;
-    let i0 = vec2<i32>(p0);
+    let q = footprint(p);
     var out = vec4<f32>(0.0);
     for (var dy = 0; dy < 2; dy++) {
-        let wy = select(f.y, 1.0 - f.y, dy == 0);
+        let wy = select(q.f.y, 1.0 - q.f.y, dy == 0);
         for (var dx = 0; dx < 2; dx++) {
-            let wx = select(f.x, 1.0 - f.x, dx == 0);
-            let q = clamp(i0 + vec2<i32>(dx, dy), vec2<i32>(0), size - vec2<i32>(1));
-            out += textureLoad(t, q, 0) * (wx * wy);
+            let wx = select(q.f.x, 1.0 - q.f.x, dx == 0);
+            let c = clamp(q.i0 + vec2<i32>(dx, dy), vec2<i32>(0), size - vec2<i32>(1));
+            out += textureLoad(t, c, 0) * (wx * wy);
+        }
+    }
+    return out;
+}
+
+// The same for one layer of an array texture.
+fn bilinear_layer(t: texture_2d_array<f32>, layer: u32, p: vec2<f32>) -> vec4<f32> {
+    let size = vec2<i32>(textureDimensions(t));
+    let q = footprint(p);
+    var out = vec4<f32>(0.0);
+    for (var dy = 0; dy < 2; dy++) {
+        let wy = select(q.f.y, 1.0 - q.f.y, dy == 0);
+        for (var dx = 0; dx < 2; dx++) {
+            let wx = select(q.f.x, 1.0 - q.f.x, dx == 0);
+            let c = clamp(q.i0 + vec2<i32>(dx, dy), vec2<i32>(0), size - vec2<i32>(1));
+            out += textureLoad(t, c, i32(layer), 0) * (wx * wy);
         }
     }
     return out;
@@ -88,15 +130,17 @@ fn env_radiance(d_in: vec3<f32>) -> vec3<f32> {
     return bilinear(env, vec2<f32>(x, ty)).xyz;
 }
 
-// The relative irradiance at ground point (x, z): 1 off the patch. Twin of
-// `RelitShadow::at`.
-fn shadow_at(x: f32, z: f32) -> vec3<f32> {
+// The relative irradiance at the world's ground point p under walker i's shadow: 1 off
+// its patch. Twin of `RelitShadow::at` in the walker's subject frame.
+fn shadow_at(i: u32, p: vec3<f32>) -> vec3<f32> {
+    let m = instances[i];
+    let q = m.col_x.xyz * p.x + m.col_y.xyz * p.y + m.col_z.xyz * p.z + m.translation.xyz;
     let half = 0.5 * params.shadow_extent;
-    if (params.has_shadow == 0u || abs(x) > half || abs(z) > half) {
+    if (params.has_shadow == 0u || m.translation.w == 0.0 || abs(q.x) > half || abs(q.z) > half) {
         return vec3<f32>(1.0);
     }
     let s = params.shadow_extent / f32(params.shadow_texels);
-    return bilinear(shadow, vec2<f32>((x + half) / s - 0.5, (z + half) / s - 0.5)).xyz;
+    return bilinear_layer(shadows, i, vec2<f32>((q.x + half) / s - 0.5, (q.z + half) / s - 0.5)).xyz;
 }
 
 fn luminance(c: vec3<f32>) -> f32 {
@@ -115,7 +159,9 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
         let p = origin + dir * (-origin.y / dir.y);
         if (finite(p.x) && finite(p.z)) {
             hits_ground = true;
-            s = shadow_at(p.x, p.z);
+            for (var i = 0u; i < params.instances; i++) {
+                s *= shadow_at(i, vec3<f32>(p.x, 0.0, p.z));
+            }
         }
     }
     var back = vec4<f32>(0.0);
@@ -132,10 +178,16 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
     if (params.backdrop == 0u) {
         under = vec4<f32>(0.0, 0.0, 0.0, clamp(1.0 - luminance(s), 0.0, 1.0));
     }
-    let front = textureLoad(subject, pixel, 0);
+    // The walkers, each over the ones behind it.
+    var front = vec4<f32>(0.0);
+    for (var i = 0u; i < params.instances; i++) {
+        let layer = textureLoad(subjects, pixel, i32(i), 0);
+        front = layer + (1.0 - clamp(layer.w, 0.0, 1.0)) * front;
+    }
     var out: Layers;
     out.composite = front + (1.0 - clamp(front.w, 0.0, 1.0)) * under;
     out.shadow = vec4<f32>(s, 1.0);
     out.backdrop = back;
+    out.subject = front;
     return out;
 }

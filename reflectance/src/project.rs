@@ -177,6 +177,23 @@ impl Projector {
             .collect()
     }
 
+    /// Per condition: the elevations (radians, lowest and highest) its region reaches,
+    /// from the lookup grid's cell edges. Turned about the vertical axis, the region
+    /// never leaves this band.
+    pub fn elevation_bands(&self) -> Vec<(f32, f32)> {
+        let mut bands = vec![(f32::INFINITY, f32::NEG_INFINITY); self.conditions()];
+        for ie in 0..EL_CELLS {
+            let lo = ie as f32 / EL_CELLS as f32 * PI - PI / 2.0;
+            let hi = (ie + 1) as f32 / EL_CELLS as f32 * PI - PI / 2.0;
+            for ia in 0..AZ_CELLS {
+                let b = &mut bands[self.grid[ie * AZ_CELLS + ia] as usize];
+                b.0 = b.0.min(lo);
+                b.1 = b.1.max(hi);
+            }
+        }
+        bands
+    }
+
     /// Whether condition `k` is a floor condition.
     pub fn is_floor(&self, k: usize) -> bool {
         self.floor[k]

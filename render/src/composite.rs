@@ -137,6 +137,39 @@ pub fn over(subject: Rgba, backdrop: Rgba, s: Rgb, transparent: bool) -> Rgba {
     [0, 1, 2, 3].map(|c| subject[c] + k * under[c])
 }
 
+/// The order to draw walkers standing at `positions` (world frame) in, back to front:
+/// farthest from the camera first, so that each goes over the ones behind it.
+pub fn back_to_front(camera: &Camera, positions: &[Vec3]) -> Vec<usize> {
+    let c = camera.centre();
+    let mut order: Vec<usize> = (0..positions.len()).collect();
+    order.sort_by(|&a, &b| {
+        (positions[b] - c)
+            .length_squared()
+            .total_cmp(&(positions[a] - c).length_squared())
+            .then(a.cmp(&b))
+    });
+    order
+}
+
+/// Walkers rendered one by one (back to front), each put over the ones before it.
+pub fn stack(layers: Vec<Image<Rgba>>) -> Result<Image<Rgba>> {
+    let mut layers = layers.into_iter();
+    let Some(mut out) = layers.next() else {
+        return Err(RenderError::BadParameter("no walker to stack".into()));
+    };
+    for layer in layers {
+        if layer.size() != out.size() {
+            return Err(RenderError::BadParameter(
+                "walker layers of different sizes".into(),
+            ));
+        }
+        for (o, l) in out.pixels_mut().iter_mut().zip(layer.pixels()) {
+            *o = over(*l, *o, [1.0; 3], false);
+        }
+    }
+    Ok(out)
+}
+
 /// Composites `subject` (rendered by `camera`) over `backdrop`, its ground darkened by
 /// `shadow(ground point)` (see the module docs): the composite and its layers.
 pub fn compose(

@@ -37,7 +37,8 @@ impl FrameStats {
         }
     }
 
-    fn merge(mut self, o: Self) -> Self {
+    /// The counts of two frames (or two walkers of a frame) together.
+    pub fn merge(mut self, o: Self) -> Self {
         self.inside += o.inside;
         self.clamped_above += o.clamped_above;
         self.clamped_below += o.clamped_below;

@@ -10,7 +10,8 @@
 //!   [`renderer`]: one front for both.
 //! - [`shadow`]: the subject's relit shadow on the ground; [`composite`]: backdrops and
 //!   Porter–Duff compositing of the subject over them.
-//! - [`path`]: virtual camera paths (keyframes, orbit).
+//! - [`path`]: virtual camera paths (keyframes, orbit); [`scene`]: scene files (walkers
+//!   in time, lighting, camera, backdrop) and the plan of what a scene needs.
 //!
 //! Conventions: [`frf_core::conventions`].
 
@@ -24,6 +25,7 @@ pub mod morph;
 pub mod path;
 pub mod renderer;
 pub mod resident;
+pub mod scene;
 pub mod shadow;
 
 pub use error::{RenderError, Result};

@@ -1,33 +1,32 @@
-//! One front for both renderers: a pose made resident either on the GPU ([`crate::gpu`])
-//! or in memory for the CPU reference ([`crate::cpu`]), rendering frames the same way.
-//! The command line and the evaluation use this, so that `--cpu` changes nothing else.
+//! One front for both renderers: poses made resident either on the GPU ([`crate::gpu`])
+//! or in memory for the CPU reference ([`crate::cpu`]), and frames drawn the same way.
+//! The command line, scenes and the evaluation use this, so that `--cpu` changes nothing
+//! else.
 //!
-//! A renderer draws the subject alone ([`Renderer::render`]) or, once given a scene
-//! ([`Renderer::set_scene`]: a backdrop and the pose's shadow maps), composites it with
-//! its shadow over the backdrop ([`Renderer::render_frame`]).
+//! - [`Device`]: where rendering happens; it makes poses resident ([`Resident`]), sets
+//!   their shadow, makes backdrops resident and draws frames of one or more walkers
+//!   ([`Device::render_frame`]): each walker's pose seen by the camera from its subject
+//!   frame, back to front, over the backdrop darkened by their shadows.
+//! - [`Renderer`]: one pose, one walker at the origin, one backdrop: the simple case.
 
-use frf_core::camera::Camera;
+use frf_core::camera::{Camera, Rigid};
 use frf_core::image::{Image, Rgb, Rgba};
 
-use crate::composite::{Backdrop, Layers, compose};
+use crate::composite::{Backdrop, Layers, back_to_front, compose, stack};
 use crate::cpu::{FrameStats, render_cpu};
 use crate::error::Result;
-use crate::gpu::composite::GpuBackdrop;
+use crate::gpu::composite::{GpuBackdrop, GpuInstanceRef};
 use crate::gpu::{Gpu, GpuPose};
 use crate::morph::Variant;
 use crate::resident::{PoseSource, ResidentPose};
 use crate::shadow::{RelitShadow, ShadowMaps};
 
-enum Backend {
-    Gpu {
-        gpu: Box<Gpu>,
-        pose: Box<GpuPose>,
-        backdrop: Option<GpuBackdrop>,
-    },
-    Cpu {
-        pose: Box<ResidentPose>,
-        shadow: Option<RelitShadow>,
-    },
+/// Where rendering happens.
+pub enum Device {
+    /// A wgpu adapter.
+    Gpu(Box<Gpu>),
+    /// The CPU reference (rayon).
+    Cpu,
 }
 
 /// Where a scene's shadow comes from.
@@ -41,173 +40,322 @@ pub enum SceneShadow<'a> {
     Relit(RelitShadow),
 }
 
+enum ResidentKind {
+    Gpu(Box<GpuPose>),
+    Cpu {
+        pose: Box<ResidentPose>,
+        shadow: Option<RelitShadow>,
+    },
+}
+
+/// A pose made resident on a [`Device`], relit.
+pub struct Resident {
+    kind: ResidentKind,
+    ground_coefficients: Option<Vec<Rgb>>,
+    shadow: bool,
+    /// The pose.
+    pub pose: u32,
+}
+
+impl Resident {
+    /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy).
+    pub fn bytes(&self) -> u64 {
+        match &self.kind {
+            ResidentKind::Gpu(p) => p.geometry.resident_bytes(),
+            ResidentKind::Cpu { pose, .. } => pose.resident_bytes(),
+        }
+    }
+
+    /// Whether the pose carries a shadow.
+    pub fn has_shadow(&self) -> bool {
+        self.shadow
+    }
+}
+
+/// A backdrop made resident on a [`Device`].
+pub struct DeviceBackdrop {
+    cpu: Backdrop,
+    gpu: Option<GpuBackdrop>,
+}
+
+/// A walker of a frame: a resident pose and where it stands.
+#[derive(Clone, Copy)]
+pub struct Walker<'a> {
+    /// Its pose, relit for it.
+    pub resident: &'a Resident,
+    /// Its subject frame in the world.
+    pub world_from_subject: Rigid,
+}
+
 /// A composited frame.
 #[derive(Debug, Clone)]
 pub struct Frame {
-    /// The subject over its shadowed backdrop (premultiplied linear RGBA).
+    /// The walkers over their shadowed backdrop (premultiplied linear RGBA).
     pub composite: Image<Rgba>,
     /// The layers, when asked for.
     pub layers: Option<Layers>,
-    /// What happened to the pixels of the subject.
+    /// What happened to the pixels of the walkers, summed.
     pub stats: FrameStats,
 }
 
-/// A resident pose and the renderer that draws it.
+impl Device {
+    /// The GPU (the default adapter; lavapipe on machines without one), or the CPU
+    /// reference when `cpu`.
+    pub fn open(cpu: bool) -> Result<Self> {
+        Ok(if cpu {
+            Device::Cpu
+        } else {
+            Device::Gpu(Box::new(Gpu::new()?))
+        })
+    }
+
+    /// What renders, in words.
+    pub fn name(&self) -> String {
+        match self {
+            Device::Gpu(gpu) => format!("GPU {}", gpu.adapter()),
+            Device::Cpu => format!("CPU reference ({} threads)", rayon::current_num_threads()),
+        }
+    }
+
+    /// Makes `source` resident, relit (on the GPU, or on the CPU).
+    pub fn make_resident(&self, source: &PoseSource) -> Result<Resident> {
+        let kind = match self {
+            Device::Gpu(gpu) => ResidentKind::Gpu(Box::new(gpu.upload_pose(source)?)),
+            Device::Cpu => ResidentKind::Cpu {
+                pose: Box::new(ResidentPose::relight_cpu(source)),
+                shadow: None,
+            },
+        };
+        Ok(Resident {
+            kind,
+            ground_coefficients: source.ground_coefficients.clone(),
+            shadow: false,
+            pose: source.geometry.pose,
+        })
+    }
+
+    /// Sets the shadow `resident` casts (maps without an environment give none).
+    pub fn set_shadow(&self, resident: &mut Resident, shadow: SceneShadow) -> Result<()> {
+        let shadow = match shadow {
+            SceneShadow::Maps(m) => resident
+                .ground_coefficients
+                .as_deref()
+                .map(|c| (Some(m), m.relight(c), c.to_vec())),
+            SceneShadow::Relit(r) => Some((None, r, Vec::new())),
+            SceneShadow::None => None,
+        };
+        match (&mut resident.kind, self) {
+            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => match &shadow {
+                // The GPU relights the maps itself (tested against the CPU's).
+                Some((Some(m), _, c)) => gpu.set_shadow(pose, m, c)?,
+                Some((None, r, _)) => gpu.upload_shadow(pose, r)?,
+                None => pose.clear_shadow(),
+            },
+            (ResidentKind::Cpu { shadow: relit, .. }, _) => {
+                *relit = shadow.as_ref().map(|s| s.1.clone());
+            }
+            (ResidentKind::Gpu(_), Device::Cpu) => {
+                return Err(crate::RenderError::BadParameter(
+                    "a GPU-resident pose given to the CPU renderer".into(),
+                ));
+            }
+        }
+        resident.shadow = shadow.is_some();
+        Ok(())
+    }
+
+    /// The relit shadow of `resident` (read back from the GPU), if there is one.
+    pub fn relit_shadow(&self, resident: &Resident) -> Result<Option<RelitShadow>> {
+        Ok(match (&resident.kind, self) {
+            (ResidentKind::Cpu { shadow, .. }, _) => shadow.clone(),
+            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => {
+                match (gpu.read_shadow(pose)?, pose.shadow_ground()) {
+                    (Some(image), Some(ground)) => Some(RelitShadow { ground, image }),
+                    _ => None,
+                }
+            }
+            (ResidentKind::Gpu(_), Device::Cpu) => None,
+        })
+    }
+
+    /// Makes `backdrop` resident.
+    pub fn backdrop(&self, backdrop: Backdrop) -> Result<DeviceBackdrop> {
+        Ok(DeviceBackdrop {
+            gpu: match self {
+                Device::Gpu(gpu) => Some(gpu.upload_backdrop(&backdrop)?),
+                Device::Cpu => None,
+            },
+            cpu: backdrop,
+        })
+    }
+
+    /// Renders the subject of `resident` alone, seen by `camera` (its subject frame):
+    /// premultiplied linear RGBA, and what happened to its pixels.
+    pub fn render_subject(
+        &self,
+        resident: &Resident,
+        camera: &Camera,
+        variant: Variant,
+    ) -> Result<(Image<Rgba>, FrameStats)> {
+        match (&resident.kind, self) {
+            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => gpu.render(pose, camera, variant),
+            (ResidentKind::Cpu { pose, .. }, _) => Ok(render_cpu(pose, camera, variant)),
+            (ResidentKind::Gpu(_), Device::Cpu) => Err(crate::RenderError::BadParameter(
+                "a GPU-resident pose given to the CPU renderer".into(),
+            )),
+        }
+    }
+
+    /// Renders a frame of `camera` (world frame): the walkers over `backdrop`, its ground
+    /// darkened by their shadows; with the layers when `layers`.
+    pub fn render_frame(
+        &self,
+        walkers: &[Walker],
+        backdrop: &DeviceBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        layers: bool,
+    ) -> Result<Frame> {
+        backdrop.cpu.check(camera)?;
+        if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
+            let instances = walkers
+                .iter()
+                .map(|w| match &w.resident.kind {
+                    ResidentKind::Gpu(pose) => Ok(GpuInstanceRef {
+                        pose,
+                        world_from_subject: w.world_from_subject,
+                    }),
+                    ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
+                        "a CPU-resident pose given to the GPU renderer".into(),
+                    )),
+                })
+                .collect::<Result<Vec<_>>>()?;
+            let (composite, l, stats) =
+                gpu.render_composite(&instances, b, camera, variant, layers)?;
+            return Ok(Frame {
+                composite,
+                layers: l,
+                stats,
+            });
+        }
+        // The CPU reference: each walker alone, stacked back to front, then composited.
+        let positions: Vec<_> = walkers
+            .iter()
+            .map(|w| w.world_from_subject.translation)
+            .collect();
+        let mut drawn = Vec::with_capacity(walkers.len());
+        let mut stats = FrameStats::default();
+        let mut shadows = Vec::new();
+        for k in back_to_front(camera, &positions) {
+            let w = &walkers[k];
+            let ResidentKind::Cpu { pose, shadow } = &w.resident.kind else {
+                return Err(crate::RenderError::BadParameter(
+                    "a GPU-resident pose given to the CPU renderer".into(),
+                ));
+            };
+            let subject_from_world = w.world_from_subject.inverse();
+            let (img, s) = render_cpu(pose, &camera.transformed(&subject_from_world), variant);
+            stats = stats.merge(s);
+            drawn.push(img);
+            if let Some(relit) = shadow {
+                shadows.push((subject_from_world, relit));
+            }
+        }
+        let shadow = |p: glam::Vec3| {
+            let mut s = [1.0f32; 3];
+            for (m, relit) in &shadows {
+                let q = m.transform_point(p);
+                let r = relit.at(q.x, q.z);
+                for c in 0..3 {
+                    s[c] *= r[c];
+                }
+            }
+            s
+        };
+        let (composite, l) = compose(stack(drawn)?, camera, &backdrop.cpu, &shadow)?;
+        Ok(Frame {
+            composite,
+            layers: layers.then_some(l),
+            stats,
+        })
+    }
+}
+
+/// A resident pose and the renderer that draws it: one walker at the origin.
 pub struct Renderer {
-    backend: Backend,
-    device: String,
-    ground_coefficients: Option<Vec<Rgb>>,
-    backdrop: Backdrop,
-    shadow_relit: bool,
+    device: Device,
+    resident: Resident,
+    backdrop: Option<DeviceBackdrop>,
 }
 
 impl Renderer {
     /// Makes `source` resident on `gpu` (relit there), or relights it on the CPU when
     /// `gpu` is `None`.
     pub fn new(source: &PoseSource, gpu: Option<Gpu>) -> Result<Self> {
-        let (backend, device) = match gpu {
-            Some(gpu) => {
-                let pose = gpu.upload_pose(source)?;
-                (
-                    Backend::Gpu {
-                        pose: Box::new(pose),
-                        backdrop: None,
-                        gpu: Box::new(gpu),
-                    },
-                    String::new(),
-                )
-            }
-            None => (
-                Backend::Cpu {
-                    pose: Box::new(ResidentPose::relight_cpu(source)),
-                    shadow: None,
-                },
-                format!("CPU reference ({} threads)", rayon::current_num_threads()),
-            ),
+        let device = match gpu {
+            Some(g) => Device::Gpu(Box::new(g)),
+            None => Device::Cpu,
         };
-        let device = match &backend {
-            Backend::Gpu { gpu, .. } => format!("GPU {}", gpu.adapter()),
-            Backend::Cpu { .. } => device,
-        };
+        let resident = device.make_resident(source)?;
         Ok(Self {
-            backend,
             device,
-            ground_coefficients: source.ground_coefficients.clone(),
-            backdrop: Backdrop::None,
-            shadow_relit: false,
+            resident,
+            backdrop: None,
         })
     }
 
-    /// Sets what frames are composited over: `backdrop`, and the subject's shadow
-    /// (see [`SceneShadow`]; maps without an environment give none).
+    /// Sets what frames are composited over: `backdrop`, and the subject's shadow.
     pub fn set_scene(&mut self, backdrop: Backdrop, shadow: SceneShadow) -> Result<()> {
-        let shadow = match shadow {
-            SceneShadow::Maps(m) => self
-                .ground_coefficients
-                .as_deref()
-                .map(|c| (Some(m), m.relight(c), c)),
-            SceneShadow::Relit(r) => Some((None, r, &[][..])),
-            SceneShadow::None => None,
-        };
-        match &mut self.backend {
-            Backend::Gpu {
-                gpu,
-                pose,
-                backdrop: resident,
-            } => {
-                *resident = Some(gpu.upload_backdrop(&backdrop)?);
-                match &shadow {
-                    // The GPU relights the maps itself (tested against the CPU's).
-                    Some((Some(m), _, c)) => gpu.set_shadow(pose, m, c)?,
-                    Some((None, r, _)) => gpu.upload_shadow(pose, r)?,
-                    None => pose.clear_shadow(),
-                }
-            }
-            Backend::Cpu { shadow: relit, .. } => {
-                *relit = shadow.as_ref().map(|s| s.1.clone());
-            }
-        }
-        self.shadow_relit = shadow.is_some();
-        self.backdrop = backdrop;
+        self.device.set_shadow(&mut self.resident, shadow)?;
+        self.backdrop = Some(self.device.backdrop(backdrop)?);
         Ok(())
     }
 
     /// Whether frames carry the subject's shadow.
     pub fn has_shadow(&self) -> bool {
-        self.shadow_relit
+        self.resident.has_shadow()
     }
 
     /// The relit shadow of the ground (read back from the GPU), if there is one.
     pub fn relit_shadow(&self) -> Result<Option<RelitShadow>> {
-        Ok(match &self.backend {
-            Backend::Cpu { shadow, .. } => shadow.clone(),
-            Backend::Gpu { gpu, pose, .. } => {
-                match (gpu.read_shadow(pose)?, pose.shadow_ground()) {
-                    (Some(image), Some(ground)) => Some(RelitShadow { ground, image }),
-                    _ => None,
-                }
-            }
-        })
+        self.device.relit_shadow(&self.resident)
     }
 
     /// Renders the subject of a frame: premultiplied linear RGBA, and what happened to
     /// its pixels.
     pub fn render(&self, camera: &Camera, variant: Variant) -> Result<(Image<Rgba>, FrameStats)> {
-        match &self.backend {
-            Backend::Gpu { gpu, pose, .. } => gpu.render(pose, camera, variant),
-            Backend::Cpu { pose, .. } => Ok(render_cpu(pose, camera, variant)),
-        }
+        self.device.render_subject(&self.resident, camera, variant)
     }
 
     /// Renders a frame composited over the scene set by [`Renderer::set_scene`] (over
     /// nothing before that), with its layers when `layers`.
     pub fn render_frame(&self, camera: &Camera, variant: Variant, layers: bool) -> Result<Frame> {
-        self.backdrop.check(camera)?;
-        match &self.backend {
-            Backend::Gpu {
-                gpu,
-                pose,
-                backdrop,
-            } => {
-                let owned;
-                let backdrop = match backdrop {
-                    Some(b) => b,
-                    None => {
-                        owned = gpu.upload_backdrop(&Backdrop::None)?;
-                        &owned
-                    }
-                };
-                let (composite, l, stats) =
-                    gpu.render_composite(pose, backdrop, camera, variant, layers)?;
-                Ok(Frame {
-                    composite,
-                    layers: l,
-                    stats,
-                })
+        let owned;
+        let backdrop = match &self.backdrop {
+            Some(b) => b,
+            None => {
+                owned = self.device.backdrop(Backdrop::None)?;
+                &owned
             }
-            Backend::Cpu { pose, shadow } => {
-                let (subject, stats) = render_cpu(pose, camera, variant);
-                let at = |p: glam::Vec3| shadow.as_ref().map_or([1.0; 3], |s| s.at(p.x, p.z));
-                let (composite, l) = compose(subject, camera, &self.backdrop, &at)?;
-                Ok(Frame {
-                    composite,
-                    layers: layers.then_some(l),
-                    stats,
-                })
-            }
-        }
+        };
+        let walker = Walker {
+            resident: &self.resident,
+            world_from_subject: Rigid {
+                rotation: glam::Mat3::IDENTITY,
+                translation: glam::Vec3::ZERO,
+            },
+        };
+        self.device
+            .render_frame(&[walker], backdrop, camera, variant, layers)
     }
 
     /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy).
     pub fn resident_bytes(&self) -> u64 {
-        match &self.backend {
-            Backend::Gpu { pose, .. } => pose.geometry.resident_bytes(),
-            Backend::Cpu { pose, .. } => pose.resident_bytes(),
-        }
+        self.resident.bytes()
     }
 
     /// What renders, in words.
-    pub fn device(&self) -> &str {
-        &self.device
+    pub fn device(&self) -> String {
+        self.device.name()
     }
 }

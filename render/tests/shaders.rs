@@ -9,7 +9,7 @@ use std::mem::{offset_of, size_of};
 
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuComposite, GpuFrame, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
+    GpuComposite, GpuFrame, GpuInstance, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -155,7 +155,17 @@ fn pod_structs_match_naga_layouts() {
             ground_radiance,
             env_size,
             env_yaw,
-            shadow_extent
+            shadow_extent,
+            instances,
+            pad0,
+            pad1,
+            pad2
         ]
+    );
+    check_layout!(
+        &composite,
+        "Instance",
+        GpuInstance,
+        [col_x, col_y, col_z, translation]
     );
 }

@@ -8,11 +8,17 @@ use frf_core::camera::Camera;
 use frf_core::image::{Image, Rgba};
 use wgpu::util::DeviceExt;
 
-use super::bind::{FLOAT, cleared, full_screen_pipeline, rgba32f, texture_2d, uniform};
+use frf_core::camera::Rigid;
+
+use super::bind::{
+    FLOAT, cleared, full_screen_pipeline, rgba32f, storage, texture_2d, texture_array, uniform,
+};
 use super::pose::GpuPose;
-use super::types::GpuComposite;
+use super::rebin::frame_uniform;
+use super::types::{GpuComposite, GpuInstance};
 use super::{Gpu, shaders};
-use crate::composite::{Backdrop, GroundLook, Layers};
+use crate::RenderError;
+use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::morph::Variant;
@@ -31,15 +37,15 @@ impl CompositePass {
         let f = wgpu::ShaderStages::FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite frame"),
-            entries: &[uniform(0, f), uniform(1, f)],
+            entries: &[uniform(0, f), uniform(1, f), storage(2, true, f)],
         });
         let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite images"),
             entries: &[
-                texture_2d(0, FLOAT),
+                texture_array(0, FLOAT),
                 texture_2d(1, FLOAT),
                 texture_2d(2, FLOAT),
-                texture_2d(3, FLOAT),
+                texture_array(3, FLOAT),
             ],
         });
         let pipeline = full_screen_pipeline(
@@ -48,7 +54,7 @@ impl CompositePass {
             &[&frame_layout, &image_layout],
             &module,
             "fs_composite",
-            3,
+            4,
         );
         Self {
             frame_layout,
@@ -56,6 +62,14 @@ impl CompositePass {
             pipeline,
         }
     }
+}
+
+/// A walker to draw: its resident pose and where it stands.
+pub struct GpuInstanceRef<'a> {
+    /// The pose it shows, relit for its heading.
+    pub pose: &'a GpuPose,
+    /// Its subject frame in the world.
+    pub world_from_subject: Rigid,
 }
 
 /// A backdrop resident on the GPU.
@@ -107,6 +121,10 @@ impl Gpu {
                 env_size: [1, 1],
                 env_yaw: 0.0,
                 shadow_extent: 1.0,
+                instances: 0,
+                pad0: 0,
+                pad1: 0,
+                pad2: 0,
             };
             let (env, plate, plate_size) = match backdrop {
                 Backdrop::None => (one("no environment"), one("no plate"), None),
@@ -152,12 +170,13 @@ impl Gpu {
         })
     }
 
-    /// Renders a frame of `camera`: the subject with `variant`, composited over
-    /// `backdrop` with the pose's relit shadow (if any); with `layers`, the subject, the
-    /// relative irradiance and the backdrop too.
+    /// Renders a frame of `camera` (world frame): every walker's pose drawn by the
+    /// camera as its subject frame sees it (back to front, [`back_to_front`]), composited
+    /// over `backdrop` with the product of their relit shadows; with `layers`, the
+    /// walkers alone, the relative irradiance and the backdrop too.
     pub fn render_composite(
         &self,
-        pose: &GpuPose,
+        instances: &[GpuInstanceRef],
         backdrop: &GpuBackdrop,
         camera: &Camera,
         variant: Variant,
@@ -166,57 +185,158 @@ impl Gpu {
         if let Some((w, h)) = backdrop.plate_size
             && (w, h) != (camera.width, camera.height)
         {
-            return Err(crate::RenderError::BadParameter(format!(
+            return Err(RenderError::BadParameter(format!(
                 "the plate is {w}x{h}, the camera {}x{}: a plate is seen by its own camera",
                 camera.width, camera.height
             )));
         }
+        if instances.is_empty() {
+            return Err(RenderError::BadParameter("a frame with no walker".into()));
+        }
+        let shadow_info = instances
+            .iter()
+            .find_map(|i| i.pose.shadow.as_ref().map(|s| s.1));
+        if let Some(info) = shadow_info
+            && instances.iter().any(|i| {
+                i.pose
+                    .shadow
+                    .as_ref()
+                    .is_some_and(|s| s.1.texels != info.texels)
+            })
+        {
+            return Err(RenderError::BadParameter(
+                "walkers with shadow maps of different sizes".into(),
+            ));
+        }
         self.scoped("compositing a frame", || {
             let size = (camera.width, camera.height);
+            let order = back_to_front(
+                camera,
+                &instances
+                    .iter()
+                    .map(|i| i.world_from_subject.translation)
+                    .collect::<Vec<_>>(),
+            );
+            let drawn: Vec<(&GpuPose, Camera)> = order
+                .iter()
+                .map(|&k| {
+                    let i = &instances[k];
+                    (i.pose, camera.transformed(&i.world_from_subject.inverse()))
+                })
+                .collect();
             let mut encoder = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("composite"),
                 });
-            let subject = self.draw_subject(&mut encoder, pose, camera, variant);
-            let mut params = backdrop.params;
-            let one = upload_rgb(self, "no shadow", (1, 1), &[[1.0; 3]]);
-            let shadow_texture = match &pose.shadow {
-                Some((texture, info)) => {
-                    params.has_shadow = 1;
-                    params.shadow_texels = info.texels;
-                    params.shadow_extent = info.extent_m;
-                    texture
+            let subjects = self.draw_subjects(&mut encoder, &drawn, size, variant);
+            let n_shadow = shadow_info.map_or(1, |s| s.texels);
+            let shadows = self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("walker shadows"),
+                size: wgpu::Extent3d {
+                    width: n_shadow,
+                    height: n_shadow,
+                    depth_or_array_layers: order.len() as u32,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            let mut gpu_instances = Vec::with_capacity(order.len());
+            for (layer, &k) in order.iter().enumerate() {
+                let i = &instances[k];
+                let m = i.world_from_subject.inverse();
+                let has = i.pose.shadow.is_some();
+                if let Some((texture, _)) = &i.pose.shadow {
+                    encoder.copy_texture_to_texture(
+                        texture.as_image_copy(),
+                        wgpu::TexelCopyTextureInfo {
+                            texture: &shadows,
+                            mip_level: 0,
+                            origin: wgpu::Origin3d {
+                                x: 0,
+                                y: 0,
+                                z: layer as u32,
+                            },
+                            aspect: wgpu::TextureAspect::All,
+                        },
+                        wgpu::Extent3d {
+                            width: n_shadow,
+                            height: n_shadow,
+                            depth_or_array_layers: 1,
+                        },
+                    );
                 }
-                None => &one,
-            };
-            let params = self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("composite params"),
-                    contents: bytemuck::bytes_of(&params),
-                    usage: wgpu::BufferUsages::UNIFORM,
+                gpu_instances.push(GpuInstance {
+                    col_x: m.rotation.x_axis.extend(0.0).to_array(),
+                    col_y: m.rotation.y_axis.extend(0.0).to_array(),
+                    col_z: m.rotation.z_axis.extend(0.0).to_array(),
+                    translation: m.translation.extend(if has { 1.0 } else { 0.0 }).to_array(),
                 });
+            }
+            let mut params = backdrop.params;
+            if let Some(info) = shadow_info {
+                params.has_shadow = 1;
+                params.shadow_texels = info.texels;
+                params.shadow_extent = info.extent_m;
+            }
+            params.instances = order.len() as u32;
+            let buffer = |label: &str, contents: &[u8], usage| {
+                self.device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(label),
+                        contents,
+                        usage,
+                    })
+            };
+            let frame = buffer(
+                "composite camera",
+                bytemuck::bytes_of(&frame_uniform(None, camera, variant)),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            let params = buffer(
+                "composite params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            let instance_buffer = buffer(
+                "walkers",
+                bytemuck::cast_slice(&gpu_instances),
+                wgpu::BufferUsages::STORAGE,
+            );
             let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("composite frame"),
                 layout: &self.composite.frame_layout,
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
-                        resource: subject.frame_buffer.as_entire_binding(),
+                        resource: frame.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
                         resource: params.as_entire_binding(),
                     },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: instance_buffer.as_entire_binding(),
+                    },
                 ],
             });
+            let array_view = |t: &wgpu::Texture| {
+                t.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                })
+            };
             let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
             let views = [
-                view(&subject.texture),
+                array_view(&subjects.texture),
                 view(&backdrop.env),
                 view(&backdrop.plate),
-                view(shadow_texture),
+                array_view(&shadows),
             ];
             let image_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("composite images"),
@@ -231,8 +351,13 @@ impl Gpu {
                     .collect::<Vec<_>>(),
             });
             let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            let targets = ["composite", "shadow layer", "backdrop layer"]
-                .map(|label| rgba32f(&self.device, label, size, usage));
+            let targets = [
+                "composite",
+                "shadow layer",
+                "backdrop layer",
+                "subject layer",
+            ]
+            .map(|label| rgba32f(&self.device, label, size, usage));
             let target_views = targets.each_ref().map(view);
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -250,10 +375,10 @@ impl Gpu {
             }
             let composite = self.copy_rgba(&mut encoder, &targets[0], size);
             let copied_layers = layers.then(|| {
-                [&subject.texture, &targets[1], &targets[2]]
+                [&targets[3], &targets[1], &targets[2]]
                     .map(|t| self.copy_rgba(&mut encoder, t, size))
             });
-            let stats = self.copy_stats(&mut encoder, &subject);
+            let stats = self.copy_stats(&mut encoder, &subjects);
             self.queue.submit([encoder.finish()]);
             let image = self.read_rgba(&composite, size)?;
             let layers = match copied_layers {

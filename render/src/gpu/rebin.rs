@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 
 use super::bind::{
     cleared, copy_to_buffer, full_screen_pipeline, padded_row, readback_buffer, rgba_pixels,
-    rgba32f, storage, texture_array, uniform,
+    storage, texture_array, uniform,
 };
 use super::pose::GpuPose;
 use super::types::GpuFrame;
@@ -64,21 +64,20 @@ impl RebinPass {
     }
 }
 
-/// A frame's subject, drawn and still on the GPU.
-pub(super) struct Subject {
-    /// The frame uniform (the camera), shared with later passes.
-    pub frame_buffer: wgpu::Buffer,
-    /// Pixel-class counters.
+/// A frame's subjects, drawn and still on the GPU.
+pub(super) struct Subjects {
+    /// Pixel-class counters, summed over the instances.
     pub stats: wgpu::Buffer,
-    /// The subject, premultiplied RGBA32F.
+    /// One layer per instance, in drawing order (back to front): premultiplied RGBA32F.
     pub texture: wgpu::Texture,
 }
 
-/// The frame uniform of `camera` for `pose`.
-fn frame_uniform(pose: &GpuPose, camera: &Camera, variant: Variant) -> GpuFrame {
+/// The frame uniform of `camera` for `pose` (`pose` `None`: the camera alone, for passes
+/// that do not read a pose).
+pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Variant) -> GpuFrame {
     let r = camera.world_from_camera.rotation;
     let k = &camera.intrinsics;
-    GpuFrame {
+    let mut f = GpuFrame {
         axis_x: r.x_axis.extend(0.0).to_array(),
         axis_y: r.y_axis.extend(0.0).to_array(),
         axis_z: r.z_axis.extend(0.0).to_array(),
@@ -86,31 +85,35 @@ fn frame_uniform(pose: &GpuPose, camera: &Camera, variant: Variant) -> GpuFrame 
         intrinsics: [k.fx, k.fy, k.cx, k.cy],
         size: [camera.width, camera.height],
         variant: variant.index(),
-        quad_count: pose.quad_count,
-        columns: pose.geometry.columns as u32,
-        rows: pose.geometry.rows as u32,
-        crop_origin: [pose.geometry.crop.x0, pose.geometry.crop.y0],
-        crop_size: [pose.geometry.crop.width, pose.geometry.crop.height],
+        quad_count: 0,
+        columns: 1,
+        rows: 1,
+        crop_origin: [0, 0],
+        crop_size: [1, 1],
         pad: [0; 2],
+    };
+    if let Some(pose) = pose {
+        f.quad_count = pose.quad_count;
+        f.columns = pose.geometry.columns as u32;
+        f.rows = pose.geometry.rows as u32;
+        f.crop_origin = [pose.geometry.crop.x0, pose.geometry.crop.y0];
+        f.crop_size = [pose.geometry.crop.width, pose.geometry.crop.height];
     }
+    f
 }
 
 impl Gpu {
-    /// Records the frame pass of `camera` into `encoder`.
-    pub(super) fn draw_subject(
+    /// Records the frame pass of every instance into `encoder`: each pose drawn by its
+    /// camera (in its subject frame) into its own layer of one texture array of `size`,
+    /// in the order given (back to front; the composite pass puts each over the ones
+    /// before it).
+    pub(super) fn draw_subjects(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        pose: &GpuPose,
-        camera: &Camera,
+        instances: &[(&GpuPose, Camera)],
+        size: (u32, u32),
         variant: Variant,
-    ) -> Subject {
-        let frame_buffer = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("frame"),
-                contents: bytemuck::bytes_of(&frame_uniform(pose, camera, variant)),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
+    ) -> Subjects {
         let stats = self
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,30 +121,50 @@ impl Gpu {
                 contents: &[0u8; 16],
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             });
-        let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &self.rebin.frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: stats.as_entire_binding(),
-                },
-            ],
-        });
-        let texture = rgba32f(
-            &self.device,
-            "subject",
-            (camera.width, camera.height),
-            wgpu::TextureUsages::RENDER_ATTACHMENT
+        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("subjects"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: instances.len().max(1) as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::COPY_SRC
                 | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        {
+            view_formats: &[],
+        });
+        for (layer, (pose, camera)) in instances.iter().enumerate() {
+            let frame_buffer = self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("frame"),
+                    contents: bytemuck::bytes_of(&frame_uniform(Some(pose), camera, variant)),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("frame"),
+                layout: &self.rebin.frame_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: frame_buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: stats.as_entire_binding(),
+                    },
+                ],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("rebin"),
                 color_attachments: &[cleared(&view)],
@@ -151,22 +174,18 @@ impl Gpu {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.rebin.pipeline);
-            pass.set_bind_group(0, &frame_group, &[]);
+            pass.set_bind_group(0, &group, &[]);
             pass.set_bind_group(1, &pose.bind_group, &[]);
             pass.draw(0..3, 0..1);
         }
-        Subject {
-            frame_buffer,
-            stats,
-            texture,
-        }
+        Subjects { stats, texture }
     }
 
     /// Copies the pixel-class counters of a drawn frame for readback.
     pub(super) fn copy_stats(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        subject: &Subject,
+        subject: &Subjects,
     ) -> wgpu::Buffer {
         let readback = readback_buffer(&self.device, "stats readback", 16);
         encoder.copy_buffer_to_buffer(&subject.stats, 0, &readback, 0, 16);
@@ -228,7 +247,7 @@ impl Gpu {
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("frame"),
                 });
-            let subject = self.draw_subject(&mut encoder, pose, camera, variant);
+            let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant);
             let image = self.copy_rgba(&mut encoder, &subject.texture, size);
             let stats = self.copy_stats(&mut encoder, &subject);
             self.queue.submit([encoder.finish()]);

@@ -123,4 +123,26 @@ pub struct GpuComposite {
     pub env_yaw: f32,
     /// Side of the shadow's ground patch, metres.
     pub shadow_extent: f32,
+    /// Walkers drawn.
+    pub instances: u32,
+    /// Padding to 16 bytes.
+    pub pad0: u32,
+    /// Padding.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
+}
+
+/// `Instance` of `shaders/composite.wgsl`: `subject_from_world` of a walker.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuInstance {
+    /// Rotation column x (w unused).
+    pub col_x: [f32; 4],
+    /// Rotation column y.
+    pub col_y: [f32; 4],
+    /// Rotation column z.
+    pub col_z: [f32; 4],
+    /// Translation.
+    pub translation: [f32; 4],
 }

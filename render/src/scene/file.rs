@@ -1,0 +1,335 @@
+//! The scene file: TOML a person writes by hand, read and checked field by field.
+//! Errors name the file, the field and its line. Paths are relative to the file.
+//!
+//! ```toml
+//! field = "../demo-out/walker.frf"    # the flowed reflectance field
+//!
+//! [time]                              # seconds; frames at start + i / fps, i = 0, 1, ...
+//! start = 0.0                         # (a still when end equals start)
+//! end = 2.0                           # exclusive
+//! fps = 12.0
+//!
+//! [output]
+//! size = [480, 270]
+//! exposure = 0.0                      # stops, PNG frames only
+//! layers = false                      # EXR layers per frame: subject, shadow, backdrop
+//! preview = "apng"                    # animated preview: "apng", "gif" or "none"
+//! variant = "fourway"                 # or "twoway", "linear", "nearest"
+//!
+//! [lighting]                          # the environment, scene frame
+//! env = "../assets/envmaps/map.hdr"   # a .hdr/.exr file, "sky", "uniform" or "none"
+//! yaw_deg = 0.0
+//! intensity = 1.0
+//! floor = "env"                       # or "ground": what lights the subject from below
+//! # [[lighting.key]]                  # keyframes, piecewise linear in time; a key may
+//! # time = 1.0                        # name another map, cross-faded from the previous
+//! # yaw_deg = 90.0                    # key's; omitted values carry over
+//!
+//! [camera]                            # an orbit over the time range, or keys
+//! orbit = { radius = 3.2, height = 1.4, start_deg = -30.0, sweep_deg = 120.0,
+//!           look_at = [0.0, 0.9, 0.0], fov_deg = 35.0 }
+//! # [[camera.key]]                    # as camera path files (frf_render::path)
+//! # time = 0.0
+//! # position = [2.5, 1.4, 3.0]
+//! # look_at = [0.0, 0.9, 0.0]
+//! # fov_deg = 30.0
+//!
+//! [composite]
+//! backdrop = "env"                    # "env", "plate" or "none"
+//! ground = "env"                      # or an albedo: 0.3 or [0.3, 0.25, 0.2]
+//! shadow = "maps"                     # "maps", "traced" or "none"
+//! # plate = "plate.png"               # with backdrop = "plate" and one camera key
+//!
+//! [[instance]]                        # default: one walker at the origin
+//! position = [0.0, 0.0, 0.0]          # metres, on the ground y = 0
+//! heading_deg = 0.0                   # about +y; 0 walks toward +x
+//! time_offset = 0.0                   # seconds added to the scene's time for its walk
+//! ```
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::error::{RenderError, Result};
+
+/// A value and where it was written.
+pub type At<T> = Spanned<T>;
+
+/// The file as written (see the module docs).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneToml {
+    /// The field.
+    pub field: Option<At<String>>,
+    /// Time range and rate.
+    pub time: At<TimeToml>,
+    /// Output.
+    #[serde(default)]
+    pub output: OutputToml,
+    /// Lighting.
+    pub lighting: At<LightingToml>,
+    /// Camera.
+    pub camera: At<CameraToml>,
+    /// Backdrop, ground and shadow.
+    #[serde(default)]
+    pub composite: CompositeToml,
+    /// The walkers.
+    #[serde(default)]
+    pub instance: Vec<At<InstanceToml>>,
+}
+
+/// `[time]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeToml {
+    /// Seconds.
+    #[serde(default = "zero")]
+    pub start: At<f32>,
+    /// Seconds, exclusive.
+    pub end: At<f32>,
+    /// Frames per second.
+    pub fps: At<f32>,
+}
+
+/// `[output]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputToml {
+    /// Frame width and height.
+    pub size: Option<At<[u32; 2]>>,
+    /// Stops, PNG only.
+    #[serde(default = "zero")]
+    pub exposure: At<f32>,
+    /// EXR layers.
+    #[serde(default)]
+    pub layers: bool,
+    /// Animated preview.
+    #[serde(default = "default_preview")]
+    pub preview: At<String>,
+    /// Interpolation.
+    #[serde(default = "default_variant")]
+    pub variant: At<String>,
+}
+
+impl Default for OutputToml {
+    fn default() -> Self {
+        Self {
+            size: None,
+            exposure: At::new(0..0, 0.0),
+            layers: false,
+            preview: default_preview(),
+            variant: default_variant(),
+        }
+    }
+}
+
+fn default_preview() -> At<String> {
+    At::new(0..0, "apng".into())
+}
+
+fn default_variant() -> At<String> {
+    At::new(0..0, "fourway".into())
+}
+
+/// `[lighting]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingToml {
+    /// Environment.
+    pub env: At<String>,
+    /// Degrees.
+    #[serde(default = "zero")]
+    pub yaw_deg: At<f32>,
+    /// Multiplier.
+    #[serde(default = "one")]
+    pub intensity: At<f32>,
+    /// "env" or "ground".
+    #[serde(default = "env_word")]
+    pub floor: At<String>,
+    /// Keyframes.
+    #[serde(default)]
+    pub key: Vec<At<LightKeyToml>>,
+}
+
+fn zero() -> At<f32> {
+    At::new(0..0, 0.0)
+}
+
+fn one() -> At<f32> {
+    At::new(0..0, 1.0)
+}
+
+fn env_word() -> At<String> {
+    At::new(0..0, "env".into())
+}
+
+/// `[[lighting.key]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightKeyToml {
+    /// Seconds.
+    pub time: At<f32>,
+    /// Another map from this key on.
+    pub env: Option<At<String>>,
+    /// Degrees.
+    pub yaw_deg: Option<At<f32>>,
+    /// Multiplier.
+    pub intensity: Option<At<f32>>,
+}
+
+/// `[camera]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraToml {
+    /// An orbit over the time range.
+    pub orbit: Option<At<OrbitToml>>,
+    /// Keys.
+    #[serde(default)]
+    pub key: Vec<At<crate::path::Key>>,
+}
+
+/// `camera.orbit`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitToml {
+    /// Metres from the vertical axis through `look_at`.
+    pub radius: f32,
+    /// Camera height, metres.
+    pub height: f32,
+    /// Degrees.
+    #[serde(default)]
+    pub start_deg: f32,
+    /// Degrees swept over the time range.
+    #[serde(default = "full_turn")]
+    pub sweep_deg: f32,
+    /// Point looked at.
+    #[serde(default = "waist")]
+    pub look_at: [f32; 3],
+    /// Vertical field of view, degrees.
+    #[serde(default = "default_fov")]
+    pub fov_deg: f32,
+}
+
+fn full_turn() -> f32 {
+    360.0
+}
+
+fn waist() -> [f32; 3] {
+    [0.0, 0.9, 0.0]
+}
+
+fn default_fov() -> f32 {
+    35.0
+}
+
+/// `[composite]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CompositeToml {
+    /// "env", "plate" or "none".
+    #[serde(default = "no_backdrop")]
+    pub backdrop: At<String>,
+    /// "env", an albedo or `[r, g, b]`.
+    #[serde(default)]
+    pub ground: Option<At<toml::Value>>,
+    /// "maps", "traced" or "none".
+    #[serde(default = "maps_word")]
+    pub shadow: At<String>,
+    /// The plate.
+    pub plate: Option<At<String>>,
+}
+
+impl Default for CompositeToml {
+    fn default() -> Self {
+        Self {
+            backdrop: no_backdrop(),
+            ground: None,
+            shadow: maps_word(),
+            plate: None,
+        }
+    }
+}
+
+fn no_backdrop() -> At<String> {
+    At::new(0..0, "none".into())
+}
+
+fn maps_word() -> At<String> {
+    At::new(0..0, "maps".into())
+}
+
+/// `[[instance]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceToml {
+    /// Metres.
+    #[serde(default)]
+    pub position: [f32; 3],
+    /// Degrees.
+    #[serde(default)]
+    pub heading_deg: f32,
+    /// Seconds.
+    #[serde(default)]
+    pub time_offset: f32,
+}
+
+/// Errors about one scene file, pointing at lines.
+pub struct Reporter<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl<'a> Reporter<'a> {
+    /// The reporter of `path`, whose contents are `text`.
+    pub fn new(path: &'a Path, text: &'a str) -> Self {
+        Self { path, text }
+    }
+
+    /// Line (1-based) of byte `offset`.
+    pub fn line(&self, offset: usize) -> usize {
+        self.text[..offset.min(self.text.len())]
+            .matches('\n')
+            .count()
+            + 1
+    }
+
+    /// An error about `field`, written at `span` (an empty span: the field was left out).
+    pub fn error(
+        &self,
+        field: &str,
+        span: Range<usize>,
+        problem: impl std::fmt::Display,
+    ) -> RenderError {
+        let place = if span.is_empty() && span.start == 0 {
+            "(not given)".to_string()
+        } else {
+            format!("line {}", self.line(span.start))
+        };
+        RenderError::BadParameter(format!(
+            "scene {}: {field} ({place}): {problem}",
+            self.path.display()
+        ))
+    }
+
+    /// A path written in the file, relative to the file's directory.
+    pub fn resolve(&self, written: &str) -> PathBuf {
+        let p = Path::new(written);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.path.parent().unwrap_or(Path::new(".")).join(p)
+        }
+    }
+}
+
+/// Parses the file's text; syntax and type errors name the file and the line.
+pub fn parse(path: &Path, text: &str) -> Result<SceneToml> {
+    toml::from_str(text).map_err(|e| {
+        let line = e.span().map_or(String::new(), |s| {
+            format!(" (line {})", Reporter::new(path, text).line(s.start))
+        });
+        RenderError::BadParameter(format!("scene {}{line}: {}", path.display(), e.message()))
+    })
+}

@@ -1,0 +1,386 @@
+//! What a scene needs from a field, computed from the scene and the field's index alone,
+//! before anything is read or drawn; the renderer then reads, relits and draws only that.
+//!
+//! - **Poses**: the poses the walkers show at the frames rendered (the nearest pose the
+//!   field holds stands in for one it lacks, and the plan says so).
+//! - **Views and flows**: the quads of the grid the camera's rays reach. Rays are traced
+//!   through the cylinder of the pose's camera centres on a grid of pixels every
+//!   [`RAY_STEP_PX`] pixels (and along the frame's border), and every quad hit is grown by
+//!   its neighbours, so that a ray between two samples, which meets the cylinder between
+//!   their quads, is covered. A quad needs its four views and the eight flows between
+//!   them.
+//! - **Conditions**: a basis condition whose coefficient is zero at every frame is not
+//!   relit. Turned by any yaw, heading or turntable angle, a condition's region of the
+//!   sphere stays in its band of elevations; so it is left out when every environment of
+//!   the scene is black over that band (e.g. the floor conditions under a black lower
+//!   hemisphere), or when the scene's intensity is zero throughout.
+//! - **Shadows**: the maps (or the hull, for traced shadows) only when the scene asks for
+//!   a shadow and some ray meets the ground patch.
+//!
+//! The plan is conservative: no frame may need something it left out (a test renders
+//! scenes with and without the plan and compares the frames).
+
+use std::collections::BTreeSet;
+
+use frf_core::camera::Camera;
+use frf_core::env::EnvMap;
+use frf_core::grid::Neighbour;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::{ChunkKind, ReadAt};
+use frf_reflectance::project::{FloorModel, Projector};
+use glam::{Vec2, Vec3};
+use serde::Serialize;
+
+use super::{Scene, ShadowSpec};
+use crate::cylinder::{Clamp, Cylinder};
+use crate::error::{RenderError, Result};
+use crate::shadow::ground_hit;
+
+/// Spacing of the rays traced to find the quads a frame reaches, pixels.
+pub const RAY_STEP_PX: u32 = 4;
+
+/// What one pose of the field must provide.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PosePlan {
+    /// The pose.
+    pub pose: u32,
+    /// Per view (`u`-major): needed.
+    pub views: Vec<bool>,
+    /// Per view and neighbour ([`Neighbour::ALL`] order): the flow is needed.
+    pub flows: Vec<[bool; 4]>,
+    /// Per basis condition: relit.
+    pub conditions: Vec<bool>,
+    /// The shadow maps are read.
+    pub shadow_maps: bool,
+    /// The visual hull is read.
+    pub hull: bool,
+}
+
+/// One frame: its time and the pose each walker shows.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FramePlan {
+    /// Index in the scene's frames.
+    pub index: usize,
+    /// Seconds.
+    pub time: f32,
+    /// Per instance: the pose drawn.
+    pub poses: Vec<u32>,
+}
+
+/// The counts a person reads (and `frf render --plan --json` prints).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct PlanCounts {
+    /// Poses the frames draw.
+    pub poses_used: usize,
+    /// Poses the field holds.
+    pub poses_total: usize,
+    /// Views read, over the poses used.
+    pub views_used: usize,
+    /// Views the poses used hold.
+    pub views_total: usize,
+    /// Flow maps read.
+    pub flows_used: usize,
+    /// Flow maps the poses used hold.
+    pub flows_total: usize,
+    /// Basis conditions relit.
+    pub conditions_used: usize,
+    /// Basis conditions of the field.
+    pub conditions_total: usize,
+    /// Bytes of the chunks read.
+    pub bytes_read: u64,
+    /// Bytes of every chunk of the field.
+    pub bytes_total: u64,
+}
+
+/// The plan of a scene on a field (see the module docs).
+#[derive(Debug, Clone, Serialize)]
+pub struct Plan {
+    /// The counts.
+    #[serde(flatten)]
+    pub counts: PlanCounts,
+    /// Per frame rendered.
+    pub frames: Vec<FramePlan>,
+    /// Per pose used.
+    pub poses: Vec<PosePlan>,
+    /// Poses the scene asks for that the field lacks, and the pose drawn instead.
+    pub poses_substituted: Vec<(u32, u32)>,
+    /// Conditions left out, by name.
+    pub conditions_left_out: Vec<String>,
+    /// Floor conditions among them.
+    pub floor_conditions_left_out: usize,
+    /// Whether some frame sees the ground patch (a shadow is drawn).
+    pub ground_seen: bool,
+}
+
+/// The nearest pose `field_poses` holds to `wanted`, going round the cycle of `n` poses.
+fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
+    *field_poses
+        .iter()
+        .min_by_key(|&&p| {
+            let d = p.abs_diff(wanted);
+            d.min(n.max(1) - d.min(n.max(1)))
+        })
+        .expect("a field holds at least one pose")
+}
+
+/// The quads `(u, v)` of `cylinder` the rays of `camera` reach, sampled every
+/// [`RAY_STEP_PX`] pixels and along the border; and whether a ray meets the ground
+/// within `ground_half` metres of the subject's axis (in the same frame).
+fn reached(
+    cylinder: &Cylinder,
+    camera: &Camera,
+    ground_half: f32,
+) -> (BTreeSet<(usize, usize)>, bool) {
+    let (w, h) = (camera.width, camera.height);
+    let mut xs: Vec<u32> = (0..w).step_by(RAY_STEP_PX as usize).collect();
+    let mut ys: Vec<u32> = (0..h).step_by(RAY_STEP_PX as usize).collect();
+    xs.push(w - 1);
+    ys.push(h - 1);
+    let mut quads = BTreeSet::new();
+    let mut ground = false;
+    for &y in &ys {
+        for &x in &xs {
+            let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
+            if let Some(hit) = cylinder.intersect(camera.centre(), dir) {
+                let v = if hit.clamped == Clamp::None {
+                    hit.v
+                } else {
+                    hit.v.min(cylinder.rows().saturating_sub(2))
+                };
+                quads.insert((hit.u, v));
+            }
+            if let Some(p) = ground_hit(camera.centre(), dir) {
+                ground |= p.x.abs() <= ground_half && p.z.abs() <= ground_half;
+            }
+        }
+    }
+    (quads, ground)
+}
+
+/// Which conditions the scene can light (see the module docs).
+fn lit_conditions(
+    scene: &Scene,
+    projector: &Projector,
+    conditions: &[frf_reflectance::field::ConditionRecord],
+) -> Result<Vec<bool>> {
+    if scene.lighting.iter().all(|k| k.intensity == 0.0) {
+        return Ok(vec![false; conditions.len()]);
+    }
+    let mut lit = vec![false; conditions.len()];
+    let bands = projector.elevation_bands();
+    for source in scene.environments() {
+        let Some(env) = source.load()? else {
+            // No relighting: every condition shows at weight 1.
+            return Ok(vec![true; conditions.len()]);
+        };
+        let rows = nonzero_rows(&env);
+        let upper_lit = rows
+            .iter()
+            .any(|&(lo, hi)| hi > 0.0 && lo < std::f32::consts::FRAC_PI_2);
+        for (k, c) in conditions.iter().enumerate() {
+            lit[k] |= if c.floor && matches!(scene.floor, FloorModel::LambertianGround { .. }) {
+                upper_lit
+            } else {
+                let (lo, hi) = bands[k];
+                rows.iter().any(|&(a, b)| a < hi && b > lo)
+            };
+        }
+    }
+    Ok(lit)
+}
+
+/// The elevation bands (radians) of the environment's rows holding any light.
+fn nonzero_rows(env: &EnvMap) -> Vec<(f32, f32)> {
+    let img = env.image();
+    let h = img.height() as f32;
+    (0..img.height())
+        .filter(|&y| img.row(y).iter().any(|p| p.iter().any(|&c| c > 0.0)))
+        .map(|y| {
+            let top = std::f32::consts::FRAC_PI_2 - y as f32 / h * std::f32::consts::PI;
+            let bottom = std::f32::consts::FRAC_PI_2 - (y + 1) as f32 / h * std::f32::consts::PI;
+            (bottom, top)
+        })
+        .collect()
+}
+
+/// The flows a quad with corners `A = (u, v)`, `B = (u+1, v)`, `C = (u, v+1)`,
+/// `D = (u+1, v+1)` reads: `(view, neighbour)` pairs (the rows clamped to the grid).
+fn quad_flows(u: usize, v: usize, columns: usize, rows: usize) -> Vec<((usize, usize), Neighbour)> {
+    let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
+    let mut out = vec![((u, v), Neighbour::Right), ((u1, v), Neighbour::Left)];
+    if v1 != v {
+        out.extend([
+            ((u, v), Neighbour::Up),
+            ((u, v1), Neighbour::Down),
+            ((u1, v), Neighbour::Up),
+            ((u1, v1), Neighbour::Down),
+            ((u, v1), Neighbour::Right),
+            ((u1, v1), Neighbour::Left),
+        ]);
+    }
+    out
+}
+
+impl Plan {
+    /// The plan of `scene` on `field` for the frames `frames` (indices into
+    /// [`Scene::frame_times`]) of `size`.
+    pub fn new<R: ReadAt>(
+        scene: &Scene,
+        field: &FieldFile<R>,
+        frames: std::ops::Range<usize>,
+        size: (u32, u32),
+    ) -> Result<Self> {
+        let h = field.header();
+        let times = scene.frame_times();
+        if frames.start >= frames.end || frames.end > times.len() {
+            return Err(RenderError::BadParameter(format!(
+                "frames {}..{} of a scene of {} frames",
+                frames.start,
+                frames.end,
+                times.len()
+            )));
+        }
+        let field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+        let mut substituted = BTreeSet::new();
+        let frame_plans: Vec<FramePlan> = frames
+            .clone()
+            .map(|index| {
+                let time = times[index];
+                let poses = (0..scene.instances.len())
+                    .map(|i| {
+                        let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                        let held = nearest_pose(wanted, &field_poses, h.poses_per_cycle);
+                        if held != wanted {
+                            substituted.insert((wanted, held));
+                        }
+                        held
+                    })
+                    .collect();
+                FramePlan { index, time, poses }
+            })
+            .collect();
+
+        let (columns, rows) = (h.columns, h.rows);
+        let views = columns * rows;
+        let half = h.shadows.as_ref().map_or(0.0, |s| 0.5 * s.ground.extent_m);
+        let projector = Projector::new(&h.conditions)?;
+        let lit = lit_conditions(scene, &projector, &h.conditions)?;
+        let mut ground_seen = false;
+        let mut poses: Vec<PosePlan> = Vec::new();
+        for fp in &frame_plans {
+            let camera = scene.camera_at(fp.time, size)?;
+            for (i, &pose) in fp.poses.iter().enumerate() {
+                let record = h.pose(pose)?;
+                let centres: Vec<Vec3> = record
+                    .views
+                    .iter()
+                    .map(|v| {
+                        v.camera
+                            .to_camera()
+                            .map(|c| c.centre())
+                            .map_err(RenderError::BadParameter)
+                    })
+                    .collect::<Result<_>>()?;
+                let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
+                let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
+                let (quads, ground) = reached(&cylinder, &subject_camera, half);
+                ground_seen |= ground;
+                let plan = match poses.iter_mut().position(|p| p.pose == pose) {
+                    Some(k) => &mut poses[k],
+                    None => {
+                        poses.push(PosePlan {
+                            pose,
+                            views: vec![false; views],
+                            flows: vec![[false; 4]; views],
+                            conditions: lit.clone(),
+                            shadow_maps: false,
+                            hull: false,
+                        });
+                        poses.last_mut().expect("just pushed")
+                    }
+                };
+                let spans = if h.wraps {
+                    columns
+                } else {
+                    columns.saturating_sub(1)
+                }
+                .max(1);
+                for &(u, v) in &quads {
+                    // The quad and its neighbours (see the module docs).
+                    for du in [spans - 1, 0, 1] {
+                        let uu = (u + du) % spans;
+                        for vv in [v.saturating_sub(1), v, (v + 1).min(rows.saturating_sub(2))] {
+                            let (u1, v1) = ((uu + 1) % columns, (vv + 1).min(rows - 1));
+                            for (a, b) in [(uu, vv), (u1, vv), (uu, v1), (u1, v1)] {
+                                plan.views[a * rows + b] = true;
+                            }
+                            for ((a, b), n) in quad_flows(uu, vv, columns, rows) {
+                                plan.flows[a * rows + b][n.index()] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;
+        for p in &mut poses {
+            p.shadow_maps = wants_shadow && scene.shadow == ShadowSpec::Maps && h.shadows.is_some();
+            p.hull = wants_shadow && scene.shadow == ShadowSpec::Traced && h.hulls.is_some();
+        }
+        poses.sort_by_key(|p| p.pose);
+
+        // Counts, from the index.
+        let mut counts = PlanCounts {
+            poses_used: poses.len(),
+            poses_total: h.poses.len(),
+            conditions_used: lit.iter().filter(|&&l| l).count(),
+            conditions_total: h.conditions.len(),
+            ..Default::default()
+        };
+        for c in field.chunks() {
+            counts.bytes_total += c.length;
+            let Some(p) = poses.iter().find(|p| p.pose == c.key.pose) else {
+                continue;
+            };
+            let view = c.key.u as usize * rows + c.key.v as usize;
+            let used = match c.key.kind {
+                ChunkKind::Basis => {
+                    counts.views_total += 1;
+                    let used = p.views.get(view).copied().unwrap_or(false);
+                    counts.views_used += used as usize;
+                    used
+                }
+                ChunkKind::Alpha => p.views.get(view).copied().unwrap_or(false),
+                ChunkKind::Flow(n) => {
+                    counts.flows_total += 1;
+                    let used = p.flows.get(view).is_some_and(|f| f[n.index()]);
+                    counts.flows_used += used as usize;
+                    used
+                }
+                ChunkKind::Shadows => p.shadow_maps,
+                ChunkKind::Hull => p.hull,
+            };
+            if used {
+                counts.bytes_read += c.length;
+            }
+        }
+        let left_out: Vec<usize> = (0..lit.len()).filter(|&k| !lit[k]).collect();
+        Ok(Self {
+            counts,
+            frames: frame_plans,
+            poses,
+            poses_substituted: substituted.into_iter().collect(),
+            conditions_left_out: left_out
+                .iter()
+                .map(|&k| h.conditions[k].name.clone())
+                .collect(),
+            floor_conditions_left_out: left_out.iter().filter(|&&k| h.conditions[k].floor).count(),
+            ground_seen,
+        })
+    }
+
+    /// The plan of pose `pose`.
+    pub fn pose(&self, pose: u32) -> Option<&PosePlan> {
+        self.poses.iter().find(|p| p.pose == pose)
+    }
+}

@@ -1,0 +1,149 @@
+//! Scene files: what they accept, what they refuse (naming the field and line), and the
+//! frame times, cameras, lighting and poses they ask for.
+
+use std::path::Path;
+
+use super::*;
+
+const MINIMAL: &str = r#"
+field = "walker.frf"
+
+[time]
+end = 1.0
+fps = 10
+
+[lighting]
+env = "sky"
+
+[camera]
+orbit = { radius = 3.0, height = 1.4 }
+"#;
+
+fn scene(text: &str) -> Result<Scene> {
+    Scene::parse(Path::new("/shots/a/scene.toml"), text)
+}
+
+fn error(text: &str) -> String {
+    scene(text).unwrap_err().to_string()
+}
+
+#[test]
+fn a_minimal_scene_gets_its_defaults() {
+    let s = scene(MINIMAL).unwrap();
+    assert_eq!(
+        s.field,
+        Some(Path::new("/shots/a/walker.frf").to_path_buf())
+    );
+    assert_eq!(s.frame_times().len(), 10);
+    assert_eq!(s.instances.len(), 1);
+    assert_eq!(s.variant, Variant::FourWay);
+    assert_eq!(s.preview, Preview::Apng);
+    assert_eq!(s.backdrop, BackdropSpec::None);
+    assert_eq!(s.shadow, ShadowSpec::Maps);
+    assert_eq!(s.lighting.len(), 1);
+    // The orbit sweeps the time range and loops.
+    let c0 = s.camera_at(0.0, (32, 18)).unwrap().centre();
+    let c_end = s.camera_at(1.0, (32, 18)).unwrap().centre();
+    assert!((c0 - c_end).length() < 1e-4);
+}
+
+#[test]
+fn a_zero_length_range_is_a_still_and_a_reversed_one_is_refused() {
+    let still = MINIMAL.replace("end = 1.0", "start = 2.0\nend = 2.0");
+    assert_eq!(scene(&still).unwrap().frame_times(), vec![2.0]);
+    let e = error(&MINIMAL.replace("end = 1.0", "start = 2.0\nend = 1.0"));
+    assert!(
+        e.contains("time.end") && e.contains("line 6") && e.contains("scene.toml"),
+        "{e}"
+    );
+}
+
+#[test]
+fn errors_name_the_field_and_its_line() {
+    let e = error(&MINIMAL.replace("fps = 10", "fps = -3"));
+    assert!(e.contains("time.fps") && e.contains("line 6"), "{e}");
+    let e = error(&MINIMAL.replace("fps = 10", "fps = \"ten\""));
+    assert!(e.contains("line 6"), "{e}");
+    let e = error(&format!("{MINIMAL}\n[composite]\nbackdrop = \"wall\"\n"));
+    assert!(
+        e.contains("composite.backdrop") && e.contains("wall") && e.contains("line 15"),
+        "{e}"
+    );
+    let e = error(&format!("{MINIMAL}\n[output]\nsize = [0, 10]\n"));
+    assert!(e.contains("output.size"), "{e}");
+    let e = error(&MINIMAL.replace("[time]", "[time]\nspeed = 2"));
+    assert!(e.contains("speed") && e.contains("line 5"), "{e}");
+    let e = error(&MINIMAL.replace("orbit = { radius = 3.0, height = 1.4 }", ""));
+    assert!(e.contains("camera") && e.contains("orbit or keys"), "{e}");
+    let e = error(&format!(
+        "{MINIMAL}\n[composite]\nground = 2.0\nbackdrop = \"env\"\n"
+    ));
+    assert!(e.contains("composite.ground"), "{e}");
+    let e = error(&format!(
+        "{MINIMAL}\n[[instance]]\nposition = [0.0, 1.0, 0.0]\n"
+    ));
+    assert!(e.contains("instance[0]") && e.contains("ground"), "{e}");
+}
+
+#[test]
+fn lighting_keys_interpolate_and_cross_fade_maps() {
+    let text = MINIMAL.replace(
+        "env = \"sky\"",
+        "env = \"sky\"\nyaw_deg = 0.0\n[[lighting.key]]\ntime = 0.0\n[[lighting.key]]\ntime = 1.0\nenv = \"uniform\"\nyaw_deg = 90.0\nintensity = 3.0",
+    );
+    let s = scene(&text).unwrap();
+    let mid = s.lighting_at(0.25);
+    assert_eq!(mid.maps.len(), 2);
+    assert!((mid.maps[1].1 - 0.25).abs() < 1e-6);
+    assert!((mid.yaw - 22.5f32.to_radians()).abs() < 1e-5);
+    assert!((mid.intensity - 1.5).abs() < 1e-5);
+    let end = s.lighting_at(5.0);
+    assert_eq!(end.maps, vec![(EnvSource::Uniform, 1.0)]);
+    let before = s.lighting_at(-1.0);
+    assert_eq!(before.maps, vec![(EnvSource::Sky, 1.0)]);
+    // Keys out of order are refused.
+    let bad = text.replace("time = 1.0", "time = 0.0");
+    assert!(error(&bad).contains("lighting.key[1].time"));
+}
+
+#[test]
+fn poses_follow_the_walk_cycle_with_each_walker_s_offset() {
+    let text = format!(
+        "{MINIMAL}\n[[instance]]\n[[instance]]\nposition = [1.0, 0.0, 0.0]\ntime_offset = 0.5\n"
+    );
+    let s = scene(&text).unwrap();
+    // A 1 s cycle of 30 poses.
+    assert_eq!(s.pose_at(0, 0.0, 1.0, 30), 0);
+    assert_eq!(s.pose_at(0, 0.1, 1.0, 30), 3);
+    assert_eq!(s.pose_at(1, 0.0, 1.0, 30), 15);
+    // Looping, and nearest: 0.99 s rounds to pose 30, which is pose 0.
+    assert_eq!(s.pose_at(0, 0.99, 1.0, 30), 0);
+    assert_eq!(s.pose_at(0, 2.1, 1.0, 30), 3);
+    // The second walker's frame: a camera at its position sees it from its origin.
+    let cam = Camera::look_at(
+        Vec3::new(1.0, 1.5, 4.0),
+        Vec3::new(1.0, 0.9, 0.0),
+        Vec3::Y,
+        0.6,
+        8,
+        8,
+    )
+    .unwrap();
+    let seen = s.instances[1].camera_in_subject_frame(&cam);
+    assert!((seen.centre() - Vec3::new(0.0, 1.5, 4.0)).length() < 1e-5);
+}
+
+#[test]
+fn a_plate_needs_one_camera_key() {
+    let text = format!("{MINIMAL}\n[composite]\nbackdrop = \"plate\"\nplate = \"p.png\"\n");
+    assert!(error(&text).contains("one camera key"));
+    let keyed = text.replace(
+        "orbit = { radius = 3.0, height = 1.4 }",
+        "[[camera.key]]\ntime = 0.0\nposition = [0.0, 1.5, 4.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 30.0",
+    );
+    let s = scene(&keyed).unwrap();
+    assert_eq!(
+        s.backdrop,
+        BackdropSpec::Plate(Path::new("/shots/a/p.png").to_path_buf())
+    );
+}
