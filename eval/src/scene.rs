@@ -65,6 +65,9 @@ pub fn composite_psnr(truth: &Image<Rgba>, test: &Image<Rgba>) -> f64 {
 /// Scores of the scene at a set of cameras.
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneScore {
+    /// Intersection over union of the pose's visual hull with the true body (`None`
+    /// when the field has no hull).
+    pub hull_iou: Option<f64>,
     /// [`shadow_error`] of the relit shadow (`None` when the field has no maps).
     pub shadow_mae: Option<f64>,
     /// [`shadow_error`] of the ablation: the environment's lights traced against the

@@ -188,7 +188,11 @@ pub fn run(args: EvalArgs) -> CliResult {
         let backdrop = Backdrop::environment(env.clone(), ground);
         let maps = ShadowMaps::load(&field, pose)?;
         // The ablation first: the environment's lights traced against the hull.
-        let (shadow_mae_traced, traced_seconds) = match (field.hull(pose)?, &maps) {
+        let hull = field.hull(pose)?;
+        let hull_iou = hull
+            .as_ref()
+            .map(|h| h.iou(&stage.true_occupancy(pose, h.grid())));
+        let (shadow_mae_traced, traced_seconds) = match (hull, &maps) {
             (Some(hull), Some(m)) => {
                 let t = Instant::now();
                 let traced = traced_shadow(&hull, &env.median_cut(TRACED_LIGHTS), m.spec.ground);
@@ -250,6 +254,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         }
         let (dark, bright) = (mean_of(dark.into_iter()), mean_of(bright.into_iter()));
         Some(SceneScore {
+            hull_iou,
             shadow_mae,
             shadow_mae_traced,
             psnr_composite: psnrs.iter().sum::<f64>() / psnrs.len().max(1) as f64,
@@ -299,9 +304,10 @@ pub fn run(args: EvalArgs) -> CliResult {
     if let Some(s) = &scene {
         let f = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
         eprintln!(
-            "scene: shadow MAE {} (relit maps against the true relative irradiance, {} m \
+            "scene: hull IoU {}, shadow MAE {} (relit maps against the true relative irradiance, {} m \
              patch; traced against the hull instead: {}), composite PSNR {:.2} dB (four-way, over the environment), edge-band \
              error {} over black / {} over bright (at the captured views)",
+            f(s.hull_iou),
             f(s.shadow_mae),
             ShadowMaps::load(&field, pose)?.map_or(0.0, |m| m.spec.ground.extent_m),
             f(s.shadow_mae_traced),
