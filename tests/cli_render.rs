@@ -247,3 +247,96 @@ fn bad_arguments_are_refused_naming_the_problem() {
         assert!(!e.contains("panicked"), "{args:?}: {e}");
     }
 }
+
+#[test]
+fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
+    let (dir, field) = fixture();
+    // Over the environment's own ground, with the shadow relit from the maps.
+    let out = dir.join("backdrop_env");
+    let mut args = vec![
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--backdrop",
+        "env",
+        "--ground",
+        "0.3",
+        "--orbit",
+        "3.0,1.6",
+        "--frames",
+        "2",
+        "--size",
+        "64x48",
+        "--layers",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("relit from the pose's maps"), "{}", stderr(&o));
+    let png = image::open(out.join("frame_0000.png")).unwrap().to_rgba8();
+    // Opaque everywhere: the backdrop fills the frame.
+    assert!(png.pixels().all(|p| p[3] == 255));
+    let shadow = image::open(out.join("frame_0000_shadow.exr"))
+        .unwrap()
+        .to_rgb32f();
+    // Somewhere the ground is in shadow (the sky's sun), nowhere outside [0, 1].
+    assert!(shadow.pixels().all(|p| p.0.iter().all(|&c| (0.0..=1.0).contains(&c))));
+    assert!(shadow.pixels().any(|p| p[1] < 0.7), "no shadow seen");
+    assert!(out.join("frame_0001_subject.exr").exists());
+    assert!(out.join("frame_0001_backdrop.exr").exists());
+
+    // Over a plate, seen by its one-key camera: the plate shows where the walker is not.
+    let plate = dir.join("plate.png");
+    let img = image::RgbImage::from_fn(64, 48, |x, _| image::Rgb([(x * 4) as u8, 90, 200]));
+    img.save(&plate).unwrap();
+    let path = dir.join("plate_camera.toml");
+    std::fs::write(
+        &path,
+        "[[key]]\ntime = 0.0\nposition = [0.0, 1.4, 3.2]\nlook_at = [0.0, 0.8, 0.0]\nfov_deg = 40.0\n",
+    )
+    .unwrap();
+    let out = dir.join("backdrop_plate");
+    let mut args = vec![
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--backdrop",
+        "plate",
+        "--plate",
+        plate.to_str().unwrap(),
+        "--camera",
+        path.to_str().unwrap(),
+        "--frames",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = image::open(out.join("frame_0000.png")).unwrap().to_rgba8();
+    assert_eq!((png.width(), png.height()), (64, 48), "frames take the plate's size");
+    // The top-left corner is sky in the plate: its colour comes back (8-bit sRGB round trip).
+    let p = png.get_pixel(0, 0);
+    assert!(p[1].abs_diff(90) <= 1 && p[2].abs_diff(200) <= 1, "{p:?}");
+    // A plate with an orbit is refused by name.
+    let o = frf(&[
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--backdrop",
+        "plate",
+        "--plate",
+        plate.to_str().unwrap(),
+        "--orbit",
+        "3,1",
+        "--out",
+        dir.join("bad_plate").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success() && stderr(&o).contains("one key"), "{}", stderr(&o));
+}
