@@ -275,7 +275,11 @@ fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
     args.extend(gpu_flag());
     let o = frf(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("relit from the pose's maps"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("relit from the pose's maps"),
+        "{}",
+        stderr(&o)
+    );
     let png = image::open(out.join("frame_0000.png")).unwrap().to_rgba8();
     // Opaque everywhere: the backdrop fills the frame.
     assert!(png.pixels().all(|p| p[3] == 255));
@@ -283,7 +287,11 @@ fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
         .unwrap()
         .to_rgb32f();
     // Somewhere the ground is in shadow (the sky's sun), nowhere outside [0, 1].
-    assert!(shadow.pixels().all(|p| p.0.iter().all(|&c| (0.0..=1.0).contains(&c))));
+    assert!(
+        shadow
+            .pixels()
+            .all(|p| p.0.iter().all(|&c| (0.0..=1.0).contains(&c)))
+    );
     assert!(shadow.pixels().any(|p| p[1] < 0.7), "no shadow seen");
     assert!(out.join("frame_0001_subject.exr").exists());
     assert!(out.join("frame_0001_backdrop.exr").exists());
@@ -319,7 +327,11 @@ fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
     let o = frf(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let png = image::open(out.join("frame_0000.png")).unwrap().to_rgba8();
-    assert_eq!((png.width(), png.height()), (64, 48), "frames take the plate's size");
+    assert_eq!(
+        (png.width(), png.height()),
+        (64, 48),
+        "frames take the plate's size"
+    );
     // The top-left corner is sky in the plate: its colour comes back (8-bit sRGB round trip).
     let p = png.get_pixel(0, 0);
     assert!(p[1].abs_diff(90) <= 1 && p[2].abs_diff(200) <= 1, "{p:?}");
@@ -338,5 +350,9 @@ fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
         "--out",
         dir.join("bad_plate").to_str().unwrap(),
     ]);
-    assert!(!o.status.success() && stderr(&o).contains("one key"), "{}", stderr(&o));
+    assert!(
+        !o.status.success() && stderr(&o).contains("one key"),
+        "{}",
+        stderr(&o)
+    );
 }

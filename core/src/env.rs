@@ -120,6 +120,45 @@ impl EnvMap {
         }
     }
 
+    /// The same environment with its radiance scaled by `k` (at least 0).
+    pub fn scaled(&self, k: f32) -> Self {
+        Self {
+            radiance: self.radiance.map(|p| p.map(|c| c * k.max(0.0))),
+            ..self.clone()
+        }
+    }
+
+    /// A weighted mix of environments (each with its own yaw), resampled to the first
+    /// one's texels (bilinear), with no yaw of its own: the light of a cross-fade. Empty
+    /// weights give the first map unweighted.
+    pub fn mix(maps: &[(&EnvMap, f32)]) -> Result<Self> {
+        let Some(&(first, _)) = maps.first() else {
+            return Err(CoreError::invalid("environment mix", "no environment"));
+        };
+        let (w, h) = first.radiance.size();
+        let blank = Self {
+            radiance: Image::new(w, h, [0.0; 3]),
+            yaw: 0.0,
+            clamped_texels: 0,
+        };
+        let radiance = Image::from_fn(w, h, |x, y| {
+            let d = blank.direction_of(x as f32, y as f32);
+            let mut out = [0.0f32; 3];
+            for (map, weight) in maps {
+                let l = map.radiance(d);
+                for c in 0..3 {
+                    out[c] += weight * l[c];
+                }
+            }
+            out
+        });
+        Ok(Self {
+            radiance,
+            yaw: 0.0,
+            clamped_texels: maps.iter().map(|m| m.0.clamped_texels).sum(),
+        })
+    }
+
     /// The current yaw, radians.
     pub fn yaw(&self) -> f32 {
         self.yaw
@@ -596,5 +635,30 @@ mod tests {
         assert!((total[0] - 4.0 * PI).abs() < 1e-3, "{total:?}");
         let missing = EnvSource::File("no/such.hdr".into()).load().unwrap_err();
         assert!(missing.to_string().contains("no/such.hdr"), "{missing}");
+    }
+
+    #[test]
+    fn a_mix_of_one_map_is_the_map_and_weights_add_light() {
+        let sky = EnvMap::sky().rotated(0.4);
+        let one = EnvMap::mix(&[(&sky, 1.0)]).unwrap();
+        for d in [Vec3::Y, Vec3::new(0.3, 0.2, -0.9).normalize(), Vec3::NEG_Y] {
+            let (a, b) = (sky.radiance(d), one.radiance(d));
+            for c in 0..3 {
+                assert!(
+                    (a[c] - b[c]).abs() <= 1e-3 * a[c].abs().max(1.0),
+                    "{a:?} vs {b:?}"
+                );
+            }
+        }
+        let white = EnvMap::uniform([2.0; 3], 8);
+        let half = EnvMap::mix(&[(&white, 0.25), (&white.scaled(3.0), 0.5)]).unwrap();
+        // 0.25 x 2 + 0.5 x 6 = 3.5 everywhere.
+        assert!(
+            half.image()
+                .pixels()
+                .iter()
+                .all(|p| (p[0] - 3.5).abs() < 1e-5)
+        );
+        assert!(EnvMap::mix(&[]).is_err());
     }
 }

@@ -243,9 +243,9 @@ pub fn write_png8_srgb(path: &Path, img: &RgbImage, exposure: f32) -> Result<()>
     write_dynamic(path, DynamicImage::ImageRgb8(buf))
 }
 
-/// Writes premultiplied linear RGBA as an 8-bit sRGB PNG with straight alpha (the PNG
-/// convention): colour is divided by alpha before encoding.
-pub fn write_png8_srgba(path: &Path, img: &Image<Rgba>, exposure: f32) -> Result<()> {
+/// 8-bit sRGB with straight alpha (the PNG convention) of premultiplied linear RGBA
+/// multiplied by `exposure`: colour is divided by alpha before encoding.
+pub fn srgba8_straight(img: &Image<Rgba>, exposure: f32) -> Vec<u8> {
     let mut raw = Vec::with_capacity(img.pixels().len() * 4);
     for p in img.pixels() {
         let a = p[3].clamp(0.0, 1.0);
@@ -255,6 +255,13 @@ pub fn write_png8_srgba(path: &Path, img: &Image<Rgba>, exposure: f32) -> Result
         }
         raw.push(to_u8(a));
     }
+    raw
+}
+
+/// Writes premultiplied linear RGBA as an 8-bit sRGB PNG with straight alpha
+/// ([`srgba8_straight`]).
+pub fn write_png8_srgba(path: &Path, img: &Image<Rgba>, exposure: f32) -> Result<()> {
+    let raw = srgba8_straight(img, exposure);
     let buf = buffer::<image::Rgba<u8>, _>(img, raw)?;
     write_dynamic(path, DynamicImage::ImageRgba8(buf))
 }

@@ -21,6 +21,7 @@ pub mod image;
 pub mod io;
 pub mod light;
 pub mod manifest;
+pub mod preview;
 pub mod shared_data;
 pub mod volume;
 

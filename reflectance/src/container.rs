@@ -275,6 +275,8 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     source: R,
     header: FieldHeader,
     chunks: BTreeMap<ChunkKey, ChunkEntry>,
+    /// Bytes of chunks read so far (what a plan saves is measured on it).
+    bytes_read: std::sync::atomic::AtomicU64,
 }
 
 impl FieldFile<FileSource> {
@@ -374,6 +376,7 @@ impl<R: ReadAt> FieldFile<R> {
             source,
             header: index.header,
             chunks,
+            bytes_read: std::sync::atomic::AtomicU64::new(0),
         })
     }
 
@@ -422,7 +425,14 @@ impl<R: ReadAt> FieldFile<R> {
         if crc32fast::hash(&bytes) != entry.crc32 {
             return Err(self.chunk_error(key, "checksum mismatch (damaged file)".into()));
         }
+        self.bytes_read
+            .fetch_add(entry.length, std::sync::atomic::Ordering::Relaxed);
         Ok(bytes)
+    }
+
+    /// Bytes of chunks read from this file so far.
+    pub fn bytes_read(&self) -> u64 {
+        self.bytes_read.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// An error about chunk `key` of this file.

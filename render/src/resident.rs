@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
 use crate::geometry::{Crop, PoseGeometry};
+use crate::scene::plan::PosePlan;
 
 /// How the field is lit.
 #[derive(Debug, Clone)]
@@ -96,20 +97,50 @@ pub struct PoseSource {
 impl PoseSource {
     /// Loads pose `pose` of a field and the relighting coefficients of `lighting`.
     pub fn load<R: ReadAt>(field: &FieldFile<R>, pose: u32, lighting: &Lighting) -> Result<Self> {
+        Self::load_planned(field, pose, lighting, None)
+    }
+
+    /// Loads what `plan` (if any) says pose `pose` needs: the views, flows and conditions
+    /// it leaves out are not read, decoded or relit (their views stay transparent, their
+    /// flows absent, their coefficients zero); the crop covers the views read.
+    pub fn load_planned<R: ReadAt>(
+        field: &FieldFile<R>,
+        pose: u32,
+        lighting: &Lighting,
+        plan: Option<&PosePlan>,
+    ) -> Result<Self> {
         let h = field.header();
         let record = h.pose(pose)?;
         let (columns, rows) = (h.columns, h.rows);
         let views = columns * rows;
+        if let Some(p) = plan
+            && (p.pose != pose
+                || p.views.len() != views
+                || p.conditions.len() != h.conditions.len())
+        {
+            return Err(RenderError::BadParameter(format!(
+                "the plan of pose {} does not fit pose {pose} of this field",
+                p.pose
+            )));
+        }
+        let view_used = |i: usize| plan.is_none_or(|p| p.views[i]);
+        let flow_used = |i: usize, n: Neighbour| plan.is_none_or(|p| p.flows[i][n.index()]);
         let cameras = record
             .views
             .iter()
             .map(|v| v.camera.to_camera().map_err(RenderError::BadParameter))
             .collect::<Result<Vec<_>>>()?;
+        let size = (h.width, h.height);
         let alphas: Vec<GrayImage> = (0..views)
             .into_par_iter()
-            .map(|i| Ok(field.alpha(pose, i / rows, i % rows)?))
+            .map(|i| {
+                if view_used(i) {
+                    Ok(field.alpha(pose, i / rows, i % rows)?)
+                } else {
+                    Ok(GrayImage::new(size.0 as usize, size.1 as usize, 0.0))
+                }
+            })
             .collect::<Result<_>>()?;
-        let size = (h.width, h.height);
         let crop = Crop::of_mattes(&alphas, size);
         let (coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
             Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
@@ -125,6 +156,17 @@ impl PoseSource {
                 )
             }
         };
+        let mut coefficients = coefficients;
+        if let Some(p) = plan {
+            // Conditions the plan leaves out have zero weight at every frame.
+            for c in &mut coefficients {
+                for (k, used) in p.conditions.iter().enumerate() {
+                    if !used {
+                        c[k] = [0.0; 3];
+                    }
+                }
+            }
+        }
         let used: Vec<bool> = (0..h.conditions.len())
             .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
             .collect();
@@ -144,6 +186,16 @@ impl PoseSource {
             .into_par_iter()
             .map(|i| {
                 let (u, v) = (i / rows, i % rows);
+                if !view_used(i) {
+                    let texels = crop.texels();
+                    let blank = BasisCodes {
+                        width: crop.width as usize,
+                        height: crop.height as usize,
+                        tiles: vec![vec![[0u8; 3]; texels]; h.conditions.len()],
+                        scales: vec![1.0; h.conditions.len()],
+                    };
+                    return Ok((blank, vec![0u8; texels], Default::default()));
+                }
                 let mut b = field.basis_codes(pose, u, v)?;
                 b.tiles = b.tiles.iter().map(|t| crop.rows_of(t, full_w)).collect();
                 b.width = crop.width as usize;
@@ -155,6 +207,9 @@ impl PoseSource {
                     .collect();
                 let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
                 for n in Neighbour::ALL {
+                    if !flow_used(i, n) {
+                        continue;
+                    }
                     if let Some(codes) = field.flow_codes(pose, u, v, n)? {
                         let plane = codes.len() / 2;
                         let pairs: Vec<[i8; 2]> =

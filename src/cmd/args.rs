@@ -7,18 +7,14 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use frf_core::env::{EnvMap, EnvSource};
-use frf_core::io::read_photo;
 use frf_core::volume::GroundGrid;
 use frf_flow::Preset;
 use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, DEFAULT_VOXEL_M, ShadowOptions};
-use frf_reflectance::FieldFile;
 use frf_reflectance::field::HullSpec;
 use frf_reflectance::project::FloorModel;
-use frf_render::composite::{Backdrop, GroundLook};
 use frf_render::morph::Variant;
 use frf_render::path::{CameraPath, Orbit, Trajectory};
 use frf_render::resident::Lighting;
-use frf_render::shadow::{RelitShadow, ShadowMaps, traced_shadow};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -162,7 +158,7 @@ pub struct LightingArgs {
     /// built-in sky, `uniform` for a white furnace, or `none` to show a field of
     /// photographs as captured (a file named like one of the words: `./sky`).
     #[arg(long, value_parser = parse_env)]
-    pub env: EnvSource,
+    pub env: Option<EnvSource>,
     /// Yaw of the environment about the vertical axis, degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub yaw: f32,
@@ -172,13 +168,21 @@ pub struct LightingArgs {
 }
 
 impl LightingArgs {
+    /// The environment asked for.
+    pub fn source(&self) -> CliResult<&EnvSource> {
+        Ok(self
+            .env
+            .as_ref()
+            .ok_or("give --env ENV.hdr|sky|uniform|none")?)
+    }
+
     /// The lighting of a field of `conditions` basis conditions, and the environment
     /// for truth renders (`None` for `none`).
     pub fn lighting(&self, conditions: usize) -> CliResult<(Lighting, Option<EnvMap>)> {
-        let Some(env) = self
-            .env
+        let source = self.source()?;
+        let Some(env) = source
             .load()
-            .map_err(|e| format!("environment {}: {e}", self.env))?
+            .map_err(|e| format!("environment {source}: {e}"))?
         else {
             return Ok((Lighting::Unlit, None));
         };
@@ -228,7 +232,7 @@ pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
 #[derive(Args, Clone, Serialize, PartialEq)]
 pub struct CameraArgs {
     /// Keyframed camera path (TOML; see `frf_render::path`).
-    #[arg(long, conflicts_with = "orbit", required_unless_present = "orbit")]
+    #[arg(long, conflicts_with = "orbit")]
     pub camera: Option<PathBuf>,
     /// Orbit about the vertical axis through --look-at: `RADIUS,HEIGHT[,SWEEP_DEG]`,
     /// metres and degrees (default sweep 360, a loop).
@@ -389,71 +393,6 @@ pub enum ShadowArg {
     Traced,
     /// No shadow.
     None,
-}
-
-impl BackdropArgs {
-    /// The backdrop, lit by `env` (the relighting's environment, if any).
-    pub fn backdrop(&self, env: Option<&EnvMap>) -> CliResult<Backdrop> {
-        Ok(match self.backdrop {
-            BackdropArg::None => Backdrop::None,
-            BackdropArg::Env => {
-                let env =
-                    env.ok_or("--backdrop env needs an environment (--env FILE|sky|uniform)")?;
-                let ground = match self.ground {
-                    GroundArg::Env => GroundLook::Environment,
-                    GroundArg::Albedo(a) => GroundLook::Albedo(a),
-                };
-                Backdrop::environment(env.clone(), ground)
-            }
-            BackdropArg::Plate => {
-                let path = self
-                    .plate
-                    .as_ref()
-                    .ok_or("--backdrop plate needs --plate IMAGE")?;
-                Backdrop::Plate(read_photo(path)?)
-            }
-        })
-    }
-
-    /// The shadow of pose `pose` of `field` the options ask for (`None`: no shadow),
-    /// as `(maps, traced)`: the maps to relight, or a shadow traced here under `env`.
-    pub fn shadow(
-        &self,
-        field: &FieldFile,
-        pose: u32,
-        env: Option<&EnvMap>,
-    ) -> CliResult<(Option<ShadowMaps>, Option<RelitShadow>)> {
-        Ok(match self.shadow {
-            ShadowArg::None => (None, None),
-            ShadowArg::Maps => (ShadowMaps::load(field, pose)?, None),
-            ShadowArg::Traced => {
-                let env = env.ok_or("--shadow traced needs an environment")?;
-                if !(1..=65536).contains(&self.shadow_lights) {
-                    return Err(
-                        format!("--shadow-lights {} (1 to 65536)", self.shadow_lights).into(),
-                    );
-                }
-                let hull = field
-                    .hull(pose)?
-                    .ok_or("--shadow traced: the field holds no visual hull")?;
-                let ground = field
-                    .header()
-                    .shadows
-                    .as_ref()
-                    .map_or(GroundGrid::ORIGINAL, |s| s.ground);
-                let lights = env.median_cut(self.shadow_lights);
-                (None, Some(traced_shadow(&hull, &lights, ground)))
-            }
-        })
-    }
-
-    /// The frame size a plate imposes.
-    pub fn plate_size(&self, backdrop: &Backdrop) -> Option<(u32, u32)> {
-        match backdrop {
-            Backdrop::Plate(p) => Some((p.width() as u32, p.height() as u32)),
-            _ => None,
-        }
-    }
 }
 
 #[cfg(test)]

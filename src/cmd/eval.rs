@@ -273,7 +273,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         "{} pose {pose} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
          cameras at quad centres, {}:",
         args.field.display(),
-        args.lighting.env,
+        args.lighting.source()?,
         args.lights,
         truth_seconds,
         cameras.len(),
@@ -320,7 +320,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         let report = EvalReport {
             field: args.field.clone(),
             capture: args.capture.clone(),
-            env: args.lighting.env.to_string(),
+            env: args.lighting.source()?.to_string(),
             pose,
             device: renderer.device().to_string(),
             truth_lights: args.lights,

@@ -6,6 +6,7 @@ pub mod flow;
 pub mod hull;
 pub mod info;
 pub mod ingest;
+pub mod output;
 pub mod progress;
 pub mod render;
 pub mod stage;

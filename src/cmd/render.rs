@@ -1,29 +1,40 @@
-//! `frf render FIELD --env ENV --camera PATH.toml|--orbit R,H[,SWEEP] --out DIR`: frames
-//! of a pose of a field, relit by an environment, along a camera path, on the GPU (or the
-//! CPU reference with `--cpu`). Each frame is written as an 8-bit sRGB PNG with straight
-//! alpha and a linear premultiplied EXR, with a contact sheet of up to 12 frames over
-//! gray (`contact.png`); a rerun with the same settings resumes.
+//! `frf render INPUT`: frames of walkers relit by an environment, along a camera path,
+//! shadowed and composited, on the GPU (or the CPU reference with `--cpu`).
+//!
+//! INPUT is a scene file (`SCENE.toml`, [`frf_render::scene`]; flags override it, e.g.
+//! `--field F` renders the same scene from another field) or a field file with the scene
+//! given by flags (one walker frozen in `--pose`, `--env`, `--orbit` or `--camera`).
+//! Either way a plan of what the frames need is made first ([`frf_render::scene::plan`];
+//! `--plan [--json]` prints it and stops, `--explain` measures what it saves), and only
+//! that is read, relit and drawn (`--no-plan`: everything). Frames are written as 8-bit
+//! sRGB PNG (straight alpha) and linear premultiplied EXR, with EXR layers on request, a
+//! contact sheet, an animated preview and `render.json`; `--frames A..B` renders part of
+//! a shot (for a farm), and a rerun resumes ([`crate::cmd::output`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use frf_core::atomic::write_bytes_atomic;
-use frf_core::contact;
-use frf_core::image::{Image, RgbImage, Rgba};
-use frf_core::io::{write_exr_rgb, write_exr_rgba, write_png8_srgb, write_png8_srgba};
+use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
-use frf_render::cpu::FrameStats;
+use frf_render::composite::GroundLook;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::path::Trajectory;
-use frf_render::renderer::Renderer;
-use frf_render::renderer::SceneShadow;
-use frf_render::resident::PoseSource;
+use frf_render::renderer::{Device, Renderer};
+use frf_render::resident::{Lighting, PoseSource};
+use frf_render::scene::plan::{Plan, ShotFrame};
+use frf_render::scene::shot::{Shot, ShotOptions};
+use frf_render::scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+use glam::Vec3;
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::{BackdropArgs, CameraArgs, LightingArgs, ShadowArg, VariantArg, parse_size};
+use crate::cmd::args::{
+    BackdropArg, BackdropArgs, CameraArgs, GroundArg, LightingArgs, ShadowArg, VariantArg,
+    parse_size,
+};
+use crate::cmd::output::{FrameRange, Output};
 use crate::cmd::progress::bar;
 
 /// Makes `source` resident on the GPU, or for the CPU reference when `cpu`.
@@ -40,293 +51,440 @@ pub fn pose_of(header: &FieldHeader, requested: Option<u32>, field: &Path) -> Cl
     Ok(pose)
 }
 
+/// Frames along a path of a field render, by default.
+const DEFAULT_FRAMES: usize = 36;
+/// Memory the resident poses may hold by default, MB.
+const DEFAULT_BUDGET_MB: u64 = 4096;
+
 /// Arguments of `frf render`.
 #[derive(Args, Serialize, PartialEq)]
 pub struct RenderArgs {
-    /// A field file (`frf ingest`, `frf stage field` or `frf ingest-ring`).
-    pub field: PathBuf,
+    /// A scene file (`.toml`) or a field file (`frf ingest`, `frf stage field`, `frf
+    /// ingest-ring`).
+    pub input: PathBuf,
+    /// The field (overrides the scene's).
+    #[arg(long)]
+    pub field: Option<PathBuf>,
     #[command(flatten)]
     pub lighting: LightingArgs,
     #[command(flatten)]
     pub camera: CameraArgs,
     #[command(flatten)]
     pub scene: BackdropArgs,
-    /// Output directory: frame_NNNN.png (8-bit sRGB, straight alpha) and frame_NNNN.exr
-    /// (linear, premultiplied), and render.json (the settings and the report).
+    /// Output directory: frame_NNNN.png (8-bit sRGB, straight alpha), frame_NNNN.exr
+    /// (linear, premultiplied), contact.png, the animated preview and render.json.
     #[arg(long)]
-    pub out: PathBuf,
+    pub out: Option<PathBuf>,
     /// Also write each frame's layers for compositing tools: frame_NNNN_subject.exr
     /// (premultiplied RGBA), frame_NNNN_shadow.exr (relative irradiance of the ground, 1
     /// unshadowed) and frame_NNNN_backdrop.exr.
     #[arg(long)]
     pub layers: bool,
-    /// Frame size `WxH` (default: the field's image size).
+    /// Frame size `WxH` (default: the scene's, else the field's image size).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Number of frames along the path.
-    #[arg(long, default_value_t = 36)]
-    pub frames: usize,
-    /// Pose of the field (default: its first).
+    /// Frames: `N` (the first N; along a field's path, N frames), or `A..B` (frames A to
+    /// B − 1 of a scene, e.g. one task of a farm job).
+    #[arg(long)]
+    pub frames: Option<String>,
+    /// Pose of a field render (default: its first).
     #[arg(long)]
     pub pose: Option<u32>,
-    /// Interpolation.
-    #[arg(long, value_enum, default_value = "fourway")]
-    pub variant: VariantArg,
+    /// Interpolation (default: the scene's, else four-way).
+    #[arg(long, value_enum)]
+    pub variant: Option<VariantArg>,
     /// Render with the CPU reference instead of the GPU.
     #[arg(long)]
     pub cpu: bool,
-    /// Exposure of the PNG frames, stops (the EXR frames are not scaled).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
+    /// Exposure of the PNG frames and previews, stops (default: the scene's, else 0).
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
     /// Render every frame again even where the directory holds it.
     #[arg(long)]
     #[serde(skip)]
     pub overwrite: bool,
+    /// Print the plan (what the frames need from the field, and what it leaves out) and
+    /// stop.
+    #[arg(long)]
+    #[serde(skip)]
+    pub plan: bool,
+    /// With `--plan`: as JSON.
+    #[arg(long)]
+    #[serde(skip)]
+    pub json: bool,
+    /// Print the plan for a person, with what each saving is worth in seconds, measured
+    /// by loading a pose with and without it, and stop.
+    #[arg(long)]
+    #[serde(skip)]
+    pub explain: bool,
+    /// Read, relight and draw everything of the poses drawn, not only what the plan says.
+    #[arg(long)]
+    pub no_plan: bool,
+    /// Most memory the resident poses may hold together, MB (the least recently used
+    /// leave first).
+    #[arg(long, default_value_t = DEFAULT_BUDGET_MB)]
+    pub memory_budget: u64,
 }
 
-/// The report written to `render.json`.
-#[derive(Serialize)]
-struct Report<'a> {
-    settings: &'a RenderArgs,
-    device: String,
-    pose: u32,
-    crop: [u32; 4],
-    lighting_skipped_conditions: Vec<String>,
-    images_combined: usize,
-    images_total: usize,
-    resident_bytes: u64,
-    resident_seconds: f64,
-    frames_rendered: usize,
-    frames_resumed: usize,
-    seconds_per_frame_mean: f64,
-    seconds_per_frame_median: f64,
-    seconds_first_frame: f64,
-    pixels_inside: usize,
-    pixels_clamped_above: usize,
-    pixels_clamped_below: usize,
-    pixels_missed: usize,
-}
-
-/// Frames on the contact sheet (evenly spaced).
-const SHEET_FRAMES: usize = 12;
-
-/// Premultiplied RGBA over a mid-gray backdrop, for the contact sheet.
-fn over_gray(img: &Image<Rgba>) -> RgbImage {
-    let gray = 0.18;
-    Image::from_fn(img.width(), img.height(), |x, y| {
-        let p = img.get(x, y);
-        let a = p[3].clamp(0.0, 1.0);
-        [0, 1, 2].map(|c| p[c] + (1.0 - a) * gray)
+/// The scene a field render's flags describe: one walker frozen in `pose`.
+fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Scene> {
+    let source = args.lighting.source()?.clone();
+    let backdrop = match args.scene.backdrop {
+        BackdropArg::None => BackdropSpec::None,
+        BackdropArg::Env => BackdropSpec::Environment(match args.scene.ground {
+            GroundArg::Env => GroundLook::Environment,
+            GroundArg::Albedo(a) => GroundLook::Albedo(a),
+        }),
+        BackdropArg::Plate => BackdropSpec::Plate(
+            args.scene
+                .plate
+                .clone()
+                .ok_or("--backdrop plate needs --plate IMAGE")?,
+        ),
+    };
+    if matches!(backdrop, BackdropSpec::Environment(_)) && source == EnvSource::None {
+        return Err("--backdrop env needs an environment (--env FILE|sky|uniform)".into());
+    }
+    let trajectory = args.camera.trajectory()?;
+    if matches!(backdrop, BackdropSpec::Plate(_))
+        && !matches!(&trajectory, Trajectory::Path(p) if p.keys.len() == 1)
+    {
+        return Err("--backdrop plate: the plate's camera is a --camera path of one key".into());
+    }
+    let cycle = h.cycle_seconds as f32;
+    Ok(Scene {
+        path: args.input.clone(),
+        field: Some(args.input.clone()),
+        start: 0.0,
+        end: 0.0,
+        // The preview of a field render plays at a typical video rate.
+        fps: 12.0,
+        size: None,
+        exposure: 0.0,
+        layers: false,
+        preview: Preview::Apng,
+        variant: Variant::FourWay,
+        lighting: vec![LightKey {
+            time: f32::NEG_INFINITY,
+            env: source,
+            yaw: args.lighting.yaw.to_radians(),
+            intensity: 1.0,
+        }],
+        floor: args.lighting.floor.into(),
+        camera: trajectory,
+        backdrop,
+        shadow: match args.scene.shadow {
+            ShadowArg::Maps => ShadowSpec::Maps,
+            ShadowArg::Traced => ShadowSpec::Traced,
+            ShadowArg::None => ShadowSpec::None,
+        },
+        instances: vec![Instance {
+            position: Vec3::ZERO,
+            heading: 0.0,
+            time_offset: pose as f32 / h.poses_per_cycle.max(1) as f32 * cycle,
+        }],
     })
 }
 
-fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
-    dir.join(format!("frame_{i:04}.{ext}"))
-}
-
-fn layer_path(dir: &Path, i: usize, layer: &str) -> PathBuf {
-    dir.join(format!("frame_{i:04}_{layer}.exr"))
-}
-
-/// Runs `frf render`.
-pub fn run(args: RenderArgs) -> CliResult {
-    let field = FieldFile::open(&args.field)?;
-    let h = field.header();
-    let pose = pose_of(h, args.pose, &args.field)?;
-    let (lighting, env) = args.lighting.lighting(h.conditions.len())?;
-    let backdrop = args.scene.backdrop(env.as_ref())?;
-    let (shadow_maps, traced) = args.scene.shadow(&field, pose, env.as_ref())?;
-    let trajectory = args.camera.trajectory()?;
-    let (width, height) = match args.scene.plate_size(&backdrop) {
-        Some(size) => {
-            if !matches!(&trajectory, Trajectory::Path(p) if p.keys.len() == 1) {
-                return Err(
-                    "--backdrop plate: the plate's camera is a --camera path of one key".into(),
-                );
-            }
-            size
-        }
-        None => args.size.unwrap_or((h.width, h.height)),
-    };
-    let cameras = trajectory.cameras(args.frames, width, height)?;
-    if !args.exposure.is_finite() || args.exposure.abs() > 30.0 {
-        return Err(format!("--exposure {} stops is outside [-30, 30]", args.exposure).into());
+/// The scene of the arguments: the file with its overrides, or the flags.
+fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
+    let is_scene = args
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_scene {
+        let field = args.field.clone().unwrap_or_else(|| args.input.clone());
+        let f = FieldFile::open(&field)?;
+        let pose = pose_of(f.header(), args.pose, &field)?;
+        return Ok((scene_of_flags(args, f.header(), pose)?, field));
     }
-
-    // A directory of a different render is not resumed into.
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("output directory {}: {e}", args.out.display()))?;
-    let settings_path = args.out.join("settings.json");
-    let settings = serde_json::to_string_pretty(&args)?;
-    let resume =
-        !args.overwrite && std::fs::read_to_string(&settings_path).is_ok_and(|s| s == settings);
-    if !resume && !args.overwrite && frame_path(&args.out, 0, "png").exists() {
+    if args.camera.camera.is_some() || args.camera.orbit.is_some() || args.pose.is_some() {
         return Err(format!(
-            "{} holds frames of a render with other settings; use --overwrite or another --out",
-            args.out.display()
+            "{}: a scene file gives the camera and the walk; --camera, --orbit and --pose are for field renders",
+            args.input.display()
         )
         .into());
     }
-    write_bytes_atomic(&settings_path, settings.as_bytes())?;
+    let mut scene = Scene::load(&args.input)?;
+    if let Some(env) = &args.lighting.env {
+        for k in &mut scene.lighting {
+            k.env = env.clone();
+        }
+    }
+    let field = args
+        .field
+        .clone()
+        .or_else(|| scene.field.clone())
+        .ok_or_else(|| {
+            format!(
+                "{}: no field (give field = \"...\" or --field)",
+                args.input.display()
+            )
+        })?;
+    Ok((scene, field))
+}
 
-    let start = Instant::now();
-    let source = PoseSource::load(&field, pose, &lighting)?;
-    let mut renderer = open_renderer(&source, args.cpu)?;
-    let had_maps = shadow_maps.is_some();
-    let shadow = match (&shadow_maps, traced) {
-        (Some(m), _) => SceneShadow::Maps(m),
-        (None, Some(t)) => SceneShadow::Relit(t),
-        (None, None) => SceneShadow::None,
-    };
-    renderer.set_scene(backdrop, shadow)?;
-    let resident_seconds = start.elapsed().as_secs_f64();
-    let c = source.geometry.crop;
-    eprintln!(
-        "{}: pose {pose}, {}x{} views, crop {}x{} at ({}, {}) of {}x{}",
-        args.field.display(),
-        h.columns,
-        h.rows,
-        c.width,
-        c.height,
-        c.x0,
-        c.y0,
-        h.width,
-        h.height
+/// The frames of `scene` the arguments ask for, of `size`.
+fn frames_of(
+    args: &RenderArgs,
+    scene: &Scene,
+    size: (u32, u32),
+    field_render: bool,
+) -> CliResult<(Vec<ShotFrame>, usize)> {
+    if field_render {
+        let n = match &args.frames {
+            Some(s) => s
+                .parse::<usize>()
+                .map_err(|_| format!("--frames {s:?}: a field render takes a count of frames"))?,
+            None => DEFAULT_FRAMES,
+        };
+        // A field render freezes the walk: the walker's time offset picks the pose.
+        let time = 0.0;
+        let frames = scene
+            .camera
+            .cameras(n, size.0, size.1)?
+            .into_iter()
+            .enumerate()
+            .map(|(index, camera)| ShotFrame {
+                index,
+                time,
+                camera,
+            })
+            .collect();
+        return Ok((frames, n));
+    }
+    let total = scene.frame_times().len();
+    let range = FrameRange::parse(args.frames.as_deref(), total)?;
+    Ok((scene.shot_frames(range.start..range.end, size)?, total))
+}
+
+/// The report of `--plan --json`.
+#[derive(Serialize)]
+struct PlanReport<'a> {
+    #[serde(flatten)]
+    counts: &'a frf_render::scene::plan::PlanCounts,
+    frames: usize,
+    poses: Vec<u32>,
+    poses_substituted: &'a [(u32, u32)],
+    conditions_left_out: &'a [String],
+    floor_conditions_left_out: usize,
+    ground_seen: bool,
+    shadow_maps_read: bool,
+}
+
+fn print_plan(plan: &Plan, json: bool) -> CliResult {
+    if json {
+        let report = PlanReport {
+            counts: &plan.counts,
+            frames: plan.frames.len(),
+            poses: plan.poses.iter().map(|p| p.pose).collect(),
+            poses_substituted: &plan.poses_substituted,
+            conditions_left_out: &plan.conditions_left_out,
+            floor_conditions_left_out: plan.floor_conditions_left_out,
+            ground_seen: plan.ground_seen,
+            shadow_maps_read: plan.poses.iter().any(|p| p.shadow_maps),
+        };
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    let c = &plan.counts;
+    let mb = |b: u64| b as f64 / 1e6;
+    println!("plan of {} frames:", plan.frames.len());
+    println!("  poses      {:>6} of {:>6}", c.poses_used, c.poses_total);
+    println!(
+        "  views      {:>6} of {:>6}  (over the poses used)",
+        c.views_used, c.views_total
     );
-    let plan = &source.plan;
-    eprintln!(
-        "lighting: {} of {} basis images combined; conditions left out (zero weight): {}",
-        plan.images_combined,
-        plan.images_total,
-        if plan.skipped_conditions.is_empty() {
+    println!("  flows      {:>6} of {:>6}", c.flows_used, c.flows_total);
+    println!(
+        "  conditions {:>6} of {:>6}  (left out: {})",
+        c.conditions_used,
+        c.conditions_total,
+        if plan.conditions_left_out.is_empty() {
             "none".to_string()
         } else {
-            plan.skipped_conditions.join(", ")
+            plan.conditions_left_out.join(", ")
         }
     );
-    eprintln!(
-        "{}: pose resident in {:.2} MB, loaded and relit in {resident_seconds:.2} s",
-        renderer.device(),
-        renderer.resident_bytes() as f64 / 1e6
+    println!(
+        "  bytes read {:>9.2} of {:>9.2} MB",
+        mb(c.bytes_read),
+        mb(c.bytes_total)
     );
-    eprintln!(
-        "scene: backdrop {:?}, shadow {}",
-        args.scene.backdrop,
-        match (renderer.has_shadow(), args.scene.shadow) {
-            (true, ShadowArg::Maps) => "relit from the pose's maps",
-            (true, _) => "traced against the pose's visual hull",
-            (false, ShadowArg::None) => "left out (--shadow none)",
-            (false, _) if !had_maps => "none (the field holds no shadow maps)",
-            (false, _) => "none (no environment to relight it with)",
-        }
-    );
-
-    let scale = 2f32.powf(args.exposure);
-    let variant = Variant::from(args.variant);
-    let bar = bar("frames");
-    bar.set_length(cameras.len() as u64);
-    let mut times = Vec::new();
-    let mut totals = FrameStats::default();
-    let mut resumed = 0;
-    let sheet_every = cameras.len().div_ceil(SHEET_FRAMES).max(1);
-    let mut sheet = Vec::new();
-    for (i, cam) in cameras.iter().enumerate() {
-        let (png, exr) = (
-            frame_path(&args.out, i, "png"),
-            frame_path(&args.out, i, "exr"),
-        );
-        if resume && png.exists() && exr.exists() {
-            resumed += 1;
-            bar.inc(1);
-            continue;
-        }
-        let t = Instant::now();
-        let frame = renderer.render_frame(cam, variant, args.layers)?;
-        times.push(t.elapsed().as_secs_f64());
-        let (img, stats) = (frame.composite, frame.stats);
-        totals.inside += stats.inside;
-        totals.clamped_above += stats.clamped_above;
-        totals.clamped_below += stats.clamped_below;
-        totals.missed += stats.missed;
-        if let Some(l) = &frame.layers {
-            write_exr_rgba(&layer_path(&args.out, i, "subject"), &l.subject)?;
-            write_exr_rgb(&layer_path(&args.out, i, "shadow"), &l.shadow)?;
-            write_exr_rgba(&layer_path(&args.out, i, "backdrop"), &l.backdrop)?;
-        }
-        write_exr_rgba(&exr, &img)?;
-        write_png8_srgba(&png, &img, scale)?;
-        if i % sheet_every == 0 {
-            sheet.push(over_gray(&img));
-        }
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-
-    let mean = times.iter().sum::<f64>() / times.len().max(1) as f64;
-    let mut sorted = times.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
-    let report = Report {
-        settings: &args,
-        device: renderer.device().to_string(),
-        pose,
-        crop: [c.x0, c.y0, c.width, c.height],
-        lighting_skipped_conditions: plan.skipped_conditions.clone(),
-        images_combined: plan.images_combined,
-        images_total: plan.images_total,
-        resident_bytes: renderer.resident_bytes(),
-        resident_seconds,
-        frames_rendered: times.len(),
-        frames_resumed: resumed,
-        seconds_per_frame_mean: mean,
-        seconds_per_frame_median: median,
-        seconds_first_frame: times.first().copied().unwrap_or(0.0),
-        pixels_inside: totals.inside,
-        pixels_clamped_above: totals.clamped_above,
-        pixels_clamped_below: totals.clamped_below,
-        pixels_missed: totals.missed,
-    };
-    if !sheet.is_empty() {
-        let columns = sheet.len().min(SHEET_FRAMES / 2);
-        write_png8_srgb(
-            &args.out.join("contact.png"),
-            &contact::sheet(&sheet, columns),
-            scale,
-        )?;
-    }
-    write_bytes_atomic(
-        &args.out.join("render.json"),
-        serde_json::to_string_pretty(&report)?.as_bytes(),
-    )?;
-    eprintln!(
-        "{} frames of {width}x{height} ({}, {}) in {}: {median:.3} s/frame median, {mean:.3} \
-         mean, first {:.3} (includes pipeline set-up){}",
-        times.len(),
-        variant.name(),
-        args.env_name(),
-        args.out.display(),
-        report.seconds_first_frame,
-        if resumed > 0 {
-            format!("; {resumed} frames were already there (resumed)")
+    println!(
+        "  shadow maps {}",
+        if plan.poses.iter().any(|p| p.shadow_maps) {
+            "read"
+        } else if plan.ground_seen {
+            "not read (no maps asked for)"
         } else {
-            String::new()
+            "not read (no frame sees the ground patch)"
         }
     );
-    let all = (totals.inside + totals.clamped_above + totals.clamped_below + totals.missed).max(1);
-    let pct = |n: usize| 100.0 * n as f64 / all as f64;
-    eprintln!(
-        "pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row (rays above \
-         the grid), {:.1} % clamped to the bottom row, {:.1} % missed (no view; transparent)",
-        pct(totals.inside),
-        pct(totals.clamped_above),
-        pct(totals.clamped_below),
-        pct(totals.missed)
+    for (wanted, held) in &plan.poses_substituted {
+        println!("  pose {wanted} is not in the field: pose {held} stands in for it");
+    }
+    Ok(())
+}
+
+/// `--explain`: the plan, and what each saving is worth, measured on the first pose.
+fn explain<R: frf_reflectance::container::ReadAt>(
+    scene: &Scene,
+    field: &FieldFile<R>,
+    plan: &Plan,
+    cpu: bool,
+) -> CliResult {
+    print_plan(plan, false)?;
+    let Some(first) = plan.poses.first() else {
+        return Ok(());
+    };
+    let lighting = match &scene.lighting[0].env.load()? {
+        Some(env) => Lighting::Environment {
+            env: env
+                .rotated(scene.lighting[0].yaw)
+                .scaled(scene.lighting[0].intensity),
+            floor: scene.floor,
+        },
+        None => Lighting::Unlit,
+    };
+    let device = Device::open(cpu)?;
+    let measure = |planned: bool| -> CliResult<(f64, u64)> {
+        let before = field.bytes_read();
+        let t = Instant::now();
+        let source =
+            PoseSource::load_planned(field, first.pose, &lighting, planned.then_some(first))?;
+        let resident = device.make_resident(&source)?;
+        drop(resident);
+        Ok((t.elapsed().as_secs_f64(), field.bytes_read() - before))
+    };
+    // Once untimed (caches, pipelines), then each way.
+    measure(false)?;
+    let (full_s, full_b) = measure(false)?;
+    let (planned_s, planned_b) = measure(true)?;
+    let c = &plan.counts;
+    println!(
+        "measured on pose {} ({}), reading and relighting one pose:",
+        first.pose,
+        device.name()
+    );
+    println!(
+        "  every view, flow and condition: {full_s:.3} s, {:.2} MB read",
+        full_b as f64 / 1e6
+    );
+    println!(
+        "  as planned:                     {planned_s:.3} s, {:.2} MB read",
+        planned_b as f64 / 1e6
+    );
+    println!(
+        "  views, flows and conditions left out save {:.3} s and {:.2} MB per pose, {:.2} s over the {} poses drawn",
+        full_s - planned_s,
+        (full_b.saturating_sub(planned_b)) as f64 / 1e6,
+        (full_s - planned_s) * c.poses_used as f64,
+        c.poses_used
+    );
+    println!(
+        "  the {} poses never drawn save {:.2} s (each as a full pose)",
+        c.poses_total - c.poses_used,
+        full_s * (c.poses_total - c.poses_used) as f64
     );
     Ok(())
 }
 
-impl RenderArgs {
-    fn env_name(&self) -> String {
-        format!("env {}", self.lighting.env)
+/// Runs `frf render`.
+pub fn run(args: RenderArgs) -> CliResult {
+    let (mut scene, field_path) = scene_of(&args)?;
+    let field_render = !args
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if let Some(v) = args.variant {
+        scene.variant = v.into();
     }
+    if let Some(e) = args.exposure {
+        scene.exposure = e;
+    }
+    if !scene.exposure.is_finite() || scene.exposure.abs() > 30.0 {
+        return Err(format!("--exposure {} stops is outside [-30, 30]", scene.exposure).into());
+    }
+    scene.layers |= args.layers;
+    let field = FieldFile::open(&field_path)?;
+    let h = field.header();
+    let plate_size = match &scene.backdrop {
+        BackdropSpec::Plate(p) => {
+            let (w, h) = frf_core::io::image_dimensions(p)?;
+            Some((w as u32, h as u32))
+        }
+        _ => None,
+    };
+    let size = plate_size
+        .or(args.size)
+        .or(scene.size)
+        .unwrap_or((h.width, h.height));
+    let (frames, total) = frames_of(&args, &scene, size, field_render)?;
+    if args.plan || args.explain {
+        let plan = Plan::new(&scene, &field, &frames)?;
+        if args.explain {
+            return explain(&scene, &field, &plan, args.cpu);
+        }
+        return print_plan(&plan, args.json);
+    }
+    let out_dir = args.out.clone().ok_or("give --out DIR (or --plan)")?;
+    let settings = serde_json::json!({
+        "args": &args,
+        "scene": std::fs::read_to_string(&args.input).ok().filter(|_| !field_render),
+        "size": size,
+    });
+    let mut output = Output::open(&out_dir, &settings, args.overwrite, total)?;
+
+    let start = Instant::now();
+    let device = Device::open(args.cpu)?;
+    let options = ShotOptions {
+        memory_budget: args.memory_budget.saturating_mul(1_000_000),
+        planned: !args.no_plan,
+        traced_lights: args.scene.shadow_lights,
+    };
+    let mut shot = Shot::new(&scene, &field, device, &frames, options)?;
+    let setup_seconds = start.elapsed().as_secs_f64();
+    let c = &shot.plan().counts;
+    eprintln!(
+        "{}: {} of {} frames, {}x{}, {}; plan: {} of {} poses, {} of {} views, {} of {} flows, {} of {} conditions, {:.2} of {:.2} MB{}",
+        field_path.display(),
+        frames.len(),
+        total,
+        size.0,
+        size.1,
+        shot.device(),
+        c.poses_used,
+        c.poses_total,
+        c.views_used,
+        c.views_total,
+        c.flows_used,
+        c.flows_total,
+        c.conditions_used,
+        c.conditions_total,
+        c.bytes_read as f64 / 1e6,
+        c.bytes_total as f64 / 1e6,
+        if options.planned {
+            ""
+        } else {
+            " (--no-plan: everything is read)"
+        }
+    );
+    let bar = bar("frames");
+    bar.set_length(frames.len() as u64);
+    for f in &frames {
+        if output.done(f.index) {
+            output.resumed(f.index, &shot.plan().frames)?;
+            bar.inc(1);
+            continue;
+        }
+        let t = Instant::now();
+        let r = shot.render(f, scene.layers)?;
+        output.write(f, r, t.elapsed().as_secs_f64(), scene.exposure)?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let summary = output.finish(&scene, &shot, setup_seconds, field.bytes_read())?;
+    eprintln!("{summary}");
+    Ok(())
 }

@@ -15,6 +15,7 @@
 
 pub mod file;
 pub mod plan;
+pub mod shot;
 
 use std::path::{Path, PathBuf};
 

@@ -221,31 +221,63 @@ fn quad_flows(u: usize, v: usize, columns: usize, rows: usize) -> Vec<((usize, u
     out
 }
 
+/// One frame to render: its index in the shot, its time (seconds) and its camera
+/// (scene frame).
+#[derive(Debug, Clone, Copy)]
+pub struct ShotFrame {
+    /// Index in the shot.
+    pub index: usize,
+    /// Seconds.
+    pub time: f32,
+    /// The camera.
+    pub camera: Camera,
+}
+
+impl Scene {
+    /// The frames `range` of the scene (indices into [`Scene::frame_times`]), of `size`.
+    pub fn shot_frames(
+        &self,
+        range: std::ops::Range<usize>,
+        size: (u32, u32),
+    ) -> Result<Vec<ShotFrame>> {
+        let times = self.frame_times();
+        if range.start >= range.end || range.end > times.len() {
+            return Err(RenderError::BadParameter(format!(
+                "frames {}..{} of a scene of {} frames",
+                range.start,
+                range.end,
+                times.len()
+            )));
+        }
+        range
+            .map(|index| {
+                Ok(ShotFrame {
+                    index,
+                    time: times[index],
+                    camera: self.camera_at(times[index], size)?,
+                })
+            })
+            .collect()
+    }
+}
+
 impl Plan {
-    /// The plan of `scene` on `field` for the frames `frames` (indices into
-    /// [`Scene::frame_times`]) of `size`.
+    /// The plan of `scene` on `field` for `frames`.
     pub fn new<R: ReadAt>(
         scene: &Scene,
         field: &FieldFile<R>,
-        frames: std::ops::Range<usize>,
-        size: (u32, u32),
+        frames: &[ShotFrame],
     ) -> Result<Self> {
         let h = field.header();
-        let times = scene.frame_times();
-        if frames.start >= frames.end || frames.end > times.len() {
-            return Err(RenderError::BadParameter(format!(
-                "frames {}..{} of a scene of {} frames",
-                frames.start,
-                frames.end,
-                times.len()
-            )));
+        if frames.is_empty() {
+            return Err(RenderError::BadParameter("a shot of no frame".into()));
         }
         let field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
         let mut substituted = BTreeSet::new();
         let frame_plans: Vec<FramePlan> = frames
-            .clone()
-            .map(|index| {
-                let time = times[index];
+            .iter()
+            .map(|f| {
+                let (index, time) = (f.index, f.time);
                 let poses = (0..scene.instances.len())
                     .map(|i| {
                         let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
@@ -267,8 +299,8 @@ impl Plan {
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
         let mut ground_seen = false;
         let mut poses: Vec<PosePlan> = Vec::new();
-        for fp in &frame_plans {
-            let camera = scene.camera_at(fp.time, size)?;
+        for (fp, frame) in frame_plans.iter().zip(frames) {
+            let camera = frame.camera;
             for (i, &pose) in fp.poses.iter().enumerate() {
                 let record = h.pose(pose)?;
                 let centres: Vec<Vec3> = record

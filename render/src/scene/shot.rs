@@ -1,0 +1,376 @@
+//! Rendering a scene's frames ([`Shot`]): each walker's pose made resident when a frame
+//! first needs it (read from the field as the plan says: only its views, flows and
+//! conditions), relit for the walker's heading and the frame's lighting, kept while the
+//! resident poses fit in a stated memory budget (the least recently used leaves first),
+//! and relit again only when the lighting it was relit with changes.
+//!
+//! The lighting of a frame is the scene's at its time: a mix of at most two maps (a
+//! cross-fade), turned by the yaw and scaled by the intensity, in the scene frame. A
+//! walker turned by heading `h` sees it turned by `−h`. The environment backdrop is the
+//! same lighting, seen from the scene frame.
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use frf_core::env::{EnvMap, EnvSource};
+use frf_core::image::RgbImage;
+use frf_core::io::read_photo;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
+
+use super::plan::{FramePlan, Plan, ShotFrame};
+use super::{BackdropSpec, LightingAt, Scene, ShadowSpec};
+use crate::composite::Backdrop;
+use crate::error::{RenderError, Result};
+use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
+use crate::resident::{Lighting, PoseSource};
+use crate::shadow::{ShadowMaps, traced_shadow};
+
+/// How a shot is rendered.
+#[derive(Debug, Clone, Copy)]
+pub struct ShotOptions {
+    /// Most bytes the resident poses may hold together.
+    pub memory_budget: u64,
+    /// Read, relight and draw only what the plan says (else every view, flow and
+    /// condition of the poses drawn).
+    pub planned: bool,
+    /// Median-cut lights of a traced shadow.
+    pub traced_lights: usize,
+}
+
+/// A lighting, as a key that tells two apart.
+#[derive(Debug, Clone, PartialEq)]
+struct LightingKey {
+    maps: Vec<(String, u32)>,
+    yaw: u32,
+    intensity: u32,
+}
+
+impl LightingKey {
+    fn of(l: &LightingAt) -> Self {
+        Self {
+            maps: l
+                .maps
+                .iter()
+                .map(|(e, w)| (e.to_string(), w.to_bits()))
+                .collect(),
+            yaw: l.yaw.to_bits(),
+            intensity: l.intensity.to_bits(),
+        }
+    }
+}
+
+struct Cached {
+    pose: u32,
+    heading: u32,
+    lighting: LightingKey,
+    resident: Resident,
+    last_frame: usize,
+}
+
+/// What happened while rendering the shot so far.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct ShotCounters {
+    /// Poses made resident (read and relit), counting relights for a new lighting.
+    pub poses_made_resident: usize,
+    /// Of those, relights of a pose already resident under another lighting.
+    pub relights: usize,
+    /// Poses dropped to stay within the budget.
+    pub evictions: usize,
+    /// Most bytes resident at once.
+    pub peak_resident_bytes: u64,
+    /// Seconds reading and relighting poses.
+    pub residency_seconds: f64,
+}
+
+/// One rendered frame of a shot.
+#[derive(Debug, Clone)]
+pub struct ShotResult {
+    /// The frame.
+    pub frame: Frame,
+    /// Per walker: the pose drawn.
+    pub poses: Vec<u32>,
+    /// Poses made resident (read and relit) for this frame.
+    pub made_resident: Vec<u32>,
+}
+
+/// A scene being rendered on a field (see the module docs).
+pub struct Shot<'a, R: ReadAt> {
+    scene: &'a Scene,
+    field: &'a FieldFile<R>,
+    device: Device,
+    plan: Plan,
+    options: ShotOptions,
+    envs: HashMap<String, EnvMap>,
+    world: Option<(LightingKey, Option<EnvMap>)>,
+    backdrop: Option<(LightingKey, DeviceBackdrop)>,
+    plate: Option<RgbImage>,
+    cache: Vec<Cached>,
+    counters: ShotCounters,
+}
+
+impl<'a, R: ReadAt> Shot<'a, R> {
+    /// A shot of `frames` of `scene` on `field`, rendered on `device`.
+    pub fn new(
+        scene: &'a Scene,
+        field: &'a FieldFile<R>,
+        device: Device,
+        frames: &[ShotFrame],
+        options: ShotOptions,
+    ) -> Result<Self> {
+        let plan = Plan::new(scene, field, frames)?;
+        let plate = match &scene.backdrop {
+            BackdropSpec::Plate(p) => Some(read_photo(p)?),
+            _ => None,
+        };
+        Ok(Self {
+            scene,
+            field,
+            device,
+            plan,
+            options,
+            envs: HashMap::new(),
+            world: None,
+            backdrop: None,
+            plate,
+            cache: Vec::new(),
+            counters: ShotCounters::default(),
+        })
+    }
+
+    /// The plan.
+    pub fn plan(&self) -> &Plan {
+        &self.plan
+    }
+
+    /// What happened so far.
+    pub fn counters(&self) -> &ShotCounters {
+        &self.counters
+    }
+
+    /// Whether only what the plan says is read, relit and drawn.
+    pub fn planned(&self) -> bool {
+        self.options.planned
+    }
+
+    /// The device, in words.
+    pub fn device(&self) -> String {
+        self.device.name()
+    }
+
+    /// The environment of `source`, loaded once.
+    fn env(&mut self, source: &EnvSource) -> Result<Option<EnvMap>> {
+        let key = source.to_string();
+        if let Some(e) = self.envs.get(&key) {
+            return Ok(Some(e.clone()));
+        }
+        let Some(e) = source.load()? else {
+            return Ok(None);
+        };
+        self.envs.insert(key, e.clone());
+        Ok(Some(e))
+    }
+
+    /// The lighting of the scene frame at `l`: `None` without an environment.
+    fn world_lighting(&mut self, l: &LightingAt) -> Result<Option<EnvMap>> {
+        let key = LightingKey::of(l);
+        if let Some((k, env)) = &self.world
+            && *k == key
+        {
+            return Ok(env.clone());
+        }
+        let mut maps = Vec::new();
+        for (source, weight) in &l.maps {
+            match self.env(source)? {
+                Some(e) => maps.push((e.rotated(l.yaw).scaled(l.intensity), *weight)),
+                None => {
+                    self.world = Some((key, None));
+                    return Ok(None);
+                }
+            }
+        }
+        let env = if maps.len() == 1 && maps[0].1 == 1.0 {
+            maps.remove(0).0
+        } else {
+            EnvMap::mix(&maps.iter().map(|(e, w)| (e, *w)).collect::<Vec<_>>())?
+        };
+        self.world = Some((key, Some(env.clone())));
+        Ok(Some(env))
+    }
+
+    /// Renders frame `frame` (one of the frames the shot was planned for).
+    pub fn render(&mut self, frame: &ShotFrame, layers: bool) -> Result<ShotResult> {
+        let fp: FramePlan = self
+            .plan
+            .frames
+            .iter()
+            .find(|f| f.index == frame.index)
+            .cloned()
+            .ok_or_else(|| {
+                RenderError::BadParameter(format!("frame {} was not planned", frame.index))
+            })?;
+        let lighting = self.scene.lighting_at(frame.time);
+        let key = LightingKey::of(&lighting);
+        let world = self.world_lighting(&lighting)?;
+
+        // Every walker's pose, resident and relit for this lighting.
+        let mut made_resident = Vec::new();
+        let mut slots = Vec::with_capacity(fp.poses.len());
+        for (i, &pose) in fp.poses.iter().enumerate() {
+            let heading = self.scene.instances[i].heading;
+            let found = self
+                .cache
+                .iter()
+                .position(|c| c.pose == pose && c.heading == heading.to_bits());
+            let slot = match found {
+                Some(k) if self.cache[k].lighting == key => k,
+                found => {
+                    let t = Instant::now();
+                    let resident = self.make_resident(pose, heading, world.as_ref())?;
+                    self.counters.residency_seconds += t.elapsed().as_secs_f64();
+                    self.counters.poses_made_resident += 1;
+                    made_resident.push(pose);
+                    let entry = Cached {
+                        pose,
+                        heading: heading.to_bits(),
+                        lighting: key.clone(),
+                        resident,
+                        last_frame: frame.index,
+                    };
+                    match found {
+                        Some(k) => {
+                            self.counters.relights += 1;
+                            self.cache[k] = entry;
+                            k
+                        }
+                        None => {
+                            self.cache.push(entry);
+                            self.cache.len() - 1
+                        }
+                    }
+                }
+            };
+            self.cache[slot].last_frame = frame.index;
+            slots.push(slot);
+        }
+        self.keep_within_budget(frame.index, &mut slots)?;
+
+        // The backdrop of this lighting.
+        let stale = self.backdrop.as_ref().is_none_or(|(k, _)| *k != key);
+        if stale {
+            let backdrop = match (&self.scene.backdrop, &world) {
+                (BackdropSpec::None, _) => Backdrop::None,
+                (BackdropSpec::Environment(ground), Some(env)) => {
+                    Backdrop::environment(env.clone(), *ground)
+                }
+                (BackdropSpec::Environment(_), None) => {
+                    return Err(RenderError::BadParameter(
+                        "an environment backdrop without an environment".into(),
+                    ));
+                }
+                (BackdropSpec::Plate(_), _) => Backdrop::Plate(
+                    self.plate
+                        .clone()
+                        .ok_or_else(|| RenderError::BadParameter("no plate loaded".into()))?,
+                ),
+            };
+            self.backdrop = Some((key, self.device.backdrop(backdrop)?));
+        }
+        let walkers: Vec<Walker> = slots
+            .iter()
+            .zip(&self.scene.instances)
+            .map(|(&k, inst)| Walker {
+                resident: &self.cache[k].resident,
+                world_from_subject: inst.world_from_subject(),
+            })
+            .collect();
+        let backdrop = &self.backdrop.as_ref().expect("set above").1;
+        let frame_out = self.device.render_frame(
+            &walkers,
+            backdrop,
+            &frame.camera,
+            self.scene.variant,
+            layers,
+        )?;
+        Ok(ShotResult {
+            frame: frame_out,
+            poses: fp.poses,
+            made_resident,
+        })
+    }
+
+    /// Reads pose `pose` (as planned), relights it for a walker of `heading` under the
+    /// scene frame's lighting `world`, and sets its shadow.
+    fn make_resident(&self, pose: u32, heading: f32, world: Option<&EnvMap>) -> Result<Resident> {
+        let env = world.map(|e| e.rotated(-heading));
+        let lighting = match &env {
+            Some(e) => Lighting::Environment {
+                env: e.clone(),
+                floor: self.scene.floor,
+            },
+            None => Lighting::Unlit,
+        };
+        let plan = self.plan.pose(pose).filter(|_| self.options.planned);
+        let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?;
+        let mut resident = self.device.make_resident(&source)?;
+        let wants = |planned: bool| if self.options.planned { planned } else { true };
+        match self.scene.shadow {
+            ShadowSpec::Maps if wants(plan.is_some_and(|p| p.shadow_maps)) => {
+                if let Some(maps) = ShadowMaps::load(self.field, pose)? {
+                    self.device
+                        .set_shadow(&mut resident, SceneShadow::Maps(&maps))?;
+                }
+            }
+            ShadowSpec::Traced if wants(plan.is_some_and(|p| p.hull)) => {
+                if let (Some(hull), Some(env)) = (self.field.hull(pose)?, &env) {
+                    let ground = self
+                        .field
+                        .header()
+                        .shadows
+                        .as_ref()
+                        .map_or(frf_core::volume::GroundGrid::ORIGINAL, |s| s.ground);
+                    let lights = env.median_cut(self.options.traced_lights);
+                    self.device.set_shadow(
+                        &mut resident,
+                        SceneShadow::Relit(traced_shadow(&hull, &lights, ground)),
+                    )?;
+                }
+            }
+            _ => {}
+        }
+        Ok(resident)
+    }
+
+    /// Drops the least recently used poses the current frame does not draw until the
+    /// resident poses fit the budget; `slots` (indices into the cache of this frame's
+    /// poses) are kept valid.
+    fn keep_within_budget(&mut self, frame: usize, slots: &mut [usize]) -> Result<()> {
+        let total = |c: &[Cached]| c.iter().map(|c| c.resident.bytes()).sum::<u64>();
+        while total(&self.cache) > self.options.memory_budget {
+            let victim = self
+                .cache
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.last_frame != frame)
+                .min_by_key(|(_, c)| c.last_frame)
+                .map(|(k, _)| k);
+            let Some(k) = victim else {
+                return Err(RenderError::BadParameter(format!(
+                    "frame {frame} needs {:.1} MB of resident poses, more than the memory budget of {:.1} MB",
+                    total(&self.cache) as f64 / 1e6,
+                    self.options.memory_budget as f64 / 1e6
+                )));
+            };
+            self.cache.remove(k);
+            self.counters.evictions += 1;
+            for s in slots.iter_mut() {
+                if *s > k {
+                    *s -= 1;
+                }
+            }
+        }
+        self.counters.peak_resident_bytes =
+            self.counters.peak_resident_bytes.max(total(&self.cache));
+        Ok(())
+    }
+}

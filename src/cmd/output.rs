@@ -1,0 +1,324 @@
+//! What `frf render` writes, and resuming it: per frame an 8-bit sRGB PNG (straight
+//! alpha) and a linear premultiplied EXR (and EXR layers on request), written atomically;
+//! when every frame of the shot is there, a contact sheet and an animated preview; and a
+//! report (`render.json`, or `render_frames_A-B.json` for part of a shot).
+//!
+//! A directory remembers the settings it was rendered with (`settings.json`, without the
+//! frame range): a rerun with the same settings skips the frames already written, so an
+//! interrupted render resumes and the tasks of a farm job can share one directory; other
+//! settings are refused rather than mixed in.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use frf_core::atomic::write_bytes_atomic;
+use frf_core::contact;
+use frf_core::image::{Image, RgbImage, Rgba};
+use frf_core::io::{read_rgba, write_exr_rgb, write_exr_rgba, write_png8_srgb, write_png8_srgba};
+use frf_core::preview::{fit_width, write_apng, write_gif};
+use frf_reflectance::container::ReadAt;
+use frf_render::cpu::FrameStats;
+use frf_render::scene::plan::{FramePlan, ShotFrame};
+use frf_render::scene::shot::{Shot, ShotCounters, ShotResult};
+use frf_render::scene::{Preview, Scene};
+use serde::Serialize;
+
+use crate::CliResult;
+
+/// Frames on the contact sheet (evenly spaced).
+const SHEET_FRAMES: usize = 12;
+/// Widest animated preview, pixels.
+const PREVIEW_WIDTH: usize = 480;
+
+/// A half-open range of frame indices.
+pub struct FrameRange;
+
+impl FrameRange {
+    /// Parses `--frames`: `N` (frames 0 to N − 1) or `A..B`, within a shot of `total`
+    /// frames; all of them when absent.
+    pub fn parse(s: Option<&str>, total: usize) -> CliResult<Range<usize>> {
+        let Some(s) = s else {
+            return Ok(0..total);
+        };
+        let bad = || format!("--frames {s:?}: expected N or A..B within the shot's {total} frames");
+        let range = match s.split_once("..") {
+            Some((a, b)) => {
+                let a: usize = a.trim().parse().map_err(|_| bad())?;
+                let b: usize = b.trim().parse().map_err(|_| bad())?;
+                a..b
+            }
+            None => 0..s.trim().parse::<usize>().map_err(|_| bad())?,
+        };
+        if range.start >= range.end || range.end > total {
+            return Err(bad().into());
+        }
+        Ok(range)
+    }
+}
+
+/// One frame, as the report lists it.
+#[derive(Serialize)]
+struct FrameRecord {
+    index: usize,
+    time: f32,
+    poses: Vec<u32>,
+    made_resident: Vec<u32>,
+    resumed: bool,
+    seconds: Option<f64>,
+    pixels_inside: usize,
+    pixels_clamped_above: usize,
+    pixels_clamped_below: usize,
+    pixels_missed: usize,
+}
+
+/// An output directory being filled.
+pub struct Output {
+    dir: PathBuf,
+    resume: bool,
+    total: usize,
+    records: Vec<FrameRecord>,
+    totals: FrameStats,
+}
+
+fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
+    dir.join(format!("frame_{i:04}.{ext}"))
+}
+
+fn layer_path(dir: &Path, i: usize, layer: &str) -> PathBuf {
+    dir.join(format!("frame_{i:04}_{layer}.exr"))
+}
+
+/// Premultiplied RGBA over a mid-gray backdrop, for the contact sheet.
+fn over_gray(img: &Image<Rgba>) -> RgbImage {
+    let gray = 0.18;
+    Image::from_fn(img.width(), img.height(), |x, y| {
+        let p = img.get(x, y);
+        let a = p[3].clamp(0.0, 1.0);
+        [0, 1, 2].map(|c| p[c] + (1.0 - a) * gray)
+    })
+}
+
+impl Output {
+    /// Opens `dir` for a shot of `total` frames rendered with `settings` (a rerun with
+    /// the same settings resumes; `overwrite` renders every frame again).
+    pub fn open(
+        dir: &Path,
+        settings: &serde_json::Value,
+        overwrite: bool,
+        total: usize,
+    ) -> CliResult<Self> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("output directory {}: {e}", dir.display()))?;
+        let mut settings = settings.clone();
+        if let Some(args) = settings.get_mut("args").and_then(|a| a.as_object_mut()) {
+            args.remove("frames");
+        }
+        let text = serde_json::to_string_pretty(&settings)?;
+        let path = dir.join("settings.json");
+        let same = std::fs::read_to_string(&path).is_ok_and(|s| s == text);
+        if !same && !overwrite && frame_path(dir, 0, "png").exists() {
+            return Err(format!(
+                "{} holds frames of a render with other settings; use --overwrite or another --out",
+                dir.display()
+            )
+            .into());
+        }
+        write_bytes_atomic(&path, text.as_bytes())?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            resume: same && !overwrite,
+            total,
+            records: Vec::new(),
+            totals: FrameStats::default(),
+        })
+    }
+
+    /// Whether frame `i` is there already (and may be kept).
+    pub fn done(&self, i: usize) -> bool {
+        self.resume
+            && frame_path(&self.dir, i, "png").exists()
+            && frame_path(&self.dir, i, "exr").exists()
+    }
+
+    /// Notes that frame `i` was kept from an earlier run.
+    pub fn resumed(&mut self, i: usize, plan: &[FramePlan]) -> CliResult {
+        let fp = plan
+            .iter()
+            .find(|f| f.index == i)
+            .ok_or("a frame that was not planned")?;
+        self.records.push(FrameRecord {
+            index: i,
+            time: fp.time,
+            poses: fp.poses.clone(),
+            made_resident: Vec::new(),
+            resumed: true,
+            seconds: None,
+            pixels_inside: 0,
+            pixels_clamped_above: 0,
+            pixels_clamped_below: 0,
+            pixels_missed: 0,
+        });
+        Ok(())
+    }
+
+    /// Writes a rendered frame.
+    pub fn write(
+        &mut self,
+        f: &ShotFrame,
+        r: ShotResult,
+        seconds: f64,
+        exposure_stops: f32,
+    ) -> CliResult {
+        let scale = 2f32.powf(exposure_stops);
+        let i = f.index;
+        if let Some(l) = &r.frame.layers {
+            write_exr_rgba(&layer_path(&self.dir, i, "subject"), &l.subject)?;
+            write_exr_rgb(&layer_path(&self.dir, i, "shadow"), &l.shadow)?;
+            write_exr_rgba(&layer_path(&self.dir, i, "backdrop"), &l.backdrop)?;
+        }
+        write_exr_rgba(&frame_path(&self.dir, i, "exr"), &r.frame.composite)?;
+        write_png8_srgba(&frame_path(&self.dir, i, "png"), &r.frame.composite, scale)?;
+        let s = r.frame.stats;
+        self.totals = self.totals.merge(s);
+        self.records.push(FrameRecord {
+            index: i,
+            time: f.time,
+            poses: r.poses,
+            made_resident: r.made_resident,
+            resumed: false,
+            seconds: Some(seconds),
+            pixels_inside: s.inside,
+            pixels_clamped_above: s.clamped_above,
+            pixels_clamped_below: s.clamped_below,
+            pixels_missed: s.missed,
+        });
+        Ok(())
+    }
+
+    /// Writes the contact sheet and the preview (when every frame of the shot is there)
+    /// and the report; returns a summary for people.
+    pub fn finish<R: ReadAt>(
+        self,
+        scene: &Scene,
+        shot: &Shot<'_, R>,
+        setup_seconds: f64,
+        bytes_read: u64,
+    ) -> CliResult<String> {
+        let scale = 2f32.powf(scene.exposure);
+        let all_there = (0..self.total).all(|i| frame_path(&self.dir, i, "exr").exists());
+        let mut extras = Vec::new();
+        if all_there {
+            let frames: Vec<Image<Rgba>> = (0..self.total)
+                .map(|i| read_rgba(&frame_path(&self.dir, i, "exr")))
+                .collect::<frf_core::Result<_>>()?;
+            let every = self.total.div_ceil(SHEET_FRAMES).max(1);
+            let sheet: Vec<RgbImage> = frames.iter().step_by(every).map(over_gray).collect();
+            let columns = sheet.len().min(SHEET_FRAMES / 2);
+            write_png8_srgb(
+                &self.dir.join("contact.png"),
+                &contact::sheet(&sheet, columns),
+                scale,
+            )?;
+            extras.push("contact.png".to_string());
+            if self.total > 1 {
+                let small = fit_width(&frames, PREVIEW_WIDTH);
+                match scene.preview {
+                    Preview::Apng => {
+                        write_apng(&self.dir.join("preview.png"), &small, scene.fps, scale)?;
+                        extras.push("preview.png (animated)".into());
+                    }
+                    Preview::Gif => {
+                        write_gif(&self.dir.join("preview.gif"), &small, scene.fps, scale)?;
+                        extras.push("preview.gif".into());
+                    }
+                    Preview::None => {}
+                }
+            }
+        }
+        let rendered: Vec<f64> = self.records.iter().filter_map(|r| r.seconds).collect();
+        let mut sorted = rendered.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+        let mean = rendered.iter().sum::<f64>() / rendered.len().max(1) as f64;
+        let (first, last) = (
+            self.records.iter().map(|r| r.index).min().unwrap_or(0),
+            self.records.iter().map(|r| r.index).max().unwrap_or(0),
+        );
+        let name = if first == 0 && last + 1 == self.total {
+            "render.json".to_string()
+        } else {
+            format!("render_frames_{first}-{}.json", last + 1)
+        };
+        #[derive(Serialize)]
+        struct Report<'a> {
+            device: String,
+            frames_total: usize,
+            frames_rendered: usize,
+            frames_resumed: usize,
+            seconds_setup: f64,
+            seconds_per_frame_median: f64,
+            seconds_per_frame_mean: f64,
+            plan: &'a frf_render::scene::plan::PlanCounts,
+            planned: bool,
+            bytes_read_measured: u64,
+            residency: &'a ShotCounters,
+            pixels_inside: usize,
+            pixels_clamped_above: usize,
+            pixels_clamped_below: usize,
+            pixels_missed: usize,
+            frames: &'a [FrameRecord],
+        }
+        let t = self.totals;
+        let report = Report {
+            device: shot.device(),
+            frames_total: self.total,
+            frames_rendered: rendered.len(),
+            frames_resumed: self.records.len() - rendered.len(),
+            seconds_setup: setup_seconds,
+            seconds_per_frame_median: median,
+            seconds_per_frame_mean: mean,
+            plan: &shot.plan().counts,
+            planned: shot.planned(),
+            bytes_read_measured: bytes_read,
+            residency: shot.counters(),
+            pixels_inside: t.inside,
+            pixels_clamped_above: t.clamped_above,
+            pixels_clamped_below: t.clamped_below,
+            pixels_missed: t.missed,
+            frames: &self.records,
+        };
+        write_bytes_atomic(
+            &self.dir.join(&name),
+            serde_json::to_string_pretty(&report)?.as_bytes(),
+        )?;
+        let all = (t.inside + t.clamped_above + t.clamped_below + t.missed).max(1);
+        let pct = |n: usize| 100.0 * n as f64 / all as f64;
+        let c = shot.counters();
+        Ok(format!(
+            "{} frames in {}: {median:.3} s/frame median ({mean:.3} mean), setup {setup_seconds:.2} s; \
+             {} resumed; poses made resident {} ({} relit for a new lighting, {} dropped for the memory budget, \
+             peak {:.1} MB, {:.2} s); {:.2} MB read from the field\n\
+             pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row, {:.1} % to the bottom row, \
+             {:.1} % missed; {} written{}",
+            rendered.len(),
+            self.dir.display(),
+            report.frames_resumed,
+            c.poses_made_resident,
+            c.relights,
+            c.evictions,
+            c.peak_resident_bytes as f64 / 1e6,
+            c.residency_seconds,
+            bytes_read as f64 / 1e6,
+            pct(t.inside),
+            pct(t.clamped_above),
+            pct(t.clamped_below),
+            pct(t.missed),
+            name,
+            if extras.is_empty() {
+                " (contact sheet and preview once every frame is there)".to_string()
+            } else {
+                format!(", {}", extras.join(", "))
+            }
+        ))
+    }
+}
