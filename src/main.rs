@@ -32,9 +32,12 @@ enum Command {
     Hull(cmd::hull::HullArgs),
     /// Turn a capture into a flowed reflectance field (mattes, registration, flow).
     Ingest(cmd::ingest::IngestArgs),
+    /// Join fields holding disjoint poses (parts ingested apart) into one field.
+    Merge(cmd::merge::MergeArgs),
     /// Turn a calibrated ring of photographs (Middlebury multi-view) into a field.
     IngestRing(cmd::ingest::RingArgs),
-    /// Render frames of a field, relit by an environment, along a camera path.
+    /// Render a scene (SCENE.toml), or frames of a field along a camera path: relit,
+    /// shadowed, composited.
     Render(Box<cmd::render::RenderArgs>),
     /// Score renders between the grid's views against the virtual stage's truth.
     Eval(Box<cmd::eval::EvalArgs>),
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
         Command::Hull(args) => cmd::hull::run(args),
         Command::Ingest(args) => cmd::ingest::run(args),
         Command::IngestRing(args) => cmd::ingest::run_ring(args),
+        Command::Merge(args) => cmd::merge::run(args),
         Command::Render(args) => cmd::render::run(*args),
         Command::Eval(args) => cmd::eval::run(*args),
         Command::EvalRing(args) => cmd::eval::run_ring(args),

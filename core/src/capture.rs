@@ -161,6 +161,14 @@ impl Capture {
         let conditions = check_conditions(&c, &manifest)?;
         let (slots, tracks, reference_track) = check_schedule(&c, &manifest, conditions.len())?;
         check_files_spec(&c, &manifest)?;
+        for (i, f) in manifest.filmed.iter().enumerate() {
+            if !manifest.timing.poses.contains(&f.pose) {
+                return Err(c.fail(&format!("filmed[{i}].pose"), format!("pose {} is not in timing.poses", f.pose)));
+            }
+            if let Some(v) = f.views.iter().find(|v| v[0] as usize >= manifest.turntable.azimuth_deg.len() || v[1] as usize >= cameras.len()) {
+                return Err(c.fail(&format!("filmed[{i}].views"), format!("view {v:?} is outside the grid")));
+            }
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
             manifest,
@@ -172,6 +180,22 @@ impl Capture {
         })
     }
 
+    /// Whether view `(cycle, camera)` of `pose` was filmed (every view of a captured pose
+    /// unless the manifest lists the filmed views).
+    pub fn is_filmed(&self, pose: u32, cycle: usize, camera: usize) -> bool {
+        if !self.manifest.timing.poses.contains(&pose) {
+            return false;
+        }
+        if self.manifest.filmed.is_empty() {
+            return true;
+        }
+        self.manifest
+            .filmed
+            .iter()
+            .filter(|f| f.pose == pose)
+            .any(|f| f.views.contains(&[cycle as u32, camera as u32]))
+    }
+
     /// Checks that every frame and clean plate exists and has its camera's size,
     /// reading only file headers. Names the first bad file.
     pub fn check_files(&self) -> Result<()> {
@@ -179,6 +203,9 @@ impl Capture {
         for &pose in &self.manifest.timing.poses {
             for cycle in 0..self.cycles() {
                 for camera in 0..self.cameras.len() {
+                    if !self.is_filmed(pose, cycle, camera) {
+                        continue;
+                    }
                     for slot in 0..self.slots.len() {
                         jobs.push((Some((pose, cycle)), camera, slot));
                     }

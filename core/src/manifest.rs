@@ -18,6 +18,7 @@
 //! [[conditions]]    # name, floor, lights = [{ direction, intensity, solid_angle_sr }]
 //! [[schedule]]      # kind = "basis" | "track" | "matte" | "unused", condition | index, time_offset_s
 //! [files]           # frame = "frames/p{pose:02}/...", clean_plate = "...", full_scale = 65535
+//! [[filmed]]        # optional: pose, views = [[cycle, camera], ...] (a partial capture)
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -52,6 +53,20 @@ pub struct Manifest {
     pub schedule: Vec<SlotSpec>,
     /// Where the frame files are.
     pub files: FileSpec,
+    /// The views filmed, per pose, when not every view of every pose was (a capture
+    /// made for one scene); empty: every view of every pose in `timing.poses`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filmed: Vec<FilmedSpec>,
+}
+
+/// The views filmed of one pose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilmedSpec {
+    /// The pose.
+    pub pose: u32,
+    /// The views `[cycle, camera]` filmed.
+    pub views: Vec<[u32; 2]>,
 }
 
 /// Timing of the capture.

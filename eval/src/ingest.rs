@@ -60,12 +60,14 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
     type ViewErrors = ((f64, f64), [(f64, usize); 2]);
     let per_view: Vec<ViewErrors> = (0..evidence.alphas.len())
         .into_par_iter()
+        .filter(|&i| evidence.alphas[i].is_some())
         .map(|i| {
+            let estimated = evidence.alphas[i].as_ref().expect("filtered");
             let (u, v) = (i / rows, i % rows);
             let (_, true_alpha) = stage.reference_surface(pose, u, v)?;
             let alpha = (
-                alpha_iou(&true_alpha, &evidence.alphas[i]),
-                alpha_mae(&true_alpha, &evidence.alphas[i]),
+                alpha_iou(&true_alpha, estimated),
+                alpha_mae(&true_alpha, estimated),
             );
             let mut epe = [(0.0, 0usize); 2];
             for n in Neighbour::ALL {
@@ -93,7 +95,9 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         .registered
         .par_iter()
         .map(|s| {
-            let alpha = &evidence.alphas[s.u * rows + s.v];
+            let Some(alpha) = &evidence.alphas[s.u * rows + s.v] else {
+                return Ok(Vec::new());
+            };
             let mut out = Vec::new();
             for (c, (reg, unreg)) in s.basis.iter().zip(&s.unregistered).enumerate() {
                 let truth = stage.true_view_image(pose, s.u, s.v, &stage.condition_lights(c)?)?;

@@ -35,6 +35,7 @@ fn options(poses: Vec<u32>) -> IngestOptions {
         predict_flow: true,
         matte_rule: MatteRule::MatteBelowHalfCleanPlate,
         shadows: Some(ShadowOptions::default()),
+        selection: None,
         edge: EdgeMethod::Solve,
     }
 }

@@ -70,8 +70,8 @@ pub struct SampledView {
 
 /// One pose's intermediate results, as ingest computed them.
 pub struct PoseEvidence<'a> {
-    /// Estimated alpha per view, `u`-major.
-    pub alphas: &'a [GrayImage],
+    /// Estimated alpha per view, `u`-major (`None`: the view was not ingested).
+    pub alphas: &'a [Option<GrayImage>],
     /// Estimated flows per view, in [`frf_core::grid::Neighbour::ALL`] order.
     pub flows: &'a [[Option<FlowImage>; 4]],
     /// The views the evaluator asked for ([`Evaluator::wants_unregistered`]).

@@ -106,7 +106,8 @@ pub fn keep_near_subject(flow: &FlowImage, alpha: &GrayImage) -> FlowImage {
 }
 
 /// The views of a grid, `u`-major (`index = u * rows + v`), as the flow step needs them:
-/// the image flow is measured on, its matte, and its camera seen from the subject frame.
+/// the image flow is measured on, its matte, and its camera seen from the subject frame
+/// (`None` for a view not ingested: no flow to or from it).
 pub struct GridViews<'a> {
     /// Columns.
     pub columns: usize,
@@ -115,11 +116,14 @@ pub struct GridViews<'a> {
     /// Whether the columns close into a ring.
     pub wraps: bool,
     /// Per view: the image flow is measured on.
-    pub images: &'a [&'a RgbImage],
+    pub images: &'a [Option<&'a RgbImage>],
     /// Per view: its matte (flow is kept near it).
-    pub alphas: &'a [&'a GrayImage],
+    pub alphas: &'a [Option<&'a GrayImage>],
     /// Per view: its camera, subject frame.
     pub cameras: &'a [Camera],
+    /// Per view and neighbour: the flow is wanted (`None`: all); a pair is measured when
+    /// either of its two directions is wanted, and kept where it is.
+    pub wanted: Option<&'a [[bool; 4]]>,
 }
 
 /// The flows of a grid, and the thread time they took.
@@ -154,11 +158,18 @@ pub fn grid_flows(
                 let Some((u2, v2)) = n.of(u, v, columns, rows, wraps) else {
                     continue;
                 };
-                let t = Instant::now();
                 let j = u2 * rows + v2;
+                let (Some(a), Some(b)) = (grid.images[i], grid.images[j]) else {
+                    continue;
+                };
+                let wanted = |k: usize, m: Neighbour| grid.wanted.is_none_or(|w| w[k][m.index()]);
+                if !(wanted(i, n) || wanted(j, n.opposite())) {
+                    continue;
+                }
+                let t = Instant::now();
                 flows[n.index()] = Some(rectified_flow(
-                    grid.images[i],
-                    grid.images[j],
+                    a,
+                    b,
                     &grid.cameras[i],
                     &grid.cameras[j],
                     params,
@@ -180,14 +191,19 @@ pub fn grid_flows(
             let (u, v) = (i / rows, i % rows);
             let mut out: [Option<FlowImage>; 4] = Default::default();
             for n in Neighbour::ALL {
-                let (Some(f), Some((u2, v2))) =
-                    (&raw[i].0[n.index()], n.of(u, v, columns, rows, wraps))
-                else {
+                let (Some(f), Some((u2, v2)), Some(alpha)) = (
+                    &raw[i].0[n.index()],
+                    n.of(u, v, columns, rows, wraps),
+                    grid.alphas[i],
+                ) else {
                     continue;
                 };
+                if grid.wanted.is_some_and(|w| !w[i][n.index()]) {
+                    continue;
+                }
                 let back = raw[u2 * rows + v2].0[n.opposite().index()].as_ref();
                 let f = back.map_or_else(|| f.clone(), |b| symmetrize(f, b));
-                out[n.index()] = Some(keep_near_subject(&f, grid.alphas[i]));
+                out[n.index()] = Some(keep_near_subject(&f, alpha));
             }
             out
         })

@@ -51,8 +51,35 @@ pub struct IngestOptions {
     pub matte_rule: MatteRule,
     /// The visual hull and shadow maps of every pose (`None`: neither).
     pub shadows: Option<ShadowOptions>,
+    /// Only these views and flows of each pose (`None`: all the capture filmed).
+    pub selection: Option<Selection>,
     /// What to do about backdrop light at the subject's edges.
     pub edge: EdgeMethod,
+}
+
+/// The views and flows of each pose to ingest (a field made for one scene, `frf ingest
+/// --for SCENE`): per pose, a flag per view (`u`-major) and per view and neighbour. Views
+/// the capture did not film are left out whatever it says.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Selection {
+    /// Per pose: the views wanted.
+    pub views: std::collections::BTreeMap<u32, Vec<bool>>,
+    /// Per pose: the flows wanted.
+    pub flows: std::collections::BTreeMap<u32, Vec<[bool; 4]>>,
+}
+
+impl Selection {
+    /// A short description for settings and reports: views and flows wanted per pose.
+    pub fn describe(&self) -> String {
+        self.views
+            .iter()
+            .map(|(p, v)| {
+                let flows = self.flows.get(p).map_or(0, |f| f.iter().flatten().filter(|&&x| x).count());
+                format!("p{p}: {} views, {flows} flows", v.iter().filter(|&&x| x).count())
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
 }
 
 /// Progress of long steps: `begin` a named step of `total` units, `advance` by one; and
@@ -108,6 +135,9 @@ pub struct Settings {
     /// Hull and shadow maps.
     #[serde(default)]
     pub shadows: String,
+    /// The views and flows selected (empty: all filmed).
+    #[serde(default)]
+    pub selection: String,
     /// Edge decontamination ([`EdgeMethod::name`]); parts written before it existed
     /// were made without.
     #[serde(default = "no_edge_method")]
@@ -225,6 +255,10 @@ fn settings(options: &IngestOptions) -> Settings {
             },
         ),
         edge: options.edge.name().into(),
+        selection: options
+            .selection
+            .as_ref()
+            .map_or(String::new(), Selection::describe),
     }
 }
 
@@ -318,11 +352,27 @@ fn ingest_pose(
         settings(options).flow_preset
     );
 
-    progress.begin(pose, "mattes and registration", columns * rows);
+    // The views ingested: filmed, and selected.
+    let selected = options.selection.as_ref();
+    let present: Vec<bool> = (0..columns * rows)
+        .map(|i| {
+            capture.is_filmed(pose, i / rows, i % rows)
+                && selected.is_none_or(|s| s.views.get(&pose).is_some_and(|v| v[i]))
+        })
+        .collect();
+    if !present.iter().any(|&p| p) {
+        return Err(IngestError::BadParameter(format!(
+            "pose {pose}: no view of it is both filmed and selected"
+        )));
+    }
+    progress.begin(pose, "mattes and registration", present.iter().filter(|&&p| p).count());
     let start = Instant::now();
-    let views: Vec<ViewOut> = (0..columns * rows)
+    let views: Vec<Option<ViewOut>> = (0..columns * rows)
         .into_par_iter()
         .map(|i| {
+            if !present[i] {
+                return Ok(None);
+            }
             check_stop(progress)?;
             let (u, v) = (i / rows, i % rows);
             let settings = ViewSettings {
@@ -335,7 +385,7 @@ fn ingest_pose(
             let t = Instant::now();
             let images = encode_images(&header, &r.basis, &r.alpha)?;
             progress.advance();
-            Ok(ViewOut {
+            Ok(Some(ViewOut {
                 images,
                 encode_seconds: t.elapsed().as_secs_f64(),
                 registered: r.kept.map(|k| SampledView {
@@ -349,14 +399,14 @@ fn ingest_pose(
                 alpha: r.alpha,
                 summed: r.summed,
                 seconds: r.seconds,
-            })
+            }))
         })
         .collect::<Result<_>>()?;
     let mut seconds = ViewSeconds::default();
-    for v in &views {
+    for v in views.iter().flatten() {
         seconds += v.seconds;
     }
-    let encode: f64 = views.iter().map(|v| v.encode_seconds).sum();
+    let encode: f64 = views.iter().flatten().map(|v| v.encode_seconds).sum();
     steps.extend(share(
         start.elapsed().as_secs_f64(),
         &[
@@ -370,8 +420,8 @@ fn ingest_pose(
 
     progress.begin(pose, "inter-view flow", columns * rows);
     let start = Instant::now();
-    let images: Vec<&RgbImage> = views.iter().map(|v| &v.summed).collect();
-    let alphas: Vec<&GrayImage> = views.iter().map(|v| &v.alpha).collect();
+    let images: Vec<Option<&RgbImage>> = views.iter().map(|v| v.as_ref().map(|v| &v.summed)).collect();
+    let alphas: Vec<Option<&GrayImage>> = views.iter().map(|v| v.as_ref().map(|v| &v.alpha)).collect();
     let cameras: Vec<Camera> = (0..columns * rows)
         .map(|i| capture.subject_camera(i / rows, i % rows, pose))
         .collect();
@@ -383,6 +433,7 @@ fn ingest_pose(
             images: &images,
             alphas: &alphas,
             cameras: &cameras,
+            wanted: selected.and_then(|s| s.flows.get(&pose)).map(|f| f.as_slice()),
         },
         &params,
         &|| {
@@ -403,7 +454,13 @@ fn ingest_pose(
     let shadows = match &options.shadows {
         Some(s) => {
             progress.begin(pose, "visual hull and shadow maps", 1);
-            let r = pose_shadows(&cameras, &alphas, &header.conditions, s)?;
+            // Carved from the views ingested.
+            let (cams, mattes): (Vec<Camera>, Vec<&GrayImage>) = cameras
+                .iter()
+                .zip(&alphas)
+                .filter_map(|(c, a)| a.map(|a| (*c, a)))
+                .unzip();
+            let r = pose_shadows(&cams, &mattes, &header.conditions, s)?;
             steps.push(Step {
                 name: "visual hull".into(),
                 seconds: r.hull_seconds,
@@ -432,8 +489,10 @@ fn ingest_pose(
     let (part, json) = part_paths(out, pose);
     let mut writer = FieldWriter::create(&part, header)?;
     for (i, (view, flow)) in views.iter().zip(&encoded).enumerate() {
-        writer.add_view(pose, i / rows, i % rows, &view.images)?;
-        writer.add_view(pose, i / rows, i % rows, flow)?;
+        if let Some(view) = view {
+            writer.add_view(pose, i / rows, i % rows, &view.images)?;
+            writer.add_view(pose, i / rows, i % rows, flow)?;
+        }
     }
     if let Some(s) = &shadows {
         writer.add_hull(pose, &s.hull)?;
@@ -448,9 +507,15 @@ fn ingest_pose(
     let errors = match evaluator {
         Some(evaluator) => {
             progress.begin(pose, "evaluation against the ground truth", 1);
-            let alphas: Vec<GrayImage> = views.iter().map(|v| v.alpha.clone()).collect();
-            let registered: Vec<SampledView> =
-                views.into_iter().filter_map(|v| v.registered).collect();
+            let alphas: Vec<Option<GrayImage>> = views
+                .iter()
+                .map(|v| v.as_ref().map(|v| v.alpha.clone()))
+                .collect();
+            let registered: Vec<SampledView> = views
+                .into_iter()
+                .flatten()
+                .filter_map(|v| v.registered)
+                .collect();
             let e = evaluator
                 .evaluate(
                     pose,

@@ -50,6 +50,10 @@ pub struct IngestArgs {
     /// under the edge) or `none` (the blurred binary matte, as the original).
     #[arg(long, value_enum, default_value = "solve")]
     edge: EdgeArg,
+    /// Ingest only the poses, views and flows this scene file needs (`frf render
+    /// SCENE.toml` renders from the field).
+    #[arg(long = "for", value_name = "SCENE")]
+    for_scene: Option<PathBuf>,
     /// Write the report as JSON here.
     #[arg(long)]
     report: Option<PathBuf>,
@@ -108,7 +112,7 @@ impl Progress for Bars {
 
 /// Runs `frf ingest`.
 pub fn run(args: IngestArgs) -> CliResult {
-    let options = IngestOptions {
+    let mut options = IngestOptions {
         poses: args
             .poses
             .as_deref()
@@ -128,6 +132,7 @@ pub fn run(args: IngestArgs) -> CliResult {
         jpeg_quality: args.jpeg_quality,
         predict_flow: !args.no_flow_prediction,
         shadows: args.shadows.options()?,
+        selection: None,
         matte_rule: match args.matte_rule {
             MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
             MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
@@ -143,6 +148,18 @@ pub fn run(args: IngestArgs) -> CliResult {
         StageEvaluator::open_if_stage(&args.capture)?
     };
     let evaluator = judge.as_ref().map(|j| j as &dyn Evaluator);
+    if let Some(scene) = &args.for_scene {
+        let capture = frf_core::capture::Capture::open_manifest(&args.capture)?;
+        let plan = crate::cmd::for_scene::plan(scene, &capture)?;
+        println!("{}", crate::cmd::for_scene::summary(&plan));
+        let wanted: Vec<u32> = plan.poses.iter().map(|p| p.pose).collect();
+        options.poses = if options.poses.is_empty() {
+            wanted
+        } else {
+            options.poses.iter().copied().filter(|p| wanted.contains(p)).collect()
+        };
+        options.selection = Some(crate::cmd::for_scene::selection(&plan));
+    }
     let report = ingest(&args.capture, &args.out, &options, evaluator, &bars)?;
     if let Some(b) = bars
         .current

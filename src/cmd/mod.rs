@@ -3,9 +3,11 @@
 pub mod args;
 pub mod eval;
 pub mod flow;
+pub mod for_scene;
 pub mod hull;
 pub mod info;
 pub mod ingest;
+pub mod merge;
 pub mod output;
 pub mod progress;
 pub mod render;

@@ -79,6 +79,9 @@ struct CaptureArgs {
     /// Which true flows from T1 to the other slots of each set to write.
     #[arg(long, value_enum)]
     set_flow: Option<SetFlowArg>,
+    /// Film only the poses and views this scene file needs (with all its frames).
+    #[arg(long = "for", value_name = "SCENE")]
+    for_scene: Option<PathBuf>,
     /// Render without sensor noise (quantization remains).
     #[arg(long)]
     no_noise: bool,
@@ -169,6 +172,17 @@ fn capture(args: CaptureArgs) -> CliResult {
         };
     }
     config.noise = !args.no_noise;
+    if let Some(scene) = &args.for_scene {
+        // Plan on every pose of the cycle, then film what the plan keeps.
+        let mut all = config.clone();
+        all.poses = (0..all.poses_per_cycle()).collect();
+        let stage = frf_stage::Stage::new(all)?;
+        let capture = frf_core::capture::Capture::from_manifest(&out, stage.manifest())?;
+        let plan = crate::cmd::for_scene::plan(scene, &capture)?;
+        println!("{}", crate::cmd::for_scene::summary(&plan));
+        config.poses = plan.poses.iter().map(|p| p.pose).collect();
+        config.filmed = crate::cmd::for_scene::filmed(&plan, stage.cameras().len());
+    }
     config.perturbation = args.perturbation;
     let stage = frf_stage::Stage::new(config)?;
     let bar = bar("stage: views rendered");

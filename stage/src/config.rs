@@ -73,6 +73,10 @@ pub struct StageConfig {
     pub noise: bool,
     /// Which reference-to-slot flows to write as ground truth.
     pub set_flow_truth: SetFlowTruth,
+    /// The views filmed per pose, when not every view (a capture made for one scene:
+    /// `frf stage --for SCENE`); empty: all.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub filmed: Vec<frf_core::manifest::FilmedSpec>,
 }
 
 impl StageConfig {
@@ -96,6 +100,7 @@ impl StageConfig {
             perturbation: 1.0,
             noise: true,
             set_flow_truth: SetFlowTruth::Track,
+            filmed: Vec::new(),
         }
     }
 
@@ -118,6 +123,18 @@ impl StageConfig {
         }
         if self.poses.is_empty() {
             return bad("no poses to render".into());
+        }
+        for f in &self.filmed {
+            if !self.poses.contains(&f.pose) {
+                return bad(format!("filmed views of pose {}, which is not rendered", f.pose));
+            }
+            if let Some(v) = f
+                .views
+                .iter()
+                .find(|v| v[0] >= self.cycles || v[1] >= crate::rig::CAMERA_ELEVATIONS_DEG.len() as u32)
+            {
+                return bad(format!("filmed view {v:?} of pose {} is outside the grid", f.pose));
+            }
         }
         let per_cycle = self.poses_per_cycle();
         if let Some(p) = self.poses.iter().find(|&&p| p >= per_cycle) {

@@ -13,12 +13,23 @@ use crate::error::Result;
 /// Widest contact sheet, pixels: tiles are shrunk by an integer factor to fit.
 const MAX_SHEET_WIDTH: usize = 2400;
 
-/// Writes `preview/set.png` and `preview/views.png` for the first pose.
+/// Writes `preview/set.png` (the first filmed view's set) and `preview/views.png` for the
+/// first pose (views not filmed are black).
 pub fn write_previews(capture: &Capture, dir: &Path) -> Result<()> {
     let pose = capture.poses()[0];
-    let camera = capture.cameras().len() / 2;
+    let (w, h) = (
+        capture.cameras()[0].width as usize,
+        capture.cameras()[0].height as usize,
+    );
+    let middle = capture.cameras().len() / 2;
+    let first = (0..capture.cycles())
+        .flat_map(|u| (0..capture.cameras().len()).map(move |v| (u, v)))
+        .min_by_key(|&(u, v)| (!capture.is_filmed(pose, u, v), v != middle, u));
+    let Some((u0, v0)) = first.filter(|&(u, v)| capture.is_filmed(pose, u, v)) else {
+        return Ok(());
+    };
     let set = (0..capture.slots().len())
-        .map(|slot| capture.load_frame(pose, 0, camera, slot))
+        .map(|slot| capture.load_frame(pose, u0, v0, slot))
         .collect::<frf_core::Result<Vec<_>>>()?;
     write_png8_srgb(&dir.join("preview/set.png"), &sheet(&set, 11), 1.0)?;
 
@@ -28,10 +39,12 @@ pub fn write_previews(capture: &Capture, dir: &Path) -> Result<()> {
     let mut views = Vec::new();
     for camera in (0..capture.cameras().len()).rev() {
         for cycle in 0..capture.cycles() {
-            views.push(shrink(
-                &capture.load_frame(pose, cycle, camera, reference)?,
-                factor,
-            ));
+            let frame = if capture.is_filmed(pose, cycle, camera) {
+                capture.load_frame(pose, cycle, camera, reference)?
+            } else {
+                frf_core::image::Image::new(w, h, [0.0; 3])
+            };
+            views.push(shrink(&frame, factor));
         }
     }
     write_png8_srgb(

@@ -329,6 +329,7 @@ impl Stage {
                 // 12-bit codes are stored in the top bits of 16: code 4095 -> 65520.
                 full_scale: (MAX_CODE * 16.0) as f64,
             },
+            filmed: self.config.filmed.clone(),
         }
     }
 }

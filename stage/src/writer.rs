@@ -256,6 +256,9 @@ pub fn write_capture(
     for &pose in &stage.config().poses {
         for camera in 0..stage.cameras().len() {
             for cycle in 0..stage.cycles() {
+                if !capture.is_filmed(pose, cycle, camera) {
+                    continue;
+                }
                 units.push(Unit::View {
                     pose,
                     cycle,

@@ -25,7 +25,7 @@ use std::collections::BTreeSet;
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
-use frf_reflectance::FieldFile;
+use frf_reflectance::{FieldFile, FieldHeader};
 use frf_reflectance::container::{ChunkKind, ReadAt};
 use frf_reflectance::project::{FloorModel, Projector};
 use glam::{Vec2, Vec3};
@@ -262,13 +262,50 @@ impl Scene {
 }
 
 impl Plan {
-    /// The plan of `scene` on `field` for `frames`.
+    /// The plan of `scene` on `field` for `frames`, with the bytes it reads.
     pub fn new<R: ReadAt>(
         scene: &Scene,
         field: &FieldFile<R>,
         frames: &[ShotFrame],
     ) -> Result<Self> {
-        let h = field.header();
+        let mut plan = Self::from_header(scene, field.header(), frames)?;
+        let rows = field.header().rows;
+        let counts = &mut plan.counts;
+        (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
+        for c in field.chunks() {
+            counts.bytes_total += c.length;
+            let Some(p) = plan.poses.iter().find(|p| p.pose == c.key.pose) else {
+                continue;
+            };
+            let view = c.key.u as usize * rows + c.key.v as usize;
+            let used = match c.key.kind {
+                ChunkKind::Basis => {
+                    counts.views_total += 1;
+                    let used = p.views.get(view).copied().unwrap_or(false);
+                    counts.views_used += used as usize;
+                    used
+                }
+                ChunkKind::Alpha => p.views.get(view).copied().unwrap_or(false),
+                ChunkKind::Flow(n) => {
+                    counts.flows_total += 1;
+                    let used = p.flows.get(view).is_some_and(|f| f[n.index()]);
+                    counts.flows_used += used as usize;
+                    used
+                }
+                ChunkKind::Shadows => p.shadow_maps,
+                ChunkKind::Hull => p.hull,
+            };
+            if used {
+                counts.bytes_read += c.length;
+            }
+        }
+        Ok(plan)
+    }
+
+    /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
+    /// poses, for `frames`; the counts of views and flows are those the plan asks for
+    /// (no chunk is known, so no byte either).
+    pub fn from_header(scene: &Scene, h: &FieldHeader, frames: &[ShotFrame]) -> Result<Self> {
         if frames.is_empty() {
             return Err(RenderError::BadParameter("a shot of no frame".into()));
         }
@@ -361,41 +398,21 @@ impl Plan {
         }
         poses.sort_by_key(|p| p.pose);
 
-        // Counts, from the index.
-        let mut counts = PlanCounts {
+        let counts = PlanCounts {
             poses_used: poses.len(),
             poses_total: h.poses.len(),
+            views_used: poses.iter().map(|p| p.views.iter().filter(|&&v| v).count()).sum(),
+            views_total: poses.len() * views,
+            flows_used: poses
+                .iter()
+                .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
+                .sum(),
+            flows_total: 0,
             conditions_used: lit.iter().filter(|&&l| l).count(),
             conditions_total: h.conditions.len(),
-            ..Default::default()
+            bytes_read: 0,
+            bytes_total: 0,
         };
-        for c in field.chunks() {
-            counts.bytes_total += c.length;
-            let Some(p) = poses.iter().find(|p| p.pose == c.key.pose) else {
-                continue;
-            };
-            let view = c.key.u as usize * rows + c.key.v as usize;
-            let used = match c.key.kind {
-                ChunkKind::Basis => {
-                    counts.views_total += 1;
-                    let used = p.views.get(view).copied().unwrap_or(false);
-                    counts.views_used += used as usize;
-                    used
-                }
-                ChunkKind::Alpha => p.views.get(view).copied().unwrap_or(false),
-                ChunkKind::Flow(n) => {
-                    counts.flows_total += 1;
-                    let used = p.flows.get(view).is_some_and(|f| f[n.index()]);
-                    counts.flows_used += used as usize;
-                    used
-                }
-                ChunkKind::Shadows => p.shadow_maps,
-                ChunkKind::Hull => p.hull,
-            };
-            if used {
-                counts.bytes_read += c.length;
-            }
-        }
         let left_out: Vec<usize> = (0..lit.len()).filter(|&k| !lit[k]).collect();
         Ok(Self {
             counts,
