@@ -110,9 +110,12 @@ impl Output {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("output directory {}: {e}", dir.display()))?;
         let mut settings = settings.clone();
+        // A frame range may change between runs into one directory (array jobs); the
+        // shot's frame count may not.
         if let Some(args) = settings.get_mut("args").and_then(|a| a.as_object_mut()) {
             args.remove("frames");
         }
+        settings["frames_total"] = total.into();
         let text = serde_json::to_string_pretty(&settings)?;
         let path = dir.join("settings.json");
         let same = std::fs::read_to_string(&path).is_ok_and(|s| s == text);
@@ -238,7 +241,11 @@ impl Output {
         let rendered: Vec<f64> = self.records.iter().filter_map(|r| r.seconds).collect();
         let mut sorted = rendered.clone();
         sorted.sort_by(f64::total_cmp);
-        let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+        let median = match sorted.len() {
+            0 => 0.0,
+            n if n % 2 == 1 => sorted[n / 2],
+            n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+        };
         let mean = rendered.iter().sum::<f64>() / rendered.len().max(1) as f64;
         let (first, last) = (
             self.records.iter().map(|r| r.index).min().unwrap_or(0),

@@ -390,6 +390,26 @@ fn explain<R: frf_reflectance::container::ReadAt>(
     Ok(())
 }
 
+/// Where the ground's shadow comes from, in words for the summary.
+fn shadow_words<R: frf_reflectance::container::ReadAt>(
+    scene: &Scene,
+    shot: &Shot<'_, R>,
+    traced_lights: usize,
+) -> String {
+    let plan = shot.plan();
+    match scene.shadow {
+        ShadowSpec::None => "none (--shadow none)".into(),
+        _ if !plan.ground_seen => "none drawn (no frame sees the ground patch)".into(),
+        ShadowSpec::Maps if plan.poses.iter().any(|p| p.shadow_maps) => {
+            "relit from the pose's maps".into()
+        }
+        ShadowSpec::Maps => "none (the field has no shadow maps: --shadow traced traces the hull)".into(),
+        ShadowSpec::Traced => {
+            format!("traced from the hull under {traced_lights} median-cut lights")
+        }
+    }
+}
+
 /// Runs `frf render`.
 pub fn run(args: RenderArgs) -> CliResult {
     let (mut scene, field_path) = scene_of(&args)?;
@@ -470,6 +490,7 @@ pub fn run(args: RenderArgs) -> CliResult {
             " (--no-plan: everything is read)"
         }
     );
+    eprintln!("shadow: {}", shadow_words(&scene, &shot, options.traced_lights));
     let bar = bar("frames");
     bar.set_length(frames.len() as u64);
     for f in &frames {
