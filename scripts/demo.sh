@@ -1,24 +1,64 @@
 #!/usr/bin/env bash
-# The demo, end to end on built-in data: the virtual light stage films the walker
-# (small preset, 160x224, 36x3 views, 2 poses) with its ground truth, ingest turns the
-# capture into a flowed reflectance field (reporting each step's error against the
-# truth), the renderer draws an orbit of the walker relit by an HDR environment (a USC
-# ICT light probe from ../shared/data when present, else the built-in sky) on the GPU,
-# and the four-way morph is scored against its ablations on the stage's truth between
-# grid views. Output in demo-out/ (resumable: a rerun continues an interrupted one).
+# The demo, end to end on built-in data, in about ten minutes on two cores (build
+# included): the virtual light stage films the walker for the shot of scenes/demo.toml
+# only (10 poses of the walk cycle, the views its camera reaches and a ring for the
+# visual hull, 112x160 pixels), ingest turns the capture into a flowed reflectance field
+# (each step's error against the stage's truth), `frf render scenes/demo.toml` draws the
+# shot (the walker walking, the camera moving around it, relit by the sunrise shipped in
+# assets/envmaps, its shadow on the ground, composited over the environment), and
+# `frf eval` scores frames of the shot against their true composites. Output in demo-out/
+# (every step resumes: a rerun continues an interrupted one); demo-out/report.txt holds
+# the error and the time of each step.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
-cargo build --release --quiet
-out="${1:-demo-out}"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d)}"
+chmod 700 "$XDG_RUNTIME_DIR"
+out=demo-out
+scene=scenes/demo.toml
+mkdir -p "$out"
+times="$out/times.tsv"
+: > "$times"
+
+# step NAME COMMAND...: runs COMMAND, its output shown and kept in $out/NAME.log, and
+# its wall time recorded.
+step() {
+  local name=$1
+  shift
+  local t0
+  t0=$(date +%s.%N)
+  "$@" 2>&1 | tee "$out/$name.log"
+  awk -v a="$t0" -v b="$(date +%s.%N)" -v n="$name" 'BEGIN { printf "%s\t%.1f\n", n, b - a }' >> "$times"
+}
+
+step build cargo build --release --quiet
 frf=./target/release/frf
-$frf stage --preset small --out "$out/capture"
-$frf ingest "$out/capture" --out "$out/walker.frf" --report "$out/ingest_report.json"
-$frf info "$out/walker.frf"
-env=../shared/data/envmaps/grace.hdr
-[ -f "$env" ] || env=sky
-export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
-$frf render "$out/walker.frf" --env "$env" --orbit 3.0,1.2 --frames 36 --out "$out/orbit"
-$frf eval "$out/walker.frf" --capture "$out/capture" --env "$env" --cameras 16 \
-  --json > "$out/eval.json"
-echo "demo: contact sheets in $out/capture/preview/, field $out/walker.frf with report $out/ingest_report.json, orbit frames in $out/orbit/ (contact.png), evaluation in $out/eval.json"
+step stage $frf stage --preset small --size 112x160 --lights-per-axis 2 --for "$scene" \
+  --out "$out/capture"
+step ingest $frf ingest "$out/capture" --for "$scene" --flow-preset fast \
+  --out "$out/walker.frf" --report "$out/ingest_report.json"
+step plan $frf render "$scene" --field "$out/walker.frf" --plan
+step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot"
+step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 2 \
+  --lights 256
+
+{
+  echo "frf demo: $scene, $(nproc) cores, $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo
+  echo "time per step (wall seconds):"
+  awk -F'\t' '{ printf "  %-8s %7.1f\n", $1, $2; s += $2 } END { printf "  %-8s %7.1f\n", "total", s }' "$times"
+  echo
+  echo "stage (virtual light stage, films what the scene needs):"
+  grep -E "^for the scene|^work units|^capture size" "$out/stage.log" | sed 's/^/  /'
+  echo
+  echo "ingest, against the stage's truth:"
+  sed -n '/against the virtual stage/,/^  field:/p' "$out/ingest.log" | sed '1d'
+  echo
+  echo "render:"
+  grep -E "frames in|^shadow|plan:" "$out/render.log" | sed 's/^/  /'
+  echo
+  echo "frames of the shot against their true composites:"
+  sed 's/^/  /' "$out/eval.log"
+} > "$out/report.txt"
+cat "$out/report.txt"
+echo "demo: the shot in $out/shot/ (frames, preview.png animated, contact.png), report $out/report.txt"

@@ -10,6 +10,7 @@
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
 //! - [`scene`]: the relit shadow, composites and matte edges against the truth;
+//! - [`shot`]: the frames of a scene's shot against their true composites;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
 //!   neighbours, against the photographs.
 //!
@@ -21,6 +22,7 @@ pub mod metrics;
 pub mod oracle;
 pub mod ring;
 pub mod scene;
+pub mod shot;
 pub mod storage;
 pub mod views;
 

@@ -460,7 +460,10 @@ fn ingest_pose(
                 .zip(&alphas)
                 .filter_map(|(c, a)| a.map(|a| (*c, a)))
                 .unzip();
-            let r = pose_shadows(&cams, &mattes, &header.conditions, s)?;
+            // Views allowed to disagree scale with the views there are.
+            let mut s = *s;
+            s.hull.misses = crate::shadows::misses_for(s.hull.misses, cams.len(), cameras.len());
+            let r = pose_shadows(&cams, &mattes, &header.conditions, &s)?;
             steps.push(Step {
                 name: "visual hull".into(),
                 seconds: r.hull_seconds,

@@ -28,6 +28,16 @@ pub const DEFAULT_LIGHT_SAMPLES: usize = 8;
 /// 0.835 / 0.842 / 0.844, tiny 0.741 / 0.778 / 0.777 / 0.774.
 pub const DEFAULT_MISSES: usize = 6;
 
+/// The views allowed to disagree when only `present` of a grid's `total` views were
+/// ingested (`frf ingest --for SCENE`): `misses` in proportion, rounded up, so that a
+/// full grid keeps `misses` and a few views do not carve with the tolerance of many.
+pub fn misses_for(misses: usize, present: usize, total: usize) -> usize {
+    if present >= total || total == 0 {
+        return misses;
+    }
+    (misses * present).div_ceil(total)
+}
+
 /// How the hull and the shadow maps are made.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShadowOptions {

@@ -161,7 +161,9 @@ fn one() -> usize {
 pub struct HullSpec {
     /// Voxel side, metres.
     pub voxel_m: f32,
-    /// Views allowed to disagree when carving ([`crate::hull::VoxelHull::carve`]).
+    /// Views allowed to disagree when carving ([`crate::hull::VoxelHull::carve`]) a
+    /// pose of the full grid; a pose of fewer views allows as many in proportion,
+    /// rounded up.
     pub misses: usize,
 }
 

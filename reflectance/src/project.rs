@@ -130,50 +130,107 @@ impl Projector {
     /// `∫ L dω` of `env` over each condition's region, for a subject at turntable angle
     /// `turntable` (radians), with the floor conditions lit by `floor`.
     pub fn region_light(&self, env: &EnvMap, turntable: f32, floor: FloorModel) -> Vec<Rgb> {
+        self.region_light_many(env, &[turntable], floor).remove(0)
+    }
+
+    /// [`Projector::region_light`] at each of `turntables`: the direction, radiance and
+    /// solid angle of each texel are found once for all of them (the same arithmetic,
+    /// so the same sums).
+    pub fn region_light_many(
+        &self,
+        env: &EnvMap,
+        turntables: &[f32],
+        floor: FloorModel,
+    ) -> Vec<Vec<Rgb>> {
         let img = env.image();
         let (w, h) = img.size();
         let ground = match floor {
             FloorModel::Environment => None,
             FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
         };
-        let per_row: Vec<Vec<[f64; 3]>> = (0..h)
+        // Per row: its texels' (azimuth, elevation, radiance); and its solid angle.
+        let texels: Vec<(f64, Vec<(f32, f32, Rgb)>)> = (0..h)
             .into_par_iter()
             .map(|y| {
-                let omega = env.texel_solid_angle(y) as f64;
-                let mut acc = vec![[0.0f64; 3]; self.conditions()];
-                for x in 0..w {
-                    let d = env.direction_of(x as f32, y as f32);
-                    let (az, el) = azimuth_elevation(d);
-                    let k = self.lookup(az + turntable, el);
-                    let l = match ground {
-                        Some(g) if d.y < 0.0 => g,
-                        _ => img.get(x, y),
-                    };
-                    for c in 0..3 {
-                        acc[k][c] += l[c] as f64 * omega;
-                    }
-                }
-                acc
+                let row = (0..w)
+                    .map(|x| {
+                        let d = env.direction_of(x as f32, y as f32);
+                        let (az, el) = azimuth_elevation(d);
+                        let l = match ground {
+                            Some(g) if d.y < 0.0 => g,
+                            _ => img.get(x, y),
+                        };
+                        (az, el, l)
+                    })
+                    .collect();
+                (env.texel_solid_angle(y) as f64, row)
             })
             .collect();
-        let mut total = vec![[0.0f64; 3]; self.conditions()];
-        for row in per_row {
-            for (t, r) in total.iter_mut().zip(row) {
-                for c in 0..3 {
-                    t[c] += r[c];
+        turntables
+            .iter()
+            .map(|&turntable| {
+                let per_row: Vec<Vec<[f64; 3]>> = texels
+                    .par_iter()
+                    .map(|(omega, row)| {
+                        let mut acc = vec![[0.0f64; 3]; self.conditions()];
+                        for &(az, el, l) in row {
+                            let k = self.lookup(az + turntable, el);
+                            for c in 0..3 {
+                                acc[k][c] += l[c] as f64 * omega;
+                            }
+                        }
+                        acc
+                    })
+                    .collect();
+                let mut total = vec![[0.0f64; 3]; self.conditions()];
+                for row in per_row {
+                    for (t, r) in total.iter_mut().zip(row) {
+                        for c in 0..3 {
+                            t[c] += r[c];
+                        }
+                    }
                 }
-            }
-        }
-        total.into_iter().map(|t| t.map(|v| v as f32)).collect()
+                total.into_iter().map(|t| t.map(|v| v as f32)).collect()
+            })
+            .collect()
     }
 
     /// The relighting coefficients (per condition, per channel) of `env` for a subject at
     /// turntable angle `turntable` (radians).
     pub fn project(&self, env: &EnvMap, turntable: f32, floor: FloorModel) -> Vec<Rgb> {
-        self.region_light(env, turntable, floor)
+        self.project_many(env, &[turntable], floor).remove(0)
+    }
+
+    /// [`Projector::project`] at each of `turntables` (each distinct angle once).
+    pub fn project_many(&self, env: &EnvMap, turntables: &[f32], floor: FloorModel) -> Vec<Vec<Rgb>> {
+        let mut distinct: Vec<f32> = Vec::new();
+        for &t in turntables {
+            if !distinct.iter().any(|d| d.to_bits() == t.to_bits()) {
+                distinct.push(t);
+            }
+        }
+        let lights = self.region_light_many(env, &distinct, floor);
+        let coefficients: Vec<Vec<Rgb>> = lights
             .iter()
-            .zip(&self.delivered)
-            .map(|(light, d)| [0, 1, 2].map(|c| if d[c] > 0.0 { light[c] / d[c] } else { 0.0 }))
+            .map(|light| {
+                light
+                    .iter()
+                    .zip(&self.delivered)
+                    .map(|(light, d)| {
+                        [0, 1, 2].map(|c| if d[c] > 0.0 { light[c] / d[c] } else { 0.0 })
+                    })
+                    .collect()
+            })
+            .collect();
+        turntables
+            .iter()
+            .map(|t| {
+                let k = distinct
+                    .iter()
+                    .position(|d| d.to_bits() == t.to_bits())
+                    .expect("every angle is among the distinct ones");
+                coefficients[k].clone()
+            })
             .collect()
     }
 

@@ -146,14 +146,17 @@ impl PoseSource {
             Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
             Lighting::Environment { env, floor } => {
                 let projector = Projector::new(&h.conditions)?;
-                (
-                    record
-                        .views
-                        .iter()
-                        .map(|v| projector.project(env, v.turntable_deg.to_radians(), *floor))
-                        .collect(),
-                    Some(projector.project(env, 0.0, *floor)),
-                )
+                // One pass over the map for every view's turntable angle and the
+                // subject's own frame (angle 0), the last.
+                let mut angles: Vec<f32> = record
+                    .views
+                    .iter()
+                    .map(|v| v.turntable_deg.to_radians())
+                    .collect();
+                angles.push(0.0);
+                let mut all = projector.project_many(env, &angles, *floor);
+                let own = all.pop();
+                (all, own)
             }
         };
         let mut coefficients = coefficients;

@@ -37,13 +37,20 @@ use crate::cmd::render::{open_renderer, pose_of};
 /// Arguments of `frf eval`.
 #[derive(Args)]
 pub struct EvalArgs {
-    /// A field of a virtual-stage capture (`frf stage field` or `frf ingest`).
-    field: PathBuf,
+    /// A field of a virtual-stage capture (`frf stage field` or `frf ingest`), or a scene
+    /// file (`.toml`): then frames of its shot are scored against their true composites.
+    pub(crate) field: PathBuf,
+    /// With a scene: the field to render it from (default: the scene's `field`).
+    #[arg(long = "field")]
+    pub(crate) scene_field: Option<PathBuf>,
+    /// With a scene: frames scored, spread evenly over the shot.
+    #[arg(long, default_value_t = 4)]
+    pub(crate) frames: usize,
     /// The capture the field was made from (its stage renders the truth).
     #[arg(long)]
-    capture: PathBuf,
+    pub(crate) capture: PathBuf,
     #[command(flatten)]
-    lighting: LightingArgs,
+    pub(crate) lighting: LightingArgs,
     /// Pose (default: the field's first).
     #[arg(long)]
     pose: Option<u32>,
@@ -52,9 +59,9 @@ pub struct EvalArgs {
     cameras: usize,
     /// Median-cut lights of the environment in the truth renders.
     #[arg(long, default_value_t = 512)]
-    lights: usize,
+    pub(crate) lights: usize,
     #[command(flatten)]
-    compare: CompareArgs,
+    pub(crate) compare: CompareArgs,
     /// Write each camera's truth and renders as PNGs here (with `--shadows`, also the
     /// relit and the true shadow of the ground patch, seen from above, +x right, +z down).
     #[arg(long)]
@@ -71,16 +78,16 @@ pub struct EvalArgs {
 
 /// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.
 #[derive(Args)]
-struct CompareArgs {
+pub(crate) struct CompareArgs {
     /// Variants to compare (default: all four).
     #[arg(long, value_enum, value_delimiter = ',')]
     variants: Vec<VariantArg>,
     /// Render with the CPU reference instead of the GPU.
     #[arg(long)]
-    cpu: bool,
+    pub(crate) cpu: bool,
     /// Print the report as JSON on stdout.
     #[arg(long)]
-    json: bool,
+    pub(crate) json: bool,
 }
 
 impl CompareArgs {
@@ -113,6 +120,13 @@ struct EvalReport {
 
 /// Runs `frf eval`.
 pub fn run(args: EvalArgs) -> CliResult {
+    if args
+        .field
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    {
+        return crate::cmd::eval_shot::run(&args);
+    }
     let field = FieldFile::open(&args.field)?;
     let h = field.header();
     let pose = pose_of(h, args.pose, &args.field)?;

@@ -82,6 +82,13 @@ struct CaptureArgs {
     /// Film only the poses and views this scene file needs (with all its frames).
     #[arg(long = "for", value_name = "SCENE")]
     for_scene: Option<PathBuf>,
+    /// Image size `WxH` instead of the preset's (the cameras keep their field of view).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Each basis condition is lit by an `N x N` grid of lights over its cell of the
+    /// sphere (default: the preset's; fewer is faster, with harder shadows).
+    #[arg(long)]
+    lights_per_axis: Option<u32>,
     /// Render without sensor noise (quantization remains).
     #[arg(long)]
     no_noise: bool,
@@ -172,6 +179,12 @@ fn capture(args: CaptureArgs) -> CliResult {
         };
     }
     config.noise = !args.no_noise;
+    if let Some((w, h)) = args.size {
+        (config.width, config.height) = (w, h);
+    }
+    if let Some(n) = args.lights_per_axis {
+        config.lights_per_axis = n;
+    }
     if let Some(scene) = &args.for_scene {
         // Plan on every pose of the cycle, then film what the plan keeps.
         let mut all = config.clone();

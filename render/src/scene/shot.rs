@@ -198,6 +198,38 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(Some(env))
     }
 
+    /// The scene shot.
+    pub fn scene(&self) -> &'a Scene {
+        self.scene
+    }
+
+    /// The environment lighting the scene (scene frame) at `t` seconds: `None` when the
+    /// scene shows the field unlit.
+    pub fn lighting_at(&mut self, t: f32) -> Result<Option<EnvMap>> {
+        let l = self.scene.lighting_at(t);
+        self.world_lighting(&l)
+    }
+
+    /// The backdrop of the scene under `world` (the lighting of a frame).
+    pub fn backdrop_of(&self, world: Option<&EnvMap>) -> Result<Backdrop> {
+        Ok(match (&self.scene.backdrop, world) {
+            (BackdropSpec::None, _) => Backdrop::None,
+            (BackdropSpec::Environment(ground), Some(env)) => {
+                Backdrop::environment(env.clone(), *ground)
+            }
+            (BackdropSpec::Environment(_), None) => {
+                return Err(RenderError::BadParameter(
+                    "an environment backdrop without an environment".into(),
+                ));
+            }
+            (BackdropSpec::Plate(_), _) => Backdrop::Plate(
+                self.plate
+                    .clone()
+                    .ok_or_else(|| RenderError::BadParameter("no plate loaded".into()))?,
+            ),
+        })
+    }
+
     /// Renders frame `frame` (one of the frames the shot was planned for).
     pub fn render(&mut self, frame: &ShotFrame, layers: bool) -> Result<ShotResult> {
         let fp: FramePlan = self
@@ -258,22 +290,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         // The backdrop of this lighting.
         let stale = self.backdrop.as_ref().is_none_or(|(k, _)| *k != key);
         if stale {
-            let backdrop = match (&self.scene.backdrop, &world) {
-                (BackdropSpec::None, _) => Backdrop::None,
-                (BackdropSpec::Environment(ground), Some(env)) => {
-                    Backdrop::environment(env.clone(), *ground)
-                }
-                (BackdropSpec::Environment(_), None) => {
-                    return Err(RenderError::BadParameter(
-                        "an environment backdrop without an environment".into(),
-                    ));
-                }
-                (BackdropSpec::Plate(_), _) => Backdrop::Plate(
-                    self.plate
-                        .clone()
-                        .ok_or_else(|| RenderError::BadParameter("no plate loaded".into()))?,
-                ),
-            };
+            let backdrop = self.backdrop_of(world.as_ref())?;
             self.backdrop = Some((key, self.device.backdrop(backdrop)?));
         }
         let walkers: Vec<Walker> = slots
