@@ -2,7 +2,7 @@
 # The demo, end to end on built-in data, in about ten minutes on two cores (build
 # included): the virtual light stage films the walker for the shot of scenes/demo.toml
 # only (10 poses of the walk cycle, the views its camera reaches and a ring for the
-# visual hull, 112x160 pixels), ingest turns the capture into a flowed reflectance field
+# visual hull, 96x136 pixels), ingest turns the capture into a flowed reflectance field
 # (each step's error against the stage's truth), `frf render scenes/demo.toml` draws the
 # shot (the walker walking, the camera moving around it, relit by the sunrise shipped in
 # assets/envmaps, its shadow on the ground, composited over the environment), and
@@ -33,7 +33,7 @@ step() {
 
 step build cargo build --release --quiet
 frf=./target/release/frf
-step stage $frf stage --preset small --size 112x160 --lights-per-axis 2 --for "$scene" \
+step stage $frf stage --preset small --size 96x136 --lights-per-axis 2 --for "$scene" \
   --out "$out/capture"
 step ingest $frf ingest "$out/capture" --for "$scene" --flow-preset fast \
   --out "$out/walker.frf" --report "$out/ingest_report.json"

@@ -163,10 +163,19 @@ impl Capture {
         check_files_spec(&c, &manifest)?;
         for (i, f) in manifest.filmed.iter().enumerate() {
             if !manifest.timing.poses.contains(&f.pose) {
-                return Err(c.fail(&format!("filmed[{i}].pose"), format!("pose {} is not in timing.poses", f.pose)));
+                return Err(c.fail(
+                    &format!("filmed[{i}].pose"),
+                    format!("pose {} is not in timing.poses", f.pose),
+                ));
             }
-            if let Some(v) = f.views.iter().find(|v| v[0] as usize >= manifest.turntable.azimuth_deg.len() || v[1] as usize >= cameras.len()) {
-                return Err(c.fail(&format!("filmed[{i}].views"), format!("view {v:?} is outside the grid")));
+            if let Some(v) = f.views.iter().find(|v| {
+                v[0] as usize >= manifest.turntable.azimuth_deg.len()
+                    || v[1] as usize >= cameras.len()
+            }) {
+                return Err(c.fail(
+                    &format!("filmed[{i}].views"),
+                    format!("view {v:?} is outside the grid"),
+                ));
             }
         }
         Ok(Self {

@@ -81,9 +81,8 @@ pub fn score_frame<R: ReadAt>(
     let subject = truth_frame(stage, pose, &subject_camera, &lights)?;
     let actor = stage.true_actor(pose);
     let subject_from_world = instance.world_from_subject().inverse();
-    let shadow = |p: glam::Vec3| {
-        relative_irradiance(&actor, &lights, subject_from_world.transform_point(p))
-    };
+    let shadow =
+        |p: glam::Vec3| relative_irradiance(&actor, &lights, subject_from_world.transform_point(p));
     let (truth, _) = compose(subject.clone(), &frame.camera, &backdrop, &shadow)?;
     let seconds_truth = t.elapsed().as_secs_f64();
 

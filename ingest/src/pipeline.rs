@@ -74,8 +74,14 @@ impl Selection {
         self.views
             .iter()
             .map(|(p, v)| {
-                let flows = self.flows.get(p).map_or(0, |f| f.iter().flatten().filter(|&&x| x).count());
-                format!("p{p}: {} views, {flows} flows", v.iter().filter(|&&x| x).count())
+                let flows = self
+                    .flows
+                    .get(p)
+                    .map_or(0, |f| f.iter().flatten().filter(|&&x| x).count());
+                format!(
+                    "p{p}: {} views, {flows} flows",
+                    v.iter().filter(|&&x| x).count()
+                )
             })
             .collect::<Vec<_>>()
             .join("; ")
@@ -365,7 +371,11 @@ fn ingest_pose(
             "pose {pose}: no view of it is both filmed and selected"
         )));
     }
-    progress.begin(pose, "mattes and registration", present.iter().filter(|&&p| p).count());
+    progress.begin(
+        pose,
+        "mattes and registration",
+        present.iter().filter(|&&p| p).count(),
+    );
     let start = Instant::now();
     let views: Vec<Option<ViewOut>> = (0..columns * rows)
         .into_par_iter()
@@ -420,8 +430,12 @@ fn ingest_pose(
 
     progress.begin(pose, "inter-view flow", columns * rows);
     let start = Instant::now();
-    let images: Vec<Option<&RgbImage>> = views.iter().map(|v| v.as_ref().map(|v| &v.summed)).collect();
-    let alphas: Vec<Option<&GrayImage>> = views.iter().map(|v| v.as_ref().map(|v| &v.alpha)).collect();
+    let images: Vec<Option<&RgbImage>> = views
+        .iter()
+        .map(|v| v.as_ref().map(|v| &v.summed))
+        .collect();
+    let alphas: Vec<Option<&GrayImage>> =
+        views.iter().map(|v| v.as_ref().map(|v| &v.alpha)).collect();
     let cameras: Vec<Camera> = (0..columns * rows)
         .map(|i| capture.subject_camera(i / rows, i % rows, pose))
         .collect();
@@ -433,7 +447,9 @@ fn ingest_pose(
             images: &images,
             alphas: &alphas,
             cameras: &cameras,
-            wanted: selected.and_then(|s| s.flows.get(&pose)).map(|f| f.as_slice()),
+            wanted: selected
+                .and_then(|s| s.flows.get(&pose))
+                .map(|f| f.as_slice()),
         },
         &params,
         &|| {

@@ -202,7 +202,12 @@ impl Projector {
     }
 
     /// [`Projector::project`] at each of `turntables` (each distinct angle once).
-    pub fn project_many(&self, env: &EnvMap, turntables: &[f32], floor: FloorModel) -> Vec<Vec<Rgb>> {
+    pub fn project_many(
+        &self,
+        env: &EnvMap,
+        turntables: &[f32],
+        floor: FloorModel,
+    ) -> Vec<Vec<Rgb>> {
         let mut distinct: Vec<f32> = Vec::new();
         for &t in turntables {
             if !distinct.iter().any(|d| d.to_bits() == t.to_bits()) {

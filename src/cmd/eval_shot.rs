@@ -71,7 +71,13 @@ pub fn run(args: &EvalArgs) -> CliResult {
         planned: true,
         traced_lights: args.lights,
     };
-    let mut shot = Shot::new(&scene, &field, Device::open(args.compare.cpu)?, &frames, options)?;
+    let mut shot = Shot::new(
+        &scene,
+        &field,
+        Device::open(args.compare.cpu)?,
+        &frames,
+        options,
+    )?;
     for f in &shot.plan().frames {
         if let Some(p) = f.poses.iter().find(|p| !stage.config().poses.contains(p)) {
             return Err(format!(
@@ -90,7 +96,8 @@ pub fn run(args: &EvalArgs) -> CliResult {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let mean = |g: fn(&ShotFrameScore) -> f64| scores.iter().map(g).sum::<f64>() / scores.len() as f64;
+    let mean =
+        |g: fn(&ShotFrameScore) -> f64| scores.iter().map(g).sum::<f64>() / scores.len() as f64;
     let report = ShotReport {
         scene: args.field.clone(),
         field: field_path,
@@ -122,7 +129,14 @@ pub fn run(args: &EvalArgs) -> CliResult {
     for s in &report.frames {
         println!(
             "{:>5} {:>6.2} {:>5} {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
-            s.index, s.time, s.pose, s.psnr_frame, s.psnr_subject, s.ssim_subject, s.seconds_render, s.seconds_truth
+            s.index,
+            s.time,
+            s.pose,
+            s.psnr_frame,
+            s.psnr_subject,
+            s.ssim_subject,
+            s.seconds_render,
+            s.seconds_truth
         );
     }
     println!(

@@ -7,11 +7,11 @@ use std::path::Path;
 use frf_core::capture::Capture;
 use frf_core::manifest::FilmedSpec;
 use frf_ingest::pipeline::Selection;
+use frf_ingest::shadows::ShadowOptions;
 use frf_reflectance::FieldHeader;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
-use frf_ingest::shadows::ShadowOptions;
-use frf_render::scene::{Scene, ShadowSpec};
 use frf_render::scene::plan::Plan;
+use frf_render::scene::{Scene, ShadowSpec};
 
 use crate::CliResult;
 
@@ -56,8 +56,16 @@ pub fn plan(scene: &Path, capture: &Capture) -> CliResult<Plan> {
 /// The views and flows of `plan`, for ingest.
 pub fn selection(plan: &Plan) -> Selection {
     Selection {
-        views: plan.poses.iter().map(|p| (p.pose, p.views.clone())).collect(),
-        flows: plan.poses.iter().map(|p| (p.pose, p.flows.clone())).collect(),
+        views: plan
+            .poses
+            .iter()
+            .map(|p| (p.pose, p.views.clone()))
+            .collect(),
+        flows: plan
+            .poses
+            .iter()
+            .map(|p| (p.pose, p.flows.clone()))
+            .collect(),
     }
 }
 

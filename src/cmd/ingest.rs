@@ -156,7 +156,12 @@ pub fn run(args: IngestArgs) -> CliResult {
         options.poses = if options.poses.is_empty() {
             wanted
         } else {
-            options.poses.iter().copied().filter(|p| wanted.contains(p)).collect()
+            options
+                .poses
+                .iter()
+                .copied()
+                .filter(|p| wanted.contains(p))
+                .collect()
         };
         options.selection = Some(crate::cmd::for_scene::selection(&plan));
     }

@@ -403,7 +403,9 @@ fn shadow_words<R: frf_reflectance::container::ReadAt>(
         ShadowSpec::Maps if plan.poses.iter().any(|p| p.shadow_maps) => {
             "relit from the pose's maps".into()
         }
-        ShadowSpec::Maps => "none (the field has no shadow maps: --shadow traced traces the hull)".into(),
+        ShadowSpec::Maps => {
+            "none (the field has no shadow maps: --shadow traced traces the hull)".into()
+        }
         ShadowSpec::Traced => {
             format!("traced from the hull under {traced_lights} median-cut lights")
         }
@@ -490,7 +492,10 @@ pub fn run(args: RenderArgs) -> CliResult {
             " (--no-plan: everything is read)"
         }
     );
-    eprintln!("shadow: {}", shadow_words(&scene, &shot, options.traced_lights));
+    eprintln!(
+        "shadow: {}",
+        shadow_words(&scene, &shot, options.traced_lights)
+    );
     let bar = bar("frames");
     bar.set_length(frames.len() as u64);
     for f in &frames {

@@ -126,14 +126,18 @@ impl StageConfig {
         }
         for f in &self.filmed {
             if !self.poses.contains(&f.pose) {
-                return bad(format!("filmed views of pose {}, which is not rendered", f.pose));
+                return bad(format!(
+                    "filmed views of pose {}, which is not rendered",
+                    f.pose
+                ));
             }
-            if let Some(v) = f
-                .views
-                .iter()
-                .find(|v| v[0] >= self.cycles || v[1] >= crate::rig::CAMERA_ELEVATIONS_DEG.len() as u32)
-            {
-                return bad(format!("filmed view {v:?} of pose {} is outside the grid", f.pose));
+            if let Some(v) = f.views.iter().find(|v| {
+                v[0] >= self.cycles || v[1] >= crate::rig::CAMERA_ELEVATIONS_DEG.len() as u32
+            }) {
+                return bad(format!(
+                    "filmed view {v:?} of pose {} is outside the grid",
+                    f.pose
+                ));
             }
         }
         let per_cycle = self.poses_per_cycle();

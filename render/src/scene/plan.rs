@@ -25,9 +25,9 @@ use std::collections::BTreeSet;
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
-use frf_reflectance::{FieldFile, FieldHeader};
 use frf_reflectance::container::{ChunkKind, ReadAt};
 use frf_reflectance::project::{FloorModel, Projector};
+use frf_reflectance::{FieldFile, FieldHeader};
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
@@ -401,7 +401,10 @@ impl Plan {
         let counts = PlanCounts {
             poses_used: poses.len(),
             poses_total: h.poses.len(),
-            views_used: poses.iter().map(|p| p.views.iter().filter(|&&v| v).count()).sum(),
+            views_used: poses
+                .iter()
+                .map(|p| p.views.iter().filter(|&&v| v).count())
+                .sum(),
             views_total: poses.len() * views,
             flows_used: poses
                 .iter()

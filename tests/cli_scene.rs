@@ -1,0 +1,377 @@
+//! `frf render SCENE.toml` end to end on the tiny stage's oracle field: the planner
+//! leaves things out and the frames do not change for it, a camera on one side reads
+//! only that side, a shot splits into frame ranges that resume, two walkers agree
+//! between the GPU and the CPU reference; and upstream, `frf stage --for` and
+//! `frf ingest --for` film and ingest only what a scene needs, and per-pose parts merge
+//! into the same bytes as one ingest.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn frf(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_frf"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+fn ok(args: &[&str]) -> Output {
+    let o = frf(args);
+    assert!(
+        o.status.success(),
+        "frf {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn gpu_flag() -> Option<&'static str> {
+    std::env::var("FRF_SKIP_GPU")
+        .is_ok_and(|v| v == "1")
+        .then_some("--cpu")
+}
+
+fn field() -> &'static PathBuf {
+    &frf_testkit::tiny_field().field
+}
+
+/// A scene of `walkers` walkers on the tiny field, `frames` frames at 64x48, a camera
+/// moving from `from` to `to` (x, y, z) looking at the first walker, over the built-in
+/// sky's backdrop with the shadow from the maps; written into `dir`.
+fn write_scene(dir: &Path, name: &str, walkers: &str, from: &str, to: &str) -> PathBuf {
+    let text = format!(
+        r#"field = "{field}"
+
+[time]
+start = 0.0
+end = 0.4
+fps = 10.0
+
+[output]
+size = [64, 48]
+
+[lighting]
+env = "sky"
+
+[camera]
+[[camera.key]]
+time = 0.0
+position = {from}
+look_at = [0.0, 0.9, 0.0]
+fov_deg = 45.0
+
+[[camera.key]]
+time = 0.4
+position = {to}
+look_at = [0.0, 0.9, 0.0]
+fov_deg = 45.0
+
+[composite]
+backdrop = "env"
+shadow = "maps"
+{walkers}
+"#,
+        field = field().display()
+    );
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn plan_json(scene: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["render", scene.to_str().unwrap(), "--plan", "--json"];
+    args.extend(extra);
+    serde_json::from_slice(&ok(&args).stdout).unwrap()
+}
+
+fn read_exr(path: &Path) -> Vec<f32> {
+    image::open(path)
+        .unwrap()
+        .to_rgba32f()
+        .into_raw()
+        .into_iter()
+        .collect()
+}
+
+#[test]
+fn the_planner_leaves_work_out_and_the_frames_do_not_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let walkers = "[[instance]]\n[[instance]]\nposition = [0.9, 0.0, -0.6]\nheading_deg = 60.0\ntime_offset = 0.4\n";
+    let scene = write_scene(
+        dir.path(),
+        "two.toml",
+        walkers,
+        "[1.2, 1.3, 3.0]",
+        "[-0.8, 1.4, 3.1]",
+    );
+    let plan = plan_json(&scene, &[]);
+    for key in [
+        "poses_used",
+        "poses_total",
+        "views_used",
+        "views_total",
+        "flows_used",
+        "flows_total",
+        "conditions_used",
+        "conditions_total",
+        "bytes_read",
+        "bytes_total",
+    ] {
+        assert!(plan[key].is_u64(), "--plan --json lacks {key}: {plan}");
+    }
+    let n = |k: &str| plan[k].as_u64().unwrap();
+    assert!(n("views_used") < n("views_total"), "{plan}");
+    assert!(n("flows_used") < n("flows_total"), "{plan}");
+    assert!(n("bytes_read") < n("bytes_total"), "{plan}");
+
+    let mut frames = Vec::new();
+    for (out, flag) in [("planned", None), ("unplanned", Some("--no-plan"))] {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(flag);
+        args.extend(gpu_flag());
+        ok(&args);
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+        // Every frame says which poses it drew.
+        assert_eq!(report["frames"].as_array().unwrap().len(), 4);
+        assert_eq!(report["frames"][0]["poses"].as_array().unwrap().len(), 2);
+        frames.push(
+            (0..4)
+                .map(|i| read_exr(&out.join(format!("frame_{i:04}.exr"))))
+                .collect::<Vec<_>>(),
+        );
+    }
+    assert_eq!(
+        frames[0], frames[1],
+        "the planned frames differ from the unplanned ones"
+    );
+}
+
+#[test]
+fn a_camera_on_one_side_reads_only_that_side() {
+    let dir = tempfile::tempdir().unwrap();
+    let one_side = write_scene(
+        dir.path(),
+        "side.toml",
+        "",
+        "[0.4, 1.3, 3.0]",
+        "[-0.4, 1.3, 3.0]",
+    );
+    let plan = plan_json(&one_side, &[]);
+    let n = |k: &str| plan[k].as_u64().unwrap();
+    // The camera sees the subject from the front only: well under half the grid.
+    assert!(2 * n("views_used") < n("views_total"), "{plan}");
+    assert!(plan["shadow_maps_read"].as_bool().unwrap(), "{plan}");
+
+    // Without a shadow the maps are not read.
+    let text = std::fs::read_to_string(&one_side)
+        .unwrap()
+        .replace("shadow = \"maps\"", "shadow = \"none\"");
+    let no_shadow = dir.path().join("no_shadow.toml");
+    std::fs::write(&no_shadow, text).unwrap();
+    let plan2 = plan_json(&no_shadow, &[]);
+    assert!(!plan2["shadow_maps_read"].as_bool().unwrap());
+    assert!(plan2["bytes_read"].as_u64().unwrap() < n("bytes_read"));
+}
+
+#[test]
+fn frame_ranges_split_a_shot_and_a_rerun_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "s.toml",
+        "",
+        "[1.0, 1.3, 3.0]",
+        "[-1.0, 1.3, 3.0]",
+    );
+    let out = dir.path().join("shot");
+    let run = |range: &str| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--frames",
+            range,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(gpu_flag());
+        ok(&args)
+    };
+    run("0..2");
+    assert!(out.join("render_frames_0-2.json").exists());
+    assert!(!out.join("contact.png").exists(), "a sheet of half a shot");
+    run("2..4");
+    // The second job completes the shot: the sheet and the animated preview appear.
+    assert!(out.join("contact.png").exists());
+    let preview = std::fs::read(out.join("preview.png")).unwrap();
+    assert!(
+        preview.windows(4).any(|w| w == b"acTL"),
+        "preview.png is not animated"
+    );
+    // A rerun keeps the frames there.
+    run("0..2");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("render_frames_0-2.json")).unwrap())
+            .unwrap();
+    assert_eq!(report["frames_resumed"], 2);
+    assert_eq!(report["frames_rendered"], 0);
+    // A range outside the shot is refused, naming it.
+    let o = frf(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--frames",
+        "3..9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("3..9"));
+}
+
+#[test]
+fn two_walkers_agree_between_the_gpu_and_the_cpu_reference() {
+    if gpu_flag().is_some() {
+        eprintln!("FRF_SKIP_GPU=1: no GPU to compare with");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let walkers = "[[instance]]\nposition = [-0.5, 0.0, 0.0]\n[[instance]]\nposition = [0.6, 0.0, -0.4]\nheading_deg = 90.0\n";
+    let scene = write_scene(
+        dir.path(),
+        "two.toml",
+        walkers,
+        "[0.5, 1.4, 3.2]",
+        "[-0.5, 1.4, 3.2]",
+    );
+    let mut frames = Vec::new();
+    for (out, flag) in [("gpu", None), ("cpu", Some("--cpu"))] {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--frames",
+            "0..1",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(flag);
+        ok(&args);
+        frames.push(read_exr(&out.join("frame_0000.exr")));
+    }
+    let (g, c) = (&frames[0], &frames[1]);
+    let diff = g
+        .iter()
+        .zip(c)
+        .map(|(a, b)| (a - b).abs() / b.abs().max(0.05))
+        .collect::<Vec<_>>();
+    let bad = diff.iter().filter(|&&d| d > 0.02).count();
+    // Filtering at texel edges may differ on a few pixels; the frame agrees.
+    assert!(
+        bad * 200 < diff.len(),
+        "{bad} of {} channels differ by more than 2 %",
+        diff.len()
+    );
+}
+
+#[test]
+fn stage_and_ingest_for_a_scene_and_merged_parts_are_one_ingest() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Two poses of the walk (0.0 s and 0.1 s: poses 0 and 3), seen from the front.
+    let text = std::fs::read_to_string(write_scene(
+        d,
+        "s.toml",
+        "",
+        "[0.5, 1.3, 3.0]",
+        "[-0.5, 1.3, 3.0]",
+    ))
+    .unwrap()
+    .replace("end = 0.4", "end = 0.2")
+    .replace("time = 0.4", "time = 0.2");
+    let scene = d.join("front.toml");
+    std::fs::write(&scene, text).unwrap();
+    let capture = d.join("capture");
+    let o = ok(&[
+        "stage",
+        "--preset",
+        "tiny",
+        "--for",
+        scene.to_str().unwrap(),
+        "--out",
+        capture.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(said.contains("2 of 30 poses"), "{said}");
+    let manifest = std::fs::read_to_string(capture.join("capture.toml")).unwrap();
+    assert!(
+        manifest.contains("filmed"),
+        "the manifest does not say what was filmed"
+    );
+
+    let ingest = |out: &Path, extra: &[&str]| {
+        let mut args = vec![
+            "ingest",
+            capture.to_str().unwrap(),
+            "--for",
+            scene.to_str().unwrap(),
+            "--flow-preset",
+            "fast",
+            "--no-eval",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        ok(&args);
+    };
+    let whole = d.join("whole.frf");
+    ingest(&whole, &[]);
+    let parts = [d.join("p0.frf"), d.join("p3.frf")];
+    ingest(&parts[0], &["--poses", "0"]);
+    ingest(&parts[1], &["--poses", "3"]);
+    let merged = d.join("merged.frf");
+    ok(&[
+        "merge",
+        parts[0].to_str().unwrap(),
+        parts[1].to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
+    assert!(
+        std::fs::read(&whole).unwrap() == std::fs::read(&merged).unwrap(),
+        "the merged parts differ from the single ingest"
+    );
+
+    // The field renders the scene it was made for; its plan needs nothing it lacks.
+    let out = d.join("shot");
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--field",
+        whole.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    ok(&args);
+    assert!(out.join("frame_0001.png").exists());
+
+    // Parts that share a pose are refused, naming it.
+    let o = frf(&[
+        "merge",
+        parts[0].to_str().unwrap(),
+        parts[0].to_str().unwrap(),
+        "--out",
+        d.join("bad.frf").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(!d.join("bad.frf").exists(), "a refused merge left a file");
+}
