@@ -164,7 +164,7 @@ impl Capture {
         for (i, f) in manifest.filmed.iter().enumerate() {
             if !manifest.timing.poses.contains(&f.pose) {
                 return Err(c.fail(
-                    &format!("filmed[{i}].pose"),
+                    format!("filmed[{i}].pose"),
                     format!("pose {} is not in timing.poses", f.pose),
                 ));
             }
@@ -173,7 +173,7 @@ impl Capture {
                     || v[1] as usize >= cameras.len()
             }) {
                 return Err(c.fail(
-                    &format!("filmed[{i}].views"),
+                    format!("filmed[{i}].views"),
                     format!("view {v:?} is outside the grid"),
                 ));
             }

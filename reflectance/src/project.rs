@@ -66,6 +66,9 @@ fn cell_direction(ia: usize, ie: usize) -> Vec3 {
     frf_core::light::direction_from_azimuth_elevation(az, el)
 }
 
+/// One texel of an environment map: its azimuth and elevation (radians) and radiance.
+type Texel = (f32, f32, Rgb);
+
 impl Projector {
     /// A projector for `conditions` (dome frame).
     pub fn new(conditions: &[ConditionRecord]) -> Result<Self> {
@@ -149,7 +152,7 @@ impl Projector {
             FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
         };
         // Per row: its texels' (azimuth, elevation, radiance); and its solid angle.
-        let texels: Vec<(f64, Vec<(f32, f32, Rgb)>)> = (0..h)
+        let texels: Vec<(f64, Vec<Texel>)> = (0..h)
             .into_par_iter()
             .map(|y| {
                 let row = (0..w)

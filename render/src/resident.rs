@@ -20,7 +20,7 @@ use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::io::{linear_to_srgb, srgb_to_linear};
 use frf_reflectance::FieldFile;
-use frf_reflectance::container::ReadAt;
+use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::project::{FloorModel, Projector};
@@ -123,7 +123,28 @@ impl PoseSource {
                 p.pose
             )));
         }
-        let view_used = |i: usize| plan.is_none_or(|p| p.views[i]);
+        // A view is read when the plan wants it (or there is no plan) and the field holds
+        // it: a field ingested for one scene holds only that scene's views.
+        let held = |i: usize| {
+            field.has(&ChunkKey {
+                pose,
+                u: (i / rows) as u32,
+                v: (i % rows) as u32,
+                kind: ChunkKind::Alpha,
+            })
+        };
+        if let Some(p) = plan
+            && let Some(i) = (0..views).find(|&i| p.views[i] && !held(i))
+        {
+            return Err(RenderError::BadParameter(format!(
+                "{}: the shot needs view ({}, {}) of pose {pose}, which this field does not hold \
+                 (a field made for another scene: ingest the capture with --for this scene)",
+                field.path().display(),
+                i / rows,
+                i % rows
+            )));
+        }
+        let view_used = |i: usize| plan.is_none_or(|p| p.views[i]) && held(i);
         let flow_used = |i: usize, n: Neighbour| plan.is_none_or(|p| p.flows[i][n.index()]);
         let cameras = record
             .views
@@ -148,10 +169,18 @@ impl PoseSource {
                 let projector = Projector::new(&h.conditions)?;
                 // One pass over the map for every view's turntable angle and the
                 // subject's own frame (angle 0), the last.
+                // Views not read keep angle 0 (their coefficients are never used).
                 let mut angles: Vec<f32> = record
                     .views
                     .iter()
-                    .map(|v| v.turntable_deg.to_radians())
+                    .enumerate()
+                    .map(|(i, v)| {
+                        if view_used(i) {
+                            v.turntable_deg.to_radians()
+                        } else {
+                            0.0
+                        }
+                    })
                     .collect();
                 angles.push(0.0);
                 let mut all = projector.project_many(env, &angles, *floor);
