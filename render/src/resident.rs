@@ -144,7 +144,10 @@ impl PoseSource {
                 i % rows
             )));
         }
-        let view_used = |i: usize| plan.is_none_or(|p| p.views[i]) && held(i);
+        let read: Vec<bool> = (0..views)
+            .map(|i| plan.is_none_or(|p| p.views[i]) && held(i))
+            .collect();
+        let view_used = |i: usize| read[i];
         let flow_used = |i: usize, n: Neighbour| plan.is_none_or(|p| p.flows[i][n.index()]);
         let cameras = record
             .views

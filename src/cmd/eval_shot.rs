@@ -44,16 +44,8 @@ pub fn run(args: &EvalArgs) -> CliResult {
             k.env = env.clone();
         }
     }
-    let field_path = args
-        .scene_field
-        .clone()
-        .or_else(|| scene.field.clone())
-        .ok_or_else(|| {
-            format!(
-                "{}: no field (give field = \"...\" or --field)",
-                args.field.display()
-            )
-        })?;
+    let field_path =
+        crate::cmd::render::scene_field(&scene, &args.field, args.scene_field.as_ref())?;
     if !(1..=65536).contains(&args.lights) {
         return Err(format!("--lights {} (1 to 65536)", args.lights).into());
     }

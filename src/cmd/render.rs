@@ -211,17 +211,19 @@ fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
             k.env = env.clone();
         }
     }
-    let field = args
-        .field
-        .clone()
-        .or_else(|| scene.field.clone())
-        .ok_or_else(|| {
-            format!(
-                "{}: no field (give field = \"...\" or --field)",
-                args.input.display()
-            )
-        })?;
+    let field = scene_field(&scene, &args.input, args.field.as_ref())?;
     Ok((scene, field))
+}
+
+/// The field a scene file at `path` renders from: `given` (`--field`) or the scene's own.
+pub fn scene_field(scene: &Scene, path: &Path, given: Option<&PathBuf>) -> CliResult<PathBuf> {
+    given.or(scene.field.as_ref()).cloned().ok_or_else(|| {
+        format!(
+            "{}: no field (give field = \"...\" or --field)",
+            path.display()
+        )
+        .into()
+    })
 }
 
 /// The frames of `scene` the arguments ask for, of `size`.
