@@ -46,7 +46,21 @@ struct Frame {
     rows: u32,
     crop_origin: vec2<u32>,
     crop_size: vec2<u32>,
-    pad: vec2<u32>,
+    // Refinements: 1 rays beyond the rows through the proxy, 2 occlusion-aware morphs.
+    flags: u32,
+    pad: u32,
+}
+
+// The pose's geometric proxy: the visual hull's grid (its bits are bound beside it) and
+// the vertical axis of the fallback (`render/src/proxy.rs`).
+struct Proxy {
+    origin: vec3<f32>,
+    voxel: f32,
+    dims: vec3<u32>,
+    // 1 when the pose has a hull.
+    present: u32,
+    axis: vec2<f32>,
+    pad: vec2<f32>,
 }
 
 // sRGB code -> linear, and flow code + 128 -> displacement (unknown -> 0).

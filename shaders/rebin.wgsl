@@ -16,6 +16,9 @@
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
 @group(1) @binding(4) var<storage, read> tables: Tables;
+@group(1) @binding(5) var<storage, read> proxy: Proxy;
+// The hull's occupancy: voxel i at bit i % 32 of word i / 32.
+@group(1) @binding(6) var<storage, read> hull_bits: array<u32>;
 
 fn srgb_value(code: u32) -> f32 {
     return tables.srgb[code / 4u][code % 4u];
@@ -60,6 +63,99 @@ fn intersect(origin: vec3<f32>, dir: vec3<f32>) -> Hit {
         best.clamped = 3u;
     }
     return best;
+}
+
+// Whether hull voxel `c` is occupied; outside the grid is empty.
+fn hull_at(c: vec3<i32>) -> bool {
+    let d = vec3<i32>(proxy.dims);
+    if (any(c < vec3<i32>(0)) || any(c >= d)) {
+        return false;
+    }
+    let index = u32((c.z * d.y + c.y) * d.x + c.x);
+    return ((hull_bits[index / 32u] >> (index % 32u)) & 1u) == 1u;
+}
+
+// Where the ray `origin + t dir` (t >= 0) enters its first occupied hull voxel, or -1:
+// twin of `VoxelHull::first_hit` (3D DDA).
+fn hull_first_hit(origin: vec3<f32>, dir: vec3<f32>) -> f32 {
+    if (proxy.present == 0u) {
+        return -1.0;
+    }
+    let lo = proxy.origin;
+    let hi = lo + vec3<f32>(proxy.dims) * proxy.voxel;
+    var enter = 0.0;
+    var exit = 3.4e38;
+    for (var a = 0; a < 3; a++) {
+        if (dir[a] == 0.0) {
+            if (origin[a] < lo[a] || origin[a] > hi[a]) {
+                return -1.0;
+            }
+            continue;
+        }
+        let t0 = (lo[a] - origin[a]) / dir[a];
+        let t1 = (hi[a] - origin[a]) / dir[a];
+        enter = max(enter, min(t0, t1));
+        exit = min(exit, max(t0, t1));
+    }
+    if (enter > exit) {
+        return -1.0;
+    }
+    let s = proxy.voxel;
+    let dims = vec3<i32>(proxy.dims);
+    let p = origin + dir * enter;
+    var cell = vec3<i32>(0);
+    var t_next = vec3<f32>(3.4e38);
+    var t_delta = vec3<f32>(3.4e38);
+    var step = vec3<i32>(0);
+    for (var a = 0; a < 3; a++) {
+        cell[a] = clamp(i32(floor((p[a] - lo[a]) / s)), 0, dims[a] - 1);
+        if (dir[a] != 0.0) {
+            step[a] = select(-1, 1, dir[a] > 0.0);
+            let boundary = lo[a] + f32(cell[a] + select(0, 1, step[a] > 0)) * s;
+            t_next[a] = (boundary - origin[a]) / dir[a];
+            t_delta[a] = s / abs(dir[a]);
+        }
+    }
+    var t_cell = enter;
+    let steps = dims.x + dims.y + dims.z + 3;
+    for (var i = 0; i < steps; i++) {
+        if (hull_at(cell)) {
+            return t_cell;
+        }
+        var a = 2;
+        if (t_next.x <= t_next.y && t_next.x <= t_next.z) {
+            a = 0;
+        } else if (t_next.y <= t_next.z) {
+            a = 1;
+        }
+        if (t_next[a] > exit) {
+            return -1.0;
+        }
+        t_cell = t_next[a];
+        cell[a] += step[a];
+        t_next[a] += t_delta[a];
+        if (cell[a] < 0 || cell[a] >= dims[a]) {
+            return -1.0;
+        }
+    }
+    return -1.0;
+}
+
+// Where the ray meets the subject as far as the proxy knows (w = 1), or w = 0 for a
+// vertical ray beside the hull: twin of `Proxy::point`.
+fn proxy_point(origin: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
+    let t = hull_first_hit(origin, dir);
+    if (t >= 0.0) {
+        return vec4<f32>(origin + dir * t, 1.0);
+    }
+    let o = origin.xz - proxy.axis;
+    let d = dir.xz;
+    let dd = dot(d, d);
+    if (dd < 1e-8) {
+        return vec4<f32>(0.0);
+    }
+    let tn = max(-dot(o, d) / dd, 0.0);
+    return vec4<f32>(origin + dir * tn, 1.0);
 }
 
 // Bilinear sample of a pre-lit view at full-image coordinates s (edge repeated).
@@ -127,7 +223,34 @@ const LEFT: u32 = 1u;
 const UP: u32 = 2u;
 const DOWN: u32 = 3u;
 
-// The morph of the quad's views at s (see `render/src/morph.rs` for the derivation).
+fn opposite(dir: u32) -> u32 {
+    return dir ^ 1u;
+}
+
+// The occlusion cue's factor for a squared, fraction-weighted flow inconsistency
+// (twin of `morph::confidence`; sigma 2 px, floor 1e-3).
+fn confidence(err2: f32) -> f32 {
+    return max(exp(-err2 / 4.0), 1e-3);
+}
+
+// The displacement of a source by the flow stored on `view` toward `dir`, a fraction
+// `frac` of it, and (when occlusion-aware) the squared inconsistency of that flow with
+// the flow back from the source `src` (x, y: displacement; z: inconsistency).
+fn displaced(src: u32, view: u32, dir: u32, back: u32, frac: f32, s: vec2<f32>, occlusion: bool) -> vec3<f32> {
+    if (frac == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let f = sample_flow(view, dir, s);
+    var err2 = 0.0;
+    if (occlusion) {
+        let e = frac * (f + sample_flow(src, back, s + f));
+        err2 = dot(e, e);
+    }
+    return vec3<f32>(frac * f, err2);
+}
+
+// The morph of the quad's views at s (see `render/src/morph.rs` for the derivation and
+// the occlusion cue).
 fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     let q = quad_views(hit, frame.columns, frame.rows);
     let beta = hit.beta;
@@ -135,6 +258,7 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     let b = 1.0 - beta;
     let g = 1.0 - gamma;
     let w = bilinear_weights(beta, gamma);
+    let occlusion = (frame.flags & 2u) != 0u;
     var out = vec4<f32>(0.0);
     switch frame.variant {
         case 0u: {
@@ -154,29 +278,49 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
                 }
             }
         }
-        case 2u: {
-            var p = q.x;
-            var r = q.y;
-            if (gamma >= 0.5) {
-                p = q.z;
-                r = q.w;
-            }
-            let fp = sample_flow(r, LEFT, s);
-            let fr = sample_flow(p, RIGHT, s);
-            out += sample_prelit(p, s + beta * fp) * b;
-            out += sample_prelit(r, s + b * fr) * beta;
-        }
         default: {
-            let disp = array<vec2<f32>, 4>(
-                beta * sample_flow(q.y, LEFT, s) + gamma * sample_flow(q.z, DOWN, s),
-                b * sample_flow(q.x, RIGHT, s) + gamma * sample_flow(q.w, DOWN, s),
-                beta * sample_flow(q.w, LEFT, s) + g * sample_flow(q.x, UP, s),
-                b * sample_flow(q.z, RIGHT, s) + g * sample_flow(q.y, UP, s),
+            // Per source: its view, weight, and its two flows (stored on, toward, back
+            // toward, fraction); the two-way morph uses the nearer row's two sources.
+            var src = q;
+            var weight = w;
+            var flow_view = array<vec2<u32>, 4>(
+                vec2<u32>(q.y, q.z), vec2<u32>(q.x, q.w), vec2<u32>(q.w, q.x), vec2<u32>(q.z, q.y),
             );
-            for (var i = 0u; i < 4u; i++) {
-                if (w[i] > 0.0) {
-                    out += sample_prelit(q[i], s + disp[i]) * w[i];
+            let toward = array<vec2<u32>, 4>(
+                vec2<u32>(LEFT, DOWN), vec2<u32>(RIGHT, DOWN), vec2<u32>(LEFT, UP), vec2<u32>(RIGHT, UP),
+            );
+            var frac = array<vec2<f32>, 4>(
+                vec2<f32>(beta, gamma), vec2<f32>(b, gamma), vec2<f32>(beta, g), vec2<f32>(b, g),
+            );
+            if (frame.variant == 2u) {
+                var p = q.x;
+                var r = q.y;
+                if (gamma >= 0.5) {
+                    p = q.z;
+                    r = q.w;
                 }
+                src = vec4<u32>(p, r, p, r);
+                weight = vec4<f32>(b, beta, 0.0, 0.0);
+                flow_view[0] = vec2<u32>(r, p);
+                flow_view[1] = vec2<u32>(p, p);
+                frac[0] = vec2<f32>(beta, 0.0);
+                frac[1] = vec2<f32>(b, 0.0);
+            }
+            var total = 0.0;
+            for (var i = 0u; i < 4u; i++) {
+                if (weight[i] > 0.0) {
+                    let d0 = displaced(src[i], flow_view[i].x, toward[i].x, opposite(toward[i].x), frac[i].x, s, occlusion);
+                    let d1 = displaced(src[i], flow_view[i].y, toward[i].y, opposite(toward[i].y), frac[i].y, s, occlusion);
+                    var wi = weight[i];
+                    if (occlusion) {
+                        wi *= confidence(d0.z + d1.z);
+                    }
+                    out += sample_prelit(src[i], s + (d0.xy + d1.xy)) * wi;
+                    total += wi;
+                }
+            }
+            if (occlusion && total > 0.0) {
+                out /= total;
             }
         }
     }
@@ -205,9 +349,21 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
         quat += qi * w[i];
         intr += views[q[i]].intrinsics * w[i];
     }
+    // Clamped to a row: the ray's point on the proxy, seen from the camera on the row.
+    var ray = dir;
+    if ((frame.flags & 1u) != 0u && hit.clamped != 0u) {
+        let point = proxy_point(frame.centre.xyz, dir);
+        if (point.w > 0.0) {
+            var centre = vec3<f32>(0.0);
+            for (var i = 0u; i < 4u; i++) {
+                centre += views[q[i]].centre * w[i];
+            }
+            ray = point.xyz - centre;
+        }
+    }
     let axes = quat_to_axes(quat * (1.0 / length(quat)));
-    let dcam = vec3<f32>(dot(axes[0], dir), dot(axes[1], dir), dot(axes[2], dir));
-    if (dcam.z <= 1e-6) {
+    let dcam = vec3<f32>(dot(axes[0], ray), dot(axes[1], ray), dot(axes[2], ray));
+    if (dcam.z <= 1e-6 * length(ray)) {
         atomicAdd(&stats[3], 1u);
         return vec4<f32>(0.0);
     }

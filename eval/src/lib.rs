@@ -9,6 +9,8 @@
 //!   [`frf_ingest::pipeline::ingest`]);
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
+//! - [`paths`]: the suite of camera paths people render (inside, near, outside, above and
+//!   below the grid of cameras);
 //! - [`scene`]: the relit shadow, composites and matte edges against the truth;
 //! - [`shot`]: the frames of a scene's shot against their true composites;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
@@ -20,6 +22,7 @@ pub mod error;
 pub mod ingest;
 pub mod metrics;
 pub mod oracle;
+pub mod paths;
 pub mod ring;
 pub mod scene;
 pub mod shot;

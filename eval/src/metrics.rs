@@ -256,6 +256,36 @@ pub fn alpha_iou(reference: &GrayImage, test: &GrayImage) -> f64 {
     }
 }
 
+/// Columns of subject a pair of rows needs for [`max_row_jump`] to count it.
+const ROW_JUMP_MIN_COLUMNS: usize = 3;
+
+/// The largest jump between neighbouring rows of a frame's subject: per pair of rows,
+/// the mean over the columns where both rows' alpha is at least ½ of the largest
+/// absolute difference of their premultiplied RGBA channels; the largest over the pairs
+/// with at least three such columns. A seam across the subject (a tear where the image
+/// above a row comes from elsewhere than the image below it) is a jump far larger than
+/// the true image's between any two of its rows; the true image sets the scale.
+pub fn max_row_jump(img: &Image<Rgba>) -> f64 {
+    let (w, h) = (img.width(), img.height());
+    let mut worst = 0.0f64;
+    for y in 1..h {
+        let (mut sum, mut n) = (0.0f64, 0usize);
+        for x in 0..w {
+            let (a, b) = (img.get(x, y - 1), img.get(x, y));
+            if a[3] < 0.5 || b[3] < 0.5 {
+                continue;
+            }
+            let d = (0..4).map(|c| (a[c] - b[c]).abs()).fold(0.0f32, f32::max);
+            sum += d as f64;
+            n += 1;
+        }
+        if n >= ROW_JUMP_MIN_COLUMNS {
+            worst = worst.max(sum / n as f64);
+        }
+    }
+    worst
+}
+
 /// The alpha channel of an RGBA image.
 pub fn alpha_of(img: &Image<Rgba>) -> GrayImage {
     img.map(|p| p[3])

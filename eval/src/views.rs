@@ -17,6 +17,7 @@ use frf_core::camera::Camera;
 use frf_core::image::{Image, Rgba};
 use frf_core::io::rgba_from;
 use frf_core::light::DirLight;
+use frf_render::cpu::FrameStats;
 use frf_render::cylinder::interpolate_camera;
 use frf_render::geometry::PoseGeometry;
 use frf_render::morph::Variant;
@@ -25,7 +26,7 @@ use frf_stage::Stage;
 use serde::Serialize;
 
 use crate::error::{EvalError, Result};
-use crate::metrics::{alpha_mae, alpha_of, psnr, ssim, subject_mask};
+use crate::metrics::{alpha_mae, alpha_of, max_row_jump, psnr, ssim, subject_mask};
 
 /// The scores of one frame.
 #[derive(Debug, Clone, Serialize)]
@@ -42,6 +43,10 @@ pub struct FrameScore {
     pub ssim_frame: f64,
     /// Mean absolute alpha error over the frame.
     pub alpha_mae: f64,
+    /// Share of the frame's pixels whose rays passed above or below the grid's rows.
+    pub clamped_share: f64,
+    /// The largest jump between neighbouring rows of the subject ([`max_row_jump`]).
+    pub max_row_jump: f64,
     /// Seconds to render the frame (after a warm-up frame).
     pub seconds: f64,
 }
@@ -61,6 +66,8 @@ pub struct VariantScore {
     pub ssim_frame: f64,
     /// Mean alpha error.
     pub alpha_mae: f64,
+    /// Mean share of pixels clamped to a row.
+    pub clamped_share: f64,
     /// Mean seconds per frame.
     pub seconds_per_frame: f64,
     /// Each frame.
@@ -147,9 +154,16 @@ pub fn truth_frame(
     Ok(rgba_from(&t.color, &t.alpha)?)
 }
 
-/// Scores `test` against `truth`.
-pub fn score(camera: &str, truth: &Image<Rgba>, test: &Image<Rgba>, seconds: f64) -> FrameScore {
+/// Scores `test` against `truth`; `stats` says how its pixels were re-binned.
+pub fn score(
+    camera: &str,
+    truth: &Image<Rgba>,
+    test: &Image<Rgba>,
+    stats: &FrameStats,
+    seconds: f64,
+) -> FrameScore {
     let mask = subject_mask(truth, test);
+    let pixels = (test.width() * test.height()).max(1) as f64;
     FrameScore {
         camera: camera.to_string(),
         psnr_subject: psnr(truth, test, Some(&mask)),
@@ -157,6 +171,8 @@ pub fn score(camera: &str, truth: &Image<Rgba>, test: &Image<Rgba>, seconds: f64
         psnr_frame: psnr(truth, test, None),
         ssim_frame: ssim(truth, test, None),
         alpha_mae: alpha_mae(&alpha_of(truth), &alpha_of(test)),
+        clamped_share: (stats.clamped_above + stats.clamped_below) as f64 / pixels,
+        max_row_jump: max_row_jump(test),
         seconds,
     }
 }
@@ -187,9 +203,9 @@ pub fn evaluate(
                 .enumerate()
                 .map(|(i, (c, truth))| {
                     let t = Instant::now();
-                    let (img, _) = renderer.render(&c.camera, variant)?;
+                    let (img, stats) = renderer.render(&c.camera, variant)?;
                     let seconds = t.elapsed().as_secs_f64();
-                    let scored = score(&c.name, truth, &img, seconds);
+                    let scored = score(&c.name, truth, &img, &stats, seconds);
                     on_frame(i, variant, &img)?;
                     Ok(scored)
                 })
@@ -203,6 +219,7 @@ pub fn evaluate(
                 psnr_frame: mean(&|f| f.psnr_frame),
                 ssim_frame: mean(&|f| f.ssim_frame),
                 alpha_mae: mean(&|f| f.alpha_mae),
+                clamped_share: mean(&|f| f.clamped_share),
                 seconds_per_frame: mean(&|f| f.seconds),
                 frames,
             })

@@ -209,8 +209,15 @@ impl VoxelHull {
 
     /// Whether the ray `origin + t dir` (`t ≥ 0`) passes through an occupied voxel.
     pub fn blocks(&self, origin: Vec3, dir: Vec3) -> bool {
+        self.first_hit(origin, dir).is_some()
+    }
+
+    /// The parameter `t ≥ 0` at which the ray `origin + t dir` enters its first occupied
+    /// voxel, or `None` when it passes through none (3D DDA; `shaders/proxy.wgsl` is its
+    /// twin).
+    pub fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<f32> {
         if !(dir.is_finite() && origin.is_finite()) || dir == Vec3::ZERO {
-            return false;
+            return None;
         }
         let g = &self.grid;
         let (lo, hi) = (Vec3::from(g.origin), g.max_corner());
@@ -219,7 +226,7 @@ impl VoxelHull {
         for a in 0..3 {
             if dir[a] == 0.0 {
                 if origin[a] < lo[a] || origin[a] > hi[a] {
-                    return false;
+                    return None;
                 }
                 continue;
             }
@@ -228,7 +235,7 @@ impl VoxelHull {
             exit = exit.min(t0.max(t1));
         }
         if enter > exit || enter.is_nan() || exit.is_nan() {
-            return false;
+            return None;
         }
         let s = g.voxel_m;
         let dims = g.dims.map(|n| n as i64);
@@ -245,9 +252,11 @@ impl VoxelHull {
                 t_delta[a] = s / dir[a].abs();
             }
         }
+        // Where the ray entered the current cell.
+        let mut t_cell = enter;
         loop {
             if self.at(cell[0], cell[1], cell[2]) {
-                return true;
+                return Some(t_cell);
             }
             let a = if t_next[0] <= t_next[1] && t_next[0] <= t_next[2] {
                 0
@@ -257,14 +266,24 @@ impl VoxelHull {
                 2
             };
             if t_next[a] > exit {
-                return false;
+                return None;
             }
+            t_cell = t_next[a];
             cell[a] += step[a];
             t_next[a] += t_delta[a];
             if cell[a] < 0 || cell[a] >= dims[a] {
-                return false;
+                return None;
             }
         }
+    }
+
+    /// The occupancy bits as 32-bit words, voxel `index` at bit `index % 32` of word
+    /// `index / 32` (what the GPU reads).
+    pub fn words(&self) -> Vec<u32> {
+        self.bits
+            .iter()
+            .flat_map(|w| [*w as u32, (*w >> 32) as u32])
+            .collect()
     }
 
     /// The stored form: the grid, then the occupancy bits, zstd-compressed.
@@ -474,6 +493,20 @@ mod tests {
         // Axis-parallel rays outside the box, and from inside the box.
         assert!(!hull.blocks(Vec3::new(5.0, 1.0, 0.0), Vec3::Z));
         assert!(hull.blocks(Vec3::new(0.0, 1.0, 0.0), Vec3::X));
+        // The first hit lies on the sphere's surface, to within a voxel: from 2 m away
+        // along +z toward its centre, the sphere (radius 0.3) begins 1.7 m out.
+        let t = hull
+            .first_hit(Vec3::new(0.0, 1.0, 2.0), Vec3::NEG_Z)
+            .unwrap();
+        assert!((t - 1.7).abs() < 0.035, "t {t}");
+        // From inside an occupied voxel, at once.
+        assert_eq!(hull.first_hit(Vec3::new(0.0, 1.0, 0.0), Vec3::X), Some(0.0));
+        assert!(hull.first_hit(Vec3::new(0.0, 1.0, 2.0), Vec3::Z).is_none());
+        // The words hold the same bits.
+        let words = hull.words();
+        for i in 0..hull.grid().len() {
+            assert_eq!(words[i / 32] >> (i % 32) & 1 == 1, hull.occupied(i));
+        }
     }
 
     #[test]

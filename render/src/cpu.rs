@@ -9,7 +9,7 @@ use frf_core::image::{Image, Rgba};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::cylinder::{Clamp, Cylinder, CylinderHit, interpolate_camera};
+use crate::cylinder::{Clamp, Cylinder, CylinderHit, bilinear_weights, interpolate_camera};
 use crate::geometry::PoseGeometry;
 use crate::morph::{Variant, morph, quad_views};
 use crate::resident::ResidentPose;
@@ -47,19 +47,35 @@ impl FrameStats {
     }
 }
 
-/// The pixel of the interpolated camera of `hit` through which the ray with direction
-/// `dir` passes, or `None` if it points behind that camera.
-pub fn source_pixel(geometry: &PoseGeometry, hit: &CylinderHit, dir: Vec3) -> Option<Vec2> {
-    let [a, b, c, d] = quad_views(geometry, hit);
-    let cams = [
-        &geometry.cameras[a],
-        &geometry.cameras[b],
-        &geometry.cameras[c],
-        &geometry.cameras[d],
-    ];
-    let cam = interpolate_camera(cams, hit.beta, hit.gamma, hit.point);
-    let dc = cam.world_from_camera.rotation.transpose() * dir;
-    if dc.z <= 1e-6 {
+/// The pixel of the interpolated camera of `hit` through which the ray `origin + t dir`
+/// passes, or `None` if it points behind that camera.
+///
+/// Inside the grid the camera sits at the hit, on the ray, and the ray's direction says
+/// where it crosses its image. A ray clamped to a row is, with `proxy`, looked up where
+/// its point on the subject ([`crate::proxy::Proxy::point`]) projects into the camera
+/// interpolated on the row itself (docs/design.md section 4.3); without it (or without a
+/// point), along its direction from the hit on the wall.
+pub fn source_pixel(
+    geometry: &PoseGeometry,
+    hit: &CylinderHit,
+    origin: Vec3,
+    dir: Vec3,
+    proxy: bool,
+) -> Option<Vec2> {
+    let views = quad_views(geometry, hit);
+    let cams = views.map(|i| &geometry.cameras[i]);
+    let on_row = (proxy && hit.clamped != Clamp::None)
+        .then(|| geometry.proxy.point(origin, dir))
+        .flatten()
+        .map(|p| {
+            let w = bilinear_weights(hit.beta, hit.gamma);
+            let centre: Vec3 = (0..4).map(|k| cams[k].centre() * w[k]).sum();
+            (p - centre, centre)
+        });
+    let (ray, centre) = on_row.unwrap_or((dir, hit.point));
+    let cam = interpolate_camera(cams, hit.beta, hit.gamma, centre);
+    let dc = cam.world_from_camera.rotation.transpose() * ray;
+    if dc.z <= 1e-6 * ray.length() {
         return None;
     }
     let k = &cam.intrinsics;
@@ -81,7 +97,13 @@ pub fn render_pixel(
     let Some(hit) = cylinder.intersect(camera.centre(), dir) else {
         return ([0.0; 4], None);
     };
-    let Some(s) = source_pixel(&pose.geometry, &hit, dir) else {
+    let Some(s) = source_pixel(
+        &pose.geometry,
+        &hit,
+        camera.centre(),
+        dir,
+        variant.uses_proxy(),
+    ) else {
         return ([0.0; 4], None);
     };
     (morph(pose, &hit, s, variant), Some(hit))

@@ -1,7 +1,7 @@
 //! A pose's geometry as both renderers see it, computed once when the pose is loaded and
 //! shared by its source, its CPU-resident form and its GPU upload: the grid, the crop,
-//! the cameras (subject frame), the cylinder of their centres, and where each stored
-//! flow lives in the flow texture array.
+//! the cameras (subject frame), the cylinder of their centres, the geometric proxy of
+//! the subject ([`Proxy`]), and where each stored flow lives in the flow texture array.
 //!
 //! - **Crop.** Everything is cropped to the union of the views' mattes (grown by
 //!   [`CROP_MARGIN_PX`], beyond the flows' margin): outside it every view is transparent
@@ -13,6 +13,7 @@ use frf_core::image::GrayImage;
 use glam::Vec3;
 
 use crate::cylinder::Cylinder;
+use crate::proxy::Proxy;
 use crate::gpu::types::{GpuQuad, GpuView};
 
 /// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
@@ -112,6 +113,8 @@ pub struct PoseGeometry {
     pub flow_layers: Vec<[i32; 4]>,
     /// Stored flows (layers of the flow array).
     pub flow_layer_count: usize,
+    /// Where rays beyond the grid's rows meet the subject.
+    pub proxy: Proxy,
 }
 
 impl PoseGeometry {
@@ -154,7 +157,14 @@ impl PoseGeometry {
             cylinder,
             flow_layers,
             flow_layer_count: next as usize,
+            proxy: Proxy::default(),
         }
+    }
+
+    /// The same geometry with `proxy` as its geometric proxy.
+    pub fn with_proxy(mut self, proxy: Proxy) -> Self {
+        self.proxy = proxy;
+        self
     }
 
     /// Views in the grid.
@@ -169,7 +179,7 @@ impl PoseGeometry {
 
     /// Bytes the pose holds where it is rendered, on the GPU or in the CPU's copy (the
     /// same layout): pre-lit RGBA8 texels per view, RG8 flow codes per stored flow (at
-    /// least one layer), the view and quad tables and the decoding tables.
+    /// least one layer), the view and quad tables, the decoding tables and the proxy.
     pub fn resident_bytes(&self) -> u64 {
         let texels = self.crop.texels() as u64;
         let quads = self.cylinder.quads().len() as u64;
@@ -177,5 +187,6 @@ impl PoseGeometry {
             + self.views() as u64 * std::mem::size_of::<GpuView>() as u64
             + quads * std::mem::size_of::<GpuQuad>() as u64
             + TABLE_BYTES
+            + self.proxy.resident_bytes()
     }
 }

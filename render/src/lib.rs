@@ -3,7 +3,8 @@
 //!
 //! - [`geometry`]: a pose's grid, crop, cameras and cylinder, shared by both renderers;
 //! - [`resident`]: a pose made ready to render: pre-lit views, alpha, flow codes, cropped.
-//! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres.
+//! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres;
+//!   [`proxy`]: where rays beyond the grid's rows meet the subject (the visual hull).
 //! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
 //!   nearest-view, linear-blend and two-way interpolations it is measured against.
 //! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin;
@@ -23,6 +24,7 @@ pub mod geometry;
 pub mod gpu;
 pub mod morph;
 pub mod path;
+pub mod proxy;
 pub mod renderer;
 pub mod resident;
 pub mod scene;

@@ -41,7 +41,18 @@ use crate::cylinder::{CylinderHit, bilinear_weights};
 use crate::geometry::PoseGeometry;
 use crate::resident::ResidentPose;
 
-/// Which interpolation between views.
+/// Flow inconsistency, pixels, at which the occlusion-aware morph weighs a source at
+/// `1/e` of its bilinear weight (see [`morph`]).
+pub const OCCLUSION_SIGMA_PX: f32 = 2.0;
+/// The least factor a source's weight is multiplied by: the weights stay defined where
+/// every source is inconsistent.
+pub const OCCLUSION_FLOOR: f32 = 1e-3;
+
+/// Which interpolation between views, and which of the renderer's refinements it uses.
+///
+/// The flowed morphs are occlusion-aware and every variant looks rays beyond the grid's
+/// rows up through the geometric proxy ([`crate::proxy`]); the `FourWay…` ablations
+/// each leave one or both out (`FourWayBaseline` is the four-way renderer before them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
     /// The vertex of the quad with the largest weight, unwarped.
@@ -52,15 +63,41 @@ pub enum Variant {
     TwoWay,
     /// The four-way flowed morph.
     FourWay,
+    /// Ablation: the four-way morph with plain bilinear weights (no occlusion cue).
+    FourWayNoOcclusion,
+    /// Ablation: the four-way morph reading rays beyond the rows along their direction.
+    FourWayNoProxy,
+    /// Ablation: neither (the four-way renderer before both).
+    FourWayBaseline,
+}
+
+/// The interpolations proper: what [`Variant`]s compute before the refinements.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Nearest view.
+    Nearest,
+    /// Linear blend.
+    Linear,
+    /// Two-way morph.
+    TwoWay,
+    /// Four-way morph.
+    FourWay,
 }
 
 impl Variant {
-    /// All, simplest first.
+    /// The interpolations, simplest first.
     pub const ALL: [Variant; 4] = [
         Variant::Nearest,
         Variant::Linear,
         Variant::TwoWay,
         Variant::FourWay,
+    ];
+
+    /// The four-way morph's ablations.
+    pub const ABLATIONS: [Variant; 3] = [
+        Variant::FourWayNoOcclusion,
+        Variant::FourWayNoProxy,
+        Variant::FourWayBaseline,
     ];
 
     /// Name in reports and on the command line.
@@ -70,12 +107,43 @@ impl Variant {
             Variant::Linear => "linear",
             Variant::TwoWay => "twoway",
             Variant::FourWay => "fourway",
+            Variant::FourWayNoOcclusion => "fourway-no-occlusion",
+            Variant::FourWayNoProxy => "fourway-no-proxy",
+            Variant::FourWayBaseline => "fourway-baseline",
         }
     }
 
-    /// Index used by the shaders.
+    /// The interpolation it computes.
+    pub fn kind(self) -> Kind {
+        match self {
+            Variant::Nearest => Kind::Nearest,
+            Variant::Linear => Kind::Linear,
+            Variant::TwoWay => Kind::TwoWay,
+            _ => Kind::FourWay,
+        }
+    }
+
+    /// Whether rays beyond the grid's rows are looked up through the proxy.
+    pub fn uses_proxy(self) -> bool {
+        !matches!(self, Variant::FourWayNoProxy | Variant::FourWayBaseline)
+    }
+
+    /// Whether the flowed morphs weigh sources by the consistency of their flows.
+    pub fn occlusion_aware(self) -> bool {
+        !matches!(
+            self,
+            Variant::FourWayNoOcclusion | Variant::FourWayBaseline
+        )
+    }
+
+    /// Index of the interpolation in the shaders.
     pub fn index(self) -> u32 {
-        self as u32
+        self.kind() as u32
+    }
+
+    /// The refinements as the shaders' flag bits: 1 proxy, 2 occlusion-aware.
+    pub fn flags(self) -> u32 {
+        self.uses_proxy() as u32 | (self.occlusion_aware() as u32) << 1
     }
 }
 
@@ -93,53 +161,125 @@ fn add(acc: &mut [f32; 4], x: [f32; 4], w: f32) {
     }
 }
 
+/// One source of a flowed morph: its view, bilinear weight, and the flows it is
+/// displaced by, each `(stored on view, toward neighbour, fraction)`.
+struct Source {
+    view: usize,
+    weight: f32,
+    flows: [(usize, Neighbour, f32); 2],
+}
+
+/// A flowed morph of `sources` at `s`: each sampled displaced by its flows; weighted by
+/// `weight` times, when `occlusion`, the consistency of those flows (see [`morph`]).
+fn flowed(pose: &ResidentPose, sources: &[Source], s: Vec2, occlusion: bool) -> [f32; 4] {
+    let mut out = [0.0f32; 4];
+    let mut total = 0.0f32;
+    for src in sources.iter().filter(|src| src.weight > 0.0) {
+        let mut disp = Vec2::ZERO;
+        let mut err2 = 0.0f32;
+        for &(view, n, frac) in &src.flows {
+            if frac == 0.0 {
+                continue;
+            }
+            let f = pose.sample_flow(view, n, s);
+            disp += frac * f;
+            if occlusion {
+                let back = pose.sample_flow(src.view, n.opposite(), s + f);
+                err2 += (frac * (f + back)).length_squared();
+            }
+        }
+        let w = src.weight * confidence(err2);
+        add(&mut out, pose.sample_prelit(src.view, s + disp), w);
+        total += w;
+    }
+    if occlusion && total > 0.0 {
+        out.iter_mut().for_each(|c| *c /= total);
+    }
+    out
+}
+
+/// The occlusion cue's factor for a squared, fraction-weighted flow inconsistency.
+pub fn confidence(err2: f32) -> f32 {
+    (-err2 / (OCCLUSION_SIGMA_PX * OCCLUSION_SIGMA_PX))
+        .exp()
+        .max(OCCLUSION_FLOOR)
+}
+
 /// The interpolated premultiplied RGBA at output pixel coordinates `s` inside the quad
 /// of `hit`.
+///
+/// **Occlusion.** Where a limb hides another in one view of the quad, the flow stored on
+/// the view that sees the hidden part points at the limb in front in the other: the
+/// morph samples the wrong surface there and leaves a faint copy (a ghost). The
+/// occlusion-aware variants weigh each source by how well the flows it is displaced by
+/// agree with the flows back: for a displacement `F_{X→Y}(s)` into source `Y`, the
+/// inconsistency `e = |F_{X→Y}(s) + F_{Y→X}(s + F_{X→Y}(s))|` is zero where the point is
+/// seen by both and large where `Y` does not see it; scaled by the fraction of the flow
+/// used, the source's weight is multiplied by `exp(−Σ (fraction e)² / σ²)`
+/// ([`OCCLUSION_SIGMA_PX`]) and the weights renormalized. At a vertex, and wherever the
+/// flows agree, this is the plain morph.
 pub fn morph(pose: &ResidentPose, hit: &CylinderHit, s: Vec2, variant: Variant) -> [f32; 4] {
     let [a, b_, c, d] = quad_views(&pose.geometry, hit);
     let (beta, gamma) = (hit.beta, hit.gamma);
     let (b, g) = (1.0 - beta, 1.0 - gamma);
     let w = bilinear_weights(beta, gamma);
     let views = [a, b_, c, d];
+    let occlusion = variant.occlusion_aware();
     let mut out = [0.0f32; 4];
-    match variant {
-        Variant::Nearest => {
+    match variant.kind() {
+        Kind::Nearest => {
             let k = (0..4).max_by(|&i, &j| w[i].total_cmp(&w[j])).unwrap_or(0);
             out = pose.sample_prelit(views[k], s);
         }
-        Variant::Linear => {
+        Kind::Linear => {
             for k in 0..4 {
                 if w[k] > 0.0 {
                     add(&mut out, pose.sample_prelit(views[k], s), w[k]);
                 }
             }
         }
-        Variant::TwoWay => {
+        Kind::TwoWay => {
             let (p, q) = if gamma < 0.5 { (a, b_) } else { (c, d) };
-            let fp = pose.sample_flow(q, Neighbour::Left, s);
-            let fq = pose.sample_flow(p, Neighbour::Right, s);
-            add(&mut out, pose.sample_prelit(p, s + beta * fp), b);
-            add(&mut out, pose.sample_prelit(q, s + b * fq), beta);
-        }
-        Variant::FourWay => {
-            let f = |view: usize, n: Neighbour| pose.sample_flow(view, n, s);
-            let terms = [
-                (
-                    a,
-                    beta * f(b_, Neighbour::Left) + gamma * f(c, Neighbour::Down),
-                ),
-                (
-                    b_,
-                    b * f(a, Neighbour::Right) + gamma * f(d, Neighbour::Down),
-                ),
-                (c, beta * f(d, Neighbour::Left) + g * f(a, Neighbour::Up)),
-                (d, b * f(c, Neighbour::Right) + g * f(b_, Neighbour::Up)),
+            let none = (p, Neighbour::Up, 0.0);
+            let sources = [
+                Source {
+                    view: p,
+                    weight: b,
+                    flows: [(q, Neighbour::Left, beta), none],
+                },
+                Source {
+                    view: q,
+                    weight: beta,
+                    flows: [(p, Neighbour::Right, b), none],
+                },
             ];
-            for (k, (view, disp)) in terms.into_iter().enumerate() {
-                if w[k] > 0.0 {
-                    add(&mut out, pose.sample_prelit(view, s + disp), w[k]);
-                }
-            }
+            out = flowed(pose, &sources, s, occlusion);
+        }
+        Kind::FourWay => {
+            use Neighbour::{Down, Left, Right, Up};
+            let sources = [
+                Source {
+                    view: a,
+                    weight: w[0],
+                    flows: [(b_, Left, beta), (c, Down, gamma)],
+                },
+                Source {
+                    view: b_,
+                    weight: w[1],
+                    flows: [(a, Right, b), (d, Down, gamma)],
+                },
+                Source {
+                    view: c,
+                    weight: w[2],
+                    flows: [(d, Left, beta), (a, Up, g)],
+                },
+                Source {
+                    view: d,
+                    weight: w[3],
+                    flows: [(c, Right, b), (b_, Up, g)],
+                },
+            ];
+            out = flowed(pose, &sources, s, occlusion);
         }
     }
     out

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
 use crate::geometry::{Crop, PoseGeometry};
+use crate::proxy::Proxy;
 use crate::scene::plan::PosePlan;
 
 /// How the field is lit.
@@ -154,6 +155,12 @@ impl PoseSource {
             .iter()
             .map(|v| v.camera.to_camera().map_err(RenderError::BadParameter))
             .collect::<Result<Vec<_>>>()?;
+        // The hull is the renderer's proxy for rays beyond the grid's rows.
+        let hull = if plan.is_none_or(|p| p.hull) {
+            field.hull(pose)?
+        } else {
+            None
+        };
         let size = (h.width, h.height);
         let alphas: Vec<GrayImage> = (0..views)
             .into_par_iter()
@@ -266,7 +273,8 @@ impl PoseSource {
         let geometry =
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
-            });
+            })
+            .with_proxy(Proxy::new(hull));
         Ok(Self {
             geometry: Arc::new(geometry),
             flows: Arc::new(PoseFlows {

@@ -287,7 +287,7 @@ fn the_source_pixel_of_a_vertex_ray_is_its_own_pixel() {
     ] {
         let dir = cam.ray_direction(pixel);
         let h = cyl.intersect(cam.centre(), dir).unwrap();
-        let s = source_pixel(&p.geometry, &h, dir).unwrap();
+        let s = source_pixel(&p.geometry, &h, cam.centre(), dir, true).unwrap();
         assert!((s - pixel).length() < 1e-2, "{s} vs {pixel}");
         let (px, _) = render_pixel(&p, cyl, &cam, pixel, Variant::Linear);
         assert!(px.iter().all(|c| c.is_finite()));

@@ -9,7 +9,7 @@ use std::mem::{offset_of, size_of};
 
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuComposite, GpuFrame, GpuInstance, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
+    GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -125,8 +125,15 @@ fn pod_structs_match_naga_layouts() {
             rows,
             crop_origin,
             crop_size,
+            flags,
             pad
         ]
+    );
+    check_layout!(
+        &rebin,
+        "Proxy",
+        GpuProxy,
+        [origin, voxel, dims, present, axis, pad]
     );
     let relight = module(&shaders::composed(shaders::RELIGHT), "relight");
     check_layout!(

@@ -80,6 +80,12 @@ pub enum VariantArg {
     Twoway,
     /// Four-way flowed morph.
     Fourway,
+    /// Ablation: four-way without the occlusion cue.
+    FourwayNoOcclusion,
+    /// Ablation: four-way reading rays beyond the grid's rows along their direction.
+    FourwayNoProxy,
+    /// Ablation: four-way with neither refinement (the renderer before them).
+    FourwayBaseline,
 }
 
 impl From<VariantArg> for Variant {
@@ -89,6 +95,9 @@ impl From<VariantArg> for Variant {
             VariantArg::Linear => Variant::Linear,
             VariantArg::Twoway => Variant::TwoWay,
             VariantArg::Fourway => Variant::FourWay,
+            VariantArg::FourwayNoOcclusion => Variant::FourWayNoOcclusion,
+            VariantArg::FourwayNoProxy => Variant::FourWayNoProxy,
+            VariantArg::FourwayBaseline => Variant::FourWayBaseline,
         }
     }
 }

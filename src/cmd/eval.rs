@@ -30,7 +30,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::{GroundArg, LightingArgs, VariantArg, parse_ground};
+use crate::cmd::args::{
+    CameraArgs, GroundArg, LightingArgs, VariantArg, parse_ground, parse_size,
+};
 use crate::cmd::progress::bar;
 use crate::cmd::render::{open_renderer, pose_of};
 
@@ -43,9 +45,22 @@ pub struct EvalArgs {
     /// With a scene: the field to render it from (default: the scene's `field`).
     #[arg(long = "field")]
     pub(crate) scene_field: Option<PathBuf>,
-    /// With a scene: frames scored, spread evenly over the shot.
-    #[arg(long, default_value_t = 4)]
-    pub(crate) frames: usize,
+    /// With a scene: frames scored, spread evenly over the shot (default 4); along a
+    /// path (`--orbit`, `--camera`, `--suite`): frames of each path (default 8).
+    #[arg(long)]
+    pub(crate) frames: Option<usize>,
+    /// Score frames along a camera path against the truth instead of cameras at quad
+    /// centres.
+    #[command(flatten)]
+    pub(crate) path: CameraArgs,
+    /// Score the suite of camera paths people render: inside the cylinder of cameras low
+    /// and high, just inside it, outside it, above the top camera and below the bottom one
+    /// (`frf_eval::paths`).
+    #[arg(long, conflicts_with_all = ["camera", "orbit"])]
+    pub(crate) suite: bool,
+    /// Along a path: frame size `WxH` (default: the field's image size).
+    #[arg(long, value_parser = parse_size)]
+    pub(crate) size: Option<(u32, u32)>,
     /// The capture the field was made from (its stage renders the truth).
     #[arg(long)]
     pub(crate) capture: PathBuf,
@@ -65,7 +80,7 @@ pub struct EvalArgs {
     /// Write each camera's truth and renders as PNGs here (with `--shadows`, also the
     /// relit and the true shadow of the ground patch, seen from above, +x right, +z down).
     #[arg(long)]
-    images: Option<PathBuf>,
+    pub(crate) images: Option<PathBuf>,
     /// Also score the subject in a scene: the relit shadow against the true one over the
     /// ground patch, composites over the environment against true composites, and the
     /// matte edges at the captured views.
@@ -82,6 +97,10 @@ pub(crate) struct CompareArgs {
     /// Variants to compare (default: all four).
     #[arg(long, value_enum, value_delimiter = ',')]
     variants: Vec<VariantArg>,
+    /// Also score the four-way morph's ablations (without the occlusion cue, without
+    /// the proxy, without either).
+    #[arg(long)]
+    ablations: bool,
     /// Render with the CPU reference instead of the GPU.
     #[arg(long)]
     pub(crate) cpu: bool,
@@ -91,12 +110,16 @@ pub(crate) struct CompareArgs {
 }
 
 impl CompareArgs {
-    fn variants(&self) -> Vec<Variant> {
-        if self.variants.is_empty() {
+    pub(crate) fn variants(&self) -> Vec<Variant> {
+        let mut v: Vec<Variant> = if self.variants.is_empty() {
             Variant::ALL.to_vec()
         } else {
             self.variants.iter().map(|&v| v.into()).collect()
+        };
+        if self.ablations {
+            v.extend(Variant::ABLATIONS.iter().filter(|a| !v.contains(a)).collect::<Vec<_>>());
         }
+        v
     }
 }
 
@@ -144,6 +167,9 @@ pub fn run(args: EvalArgs) -> CliResult {
         .into());
     }
     let source = PoseSource::load(&field, pose, &lighting)?;
+    if args.suite || args.path.orbit.is_some() || args.path.camera.is_some() {
+        return crate::cmd::eval_paths::run(&args, &source, &stage, &env);
+    }
     let cameras = between_view_cameras(&source.geometry, args.cameras)?;
     let at_views = grid_view_cameras(&source.geometry, args.cameras)?;
     let lights = environment_lights(&env, args.lights);
@@ -294,26 +320,11 @@ pub fn run(args: EvalArgs) -> CliResult {
         renderer.device()
     );
     eprintln!(
-        "{:<21} {:>13} {:>13} {:>11} {:>11} {:>10} {:>10}",
-        "variant",
-        "PSNR subject",
-        "SSIM subject",
-        "PSNR frame",
-        "SSIM frame",
-        "alpha MAE",
-        "s/frame"
+        "{}",
+        crate::cmd::eval_paths::TABLE_HEADER
     );
     for s in scores.iter().chain([&floor]) {
-        eprintln!(
-            "{:<21} {:>10.2} dB {:>13.4} {:>8.2} dB {:>11.4} {:>10.4} {:>10.4}",
-            s.name,
-            s.psnr_subject,
-            s.ssim_subject,
-            s.psnr_frame,
-            s.ssim_frame,
-            s.alpha_mae,
-            s.seconds_per_frame
-        );
+        eprintln!("{}", crate::cmd::eval_paths::table_row(s));
     }
     if let Some(s) = &scene {
         let f = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));

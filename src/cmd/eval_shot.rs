@@ -54,7 +54,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let h = field.header();
     let size = scene.size.unwrap_or((h.width, h.height));
     let total = scene.frame_times().len();
-    let frames: Vec<ShotFrame> = spread_frames(total, args.frames)
+    let frames: Vec<ShotFrame> = spread_frames(total, args.frames.unwrap_or(4))
         .into_iter()
         .map(|i| Ok(scene.shot_frames(i..i + 1, size)?[0]))
         .collect::<CliResult<_>>()?;

@@ -2,6 +2,7 @@
 
 pub mod args;
 pub mod eval;
+pub mod eval_paths;
 pub mod eval_shot;
 pub mod flow;
 pub mod for_scene;

@@ -225,6 +225,9 @@ impl Gpu {
         let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
         let tables = buffer("tables", &table_bytes(&[srgb_lut(), source.flows.table]));
+        let (proxy, hull_words) = geometry.proxy.gpu();
+        let proxy_buffer = buffer("proxy", bytemuck::bytes_of(&proxy));
+        let hull_buffer = buffer("hull", bytemuck::cast_slice(&hull_words));
         let view_of = |t: &wgpu::Texture| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -254,6 +257,14 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: tables.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: proxy_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: hull_buffer.as_entire_binding(),
                 },
             ],
         });

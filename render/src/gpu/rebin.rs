@@ -46,6 +46,8 @@ impl RebinPass {
                 storage(2, true, f),
                 storage(3, true, f),
                 storage(4, true, f),
+                storage(5, true, f),
+                storage(6, true, f),
             ],
         });
         let pipeline = full_screen_pipeline(
@@ -90,7 +92,8 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         rows: 1,
         crop_origin: [0, 0],
         crop_size: [1, 1],
-        pad: [0; 2],
+        flags: variant.flags(),
+        pad: 0,
     };
     if let Some(pose) = pose {
         f.quad_count = pose.quad_count;

@@ -73,8 +73,28 @@ pub struct GpuFrame {
     pub crop_origin: [u32; 2],
     /// Crop size.
     pub crop_size: [u32; 2],
+    /// [`crate::morph::Variant::flags`].
+    pub flags: u32,
     /// Padding to 16 bytes.
-    pub pad: [u32; 2],
+    pub pad: u32,
+}
+
+/// `Proxy` of `shaders/common.wgsl`: the pose's geometric proxy ([`crate::proxy`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuProxy {
+    /// The hull grid's lowest corner.
+    pub origin: [f32; 3],
+    /// Voxel side, metres.
+    pub voxel: f32,
+    /// Voxels along x, y, z.
+    pub dims: [u32; 3],
+    /// 1 when the pose has a hull.
+    pub present: u32,
+    /// `(x, z)` of the fallback's vertical axis.
+    pub axis: [f32; 2],
+    /// Padding to 16 bytes.
+    pub pad: [f32; 2],
 }
 
 /// `RelightParams` of `shaders/relight.wgsl`.

@@ -14,8 +14,9 @@
 //!   sphere stays in its band of elevations; so it is left out when every environment of
 //!   the scene is black over that band (e.g. the floor conditions under a black lower
 //!   hemisphere), or when the scene's intensity is zero throughout.
-//! - **Shadows**: the maps (or the hull, for traced shadows) only when the scene asks for
-//!   a shadow and some ray meets the ground patch.
+//! - **Shadows**: the maps only when the scene asks for a shadow and some ray meets the
+//!   ground patch. The visual hull (a few kilobytes) is always read when the field holds
+//!   it: it is the renderer's proxy for rays beyond the grid's rows, and traced shadows'.
 //!
 //! The plan is conservative: no frame may need something it left out (a test renders
 //! scenes with and without the plan and compares the frames).
@@ -394,7 +395,8 @@ impl Plan {
         let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;
         for p in &mut poses {
             p.shadow_maps = wants_shadow && scene.shadow == ShadowSpec::Maps && h.shadows.is_some();
-            p.hull = wants_shadow && scene.shadow == ShadowSpec::Traced && h.hulls.is_some();
+            // The hull is the proxy of rays beyond the grid's rows, and traced shadows'.
+            p.hull = h.hulls.is_some();
         }
         poses.sort_by_key(|p| p.pose);
 

@@ -1,0 +1,163 @@
+//! The geometric proxy of a pose (docs/design.md section 4.3): where a ray that leaves the
+//! grid's rows meets the subject, so that it can be looked up in the row it is clamped to.
+//!
+//! Inside the grid the camera interpolated at the ray's hit on the cylinder lies on the
+//! ray, and the ray's direction alone says where it passes through that camera's image.
+//! Above the top row or below the bottom one, the ray is clamped to the row: the row's
+//! camera no longer lies on the ray, and reading its image along the ray's direction (as
+//! if the camera had been carried up the wall to the ray) tears the image at the row's
+//! edge (the head shifted against the body, for a camera inside the cylinder looking
+//! up). Instead the point where the ray meets the subject is found on the proxy and
+//! projected into the row's camera. At the row's edge the camera is on the ray again and
+//! both readings agree, so the image continues without a seam; beyond it, the lookup is
+//! right to the accuracy of the proxy.
+//!
+//! - **The visual hull** when the field holds one: the ray's first occupied voxel in front
+//!   of the virtual camera ([`VoxelHull::first_hit`]; the hull contains the subject, so its
+//!   surface is at most a voxel or two in front of it).
+//! - **Otherwise** (no hull, or a ray passing beside it): the point of the ray nearest the
+//!   vertical axis through the hull's box (the subject frame's axis without a hull), in
+//!   front of the camera; such rays mostly see nothing of the subject, and the point
+//!   keeps their lookup near the subject's depth.
+//!
+//! `proxy_point` in `shaders/rebin.wgsl` is the GPU twin.
+
+use std::sync::Arc;
+
+use frf_reflectance::hull::VoxelHull;
+use bytemuck::Zeroable;
+use glam::{Vec2, Vec3};
+
+use crate::gpu::types::GpuProxy;
+
+/// Below this squared horizontal length a ray is treated as vertical: it has no nearest
+/// point to a vertical axis.
+const VERTICAL_EPS: f32 = 1e-8;
+
+/// A pose's geometric proxy (see the module docs).
+#[derive(Debug, Clone, Default)]
+pub struct Proxy {
+    hull: Option<Arc<VoxelHull>>,
+    /// `(x, z)` of the vertical axis of the fallback.
+    axis: Vec2,
+}
+
+impl Proxy {
+    /// The proxy of a pose with `hull` (none: the subject frame's vertical axis alone).
+    pub fn new(hull: Option<VoxelHull>) -> Self {
+        let axis = hull
+            .as_ref()
+            .and_then(|h| h.bounds())
+            .map_or(Vec2::ZERO, |(lo, hi)| {
+                let c = 0.5 * (lo + hi);
+                Vec2::new(c.x, c.z)
+            });
+        Self {
+            hull: hull.map(Arc::new),
+            axis,
+        }
+    }
+
+    /// The visual hull, if there is one.
+    pub fn hull(&self) -> Option<&VoxelHull> {
+        self.hull.as_deref()
+    }
+
+    /// `(x, z)` of the fallback's vertical axis.
+    pub fn axis(&self) -> Vec2 {
+        self.axis
+    }
+
+    /// The proxy as the GPU reads it: its description and the hull's occupancy words
+    /// (one empty word without a hull: a binding is never empty).
+    pub fn gpu(&self) -> (GpuProxy, Vec<u32>) {
+        let (info, words) = match self.hull.as_deref() {
+            Some(h) => {
+                let g = h.grid();
+                (
+                    GpuProxy {
+                        origin: g.origin,
+                        voxel: g.voxel_m,
+                        dims: g.dims,
+                        present: 1,
+                        ..Zeroable::zeroed()
+                    },
+                    h.words(),
+                )
+            }
+            None => (GpuProxy::zeroed(), vec![0]),
+        };
+        (
+            GpuProxy {
+                axis: self.axis.to_array(),
+                ..info
+            },
+            words,
+        )
+    }
+
+    /// Bytes the proxy holds where it is rendered.
+    pub fn resident_bytes(&self) -> u64 {
+        let words = self
+            .hull
+            .as_deref()
+            .map_or(1, |h| h.grid().len().div_ceil(32).max(1));
+        (4 * words + std::mem::size_of::<GpuProxy>()) as u64
+    }
+
+    /// Where the ray `origin + t dir` (`t ≥ 0`) meets the subject, as far as the proxy
+    /// knows: its first hull voxel, else its point nearest the axis; `None` for a
+    /// vertical ray that misses the hull.
+    pub fn point(&self, origin: Vec3, dir: Vec3) -> Option<Vec3> {
+        if let Some(t) = self.hull.as_ref().and_then(|h| h.first_hit(origin, dir)) {
+            return Some(origin + dir * t);
+        }
+        let o = Vec2::new(origin.x, origin.z) - self.axis;
+        let d = Vec2::new(dir.x, dir.z);
+        let dd = d.length_squared();
+        if dd < VERTICAL_EPS {
+            return None;
+        }
+        let t = (-o.dot(d) / dd).max(0.0);
+        Some(origin + dir * t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use frf_core::volume::VoxelGrid;
+
+    #[test]
+    fn without_a_hull_the_point_is_nearest_the_axis_and_in_front() {
+        let p = Proxy::new(None);
+        let q = p
+            .point(Vec3::new(0.0, 1.0, 3.0), Vec3::new(0.0, 0.6, -0.8))
+            .unwrap();
+        assert!((q - Vec3::new(0.0, 3.25, 0.0)).length() < 1e-5, "{q}");
+        // Looking away from the axis: the camera's own position.
+        let q = p
+            .point(Vec3::new(0.0, 1.0, 3.0), Vec3::new(0.0, 0.0, 1.0))
+            .unwrap();
+        assert_eq!(q, Vec3::new(0.0, 1.0, 3.0));
+        assert!(p.point(Vec3::new(0.0, 1.0, 3.0), Vec3::Y).is_none());
+    }
+
+    #[test]
+    fn with_a_hull_the_point_is_on_its_surface_and_the_axis_through_its_box() {
+        let grid = VoxelGrid::covering(Vec3::new(0.5, 0.0, 0.5), Vec3::new(1.5, 2.0, 1.5), 0.1)
+            .unwrap();
+        let hull = VoxelHull::full(grid);
+        let p = Proxy::new(Some(hull));
+        assert!((p.axis() - Vec2::new(1.0, 1.0)).length() < 1e-5);
+        let q = p
+            .point(Vec3::new(1.0, 1.0, 4.0), Vec3::NEG_Z)
+            .unwrap();
+        assert!((q - Vec3::new(1.0, 1.0, 1.5)).length() < 1e-4, "{q}");
+        // Beside the box: nearest the box's axis.
+        let q = p
+            .point(Vec3::new(1.0, 3.0, 4.0), Vec3::NEG_Z)
+            .unwrap();
+        assert!((q - Vec3::new(1.0, 3.0, 1.0)).length() < 1e-4, "{q}");
+    }
+}
