@@ -34,18 +34,30 @@ pub struct RingScore {
     pub psnr_per_view: Vec<f64>,
 }
 
-/// The views held out of a ring of `views` views ingested at `stride`: the view halfway
-/// between two kept views (on an open ring, only between kept views).
+/// The views held out of a ring of `views` views ingested at `stride` (kept: every
+/// `stride`-th view from the first): between each two successive kept views (and, when
+/// the ring closes, between the last and the first) that have views between them, the
+/// one halfway (the earlier of two at odd strides). Any number of views and any stride
+/// from 2: an uneven last gap gets its own halfway view.
 pub fn held_out_views(views: usize, stride: usize, wraps: bool) -> Result<Vec<usize>> {
-    if stride < 2 || views / stride < 2 {
+    if stride < 2 || views.div_ceil(stride.max(1)) < 2 {
         return Err(EvalError::BadParameter(format!(
             "stride {stride} over {views} views holds no view out between two kept ones"
         )));
     }
-    Ok((0..views / stride)
-        .map(|j| j * stride + stride / 2)
-        .filter(|&i| wraps || i + stride / 2 < views)
-        .collect())
+    let kept: Vec<usize> = (0..views).step_by(stride).collect();
+    let mut held = Vec::new();
+    for (j, &k) in kept.iter().enumerate() {
+        let next = match kept.get(j + 1) {
+            Some(&n) => n,
+            None if wraps => views,
+            None => break,
+        };
+        if next - k >= 2 {
+            held.push(k + (next - k) / 2);
+        }
+    }
+    Ok(held)
 }
 
 /// Renders each held-out view `held` (indices into `views` and `cameras`, the whole
@@ -103,6 +115,12 @@ mod tests {
         assert_eq!(&held_out_views(48, 4, true).unwrap()[..3], &[2, 6, 10]);
         // An open ring of 10 views at stride 4 keeps 0, 4, 8: 2 and 6 lie between them.
         assert_eq!(held_out_views(10, 4, false).unwrap(), vec![2, 6]);
+        // Any stride, any number of views: odd strides take the earlier middle view, an
+        // uneven closing gap its own.
+        assert_eq!(held_out_views(9, 3, true).unwrap(), vec![1, 4, 7]);
+        assert_eq!(held_out_views(11, 4, true).unwrap(), vec![2, 6, 9]);
+        assert_eq!(held_out_views(11, 4, false).unwrap(), vec![2, 6]);
+        assert_eq!(held_out_views(9, 2, true).unwrap(), vec![1, 3, 5, 7]);
         let e = held_out_views(48, 1, true).unwrap_err().to_string();
         assert!(e.contains("stride 1"), "{e}");
     }

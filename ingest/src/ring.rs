@@ -9,7 +9,10 @@
 //!   the plane of the camera centres, oriented so that most images are upright) through
 //!   the point all cameras look at (least-squares meeting point of their optical axes),
 //!   and the first view at azimuth 0. Views are ordered by azimuth about the axis; the
-//!   grid closes when no gap between azimuths exceeds 2.5 times the median gap.
+//!   grid closes when no gap between azimuths (the one closing the circle included)
+//!   exceeds 2.5 times the median gap; otherwise the ring is an open arc, ordered from
+//!   the view after its widest gap (a 130° arc of a ring is open, however its views are
+//!   listed).
 //! - **Images**: 8-bit sRGB, linearized. **Alpha**: the recipe of the data set's README
 //!   (object brighter than 0.19 against the black background), closed by 3 pixels to fill
 //!   dark shadows on the object, the largest central component kept, blurred by 1 pixel.
@@ -204,33 +207,49 @@ pub fn ring_frame(views: &[RingView]) -> Result<(Rigid, Vec<usize>, bool)> {
     }
     let look = meeting_point(&views.iter().map(|v| v.camera).collect::<Vec<_>>());
     let origin = circle_centre(&centres, mean, axis) + axis * (look - mean).dot(axis);
-    // x and z: the first camera's direction from the axis is +z.
-    let radial = (centres[0] - origin) - axis * (centres[0] - origin).dot(axis);
-    let z = radial.normalize_or_zero();
-    let x = axis.cross(z);
-    let world_to_subject = Mat3::from_cols(x, axis, z).transpose();
-    let subject_from_world = Rigid {
-        rotation: world_to_subject,
-        translation: -(world_to_subject * origin),
+    // x and z: view `first`'s direction from the axis is +z.
+    let frame = |first: usize| {
+        let radial = (centres[first] - origin) - axis * (centres[first] - origin).dot(axis);
+        let z = radial.normalize_or_zero();
+        let x = axis.cross(z);
+        let world_to_subject = Mat3::from_cols(x, axis, z).transpose();
+        Rigid {
+            rotation: world_to_subject,
+            translation: -(world_to_subject * origin),
+        }
     };
-    let mut azimuths: Vec<(f32, usize)> = centres
+    let sorted = |f: &Rigid| {
+        let mut azimuths: Vec<(f32, usize)> = centres
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let p = f.transform_point(*c);
+                (p.x.atan2(p.z).rem_euclid(std::f32::consts::TAU), i)
+            })
+            .collect();
+        azimuths.sort_by(|a, b| a.0.total_cmp(&b.0));
+        azimuths
+    };
+    let azimuths = sorted(&frame(0));
+    let n = azimuths.len();
+    // The gaps between successive azimuths, the last one closing the circle: the ring
+    // is open where one gap exceeds 2.5 times the median gap, and starts after it.
+    let gaps: Vec<f32> = (0..n)
+        .map(|i| (azimuths[(i + 1) % n].0 - azimuths[i].0).rem_euclid(std::f32::consts::TAU))
+        .collect();
+    let mut by_size = gaps.clone();
+    by_size.sort_by(f32::total_cmp);
+    let median = by_size[n / 2];
+    let (widest, &gap) = gaps
         .iter()
         .enumerate()
-        .map(|(i, c)| {
-            let p = subject_from_world.transform_point(*c);
-            (p.x.atan2(p.z).rem_euclid(std::f32::consts::TAU), i)
-        })
-        .collect();
-    azimuths.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut gaps: Vec<f32> = azimuths.windows(2).map(|w| w[1].0 - w[0].0).collect();
-    let closing = azimuths[0].0 + std::f32::consts::TAU - azimuths[azimuths.len() - 1].0;
-    gaps.sort_by(f32::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    Ok((
-        subject_from_world,
-        azimuths.iter().map(|a| a.1).collect(),
-        closing < 2.5 * median,
-    ))
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .ok_or_else(|| IngestError::BadParameter("a ring without views".into()))?;
+    let wraps = gap < 2.5 * median;
+    let start = if wraps { 0 } else { (widest + 1) % n };
+    let order: Vec<usize> = (0..n).map(|k| azimuths[(start + k) % n].1).collect();
+    // The first view of the order at azimuth 0.
+    Ok((frame(order[0]), order, wraps))
 }
 
 /// A photograph: linear RGB (sRGB decoded) and its alpha.
@@ -314,8 +333,8 @@ pub fn ring_views(par: &Path) -> Result<(Vec<RingView>, Vec<Camera>, bool)> {
 }
 
 /// Ingests the ring described by `par` into the field file `out`, keeping every
-/// `stride`-th view in azimuth order (1: all; 2, 4, 6: the views between them are held
-/// out for evaluation, in the subject frame of the whole ring).
+/// `stride`-th view in azimuth order from the first (1: all; 2, 3, 4, ...: the views
+/// between them are held out for evaluation, in the subject frame of the whole ring).
 pub fn ingest_ring(
     par: &Path,
     out: &Path,
@@ -334,7 +353,9 @@ pub fn ingest_ring(
             ),
         ));
     }
-    let wraps = all_wrap && all_views.len() % stride == 0;
+    // The kept views close into a ring when the whole ring does (the gap from the last
+    // kept view to the first is then at most `stride` views).
+    let wraps = all_wrap;
     let views: Vec<&RingView> = all_views.iter().step_by(stride).collect();
     let cameras: Vec<Camera> = all_cameras.iter().step_by(stride).copied().collect();
     let (w, h) = (cameras[0].width, cameras[0].height);
@@ -422,4 +443,52 @@ pub fn ingest_ring(
         coverage,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Views on a circle of radius 2 about the vertical axis through `(0, 1, 0)`, from
+    /// azimuth 0 over `arc_deg` degrees, looking at its centre, listed out of order.
+    fn arc(count: usize, arc_deg: f32, closed: bool) -> Vec<RingView> {
+        let step = if closed {
+            arc_deg / count as f32
+        } else {
+            arc_deg / (count - 1) as f32
+        };
+        let mut views: Vec<RingView> = (0..count)
+            .map(|i| {
+                let a = (i as f32 * step).to_radians();
+                let eye = Vec3::new(2.0 * a.sin(), 1.3, 2.0 * a.cos());
+                RingView {
+                    path: PathBuf::from(format!("view{i}.png")),
+                    camera: Camera::look_at(eye, Vec3::new(0.0, 1.0, 0.0), Vec3::Y, 0.6, 64, 48)
+                        .unwrap(),
+                }
+            })
+            .collect();
+        views.swap(1, count - 2);
+        // Listed from the middle of the arc.
+        views.rotate_left(count / 2);
+        views
+    }
+
+    #[test]
+    fn the_calibration_says_whether_a_ring_closes() {
+        let (_, order, wraps) = ring_frame(&arc(48, 360.0, true)).unwrap();
+        assert!(wraps, "a whole ring closes");
+        assert_eq!(order.len(), 48);
+        // A 130-degree arc of a ring is open, however its views are listed; its views
+        // come out in azimuth order from one end.
+        let views = arc(16, 130.0, false);
+        let (frame, order, wraps) = ring_frame(&views).unwrap();
+        assert!(!wraps, "a 130-degree arc is open");
+        let azimuth = |i: usize| {
+            let p = frame.transform_point(views[order[i]].camera.centre());
+            p.x.atan2(p.z).rem_euclid(std::f32::consts::TAU)
+        };
+        assert!((1..16).all(|i| azimuth(i) > azimuth(i - 1)));
+        assert!(azimuth(15) - azimuth(0) < 131f32.to_radians());
+    }
 }

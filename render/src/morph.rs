@@ -50,9 +50,11 @@ pub const OCCLUSION_FLOOR: f32 = 1e-3;
 
 /// Which interpolation between views, and which of the renderer's refinements it uses.
 ///
-/// The flowed morphs are occlusion-aware and every variant looks rays beyond the grid's
-/// rows up through the geometric proxy ([`crate::proxy`]); the `FourWay…` ablations
-/// each leave one or both out (`FourWayBaseline` is the four-way renderer before them).
+/// Every variant looks rays beyond the grid's rows up through the geometric proxy
+/// ([`crate::proxy`]). The four-way morph's ablations: `FourWayOcclusion` adds the
+/// occlusion cue (measured: no gain on the stage or on real photographs, at twice the
+/// cost on lavapipe; see docs/results/render.md), `FourWayNoProxy` reads rays beyond the
+/// rows along their direction (the renderer before the proxy).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Variant {
     /// The vertex of the quad with the largest weight, unwarped.
@@ -63,12 +65,11 @@ pub enum Variant {
     TwoWay,
     /// The four-way flowed morph.
     FourWay,
-    /// Ablation: the four-way morph with plain bilinear weights (no occlusion cue).
-    FourWayNoOcclusion,
+    /// Ablation: the four-way morph weighing its sources by the consistency of their
+    /// flows (the occlusion cue of [`morph`]).
+    FourWayOcclusion,
     /// Ablation: the four-way morph reading rays beyond the rows along their direction.
     FourWayNoProxy,
-    /// Ablation: neither (the four-way renderer before both).
-    FourWayBaseline,
 }
 
 /// The interpolations proper: what [`Variant`]s compute before the refinements.
@@ -94,11 +95,7 @@ impl Variant {
     ];
 
     /// The four-way morph's ablations.
-    pub const ABLATIONS: [Variant; 3] = [
-        Variant::FourWayNoOcclusion,
-        Variant::FourWayNoProxy,
-        Variant::FourWayBaseline,
-    ];
+    pub const ABLATIONS: [Variant; 2] = [Variant::FourWayOcclusion, Variant::FourWayNoProxy];
 
     /// Name in reports and on the command line.
     pub fn name(self) -> &'static str {
@@ -107,9 +104,8 @@ impl Variant {
             Variant::Linear => "linear",
             Variant::TwoWay => "twoway",
             Variant::FourWay => "fourway",
-            Variant::FourWayNoOcclusion => "fourway-no-occlusion",
+            Variant::FourWayOcclusion => "fourway-occlusion",
             Variant::FourWayNoProxy => "fourway-no-proxy",
-            Variant::FourWayBaseline => "fourway-baseline",
         }
     }
 
@@ -125,15 +121,12 @@ impl Variant {
 
     /// Whether rays beyond the grid's rows are looked up through the proxy.
     pub fn uses_proxy(self) -> bool {
-        !matches!(self, Variant::FourWayNoProxy | Variant::FourWayBaseline)
+        self != Variant::FourWayNoProxy
     }
 
-    /// Whether the flowed morphs weigh sources by the consistency of their flows.
+    /// Whether the morph weighs its sources by the consistency of their flows.
     pub fn occlusion_aware(self) -> bool {
-        !matches!(
-            self,
-            Variant::FourWayNoOcclusion | Variant::FourWayBaseline
-        )
+        self == Variant::FourWayOcclusion
     }
 
     /// Index of the interpolation in the shaders.
@@ -211,7 +204,7 @@ pub fn confidence(err2: f32) -> f32 {
 /// **Occlusion.** Where a limb hides another in one view of the quad, the flow stored on
 /// the view that sees the hidden part points at the limb in front in the other: the
 /// morph samples the wrong surface there and leaves a faint copy (a ghost). The
-/// occlusion-aware variants weigh each source by how well the flows it is displaced by
+/// occlusion-aware variant weighs each source by how well the flows it is displaced by
 /// agree with the flows back: for a displacement `F_{X→Y}(s)` into source `Y`, the
 /// inconsistency `e = |F_{X→Y}(s) + F_{Y→X}(s + F_{X→Y}(s))|` is zero where the point is
 /// seen by both and large where `Y` does not see it; scaled by the fraction of the flow

@@ -80,12 +80,10 @@ pub enum VariantArg {
     Twoway,
     /// Four-way flowed morph.
     Fourway,
-    /// Ablation: four-way without the occlusion cue.
-    FourwayNoOcclusion,
+    /// Ablation: four-way weighing its sources by the consistency of their flows.
+    FourwayOcclusion,
     /// Ablation: four-way reading rays beyond the grid's rows along their direction.
     FourwayNoProxy,
-    /// Ablation: four-way with neither refinement (the renderer before them).
-    FourwayBaseline,
 }
 
 impl From<VariantArg> for Variant {
@@ -95,9 +93,8 @@ impl From<VariantArg> for Variant {
             VariantArg::Linear => Variant::Linear,
             VariantArg::Twoway => Variant::TwoWay,
             VariantArg::Fourway => Variant::FourWay,
-            VariantArg::FourwayNoOcclusion => Variant::FourWayNoOcclusion,
+            VariantArg::FourwayOcclusion => Variant::FourWayOcclusion,
             VariantArg::FourwayNoProxy => Variant::FourWayNoProxy,
-            VariantArg::FourwayBaseline => Variant::FourWayBaseline,
         }
     }
 }

@@ -97,8 +97,8 @@ pub(crate) struct CompareArgs {
     /// Variants to compare (default: all four).
     #[arg(long, value_enum, value_delimiter = ',')]
     variants: Vec<VariantArg>,
-    /// Also score the four-way morph's ablations (without the occlusion cue, without
-    /// the proxy, without either).
+    /// Also score the four-way morph's ablations (with the occlusion cue; without the
+    /// proxy for rays beyond the grid's rows).
     #[arg(long)]
     ablations: bool,
     /// Render with the CPU reference instead of the GPU.
@@ -369,7 +369,8 @@ pub struct RingEvalArgs {
     #[arg(long)]
     par: PathBuf,
     /// The stride the field was ingested with: the view halfway between two kept views
-    /// is rendered (2: view i from i±1; 4: from i±2; 6: from i±3).
+    /// is rendered (2: view i from i±1; 4: from i±2; 3: view i+1 from i and i+3); any
+    /// stride from 2 and any number of views.
     #[arg(long)]
     stride: usize,
     #[command(flatten)]
@@ -379,9 +380,10 @@ pub struct RingEvalArgs {
 /// Runs `frf eval-ring`.
 pub fn run_ring(args: RingEvalArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
-    let (views, cameras, wraps) = frf_ingest::ring::ring_views(&args.par)?;
+    let (views, cameras, _) = frf_ingest::ring::ring_views(&args.par)?;
     let s = args.stride;
-    if s < 2 || views.len() / s != field.header().columns {
+    let wraps = field.header().wraps;
+    if s < 2 || views.len().div_ceil(s) != field.header().columns {
         return Err(format!(
             "{}: {} views do not come from {} views at stride {s}",
             args.field.display(),
@@ -395,11 +397,16 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
     let renderer = open_renderer(&source, args.compare.cpu)?;
     let scores = score_held_out(&renderer, &views, &cameras, &held, &args.compare.variants())?;
     eprintln!(
-        "{}: {} held-out views, each rendered from views {} apart ({} each side), {}:",
+        "{}: {} held-out views, each rendered from the kept views either side ({} apart, \
+         the last gap {}), {}:",
         args.field.display(),
         held.len(),
         s,
-        s / 2,
+        if wraps {
+            format!("{} apart", views.len() - (views.len() - 1) / s * s)
+        } else {
+            "open".into()
+        },
         renderer.device()
     );
     eprintln!(
