@@ -141,9 +141,12 @@ fn hull_first_hit(origin: vec3<f32>, dir: vec3<f32>) -> f32 {
     return -1.0;
 }
 
-// Where the ray meets the subject as far as the proxy knows (w = 1), or w = 0 for a
-// vertical ray beside the hull: twin of `Proxy::point`.
+// Where the ray meets the subject as far as the proxy knows (w = 1), or w = 0 without a
+// hull and for a vertical ray beside it: twin of `Proxy::point`.
 fn proxy_point(origin: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
+    if (proxy.present == 0u) {
+        return vec4<f32>(0.0);
+    }
     let t = hull_first_hit(origin, dir);
     if (t >= 0.0) {
         return vec4<f32>(origin + dir * t, 1.0);

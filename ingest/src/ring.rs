@@ -8,7 +8,7 @@
 //! - **Frame**: the field's subject frame puts the ring's axis on `+y` (the normal of
 //!   the plane of the camera centres, oriented so that most images are upright) through
 //!   the point all cameras look at (least-squares meeting point of their optical axes),
-//!   and the first view at azimuth 0. Views are ordered by azimuth about the axis; the
+//!   and the first view at azimuth 0 (of an open arc: the view at its end). Views are ordered by azimuth about the axis; the
 //!   grid closes when no gap between azimuths (the one closing the circle included)
 //!   exceeds 2.5 times the median gap; otherwise the ring is an open arc, ordered from
 //!   the view after its widest gap (a 130° arc of a ring is open, however its views are
@@ -248,8 +248,10 @@ pub fn ring_frame(views: &[RingView]) -> Result<(Rigid, Vec<usize>, bool)> {
     let wraps = gap < 2.5 * median;
     let start = if wraps { 0 } else { (widest + 1) % n };
     let order: Vec<usize> = (0..n).map(|k| azimuths[(start + k) % n].1).collect();
-    // The first view of the order at azimuth 0.
-    Ok((frame(order[0]), order, wraps))
+    // A closed ring keeps the first listed view at azimuth 0 (fields ingested before
+    // open arcs were recognised depend on it); an open arc puts its first view there.
+    let first = if wraps { 0 } else { order[0] };
+    Ok((frame(first), order, wraps))
 }
 
 /// A photograph: linear RGB (sRGB decoded) and its alpha.

@@ -13,8 +13,8 @@ use frf_core::image::GrayImage;
 use glam::Vec3;
 
 use crate::cylinder::Cylinder;
-use crate::proxy::Proxy;
 use crate::gpu::types::{GpuQuad, GpuView};
+use crate::proxy::Proxy;
 
 /// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
 pub const CROP_MARGIN_PX: u32 = 4;

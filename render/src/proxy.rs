@@ -12,20 +12,23 @@
 //! both readings agree, so the image continues without a seam; beyond it, the lookup is
 //! right to the accuracy of the proxy.
 //!
-//! - **The visual hull** when the field holds one: the ray's first occupied voxel in front
-//!   of the virtual camera ([`VoxelHull::first_hit`]; the hull contains the subject, so its
-//!   surface is at most a voxel or two in front of it).
-//! - **Otherwise** (no hull, or a ray passing beside it): the point of the ray nearest the
-//!   vertical axis through the hull's box (the subject frame's axis without a hull), in
-//!   front of the camera; such rays mostly see nothing of the subject, and the point
-//!   keeps their lookup near the subject's depth.
+//! - **The visual hull**: the ray's first occupied voxel in front of the virtual camera
+//!   ([`VoxelHull::first_hit`]; the hull contains the subject, so its surface is at most
+//!   a voxel or two in front of it).
+//! - **Beside the hull**: the point of the ray nearest the vertical axis through the
+//!   hull's box, in front of the camera; such rays see little of the subject, and the
+//!   point keeps their lookup near the subject's depth (read along their direction, the
+//!   row's image would show a displaced copy of the subject there).
+//! - **Without a hull** (a ring of photographs, a field ingested without shadows) there
+//!   is no proxy, and clamped rays are read along their direction as before: a guessed
+//!   depth does worse than none (measured on dinoRing, one row: 20.2 against 23.9 dB).
 //!
 //! `proxy_point` in `shaders/rebin.wgsl` is the GPU twin.
 
 use std::sync::Arc;
 
-use frf_reflectance::hull::VoxelHull;
 use bytemuck::Zeroable;
+use frf_reflectance::hull::VoxelHull;
 use glam::{Vec2, Vec3};
 
 use crate::gpu::types::GpuProxy;
@@ -43,7 +46,7 @@ pub struct Proxy {
 }
 
 impl Proxy {
-    /// The proxy of a pose with `hull` (none: the subject frame's vertical axis alone).
+    /// The proxy of a pose with `hull` (none: no proxy).
     pub fn new(hull: Option<VoxelHull>) -> Self {
         let axis = hull
             .as_ref()
@@ -106,10 +109,11 @@ impl Proxy {
     }
 
     /// Where the ray `origin + t dir` (`t ≥ 0`) meets the subject, as far as the proxy
-    /// knows: its first hull voxel, else its point nearest the axis; `None` for a
-    /// vertical ray that misses the hull.
+    /// knows: its first hull voxel, else its point nearest the hull's axis; `None`
+    /// without a hull, and for a vertical ray that misses it.
     pub fn point(&self, origin: Vec3, dir: Vec3) -> Option<Vec3> {
-        if let Some(t) = self.hull.as_ref().and_then(|h| h.first_hit(origin, dir)) {
+        let hull = self.hull.as_ref()?;
+        if let Some(t) = hull.first_hit(origin, dir) {
             return Some(origin + dir * t);
         }
         let o = Vec2::new(origin.x, origin.z) - self.axis;
@@ -129,8 +133,16 @@ mod tests {
     use frf_core::volume::VoxelGrid;
 
     #[test]
-    fn without_a_hull_the_point_is_nearest_the_axis_and_in_front() {
+    fn without_a_hull_there_is_no_point() {
         let p = Proxy::new(None);
+        assert!(p.point(Vec3::new(0.0, 1.0, 3.0), Vec3::NEG_Z).is_none());
+    }
+
+    #[test]
+    fn beside_a_hull_the_point_is_nearest_its_axis_and_in_front() {
+        let grid =
+            VoxelGrid::covering(Vec3::new(-0.1, 0.0, -0.1), Vec3::new(0.1, 0.2, 0.1), 0.1).unwrap();
+        let p = Proxy::new(Some(VoxelHull::full(grid)));
         let q = p
             .point(Vec3::new(0.0, 1.0, 3.0), Vec3::new(0.0, 0.6, -0.8))
             .unwrap();
@@ -145,19 +157,15 @@ mod tests {
 
     #[test]
     fn with_a_hull_the_point_is_on_its_surface_and_the_axis_through_its_box() {
-        let grid = VoxelGrid::covering(Vec3::new(0.5, 0.0, 0.5), Vec3::new(1.5, 2.0, 1.5), 0.1)
-            .unwrap();
+        let grid =
+            VoxelGrid::covering(Vec3::new(0.5, 0.0, 0.5), Vec3::new(1.5, 2.0, 1.5), 0.1).unwrap();
         let hull = VoxelHull::full(grid);
         let p = Proxy::new(Some(hull));
         assert!((p.axis() - Vec2::new(1.0, 1.0)).length() < 1e-5);
-        let q = p
-            .point(Vec3::new(1.0, 1.0, 4.0), Vec3::NEG_Z)
-            .unwrap();
+        let q = p.point(Vec3::new(1.0, 1.0, 4.0), Vec3::NEG_Z).unwrap();
         assert!((q - Vec3::new(1.0, 1.0, 1.5)).length() < 1e-4, "{q}");
         // Beside the box: nearest the box's axis.
-        let q = p
-            .point(Vec3::new(1.0, 3.0, 4.0), Vec3::NEG_Z)
-            .unwrap();
+        let q = p.point(Vec3::new(1.0, 3.0, 4.0), Vec3::NEG_Z).unwrap();
         assert!((q - Vec3::new(1.0, 3.0, 1.0)).length() < 1e-4, "{q}");
     }
 }

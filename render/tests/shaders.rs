@@ -9,7 +9,8 @@ use std::mem::{offset_of, size_of};
 
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams, GpuShadowParams, GpuView,
+    GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams, GpuShadowParams,
+    GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 

@@ -30,9 +30,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::{
-    CameraArgs, GroundArg, LightingArgs, VariantArg, parse_ground, parse_size,
-};
+use crate::cmd::args::{CameraArgs, GroundArg, LightingArgs, VariantArg, parse_ground, parse_size};
 use crate::cmd::progress::bar;
 use crate::cmd::render::{open_renderer, pose_of};
 
@@ -117,7 +115,12 @@ impl CompareArgs {
             self.variants.iter().map(|&v| v.into()).collect()
         };
         if self.ablations {
-            v.extend(Variant::ABLATIONS.iter().filter(|a| !v.contains(a)).collect::<Vec<_>>());
+            v.extend(
+                Variant::ABLATIONS
+                    .iter()
+                    .filter(|a| !v.contains(a))
+                    .collect::<Vec<_>>(),
+            );
         }
         v
     }
@@ -319,10 +322,7 @@ pub fn run(args: EvalArgs) -> CliResult {
         cameras.len(),
         renderer.device()
     );
-    eprintln!(
-        "{}",
-        crate::cmd::eval_paths::TABLE_HEADER
-    );
+    eprintln!("{}", crate::cmd::eval_paths::TABLE_HEADER);
     for s in scores.iter().chain([&floor]) {
         eprintln!("{}", crate::cmd::eval_paths::table_row(s));
     }

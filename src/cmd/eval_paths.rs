@@ -121,14 +121,15 @@ pub fn run(args: &EvalArgs, source: &PoseSource, stage: &Stage, env: &EnvMap) ->
         truth_bar.finish_and_clear();
         let bar = bar(&format!("{}: rendered frames", p.name));
         bar.set_length((cameras.len() * variants.len()) as u64);
-        let variant_scores = evaluate(&renderer, &cameras, &truths, &variants, &mut |i, v, img| {
-            bar.inc(1);
-            if let Some(dir) = &args.images {
-                let name = format!("{}_{i:02}_{}.png", p.name, v.name());
-                frf_core::io::write_png8_srgba(&dir.join(name), img, 1.0)?;
-            }
-            Ok(())
-        })?;
+        let variant_scores =
+            evaluate(&renderer, &cameras, &truths, &variants, &mut |i, v, img| {
+                bar.inc(1);
+                if let Some(dir) = &args.images {
+                    let name = format!("{}_{i:02}_{}.png", p.name, v.name());
+                    frf_core::io::write_png8_srgba(&dir.join(name), img, 1.0)?;
+                }
+                Ok(())
+            })?;
         bar.finish_and_clear();
         if let Some(dir) = &args.images {
             for (i, t) in truths.iter().enumerate() {
@@ -156,7 +157,10 @@ pub fn run(args: &EvalArgs, source: &PoseSource, stage: &Stage, env: &EnvMap) ->
     );
     for p in &scores {
         let jump = p.truth_max_row_jump.iter().cloned().fold(0.0, f64::max);
-        eprintln!("{} ({}; the truth's largest row jump {jump:.3}):", p.name, p.about);
+        eprintln!(
+            "{} ({}; the truth's largest row jump {jump:.3}):",
+            p.name, p.about
+        );
         eprintln!("  {TABLE_HEADER}");
         for s in &p.variants {
             let worst = s.frames.iter().map(|f| f.max_row_jump).fold(0.0, f64::max);
