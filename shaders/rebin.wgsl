@@ -1,32 +1,53 @@
 // The frame pass: for every pixel of the virtual camera, re-bin its ray through the
-// cylinder of camera centres and morph the quad's pre-lit images there. A full-screen
-// triangle; the fragment shader is the twin of `render/src/cpu.rs` (`render_pixel`).
-// Compiled after `common.wgsl`.
+// cylinder of camera centres and morph the quad's pre-lit images there; the twin of
+// `render/src/cpu.rs` (`render_pixel`). Compiled after `common.wgsl` and two sampling
+// snippets of `sample/` (how the pre-lit views and the flows are stored and filtered:
+// `sample_prelit` and `sample_flow_layer`), chosen by `frf_render::gpu::formats`.
 //
+// Entry points: `fs_main` (a full-screen triangle into a colour target), `cs_main` (the
+// same pixels from a compute pass into a storage texture), `cs_classes` (what happened
+// to each pixel's ray, counted per workgroup, then once per workgroup into `stats`).
 // Bind group 0 holds per-frame data, bind group 1 the resident pose.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Pixels inside the grid, clamped above, clamped below, missed.
+// Pixels inside the grid, clamped above, clamped below, missed (`cs_classes` only).
 @group(0) @binding(1) var<storage, read_write> stats: array<atomic<u32>, 4>;
+// The compute pass's target (`cs_main` only).
+@group(0) @binding(2) var target_image: texture_storage_2d<rgba32float, write>;
 
-// Pre-lit views: RGB sRGB codes of colour / scale, alpha code; one layer per view.
-@group(1) @binding(0) var prelit: texture_2d_array<u32>;
-// Flow codes (u, v); one layer per stored flow.
-@group(1) @binding(1) var flows: texture_2d_array<i32>;
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
 @group(1) @binding(4) var<storage, read> tables: Tables;
 @group(1) @binding(5) var<storage, read> proxy: Proxy;
 // The hull's occupancy: voxel i at bit i % 32 of word i / 32.
 @group(1) @binding(6) var<storage, read> hull_bits: array<u32>;
+// Bilinear, clamped to the edge: for the formats the hardware filters.
+@group(1) @binding(8) var bilinear: sampler;
 
-fn srgb_value(code: u32) -> f32 {
-    return tables.srgb[code / 4u][code % 4u];
+// The four texels (in the crop) and weights of a bilinear sample at full-image
+// coordinates s, texel centres at integers, the edge repeated.
+struct CropSample {
+    texel: array<vec2<i32>, 4>,
+    weight: vec4<f32>,
 }
 
-fn flow_value(code: i32) -> f32 {
-    let i = u32(code + 128);
-    return tables.flow[i / 4u][i % 4u];
+fn crop_position(s: vec2<f32>) -> CropSample {
+    let size = vec2<f32>(frame.crop_size);
+    let p = clamp(s - vec2<f32>(frame.crop_origin), vec2<f32>(-1.0), size);
+    let p0 = floor(p);
+    let f = p - p0;
+    let last = vec2<i32>(frame.crop_size) - vec2<i32>(1);
+    let a = clamp(vec2<i32>(p0), vec2<i32>(0), last);
+    let b = clamp(vec2<i32>(p0) + vec2<i32>(1), vec2<i32>(0), last);
+    var out: CropSample;
+    out.texel = array<vec2<i32>, 4>(a, vec2<i32>(b.x, a.y), vec2<i32>(a.x, b.y), b);
+    out.weight = vec4<f32>((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    return out;
+}
+
+// The sampler's coordinates of full-image position s (texel centres at integers).
+fn crop_uv(s: vec2<f32>) -> vec2<f32> {
+    return (s - vec2<f32>(frame.crop_origin) + 0.5) / vec2<f32>(frame.crop_size);
 }
 
 // Where the ray `origin + t dir` enters the cylinder: the smallest parameter of all
@@ -161,64 +182,14 @@ fn proxy_point(origin: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(origin + dir * tn, 1.0);
 }
 
-// Bilinear sample of a pre-lit view at full-image coordinates s (edge repeated).
-fn sample_prelit(view: u32, s: vec2<f32>) -> vec4<f32> {
-    let size = vec2<f32>(frame.crop_size);
-    let x = clamp(s.x - f32(frame.crop_origin.x), -1.0, size.x);
-    let y = clamp(s.y - f32(frame.crop_origin.y), -1.0, size.y);
-    let x0 = floor(x);
-    let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let scale = views[view].scale;
-    let last = vec2<i32>(frame.crop_size) - vec2<i32>(1);
-    var out = vec4<f32>(0.0);
-    for (var dy = 0; dy < 2; dy++) {
-        let wy = select(fy, 1.0 - fy, dy == 0);
-        for (var dx = 0; dx < 2; dx++) {
-            let wx = select(fx, 1.0 - fx, dx == 0);
-            let xi = clamp(i32(x0) + dx, 0, last.x);
-            let yi = clamp(i32(y0) + dy, 0, last.y);
-            let t = textureLoad(prelit, vec2<i32>(xi, yi), i32(view), 0);
-            let wt = wx * wy;
-            out.x += wt * (scale * srgb_value(t.x));
-            out.y += wt * (scale * srgb_value(t.y));
-            out.z += wt * (scale * srgb_value(t.z));
-            out.w += wt * f32(t.w) / 255.0;
-        }
-    }
-    return out;
-}
-
-// Bilinear sample of the flow from a view toward `dir` (0 right, 1 left, 2 up, 3 down),
-// each texel decoded first; unknown texels and absent flows displace by zero.
+// Bilinear sample of the flow from a view toward `dir` (0 right, 1 left, 2 up, 3 down);
+// absent flows displace by zero.
 fn sample_flow(view: u32, dir: u32, s: vec2<f32>) -> vec2<f32> {
     let layer = views[view].flow_layers[dir];
     if (layer < 0) {
         return vec2<f32>(0.0);
     }
-    let size = vec2<f32>(frame.crop_size);
-    let x = clamp(s.x - f32(frame.crop_origin.x), -1.0, size.x);
-    let y = clamp(s.y - f32(frame.crop_origin.y), -1.0, size.y);
-    let x0 = floor(x);
-    let y0 = floor(y);
-    let fx = x - x0;
-    let fy = y - y0;
-    let last = vec2<i32>(frame.crop_size) - vec2<i32>(1);
-    var out = vec2<f32>(0.0);
-    for (var dy = 0; dy < 2; dy++) {
-        let wy = select(fy, 1.0 - fy, dy == 0);
-        for (var dx = 0; dx < 2; dx++) {
-            let wx = select(fx, 1.0 - fx, dx == 0);
-            let xi = clamp(i32(x0) + dx, 0, last.x);
-            let yi = clamp(i32(y0) + dy, 0, last.y);
-            let c = textureLoad(flows, vec2<i32>(xi, yi), layer, 0);
-            if (c.x != -128 && c.y != -128) {
-                out += vec2<f32>(flow_value(c.x), flow_value(c.y)) * (wx * wy);
-            }
-        }
-    }
-    return out;
+    return sample_flow_layer(layer, s);
 }
 
 const RIGHT: u32 = 0u;
@@ -330,13 +301,22 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     return out;
 }
 
-@fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    let dir = pixel_ray(frame, position);
+// Where a pixel's ray samples the views: its hit on the cylinder, the position s in the
+// interpolated camera, and its class (0 inside, 1 clamped above, 2 below, 3 missed).
+struct Classified {
+    hit: Hit,
+    s: vec2<f32>,
+    kind: u32,
+}
+
+fn classify(position: vec2<f32>) -> Classified {
+    var out: Classified;
+    let dir = pixel_ray(frame, vec4<f32>(position, 0.0, 1.0));
     let hit = intersect(frame.centre.xyz, dir);
+    out.hit = hit;
+    out.kind = 3u;
     if (hit.clamped == 3u) {
-        atomicAdd(&stats[3], 1u);
-        return vec4<f32>(0.0);
+        return out;
     }
     let q = quad_views(hit, frame.columns, frame.rows);
     // The camera at (beta, gamma), centred at the hit.
@@ -367,10 +347,51 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     let axes = quat_to_axes(quat * (1.0 / length(quat)));
     let dcam = vec3<f32>(dot(axes[0], ray), dot(axes[1], ray), dot(axes[2], ray));
     if (dcam.z <= 1e-6 * length(ray)) {
-        atomicAdd(&stats[3], 1u);
+        return out;
+    }
+    out.s = vec2<f32>(intr.x * dcam.x / dcam.z + intr.z, intr.y * dcam.y / dcam.z + intr.w);
+    out.kind = hit.clamped;
+    return out;
+}
+
+// The premultiplied linear RGBA of the pixel at `position` (its centre).
+fn shade(position: vec2<f32>) -> vec4<f32> {
+    let c = classify(position);
+    if (c.kind == 3u) {
         return vec4<f32>(0.0);
     }
-    let s = vec2<f32>(intr.x * dcam.x / dcam.z + intr.z, intr.y * dcam.y / dcam.z + intr.w);
-    atomicAdd(&stats[hit.clamped], 1u);
-    return morph(hit, s);
+    return morph(c.hit, c.s);
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    return shade(position.xy);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= frame.size.x || id.y >= frame.size.y) {
+        return;
+    }
+    textureStore(target_image, id.xy, shade(vec2<f32>(id.xy) + 0.5));
+}
+
+var<workgroup> class_counts: array<atomic<u32>, 4>;
+
+@compute @workgroup_size(8, 8)
+fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    if (local < 4u) {
+        atomicStore(&class_counts[local], 0u);
+    }
+    workgroupBarrier();
+    if (id.x < frame.size.x && id.y < frame.size.y) {
+        atomicAdd(&class_counts[classify(vec2<f32>(id.xy) + 0.5).kind], 1u);
+    }
+    workgroupBarrier();
+    if (local < 4u) {
+        let n = atomicLoad(&class_counts[local]);
+        if (n > 0u) {
+            atomicAdd(&stats[local], n);
+        }
+    }
 }

@@ -13,6 +13,8 @@
 //!   Porter–Duff compositing of the subject over them.
 //! - [`path`]: virtual camera paths (keyframes, orbit); [`scene`]: scene files (walkers
 //!   in time, lighting, camera, backdrop) and the plan of what a scene needs.
+//! - [`synthetic`]: a procedural pose of the original's shape, for benchmarks without a
+//!   field.
 //!
 //! Conventions: [`frf_core::conventions`].
 
@@ -29,5 +31,6 @@ pub mod renderer;
 pub mod resident;
 pub mod scene;
 pub mod shadow;
+pub mod synthetic;
 
 pub use error::{RenderError, Result};

@@ -7,6 +7,7 @@
 
 use std::mem::{offset_of, size_of};
 
+use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
     GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams, GpuShadowParams,
@@ -37,6 +38,17 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         if name == "common.wgsl" {
             module(&text, &name);
             assert_eq!(text, shaders::COMMON, "{name} as compiled");
+        } else if name == "rebin.wgsl" {
+            // The frame pass, composed with every choice of its sampling snippets.
+            assert_eq!(text, shaders::REBIN, "{name} as compiled");
+            for image in ImageFormat::ALL {
+                for flow in FlowFormat::ALL {
+                    let formats = PoseFormats { image, flow };
+                    let m = module(&formats.rebin_source(), &formats.name());
+                    // vs_main, fs_main, cs_main, cs_classes.
+                    assert_eq!(m.entry_points.len(), 4, "{}", formats.name());
+                }
+            }
         } else {
             let m = module(&shaders::composed(&text), &name);
             assert!(!m.entry_points.is_empty(), "{name} has no entry point");
@@ -54,7 +66,9 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
 fn a_broken_shader_is_refused() {
     // The validation above can fail: a type error in an otherwise valid pass.
     let broken = shaders::REBIN.replacen("fn ", "fn broken() -> f32 { return 1u; }\nfn ", 1);
-    let source = shaders::composed(&broken);
+    let source = PoseFormats::DEFAULT
+        .rebin_source()
+        .replace(shaders::REBIN, &broken);
     let parsed = naga::front::wgsl::parse_str(&source);
     let refused = match parsed {
         Err(_) => true,
@@ -96,7 +110,7 @@ macro_rules! check_layout {
 
 #[test]
 fn pod_structs_match_naga_layouts() {
-    let rebin = module(&shaders::composed(shaders::REBIN), "rebin");
+    let rebin = module(&PoseFormats::DEFAULT.rebin_source(), "rebin");
     check_layout!(
         &rebin,
         "View",

@@ -410,12 +410,12 @@ pub fn run_ring(args: RingEvalArgs) -> CliResult {
         renderer.device()
     );
     eprintln!(
-        "{:<8} {:>17} {:>17} {:>9}",
+        "{:<18} {:>17} {:>17} {:>9}",
         "variant", "PSNR silhouette", "SSIM silhouette", "s/frame"
     );
     for r in &scores {
         eprintln!(
-            "{:<8} {:>14.2} dB {:>17.4} {:>9.4}",
+            "{:<18} {:>14.2} dB {:>17.4} {:>9.4}",
             r.name, r.psnr_silhouette, r.ssim_silhouette, r.seconds_per_frame
         );
     }

@@ -333,7 +333,7 @@ impl Gpu {
             };
             let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
             let views = [
-                array_view(&subjects.texture),
+                array_view(subjects.texture()),
                 view(&backdrop.env),
                 view(&backdrop.plate),
                 array_view(&shadows),

@@ -17,6 +17,7 @@
 
 pub mod bind;
 pub mod composite;
+pub mod formats;
 pub mod pose;
 pub mod rebin;
 pub mod scope;
@@ -39,13 +40,25 @@ pub mod shaders {
     pub const SHADOW: &str = include_str!("../../../shaders/shadow.wgsl");
     /// `shaders/composite.wgsl`, standalone.
     pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
+    /// `shaders/floor.wgsl`, standalone.
+    pub const FLOOR: &str = include_str!("../../../shaders/floor.wgsl");
+    /// `shaders/sample/prelit_codes.wgsl`: pre-lit views as integer codes.
+    pub const PRELIT_CODES: &str = include_str!("../../../shaders/sample/prelit_codes.wgsl");
+    /// `shaders/sample/prelit_srgb.wgsl`: pre-lit views as sRGB8, filtered in hardware.
+    pub const PRELIT_SRGB: &str = include_str!("../../../shaders/sample/prelit_srgb.wgsl");
+    /// `shaders/sample/flow_codes.wgsl`: flows as 8-bit log codes.
+    pub const FLOW_CODES: &str = include_str!("../../../shaders/sample/flow_codes.wgsl");
+    /// `shaders/sample/flow_f16.wgsl`: flows as half floats, filtered in hardware.
+    pub const FLOW_F16: &str = include_str!("../../../shaders/sample/flow_f16.wgsl");
+    /// `shaders/sample/flow_f32.wgsl`: flows as floats.
+    pub const FLOW_F32: &str = include_str!("../../../shaders/sample/flow_f32.wgsl");
 
-    /// Every pass, named.
+    /// Every pass but the frame pass (composed by [`super::formats::PoseFormats`]), named.
     pub const PASSES: [(&str, &str); 4] = [
         ("relight", RELIGHT),
-        ("rebin", REBIN),
         ("shadow", SHADOW),
         ("composite", COMPOSITE),
+        ("floor", FLOOR),
     ];
 
     /// A pass's shader module on `device`.
@@ -74,6 +87,12 @@ pub struct Gpu {
     uncaptured: scope::Uncaptured,
     relight: pose::RelightPass,
     rebin: rebin::RebinPass,
+    /// How the frame pass runs.
+    stage: rebin::Stage,
+    /// Frame targets kept per size and number of walkers.
+    targets: std::sync::Mutex<Vec<(((u32, u32), u32), std::sync::Arc<rebin::SubjectTargets>)>>,
+    /// Whether passes can be timed on the GPU (`Features::TIMESTAMP_QUERY`).
+    timestamps: bool,
     shadow: shadow::ShadowPass,
     composite: composite::CompositePass,
 }
@@ -93,7 +112,7 @@ impl Gpu {
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("frf"),
-            required_features: wgpu::Features::empty(),
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: limits,
             ..Default::default()
         }))
@@ -120,7 +139,10 @@ impl Gpu {
     ) -> Self {
         Self {
             relight: pose::RelightPass::new(&device),
-            rebin: rebin::RebinPass::new(&device),
+            rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
+            stage: rebin::Stage::Fragment,
+            targets: Default::default(),
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             shadow: shadow::ShadowPass::new(&device),
             composite: composite::CompositePass::new(&device),
             device,

@@ -11,11 +11,12 @@ use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::bind::{copy_to_buffer, storage, table_bytes, uniform};
+use super::rebin::RebinPass;
 use super::types::{GpuQuad, GpuRelightParams, GpuView};
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
-use crate::resident::{PoseSource, srgb_lut};
+use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
 
 /// Workgroup size of the relighting pass (`@workgroup_size(64)`).
 const WORKGROUP: u32 = 64;
@@ -179,7 +180,103 @@ impl Gpu {
             view_formats: &[],
         });
         let scales = self.relight_views(source, &prelit)?;
+        Ok(self.bind_pose(
+            &self.rebin,
+            &source.geometry,
+            scales,
+            prelit,
+            &flows,
+            source.flows.table,
+        ))
+    }
 
+    /// Makes a pose relit on the CPU resident with the storage `pass` reads
+    /// ([`super::formats`]): its pre-lit codes and flows uploaded in those formats (the
+    /// benchmark's way to compare them; the renderer relights on the GPU).
+    pub fn upload_resident(&self, resident: &ResidentPose, pass: &RebinPass) -> Result<GpuPose> {
+        self.scoped("making a CPU-relit pose resident", || {
+            let geometry = &resident.geometry;
+            let crop = geometry.crop;
+            let texels = crop.texels();
+            let texture = |label, format, layers: usize, bytes: &[u8]| {
+                self.device.create_texture_with_data(
+                    &self.queue,
+                    &wgpu::TextureDescriptor {
+                        label: Some(label),
+                        size: wgpu::Extent3d {
+                            width: crop.width,
+                            height: crop.height,
+                            depth_or_array_layers: layers.max(1) as u32,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    bytes,
+                )
+            };
+            let prelit_bytes: Vec<u8> = resident
+                .prelit
+                .iter()
+                .flatten()
+                .flatten()
+                .copied()
+                .collect();
+            let prelit = texture(
+                "prelit",
+                pass.formats.image.texture(),
+                resident.prelit.len(),
+                &prelit_bytes,
+            );
+            let stored = resident.flows.codes.iter().flat_map(|f| f.iter().flatten());
+            let q = &resident.flows.quantizer;
+            let decoded: Vec<[f32; 2]> = stored
+                .clone()
+                .flat_map(|codes| codes.iter().map(|&c| decode_flow(c, q).to_array()))
+                .collect();
+            let mut bytes = match pass.formats.flow.encode(&decoded) {
+                Some(b) => b,
+                None => stored
+                    .flat_map(|codes| codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
+                    .collect(),
+            };
+            if bytes.is_empty() {
+                bytes = match pass.formats.flow.encode(&vec![[0.0; 2]; texels]) {
+                    Some(b) => b,
+                    None => vec![128u8; texels * 2],
+                };
+            }
+            let flows = texture(
+                "flows",
+                pass.formats.flow.texture(),
+                geometry.flow_layer_count,
+                &bytes,
+            );
+            Ok(self.bind_pose(
+                pass,
+                geometry,
+                resident.scales.clone(),
+                prelit,
+                &flows,
+                resident.flows.table,
+            ))
+        })
+    }
+
+    /// The pose's tables uploaded and bound with its textures for `pass`.
+    fn bind_pose(
+        &self,
+        pass: &RebinPass,
+        geometry: &Arc<PoseGeometry>,
+        scales: Vec<f32>,
+        prelit: wgpu::Texture,
+        flows: &wgpu::Texture,
+        flow_table: [f32; 256],
+    ) -> GpuPose {
         let gpu_views: Vec<GpuView> = geometry
             .cameras
             .iter()
@@ -224,7 +321,7 @@ impl Gpu {
         };
         let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
-        let tables = buffer("tables", &table_bytes(&[srgb_lut(), source.flows.table]));
+        let tables = buffer("tables", &table_bytes(&[srgb_lut(), flow_table]));
         let (proxy, hull_words) = geometry.proxy.gpu();
         let proxy_buffer = buffer("proxy", bytemuck::bytes_of(&proxy));
         let hull_buffer = buffer("hull", bytemuck::cast_slice(&hull_words));
@@ -236,7 +333,7 @@ impl Gpu {
         };
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pose"),
-            layout: &self.rebin.pose_layout,
+            layout: &pass.pose_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -266,16 +363,20 @@ impl Gpu {
                     binding: 6,
                     resource: hull_buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: wgpu::BindingResource::Sampler(&pass.sampler),
+                },
             ],
         });
-        Ok(GpuPose {
+        GpuPose {
             bind_group,
             prelit,
             scales,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,
             shadow: None,
-        })
+        }
     }
 
     /// Relights every view into its layer of `prelit`; returns the views' scales.

@@ -4,74 +4,165 @@
 //! pixel classes (inside, clamped above or below, missed) are counted. Twin of
 //! [`crate::cpu::render_cpu`].
 
+use std::sync::Arc;
+
 use frf_core::camera::Camera;
 use frf_core::image::{Image, Rgba};
-use wgpu::util::DeviceExt;
 
+use super::Gpu;
 use super::bind::{
-    cleared, copy_to_buffer, full_screen_pipeline, padded_row, readback_buffer, rgba_pixels,
-    storage, texture_array, uniform,
+    cleared, compute_pipeline, copy_to_buffer, full_screen_pipeline, padded_row, readback_buffer,
+    rgba_pixels, storage, storage_texture, texture_array, uniform,
 };
+use super::formats::PoseFormats;
 use super::pose::GpuPose;
 use super::types::GpuFrame;
-use super::{Gpu, shaders};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::morph::Variant;
 
-/// The frame pass's layouts and pipeline.
-pub struct RebinPass {
-    pub(super) frame_layout: wgpu::BindGroupLayout,
-    pub(super) pose_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
+/// Whether a pass runs as a full-screen triangle or as a compute dispatch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Stage {
+    /// Fragment shader into a colour attachment.
+    Fragment,
+    /// Compute shader (8 x 8 workgroups) into a storage texture.
+    Compute,
 }
 
-impl RebinPass {
-    /// Builds the pass on `device`.
-    pub fn new(device: &wgpu::Device) -> Self {
-        let rebin_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("rebin"),
-            source: wgpu::ShaderSource::Wgsl(shaders::composed(shaders::REBIN).into()),
-        });
-        let f = wgpu::ShaderStages::FRAGMENT;
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("frame"),
-            entries: &[uniform(0, f), storage(1, false, f)],
-        });
-        let pose_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pose"),
-            entries: &[
-                texture_array(0, wgpu::TextureSampleType::Uint),
-                texture_array(1, wgpu::TextureSampleType::Sint),
-                storage(2, true, f),
-                storage(3, true, f),
-                storage(4, true, f),
-                storage(5, true, f),
-                storage(6, true, f),
-            ],
-        });
-        let pipeline = full_screen_pipeline(
-            device,
-            "rebin",
-            &[&frame_layout, &pose_layout],
-            &rebin_module,
-            "fs_main",
-            1,
-        );
-        Self {
-            frame_layout,
-            pose_layout,
-            pipeline,
+impl Stage {
+    /// Both.
+    pub const ALL: [Stage; 2] = [Stage::Fragment, Stage::Compute];
+
+    /// Its name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Fragment => "fragment",
+            Stage::Compute => "compute",
         }
     }
 }
 
-/// A frame's subjects, drawn and still on the GPU.
+/// Workgroups of 8 x 8 covering `size`.
+pub(super) fn workgroups(size: (u32, u32)) -> (u32, u32) {
+    (size.0.div_ceil(8), size.1.div_ceil(8))
+}
+
+/// The frame pass's layouts and pipelines for one [`PoseFormats`].
+pub struct RebinPass {
+    /// The storage these pipelines read.
+    pub formats: PoseFormats,
+    pub(super) frame_layout: wgpu::BindGroupLayout,
+    pub(super) compute_layout: wgpu::BindGroupLayout,
+    pub(super) classes_layout: wgpu::BindGroupLayout,
+    pub(super) pose_layout: wgpu::BindGroupLayout,
+    pub(super) fragment: wgpu::RenderPipeline,
+    pub(super) compute: wgpu::ComputePipeline,
+    pub(super) classes: wgpu::ComputePipeline,
+    pub(super) sampler: wgpu::Sampler,
+}
+
+impl RebinPass {
+    /// Builds the pass on `device` for poses stored as `formats`.
+    pub fn new(device: &wgpu::Device, formats: PoseFormats) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rebin"),
+            source: wgpu::ShaderSource::Wgsl(formats.rebin_source().into()),
+        });
+        let both = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        let frame_layout = layout("frame", &[uniform(0, both)]);
+        let compute_layout = layout(
+            "frame (compute)",
+            &[
+                uniform(0, both),
+                storage_texture(2, wgpu::TextureFormat::Rgba32Float),
+            ],
+        );
+        let classes_layout = layout(
+            "frame (classes)",
+            &[
+                uniform(0, both),
+                storage(1, false, wgpu::ShaderStages::COMPUTE),
+            ],
+        );
+        let pose_layout = layout(
+            "pose",
+            &[
+                texture_array(0, formats.image.sample_type()),
+                texture_array(1, formats.flow.sample_type()),
+                storage(2, true, both),
+                storage(3, true, both),
+                storage(4, true, both),
+                storage(5, true, both),
+                storage(6, true, both),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: both,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        );
+        let fragment = full_screen_pipeline(
+            device,
+            "rebin",
+            &[&frame_layout, &pose_layout],
+            &module,
+            "fs_main",
+            1,
+        );
+        let compute = compute_pipeline(
+            device,
+            "rebin",
+            &[&compute_layout, &pose_layout],
+            &module,
+            "cs_main",
+        );
+        let classes = compute_pipeline(
+            device,
+            "classes",
+            &[&classes_layout, &pose_layout],
+            &module,
+            "cs_classes",
+        );
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("bilinear"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            formats,
+            frame_layout,
+            compute_layout,
+            classes_layout,
+            pose_layout,
+            fragment,
+            compute,
+            classes,
+            sampler,
+        }
+    }
+}
+
+/// A frame's subjects, drawn and still on the GPU: one layer per instance of the
+/// targets' texture, in drawing order (back to front), premultiplied RGBA32F, and the
+/// pixel-class counters summed over the instances.
 pub(super) struct Subjects {
-    /// Pixel-class counters, summed over the instances.
-    pub stats: wgpu::Buffer,
-    /// One layer per instance, in drawing order (back to front): premultiplied RGBA32F.
-    pub texture: wgpu::Texture,
+    targets: Arc<SubjectTargets>,
+}
+
+impl Subjects {
+    /// The texture array of the subjects.
+    pub fn texture(&self) -> &wgpu::Texture {
+        &self.targets.texture
+    }
 }
 
 /// The frame uniform of `camera` for `pose` (`pose` `None`: the camera alone, for passes
@@ -105,11 +196,198 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
     f
 }
 
+/// A frame's targets and per-frame buffers for one size and number of walkers, made once
+/// and kept ([`Gpu::subject_targets`]): the subjects' texture array, its layer views, the
+/// pixel-class counters, and per layer a frame uniform (written with `write_buffer`)
+/// with the bind groups of the fragment, compute and class passes.
+pub(super) struct SubjectTargets {
+    texture: wgpu::Texture,
+    layers: Vec<LayerTargets>,
+    stats: wgpu::Buffer,
+}
+
+struct LayerTargets {
+    view: wgpu::TextureView,
+    uniform: wgpu::Buffer,
+    fragment: wgpu::BindGroup,
+    compute: wgpu::BindGroup,
+    classes: wgpu::BindGroup,
+}
+
+impl SubjectTargets {
+    fn new(device: &wgpu::Device, pass: &RebinPass, size: (u32, u32), layers: u32) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("subjects"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let stats = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("stats"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = |label, layout, entries: &[wgpu::BindGroupEntry]| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout,
+                entries,
+            })
+        };
+        let layers = (0..layers)
+            .map(|layer| {
+                let view = texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                });
+                let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("frame"),
+                    size: std::mem::size_of::<GpuFrame>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let frame = wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform.as_entire_binding(),
+                };
+                LayerTargets {
+                    fragment: group("frame", &pass.frame_layout, std::slice::from_ref(&frame)),
+                    compute: group(
+                        "frame (compute)",
+                        &pass.compute_layout,
+                        &[
+                            frame.clone(),
+                            wgpu::BindGroupEntry {
+                                binding: 2,
+                                resource: wgpu::BindingResource::TextureView(&view),
+                            },
+                        ],
+                    ),
+                    classes: group(
+                        "frame (classes)",
+                        &pass.classes_layout,
+                        &[
+                            frame.clone(),
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: stats.as_entire_binding(),
+                            },
+                        ],
+                    ),
+                    view,
+                    uniform,
+                }
+            })
+            .collect();
+        Self {
+            texture,
+            layers,
+            stats,
+        }
+    }
+}
+
+impl RebinPass {
+    /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer,
+    /// into `layer` of `targets`, by `stage`, with the pass's timestamps when given; and
+    /// with its pixel classes counted into the targets' counters when `classes`.
+    pub(super) fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &SubjectTargets,
+        layer: usize,
+        pose_group: &wgpu::BindGroup,
+        stage: Stage,
+        size: (u32, u32),
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+        classes: bool,
+    ) {
+        let t = &targets.layers[layer];
+        match stage {
+            Stage::Fragment => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("rebin"),
+                    color_attachments: &[cleared(&t.view)],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
+                        query_set: q,
+                        beginning_of_pass_write_index: Some(i),
+                        end_of_pass_write_index: Some(i + 1),
+                    }),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.fragment);
+                pass.set_bind_group(0, &t.fragment, &[]);
+                pass.set_bind_group(1, pose_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            Stage::Compute => {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("rebin"),
+                    timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
+                        query_set: q,
+                        beginning_of_pass_write_index: Some(i),
+                        end_of_pass_write_index: Some(i + 1),
+                    }),
+                });
+                pass.set_pipeline(&self.compute);
+                pass.set_bind_group(0, &t.compute, &[]);
+                pass.set_bind_group(1, pose_group, &[]);
+                let (x, y) = workgroups(size);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        }
+        if classes {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("classes"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.classes);
+            pass.set_bind_group(0, &t.classes, &[]);
+            pass.set_bind_group(1, pose_group, &[]);
+            let (x, y) = workgroups(size);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+}
+
 impl Gpu {
+    /// The kept targets of frames of `size` with `layers` walkers (made on first use;
+    /// the last few sizes are kept).
+    pub(super) fn subject_targets(&self, size: (u32, u32), layers: u32) -> Arc<SubjectTargets> {
+        let mut cache = self.targets.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, t)) = cache.iter().find(|(k, _)| *k == (size, layers)) {
+            return t.clone();
+        }
+        let t = Arc::new(SubjectTargets::new(&self.device, &self.rebin, size, layers));
+        if cache.len() >= 4 {
+            cache.remove(0);
+        }
+        cache.push(((size, layers), t.clone()));
+        t
+    }
+
     /// Records the frame pass of every instance into `encoder`: each pose drawn by its
     /// camera (in its subject frame) into its own layer of one texture array of `size`,
     /// in the order given (back to front; the composite pass puts each over the ones
-    /// before it).
+    /// before it), and their pixel classes counted.
     pub(super) fn draw_subjects(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -117,71 +395,27 @@ impl Gpu {
         size: (u32, u32),
         variant: Variant,
     ) -> Subjects {
-        let stats = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("stats"),
-                contents: &[0u8; 16],
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            });
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("subjects"),
-            size: wgpu::Extent3d {
-                width: size.0,
-                height: size.1,
-                depth_or_array_layers: instances.len().max(1) as u32,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let targets = self.subject_targets(size, instances.len().max(1) as u32);
+        encoder.clear_buffer(&targets.stats, 0, None);
         for (layer, (pose, camera)) in instances.iter().enumerate() {
-            let frame_buffer = self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("frame"),
-                    contents: bytemuck::bytes_of(&frame_uniform(Some(pose), camera, variant)),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("frame"),
-                layout: &self.rebin.frame_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: frame_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: stats.as_entire_binding(),
-                    },
-                ],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer as u32,
-                array_layer_count: Some(1),
-                ..Default::default()
-            });
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("rebin"),
-                color_attachments: &[cleared(&view)],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.rebin.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.set_bind_group(1, &pose.bind_group, &[]);
-            pass.draw(0..3, 0..1);
+            let frame = frame_uniform(Some(pose), camera, variant);
+            self.queue.write_buffer(
+                &targets.layers[layer].uniform,
+                0,
+                bytemuck::bytes_of(&frame),
+            );
+            self.rebin.record(
+                encoder,
+                &targets,
+                layer,
+                &pose.bind_group,
+                self.stage,
+                size,
+                None,
+                true,
+            );
         }
-        Subjects { stats, texture }
+        Subjects { targets }
     }
 
     /// Copies the pixel-class counters of a drawn frame for readback.
@@ -191,7 +425,7 @@ impl Gpu {
         subject: &Subjects,
     ) -> wgpu::Buffer {
         let readback = readback_buffer(&self.device, "stats readback", 16);
-        encoder.copy_buffer_to_buffer(&subject.stats, 0, &readback, 0, 16);
+        encoder.copy_buffer_to_buffer(&subject.targets.stats, 0, &readback, 0, 16);
         readback
     }
 
@@ -251,7 +485,7 @@ impl Gpu {
                     label: Some("frame"),
                 });
             let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant);
-            let image = self.copy_rgba(&mut encoder, &subject.texture, size);
+            let image = self.copy_rgba(&mut encoder, subject.texture(), size);
             let stats = self.copy_stats(&mut encoder, &subject);
             self.queue.submit([encoder.finish()]);
             Ok((self.read_rgba(&image, size)?, self.read_stats(&stats)?))
