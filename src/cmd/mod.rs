@@ -1,6 +1,7 @@
 //! One module per subcommand, plus shared progress reporting and argument parsing.
 
 pub mod args;
+pub mod bench;
 pub mod eval;
 pub mod eval_paths;
 pub mod eval_shot;

@@ -15,6 +15,7 @@
 //! request runs inside error scopes ([`scope`]). Readback pads rows to
 //! `COPY_BYTES_PER_ROW_ALIGNMENT` ([`bind`]).
 
+pub mod bench;
 pub mod bind;
 pub mod composite;
 pub mod formats;
@@ -22,6 +23,7 @@ pub mod pose;
 pub mod rebin;
 pub mod scope;
 pub mod shadow;
+pub mod timing;
 pub mod types;
 
 use crate::error::{RenderError, Result};
@@ -84,6 +86,7 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     adapter: String,
+    info: wgpu::AdapterInfo,
     uncaptured: scope::Uncaptured,
     relight: pose::RelightPass,
     rebin: rebin::RebinPass,
@@ -119,14 +122,8 @@ impl Gpu {
         .map_err(gpu_err)?;
         let uncaptured = scope::Uncaptured::default();
         uncaptured.install(&device);
-        let adapter = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
         scope::scoped(&device, &uncaptured, "building the pipelines", || {
-            Ok(Self::build(
-                device.clone(),
-                queue,
-                adapter,
-                uncaptured.clone(),
-            ))
+            Ok(Self::build(device.clone(), queue, info, uncaptured.clone()))
         })
     }
 
@@ -134,9 +131,10 @@ impl Gpu {
     fn build(
         device: wgpu::Device,
         queue: wgpu::Queue,
-        adapter: String,
+        info: wgpu::AdapterInfo,
         uncaptured: scope::Uncaptured,
     ) -> Self {
+        let adapter = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
         Self {
             relight: pose::RelightPass::new(&device),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
@@ -148,6 +146,7 @@ impl Gpu {
             device,
             queue,
             adapter,
+            info,
             uncaptured,
         }
     }

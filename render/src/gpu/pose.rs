@@ -104,6 +104,14 @@ pub struct RelitShadowInfo {
 }
 
 impl GpuPose {
+    /// A view of the pre-lit texture array.
+    pub(super) fn prelit_codes_view(&self) -> wgpu::TextureView {
+        self.prelit.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        })
+    }
+
     /// Whether a relit shadow is resident.
     pub fn has_shadow(&self) -> bool {
         self.shadow.is_some()

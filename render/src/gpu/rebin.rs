@@ -161,7 +161,7 @@ pub(super) struct Subjects {
 impl Subjects {
     /// The texture array of the subjects.
     pub fn texture(&self) -> &wgpu::Texture {
-        &self.targets.texture
+        self.targets.texture()
     }
 }
 
@@ -215,7 +215,12 @@ struct LayerTargets {
 }
 
 impl SubjectTargets {
-    fn new(device: &wgpu::Device, pass: &RebinPass, size: (u32, u32), layers: u32) -> Self {
+    pub(super) fn new(
+        device: &wgpu::Device,
+        pass: &RebinPass,
+        size: (u32, u32),
+        layers: u32,
+    ) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("subjects"),
             size: wgpu::Extent3d {
@@ -300,6 +305,33 @@ impl SubjectTargets {
             layers,
             stats,
         }
+    }
+}
+
+impl SubjectTargets {
+    /// The texture array of the subjects.
+    pub(super) fn texture(&self) -> &wgpu::Texture {
+        &self.texture
+    }
+
+    /// The frame uniform of `layer`.
+    pub(super) fn uniform(&self, layer: usize) -> &wgpu::Buffer {
+        &self.layers[layer].uniform
+    }
+
+    /// The view of `layer`.
+    pub(super) fn layer_view(&self, layer: usize) -> &wgpu::TextureView {
+        &self.layers[layer].view
+    }
+
+    /// The fragment pass's frame bind group of `layer`.
+    pub(super) fn fragment_group(&self, layer: usize) -> &wgpu::BindGroup {
+        &self.layers[layer].fragment
+    }
+
+    /// The compute pass's frame bind group of `layer`.
+    pub(super) fn compute_group(&self, layer: usize) -> &wgpu::BindGroup {
+        &self.layers[layer].compute
     }
 }
 

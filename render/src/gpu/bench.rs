@@ -1,0 +1,478 @@
+//! The GPU interpolation benchmark (`frf bench interp`): one pose, one camera between
+//! views, frames of several sizes, and per size the time of a floor pass (one texel
+//! fetch and one write per pixel: the least any frame pass can cost on the device) and of
+//! the nearest-view, linear-blend, two-way and four-way passes, for every storage format
+//! of the pose ([`super::formats`]) and as fragment and compute passes ([`Stage`]); the
+//! CPU reference renders the same frames in the same run. Each GPU combination's frame is
+//! compared with the CPU reference's at the first size: a combination is correct when it
+//! stays within [`CORRECT_MAX_ABS`] of it.
+
+use serde::Serialize;
+
+use super::Gpu;
+use super::bind::{compute_pipeline, full_screen_pipeline, texture_array};
+use super::formats::{FlowFormat, ImageFormat, PoseFormats};
+use super::pose::GpuPose;
+use super::rebin::{RebinPass, Stage, SubjectTargets, frame_uniform, workgroups};
+use super::timing::{Timestamps, median_min};
+use crate::cpu::render_cpu;
+use crate::error::Result;
+use crate::morph::Variant;
+use crate::resident::ResidentPose;
+use crate::synthetic::bench_camera;
+
+/// The largest difference from the CPU reference (premultiplied linear RGBA, at the
+/// pose's scale) of a combination called correct: the exact twins measure ~1e-6; the
+/// hardware's 8-bit filter weights and half-float flows stay near 1e-2 on sharp edges.
+pub const CORRECT_MAX_ABS: f64 = 2e-2;
+
+/// The variants timed, after the floor.
+pub const VARIANTS: [Variant; 4] = [
+    Variant::Nearest,
+    Variant::Linear,
+    Variant::TwoWay,
+    Variant::FourWay,
+];
+
+/// What to measure.
+#[derive(Debug, Clone)]
+pub struct BenchOptions {
+    /// Frame sizes.
+    pub sizes: Vec<(u32, u32)>,
+    /// Storage formats.
+    pub formats: Vec<PoseFormats>,
+    /// Fragment and/or compute.
+    pub stages: Vec<Stage>,
+    /// Passes run before timing.
+    pub warmup: u32,
+    /// Passes timed.
+    pub repeats: u32,
+    /// Frames the CPU reference renders per variant and size.
+    pub cpu_repeats: u32,
+    /// The CPU reference renders sizes up to this many pixels.
+    pub cpu_max_pixels: u64,
+}
+
+/// One GPU measurement.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchRow {
+    /// `floor`, `nearest`, `linear`, `twoway` or `fourway`.
+    pub variant: String,
+    /// `codes8`, `f16` or `f32`.
+    pub flow_format: String,
+    /// `codes` or `srgb8`.
+    pub image_format: String,
+    /// `fragment` or `compute`.
+    pub stage: String,
+    /// Frame width.
+    pub width: u32,
+    /// Frame height.
+    pub height: u32,
+    /// Median time of the pass, ms.
+    pub ms_median: f64,
+    /// Least time of the pass, ms.
+    pub ms_min: f64,
+    /// Median against the floor pass's median at the same size and stage.
+    pub vs_floor: f64,
+    /// Nanoseconds a pixel (median).
+    pub ns_per_pixel: f64,
+    /// Largest difference from the CPU reference's frame at the first size (`None` for
+    /// the floor and at other sizes).
+    pub max_abs_vs_cpu: Option<f64>,
+}
+
+/// One CPU reference measurement.
+#[derive(Debug, Clone, Serialize)]
+pub struct CpuRow {
+    /// Variant.
+    pub variant: String,
+    /// Frame width.
+    pub width: u32,
+    /// Frame height.
+    pub height: u32,
+    /// Median time of a frame, ms.
+    pub ms_median: f64,
+    /// Least time of a frame, ms.
+    pub ms_min: f64,
+    /// Threads of the CPU reference.
+    pub threads: usize,
+}
+
+/// Bytes a pose holds on the GPU in one storage choice.
+#[derive(Debug, Clone, Serialize)]
+pub struct PoseBytes {
+    /// `image/flow`.
+    pub formats: String,
+    /// Bytes.
+    pub bytes: u64,
+}
+
+/// The floor pass's achieved memory bandwidth at one size.
+#[derive(Debug, Clone, Serialize)]
+pub struct FloorBandwidth {
+    /// Fragment or compute.
+    pub stage: String,
+    /// Frame width.
+    pub width: u32,
+    /// Frame height.
+    pub height: u32,
+    /// Bytes read and written a frame (4 read, 16 written a pixel) over its median time,
+    /// GB/s.
+    pub gb_per_s: f64,
+}
+
+/// Everything measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    /// The adapter, in words.
+    pub adapter: String,
+    /// Its backend.
+    pub backend: String,
+    /// Its driver, as the adapter says.
+    pub driver: String,
+    /// How passes were timed: `gpu-timestamps` or `fenced-wall`.
+    pub clock: String,
+    /// GPU rows.
+    pub rows: Vec<BenchRow>,
+    /// CPU reference rows.
+    pub cpu_rows: Vec<CpuRow>,
+    /// Bytes of the pose in the default storage.
+    pub bytes_per_pose: u64,
+    /// Bytes of the pose in each storage measured.
+    pub bytes_per_pose_by_format: Vec<PoseBytes>,
+    /// The floor pass's bandwidth per size.
+    pub floor_bandwidth: Vec<FloorBandwidth>,
+    /// The fastest correct four-way combination at the largest size: `image/flow stage`.
+    pub fastest_correct_fourway: Option<String>,
+}
+
+/// The floor pass's pipelines (`shaders/floor.wgsl`).
+struct FloorPass {
+    layout: wgpu::BindGroupLayout,
+    fragment: wgpu::RenderPipeline,
+    compute: wgpu::ComputePipeline,
+}
+
+impl FloorPass {
+    fn new(device: &wgpu::Device, rebin: &RebinPass) -> Self {
+        let module = super::shaders::module(device, "floor", super::shaders::FLOOR);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("floor"),
+            entries: &[texture_array(0, wgpu::TextureSampleType::Uint)],
+        });
+        let fragment = full_screen_pipeline(
+            device,
+            "floor",
+            &[&rebin.frame_layout, &layout],
+            &module,
+            "fs_floor",
+            1,
+        );
+        let compute = compute_pipeline(
+            device,
+            "floor",
+            &[&rebin.compute_layout, &layout],
+            &module,
+            "cs_floor",
+        );
+        Self {
+            layout,
+            fragment,
+            compute,
+        }
+    }
+}
+
+/// Bytes of `pose` stored as `formats`.
+fn pose_bytes(pose: &ResidentPose, formats: PoseFormats) -> u64 {
+    let g = &pose.geometry;
+    let texels = g.crop.texels() as u64;
+    let codes = g.resident_bytes();
+    let flows = texels * g.flow_layer_count.max(1) as u64;
+    codes - 2 * flows + formats.flow.texel_bytes() * flows
+}
+
+/// Runs the benchmark on `gpu` with `pose` (relit on the CPU; uploaded in every format).
+pub fn run(
+    gpu: &Gpu,
+    pose: &ResidentPose,
+    options: &BenchOptions,
+    progress: &mut dyn FnMut(&str),
+) -> Result<BenchReport> {
+    let info = &gpu.info;
+    let mut rows = Vec::new();
+    let mut floor_bandwidth = Vec::new();
+    let first_size = options.sizes.first().copied();
+    // The CPU reference first: its frames at the first size are the yardstick.
+    let mut cpu_rows = Vec::new();
+    let mut reference = Vec::new();
+    for &size in &options.sizes {
+        if u64::from(size.0) * u64::from(size.1) > options.cpu_max_pixels {
+            continue;
+        }
+        let camera = bench_camera(size)?;
+        for v in VARIANTS {
+            progress(&format!("CPU reference {} {}x{}", v.name(), size.0, size.1));
+            let mut times = Vec::new();
+            let mut frame = None;
+            for _ in 0..options.cpu_repeats.max(1) {
+                let start = std::time::Instant::now();
+                let (img, _) = render_cpu(pose, &camera, v);
+                times.push(start.elapsed().as_secs_f64() * 1e3);
+                frame = Some(img);
+            }
+            let (ms_median, ms_min) = median_min(&times);
+            cpu_rows.push(CpuRow {
+                variant: v.name().to_string(),
+                width: size.0,
+                height: size.1,
+                ms_median,
+                ms_min,
+                threads: rayon::current_num_threads(),
+            });
+            if Some(size) == first_size
+                && let Some(f) = frame
+            {
+                reference.push((v, f));
+            }
+        }
+    }
+    let mut fastest: Option<(f64, String)> = None;
+    let largest = options
+        .sizes
+        .iter()
+        .copied()
+        .max_by_key(|s| u64::from(s.0) * u64::from(s.1));
+    // The floor, once per size and stage, on the codes' texture.
+    let codes_pass = RebinPass::new(&gpu.device, PoseFormats::DEFAULT);
+    let codes_pose = gpu.upload_resident(pose, &codes_pass)?;
+    let floor = FloorPass::new(&gpu.device, &codes_pass);
+    let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
+    for &size in &options.sizes {
+        let camera = bench_camera(size)?;
+        let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1);
+        gpu.queue.write_buffer(
+            targets.uniform(0),
+            0,
+            bytemuck::bytes_of(&frame_uniform(Some(&codes_pose), &camera, Variant::Nearest)),
+        );
+        for &stage in &options.stages {
+            progress(&format!("floor {} {}x{}", stage.name(), size.0, size.1));
+            let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
+                record_floor(&floor, &targets, &floor_group, stage, size, e, t)
+            })?;
+            let (median, min) = median_min(&times);
+            let pixels = f64::from(size.0) * f64::from(size.1);
+            floor_bandwidth.push(FloorBandwidth {
+                stage: stage.name().to_string(),
+                width: size.0,
+                height: size.1,
+                gb_per_s: pixels * 20.0 / (median * 1e-3) / 1e9,
+            });
+            rows.push(row(
+                "floor",
+                PoseFormats::DEFAULT,
+                stage,
+                size,
+                (median, min),
+                median,
+                None,
+            ));
+        }
+    }
+    drop(codes_pose);
+    for &formats in &options.formats {
+        let pass = RebinPass::new(&gpu.device, formats);
+        let gpu_pose = gpu.upload_resident(pose, &pass)?;
+        for &size in &options.sizes {
+            let camera = bench_camera(size)?;
+            let targets = SubjectTargets::new(&gpu.device, &pass, size, 1);
+            for &stage in &options.stages {
+                let floor_ms = rows
+                    .iter()
+                    .find(|r| {
+                        r.variant == "floor"
+                            && r.stage == stage.name()
+                            && (r.width, r.height) == size
+                    })
+                    .map_or(f64::NAN, |r| r.ms_median);
+                for v in VARIANTS {
+                    progress(&format!(
+                        "{} {} {} {}x{}",
+                        v.name(),
+                        formats.name(),
+                        stage.name(),
+                        size.0,
+                        size.1
+                    ));
+                    gpu.queue.write_buffer(
+                        targets.uniform(0),
+                        0,
+                        bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
+                    );
+                    let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
+                        pass.record(e, &targets, 0, &gpu_pose.bind_group, stage, size, t, false)
+                    })?;
+                    let timing = median_min(&times);
+                    let error = match reference.iter().find(|(rv, _)| *rv == v) {
+                        Some((_, cpu)) if Some(size) == first_size => {
+                            let mut e = gpu.device.create_command_encoder(&Default::default());
+                            pass.record(
+                                &mut e,
+                                &targets,
+                                0,
+                                &gpu_pose.bind_group,
+                                stage,
+                                size,
+                                None,
+                                false,
+                            );
+                            let copied = gpu.copy_rgba(&mut e, targets.texture(), size);
+                            gpu.queue.submit([e.finish()]);
+                            let img = gpu.read_rgba(&copied, size)?;
+                            Some(
+                                img.pixels()
+                                    .iter()
+                                    .zip(cpu.pixels())
+                                    .flat_map(|(a, b)| {
+                                        (0..4).map(move |k| f64::from((a[k] - b[k]).abs()))
+                                    })
+                                    .fold(0.0, f64::max),
+                            )
+                        }
+                        _ => None,
+                    };
+                    let r = row(v.name(), formats, stage, size, timing, floor_ms, error);
+                    if v == Variant::FourWay && Some(size) == largest {
+                        let correct = rows
+                            .iter()
+                            .chain(std::iter::once(&r))
+                            .filter(|x| {
+                                x.variant == "fourway"
+                                    && x.image_format == formats.image.name()
+                                    && x.flow_format == formats.flow.name()
+                                    && x.stage == stage.name()
+                            })
+                            .all(|x| x.max_abs_vs_cpu.is_none_or(|e| e <= CORRECT_MAX_ABS));
+                        let name = format!("{} {}", formats.name(), stage.name());
+                        if correct && fastest.as_ref().is_none_or(|(t, _)| r.ms_median < *t) {
+                            fastest = Some((r.ms_median, name));
+                        }
+                    }
+                    rows.push(r);
+                }
+            }
+        }
+    }
+    Ok(BenchReport {
+        adapter: info.name.clone(),
+        backend: format!("{:?}", info.backend),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_string(),
+        clock: gpu.clock().name().to_string(),
+        rows,
+        cpu_rows,
+        bytes_per_pose: pose_bytes(pose, PoseFormats::DEFAULT),
+        bytes_per_pose_by_format: options
+            .formats
+            .iter()
+            .map(|&f| PoseBytes {
+                formats: f.name(),
+                bytes: pose_bytes(pose, f),
+            })
+            .collect(),
+        floor_bandwidth,
+        fastest_correct_fourway: fastest.map(|f| f.1),
+    })
+}
+
+fn row(
+    variant: &str,
+    formats: PoseFormats,
+    stage: Stage,
+    size: (u32, u32),
+    (ms_median, ms_min): (f64, f64),
+    floor_ms: f64,
+    max_abs_vs_cpu: Option<f64>,
+) -> BenchRow {
+    BenchRow {
+        variant: variant.to_string(),
+        flow_format: formats.flow.name().to_string(),
+        image_format: formats.image.name().to_string(),
+        stage: stage.name().to_string(),
+        width: size.0,
+        height: size.1,
+        ms_median,
+        ms_min,
+        vs_floor: ms_median / floor_ms,
+        ns_per_pixel: ms_median * 1e6 / (f64::from(size.0) * f64::from(size.1)),
+        max_abs_vs_cpu,
+    }
+}
+
+fn floor_bind_group(gpu: &Gpu, floor: &FloorPass, pose: &GpuPose) -> wgpu::BindGroup {
+    let view = pose.prelit_codes_view();
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("floor"),
+        layout: &floor.layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::TextureView(&view),
+        }],
+    })
+}
+
+fn record_floor(
+    floor: &FloorPass,
+    targets: &SubjectTargets,
+    group: &wgpu::BindGroup,
+    stage: Stage,
+    size: (u32, u32),
+    encoder: &mut wgpu::CommandEncoder,
+    timestamps: Timestamps,
+) {
+    match stage {
+        Stage::Fragment => {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("floor"),
+                color_attachments: &[super::bind::cleared(targets.layer_view(0))],
+                depth_stencil_attachment: None,
+                timestamp_writes: timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(i),
+                    end_of_pass_write_index: Some(i + 1),
+                }),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&floor.fragment);
+            pass.set_bind_group(0, targets.fragment_group(0), &[]);
+            pass.set_bind_group(1, group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        Stage::Compute => {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("floor"),
+                timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: Some(i),
+                    end_of_pass_write_index: Some(i + 1),
+                }),
+            });
+            pass.set_pipeline(&floor.compute);
+            pass.set_bind_group(0, targets.compute_group(0), &[]);
+            pass.set_bind_group(1, group, &[]);
+            let (x, y) = workgroups(size);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+}
+
+/// Every storage combination.
+pub fn all_formats() -> Vec<PoseFormats> {
+    ImageFormat::ALL
+        .iter()
+        .flat_map(|&image| FlowFormat::ALL.map(|flow| PoseFormats { image, flow }))
+        .collect()
+}

@@ -1,0 +1,215 @@
+//! `frf bench interp`: the GPU interpolation benchmark ([`frf_render::gpu::bench`]) on a
+//! field's pose or on the synthetic pose of the original's shape, printed as a table or
+//! as JSON.
+
+use std::path::PathBuf;
+
+use clap::{Args, Subcommand, ValueEnum};
+use frf_reflectance::FieldFile;
+use frf_render::gpu::Gpu;
+use frf_render::gpu::bench::{BenchOptions, BenchReport, all_formats, run};
+use frf_render::gpu::formats::PoseFormats;
+use frf_render::gpu::rebin::Stage;
+use frf_render::resident::{Lighting, PoseSource, ResidentPose};
+use frf_render::synthetic::synthetic_pose;
+
+use super::args::{LightingArgs, parse_size};
+use super::progress::bar;
+use crate::CliResult;
+
+/// `frf bench ...`.
+#[derive(Args)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    what: BenchCommand,
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Time per frame of the floor pass and every interpolation, every storage format,
+    /// fragment and compute, several sizes; the CPU reference in the same run.
+    Interp(InterpArgs),
+}
+
+/// Which storage formats to time.
+#[derive(Clone, Copy, ValueEnum)]
+enum FormatsArg {
+    /// Every image and flow format.
+    All,
+    /// The renderer's default only.
+    Default,
+}
+
+/// Which stages to time.
+#[derive(Clone, Copy, ValueEnum)]
+enum StagesArg {
+    /// Fragment and compute.
+    Both,
+    /// Fragment only.
+    Fragment,
+    /// Compute only.
+    Compute,
+}
+
+/// Arguments of `frf bench interp`.
+#[derive(Args)]
+struct InterpArgs {
+    /// A field to take the pose from (default: a synthetic pose of the original's shape,
+    /// 36 x 3 views of 320 x 448).
+    #[arg(long)]
+    field: Option<PathBuf>,
+    /// The field's pose.
+    #[arg(long, default_value_t = 0)]
+    pose: u32,
+    #[command(flatten)]
+    lighting: LightingArgs,
+    /// Frame sizes, WxH (repeatable; default 0.26, 1, 2 and 8 megapixels).
+    #[arg(long = "size", value_parser = parse_size)]
+    sizes: Vec<(u32, u32)>,
+    /// Storage formats timed.
+    #[arg(long, value_enum, default_value = "all")]
+    formats: FormatsArg,
+    /// Stages timed.
+    #[arg(long, value_enum, default_value = "both")]
+    stages: StagesArg,
+    /// Passes run before timing each combination.
+    #[arg(long, default_value_t = 3)]
+    warmup: u32,
+    /// Passes timed per combination.
+    #[arg(long, default_value_t = 20)]
+    repeats: u32,
+    /// Frames the CPU reference renders per variant and size.
+    #[arg(long, default_value_t = 3)]
+    cpu_repeats: u32,
+    /// The CPU reference renders sizes up to this many megapixels.
+    #[arg(long, default_value_t = 2.1)]
+    cpu_max_mp: f64,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Runs `frf bench`.
+pub fn run_bench(args: BenchArgs) -> CliResult {
+    match args.what {
+        BenchCommand::Interp(a) => interp(a),
+    }
+}
+
+fn interp(args: InterpArgs) -> CliResult {
+    let source = match &args.field {
+        Some(path) => {
+            let field = FieldFile::open(path)?;
+            let conditions = field.header().conditions.len();
+            let lighting = match args.lighting.env {
+                Some(_) => args.lighting.lighting(conditions)?.0,
+                None => Lighting::Unlit,
+            };
+            PoseSource::load(&field, args.pose, &lighting)
+                .map_err(|e| format!("{}: pose {}: {e}", path.display(), args.pose))?
+        }
+        None => synthetic_pose()?,
+    };
+    let pose = ResidentPose::relight_cpu(&source);
+    let sizes = if args.sizes.is_empty() {
+        vec![(640, 400), (1280, 800), (1920, 1080), (3840, 2160)]
+    } else {
+        args.sizes.clone()
+    };
+    if let Some(&(w, h)) = sizes
+        .iter()
+        .find(|(w, h)| *w == 0 || *h == 0 || *w > 16384 || *h > 16384)
+    {
+        return Err(format!("--size {w}x{h}: frames are 1 to 16384 pixels a side").into());
+    }
+    if args.repeats == 0 {
+        return Err("--repeats must be at least 1".into());
+    }
+    let options = BenchOptions {
+        sizes,
+        formats: match args.formats {
+            FormatsArg::All => all_formats(),
+            FormatsArg::Default => vec![PoseFormats::DEFAULT],
+        },
+        stages: match args.stages {
+            StagesArg::Both => Stage::ALL.to_vec(),
+            StagesArg::Fragment => vec![Stage::Fragment],
+            StagesArg::Compute => vec![Stage::Compute],
+        },
+        warmup: args.warmup,
+        repeats: args.repeats,
+        cpu_repeats: args.cpu_repeats,
+        cpu_max_pixels: (args.cpu_max_mp.max(0.0) * 1e6) as u64,
+    };
+    let gpu = Gpu::new()?;
+    let progress = bar("benchmark");
+    let report = run(&gpu, &pose, &options, &mut |m| {
+        progress.set_message(m.to_string())
+    })?;
+    progress.finish_and_clear();
+    print_table(&report, args.field.is_some());
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
+
+fn print_table(r: &BenchReport, field: bool) {
+    eprintln!(
+        "{} ({}, {}; timed by {}); pose: {}, {:.1} MB resident as codes/codes8",
+        r.adapter,
+        r.backend,
+        r.driver,
+        r.clock,
+        if field {
+            "the field's"
+        } else {
+            "synthetic, 36 x 3 views of 320 x 448"
+        },
+        r.bytes_per_pose as f64 / 1e6
+    );
+    eprintln!(
+        "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10} {:>10} {:>9} {:>8} {:>11}",
+        "variant",
+        "image",
+        "flow",
+        "stage",
+        "size",
+        "median ms",
+        "min ms",
+        "x floor",
+        "ns/px",
+        "max |Δ| cpu"
+    );
+    for x in &r.rows {
+        eprintln!(
+            "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10.4} {:>10.4} {:>9.2} {:>8.2} {:>11}",
+            x.variant,
+            x.image_format,
+            x.flow_format,
+            x.stage,
+            format!("{}x{}", x.width, x.height),
+            x.ms_median,
+            x.ms_min,
+            x.vs_floor,
+            x.ns_per_pixel,
+            x.max_abs_vs_cpu
+                .map_or("".to_string(), |e| format!("{e:.2e}"))
+        );
+    }
+    for x in &r.cpu_rows {
+        eprintln!(
+            "CPU reference ({} threads) {:<8} {}x{}: {:.2} ms median, {:.2} ms min",
+            x.threads, x.variant, x.width, x.height, x.ms_median, x.ms_min
+        );
+    }
+    for b in &r.floor_bandwidth {
+        eprintln!(
+            "floor {} {}x{}: {:.1} GB/s achieved (4 B read + 16 B written a pixel)",
+            b.stage, b.width, b.height, b.gb_per_s
+        );
+    }
+    if let Some(f) = &r.fastest_correct_fourway {
+        eprintln!("fastest correct four-way at the largest size: {f}");
+    }
+}
