@@ -48,6 +48,7 @@ impl RebinPass {
                 storage(4, true, f),
                 storage(5, true, f),
                 storage(6, true, f),
+                storage(7, true, f),
             ],
         });
         let pipeline = full_screen_pipeline(
