@@ -501,6 +501,38 @@ mod tests {
     }
 
     #[test]
+    fn a_vertical_line_at_a_column_reaches_the_spans_either_side() {
+        for (name, (centres, cyl)) in [("stage", stage()), ("ring", ring()), ("arc", arc())] {
+            let index = cyl.index.as_ref().unwrap();
+            let spans = index.ranges.len();
+            let rows = cyl.rows();
+            let radius = 0.5 * (index.r_min + index.r_max);
+            for c in 0..cyl.columns() {
+                let column = &centres[c * rows..(c + 1) * rows];
+                let centre = column.iter().map(|&p| xz(p)).sum::<Vec2>() / rows as f32;
+                let towards = (centre - index.axis).normalize();
+                // Either side of the column, well within the ranges' margins.
+                for turn in [-5e-4f32, 0.0, 5e-4] {
+                    let d = Vec2::from_angle(turn).rotate(towards) * radius + index.axis;
+                    let mut visited = Vec::new();
+                    index.spans_along(Vec3::new(d.x, 1.0, d.y), Vec3::Y, |u| visited.push(u));
+                    // The span after the column, and the one before (across the seam
+                    // of a ring).
+                    let wraps = spans == cyl.columns();
+                    let after = (c < spans).then_some(c);
+                    let before = match c {
+                        0 => wraps.then_some(spans - 1),
+                        _ => Some(c - 1),
+                    };
+                    for u in after.into_iter().chain(before) {
+                        assert!(visited.contains(&u), "{name}, column {c}: {visited:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn a_grid_the_index_does_not_fit_solves_every_quad() {
         // A straight rig: the axis point lies on its footprint.
         let centres: Vec<Vec3> = (0..10)
