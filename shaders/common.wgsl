@@ -31,6 +31,23 @@ struct Quad {
     pad: f32,
 }
 
+// The header of a cylinder's column index (`render/src/cylinder/column_index.rs`): which
+// column spans a ray's line can reach, seen from above.
+struct ColumnIndex {
+    // (x, z) of the axis point A, and the unit direction from it of azimuth 0.
+    axis: vec2<f32>,
+    reference: vec2<f32>,
+    // 1 when the columns run counterclockwise in (x, z), -1 otherwise.
+    orientation: f32,
+    // The annulus about A holding every quad's footprint.
+    r_min: f32,
+    r_max: f32,
+    spans: u32,
+    quads_per_span: u32,
+    // 0: every quad is solved.
+    enabled: u32,
+}
+
 // What a frame renders.
 struct Frame {
     // The virtual camera: `world_from_camera` columns, centre, intrinsics.

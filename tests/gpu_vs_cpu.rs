@@ -53,6 +53,8 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let source = tiny_source();
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
+    // The frames below find their quads through the cylinder's column index.
+    assert!(pose.geometry.cylinder.has_column_index());
 
     for (i, (a, b)) in cpu.scales.iter().zip(&pose.scales).enumerate() {
         assert!(

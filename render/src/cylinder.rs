@@ -18,11 +18,22 @@
 //!   `p = P00 + β e1 + γ e2 + βγ e3` is solved for `(β, γ)` in the quad's plane (a
 //!   quadratic in `γ`; linear for parallelograms such as the walls).
 //!
+//! - **Which quads.** Only the quads of the column spans the ray's line can reach, seen
+//!   from above, are solved ([`column_index`]); the loop over every quad
+//!   ([`Cylinder::intersect_brute`]) gives the same hit and is kept as the reference.
+//!
 //! Every function here has a WGSL twin in `shaders/rebin.wgsl`; the GPU and CPU paths are
 //! tested against each other.
 
+pub mod column_index;
+
+use std::cmp::Ordering;
+
 use frf_core::camera::{Camera, Intrinsics, Rigid};
 use glam::{Mat3, Quat, Vec2, Vec3};
+
+use crate::gpu::types::GpuColumnIndex;
+use column_index::ColumnIndex;
 
 /// Height of the walls above and below the grid, metres: far beyond any scene.
 const WALL_HEIGHT_M: f32 = 1.0e3;
@@ -87,6 +98,90 @@ impl Quad {
             wall,
         }
     }
+
+    /// The corners of the patch the inverse bilinear map solves on: `P00, P10, P01, P11`
+    /// carried into the quad's plane along the direction its in-plane frame ignores (the
+    /// corners themselves for a planar quad, such as a wall). The point of a hit at
+    /// `(β, γ)` is their bilinear blend. `None` when that frame is degenerate.
+    fn plane_corners(&self) -> Option<[Vec3; 4]> {
+        let (x_axis, y_axis) = plane_frame(self.e1, self.normal);
+        let along = x_axis.cross(y_axis);
+        let across = self.normal.dot(along);
+        if across.abs() < 1e-3 {
+            return None;
+        }
+        let into_plane = |p: Vec3| p - along * (self.normal.dot(p - self.p00) / across);
+        let (p10, p01) = (self.p00 + self.e1, self.p00 + self.e2);
+        Some([self.p00, p10, p01, p10 + self.e2 + self.e3].map(into_plane))
+    }
+
+    /// Where the ray `origin + t dir` meets this quad (any `t`), if it does.
+    fn hit(&self, origin: Vec3, dir: Vec3) -> Option<CylinderHit> {
+        let denom = self.normal.dot(dir);
+        if denom.abs() < 1e-9 {
+            return None;
+        }
+        let t = self.normal.dot(self.p00 - origin) / denom;
+        let p = origin + dir * t;
+        let bg = inverse_bilinear(p, self.p00, self.e1, self.e2, self.e3, self.normal)?;
+        if outside(bg) > EDGE_SLACK {
+            return None;
+        }
+        let beta = bg.x.clamp(0.0, 1.0);
+        let (gamma, clamped) = match self.wall {
+            Some((g, c)) => (g, c),
+            None => (bg.y.clamp(0.0, 1.0), Clamp::None),
+        };
+        Some(CylinderHit {
+            u: self.u,
+            v: self.v,
+            beta,
+            gamma,
+            point: p,
+            t,
+            clamped,
+        })
+    }
+}
+
+/// The 2D frame of a quad's plane in which the inverse bilinear map is solved: `e1`'s
+/// direction, and the normal crossed with it.
+fn plane_frame(e1: Vec3, normal: Vec3) -> (Vec3, Vec3) {
+    let x_axis = e1.normalize_or_zero();
+    (x_axis, normal.cross(x_axis))
+}
+
+/// What the search over quads keeps: the hit of smallest `t` (of equal ones, that of the
+/// first quad in the cylinder's order, whatever order they are offered in), and whether
+/// any hit lies ahead of the ray's origin.
+#[derive(Debug, Default)]
+struct Nearest {
+    best: Option<(usize, CylinderHit)>,
+    any_ahead: bool,
+}
+
+impl Nearest {
+    /// Takes the hit, if any, of quad `index`.
+    fn offer(&mut self, index: usize, hit: Option<CylinderHit>) {
+        let Some(hit) = hit else { return };
+        self.any_ahead |= hit.t >= 0.0 || hit.t.is_nan();
+        let better = match &self.best {
+            None => true,
+            Some((i, best)) => match hit.t.total_cmp(&best.t) {
+                Ordering::Less => true,
+                Ordering::Equal => index < *i,
+                Ordering::Greater => false,
+            },
+        };
+        if better {
+            self.best = Some((index, hit));
+        }
+    }
+
+    /// The entry, unless every hit lies behind the origin (or there is none).
+    fn entry(self) -> Option<CylinderHit> {
+        self.best.filter(|_| self.any_ahead).map(|(_, hit)| hit)
+    }
 }
 
 /// The inverse bilinear map on a quad, in its plane: `(β, γ)` with `p = P00 + β e1 +
@@ -100,8 +195,7 @@ pub fn inverse_bilinear(
     normal: Vec3,
 ) -> Option<Vec2> {
     // 2D basis in the plane.
-    let x_axis = e1.normalize_or_zero();
-    let y_axis = normal.cross(x_axis);
+    let (x_axis, y_axis) = plane_frame(e1, normal);
     let flat = |v: Vec3| Vec2::new(v.dot(x_axis), v.dot(y_axis));
     let (q, a, b, c) = (flat(p - p00), flat(e1), flat(e2), flat(e3));
     // q = β a + γ b + βγ c. Eliminating β: (a + γ c) × (q − γ b) = 0 (2D cross).
@@ -181,6 +275,8 @@ pub struct Cylinder {
     columns: usize,
     rows: usize,
     quads: Vec<Quad>,
+    /// Which spans a ray's line can reach; `None` where the grid does not allow it.
+    index: Option<ColumnIndex>,
 }
 
 impl Cylinder {
@@ -219,10 +315,12 @@ impl Cylinder {
                 Some((0.0, Clamp::Below)),
             ));
         }
+        let index = ColumnIndex::new(&quads, rows + 1, centres, rows);
         Self {
             columns,
             rows,
             quads,
+            index,
         }
     }
 
@@ -236,41 +334,56 @@ impl Cylinder {
         self.rows
     }
 
-    /// Where the ray `origin + t dir` enters the cylinder (see the module docs).
+    /// Where the ray `origin + t dir` enters the cylinder (see the module docs): the
+    /// quads of the spans its line can reach are solved, all of them where the grid has no
+    /// column index. The same hit as [`Cylinder::intersect_brute`].
     pub fn intersect(&self, origin: Vec3, dir: Vec3) -> Option<CylinderHit> {
-        let mut hits: Vec<CylinderHit> = Vec::new();
-        for q in &self.quads {
-            let denom = q.normal.dot(dir);
-            if denom.abs() < 1e-9 {
-                continue;
-            }
-            let t = q.normal.dot(q.p00 - origin) / denom;
-            let p = origin + dir * t;
-            let Some(bg) = inverse_bilinear(p, q.p00, q.e1, q.e2, q.e3, q.normal) else {
-                continue;
-            };
-            if outside(bg) > EDGE_SLACK {
-                continue;
-            }
-            let beta = bg.x.clamp(0.0, 1.0);
-            let (gamma, clamped) = match q.wall {
-                Some((g, c)) => (g, c),
-                None => (bg.y.clamp(0.0, 1.0), Clamp::None),
-            };
-            hits.push(CylinderHit {
-                u: q.u,
-                v: q.v,
-                beta,
-                gamma,
-                point: p,
-                t,
-                clamped,
-            });
+        self.intersect_counted(origin, dir).0
+    }
+
+    /// Where the ray `origin + t dir` enters the cylinder, every quad solved: the
+    /// reference for [`Cylinder::intersect`].
+    pub fn intersect_brute(&self, origin: Vec3, dir: Vec3) -> Option<CylinderHit> {
+        let mut nearest = Nearest::default();
+        for (i, q) in self.quads.iter().enumerate() {
+            nearest.offer(i, q.hit(origin, dir));
         }
-        if hits.iter().all(|h| h.t < 0.0) {
-            return None;
-        }
-        hits.into_iter().min_by(|a, b| a.t.total_cmp(&b.t))
+        nearest.entry()
+    }
+
+    /// How many quads [`Cylinder::intersect`] solves for the ray `origin + t dir`.
+    pub fn quads_tested(&self, origin: Vec3, dir: Vec3) -> usize {
+        self.intersect_counted(origin, dir).1
+    }
+
+    /// [`Cylinder::intersect`], and the number of quads it solved.
+    fn intersect_counted(&self, origin: Vec3, dir: Vec3) -> (Option<CylinderHit>, usize) {
+        let index = match &self.index {
+            Some(index) if origin.is_finite() && dir.is_finite() => index,
+            _ => return (self.intersect_brute(origin, dir), self.quads.len()),
+        };
+        let per_span = index.quads_per_span();
+        let mut nearest = Nearest::default();
+        let mut tested = 0;
+        index.spans_along(origin, dir, |span| {
+            let first = span * per_span;
+            for (i, q) in self.quads[first..first + per_span].iter().enumerate() {
+                nearest.offer(first + i, q.hit(origin, dir));
+            }
+            tested += per_span;
+        });
+        (nearest.entry(), tested)
+    }
+
+    /// Whether [`Cylinder::intersect`] looks the quads up (else it solves them all).
+    pub fn has_column_index(&self) -> bool {
+        self.index.is_some()
+    }
+
+    /// The column index as the GPU reads it: its header (disabled where the grid has
+    /// none) and per span its range of azimuths (at least one entry).
+    pub fn column_index_gpu(&self) -> (GpuColumnIndex, Vec<[f32; 2]>) {
+        ColumnIndex::gpu(self.index.as_ref())
     }
 
     /// The quads and walls, as the GPU needs them.
@@ -346,7 +459,7 @@ mod tests {
     use super::*;
 
     /// A stage-like grid: 36 columns 10° apart, rows at 0°, 17°, 34° elevation.
-    fn grid() -> (Vec<Vec3>, usize, usize) {
+    pub(super) fn grid() -> (Vec<Vec3>, usize, usize) {
         let mut centres = Vec::new();
         for u in 0..36 {
             for e in [0.0f32, 17.0, 34.0] {

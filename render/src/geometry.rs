@@ -179,13 +179,16 @@ impl PoseGeometry {
 
     /// Bytes the pose holds where it is rendered, on the GPU or in the CPU's copy (the
     /// same layout): pre-lit RGBA8 texels per view, RG8 flow codes per stored flow (at
-    /// least one layer), the view and quad tables, the decoding tables and the proxy.
+    /// least one layer), the view and quad tables, the cylinder's column index, the
+    /// decoding tables and the proxy.
     pub fn resident_bytes(&self) -> u64 {
         let texels = self.crop.texels() as u64;
         let quads = self.cylinder.quads().len() as u64;
+        let (index, ranges) = self.cylinder.column_index_gpu();
         texels * (4 * self.views() as u64 + 2 * self.flow_layer_count.max(1) as u64)
             + self.views() as u64 * std::mem::size_of::<GpuView>() as u64
             + quads * std::mem::size_of::<GpuQuad>() as u64
+            + (std::mem::size_of_val(&index) + std::mem::size_of_val(ranges.as_slice())) as u64
             + TABLE_BYTES
             + self.proxy.resident_bytes()
     }

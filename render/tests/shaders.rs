@@ -10,8 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams, GpuShadowParams,
-    GpuView,
+    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams,
+    GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -149,6 +149,28 @@ fn pod_structs_match_naga_layouts() {
         "Proxy",
         GpuProxy,
         [origin, voxel, dims, present, axis, pad]
+    );
+    check_layout!(
+        &rebin,
+        "ColumnIndex",
+        GpuColumnIndex,
+        [
+            axis,
+            reference,
+            orientation,
+            r_min,
+            r_max,
+            spans,
+            quads_per_span,
+            enabled
+        ]
+    );
+    // The column index's ranges follow its header in one buffer.
+    let (_, fields) = layout(&rebin, "ColumnLookup");
+    let ranges = size_of::<GpuColumnIndex>() as u32;
+    assert_eq!(
+        fields,
+        [("header".to_string(), 0), ("ranges".to_string(), ranges)]
     );
     let relight = module(&shaders::composed(shaders::RELIGHT), "relight");
     check_layout!(

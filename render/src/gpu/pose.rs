@@ -1,8 +1,9 @@
 //! Making a pose resident on the GPU: its flows as RG8 integer texture arrays (the 8-bit
-//! log codes, decoded in the shader), the view and quad tables as storage buffers, and
-//! every view relit on the GPU into an RGBA8 texture array (`shaders/relight.wgsl`), one
-//! dispatch pair per view: the weighted sum of its basis images, then its encoding with
-//! the view's peak. Twin of [`crate::resident::ResidentPose::relight_cpu`].
+//! log codes, decoded in the shader), the view and quad tables and the cylinder's column
+//! index as storage buffers, and every view relit on the GPU into an RGBA8 texture array
+//! (`shaders/relight.wgsl`), one dispatch pair per view: the weighted sum of its basis
+//! images, then its encoding with the view's peak. Twin of
+//! [`crate::resident::ResidentPose::relight_cpu`].
 
 use std::sync::Arc;
 
@@ -330,6 +331,10 @@ impl Gpu {
         let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
         let tables = buffer("tables", &table_bytes(&[srgb_lut(), flow_table]));
+        let (index, ranges) = geometry.cylinder.column_index_gpu();
+        let mut index_bytes = bytemuck::bytes_of(&index).to_vec();
+        index_bytes.extend_from_slice(bytemuck::cast_slice(&ranges));
+        let index_buffer = buffer("column index", &index_bytes);
         let (proxy, hull_words) = geometry.proxy.gpu();
         let proxy_buffer = buffer("proxy", bytemuck::bytes_of(&proxy));
         let hull_buffer = buffer("hull", bytemuck::cast_slice(&hull_words));
@@ -370,6 +375,10 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 6,
                     resource: hull_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: index_buffer.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 8,

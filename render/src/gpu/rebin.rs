@@ -101,6 +101,7 @@ impl RebinPass {
                 storage(4, true, both),
                 storage(5, true, both),
                 storage(6, true, both),
+                storage(7, true, both),
                 wgpu::BindGroupLayoutEntry {
                     binding: 8,
                     visibility: both,

@@ -166,3 +166,27 @@ pub struct GpuInstance {
     /// Translation.
     pub translation: [f32; 4],
 }
+
+/// `ColumnIndex` of `shaders/common.wgsl`: the header of a cylinder's column index
+/// ([`crate::cylinder::column_index`]); per span its range of azimuths follows it in the
+/// same buffer.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuColumnIndex {
+    /// `(x, z)` of the axis point.
+    pub axis: [f32; 2],
+    /// Unit direction `(x, z)` of azimuth 0.
+    pub reference: [f32; 2],
+    /// 1 when the columns run counterclockwise in `(x, z)`, −1 otherwise.
+    pub orientation: f32,
+    /// Inner radius of the annulus holding every footprint.
+    pub r_min: f32,
+    /// Outer radius.
+    pub r_max: f32,
+    /// Column spans.
+    pub spans: u32,
+    /// Quads per span (`rows + 1`).
+    pub quads_per_span: u32,
+    /// 1 when the index is used; 0: every quad is solved.
+    pub enabled: u32,
+}
