@@ -5,12 +5,13 @@
 // `sample_prelit` and `sample_flow_layer`), chosen by `frf_render::gpu::formats`.
 //
 // Entry points: `fs_main` (a full-screen triangle into a colour target), `cs_main` (the
-// same pixels from a compute pass into a storage texture), `cs_classes` (what happened
-// to each pixel's ray, counted per workgroup, then once per workgroup into `stats`).
+// same pixels from a compute pass into a storage texture, and what happened to each
+// pixel's ray counted per workgroup, then once per workgroup into `stats`), `cs_classes`
+// (those counts alone, for frames drawn by `fs_main`).
 // Bind group 0 holds per-frame data, bind group 1 the resident pose.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Pixels inside the grid, clamped above, clamped below, missed (`cs_classes` only).
+// Pixels inside the grid, clamped above, clamped below, missed (compute entry points).
 @group(0) @binding(1) var<storage, read_write> stats: array<atomic<u32>, 4>;
 // The compute pass's target (`cs_main` only).
 @group(0) @binding(2) var target_image: texture_storage_2d<rgba32float, write>;
@@ -479,25 +480,17 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     return shade(position.xy);
 }
 
-@compute @workgroup_size(8, 8)
-fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= frame.size.x || id.y >= frame.size.y) {
-        return;
-    }
-    textureStore(target_image, id.xy, shade(vec2<f32>(id.xy) + 0.5));
-}
-
+// Per workgroup, how many of its pixels fell in each class; added to `stats` once.
 var<workgroup> class_counts: array<atomic<u32>, 4>;
 
-@compute @workgroup_size(8, 8)
-fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+fn clear_counts(local: u32) {
     if (local < 4u) {
         atomicStore(&class_counts[local], 0u);
     }
     workgroupBarrier();
-    if (id.x < frame.size.x && id.y < frame.size.y) {
-        atomicAdd(&class_counts[classify(vec2<f32>(id.xy) + 0.5).kind], 1u);
-    }
+}
+
+fn flush_counts(local: u32) {
     workgroupBarrier();
     if (local < 4u) {
         let n = atomicLoad(&class_counts[local]);
@@ -505,4 +498,30 @@ fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invoc
             atomicAdd(&stats[local], n);
         }
     }
+}
+
+// The frame pass as a compute dispatch: shades and counts the pixel classes.
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    clear_counts(local);
+    if (id.x < frame.size.x && id.y < frame.size.y) {
+        let c = classify(vec2<f32>(id.xy) + 0.5);
+        var colour = vec4<f32>(0.0);
+        if (c.kind != 3u) {
+            colour = morph(c.hit, c.s);
+        }
+        textureStore(target_image, id.xy, colour);
+        atomicAdd(&class_counts[c.kind], 1u);
+    }
+    flush_counts(local);
+}
+
+// The pixel classes alone, for frames drawn by the fragment pass.
+@compute @workgroup_size(8, 8)
+fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    clear_counts(local);
+    if (id.x < frame.size.x && id.y < frame.size.y) {
+        atomicAdd(&class_counts[classify(vec2<f32>(id.xy) + 0.5).kind], 1u);
+    }
+    flush_counts(local);
 }

@@ -204,11 +204,14 @@ pub fn inverse_bilinear(
     let k1 = cross(a, b) - cross(c, q);
     let k0 = -cross(a, q);
     let scale = k1.abs().max(k0.abs()).max(1e-30);
-    let gammas: Vec<f32> = if k2.abs() <= 1e-6 * scale {
+    // At most two roots, without allocating (this runs per quad per pixel).
+    let mut roots = [0.0f32; 2];
+    let count = if k2.abs() <= 1e-6 * scale {
         if k1.abs() < 1e-30 {
             return None;
         }
-        vec![-k0 / k1]
+        roots[0] = -k0 / k1;
+        1
     } else {
         let disc = k1 * k1 - 4.0 * k2 * k0;
         if disc < 0.0 {
@@ -217,16 +220,18 @@ pub fn inverse_bilinear(
         let s = disc.sqrt();
         // Numerically stable roots.
         let qq = -0.5 * (k1 + k1.signum() * s);
-        let mut roots = vec![qq / k2];
+        roots[0] = qq / k2;
         if qq.abs() > 1e-30 {
-            roots.push(k0 / qq);
+            roots[1] = k0 / qq;
+            2
+        } else {
+            1
         }
-        roots
     };
     // Of the roots, the one inside (or nearest to) the unit square.
-    gammas
-        .into_iter()
-        .filter_map(|g| {
+    roots[..count]
+        .iter()
+        .filter_map(|&g| {
             let d = a + c * g;
             let beta = if d.x.abs() >= d.y.abs() {
                 (q.x - g * b.x) / d.x

@@ -64,11 +64,43 @@ struct FrameRecord {
     poses: Vec<u32>,
     made_resident: Vec<u32>,
     resumed: bool,
+    /// Rendering it, read back included.
     seconds: Option<f64>,
+    /// Encoding and writing its files (overlapped with the next frame's rendering).
+    seconds_writing: Option<f64>,
     pixels_inside: usize,
     pixels_clamped_above: usize,
     pixels_clamped_below: usize,
     pixels_missed: usize,
+}
+
+/// The files of one rendered frame, not yet written.
+pub struct FrameFiles {
+    dir: PathBuf,
+    index: usize,
+    frame: frf_render::renderer::Frame,
+}
+
+impl FrameFiles {
+    /// Which frame.
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// Encodes and writes them (each file atomically), exposed by `exposure_stops` for
+    /// the PNG.
+    pub fn write(&self, exposure_stops: f32) -> CliResult {
+        let scale = 2f32.powf(exposure_stops);
+        let (dir, i) = (&self.dir, self.index);
+        if let Some(l) = &self.frame.layers {
+            write_exr_rgba(&layer_path(dir, i, "subject"), &l.subject)?;
+            write_exr_rgb(&layer_path(dir, i, "shadow"), &l.shadow)?;
+            write_exr_rgba(&layer_path(dir, i, "backdrop"), &l.backdrop)?;
+        }
+        write_exr_rgba(&frame_path(dir, i, "exr"), &self.frame.composite)?;
+        write_png8_srgba(&frame_path(dir, i, "png"), &self.frame.composite, scale)?;
+        Ok(())
+    }
 }
 
 /// An output directory being filled.
@@ -156,6 +188,7 @@ impl Output {
             made_resident: Vec::new(),
             resumed: true,
             seconds: None,
+            seconds_writing: None,
             pixels_inside: 0,
             pixels_clamped_above: 0,
             pixels_clamped_below: 0,
@@ -164,38 +197,36 @@ impl Output {
         Ok(())
     }
 
-    /// Writes a rendered frame.
-    pub fn write(
-        &mut self,
-        f: &ShotFrame,
-        r: ShotResult,
-        seconds: f64,
-        exposure_stops: f32,
-    ) -> CliResult {
-        let scale = 2f32.powf(exposure_stops);
-        let i = f.index;
-        if let Some(l) = &r.frame.layers {
-            write_exr_rgba(&layer_path(&self.dir, i, "subject"), &l.subject)?;
-            write_exr_rgb(&layer_path(&self.dir, i, "shadow"), &l.shadow)?;
-            write_exr_rgba(&layer_path(&self.dir, i, "backdrop"), &l.backdrop)?;
-        }
-        write_exr_rgba(&frame_path(&self.dir, i, "exr"), &r.frame.composite)?;
-        write_png8_srgba(&frame_path(&self.dir, i, "png"), &r.frame.composite, scale)?;
+    /// Records a rendered frame (`seconds` to render it) and returns its files, to be
+    /// written by [`FrameFiles::write`], on another thread while the next frame renders.
+    pub fn accept(&mut self, f: &ShotFrame, r: ShotResult, seconds: f64) -> FrameFiles {
         let s = r.frame.stats;
         self.totals = self.totals.merge(s);
         self.records.push(FrameRecord {
-            index: i,
+            index: f.index,
             time: f.time,
             poses: r.poses,
             made_resident: r.made_resident,
             resumed: false,
             seconds: Some(seconds),
+            seconds_writing: None,
             pixels_inside: s.inside,
             pixels_clamped_above: s.clamped_above,
             pixels_clamped_below: s.clamped_below,
             pixels_missed: s.missed,
         });
-        Ok(())
+        FrameFiles {
+            dir: self.dir.clone(),
+            index: f.index,
+            frame: r.frame,
+        }
+    }
+
+    /// Notes how long writing frame `i`'s files took.
+    pub fn written(&mut self, i: usize, seconds: f64) {
+        if let Some(r) = self.records.iter_mut().rev().find(|r| r.index == i) {
+            r.seconds_writing = Some(seconds);
+        }
     }
 
     /// Writes the contact sheet and the preview (when every frame of the shot is there)
@@ -205,6 +236,7 @@ impl Output {
         scene: &Scene,
         shot: &Shot<'_, R>,
         setup_seconds: f64,
+        wall_seconds: f64,
         bytes_read: u64,
     ) -> CliResult<String> {
         let scale = 2f32.powf(scene.exposure);
@@ -247,6 +279,12 @@ impl Output {
             n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
         };
         let mean = rendered.iter().sum::<f64>() / rendered.len().max(1) as f64;
+        let writing: Vec<f64> = self
+            .records
+            .iter()
+            .filter_map(|r| r.seconds_writing)
+            .collect();
+        let writing_mean = writing.iter().sum::<f64>() / writing.len().max(1) as f64;
         let (first, last) = (
             self.records.iter().map(|r| r.index).min().unwrap_or(0),
             self.records.iter().map(|r| r.index).max().unwrap_or(0),
@@ -265,6 +303,8 @@ impl Output {
             seconds_setup: f64,
             seconds_per_frame_median: f64,
             seconds_per_frame_mean: f64,
+            seconds_writing_per_frame_mean: f64,
+            seconds_wall: f64,
             plan: &'a frf_render::scene::plan::PlanCounts,
             planned: bool,
             bytes_read_measured: u64,
@@ -284,6 +324,8 @@ impl Output {
             seconds_setup: setup_seconds,
             seconds_per_frame_median: median,
             seconds_per_frame_mean: mean,
+            seconds_writing_per_frame_mean: writing_mean,
+            seconds_wall: wall_seconds,
             plan: &shot.plan().counts,
             planned: shot.planned(),
             bytes_read_measured: bytes_read,
@@ -302,7 +344,8 @@ impl Output {
         let pct = |n: usize| 100.0 * n as f64 / all as f64;
         let c = shot.counters();
         Ok(format!(
-            "{} frames in {}: {median:.3} s/frame median ({mean:.3} mean), setup {setup_seconds:.2} s; \
+            "{} frames in {}: {median:.3} s/frame median to render ({mean:.3} mean), {writing_mean:.3} s mean to write \
+             (on its own thread), {wall_seconds:.2} s wall; setup {setup_seconds:.2} s; \
              {} resumed; poses made resident {} ({} relit for a new lighting, {} dropped for the memory budget, \
              peak {:.1} MB, {:.2} s); {:.2} MB read from the field\n\
              pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row, {:.1} % to the bottom row, \

@@ -329,7 +329,7 @@ pub fn run(
                             );
                             let copied = gpu.copy_rgba(&mut e, targets.texture(), size);
                             gpu.queue.submit([e.finish()]);
-                            let img = gpu.read_rgba(&copied, size)?;
+                            let img = gpu.read_rgba(&copied)?;
                             Some(
                                 img.pixels()
                                     .iter()

@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt;
 use frf_core::camera::Rigid;
 
 use super::bind::{
-    FLOAT, cleared, full_screen_pipeline, rgba32f, storage, texture_2d, texture_array, uniform,
+    FLOAT, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
 };
 use super::pose::GpuPose;
 use super::rebin::frame_uniform;
@@ -25,7 +25,7 @@ use crate::morph::Variant;
 
 /// The pass's layouts and pipeline.
 pub struct CompositePass {
-    frame_layout: wgpu::BindGroupLayout,
+    pub(super) frame_layout: wgpu::BindGroupLayout,
     image_layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
 }
@@ -231,20 +231,7 @@ impl Gpu {
                 });
             let subjects = self.draw_subjects(&mut encoder, &drawn, size, variant);
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
-            let shadows = self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("walker shadows"),
-                size: wgpu::Extent3d {
-                    width: n_shadow,
-                    height: n_shadow,
-                    depth_or_array_layers: order.len() as u32,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
+            let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let mut gpu_instances = Vec::with_capacity(order.len());
             for (layer, &k) in order.iter().enumerate() {
                 let i = &instances[k];
@@ -254,7 +241,7 @@ impl Gpu {
                     encoder.copy_texture_to_texture(
                         texture.as_image_copy(),
                         wgpu::TexelCopyTextureInfo {
-                            texture: &shadows,
+                            texture: &t.shadows,
                             mip_level: 0,
                             origin: wgpu::Origin3d {
                                 x: 0,
@@ -284,47 +271,15 @@ impl Gpu {
                 params.shadow_extent = info.extent_m;
             }
             params.instances = order.len() as u32;
-            let buffer = |label: &str, contents: &[u8], usage| {
-                self.device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(label),
-                        contents,
-                        usage,
-                    })
+            let write = |buffer: &wgpu::Buffer, bytes: &[u8]| {
+                self.queue.write_buffer(buffer, 0, bytes);
             };
-            let frame = buffer(
-                "composite camera",
+            write(
+                &t.frame,
                 bytemuck::bytes_of(&frame_uniform(None, camera, variant)),
-                wgpu::BufferUsages::UNIFORM,
             );
-            let params = buffer(
-                "composite params",
-                bytemuck::bytes_of(&params),
-                wgpu::BufferUsages::UNIFORM,
-            );
-            let instance_buffer = buffer(
-                "walkers",
-                bytemuck::cast_slice(&gpu_instances),
-                wgpu::BufferUsages::STORAGE,
-            );
-            let frame_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("composite frame"),
-                layout: &self.composite.frame_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: frame.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: instance_buffer.as_entire_binding(),
-                    },
-                ],
-            });
+            write(&t.params, bytemuck::bytes_of(&params));
+            write(&t.instances, bytemuck::cast_slice(&gpu_instances));
             let array_view = |t: &wgpu::Texture| {
                 t.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -336,7 +291,7 @@ impl Gpu {
                 array_view(subjects.texture()),
                 view(&backdrop.env),
                 view(&backdrop.plate),
-                array_view(&shadows),
+                array_view(&t.shadows),
             ];
             let image_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("composite images"),
@@ -350,46 +305,38 @@ impl Gpu {
                     })
                     .collect::<Vec<_>>(),
             });
-            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-            let targets = [
-                "composite",
-                "shadow layer",
-                "backdrop layer",
-                "subject layer",
-            ]
-            .map(|label| rgba32f(&self.device, label, size, usage));
-            let target_views = targets.each_ref().map(view);
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("composite"),
-                    color_attachments: &target_views.iter().map(cleared).collect::<Vec<_>>(),
+                    color_attachments: &t.target_views.iter().map(cleared).collect::<Vec<_>>(),
                     depth_stencil_attachment: None,
                     timestamp_writes: None,
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 pass.set_pipeline(&self.composite.pipeline);
-                pass.set_bind_group(0, &frame_group, &[]);
+                pass.set_bind_group(0, &t.frame_group, &[]);
                 pass.set_bind_group(1, &image_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            let composite = self.copy_rgba(&mut encoder, &targets[0], size);
-            let copied_layers = layers.then(|| {
-                [&targets[3], &targets[1], &targets[2]]
-                    .map(|t| self.copy_rgba(&mut encoder, t, size))
-            });
-            let stats = self.copy_stats(&mut encoder, &subjects);
+            // Composite, then (with layers) subject, shadow and backdrop.
+            let read: &[usize] = if layers { &[0, 3, 1, 2] } else { &[0] };
+            for &k in read {
+                t.readback[k].copy(&mut encoder, &t.targets[k]);
+            }
+            self.copy_stats(&mut encoder, &subjects);
             self.queue.submit([encoder.finish()]);
-            let image = self.read_rgba(&composite, size)?;
-            let layers = match copied_layers {
-                Some([s, sh, b]) => Some(Layers {
-                    subject: self.read_rgba(&s, size)?,
-                    shadow: self.read_rgba(&sh, size)?.map(|p| [p[0], p[1], p[2]]),
-                    backdrop: self.read_rgba(&b, size)?,
-                }),
-                None => None,
+            let image = self.read_rgba(&t.readback[0])?;
+            let layers = if layers {
+                Some(Layers {
+                    subject: self.read_rgba(&t.readback[3])?,
+                    shadow: self.read_rgba(&t.readback[1])?.map(|p| [p[0], p[1], p[2]]),
+                    backdrop: self.read_rgba(&t.readback[2])?,
+                })
+            } else {
+                None
             };
-            Ok((image, layers, self.read_stats(&stats)?))
+            Ok((image, layers, self.read_stats(&subjects)?))
         })
     }
 }

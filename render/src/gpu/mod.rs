@@ -18,8 +18,10 @@
 pub mod bench;
 pub mod bind;
 pub mod composite;
+mod composite_targets;
 pub mod formats;
 pub mod pose;
+mod readback;
 pub mod rebin;
 pub mod scope;
 pub mod shadow;
@@ -81,6 +83,9 @@ fn gpu_err(e: impl std::fmt::Display) -> RenderError {
     RenderError::Gpu(e.to_string())
 }
 
+/// Resources kept per key (the last few keys used), shared with the frames using them.
+type Kept<K, T> = std::sync::Mutex<Vec<(K, std::sync::Arc<T>)>>;
+
 /// An open GPU with the renderer's pipelines.
 pub struct Gpu {
     device: wgpu::Device,
@@ -93,7 +98,9 @@ pub struct Gpu {
     /// How the frame pass runs.
     stage: rebin::Stage,
     /// Frame targets kept per size and number of walkers.
-    targets: std::sync::Mutex<Vec<(((u32, u32), u32), std::sync::Arc<rebin::SubjectTargets>)>>,
+    targets: Kept<((u32, u32), u32), rebin::SubjectTargets>,
+    /// Composite targets kept per size, number of walkers and shadow-map size.
+    composite_targets: Kept<composite_targets::CompositeKey, composite_targets::CompositeTargets>,
     /// Whether passes can be timed on the GPU (`Features::TIMESTAMP_QUERY`).
     timestamps: bool,
     shadow: shadow::ShadowPass,
@@ -138,8 +145,9 @@ impl Gpu {
         Self {
             relight: pose::RelightPass::new(&device),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
-            stage: rebin::Stage::Fragment,
+            stage: rebin::Stage::Compute,
             targets: Default::default(),
+            composite_targets: Default::default(),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             shadow: shadow::ShadowPass::new(&device),
             composite: composite::CompositePass::new(&device),

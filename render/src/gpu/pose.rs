@@ -354,7 +354,7 @@ impl Gpu {
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view_of(&flows)),
+                    resource: wgpu::BindingResource::TextureView(&view_of(flows)),
                 },
                 wgpu::BindGroupEntry {
                     binding: 2,

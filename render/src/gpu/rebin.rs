@@ -11,11 +11,12 @@ use frf_core::image::{Image, Rgba};
 
 use super::Gpu;
 use super::bind::{
-    cleared, compute_pipeline, copy_to_buffer, full_screen_pipeline, padded_row, readback_buffer,
-    rgba_pixels, storage, storage_texture, texture_array, uniform,
+    cleared, compute_pipeline, full_screen_pipeline, readback_buffer, storage, storage_texture,
+    texture_array, uniform, uniform_buffer,
 };
 use super::formats::PoseFormats;
 use super::pose::GpuPose;
+use super::readback::Readback;
 use super::types::GpuFrame;
 use crate::cpu::FrameStats;
 use crate::error::Result;
@@ -81,6 +82,7 @@ impl RebinPass {
             "frame (compute)",
             &[
                 uniform(0, both),
+                storage(1, false, wgpu::ShaderStages::COMPUTE),
                 storage_texture(2, wgpu::TextureFormat::Rgba32Float),
             ],
         );
@@ -199,12 +201,15 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
 
 /// A frame's targets and per-frame buffers for one size and number of walkers, made once
 /// and kept ([`Gpu::subject_targets`]): the subjects' texture array, its layer views, the
-/// pixel-class counters, and per layer a frame uniform (written with `write_buffer`)
+/// pixel-class counters, staging buffers to read them back through, and per layer a frame uniform (written with `write_buffer`)
 /// with the bind groups of the fragment, compute and class passes.
 pub(super) struct SubjectTargets {
     texture: wgpu::Texture,
     layers: Vec<LayerTargets>,
     stats: wgpu::Buffer,
+    /// Staging buffers of the counters and of layer 0.
+    stats_readback: wgpu::Buffer,
+    readback: Readback,
 }
 
 struct LayerTargets {
@@ -262,12 +267,7 @@ impl SubjectTargets {
                     array_layer_count: Some(1),
                     ..Default::default()
                 });
-                let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("frame"),
-                    size: std::mem::size_of::<GpuFrame>() as u64,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
+                let uniform = uniform_buffer(device, "frame", std::mem::size_of::<GpuFrame>());
                 let frame = wgpu::BindGroupEntry {
                     binding: 0,
                     resource: uniform.as_entire_binding(),
@@ -279,6 +279,10 @@ impl SubjectTargets {
                         &pass.compute_layout,
                         &[
                             frame.clone(),
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: stats.as_entire_binding(),
+                            },
                             wgpu::BindGroupEntry {
                                 binding: 2,
                                 resource: wgpu::BindingResource::TextureView(&view),
@@ -305,6 +309,8 @@ impl SubjectTargets {
             texture,
             layers,
             stats,
+            stats_readback: readback_buffer(device, "stats readback", 16),
+            readback: Readback::new(device, "subject readback", size),
         }
     }
 }
@@ -338,8 +344,10 @@ impl SubjectTargets {
 
 impl RebinPass {
     /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer,
-    /// into `layer` of `targets`, by `stage`, with the pass's timestamps when given; and
-    /// with its pixel classes counted into the targets' counters when `classes`.
+    /// into `layer` of `targets`, by `stage`, with the pass's timestamps when given. Its
+    /// pixel classes are counted into the targets' counters by the compute pass itself,
+    /// and after a fragment pass by a pass of their own when `classes`.
+    #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
     pub(super) fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -387,7 +395,8 @@ impl RebinPass {
                 pass.dispatch_workgroups(x, y, 1);
             }
         }
-        if classes {
+        // The compute pass counts as it shades; a fragment pass needs its own.
+        if classes && stage == Stage::Fragment {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("classes"),
                 timestamp_writes: None,
@@ -451,20 +460,15 @@ impl Gpu {
         Subjects { targets }
     }
 
-    /// Copies the pixel-class counters of a drawn frame for readback.
-    pub(super) fn copy_stats(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        subject: &Subjects,
-    ) -> wgpu::Buffer {
-        let readback = readback_buffer(&self.device, "stats readback", 16);
-        encoder.copy_buffer_to_buffer(&subject.targets.stats, 0, &readback, 0, 16);
-        readback
+    /// Copies the pixel-class counters of a drawn frame into its staging buffer.
+    pub(super) fn copy_stats(&self, encoder: &mut wgpu::CommandEncoder, subject: &Subjects) {
+        let t = &subject.targets;
+        encoder.copy_buffer_to_buffer(&t.stats, 0, &t.stats_readback, 0, 16);
     }
 
-    /// The counters read back.
-    pub(super) fn read_stats(&self, readback: &wgpu::Buffer) -> Result<FrameStats> {
-        let counts = self.read_buffer(readback)?;
+    /// The counters [`Gpu::copy_stats`] copied (after its submission).
+    pub(super) fn read_stats(&self, subject: &Subjects) -> Result<FrameStats> {
+        let counts = self.read_buffer(&subject.targets.stats_readback)?;
         let counts: &[u32] = bytemuck::cast_slice(&counts);
         Ok(FrameStats {
             inside: counts[0] as usize,
@@ -474,32 +478,17 @@ impl Gpu {
         })
     }
 
-    /// Copies an RGBA32F texture of `size` into a new readback buffer; returns it and its
-    /// padded row length.
+    /// Copies (layer 0 of) an RGBA32F texture of `size` into a new staging buffer, for
+    /// one-off reads; frames read back through their targets' own.
     pub(super) fn copy_rgba(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         texture: &wgpu::Texture,
         size: (u32, u32),
-    ) -> (wgpu::Buffer, u32) {
-        let row = padded_row(size.0 * 16);
-        let buffer = readback_buffer(&self.device, "readback", (row * size.1) as u64);
-        copy_to_buffer(encoder, texture, &buffer, row, (size.0, size.1, 1));
-        (buffer, row)
-    }
-
-    /// Reads back what [`Gpu::copy_rgba`] copied.
-    pub(super) fn read_rgba(
-        &self,
-        (buffer, row): &(wgpu::Buffer, u32),
-        size: (u32, u32),
-    ) -> Result<Image<Rgba>> {
-        let bytes = self.read_buffer(buffer)?;
-        Ok(Image::from_vec(
-            size.0 as usize,
-            size.1 as usize,
-            rgba_pixels(&bytes, size, *row),
-        )?)
+    ) -> Readback {
+        let readback = Readback::new(&self.device, "readback", size);
+        readback.copy(encoder, texture);
+        readback
     }
 
     /// Renders the subject of a frame of `camera` (subject frame) with `variant`:
@@ -518,10 +507,11 @@ impl Gpu {
                     label: Some("frame"),
                 });
             let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant);
-            let image = self.copy_rgba(&mut encoder, subject.texture(), size);
-            let stats = self.copy_stats(&mut encoder, &subject);
+            let t = &subject.targets;
+            t.readback.copy(&mut encoder, &t.texture);
+            self.copy_stats(&mut encoder, &subject);
             self.queue.submit([encoder.finish()]);
-            Ok((self.read_rgba(&image, size)?, self.read_stats(&stats)?))
+            Ok((self.read_rgba(&t.readback)?, self.read_stats(&subject)?))
         })
     }
 }

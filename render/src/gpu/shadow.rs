@@ -230,7 +230,7 @@ impl Gpu {
                 });
             let copied = self.copy_rgba(&mut encoder, texture, size);
             self.queue.submit([encoder.finish()]);
-            let img = self.read_rgba(&copied, size)?;
+            let img = self.read_rgba(&copied)?;
             Ok(Some(img.map(|p| [p[0], p[1], p[2]])))
         })
     }

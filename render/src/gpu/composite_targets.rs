@@ -1,0 +1,118 @@
+//! What a composited frame of one size, number of walkers and shadow-map size needs
+//! besides its inputs, made once and kept ([`Gpu::composite_targets`]): the four RGBA32F
+//! targets, the walkers' shadow maps gathered into one array, the uniforms and walker
+//! buffer (written with `write_buffer` each frame), the frame's bind group, and the
+//! staging buffers its images are read back through.
+
+use std::sync::Arc;
+
+use super::Gpu;
+use super::bind::{rgba32f, uniform_buffer};
+use super::composite::CompositePass;
+use super::readback::Readback;
+use super::types::{GpuComposite, GpuFrame, GpuInstance};
+
+/// The key of a set of composite targets: size, walkers, shadow-map texels.
+pub(super) type CompositeKey = ((u32, u32), u32, u32);
+
+/// The composite pass's kept targets and buffers for one [`CompositeKey`].
+pub(super) struct CompositeTargets {
+    /// Composite, relative irradiance (shadow), backdrop, subjects alone.
+    pub(super) targets: [wgpu::Texture; 4],
+    pub(super) target_views: [wgpu::TextureView; 4],
+    /// Per walker (back to front), its relit shadow map.
+    pub(super) shadows: wgpu::Texture,
+    pub(super) frame: wgpu::Buffer,
+    pub(super) params: wgpu::Buffer,
+    pub(super) instances: wgpu::Buffer,
+    pub(super) frame_group: wgpu::BindGroup,
+    /// One staging buffer per target, in the order of `targets`.
+    pub(super) readback: [Readback; 4],
+}
+
+impl CompositeTargets {
+    fn new(device: &wgpu::Device, pass: &CompositePass, key: CompositeKey) -> Self {
+        let (size, walkers, texels) = key;
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let labels = [
+            "composite",
+            "shadow layer",
+            "backdrop layer",
+            "subject layer",
+        ];
+        let targets = labels.map(|label| rgba32f(device, label, size, usage));
+        let target_views = targets
+            .each_ref()
+            .map(|t| t.create_view(&wgpu::TextureViewDescriptor::default()));
+        let shadows = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("walker shadows"),
+            size: wgpu::Extent3d {
+                width: texels,
+                height: texels,
+                depth_or_array_layers: walkers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let frame = uniform_buffer(device, "composite camera", size_of::<GpuFrame>());
+        let params = uniform_buffer(device, "composite params", size_of::<GpuComposite>());
+        let instances = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("walkers"),
+            size: (size_of::<GpuInstance>() * walkers as usize) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite frame"),
+            layout: &pass.frame_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: frame.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: instances.as_entire_binding(),
+                },
+            ],
+        });
+        let readback = labels.map(|label| Readback::new(device, label, size));
+        Self {
+            targets,
+            target_views,
+            shadows,
+            frame,
+            params,
+            instances,
+            frame_group,
+            readback,
+        }
+    }
+}
+
+impl Gpu {
+    /// The kept composite targets for `key` (made on first use; the last few kept).
+    pub(super) fn composite_targets(&self, key: CompositeKey) -> Arc<CompositeTargets> {
+        let mut cache = self
+            .composite_targets
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        if let Some((_, t)) = cache.iter().find(|(k, _)| *k == key) {
+            return t.clone();
+        }
+        let t = Arc::new(CompositeTargets::new(&self.device, &self.composite, key));
+        if cache.len() >= 4 {
+            cache.remove(0);
+        }
+        cache.push((key, t.clone()));
+        t
+    }
+}
