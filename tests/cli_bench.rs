@@ -61,7 +61,10 @@ fn the_bench_reports_every_variant_stage_and_the_floor_as_json() {
                     row["ms_median"].as_f64().unwrap(),
                     row["ms_min"].as_f64().unwrap(),
                 );
-                assert!(min > 0.0 && min <= median, "{variant} {stage}: {min} {median}");
+                assert!(
+                    min > 0.0 && min <= median,
+                    "{variant} {stage}: {min} {median}"
+                );
                 assert!(row["flow_format"].is_string() && row["image_format"].is_string());
                 // Morphs at the first size are checked against the CPU reference.
                 if variant != "floor" && size == (64, 48) {
@@ -83,5 +86,9 @@ fn absurd_sizes_and_missing_fields_are_refused() {
     assert!(stderr(&o).contains("0x48"), "{}", stderr(&o));
     let o = frf(&["bench", "interp", "--field", "/nonexistent/field.frf"]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("/nonexistent/field.frf"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("/nonexistent/field.frf"),
+        "{}",
+        stderr(&o)
+    );
 }

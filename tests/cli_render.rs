@@ -39,10 +39,7 @@ fn envmap(name: &str) -> String {
 }
 
 fn gpu_flag() -> Option<&'static str> {
-    // The GPU path runs unless the machine has no adapter and says so.
-    std::env::var("FRF_SKIP_GPU")
-        .is_ok_and(|v| v == "1")
-        .then_some("--cpu")
+    frf_testkit::cpu_flag()
 }
 
 #[test]
@@ -357,4 +354,34 @@ fn render_composites_over_the_environment_and_over_a_plate_with_layers() {
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn negative_numbers_are_accepted_where_coordinates_and_angles_are_expected() {
+    // `--look-at -0.1,...`, `--start -30`, `--yaw -45` and `--exposure -1` are values, not
+    // flags: the plan (which stops before rendering) is made for them.
+    let (_, field) = fixture();
+    let o = frf(&[
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--yaw",
+        "-45",
+        "--orbit",
+        "3.2,-0.4,-90",
+        "--look-at",
+        "-0.1,0.9,-0.2",
+        "--start",
+        "-30",
+        "--exposure",
+        "-1",
+        "--frames",
+        "3",
+        "--plan",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(plan.is_object(), "{plan}");
 }

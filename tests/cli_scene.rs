@@ -29,9 +29,7 @@ fn ok(args: &[&str]) -> Output {
 }
 
 fn gpu_flag() -> Option<&'static str> {
-    std::env::var("FRF_SKIP_GPU")
-        .is_ok_and(|v| v == "1")
-        .then_some("--cpu")
+    frf_testkit::cpu_flag()
 }
 
 fn field() -> &'static PathBuf {

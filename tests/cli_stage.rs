@@ -39,7 +39,7 @@ fn truth_renders_a_novel_camera_under_the_built_in_sky_and_a_basis_mix() {
         "--capture",
         cap,
         "--eye",
-        "2,1.5,3",
+        "-2,1.5,-3",
         "--look-at",
         "0,0.9,0",
         "--size",

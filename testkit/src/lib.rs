@@ -7,6 +7,8 @@
 //! maps carved from the true mattes with ingest's defaults). Its directory holds
 //! the stage's configuration, so it serves as the `--capture` of `frf eval`. Building it
 //! takes about 10 s on two cores.
+//!
+//! [`cpu_flag`]: whether command-line tests must render on the CPU reference.
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -14,6 +16,27 @@ use std::sync::OnceLock;
 use frf_eval::oracle::{OracleOptions, write_oracle_field};
 use frf_ingest::shadows::ShadowOptions;
 use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
+
+/// `Some("--cpu")` when command-line tests must render with the CPU reference: only when
+/// no GPU adapter opens and `FRF_SKIP_GPU=1` says the machine has none on purpose. With
+/// an adapter the GPU path runs whatever the variable says (it excuses a missing adapter,
+/// it does not hide a present one); without one and without the variable, the tests fail
+/// saying what to install.
+pub fn cpu_flag() -> Option<&'static str> {
+    static ADAPTER: OnceLock<Result<(), String>> = OnceLock::new();
+    let adapter = ADAPTER.get_or_init(|| {
+        frf_render::gpu::Gpu::new()
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    });
+    match adapter {
+        Ok(()) => None,
+        Err(_) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => Some("--cpu"),
+        Err(e) => panic!(
+            "no GPU adapter ({e}): install mesa-vulkan-drivers, or set FRF_SKIP_GPU=1 to test the CPU path alone"
+        ),
+    }
+}
 
 /// The tiny stage and its oracle field (see the crate docs).
 pub struct TinyField {
