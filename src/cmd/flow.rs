@@ -80,6 +80,29 @@ pub fn run(args: FlowArgs) -> CliResult {
     let a = read_rgb(&args.a)?;
     let b = read_rgb(&args.b)?;
     let init = args.init.as_deref().map(read_flo).transpose()?;
+    // Sizes checked here, where the files' names are known.
+    let size = |w: usize, h: usize| format!("{w}x{h}");
+    let a_size = size(a.width(), a.height());
+    if (b.width(), b.height()) != (a.width(), a.height()) {
+        return Err(format!(
+            "{} is {} pixels but {} is {a_size}: the two images must be the same size",
+            args.b.display(),
+            size(b.width(), b.height()),
+            args.a.display()
+        )
+        .into());
+    }
+    if let (Some(f), Some(path)) = (&init, &args.init)
+        && (f.width(), f.height()) != (a.width(), a.height())
+    {
+        return Err(format!(
+            "{} is a {} flow but {} is {a_size}: the initial flow must be the first image's size",
+            path.display(),
+            size(f.width(), f.height()),
+            args.a.display()
+        )
+        .into());
+    }
     eprintln!(
         "flow {}x{} ({}), {} threads ...",
         a.width(),

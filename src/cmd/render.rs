@@ -458,7 +458,6 @@ pub fn run(args: RenderArgs) -> CliResult {
         "scene": std::fs::read_to_string(&args.input).ok().filter(|_| !field_render),
         "size": size,
     });
-    let mut output = Output::open(&out_dir, &settings, args.overwrite, total)?;
 
     let start = Instant::now();
     let device = Device::open(args.cpu)?;
@@ -469,6 +468,9 @@ pub fn run(args: RenderArgs) -> CliResult {
     };
     let mut shot = Shot::new(&scene, &field, device, &frames, options)?;
     let setup_seconds = start.elapsed().as_secs_f64();
+    // Opened once every input has been read and checked: a bad environment, plate or
+    // field leaves no output directory behind.
+    let mut output = Output::open(&out_dir, &settings, args.overwrite, total)?;
     let c = &shot.plan().counts;
     eprintln!(
         "{}: {} of {} frames, {}x{}, {}; plan: {} of {} poses, {} of {} views, {} of {} flows, {} of {} conditions, {:.2} of {:.2} MB{}",

@@ -1,0 +1,201 @@
+//! The bad-input corpus of `tests/bad/` through the binary: every case is refused with a
+//! failing status that is not a panic's, a message naming the file and the problem, and
+//! no output left behind (no flow file, no render directory).
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A case: the command (`{bad}` is the corpus directory, `{out}` a path in a fresh
+/// scratch directory that must stay empty), the file it names and the words of the problem.
+struct Case {
+    args: &'static [&'static str],
+    file: &'static str,
+    problem: &'static [&'static str],
+}
+
+const CASES: &[Case] = &[
+    Case {
+        args: &["render", "{bad}/scene_unknown_key.toml", "--plan"],
+        file: "scene_unknown_key.toml",
+        problem: &["unknown field `colour_grade`", "line 2"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_wrong_type.toml", "--plan"],
+        file: "scene_wrong_type.toml",
+        problem: &["invalid type", "line 3"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_missing_field.toml", "--plan"],
+        file: "scene_missing_field.toml",
+        problem: &["missing field `lighting`"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_out_of_range.toml", "--plan"],
+        file: "scene_out_of_range.toml",
+        problem: &["time.fps", "-10"],
+    },
+    Case {
+        args: &["ingest", "{bad}/cap_wrong_type", "--out", "{out}/f.frf"],
+        file: "capture.toml",
+        problem: &["invalid type", "\"one\""],
+    },
+    Case {
+        args: &["ingest", "{bad}/cap_unknown", "--out", "{out}/f.frf"],
+        file: "capture.toml",
+        problem: &["unknown field `flash`"],
+    },
+    Case {
+        args: &["ingest", "{bad}/cap_missing", "--out", "{out}/f.frf"],
+        file: "capture.toml",
+        problem: &["missing field `timing`"],
+    },
+    Case {
+        args: &["ingest", "{bad}/cap_range", "--out", "{out}/f.frf"],
+        file: "capture.toml",
+        problem: &["cameras[0].width", "outside"],
+    },
+    Case {
+        args: &["flow", "{bad}/huge.png", "{bad}/good4.png", "--out", "{out}/f.flo"],
+        file: "huge.png",
+        problem: &["limit"],
+    },
+    Case {
+        args: &["flow", "{bad}/truncated.png", "{bad}/good4.png", "--out", "{out}/f.flo"],
+        file: "truncated.png",
+        problem: &["end of file"],
+    },
+    Case {
+        args: &["flow", "{bad}/good4.png", "{bad}/good5x4.png", "--out", "{out}/f.flo"],
+        file: "good5x4.png",
+        problem: &["5x4", "4x4", "same size"],
+    },
+    Case {
+        args: &[
+            "flow",
+            "{bad}/good4.png",
+            "{bad}/good4.png",
+            "--init",
+            "{bad}/bad_magic.flo",
+            "--out",
+            "{out}/f.flo",
+        ],
+        file: "bad_magic.flo",
+        problem: &["magic"],
+    },
+    Case {
+        args: &[
+            "flow",
+            "{bad}/good4.png",
+            "{bad}/good4.png",
+            "--init",
+            "{bad}/bad_size.flo",
+            "--out",
+            "{out}/f.flo",
+        ],
+        file: "bad_size.flo",
+        problem: &["1000000000x1000000000", "outside"],
+    },
+    Case {
+        args: &[
+            "flow",
+            "{bad}/good4.png",
+            "{bad}/good4.png",
+            "--init",
+            "{bad}/short.flo",
+            "--out",
+            "{out}/f.flo",
+        ],
+        file: "short.flo",
+        problem: &["truncated"],
+    },
+    Case {
+        args: &[
+            "flow",
+            "{bad}/good4.png",
+            "{bad}/good4.png",
+            "--init",
+            "{bad}/wrong_dims.flo",
+            "--out",
+            "{out}/f.flo",
+        ],
+        file: "wrong_dims.flo",
+        problem: &["8x8", "4x4"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--env",
+            "{bad}/huge.hdr",
+            "--orbit",
+            "3,1.2",
+            "--frames",
+            "1",
+            "--out",
+            "{out}/render",
+        ],
+        file: "huge.hdr",
+        problem: &["limit"],
+    },
+];
+
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad")
+}
+
+#[test]
+fn every_bad_input_is_refused_naming_the_file_and_the_problem() {
+    let field = &frf_testkit::tiny_field().field;
+    let mut failures = Vec::new();
+    for case in CASES {
+        let out = tempfile::tempdir().unwrap();
+        let args: Vec<String> = case
+            .args
+            .iter()
+            .map(|a| {
+                a.replace("{bad}", corpus().to_str().unwrap())
+                    .replace("{out}", out.path().to_str().unwrap())
+                    .replace("{field}", field.to_str().unwrap())
+            })
+            .collect();
+        let o = Command::new(env!("CARGO_BIN_EXE_frf"))
+            .args(&args)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        let left: Vec<_> = std::fs::read_dir(out.path()).unwrap().collect();
+        let named = stderr.contains(case.file);
+        let explained = case.problem.iter().all(|w| stderr.contains(w));
+        // 101 is the status of a Rust panic.
+        let refused = !o.status.success() && o.status.code() != Some(101);
+        if !(refused && named && explained && left.is_empty()) {
+            failures.push(format!(
+                "{}: status {:?}, names the file {named}, explains {explained}, left {} entries:\n{stderr}",
+                args.join(" "),
+                o.status.code(),
+                left.len()
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn the_corpus_is_exactly_the_files_the_cases_name() {
+    // Every file of tests/bad is used by a case (or is a valid partner, or the README).
+    let used: Vec<&str> = CASES
+        .iter()
+        .flat_map(|c| c.args.iter())
+        .filter_map(|a| a.strip_prefix("{bad}/"))
+        .collect();
+    for entry in std::fs::read_dir(corpus()).unwrap() {
+        let name = entry.unwrap().file_name().into_string().unwrap();
+        assert!(
+            name == "README.md" || used.contains(&name.as_str()),
+            "tests/bad/{name} is not read by any case"
+        );
+    }
+}
