@@ -1,0 +1,132 @@
+//! Interruption and the disk, through the binary: a render killed mid-way leaves only
+//! whole frames under their final names and its rerun resumes the rest; a render whose
+//! disk fills (a file-size limit) reports the file and the problem, leaves no partial
+//! frame behind and does not panic.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn render_args(field: &Path, out: &Path, frames: &str) -> Vec<String> {
+    let mut args: Vec<String> = [
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--orbit",
+        "3.2,1.3",
+        "--size",
+        "64x48",
+        "--frames",
+        frames,
+        "--out",
+        out.to_str().unwrap(),
+    ]
+    .map(String::from)
+    .to_vec();
+    if let Some(flag) = frf_testkit::cpu_flag() {
+        args.push(flag.into());
+    }
+    args
+}
+
+/// Frame files under their final names, and temporary files, in `dir`.
+fn frames_and_temporaries(dir: &Path) -> (Vec<String>, Vec<String>) {
+    let names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    let frames = names
+        .iter()
+        .filter(|n| n.starts_with("frame_"))
+        .cloned()
+        .collect();
+    let temporaries = names.iter().filter(|n| n.ends_with(".tmp")).cloned().collect();
+    (frames, temporaries)
+}
+
+#[test]
+fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
+    let field = &frf_testkit::tiny_field().field;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("shot");
+    let args = render_args(field, &out, "40");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_frf"))
+        .args(&args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Killed (SIGKILL: no chance to clean up) once its first frames are there.
+    let start = Instant::now();
+    while !out.join("frame_0002.png").exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the render ended before it could be interrupted"
+        );
+        assert!(start.elapsed() < Duration::from_secs(120), "no frame in 2 min");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let (frames, _) = frames_and_temporaries(&out);
+    assert!(!out.join("render.json").exists(), "killed before the report");
+    // Every frame under its final name is whole: it decodes.
+    for name in frames.iter().filter(|n| n.ends_with(".png")) {
+        image::open(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    let kept = frames.iter().filter(|n| n.ends_with(".png")).count();
+    // The rerun resumes: the frames already there are kept, the rest rendered.
+    let o = Command::new(env!("CARGO_BIN_EXE_frf"))
+        .args(&args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+    let resumed = report["frames_resumed"].as_u64().unwrap() as usize;
+    assert!(resumed + 1 >= kept && resumed >= 1, "resumed {resumed} of {kept} frames kept");
+    assert_eq!(
+        report["frames_rendered"].as_u64().unwrap() as usize + resumed,
+        40
+    );
+    let (frames, temporaries) = frames_and_temporaries(&out);
+    assert_eq!(frames.iter().filter(|n| n.ends_with(".png")).count(), 40);
+    // A frame cut by the kill may leave its temporary file; never a final name.
+    assert!(temporaries.iter().all(|t| t.starts_with(".frame_")), "{temporaries:?}");
+}
+
+#[test]
+fn a_full_disk_is_reported_naming_the_file_without_partial_frames() {
+    let field = &frf_testkit::tiny_field().field;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("shot");
+    let args = render_args(field, &out, "3");
+    // A file-size limit of 4 KiB stands for a full disk: a 64x48 RGBA32F EXR is larger.
+    // SIGXFSZ is ignored so that the write fails with EFBIG instead of killing the process.
+    let quoted: Vec<String> = args.iter().map(|a| format!("'{a}'")).collect();
+    let script = format!(
+        "trap '' XFSZ; ulimit -f 4; exec '{}' {}",
+        env!("CARGO_BIN_EXE_frf"),
+        quoted.join(" ")
+    );
+    let o = Command::new("bash")
+        .args(["-c", &script])
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
+    assert!(
+        stderr.contains("frame_0000") && stderr.to_lowercase().contains("file too large"),
+        "{stderr}"
+    );
+    let (frames, temporaries) = frames_and_temporaries(&out);
+    assert!(frames.is_empty(), "partial frames left: {frames:?}");
+    assert!(temporaries.is_empty(), "temporary files left: {temporaries:?}");
+}
