@@ -57,17 +57,35 @@ const CASES: &[Case] = &[
         problem: &["cameras[0].width", "outside"],
     },
     Case {
-        args: &["flow", "{bad}/huge.png", "{bad}/good4.png", "--out", "{out}/f.flo"],
+        args: &[
+            "flow",
+            "{bad}/huge.png",
+            "{bad}/good4.png",
+            "--out",
+            "{out}/f.flo",
+        ],
         file: "huge.png",
         problem: &["limit"],
     },
     Case {
-        args: &["flow", "{bad}/truncated.png", "{bad}/good4.png", "--out", "{out}/f.flo"],
+        args: &[
+            "flow",
+            "{bad}/truncated.png",
+            "{bad}/good4.png",
+            "--out",
+            "{out}/f.flo",
+        ],
         file: "truncated.png",
         problem: &["end of file"],
     },
     Case {
-        args: &["flow", "{bad}/good4.png", "{bad}/good5x4.png", "--out", "{out}/f.flo"],
+        args: &[
+            "flow",
+            "{bad}/good4.png",
+            "{bad}/good5x4.png",
+            "--out",
+            "{out}/f.flo",
+        ],
         file: "good5x4.png",
         problem: &["5x4", "4x4", "same size"],
     },

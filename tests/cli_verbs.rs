@@ -60,7 +60,10 @@ fn info_accounts_for_the_bytes_of_the_field_file() {
         .sum();
     let size = std::fs::metadata(field).unwrap().len();
     // The chunks account for the file, less its header and index (under 1 %).
-    assert!(parts <= size && parts as f64 > 0.99 * size as f64, "{parts} of {size}");
+    assert!(
+        parts <= size && parts as f64 > 0.99 * size as f64,
+        "{parts} of {size}"
+    );
 }
 
 #[test]
@@ -103,7 +106,11 @@ fn flow_bench_scores_a_sequence_against_its_true_flow() {
     shifted_pair(&seq, (2, 1));
     let truth = frf_core::image::Image::from_fn(48, 40, |_, _| [2.0f32, 1.0]);
     frf_flow::write_flo(&seq.join("flow10.flo"), &truth).unwrap();
-    let report = ok_json(&frf(&["flow-bench", dir.path().to_str().unwrap(), "--json"]));
+    let report = ok_json(&frf(&[
+        "flow-bench",
+        dir.path().to_str().unwrap(),
+        "--json",
+    ]));
     let s = &report["sequences"][0];
     assert_eq!(s["name"], "Shift");
     // Measured 0.016 px; a translation this smooth is the estimator's easy case.
@@ -154,7 +161,12 @@ fn hull_exports_a_mesh_where_the_walker_stands() {
     let field = &frf_testkit::tiny_field().field;
     let dir = tempfile::tempdir().unwrap();
     let ply = dir.path().join("hull.ply");
-    let o = frf(&["hull", field.to_str().unwrap(), "--out", ply.to_str().unwrap()]);
+    let o = frf(&[
+        "hull",
+        field.to_str().unwrap(),
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read(&ply).unwrap();
     let header_end = text.windows(10).position(|w| w == b"end_header").unwrap();
@@ -212,6 +224,9 @@ fn render_follows_a_camera_path_with_a_grey_ground_and_a_chosen_pose() {
             .to_rgba8();
         assert_eq!(img.dimensions(), (48, 64));
         let covered = img.pixels().filter(|p| p[3] > 128).count();
-        assert!(covered > 100, "frame {i}: the walker covers {covered} pixels");
+        assert!(
+            covered > 100,
+            "frame {i}: the walker covers {covered} pixels"
+        );
     }
 }

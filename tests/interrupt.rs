@@ -43,7 +43,11 @@ fn frames_and_temporaries(dir: &Path) -> (Vec<String>, Vec<String>) {
         .filter(|n| n.starts_with("frame_"))
         .cloned()
         .collect();
-    let temporaries = names.iter().filter(|n| n.ends_with(".tmp")).cloned().collect();
+    let temporaries = names
+        .iter()
+        .filter(|n| n.ends_with(".tmp"))
+        .cloned()
+        .collect();
     (frames, temporaries)
 }
 
@@ -67,13 +71,19 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
             child.try_wait().unwrap().is_none(),
             "the render ended before it could be interrupted"
         );
-        assert!(start.elapsed() < Duration::from_secs(120), "no frame in 2 min");
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no frame in 2 min"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     let (frames, _) = frames_and_temporaries(&out);
-    assert!(!out.join("render.json").exists(), "killed before the report");
+    assert!(
+        !out.join("render.json").exists(),
+        "killed before the report"
+    );
     // Every frame under its final name is whole: it decodes.
     for name in frames.iter().filter(|n| n.ends_with(".png")) {
         image::open(out.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -89,7 +99,10 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
     let resumed = report["frames_resumed"].as_u64().unwrap() as usize;
-    assert!(resumed + 1 >= kept && resumed >= 1, "resumed {resumed} of {kept} frames kept");
+    assert!(
+        resumed + 1 >= kept && resumed >= 1,
+        "resumed {resumed} of {kept} frames kept"
+    );
     assert_eq!(
         report["frames_rendered"].as_u64().unwrap() as usize + resumed,
         40
@@ -97,7 +110,10 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
     let (frames, temporaries) = frames_and_temporaries(&out);
     assert_eq!(frames.iter().filter(|n| n.ends_with(".png")).count(), 40);
     // A frame cut by the kill may leave its temporary file; never a final name.
-    assert!(temporaries.iter().all(|t| t.starts_with(".frame_")), "{temporaries:?}");
+    assert!(
+        temporaries.iter().all(|t| t.starts_with(".frame_")),
+        "{temporaries:?}"
+    );
 }
 
 #[test]
@@ -128,5 +144,8 @@ fn a_full_disk_is_reported_naming_the_file_without_partial_frames() {
     );
     let (frames, temporaries) = frames_and_temporaries(&out);
     assert!(frames.is_empty(), "partial frames left: {frames:?}");
-    assert!(temporaries.is_empty(), "temporary files left: {temporaries:?}");
+    assert!(
+        temporaries.is_empty(),
+        "temporary files left: {temporaries:?}"
+    );
 }
