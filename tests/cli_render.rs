@@ -146,6 +146,17 @@ fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
         }
     }
     let four = get("fourway", "psnr_subject");
+    eprintln!(
+        "subject PSNR: fourway {four:.2}, linear {:.2}, nearest {:.2}; SSIM fourway {:.3}, linear {:.3}",
+        get("linear", "psnr_subject"),
+        get("nearest", "psnr_subject"),
+        get("fourway", "ssim_subject"),
+        get("linear", "ssim_subject")
+    );
+    // Measured on this fixture (lavapipe and the CPU reference alike): four-way 24.10 dB,
+    // linear 22.42, nearest 18.62; SSIM 0.820 against 0.744. The bounds are the claims
+    // (the morph beats the blend and, by more, the nearest view), each with about a
+    // third of its measured margin as headroom for environment and driver changes.
     assert!(four > get("linear", "psnr_subject") + 0.5, "{}", stderr(&o));
     assert!(
         four > get("nearest", "psnr_subject") + 2.0,
@@ -153,7 +164,8 @@ fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
         stderr(&o)
     );
     assert!(get("fourway", "ssim_subject") > get("linear", "ssim_subject"));
-    // On a repeating walker the four-way morph should land close to the truth.
+    // On a repeating walker the four-way morph lands within about 3 dB of the captured
+    // views (27.0 dB, docs/results/render.md); 22 dB leaves 2.1 dB of headroom.
     assert!(four > 22.0, "{}", stderr(&o));
 }
 
