@@ -114,14 +114,14 @@ const POSE_ELEVATIONS: [f32; 2] = [0.0, 0.3];
 /// An 8x2 ring of cameras 4 m from the subject; views are colour ramps, each neighbour's
 /// flow a constant shift (different per direction and view).
 fn pose() -> ResidentPose {
-    let (columns, rows) = (POSE_COLUMNS, 2usize);
+    let (columns, rows) = (POSE_COLUMNS, POSE_ELEVATIONS.len());
     let q = LogQuantizer::new(0.5, 8.0).unwrap();
     let mut cameras = Vec::new();
     let mut prelit = Vec::new();
     let mut flows = Vec::new();
     for u in 0..columns {
-        for v in 0..rows {
-            let d = direction_from_azimuth_elevation(-(u as f32) * 0.785, POSE_ELEVATIONS[v]);
+        for (v, &elevation) in POSE_ELEVATIONS.iter().enumerate() {
+            let d = direction_from_azimuth_elevation(-(u as f32) * 0.785, elevation);
             let eye = TARGET + d * POSE_RADIUS;
             cameras.push(Camera::look_at(eye, TARGET, Vec3::Y, 0.5, W, H).unwrap());
             let seed = (u * 2 + v) as u32;
