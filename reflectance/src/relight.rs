@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use crate::error::{ReflectanceError, Result};
 
 /// `Σ_k coefficients[k] ⊙ basis[k]`; conditions whose coefficient is zero are skipped.
+/// Non-finite coefficients, and products or sums that overflow `f32`, are refused.
 pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
     if basis.len() != coefficients.len() {
         return Err(ReflectanceError::Mismatch {
@@ -57,5 +58,14 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
             out
         })
         .collect();
+    // Finite inputs can still overflow f32 (huge coefficients on bright texels): refuse
+    // rather than return infinities.
+    if let Some(i) = pixels.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
+        return Err(ReflectanceError::BadParameter(format!(
+            "relit pixel ({}, {}) overflows f32: coefficients too large for the basis",
+            i % w,
+            i / w
+        )));
+    }
     Ok(Image::from_vec(w, h, pixels)?)
 }

@@ -158,14 +158,17 @@ impl CameraPath {
         let (a, b) = (&k[i], &k[i + 1]);
         let h = b.time - a.time;
         let s = (t - a.time) / h;
-        // Tangents (per second) from the neighbouring keys; one-sided at the ends.
+        // Tangents from the neighbouring keys (one-sided at the ends), scaled to this
+        // segment: the change over the neighbours times `h` over their time span. The
+        // ratio of spans first, so that keys a subnormal time apart do not divide by it
+        // (an infinite tangent times a tiny `h`).
         let tangent = |j: usize, f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
             let (l, r) = (j.saturating_sub(1), (j + 1).min(k.len() - 1));
-            (f(&k[r]) - f(&k[l])) / (k[r].time - k[l].time)
+            (f(&k[r]) - f(&k[l])) * (h / (k[r].time - k[l].time))
         };
         let hermite = |f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
             let (p0, p1) = (f(a), f(b));
-            let (m0, m1) = (tangent(i, f) * h, tangent(i + 1, f) * h);
+            let (m0, m1) = (tangent(i, f), tangent(i + 1, f));
             let (s2, s3) = (s * s, s * s * s);
             p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
                 + m0 * (s3 - 2.0 * s2 + s)

@@ -31,14 +31,24 @@ pub struct LogQuantizer {
 }
 
 impl LogQuantizer {
-    /// A quantizer, checked: both parameters finite and positive.
+    /// A quantizer, checked: both parameters finite and positive, and their ratio within
+    /// `f32` (else the step `ln(1 + M/s) / 127` is infinite or zero, and every code
+    /// decodes to infinity, or every value, 0 included, encodes to the extreme code).
     pub fn new(scale: f32, range: f32) -> Result<Self> {
         if !(scale.is_finite() && range.is_finite() && scale > 0.0 && range > 0.0) {
             return Err(ReflectanceError::BadParameter(format!(
                 "log quantizer needs finite positive scale and range, got s = {scale}, M = {range}"
             )));
         }
-        Ok(Self { scale, range })
+        let q = Self { scale, range };
+        let k = q.k();
+        if !(k.is_finite() && k > 0.0) {
+            return Err(ReflectanceError::BadParameter(format!(
+                "log quantizer's range and scale are too far apart for f32: M / s = {}",
+                range / scale
+            )));
+        }
+        Ok(q)
     }
 
     fn k(&self) -> f32 {
