@@ -129,8 +129,14 @@ impl Capture {
     pub fn open_manifest(dir: &Path) -> Result<Self> {
         let path = dir.join(MANIFEST_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| CoreError::io(&path, e))?;
-        let manifest: Manifest = toml::from_str(&text).map_err(|e| CoreError::Manifest {
-            path: path.clone(),
+        Self::parse_manifest(dir, &text)
+    }
+
+    /// Parses and validates the text of `DIR/capture.toml` (the files are not checked).
+    pub fn parse_manifest(dir: &Path, text: &str) -> Result<Self> {
+        let path = dir.join(MANIFEST_FILE);
+        let manifest: Manifest = toml::from_str(text).map_err(|e| CoreError::Manifest {
+            path,
             field: "(syntax)".into(),
             problem: e.to_string().trim().to_string(),
         })?;

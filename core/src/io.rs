@@ -24,30 +24,52 @@ pub mod limits {
     pub const MAX_ALLOC_BYTES: u64 = 2 << 30;
 }
 
-fn reader(path: &Path) -> Result<ImageReader<std::io::BufReader<std::fs::File>>> {
-    let mut reader = ImageReader::open(path)
-        .map_err(|e| CoreError::io(path, e))?
-        .with_guessed_format()
-        .map_err(|e| CoreError::io(path, e))?;
+/// `reader` with the [`limits`] applied.
+fn limited<R: std::io::BufRead + std::io::Seek>(mut reader: ImageReader<R>) -> ImageReader<R> {
     let mut lim = image::Limits::default();
     lim.max_image_width = Some(limits::MAX_DIMENSION);
     lim.max_image_height = Some(limits::MAX_DIMENSION);
     lim.max_alloc = Some(limits::MAX_ALLOC_BYTES);
     reader.limits(lim);
-    Ok(reader)
+    reader
 }
 
-fn decode(path: &Path) -> Result<DynamicImage> {
-    if !path.exists() {
-        return Err(CoreError::bad_file(path, "file not found"));
-    }
-    reader(path)?.decode().map_err(|e| match e {
+fn reader(path: &Path) -> Result<ImageReader<std::io::BufReader<std::fs::File>>> {
+    let reader = ImageReader::open(path)
+        .map_err(|e| CoreError::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| CoreError::io(path, e))?;
+    Ok(limited(reader))
+}
+
+/// Decodes what `reader` reads, errors naming `path`.
+fn decode_with<R: std::io::BufRead + std::io::Seek>(
+    path: &Path,
+    reader: ImageReader<R>,
+) -> Result<DynamicImage> {
+    reader.decode().map_err(|e| match e {
         image::ImageError::Limits(l) => CoreError::LimitExceeded {
             what: path.display().to_string(),
             problem: l.to_string(),
         },
         other => CoreError::bad_file(path, format!("cannot decode image: {other}")),
     })
+}
+
+fn decode(path: &Path) -> Result<DynamicImage> {
+    if !path.exists() {
+        return Err(CoreError::bad_file(path, "file not found"));
+    }
+    decode_with(path, reader(path)?)
+}
+
+/// [`read_rgb`] of the bytes of a file named `name` (the same formats, limits and checks;
+/// for decoders fed from memory, such as the fuzz targets).
+pub fn read_rgb_bytes(name: &Path, bytes: &[u8]) -> Result<RgbImage> {
+    let reader = ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| CoreError::io(name, e))?;
+    rgb_checked(name, decode_with(name, limited(reader))?)
 }
 
 /// Width and height of an image file, read from its header only.
@@ -79,7 +101,12 @@ fn check_finite<P: crate::image::Pixel>(path: &Path, img: &Image<P>) -> Result<(
 /// Reads an RGB image (PNG 8/16-bit gray, RGB or RGBA; EXR; Radiance HDR). Alpha is dropped.
 /// Non-finite values are refused.
 pub fn read_rgb(path: &Path) -> Result<RgbImage> {
-    let img = decode(path)?.into_rgb32f();
+    rgb_checked(path, decode(path)?)
+}
+
+/// A decoded image as linear RGB, alpha dropped, non-finite values refused naming `path`.
+fn rgb_checked(path: &Path, img: DynamicImage) -> Result<RgbImage> {
+    let img = img.into_rgb32f();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let pixels = img
         .into_raw()
@@ -297,6 +324,26 @@ pub fn rgba_from(rgb: &RgbImage, alpha: &GrayImage) -> Result<Image<Rgba>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn images_read_from_bytes_match_the_file_and_keep_the_limits() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        let img = Image::from_fn(6, 4, |x, y| [x as f32 / 6.0, y as f32 / 4.0, 0.5]);
+        write_png16_rgb(&path, &img).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let from_bytes = read_rgb_bytes(&path, &bytes).unwrap();
+        assert_eq!(from_bytes.pixels(), read_rgb(&path).unwrap().pixels());
+        // A Radiance header claiming 10^9 x 10^9 pixels is refused by the limits, named.
+        let huge = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1000000000 +X 1000000000\n";
+        let e = read_rgb_bytes(Path::new("huge.hdr"), huge)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("huge.hdr"), "{e}");
+        // Half a file is an error naming it, not a panic.
+        let e = read_rgb_bytes(&path, &bytes[..bytes.len() / 2]).unwrap_err();
+        assert!(e.to_string().contains("a.png"), "{e}");
+    }
 
     #[test]
     fn png16_round_trip_is_exact_to_16_bits() {
