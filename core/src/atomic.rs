@@ -65,7 +65,8 @@ mod tests {
             w.write_all(b"partial").unwrap();
             Err(CoreError::invalid("test", "abort"))
         });
-        assert!(err.is_err());
+        let e = err.unwrap_err().to_string();
+        assert!(e.contains("test") && e.contains("abort"), "{e}");
         assert!(!path.exists());
         let leftovers: Vec<_> = std::fs::read_dir(path.parent().unwrap()).unwrap().collect();
         assert!(leftovers.is_empty(), "temporary file left behind");

@@ -141,15 +141,21 @@ impl Camera {
         if !(eye.is_finite() && target.is_finite() && up.is_finite()) {
             return Err(CoreError::invalid(
                 "camera",
-                "eye, target or up is not finite",
+                format!("eye {eye}, target {target} and up {up} must be finite"),
             ));
         }
         let forward = (target - eye).normalize_or_zero();
-        let right = forward.cross(up).normalize_or_zero();
-        if forward == Vec3::ZERO || right == Vec3::ZERO {
+        if forward == Vec3::ZERO {
             return Err(CoreError::invalid(
                 "camera",
-                "eye equals target, or the view direction is parallel to up",
+                format!("eye {eye} equals target {target}"),
+            ));
+        }
+        let right = forward.cross(up).normalize_or_zero();
+        if right == Vec3::ZERO {
+            return Err(CoreError::invalid(
+                "camera",
+                format!("view direction {forward} is parallel to up {up}"),
             ));
         }
         let down = forward.cross(right);
@@ -273,9 +279,30 @@ mod tests {
 
     #[test]
     fn degenerate_look_at_is_refused() {
-        assert!(Camera::look_at(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 0.5, 8, 8).is_err());
-        assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 0.5, 8, 8).is_err());
-        assert!(Camera::look_at(Vec3::ZERO, Vec3::X, Vec3::Y, 0.0, 8, 8).is_err());
-        assert!(Camera::look_at(Vec3::NAN, Vec3::X, Vec3::Y, 0.5, 8, 8).is_err());
+        let e = Camera::look_at(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 0.5, 8, 8)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("eye [0, 0, 0] equals target [0, 0, 0]"), "{e}");
+        let e = Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, 0.5, 8, 8)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("view direction [0, 1, 0] is parallel to up [0, 1, 0]"),
+            "{e}"
+        );
+        let e = Camera::look_at(Vec3::ZERO, Vec3::X, Vec3::Y, 0.0, 8, 8)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("field of view") && e.contains("0.000 degrees"),
+            "{e}"
+        );
+        let e = Camera::look_at(Vec3::NAN, Vec3::X, Vec3::Y, 0.5, 8, 8)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("eye [NaN, NaN, NaN]") && e.contains("finite"),
+            "{e}"
+        );
     }
 }

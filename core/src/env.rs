@@ -481,7 +481,11 @@ impl FromStr for EnvSource {
 
     fn from_str(s: &str) -> std::result::Result<Self, String> {
         Ok(match s {
-            "" => return Err("an environment: a .hdr/.exr file, sky, uniform or none".into()),
+            "" => {
+                return Err(
+                    "empty environment: expected a .hdr/.exr file, sky, uniform or none".into(),
+                );
+            }
             "sky" => EnvSource::Sky,
             "uniform" => EnvSource::Uniform,
             "none" => EnvSource::None,
@@ -627,7 +631,8 @@ mod tests {
             assert_eq!(text.parse::<EnvSource>().unwrap(), source);
             assert_eq!(source.to_string(), text);
         }
-        assert!("".parse::<EnvSource>().is_err());
+        let e = "".parse::<EnvSource>().unwrap_err().to_string();
+        assert!(e.contains("empty environment") && e.contains("sky"), "{e}");
         assert_eq!(EnvSource::File("a/grace.hdr".into()).name(), "grace");
         assert!(EnvSource::None.load().unwrap().is_none());
         let furnace = EnvSource::Uniform.load().unwrap().unwrap();
@@ -659,6 +664,10 @@ mod tests {
                 .iter()
                 .all(|p| (p[0] - 3.5).abs() < 1e-5)
         );
-        assert!(EnvMap::mix(&[]).is_err());
+        let e = EnvMap::mix(&[]).unwrap_err().to_string();
+        assert!(
+            e.contains("environment mix") && e.contains("no environment"),
+            "{e}"
+        );
     }
 }

@@ -143,7 +143,8 @@ mod tests {
         );
         let mut hostile = bytes.clone();
         hostile[4..8].copy_from_slice(&i32::MAX.to_le_bytes());
-        assert!(decode_flo(p, &hostile).is_err());
+        let e = decode_flo(p, &hostile).unwrap_err().to_string();
+        assert!(e.contains("bad.flo") && e.contains("2147483647x4"), "{e}");
         let mut wrong_magic = bytes;
         wrong_magic[0] ^= 1;
         assert!(
@@ -152,6 +153,10 @@ mod tests {
                 .to_string()
                 .contains("magic")
         );
-        assert!(decode_flo(p, &[0u8; 5]).is_err());
+        let e = decode_flo(p, &[0u8; 5]).unwrap_err().to_string();
+        assert!(
+            e.contains("bad.flo") && e.contains("truncated") && e.contains("5 bytes"),
+            "{e}"
+        );
     }
 }

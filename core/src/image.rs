@@ -269,6 +269,12 @@ mod tests {
 
     #[test]
     fn from_vec_refuses_wrong_length() {
-        assert!(Image::from_vec(3, 3, vec![0.0f32; 8]).is_err());
+        let e = Image::from_vec(3, 3, vec![0.0f32; 8])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("pixels") && e.contains("8 pixels for a 3x3 image"),
+            "{e}"
+        );
     }
 }

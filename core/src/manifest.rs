@@ -266,9 +266,19 @@ mod tests {
             pattern_placeholders("a{pose}{slot:02}").unwrap(),
             vec!["pose", "slot"]
         );
-        assert!(pattern_placeholders("a{poze}").is_err());
-        assert!(pattern_placeholders("a{pose").is_err());
-        assert!(pattern_placeholders("a{pose:x}").is_err());
-        assert!(pattern_placeholders("a}").is_err());
+        let e = pattern_placeholders("a{poze}").unwrap_err().to_string();
+        assert!(
+            e.contains("unknown placeholder {poze}") && e.contains("a{poze}"),
+            "{e}"
+        );
+        let e = pattern_placeholders("a{pose").unwrap_err().to_string();
+        assert!(e.contains("unclosed") && e.contains(r#""a{pose""#), "{e}");
+        let e = pattern_placeholders("a{pose:x}").unwrap_err().to_string();
+        assert!(
+            e.contains(r#"bad width "x""#) && e.contains("{pose:x}"),
+            "{e}"
+        );
+        let e = pattern_placeholders("a}").unwrap_err().to_string();
+        assert!(e.contains("unmatched '}'") && e.contains(r#""a}""#), "{e}");
     }
 }

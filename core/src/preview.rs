@@ -29,7 +29,10 @@ pub fn fit_width(frames: &[Image<Rgba>], max_width: usize) -> Vec<Image<Rgba>> {
 
 fn check(frames: &[Image<Rgba>], path: &Path) -> Result<(u32, u32)> {
     let Some(first) = frames.first() else {
-        return Err(CoreError::invalid("animated preview", "no frame"));
+        return Err(CoreError::invalid(
+            format!("animated preview {}", path.display()),
+            "no frame to write",
+        ));
     };
     if frames.iter().any(|f| f.size() != first.size()) {
         return Err(CoreError::bad_file(path, "preview frames differ in size"));
@@ -112,7 +115,11 @@ mod tests {
         let actl = reader.info().animation_control().unwrap();
         assert_eq!((actl.num_frames, actl.num_plays), (3, 0));
         assert_eq!((reader.info().width, reader.info().height), (20, 10));
-        assert!(write_apng(&path, &[], 12.0, 1.0).is_err());
+        let e = write_apng(&path, &[], 12.0, 1.0).unwrap_err().to_string();
+        assert!(
+            e.contains(&path.display().to_string()) && e.contains("no frame"),
+            "{e}"
+        );
     }
 
     #[test]

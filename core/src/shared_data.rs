@@ -68,7 +68,13 @@ mod tests {
             "{e}"
         );
         let missing = PathBuf::from("/nonexistent/frf-data");
-        assert!(explicit_dir(Some(missing.into_os_string())).is_err());
+        let e = explicit_dir(Some(missing.into_os_string()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("/nonexistent/frf-data") && e.contains("not a directory"),
+            "{e}"
+        );
         let dir = std::env::temp_dir();
         assert_eq!(
             explicit_dir(Some(dir.clone().into_os_string())),

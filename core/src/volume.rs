@@ -194,9 +194,24 @@ mod tests {
         }
         assert_eq!(g.centre(0, 0, 0), Vec3::new(-0.875, 0.125, -0.375));
         assert_eq!(g.max_corner(), Vec3::new(1.0, 2.0, 0.5));
-        assert!(VoxelGrid::covering(Vec3::ZERO, Vec3::ONE, 0.0).is_err());
-        assert!(VoxelGrid::covering(Vec3::ZERO, Vec3::ONE, 1e-4).is_err());
-        assert!(VoxelGrid::covering(Vec3::ONE, Vec3::ZERO, 0.1).is_err());
+        let e = VoxelGrid::covering(Vec3::ZERO, Vec3::ONE, 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("voxel side 0 m"), "{e}");
+        let e = VoxelGrid::covering(Vec3::ZERO, Vec3::ONE, 1e-4)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("10000 x 10000 x 10000 voxels") && e.contains("exceed"),
+            "{e}"
+        );
+        let e = VoxelGrid::covering(Vec3::ONE, Vec3::ZERO, 0.1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("box [1, 1, 1] – [0, 0, 0]") && e.contains("empty"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -207,21 +222,21 @@ mod tests {
         let t = g.texel_of(p.x, p.z);
         assert!((t - Vec2::new(0.0, 127.0)).length() < 1e-4);
         assert!(g.contains(1.5, -1.5) && !g.contains(1.51, 0.0));
-        assert!(
-            GroundGrid {
-                extent_m: 0.0,
-                texels: 4
-            }
-            .validate()
-            .is_err()
-        );
-        assert!(
-            GroundGrid {
-                extent_m: 3.0,
-                texels: 0
-            }
-            .validate()
-            .is_err()
-        );
+        let e = GroundGrid {
+            extent_m: 0.0,
+            texels: 4,
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("ground extent 0 m"), "{e}");
+        let e = GroundGrid {
+            extent_m: 3.0,
+            texels: 0,
+        }
+        .validate()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("0 ground texels"), "{e}");
     }
 }

@@ -140,7 +140,10 @@ fn an_interrupted_ingest_resumes_and_never_leaves_a_corrupt_field() {
         after: 72 + 10,
     };
     std::fs::remove_file(&out).unwrap();
-    assert!(ingest(&cap, &out, &opts, None, &stop).is_err());
+    let e = ingest(&cap, &out, &opts, None, &stop)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("interrupted") && e.contains("resume"), "{e}");
     let mut other = opts.clone();
     other.jpeg_quality = 50;
     let err = ingest(&cap, &out, &other, None, &Silent)
@@ -183,7 +186,10 @@ fn bad_requests_are_refused_by_name() {
     assert!(err.contains("pose 7"), "{err}");
     let mut bad = options(vec![0]);
     bad.jpeg_quality = 0;
-    assert!(ingest(&cap, &dir.path().join("f.frf"), &bad, None, &Silent).is_err());
+    let e = ingest(&cap, &dir.path().join("f.frf"), &bad, None, &Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("JPEG quality 0") && e.contains("1..=100"), "{e}");
     bad = options(vec![0]);
     bad.flow_settings = vec![("warps".into(), "many".into())];
     let err = ingest(&cap, &dir.path().join("f.frf"), &bad, None, &Silent)

@@ -174,6 +174,7 @@ mod tests {
         let back = frf_core::io::read_rgb(&path).unwrap();
         assert_eq!(back.size(), (8, 5));
         let empty = Image::<[f32; 2]>::new(0, 0, [0.0, 0.0]);
-        assert!(write_flow_png(&path, &empty, None).is_err());
+        let e = write_flow_png(&path, &empty, None).unwrap_err().to_string();
+        assert!(e.contains("flow to visualize") && e.contains("0x0"), "{e}");
     }
 }

@@ -67,9 +67,14 @@ impl EdgeMethod {
 }
 
 fn refuse_non_finite<P: frf_core::image::Pixel>(what: &str, img: &Image<P>) -> Result<()> {
-    if !img.all_finite() {
+    if let Some(i) = img
+        .pixels()
+        .iter()
+        .position(|p| !p.channels().iter().all(|c| c.is_finite()))
+    {
+        let (x, y) = (i % img.width(), i / img.width());
         return Err(IngestError::BadParameter(format!(
-            "{what} holds non-finite values"
+            "{what} holds a non-finite value at pixel ({x}, {y})"
         )));
     }
     Ok(())
@@ -86,9 +91,15 @@ pub fn soft_alpha(
     matte_clean: &RgbImage,
 ) -> Result<GrayImage> {
     if !(alpha.same_size(matte) && alpha.same_size(matte_clean)) {
-        return Err(IngestError::BadParameter(
-            "alpha, matte frame and its clean plate differ in size".into(),
-        ));
+        return Err(IngestError::BadParameter(format!(
+            "alpha ({}x{}), matte frame ({}x{}) and its clean plate ({}x{}) differ in size",
+            alpha.width(),
+            alpha.height(),
+            matte.width(),
+            matte.height(),
+            matte_clean.width(),
+            matte_clean.height()
+        )));
     }
     refuse_non_finite("the matte frame", matte)?;
     refuse_non_finite("the matte frame's clean plate", matte_clean)?;
@@ -170,9 +181,13 @@ fn push_pull(straight: &RgbImage, weight: &GrayImage) -> RgbImage {
 /// input.
 pub fn extend_interior(premultiplied: &RgbImage, alpha: &GrayImage) -> Result<RgbImage> {
     if !premultiplied.same_size(alpha) {
-        return Err(IngestError::BadParameter(
-            "image and alpha sizes differ".into(),
-        ));
+        return Err(IngestError::BadParameter(format!(
+            "image ({}x{}) and alpha ({}x{}) differ in size",
+            premultiplied.width(),
+            premultiplied.height(),
+            alpha.width(),
+            alpha.height()
+        )));
     }
     refuse_non_finite("the premultiplied image", premultiplied)?;
     refuse_non_finite("alpha", alpha)?;
@@ -368,13 +383,33 @@ mod tests {
         let blurred = blurred_alpha(&s);
         let mut bad = s.matte.clone();
         bad.set(3, 3, [f32::NAN; 3]);
-        assert!(soft_alpha(&blurred, &bad, &s.matte_clean).is_err());
+        let e = soft_alpha(&blurred, &bad, &s.matte_clean)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("matte frame") && e.contains("pixel (3, 3)"),
+            "{e}"
+        );
         let mut inf = s.frame.clone();
         inf.set(20, 20, [f32::INFINITY; 3]);
-        assert!(extend_interior(&inf, &blurred).is_err());
+        let e = extend_interior(&inf, &blurred).unwrap_err().to_string();
+        assert!(
+            e.contains("premultiplied image") && e.contains("pixel (20, 20)"),
+            "{e}"
+        );
         let small = Image::new(10, 10, [0.5f32; 3]);
-        assert!(soft_alpha(&blurred, &small, &s.matte_clean).is_err());
-        assert!(extend_interior(&small, &blurred).is_err());
+        let e = soft_alpha(&blurred, &small, &s.matte_clean)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("matte frame (10x10)") && e.contains("differ in size"),
+            "{e}"
+        );
+        let e = extend_interior(&small, &blurred).unwrap_err().to_string();
+        assert!(
+            e.contains("image (10x10)") && e.contains("differ in size"),
+            "{e}"
+        );
         // A zero clean plate (no contrast anywhere) gives the blurred matte back, finite.
         let black = Image::new(40, 50, [0.0f32; 3]);
         assert_eq!(soft_alpha(&blurred, &s.matte, &black).unwrap(), blurred);

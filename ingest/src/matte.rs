@@ -293,6 +293,12 @@ mod tests {
             );
         }
         let g = (f.0.clone(), Image::new(21, 20, [1.0f32; 3]), f.2.clone());
-        assert!(foreground(&input(&g), MatteRule::TrackBrighterThanMatte).is_err());
+        let e = foreground(&input(&g), MatteRule::TrackBrighterThanMatte)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("track and matte frames") && e.contains("20x20 and 21x20"),
+            "{e}"
+        );
     }
 }

@@ -169,6 +169,12 @@ mod tests {
         let got = f.get(10, 70);
         assert!((got[0] - expected.x).abs() < 1e-4 && (got[1] - expected.y).abs() < 1e-4);
         // A degenerate plane is refused.
-        assert!(plane_homography(&a, &b, a.centre(), Vec3::Z).is_err());
+        let e = plane_homography(&a, &b, a.centre(), Vec3::Z)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rectification plane") && e.contains("reference camera"),
+            "{e}"
+        );
     }
 }

@@ -31,13 +31,20 @@ impl TrackFlows {
             ));
         };
         let (w, h) = first.size();
-        if to_tracks
-            .iter()
-            .any(|(t, f)| !t.is_finite() || *t == 0.0 || f.size() != (w, h))
-        {
-            return Err(IngestError::BadParameter(
-                "track flows need distinct non-zero finite times and one size".into(),
-            ));
+        for (i, (t, f)) in to_tracks.iter().enumerate() {
+            if !t.is_finite() || *t == 0.0 {
+                return Err(IngestError::BadParameter(format!(
+                    "track flow {i} has time {t} s; times must be finite and non-zero \
+                     (0 is the reference frame)"
+                )));
+            }
+            if f.size() != (w, h) {
+                return Err(IngestError::BadParameter(format!(
+                    "track flow {i} is {}x{}, the first is {w}x{h}",
+                    f.width(),
+                    f.height()
+                )));
+            }
         }
         to_tracks.push((0.0, Image::new(w, h, [0.0; 2])));
         to_tracks.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -115,11 +122,16 @@ mod tests {
         // Beyond the last track frame the last segment continues.
         assert_eq!(t.at(16.0).get(0, 0), [6.0, 2.0]);
         assert_eq!(t.at(-12.0).get(0, 0), [-3.0, 6.0]);
-        assert!(TrackFlows::new(vec![]).is_err());
-        assert!(TrackFlows::new(vec![(0.0, constant([0.0; 2]))]).is_err());
-        assert!(
-            TrackFlows::new(vec![(1.0, constant([0.0; 2])), (1.0, constant([1.0; 2]))]).is_err()
-        );
+        let e = TrackFlows::new(vec![]).unwrap_err().to_string();
+        assert!(e.contains("at least one other track frame"), "{e}");
+        let e = TrackFlows::new(vec![(0.0, constant([0.0; 2]))])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("track flow 0 has time 0 s"), "{e}");
+        let e = TrackFlows::new(vec![(1.0, constant([0.0; 2])), (1.0, constant([1.0; 2]))])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("share a time"), "{e}");
     }
 
     #[test]

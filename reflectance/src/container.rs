@@ -207,11 +207,17 @@ impl FieldWriter {
         &self.header
     }
 
+    /// The path the field is written to (once finished).
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// Appends a chunk; a key may be written once.
     pub fn add_chunk(&mut self, key: ChunkKey, bytes: &[u8]) -> Result<()> {
         if self.chunks.contains_key(&key) {
             return Err(ReflectanceError::BadParameter(format!(
-                "{key} written twice"
+                "{}: {key} written twice",
+                self.path.display()
             )));
         }
         let out = self

@@ -291,7 +291,7 @@ impl FieldHeader {
             .find(|p| p.pose == pose)
             .ok_or_else(|| {
                 ReflectanceError::BadParameter(format!(
-                    "pose {pose} is not in the field (it has {available:?})"
+                    "pose {pose} is not in the field (it has poses {available:?})"
                 ))
             })
     }
@@ -300,7 +300,7 @@ impl FieldHeader {
     pub fn pose(&self, pose: u32) -> Result<&PoseRecord> {
         self.poses.iter().find(|p| p.pose == pose).ok_or_else(|| {
             ReflectanceError::BadParameter(format!(
-                "pose {pose} is not in the field (it has {:?})",
+                "pose {pose} is not in the field (it has poses {:?})",
                 self.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
             ))
         })

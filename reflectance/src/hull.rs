@@ -309,8 +309,10 @@ impl VoxelHull {
         // The grid comes first: decompress it alone, check it, then the whole.
         let mut header = zstd::stream::Decoder::new(bytes).map_err(|e| corrupt(e.to_string()))?;
         let mut grid_bytes = [0u8; GRID_BYTES];
-        std::io::Read::read_exact(&mut header, &mut grid_bytes)
-            .map_err(|_| corrupt("shorter than its grid".into()))?;
+        std::io::Read::read_exact(&mut header, &mut grid_bytes).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => corrupt("truncated: shorter than its grid".into()),
+            _ => corrupt(format!("not a zstd-compressed hull: {e}")),
+        })?;
         let f = |at: usize| f32::from_le_bytes(grid_bytes[at..at + 4].try_into().expect("4 bytes"));
         let u = |at: usize| u32::from_le_bytes(grid_bytes[at..at + 4].try_into().expect("4 bytes"));
         let grid = VoxelGrid {
@@ -515,8 +517,12 @@ mod tests {
         let hull = VoxelHull::carve(&silhouettes(&views), 0.05, 0).unwrap();
         let bytes = hull.encode().unwrap();
         assert_eq!(VoxelHull::decode(&bytes).unwrap(), hull);
-        assert!(VoxelHull::decode(&bytes[..bytes.len() / 2]).is_err());
-        assert!(VoxelHull::decode(b"not zstd").is_err());
+        let e = VoxelHull::decode(&bytes[..bytes.len() / 2])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("visual hull") && e.contains("truncated"), "{e}");
+        let e = VoxelHull::decode(b"not zstd").unwrap_err().to_string();
+        assert!(e.contains("visual hull") && e.contains("not a zstd"), "{e}");
         // A grid claiming more voxels than allowed is refused before allocating.
         let mut raw = vec![0u8; GRID_BYTES];
         raw[12..16].copy_from_slice(&0.01f32.to_le_bytes());

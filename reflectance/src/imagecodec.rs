@@ -340,19 +340,34 @@ mod tests {
 
     #[test]
     fn bad_input_is_refused() {
-        assert!(encode_basis(&[], 90).is_err());
-        assert!(encode_basis(&[gradient(4, 4, 1.0)], 0).is_err());
-        assert!(encode_basis(&[gradient(4, 4, 1.0), gradient(5, 4, 1.0)], 90).is_err());
+        let e = encode_basis(&[], 90).unwrap_err().to_string();
+        assert!(e.contains("no basis images"), "{e}");
+        let e = encode_basis(&[gradient(4, 4, 1.0)], 0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("JPEG quality 0"), "{e}");
+        let e = encode_basis(&[gradient(4, 4, 1.0), gradient(5, 4, 1.0)], 90)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("expected 4x4, got 5x4"), "{e}");
         let bytes = encode_basis(&vec![gradient(8, 8, 1.0); 3], 90).unwrap();
-        assert!(decode_basis(&bytes[..bytes.len() / 2]).is_err());
+        let e = decode_basis(&bytes[..bytes.len() / 2])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("basis mosaic JPEG"), "{e}");
         let mut hostile = bytes.clone();
         hostile[4..8].copy_from_slice(&1_000_000u32.to_le_bytes());
-        assert!(decode_basis(&hostile).is_err());
+        let e = decode_basis(&hostile).unwrap_err().to_string();
+        assert!(e.contains("3 tiles of 1000000x8"), "{e}");
         let mut nan_scale = bytes;
         nan_scale[12..16].copy_from_slice(&f32::NAN.to_le_bytes());
-        assert!(decode_basis(&nan_scale).is_err());
+        let e = decode_basis(&nan_scale).unwrap_err().to_string();
+        assert!(e.contains("tile scale NaN"), "{e}");
         let planes = encode_planes(&[Image::new(4, 4, 0.5)]).unwrap();
-        assert!(decode_planes(&planes[..planes.len() - 3]).is_err());
+        let e = decode_planes(&planes[..planes.len() - 3])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("plane data") && e.contains("truncated"), "{e}");
     }
 
     proptest! {

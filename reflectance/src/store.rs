@@ -101,7 +101,9 @@ pub fn encode_view(header: &FieldHeader, pose: u32, view: &ViewData) -> Result<E
 impl FieldWriter {
     /// Writes an encoded view of pose `pose` at `(u, v)`.
     pub fn add_view(&mut self, pose: u32, u: usize, v: usize, view: &EncodedView) -> Result<()> {
-        self.header().pose(pose)?;
+        self.header()
+            .pose(pose)
+            .map_err(|e| naming(self.path(), e))?;
         for (kind, bytes) in &view.0 {
             let key = ChunkKey {
                 pose,
@@ -147,6 +149,17 @@ impl FieldWriter {
             ));
         }
         self.add_chunk(key(pose, 0, 0, ChunkKind::Hull), &hull.encode()?)
+    }
+}
+
+/// `e` with the field file `path` in front of its message, where it is the caller's
+/// fault (other errors name their file already).
+fn naming(path: &std::path::Path, e: ReflectanceError) -> ReflectanceError {
+    match e {
+        ReflectanceError::BadParameter(p) => {
+            ReflectanceError::BadParameter(format!("{}: {p}", path.display()))
+        }
+        other => other,
     }
 }
 
@@ -229,12 +242,15 @@ impl<R: ReadAt> FieldFile<R> {
 
     /// Everything of one view, read from that view's chunks only.
     pub fn view(&self, pose: u32, u: usize, v: usize) -> Result<ViewData> {
-        self.header().pose(pose)?;
-        if u >= self.header().columns || v >= self.header().rows {
+        self.header()
+            .pose(pose)
+            .map_err(|e| naming(self.path(), e))?;
+        let (columns, rows) = (self.header().columns, self.header().rows);
+        if u >= columns || v >= rows {
             return Err(ReflectanceError::BadParameter(format!(
-                "view ({u}, {v}) is outside the {}x{} grid",
-                self.header().columns,
-                self.header().rows
+                "{}: view ({u}, {v}) is outside the field's {columns}x{rows} grid \
+                 (u < {columns}, v < {rows})",
+                self.path().display()
             )));
         }
         let mut flows: [Option<FlowImage>; 4] = Default::default();

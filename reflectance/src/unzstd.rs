@@ -36,8 +36,9 @@ pub fn decompress_exact(src: &[u8], expected: usize, what: &str) -> Result<Vec<u
             "{what}: holds {n} bytes, expected {expected}"
         )));
     }
-    let out = zstd::bulk::decompress(src, expected)
-        .map_err(|e| ReflectanceError::Corrupt(format!("{what}: {e}")))?;
+    let out = zstd::bulk::decompress(src, expected).map_err(|e| {
+        ReflectanceError::Corrupt(format!("{what}: damaged or truncated zstd data ({e})"))
+    })?;
     if out.len() != expected {
         return Err(ReflectanceError::Corrupt(format!(
             "{what}: holds {} bytes, expected {expected}",
@@ -67,11 +68,28 @@ mod tests {
         let data = vec![7u8; 1000];
         let packed = zstd::bulk::compress(&data, 3).unwrap();
         assert_eq!(decompress_exact(&packed, 1000, "x").unwrap(), data);
-        assert!(decompress_exact(&packed, 999, "x").is_err());
-        assert!(decompress_exact(&packed, usize::MAX / 2, "x").is_err());
+        let e = decompress_exact(&packed, 999, "x").unwrap_err().to_string();
+        assert!(e.contains("x: holds 1000 bytes, expected 999"), "{e}");
+        let e = decompress_exact(&packed, usize::MAX / 2, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x: ") && e.contains("exceed the 1073741824-byte limit"),
+            "{e}"
+        );
         assert_eq!(decompress_at_most(&packed, 1000, "x").unwrap(), data);
-        assert!(decompress_at_most(&packed, 999, "x").is_err());
-        assert!(decompress_exact(&[0x0a], 10, "x").is_err());
-        assert!(decompress_at_most(&packed[..packed.len() - 2], 5000, "x").is_err());
+        let e = decompress_at_most(&packed, 999, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("x: declares 1000 bytes, more than the 999 allowed"),
+            "{e}"
+        );
+        let e = decompress_exact(&[0x0a], 10, "x").unwrap_err().to_string();
+        assert!(e.contains("x: not a zstd frame"), "{e}");
+        let e = decompress_at_most(&packed[..packed.len() - 2], 5000, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("x: damaged or truncated"), "{e}");
     }
 }

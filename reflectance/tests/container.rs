@@ -237,8 +237,20 @@ fn truncated_and_corrupted_files_are_refused_naming_the_chunk() {
     // Asking for what is not there.
     std::fs::write(&path, &good).unwrap();
     let field = FieldFile::open(&path).unwrap();
-    assert!(field.view(5, 0, 0).is_err());
-    assert!(field.view(0, 9, 0).is_err());
+    let e = field.view(5, 0, 0).unwrap_err().to_string();
+    assert!(
+        e.contains(&path.display().to_string())
+            && e.contains("pose 5 is not in the field")
+            && e.contains("poses [0, 1]"),
+        "{e}"
+    );
+    let e = field.view(0, 9, 0).unwrap_err().to_string();
+    assert!(
+        e.contains(&path.display().to_string())
+            && e.contains("view (9, 0)")
+            && e.contains("4x3 grid"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -257,12 +269,27 @@ fn an_unfinished_writer_leaves_nothing() {
     let mut w = FieldWriter::create(&path, h.clone()).unwrap();
     let enc = encode_view(&h, 0, &view(&h, 0, 0, 0)).unwrap();
     w.add_view(0, 0, 0, &enc).unwrap();
-    assert!(w.add_view(0, 0, 0, &enc).is_err());
-    assert!(w.add_view(7, 0, 0, &enc).is_err());
+    let e = w.add_view(0, 0, 0, &enc).unwrap_err().to_string();
+    assert!(
+        e.contains(&path.display().to_string()) && e.contains("pose 0 view (0, 0) written twice"),
+        "{e}"
+    );
+    let e = w.add_view(7, 0, 0, &enc).unwrap_err().to_string();
+    assert!(
+        e.contains(&path.display().to_string()) && e.contains("pose 7 is not in the field"),
+        "{e}"
+    );
     let mut wrong = view(&h, 0, 0, 0);
     wrong.basis.pop();
-    assert!(encode_view(&h, 0, &wrong).is_err());
-    assert!(encode_view(&h, 9, &view(&h, 0, 0, 0)).is_err());
+    let e = encode_view(&h, 0, &wrong).unwrap_err().to_string();
+    assert!(
+        e.contains("basis images per view") && e.contains("expected 26, got 25"),
+        "{e}"
+    );
+    let e = encode_view(&h, 9, &view(&h, 0, 0, 0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("pose 9 is not in the field"), "{e}");
 }
 
 #[test]
@@ -324,8 +351,12 @@ fn poses_written_apart_merge_into_one_field() {
         single.header().pose(1).unwrap().flow_quantizer
     );
     // The same pose twice is refused.
-    assert!(
+    let e =
         frf_reflectance::container::merge_fields(&[parts[0].clone(), parts[0].clone()], &merged)
-            .is_err()
+            .unwrap_err()
+            .to_string();
+    assert!(
+        e.contains(&parts[0].display().to_string()) && e.contains("pose 1 is in two parts"),
+        "{e}"
     );
 }

@@ -179,7 +179,15 @@ mod tests {
         assert!(c.validate().unwrap_err().to_string().contains("pose 99"));
         let mut c = StageConfig::preset(Preset::Tiny);
         c.perturbation = f32::NAN;
-        assert!(c.validate().is_err());
-        assert!(Preset::parse("huge").is_err());
+        let e = c.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("perturbation NaN") && e.contains("0..=10"),
+            "{e}"
+        );
+        let e = Preset::parse("huge").unwrap_err().to_string();
+        assert!(
+            e.contains(r#"unknown preset "huge""#) && e.contains("tiny"),
+            "{e}"
+        );
     }
 }

@@ -161,7 +161,11 @@ fn an_interrupted_capture_resumes_and_a_different_one_is_refused() {
     let before = std::fs::read(&frame).unwrap();
     std::fs::remove_file(&frame).unwrap();
     std::fs::remove_file(dir.path().join(".progress/p02_v0_u01")).unwrap();
-    assert!(Capture::open(dir.path()).is_err());
+    let e = Capture::open(dir.path()).unwrap_err().to_string();
+    assert!(
+        e.contains(&frame.display().to_string()) && e.contains("not found"),
+        "{e}"
+    );
     let second = write(small_config(), dir.path());
     assert_eq!(
         (second.units_rendered, second.units_skipped),

@@ -359,21 +359,31 @@ mod tests {
         let mut bytes = [0u8; TABLE_BYTES];
         bytes[0] = 0x11;
         bytes[1] = 0x10;
-        assert!(HuffmanTable::from_bytes(&bytes).is_err());
-        assert!(HuffmanTable::from_bytes(&bytes[..10]).is_err());
+        let e = HuffmanTable::from_bytes(&bytes).unwrap_err().to_string();
+        assert!(e.contains("over-subscribed"), "{e}");
+        let e = HuffmanTable::from_bytes(&bytes[..10])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated") && e.contains("10 of 128"), "{e}");
         let symbols = vec![1u8, 2, 3, 1, 1, 1, 2];
         let table = HuffmanTable::from_counts(&counts(&symbols));
         let bits = table.encode(&symbols).unwrap();
+        let e = table
+            .decode(&bits[..bits.len() - 1], symbols.len())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("ends early"), "{e}");
+        let e = table.decode(&bits, 1_000_000).unwrap_err().to_string();
         assert!(
-            table
-                .decode(&bits[..bits.len() - 1], symbols.len())
-                .is_err()
+            e.contains("1000000 symbols") && e.contains("2 bytes"),
+            "{e}"
         );
-        assert!(table.decode(&bits, 1_000_000).is_err());
-        assert!(table.encode(&[200]).is_err());
+        let e = table.encode(&[200]).unwrap_err().to_string();
+        assert!(e.contains("symbol 200"), "{e}");
         // A one-symbol table whose stream holds the unassigned code.
         let single = HuffmanTable::from_counts(&counts(&[7, 7, 7]));
-        assert!(single.decode(&[0xFF], 1).is_err());
+        let e = single.decode(&[0xFF], 1).unwrap_err().to_string();
+        assert!(e.contains("no symbol owns"), "{e}");
         assert_eq!(single.decode(&[0x00], 3).unwrap(), vec![7, 7, 7]);
     }
 }

@@ -259,9 +259,13 @@ mod tests {
         bytes[1..5].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(decode(&bytes, &q).unwrap_err().to_string().contains("size"));
         let bytes = encode(&flow, &q, true).unwrap();
-        assert!(decode(&bytes[..bytes.len() - 2], &q).is_err());
+        let e = decode(&bytes[..bytes.len() - 2], &q)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("42 symbols cannot fit in 5 bytes"), "{e}");
         let mut flagged = bytes.clone();
         flagged[0] = 0x80;
-        assert!(decode(&flagged, &q).is_err());
+        let e = decode(&flagged, &q).unwrap_err().to_string();
+        assert!(e.contains("flags 0x80"), "{e}");
     }
 }
