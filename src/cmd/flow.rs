@@ -347,7 +347,7 @@ mod tests {
             .unwrap();
         let err = run(cli.args).unwrap_err().to_string();
         assert!(
-            err.contains("expected 32x32") && err.contains("32x31"),
+            err.contains("b.png is 32x31") && err.contains("a.png is 32x32"),
             "{err}"
         );
         assert!(!dir.path().join("f.flo").exists());
