@@ -5,19 +5,9 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::process::{Command, Output};
+mod common;
 
-fn frf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{frf, stderr};
 
 #[test]
 fn the_bench_reports_every_variant_stage_and_the_floor_as_json() {

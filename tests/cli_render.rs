@@ -5,20 +5,11 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+mod common;
+
+use common::{frf, stderr};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn frf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 /// The tiny stage's oracle field and its capture directory, shared by the tests of this
 /// file; `(directory, field)`.

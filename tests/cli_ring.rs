@@ -6,15 +6,9 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::process::{Command, Output};
+mod common;
 
-fn frf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap()
-}
+use common::frf;
 
 #[test]
 fn a_real_ring_ingests_closed_and_its_held_out_photographs_score() {

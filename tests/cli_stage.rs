@@ -3,17 +3,13 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+mod common;
+
+use common::{frf, stderr};
+
 use std::path::Path;
-use std::process::{Command, Output};
 
 use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig, write_capture};
-
-fn frf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn small_capture(dir: &Path) {
     let mut c = StageConfig::preset(Preset::Tiny);
@@ -21,10 +17,6 @@ fn small_capture(dir: &Path) {
     c.poses = vec![0];
     c.set_flow_truth = SetFlowTruth::None;
     write_capture(&Stage::new(c).unwrap(), dir, &|_, _| {}).unwrap();
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 #[test]
