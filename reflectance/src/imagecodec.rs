@@ -371,10 +371,45 @@ mod tests {
     }
 
     proptest! {
+        /// A valid mosaic and valid planes, then damaged (flipped bits anywhere and a cut
+        /// tail): each decodes to what its header declares, finite and in range, or is
+        /// refused as corrupt. Random bytes would stop at the header checks.
         #[test]
-        fn garbage_never_panics(bytes in proptest::collection::vec(any::<u8>(), 0..300)) {
-            let _ = decode_basis(&bytes);
-            let _ = decode_planes(&bytes);
+        fn damaged_mosaics_and_planes_decode_or_are_refused(
+            count in 1usize..8, w in 1usize..20, h in 1usize..20,
+            flips in proptest::collection::vec((any::<prop::sample::Index>(), 0u8..8), 1..4),
+            cut in 0usize..16,
+        ) {
+            let damage = |mut bytes: Vec<u8>| {
+                for (at, bit) in &flips {
+                    let i = at.index(bytes.len());
+                    bytes[i] ^= 1 << bit;
+                }
+                bytes.truncate(bytes.len() - cut.min(bytes.len()));
+                bytes
+            };
+            let images: Vec<RgbImage> = (0..count).map(|i| gradient(w, h, 0.1 + i as f32)).collect();
+            let bytes = damage(encode_basis(&images, 90).unwrap());
+            match decode_basis(&bytes) {
+                Ok(back) => {
+                    let (n, tw, th) = (le_u32(&bytes, 0) as usize, le_u32(&bytes, 4) as usize, le_u32(&bytes, 8) as usize);
+                    prop_assert_eq!(back.len(), n);
+                    prop_assert!(back.iter().all(|i| i.size() == (tw, th)));
+                    prop_assert!(back.iter().all(|i| i.pixels().iter().flatten().all(|c| c.is_finite())));
+                }
+                Err(e) => prop_assert!(matches!(e, ReflectanceError::Corrupt(_)), "{}", e),
+            }
+            let planes: Vec<GrayImage> = (0..count)
+                .map(|i| Image::from_fn(w, h, |x, y| ((x * 7 + y * 3 + i) % 11) as f32 / 10.0))
+                .collect();
+            let bytes = damage(encode_planes(&planes).unwrap());
+            match decode_planes(&bytes) {
+                Ok(back) => {
+                    prop_assert_eq!(back.len(), le_u32(&bytes, 0) as usize);
+                    prop_assert!(back.iter().all(|p| p.pixels().iter().all(|v| (0.0..=1.0).contains(v))));
+                }
+                Err(e) => prop_assert!(matches!(e, ReflectanceError::Corrupt(_)), "{}", e),
+            }
         }
     }
 }

@@ -57,8 +57,14 @@ fn view(h: &FieldHeader, pose: u32, u: usize, v: usize) -> ViewData {
 
 fn write_field(path: &std::path::Path) -> FieldHeader {
     let h = header();
+    write_views(path, h.clone());
+    h
+}
+
+/// Writes every view of every pose of `h`.
+fn write_views(path: &std::path::Path, h: FieldHeader) {
     let mut w = FieldWriter::create(path, h.clone()).unwrap();
-    for pose in [0, 1] {
+    for pose in h.poses.iter().map(|p| p.pose).collect::<Vec<_>>() {
         for u in 0..h.columns {
             for v in 0..h.rows {
                 w.add_view(
@@ -72,7 +78,6 @@ fn write_field(path: &std::path::Path) -> FieldHeader {
         }
     }
     w.finish().unwrap();
-    h
 }
 
 #[test]
@@ -292,20 +297,67 @@ fn an_unfinished_writer_leaves_nothing() {
     assert!(e.contains("pose 9 is not in the field"), "{e}");
 }
 
+/// Recomputes every chunk's CRC-32 and the index's, as a writer would have: damage made
+/// to chunk bytes then reaches the chunk decoders instead of stopping at the checksum.
+/// The index and footer are the file's tail (module docs of `container`), so they are
+/// rewritten in place.
+fn sealed(mut bytes: Vec<u8>) -> Vec<u8> {
+    let footer = bytes.len() - 32;
+    let word = |i: usize| u64::from_le_bytes(bytes[i..i + 8].try_into().unwrap()) as usize;
+    let (at, len) = (word(footer), word(footer + 8));
+    let tail = bytes[footer + 20..].to_vec(); // version and end magic
+    let json = zstd::bulk::decompress(&bytes[at..at + len], 1 << 26).unwrap();
+    let mut index: serde_json::Value = serde_json::from_slice(&json).unwrap();
+    for c in index["chunks"].as_array_mut().unwrap() {
+        let (o, l) = (
+            c["offset"].as_u64().unwrap() as usize,
+            c["length"].as_u64().unwrap() as usize,
+        );
+        c["crc32"] = crc32fast::hash(&bytes[o..o + l]).into();
+    }
+    let packed = zstd::bulk::compress(&serde_json::to_vec(&index).unwrap(), 3).unwrap();
+    bytes.truncate(at);
+    bytes.extend_from_slice(&packed);
+    bytes.extend_from_slice(&(at as u64).to_le_bytes());
+    bytes.extend_from_slice(&(packed.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&crc32fast::hash(&packed).to_le_bytes());
+    bytes.extend_from_slice(&tail);
+    bytes
+}
+
 #[test]
-fn garbage_never_panics() {
+fn damaged_chunks_with_valid_checksums_are_decoded_or_refused_naming_the_chunk() {
     use proptest::prelude::*;
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("f.frf");
-    write_field(&path);
+    let h = write_field(&path);
     let good = std::fs::read(&path).unwrap();
-    proptest!(ProptestConfig::with_cases(200), |(at in 0usize..good.len(), byte in any::<u8>(), cut in 0usize..64)| {
+    let entries: Vec<_> = FieldFile::open(&path).unwrap().chunks().copied().collect();
+    let resealed =
+        FieldFile::from_source(std::path::Path::new("resealed.frf"), sealed(good.clone())).unwrap();
+    assert_eq!(resealed.chunks().copied().collect::<Vec<_>>(), entries);
+    proptest!(ProptestConfig::with_cases(300), |(
+        which in any::<prop::sample::Index>(),
+        flips in proptest::collection::vec((any::<prop::sample::Index>(), 0u8..8), 1..4),
+    )| {
+        let entry = *which.get(&entries);
         let mut bytes = good.clone();
-        bytes[at] = byte;
-        bytes.truncate(bytes.len() - cut);
-        if let Ok(field) = FieldFile::from_source(std::path::Path::new("fuzz.frf"), bytes) {
-            let _ = field.view(0, 1, 1);
-            let _ = field.stats();
+        for (at, bit) in &flips {
+            bytes[entry.offset as usize + at.index(entry.length as usize)] ^= 1 << bit;
+        }
+        let bytes = sealed(bytes);
+        let field = FieldFile::from_source(std::path::Path::new("damaged.frf"), bytes).unwrap();
+        let key = entry.key;
+        let read = if matches!(key.kind, ChunkKind::Shadows | ChunkKind::Hull) {
+            field.shadows(key.pose).map(|_| ())
+        } else {
+            field.view(key.pose, key.u as usize, key.v as usize).map(|v| {
+                assert_eq!(v.alpha.size(), (h.width as usize, h.height as usize));
+            })
+        };
+        if let Err(e) = read {
+            let e = e.to_string();
+            prop_assert!(e.contains("damaged.frf") && e.contains(&key.to_string()), "{}", e);
         }
     });
 }
@@ -359,4 +411,45 @@ fn poses_written_apart_merge_into_one_field() {
         e.contains(&parts[0].display().to_string()) && e.contains("pose 1 is in two parts"),
         "{e}"
     );
+}
+
+/// The fuzz targets start from small valid inputs (`fuzz/seeds/{container,huffman,images}`)
+/// so that mutation reaches the decoders rather than the header checks. Each seed must be
+/// valid; `FRF_WRITE_FUZZ_SEEDS=1` writes them afresh from the fixtures here.
+#[test]
+fn the_fuzz_seeds_are_valid_inputs() {
+    let seeds = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/seeds");
+    let container = seeds.join("container/tiny.frf");
+    let flow = seeds.join("huffman/flow_map.bin");
+    let (basis, planes) = (
+        seeds.join("images/basis.bin"),
+        seeds.join("images/planes.bin"),
+    );
+    let q = LogQuantizer::new(0.3, 20.0).unwrap(); // the huffman target's quantizer
+    if std::env::var_os("FRF_WRITE_FUZZ_SEEDS").is_some() {
+        let capture = common::tiny_capture(2, 8, 8);
+        let h = FieldHeader::from_capture(&capture, &[0], q, 90).unwrap();
+        for p in [&container, &flow, &basis] {
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        }
+        write_views(&container, h.clone());
+        let v = view(&h, 0, 0, 1);
+        let f = v.flows.iter().flatten().next().unwrap();
+        std::fs::write(&flow, flowcodec::encode(f, &q, true).unwrap()).unwrap();
+        let b = frf_reflectance::imagecodec::encode_basis(&v.basis[..3], 90).unwrap();
+        std::fs::write(&basis, b).unwrap();
+        let p = frf_reflectance::imagecodec::encode_planes(&[v.alpha]).unwrap();
+        std::fs::write(&planes, p).unwrap();
+    }
+    let field = FieldFile::open(&container).unwrap();
+    let h = field.header().clone();
+    for u in 0..h.columns {
+        for v in 0..h.rows {
+            field.view(0, u, v).unwrap();
+        }
+    }
+    assert!(field.size() < 64 << 10, "seed of {} bytes", field.size());
+    flowcodec::decode(&std::fs::read(&flow).unwrap(), &q).unwrap();
+    frf_reflectance::imagecodec::decode_basis(&std::fs::read(&basis).unwrap()).unwrap();
+    frf_reflectance::imagecodec::decode_planes(&std::fs::read(&planes).unwrap()).unwrap();
 }

@@ -322,12 +322,40 @@ mod tests {
             prop_assert_eq!(back.decode(&bits, symbols.len()).unwrap(), symbols);
         }
 
+        /// A valid table and stream, then damaged: a flipped bit in the table is refused
+        /// or yields a table that still decodes `count` symbols or errors; a damaged or cut
+        /// stream decodes to exactly `count` symbols or is refused. Random bytes would
+        /// rarely pass the Kraft test, so the decoder itself would go untested.
         #[test]
-        fn garbage_never_panics(table in proptest::collection::vec(any::<u8>(), 128),
-                                stream in proptest::collection::vec(any::<u8>(), 0..200),
-                                count in 0usize..5000) {
-            if let Ok(t) = HuffmanTable::from_bytes(&table) {
-                let _ = t.decode(&stream, count);
+        fn damaged_tables_and_streams_decode_or_are_refused(
+            symbols in proptest::collection::vec(0u8..40, 1..2000),
+            table_bit in 0usize..TABLE_BYTES * 8,
+            stream_flips in proptest::collection::vec((any::<prop::sample::Index>(), 0u8..8), 0..4),
+            cut in 0usize..8,
+        ) {
+            let table = HuffmanTable::from_counts(&counts(&symbols));
+            let bits = table.encode(&symbols).unwrap();
+            let mut table_bytes = table.to_bytes();
+            table_bytes[table_bit / 8] ^= 1 << (table_bit % 8);
+            if let Ok(t) = HuffmanTable::from_bytes(&table_bytes) {
+                if let Ok(out) = t.decode(&bits, symbols.len()) {
+                    prop_assert_eq!(out.len(), symbols.len());
+                }
+            }
+            let mut stream = bits.clone();
+            for (at, bit) in stream_flips.iter().filter(|_| !bits.is_empty()) {
+                let i = at.index(stream.len());
+                stream[i] ^= 1 << bit;
+            }
+            stream.truncate(stream.len().saturating_sub(cut));
+            match table.decode(&stream, symbols.len()) {
+                Ok(out) => {
+                    prop_assert_eq!(out.len(), symbols.len());
+                    if stream_flips.is_empty() && cut == 0 {
+                        prop_assert_eq!(out, symbols);
+                    }
+                }
+                Err(e) => prop_assert!(matches!(e, ReflectanceError::Corrupt(_)), "{}", e),
             }
         }
     }

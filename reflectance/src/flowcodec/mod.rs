@@ -244,10 +244,34 @@ mod tests {
             prop_assert_eq!(decode(&bytes, &q).unwrap(), expected);
         }
 
+        /// A valid map, then damaged (flipped bits anywhere, header included, and a cut
+        /// tail): it decodes to a map of the size its header declares, or is refused with
+        /// an error saying what is wrong. Random bytes would stop at the size check.
         #[test]
-        fn corrupted_maps_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+        fn damaged_maps_decode_or_are_refused(
+            w in 1usize..24, h in 1usize..24, predicted in any::<bool>(),
+            flips in proptest::collection::vec((any::<prop::sample::Index>(), 0u8..8), 1..4),
+            cut in 0usize..4,
+        ) {
             let q = LogQuantizer::new(0.3, 30.0).unwrap();
-            let _ = decode(&bytes, &q);
+            let flow = smooth_flow(w, h);
+            let mut bytes = encode(&flow, &q, predicted).unwrap();
+            for (at, bit) in &flips {
+                let i = at.index(bytes.len());
+                bytes[i] ^= 1 << bit;
+            }
+            bytes.truncate(bytes.len() - cut.min(bytes.len()));
+            match decode(&bytes, &q) {
+                Ok(map) => {
+                    let (dw, dh) = (
+                        u32::from_le_bytes(bytes[1..5].try_into().unwrap()) as usize,
+                        u32::from_le_bytes(bytes[5..9].try_into().unwrap()) as usize,
+                    );
+                    prop_assert_eq!((map.width(), map.height()), (dw, dh));
+                    prop_assert!(map.pixels().iter().flatten().all(|c| c.is_finite() || *c == frf_core::flo::UNKNOWN));
+                }
+                Err(e) => prop_assert!(matches!(e, ReflectanceError::Corrupt(_)), "{}", e),
+            }
         }
     }
 
