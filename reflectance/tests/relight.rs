@@ -231,10 +231,21 @@ fn lambertian_ground_of_albedo_one_under_a_uniform_sky_is_the_sky() {
 #[test]
 fn bad_relighting_input_is_refused() {
     let basis = basis_images(3);
-    assert!(relight(&basis, &[[1.0; 3]; 2]).is_err());
-    assert!(relight(&basis, &[[1.0; 3], [f32::NAN, 0.0, 0.0], [0.0; 3]]).is_err());
-    assert!(relight(&[], &[]).is_err());
+    let refused = |basis: &[RgbImage], c: &[[f32; 3]]| relight(basis, c).unwrap_err().to_string();
+    let e = refused(&basis, &[[1.0; 3]; 2]);
+    assert!(
+        e.contains("relighting coefficients: expected 3, got 2"),
+        "{e}"
+    );
+    let e = refused(&basis, &[[1.0; 3], [f32::NAN, 0.0, 0.0], [0.0; 3]]);
+    assert!(
+        e.contains("coefficient [NaN, 0.0, 0.0] is not finite"),
+        "{e}"
+    );
+    let e = refused(&[], &[]);
+    assert!(e.contains("no basis images to relight"), "{e}");
     let mut odd = basis.clone();
     odd[1] = Image::new(3, 3, [0.0; 3]);
-    assert!(relight(&odd, &[[1.0; 3]; 3]).is_err());
+    let e = refused(&odd, &[[1.0; 3]; 3]);
+    assert!(e.contains("basis image size: expected 8x6, got 3x3"), "{e}");
 }

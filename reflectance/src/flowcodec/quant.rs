@@ -167,8 +167,12 @@ mod tests {
         assert_eq!(q.encode(1e10), UNKNOWN_CODE);
         assert_eq!(q.decode(UNKNOWN_CODE), frf_core::flo::UNKNOWN);
         assert_eq!(q.encode(0.0), 0);
-        assert!(LogQuantizer::new(0.0, 1.0).is_err());
-        assert!(LogQuantizer::new(1.0, f32::INFINITY).is_err());
+        let e = LogQuantizer::new(0.0, 1.0).unwrap_err().to_string();
+        assert!(e.contains("got s = 0, M = 1"), "{e}");
+        let e = LogQuantizer::new(1.0, f32::INFINITY)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("got s = 1, M = inf"), "{e}");
     }
 
     #[test]
