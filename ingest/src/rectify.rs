@@ -159,15 +159,39 @@ mod tests {
         }
     }
 
+    /// Checked against geometry, not the homography's formula: a pixel's ray from the
+    /// reference camera meets the rectification plane at a point whose projection into
+    /// the other camera is where zero rectified flow must land, and where the rectified
+    /// image must have sampled the other image.
     #[test]
-    fn unrectified_flow_of_zero_is_the_homography() {
+    fn zero_rectified_flow_lands_where_the_plane_point_projects() {
         let (a, b) = cameras();
         let h = rectifying_homography(&a, &b).unwrap();
         let f = unrectify_flow(&Image::new(64, 90, [0.0; 2]), &h);
-        let s = Vec2::new(10.0, 70.0);
-        let expected = h.apply(s) - s;
-        let got = f.get(10, 70);
-        assert!((got[0] - expected.x).abs() < 1e-4 && (got[1] - expected.y).abs() < 1e-4);
+        // The other image: a smooth function of its pixel position.
+        let g = |p: Vec2| [0.01 * p.x + 0.002 * p.y * p.y / 90.0, 0.3];
+        let other = Image::from_fn(64, 90, |x, y| g(Vec2::new(x as f32, y as f32)));
+        let rectified = rectify(&other, &h, 64, 90);
+        let (p0, n) = (axis_point(&a), a.forward());
+        for (x, y) in [(10, 70), (32, 45), (5, 5), (60, 20)] {
+            let s = Vec2::new(x as f32, y as f32);
+            let d = a.ray_direction(s);
+            let t = (p0 - a.centre()).dot(n) / d.dot(n);
+            let pb = b.project(a.centre() + d * t).unwrap();
+            let got = f.get(x, y);
+            assert!(
+                (Vec2::new(got[0], got[1]) - (pb - s)).length() < 1e-2,
+                "flow at ({x}, {y}) {got:?}, the plane point moves by {}",
+                pb - s
+            );
+            if (1.0..62.0).contains(&pb.x) && (1.0..88.0).contains(&pb.y) {
+                let (r, expected) = (rectified.get(x, y)[0], g(pb)[0]);
+                assert!(
+                    (r - expected).abs() < 1e-3,
+                    "rectified ({x}, {y}) {r} vs {expected}"
+                );
+            }
+        }
         // A degenerate plane is refused.
         let e = plane_homography(&a, &b, a.centre(), Vec3::Z)
             .unwrap_err()

@@ -114,6 +114,75 @@ fn an_environment_equal_to_one_condition_relights_to_its_image() {
     }
 }
 
+/// The projection checked against a computation of its own: an environment lit in one
+/// texel puts `L · Δω / Σ E` into the condition of the light nearest the texel's direction
+/// (turned by the turntable), found by brute force over every light, with the texel's
+/// solid angle from the equirectangular band formula; every other coefficient is zero.
+/// Nothing here uses the projector's lookup grid or its sums.
+#[test]
+fn a_lit_texel_projects_onto_the_condition_of_its_nearest_light() {
+    let conds = conditions();
+    let projector = Projector::new(&conds).unwrap();
+    let lights: Vec<(usize, glam::Vec3)> = conds
+        .iter()
+        .enumerate()
+        .flat_map(|(k, c)| {
+            c.lights
+                .iter()
+                .map(move |l| (k, glam::Vec3::from(l.direction)))
+        })
+        .collect();
+    let (w, h) = (256usize, 128usize);
+    let probe = EnvMap::uniform([0.0; 3], h);
+    let radiance = [3.0f32, 2.0, 1.0];
+    let mut checked = 0;
+    for (i, turntable) in [0.0f32, 0.7, 2.5].into_iter().enumerate() {
+        for t in 0..40usize {
+            let (x, y) = ((t * 53 + i * 17) % w, (t * 29 + i * 11) % h);
+            let d = Mat3::from_rotation_y(turntable) * probe.direction_of(x as f32, y as f32);
+            let mut near: Vec<(f32, usize)> = lights.iter().map(|&(k, l)| (l.dot(d), k)).collect();
+            near.sort_by(|a, b| b.0.total_cmp(&a.0));
+            // Away from region boundaries: the projector's lookup grid is 0.5 degrees.
+            let (best, second) = (near[0], near.iter().find(|n| n.1 != near[0].1).unwrap());
+            if best.0.clamp(-1.0, 1.0).acos() + 2f32.to_radians() > second.0.clamp(-1.0, 1.0).acos()
+            {
+                continue;
+            }
+            let band = (2.0 * PI / w as f32)
+                * ((y as f32 * PI / h as f32).cos() - ((y + 1) as f32 * PI / h as f32).cos());
+            let env = EnvMap::from_image(Image::from_fn(w, h, |px, py| {
+                if (px, py) == (x, y) {
+                    radiance
+                } else {
+                    [0.0; 3]
+                }
+            }))
+            .unwrap();
+            let k = projector.project(&env, turntable, FloorModel::Environment);
+            let e = delivered(&conds[best.1]);
+            for (j, c) in k.iter().enumerate() {
+                for ch in 0..3 {
+                    let expected = if j == best.1 {
+                        radiance[ch] * band / e[ch]
+                    } else {
+                        0.0
+                    };
+                    assert!(
+                        (c[ch] - expected).abs() <= 1e-4 * expected.abs().max(1e-6),
+                        "texel ({x}, {y}) at turntable {turntable}: condition {j} = {c:?}, expected {expected} in channel {ch} of condition {}",
+                        best.1
+                    );
+                }
+            }
+            checked += 1;
+        }
+    }
+    assert!(
+        checked >= 60,
+        "only {checked} texels away from region boundaries"
+    );
+}
+
 #[test]
 fn projection_and_relighting_are_linear() {
     let projector = Projector::new(&conditions()).unwrap();

@@ -150,6 +150,85 @@ fn a_basis_frame_is_the_sum_of_its_lights_rendered_alone() {
     assert!(max_diff < 1e-5 * peak.max(1.0), "max difference {max_diff}");
 }
 
+/// A basis frame checked against a computation of its own: where a pixel sees the gray
+/// backdrop (18 % Lambertian paper, facing +z, behind the subject; every sub-sample's ray
+/// meets it, found here by intersecting the plane), its radiance is `ρ/π Σ E_l max(0,
+/// l_z)` over the condition's lights, less only what the actor's shadows take.
+#[test]
+fn a_basis_frame_shows_the_backdrop_at_its_lambertian_radiance() {
+    let stage = Stage::new(small_config()).unwrap();
+    let (pose, cycle, camera) = (2, 1, 1);
+    let lambertian = |condition: usize| -> [f32; 3] {
+        let lights = stage.condition_lights(condition).unwrap();
+        std::array::from_fn(|c| {
+            lights
+                .iter()
+                .map(|l| 0.18 / std::f32::consts::PI * l.irradiance[c] * l.direction.z.max(0.0))
+                .sum()
+        })
+    };
+    // The basis slot whose condition lights the backdrop most.
+    let (slot, expected) = (0..stage.schedule().len())
+        .filter_map(|slot| match stage.schedule()[slot] {
+            StageSlot::Basis(c) => Some((slot, lambertian(c))),
+            _ => None,
+        })
+        .max_by(|a, b| a.1[1].total_cmp(&b.1[1]))
+        .unwrap();
+    assert!(
+        expected[1] > 1e-3,
+        "no condition lights the backdrop: {expected:?}"
+    );
+    let frame = stage.render_frame(pose, cycle, camera, slot).unwrap();
+    let cam = stage
+        .view_setup(pose, cycle, camera, slot_time_offset_s(slot))
+        .unwrap()
+        .camera;
+    let on_backdrop = |x: f32, y: f32| {
+        let d = cam.ray_direction(glam::Vec2::new(x, y));
+        let t = (-frf_stage::studio::BACKDROP_DISTANCE_M - cam.centre().z) / d.z;
+        let p = cam.centre() + d * t;
+        d.z < 0.0 && t > 0.0 && p.x.abs() < 2.4 && (0.05..3.9).contains(&p.y)
+    };
+    let (mut seen, mut exact) = (0, 0);
+    for (i, (c, a)) in frame
+        .color
+        .pixels()
+        .iter()
+        .zip(frame.alpha.pixels())
+        .enumerate()
+    {
+        let (x, y) = (
+            (i % frame.color.width()) as f32,
+            (i / frame.color.width()) as f32,
+        );
+        let corners = [
+            (-0.5, -0.5),
+            (0.5, -0.5),
+            (-0.5, 0.5),
+            (0.5, 0.5),
+            (0.0, 0.0),
+        ];
+        if *a > 0.0 || !corners.iter().all(|(dx, dy)| on_backdrop(x + dx, y + dy)) {
+            continue;
+        }
+        seen += 1;
+        for ch in 0..3 {
+            assert!(
+                c[ch] <= expected[ch] * (1.0 + 1e-4),
+                "pixel ({x}, {y}): {c:?} above {expected:?}"
+            );
+        }
+        exact += (0..3).all(|ch| (c[ch] - expected[ch]).abs() <= 1e-4 * expected[ch]) as usize;
+    }
+    // The backdrop fills the view behind the subject; the actor's shadows fall on a part.
+    assert!(seen > 100, "{seen} backdrop pixels");
+    assert!(
+        exact * 10 >= seen * 7,
+        "{exact} of {seen} backdrop pixels at the Lambertian value"
+    );
+}
+
 #[test]
 fn an_interrupted_capture_resumes_and_a_different_one_is_refused() {
     let dir = tempfile::tempdir().unwrap();
