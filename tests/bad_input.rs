@@ -146,6 +146,22 @@ const CASES: &[Case] = &[
             "render",
             "{field}",
             "--env",
+            "{bad}/nan.exr",
+            "--orbit",
+            "3,1.2",
+            "--frames",
+            "1",
+            "--out",
+            "{out}/render",
+        ],
+        file: "nan.exr",
+        problem: &["pixel (5, 1) is not finite"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--env",
             "{bad}/huge.hdr",
             "--orbit",
             "3,1.2",
@@ -216,4 +232,72 @@ fn the_corpus_is_exactly_the_files_the_cases_name() {
             "tests/bad/{name} is not read by any case"
         );
     }
+}
+
+/// A frame of 8 bits per channel in a capture that declares 16-bit linear frames would
+/// be read at 1/257 of its scale's precision (or, rescaled by mistake, 257 times too
+/// dark): ingest refuses it naming the frame, before writing anything. (A capture is too
+/// large for the corpus; this one is made here.)
+#[test]
+fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_frf"))
+            .args(args)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap()
+    };
+    let made = run(&[
+        "stage",
+        "--preset",
+        "tiny",
+        "--poses",
+        "0",
+        "--size",
+        "32x45",
+        "--lights-per-axis",
+        "1",
+        "--set-flow",
+        "none",
+        "--out",
+        cap.to_str().unwrap(),
+    ]);
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let frame = frf_core::capture::Capture::open(&cap)
+        .unwrap()
+        .frame_path(0, 3, 1, 5);
+    let linear = frf_core::io::read_rgb(&frame).unwrap();
+    frf_core::io::write_png8_srgb(&frame, &linear, 1.0).unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let o = run(&[
+        "ingest",
+        cap.to_str().unwrap(),
+        "--flow-preset",
+        "fast",
+        "--no-eval",
+        "--out",
+        out.join("f.frf").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && o.status.code() != Some(101),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains(&frame.display().to_string())
+            && stderr.contains("8 bits per channel where the capture declares 16-bit frames"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        0,
+        "ingest left output"
+    );
 }

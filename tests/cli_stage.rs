@@ -194,3 +194,109 @@ fn bad_arguments_are_refused_by_name() {
     }
     assert!(!Path::new(out).exists(), "a failed command left an output");
 }
+
+/// A capture made through the binary with the default settings carries the true set
+/// flows (track slots), and `stage field` turns it into a complete oracle field whose
+/// flows are the truth's within the quantizer's bound.
+#[test]
+fn a_capture_through_the_binary_carries_its_truth_and_becomes_an_oracle_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    let o = frf(&[
+        "stage",
+        "--preset",
+        "tiny",
+        "--poses",
+        "0",
+        "--size",
+        "32x45",
+        "--lights-per-axis",
+        "1",
+        "--out",
+        cap.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("36 cycles x 3 cameras, 1 poses"), "{said}");
+    let capture = frf_core::capture::Capture::open(&cap).unwrap();
+    capture.check_files().unwrap();
+
+    // Default set-flow truth: from the reference track slot to each other track slot.
+    let reference = capture.reference_track().track_slot;
+    let others: Vec<usize> = capture
+        .tracks()
+        .iter()
+        .map(|t| t.track_slot)
+        .filter(|&s| s != reference)
+        .collect();
+    assert_eq!(others.len(), 2, "tracks {:?}", capture.tracks());
+    let (mut known, mut largest) = (0usize, 0.0f32);
+    for camera in 0..3 {
+        for cycle in 0..36 {
+            for &slot in &others {
+                let path = frf_stage::writer::truth_set_flow_path(&cap, 0, cycle, camera, slot);
+                let flow = frf_core::flo::read_flo(&path).unwrap();
+                assert_eq!(flow.size(), (32, 45), "{}", path.display());
+                for f in flow
+                    .pixels()
+                    .iter()
+                    .filter(|f| frf_core::flo::is_known(**f))
+                {
+                    assert!(f.iter().all(|c| c.is_finite()), "{}", path.display());
+                    largest = largest.max(f[0].hypot(f[1]));
+                    known += 1;
+                }
+            }
+        }
+    }
+    // The subject covers part of each view; it moves between track slots 16 ms apart by
+    // at most a few pixels at this size.
+    assert!(known > 36 * 3 * 2 * 50, "{known} known set-flow vectors");
+    assert!(
+        largest > 0.0 && largest < 8.0,
+        "largest set flow {largest} px"
+    );
+
+    let field = dir.path().join("oracle.frf");
+    let o = frf(&[
+        "stage",
+        "field",
+        "--capture",
+        cap.to_str().unwrap(),
+        "--out",
+        field.to_str().unwrap(),
+        "--shadow-texels",
+        "32",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = frf(&["info", field.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // A 36 x 3 grid: 108 views of 26 basis images; right and left flows in every row,
+    // up and down flows between the rows; one hull for the pose.
+    assert_eq!(info["views"], 108, "{info}");
+    assert_eq!(info["basis_images"], 108 * 26, "{info}");
+    assert_eq!(info["flow_maps"], 2 * 36 * 3 + 2 * 36 * 2, "{info}");
+    assert_eq!(info["hulls"], 1, "{info}");
+    let file = frf_reflectance::FieldFile::open(&field).unwrap();
+    let q = file.header().pose(0).unwrap().flow_quantizer;
+    for (cycle, camera) in [(0, 0), (17, 1), (35, 2)] {
+        for n in frf_core::grid::Neighbour::ALL {
+            let Some(stored) = file.flow(0, cycle, camera, n).unwrap() else {
+                continue;
+            };
+            let truth = frf_stage::writer::truth_flow_path(&cap, 0, cycle, camera, n);
+            let truth = frf_core::flo::read_flo(&truth).unwrap();
+            for (s, t) in stored.pixels().iter().zip(truth.pixels()) {
+                if frf_core::flo::is_known(*t) && t[0].hypot(t[1]) < q.range {
+                    for c in 0..2 {
+                        assert!(
+                            (s[c] - t[c]).abs() <= q.error_bound(t[c]) + 1e-4,
+                            "view ({cycle}, {camera}) {n:?}: {s:?} vs truth {t:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}

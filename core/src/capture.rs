@@ -367,7 +367,18 @@ impl Capture {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr") || e.eq_ignore_ascii_case("hdr"));
         if !is_float {
-            let k = (65535.0 / self.manifest.files.full_scale) as f32;
+            let full_scale = self.manifest.files.full_scale;
+            let bits = crate::io::bits_per_channel(path)?;
+            if full_scale > 255.0 && bits < 16 {
+                return Err(CoreError::bad_file(
+                    path,
+                    format!(
+                        "{bits} bits per channel where the capture declares 16-bit frames \
+                         (files.full_scale = {full_scale}): re-export it as 16-bit PNG"
+                    ),
+                ));
+            }
+            let k = (65535.0 / full_scale) as f32;
             if k != 1.0 {
                 for p in img.pixels_mut() {
                     *p = p.map(|c| c * k);

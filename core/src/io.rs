@@ -83,6 +83,16 @@ pub fn image_dimensions(path: &Path) -> Result<(usize, usize)> {
     Ok((w as usize, h as usize))
 }
 
+/// Bits per channel of an image file (8, 16 or 32), read from its header only.
+pub fn bits_per_channel(path: &Path) -> Result<u16> {
+    use image::ImageDecoder;
+    let decoder = reader(path)?
+        .into_decoder()
+        .map_err(|e| CoreError::bad_file(path, format!("cannot read image header: {e}")))?;
+    let color = decoder.color_type();
+    Ok(color.bits_per_pixel() / color.channel_count() as u16)
+}
+
 fn check_finite<P: crate::image::Pixel>(path: &Path, img: &Image<P>) -> Result<()> {
     if let Some(i) = img
         .pixels()

@@ -361,8 +361,9 @@ impl<R: ReadAt> FieldFile<R> {
         if checksums_checked() && crc32fast::hash(&packed) != index_crc {
             return Err(bad("index checksum mismatch (damaged file)".into()));
         }
-        let json = zstd::bulk::decompress(&packed, MAX_INDEX_BYTES)
-            .map_err(|e| bad(format!("index: {e}")))?;
+        // The size the frame declares is checked before anything is reserved.
+        let json = crate::unzstd::decompress_at_most(&packed, MAX_INDEX_BYTES, "index")
+            .map_err(|e| bad(e.to_string()))?;
         let index: Index = serde_json::from_slice(&json).map_err(|e| bad(format!("index: {e}")))?;
         index
             .header
