@@ -13,6 +13,8 @@
 //!   below the grid of cameras);
 //! - [`scene`]: the relit shadow, composites and matte edges against the truth;
 //! - [`shot`]: the frames of a scene's shot against their true composites;
+//! - [`report`]: error against run time of every stage's settings: rows, Pareto fronts,
+//!   plots and the page that shows them;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
 //!   neighbours, against the photographs.
 //!
@@ -23,6 +25,7 @@ pub mod ingest;
 pub mod metrics;
 pub mod oracle;
 pub mod paths;
+pub mod report;
 pub mod ring;
 pub mod scene;
 pub mod shot;

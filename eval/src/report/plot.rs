@@ -1,0 +1,212 @@
+//! The plot of one stage: error against seconds (log scale), one panel per metric, one
+//! point per setting labelled with its value, the Pareto front drawn through its points,
+//! the default setting ringed, peers' points in their own colour. Drawn with `plotters`
+//! as SVG (text left to the viewer's fonts) and as PNG (text rasterised with a system
+//! font found at run time; without one, no PNG is drawn and the caller is told).
+
+use std::sync::OnceLock;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::{PeerPoint, Report, Row, pareto_front};
+use crate::{EvalError, Result};
+
+/// Pixels per panel.
+const PANEL: (u32, u32) = (560, 400);
+
+/// Fonts tried for the PNG's text, in order.
+const FONT_FILES: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+];
+
+/// Registers a system font for the text of the plots, once; `false` when none exists.
+pub fn fonts_available() -> bool {
+    static FOUND: OnceLock<bool> = OnceLock::new();
+    *FOUND.get_or_init(|| {
+        FONT_FILES.iter().any(|path| {
+            let Ok(bytes) = std::fs::read(path) else {
+                return false;
+            };
+            let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            plotters::style::register_font("sans-serif", FontStyle::Normal, bytes).is_ok()
+        })
+    })
+}
+
+fn plot_error(e: impl std::fmt::Display) -> EvalError {
+    EvalError::BadParameter(format!("plot: {e}"))
+}
+
+/// Panels laid out side by side, at most three per row.
+fn layout(metrics: usize) -> (usize, usize) {
+    let columns = metrics.clamp(1, 3);
+    (columns, metrics.div_ceil(columns).max(1))
+}
+
+/// The size of a stage's plot, pixels.
+pub fn size(report: &Report, stage: &str) -> (u32, u32) {
+    let (c, r) = layout(report.metrics(stage).len());
+    (PANEL.0 * c as u32, PANEL.1 * r as u32)
+}
+
+/// A stage's plot as SVG text.
+pub fn svg(report: &Report, stage: &str) -> Result<String> {
+    fonts_available();
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, size(report, stage)).into_drawing_area();
+        draw(&root, report, stage)?;
+        root.present().map_err(plot_error)?;
+    }
+    Ok(out)
+}
+
+/// A stage's plot as PNG bytes, or `None` without a font for its text.
+pub fn png(report: &Report, stage: &str) -> Result<Option<Vec<u8>>> {
+    if !fonts_available() {
+        return Ok(None);
+    }
+    let (w, h) = size(report, stage);
+    let mut rgb = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        draw(&root, report, stage)?;
+        root.present().map_err(plot_error)?;
+    }
+    let img = image::RgbImage::from_raw(w, h, rgb)
+        .ok_or_else(|| plot_error("the bitmap has the wrong size"))?;
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+        .map_err(plot_error)?;
+    Ok(Some(bytes))
+}
+
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    report: &Report,
+    stage: &str,
+) -> Result<()> {
+    root.fill(&WHITE).map_err(plot_error)?;
+    let metrics = report.metrics(stage);
+    let (columns, rows) = layout(metrics.len());
+    let panels = root.split_evenly((rows, columns));
+    for (panel, metric) in panels.iter().zip(&metrics) {
+        let series = report.series(stage, metric);
+        let peers: Vec<&PeerPoint> = report
+            .peers
+            .iter()
+            .filter(|p| p.stage == stage && p.metric == *metric)
+            .collect();
+        draw_panel(panel, stage, metric, &series, &peers)?;
+    }
+    Ok(())
+}
+
+/// Axis ranges with a margin: seconds on a log scale, errors linear.
+fn ranges(series: &[&Row], peers: &[&PeerPoint]) -> ((f64, f64), (f64, f64)) {
+    let points = series
+        .iter()
+        .map(|r| (r.seconds, r.error))
+        .chain(peers.iter().map(|p| (p.seconds, p.error)));
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in points {
+        x0 = x0.min(x.max(1e-6));
+        x1 = x1.max(x.max(1e-6));
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        return ((1e-3, 1.0), (0.0, 1.0));
+    }
+    let pad = ((y1 - y0) * 0.12).max(y1.abs() * 0.02).max(1e-3);
+    ((x0 / 1.6, x1 * 1.6), (y0 - pad, y1 + pad))
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    stage: &str,
+    metric: &str,
+    series: &[&Row],
+    peers: &[&PeerPoint],
+) -> Result<()> {
+    let ((x0, x1), (y0, y1)) = ranges(series, peers);
+    let timed = series.first().map_or("", |r| r.timed.as_str());
+    let mut chart = ChartBuilder::on(area)
+        .caption(format!("{stage}: {metric}"), ("sans-serif", 17))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(56)
+        .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+        .map_err(plot_error)?;
+    chart
+        .configure_mesh()
+        .x_desc(format!("seconds ({timed}, log scale)"))
+        .y_desc(metric)
+        .x_label_formatter(&|x| format!("{x:.3}"))
+        .label_style(("sans-serif", 12))
+        .draw()
+        .map_err(plot_error)?;
+    let front: Vec<(f64, f64)> = pareto_front(series)
+        .into_iter()
+        .map(|i| (series[i].seconds, series[i].error))
+        .collect();
+    let accent = RGBColor(200, 60, 40);
+    chart
+        .draw_series(LineSeries::new(front, accent.stroke_width(2)))
+        .map_err(plot_error)?
+        .label("Pareto front")
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], accent.stroke_width(2)));
+    let ours = RGBColor(30, 90, 170);
+    chart
+        .draw_series(series.iter().map(|r| {
+            EmptyElement::at((r.seconds, r.error))
+                + Circle::new((0, 0), 4, ours.filled())
+                + Text::new(
+                    format!("{}={}", short(&r.knob), r.value),
+                    (6, -12),
+                    ("sans-serif", 11),
+                )
+        }))
+        .map_err(plot_error)?
+        .label("settings")
+        .legend(move |(x, y)| Circle::new((x + 8, y), 4, ours.filled()));
+    chart
+        .draw_series(
+            series
+                .iter()
+                .filter(|r| r.default)
+                .map(|r| Circle::new((r.seconds, r.error), 9, accent.stroke_width(2))),
+        )
+        .map_err(plot_error)?
+        .label("default")
+        .legend(move |(x, y)| Circle::new((x + 8, y), 6, accent.stroke_width(2)));
+    if !peers.is_empty() {
+        let peer = RGBColor(40, 150, 70);
+        chart
+            .draw_series(peers.iter().map(|p| {
+                EmptyElement::at((p.seconds, p.error))
+                    + TriangleMarker::new((0, 0), 6, peer.filled())
+                    + Text::new(p.method.clone(), (6, 4), ("sans-serif", 11))
+            }))
+            .map_err(plot_error)?
+            .label("peers")
+            .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 5, peer.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.3))
+        .label_font(("sans-serif", 11))
+        .draw()
+        .map_err(plot_error)?;
+    Ok(())
+}
+
+/// A knob's name shortened for a point's label (its last word).
+fn short(knob: &str) -> &str {
+    knob.rsplit(' ').next().unwrap_or(knob)
+}
