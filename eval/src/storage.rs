@@ -182,3 +182,66 @@ pub fn codec_curve(
         })
         .collect()
 }
+
+/// One flow quantizer measured on true flows ([`flow_quantization`]).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct QuantizationScore {
+    /// Scale `s` of the log quantizer, pixels.
+    pub scale: f32,
+    /// Range `M`, pixels (the largest magnitude among the flows).
+    pub range: f32,
+    /// Mean end-point error the codes add to the true flow, pixels.
+    pub epe: f64,
+    /// Coded size per known vector, bits (Huffman-coded, left-predicted codes).
+    pub bits_per_vector: f64,
+    /// Encoding and decoding time per map, seconds.
+    pub seconds_per_map: f64,
+}
+
+/// The error and size of storing `flows` (true flows, unknown pixels skipped) with a log
+/// quantizer of scale `scale` (`None`: the scale ingest fits to them) and the flows' own
+/// range: each map is encoded as a field stores it and decoded again.
+pub fn flow_quantization(
+    flows: &[frf_core::image::FlowImage],
+    scale: Option<f32>,
+) -> Result<QuantizationScore> {
+    use frf_core::flo::is_known;
+    use frf_reflectance::flowcodec::{self, quant::LogQuantizer};
+    if flows.is_empty() {
+        return Err(EvalError::BadParameter("no flows to quantize".into()));
+    }
+    let values = || {
+        flows
+            .iter()
+            .flat_map(|f| f.pixels().iter().filter(|v| is_known(**v)).flatten().copied())
+    };
+    let fitted = LogQuantizer::fit(values());
+    let q = match scale {
+        Some(s) => LogQuantizer::new(s, fitted.range)?,
+        None => fitted,
+    };
+    let (mut sum, mut known, mut bytes) = (0.0f64, 0usize, 0usize);
+    let start = Instant::now();
+    for f in flows {
+        let coded = flowcodec::encode(f, &q, true)?;
+        let back = flowcodec::decode(&coded, &q)?;
+        bytes += coded.len();
+        for (t, b) in f.pixels().iter().zip(back.pixels()) {
+            if is_known(*t) {
+                sum += f64::from((t[0] - b[0]).hypot(t[1] - b[1]));
+                known += 1;
+            }
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    if known == 0 {
+        return Err(EvalError::BadParameter("the flows hold no known vector".into()));
+    }
+    Ok(QuantizationScore {
+        scale: q.scale,
+        range: q.range,
+        epe: sum / known as f64,
+        bits_per_vector: bytes as f64 * 8.0 / known as f64,
+        seconds_per_map: seconds / flows.len() as f64,
+    })
+}

@@ -145,3 +145,29 @@ fn basis_projection_error_per_environment() {
         }
     }
 }
+
+#[test]
+fn the_fitted_flow_quantizer_beats_scales_too_fine_or_too_coarse() {
+    // A smooth true flow with unknown pixels, as a field stores it.
+    let flow = frf_core::image::Image::from_fn(40, 30, |x, y| {
+        if x < 3 {
+            [frf_core::flo::UNKNOWN; 2]
+        } else {
+            [0.2 * x as f32 - 3.0, 0.05 * y as f32 * (x as f32 * 0.3).sin()]
+        }
+    });
+    let flows = [flow];
+    // Codes are 8 bits whatever the scale: a tiny scale spends them near zero and leaves
+    // wide steps at the range; a large one is nearly linear, wide steps everywhere.
+    let fine = frf_eval::storage::flow_quantization(&flows, Some(0.0005)).unwrap();
+    let coarse = frf_eval::storage::flow_quantization(&flows, Some(50.0)).unwrap();
+    let fitted = frf_eval::storage::flow_quantization(&flows, None).unwrap();
+    // The bound of the log quantizer (half a code step, relative) holds on average.
+    for s in [fine, coarse, fitted] {
+        assert!(s.epe.is_finite() && s.epe < 0.2, "{s:?}");
+    }
+    eprintln!("{fine:?}\n{coarse:?}\n{fitted:?}");
+    assert!(fitted.epe < fine.epe && fitted.epe < coarse.epe, "{fitted:?}");
+    assert_eq!(fitted.range, fine.range);
+    assert!(frf_eval::storage::flow_quantization(&[], None).is_err());
+}
