@@ -43,6 +43,9 @@ enum Command {
     Eval(Box<cmd::eval::EvalArgs>),
     /// Score views held out of a ring of photographs, rendered from their neighbours.
     EvalRing(cmd::eval::RingEvalArgs),
+    /// Error against run time of every stage's settings on a stage capture: JSON, plots,
+    /// and one page.
+    Report(cmd::report::ReportArgs),
     /// Benchmarks: `frf bench interp` times the GPU interpolation passes.
     Bench(cmd::bench::BenchArgs),
     /// Optical flow from image A to image B, written as a Middlebury .flo file.
@@ -63,6 +66,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(*args),
         Command::Eval(args) => cmd::eval::run(*args),
         Command::EvalRing(args) => cmd::eval::run_ring(args),
+        Command::Report(args) => cmd::report::run(args),
         Command::Bench(args) => cmd::bench::run_bench(args),
         Command::Flow(args) => cmd::flow::run(args),
         Command::FlowBench(args) => cmd::flow::run_bench(args),

@@ -3,7 +3,8 @@
 //! refused with a message saying so, and the decoder reserves almost nothing on the way.
 //! A counting allocator measures the peak memory each refusal took.
 
-#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+#![allow(clippy::unwrap_used)]
+// tests: a failed unwrap is a failed test
 // A global allocator is an unsafe trait; this one only counts and forwards to `System`.
 #![allow(unsafe_code)]
 

@@ -211,9 +211,13 @@ pub fn flow_quantization(
         return Err(EvalError::BadParameter("no flows to quantize".into()));
     }
     let values = || {
-        flows
-            .iter()
-            .flat_map(|f| f.pixels().iter().filter(|v| is_known(**v)).flatten().copied())
+        flows.iter().flat_map(|f| {
+            f.pixels()
+                .iter()
+                .filter(|v| is_known(**v))
+                .flatten()
+                .copied()
+        })
     };
     let fitted = LogQuantizer::fit(values());
     let q = match scale {
@@ -235,7 +239,9 @@ pub fn flow_quantization(
     }
     let seconds = start.elapsed().as_secs_f64();
     if known == 0 {
-        return Err(EvalError::BadParameter("the flows hold no known vector".into()));
+        return Err(EvalError::BadParameter(
+            "the flows hold no known vector".into(),
+        ));
     }
     Ok(QuantizationScore {
         scale: q.scale,

@@ -153,7 +153,10 @@ fn the_fitted_flow_quantizer_beats_scales_too_fine_or_too_coarse() {
         if x < 3 {
             [frf_core::flo::UNKNOWN; 2]
         } else {
-            [0.2 * x as f32 - 3.0, 0.05 * y as f32 * (x as f32 * 0.3).sin()]
+            [
+                0.2 * x as f32 - 3.0,
+                0.05 * y as f32 * (x as f32 * 0.3).sin(),
+            ]
         }
     });
     let flows = [flow];
@@ -167,7 +170,10 @@ fn the_fitted_flow_quantizer_beats_scales_too_fine_or_too_coarse() {
         assert!(s.epe.is_finite() && s.epe < 0.2, "{s:?}");
     }
     eprintln!("{fine:?}\n{coarse:?}\n{fitted:?}");
-    assert!(fitted.epe < fine.epe && fitted.epe < coarse.epe, "{fitted:?}");
+    assert!(
+        fitted.epe < fine.epe && fitted.epe < coarse.epe,
+        "{fitted:?}"
+    );
     assert_eq!(fitted.range, fine.range);
     assert!(frf_eval::storage::flow_quantization(&[], None).is_err());
 }

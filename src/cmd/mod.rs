@@ -14,5 +14,6 @@ pub mod merge;
 pub mod output;
 pub mod progress;
 pub mod render;
+pub mod report;
 pub mod stage;
 pub mod stage_field;

@@ -16,7 +16,13 @@ fn escape(s: &str) -> String {
 pub fn plot_name(stage: &str) -> String {
     let mut name: String = stage
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
         .collect();
     while name.contains("__") {
         name = name.replace("__", "_");
@@ -59,16 +65,20 @@ pub fn page(report: &Report, png: bool) -> String {
         for metric in report.metrics(stage) {
             let series = report.series(stage, metric);
             let front = pareto_front(&series);
-            let _ = write!(
+            let _ = writeln!(
                 h,
-                "<table><tr><th>knob</th><th>value</th><th>{}</th><th>seconds</th><th>timed</th><th>default</th><th>command</th></tr>\n",
+                "<table><tr><th>knob</th><th>value</th><th>{}</th><th>seconds</th><th>timed</th><th>default</th><th>command</th></tr>",
                 escape(metric)
             );
             for (i, r) in series.iter().enumerate() {
                 let _ = writeln!(
                     h,
                     "<tr{}><td class=l>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.4}</td><td class=l>{}</td><td>{}</td><td class=l><code>{}</code></td></tr>",
-                    if front.contains(&i) { " class=front" } else { "" },
+                    if front.contains(&i) {
+                        " class=front"
+                    } else {
+                        ""
+                    },
                     escape(&r.knob),
                     escape(&r.value),
                     r.error,

@@ -97,7 +97,8 @@ pub struct Report {
     pub machine: Machine,
     /// The reduced sweep of `--quick`?
     pub quick: bool,
-    /// Wall time of the whole sweep, seconds.
+    /// Wall time of the sweep's measurements, seconds (those kept from an interrupted
+    /// run included).
     pub seconds_total: f64,
     /// Every measured setting.
     pub rows: Vec<Row>,
@@ -234,7 +235,10 @@ mod tests {
         };
         let p = r.problems(&["s", "novel views"]);
         assert_eq!(p.len(), 2, "{p:?}");
-        assert!(p[0].contains("novel views") && p[1].contains("NaN"), "{p:?}");
+        assert!(
+            p[0].contains("novel views") && p[1].contains("NaN"),
+            "{p:?}"
+        );
         r.rows[0].error = 0.5;
         assert!(r.problems(&["s"]).is_empty());
         assert_eq!(Better::of("subject PSNR dB"), Better::Higher);
@@ -271,7 +275,13 @@ mod tests {
             }],
         };
         let svg = plot::svg(&report, "s").unwrap();
-        for text in ["s: EPE px", "s: alpha IoU", "k=balanced", "Farneback", "Pareto front"] {
+        for text in [
+            "s: EPE px",
+            "s: alpha IoU",
+            ">balanced<",
+            "Farneback",
+            "Pareto front",
+        ] {
             assert!(svg.contains(text), "the plot lacks {text:?}");
         }
         if let Some(png) = plot::png(&report, "s").unwrap() {
@@ -279,7 +289,10 @@ mod tests {
             assert_eq!((img.width(), img.height()), plot::size(&report, "s"));
         }
         let page = html::page(&report, false);
-        assert!(page.contains("cap&lt;1&gt;") && page.contains("s.svg"), "{page}");
+        assert!(
+            page.contains("cap&lt;1&gt;") && page.contains("s.svg"),
+            "{page}"
+        );
         assert_eq!(page.matches("<tr class=front>").count(), 3 + 1);
         assert_eq!(html::plot_name("novel views (GPU)"), "novel_views_gpu");
     }

@@ -9,7 +9,7 @@ use std::sync::OnceLock;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::{PeerPoint, Report, Row, pareto_front};
+use super::{Better, PeerPoint, Report, Row, pareto_front};
 use crate::{EvalError, Result};
 
 /// Pixels per panel.
@@ -80,8 +80,11 @@ pub fn png(report: &Report, stage: &str) -> Result<Option<Vec<u8>>> {
     let img = image::RgbImage::from_raw(w, h, rgb)
         .ok_or_else(|| plot_error("the bitmap has the wrong size"))?;
     let mut bytes = Vec::new();
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-        .map_err(plot_error)?;
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(plot_error)?;
     Ok(Some(bytes))
 }
 
@@ -120,10 +123,11 @@ fn ranges(series: &[&Row], peers: &[&PeerPoint]) -> ((f64, f64), (f64, f64)) {
         y1 = y1.max(y);
     }
     if x0 > x1 {
-        return ((1e-3, 1.0), (0.0, 1.0));
+        return ((-3.0, 0.0), (0.0, 1.0));
     }
     let pad = ((y1 - y0) * 0.12).max(y1.abs() * 0.02).max(1e-3);
-    ((x0 / 1.6, x1 * 1.6), (y0 - pad, y1 + pad))
+    // Seconds are drawn as their base-10 logarithm on a linear axis (ticks at any range).
+    ((x0.log10() - 0.2, x1.log10() + 0.2), (y0 - pad, y1 + pad))
 }
 
 fn draw_panel<DB: DrawingBackend>(
@@ -140,19 +144,20 @@ fn draw_panel<DB: DrawingBackend>(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(56)
-        .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(plot_error)?;
     chart
         .configure_mesh()
         .x_desc(format!("seconds ({timed}, log scale)"))
         .y_desc(metric)
-        .x_label_formatter(&|x| format!("{x:.3}"))
+        .x_labels(8)
+        .x_label_formatter(&|x| seconds_label(10f64.powf(*x)))
         .label_style(("sans-serif", 12))
         .draw()
         .map_err(plot_error)?;
     let front: Vec<(f64, f64)> = pareto_front(series)
         .into_iter()
-        .map(|i| (series[i].seconds, series[i].error))
+        .map(|i| (lg(series[i].seconds), series[i].error))
         .collect();
     let accent = RGBColor(200, 60, 40);
     chart
@@ -162,14 +167,12 @@ fn draw_panel<DB: DrawingBackend>(
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], accent.stroke_width(2)));
     let ours = RGBColor(30, 90, 170);
     chart
-        .draw_series(series.iter().map(|r| {
-            EmptyElement::at((r.seconds, r.error))
+        .draw_series(series.iter().enumerate().map(|(i, r)| {
+            // Neighbouring settings' labels alternate above and below their points.
+            let dy = if i % 2 == 0 { -14 } else { 4 };
+            EmptyElement::at((lg(r.seconds), r.error))
                 + Circle::new((0, 0), 4, ours.filled())
-                + Text::new(
-                    format!("{}={}", short(&r.knob), r.value),
-                    (6, -12),
-                    ("sans-serif", 11),
-                )
+                + Text::new(r.value.clone(), (6, dy), ("sans-serif", 11))
         }))
         .map_err(plot_error)?
         .label("settings")
@@ -179,7 +182,7 @@ fn draw_panel<DB: DrawingBackend>(
             series
                 .iter()
                 .filter(|r| r.default)
-                .map(|r| Circle::new((r.seconds, r.error), 9, accent.stroke_width(2))),
+                .map(|r| Circle::new((lg(r.seconds), r.error), 9, accent.stroke_width(2))),
         )
         .map_err(plot_error)?
         .label("default")
@@ -188,7 +191,7 @@ fn draw_panel<DB: DrawingBackend>(
         let peer = RGBColor(40, 150, 70);
         chart
             .draw_series(peers.iter().map(|p| {
-                EmptyElement::at((p.seconds, p.error))
+                EmptyElement::at((lg(p.seconds), p.error))
                     + TriangleMarker::new((0, 0), 6, peer.filled())
                     + Text::new(p.method.clone(), (6, 4), ("sans-serif", 11))
             }))
@@ -196,8 +199,15 @@ fn draw_panel<DB: DrawingBackend>(
             .label("peers")
             .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 5, peer.filled()));
     }
+    // The legend goes in the corner the front leaves empty: it climbs from the lower
+    // left for scores and falls from the upper left for errors.
+    let corner = match Better::of(metric) {
+        Better::Higher => SeriesLabelPosition::UpperLeft,
+        Better::Lower => SeriesLabelPosition::LowerLeft,
+    };
     chart
         .configure_series_labels()
+        .position(corner)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK.mix(0.3))
         .label_font(("sans-serif", 11))
@@ -206,7 +216,19 @@ fn draw_panel<DB: DrawingBackend>(
     Ok(())
 }
 
-/// A knob's name shortened for a point's label (its last word).
-fn short(knob: &str) -> &str {
-    knob.rsplit(' ').next().unwrap_or(knob)
+/// Where a time sits on the x axis: its base-10 logarithm (times below a microsecond are
+/// drawn at one).
+fn lg(seconds: f64) -> f64 {
+    seconds.max(1e-6).log10()
+}
+
+/// A tick's time with the digits it needs.
+fn seconds_label(s: f64) -> String {
+    if s >= 10.0 {
+        format!("{s:.0}")
+    } else if s >= 0.1 {
+        format!("{s:.2}")
+    } else {
+        format!("{s:.1e}")
+    }
 }
