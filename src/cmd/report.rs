@@ -174,6 +174,11 @@ pub fn run(args: ReportArgs) -> CliResult {
         .poses()
         .first()
         .ok_or_else(|| format!("{}: the capture has no poses", args.capture.display()))?;
+    // Peers are read first: a bad file is refused before minutes of measuring.
+    let (mut peer_flow_rows, mut peers) = (Vec::new(), Vec::new());
+    if let Some(p) = &args.peers {
+        peer_rows(p, &mut peer_flow_rows, &mut peers)?;
+    }
     let runs = args.out.join("runs");
     std::fs::create_dir_all(&runs)
         .map_err(|e| format!("{}: cannot create it: {e}", runs.display()))?;
@@ -633,10 +638,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     }
     runner.bar.finish_and_clear();
 
-    let mut peers = Vec::new();
-    if let Some(p) = &args.peers {
-        peer_rows(p, &mut rows, &mut peers)?;
-    }
+    rows.extend(peer_flow_rows);
     let report = Report {
         capture: cap,
         commit: commit(),
