@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod common;
+
 /// A case: the command (`{bad}` is the corpus directory, `{out}` a path in a fresh
 /// scratch directory that must stay empty), the file it names and the words of the problem.
 struct Case {
@@ -241,34 +243,7 @@ fn the_corpus_is_exactly_the_files_the_cases_name() {
 #[test]
 fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let cap = dir.path().join("cap");
-    let run = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_frf"))
-            .args(args)
-            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-            .output()
-            .unwrap()
-    };
-    let made = run(&[
-        "stage",
-        "--preset",
-        "tiny",
-        "--poses",
-        "0",
-        "--size",
-        "32x45",
-        "--lights-per-axis",
-        "1",
-        "--set-flow",
-        "none",
-        "--out",
-        cap.to_str().unwrap(),
-    ]);
-    assert!(
-        made.status.success(),
-        "{}",
-        String::from_utf8_lossy(&made.stderr)
-    );
+    let cap = common::staged_capture(dir.path());
     let frame = frf_core::capture::Capture::open(&cap)
         .unwrap()
         .frame_path(0, 3, 1, 5);
@@ -276,7 +251,7 @@ fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
     frf_core::io::write_png8_srgb(&frame, &linear, 1.0).unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
-    let o = run(&[
+    let o = common::frf(&[
         "ingest",
         cap.to_str().unwrap(),
         "--flow-preset",

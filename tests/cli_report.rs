@@ -7,40 +7,13 @@
 
 mod common;
 
-use common::{frf, stderr};
-
-/// The stages `frf report` must always measure (`src/cmd/report.rs::STAGES`).
-const STAGES: &[&str] = &[
-    "inter-view flow",
-    "registration and mattes",
-    "flow storage",
-    "basis compression",
-    "novel views",
-    "camera paths",
-    "frame size",
-    "renderer",
-    "shadows",
-    "composite",
-];
+use common::{frf, staged_capture, stderr};
+use frf_eval::report::STAGES;
 
 #[test]
 fn a_quick_report_measures_every_stage_and_resumes() {
     let dir = tempfile::tempdir().unwrap();
-    let cap = dir.path().join("cap");
-    let o = frf(&[
-        "stage",
-        "--preset",
-        "tiny",
-        "--poses",
-        "0",
-        "--size",
-        "32x45",
-        "--lights-per-axis",
-        "1",
-        "--out",
-        cap.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let cap = staged_capture(dir.path());
     // The peer script's output shape (benches/flow_peers/run_peers.py), two of ours and
     // two of OpenCV's methods.
     let peers = dir.path().join("peers.json");

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{frf, stderr};
+use common::{frf, staged_capture, stderr};
 
 use std::path::Path;
 
@@ -201,23 +201,7 @@ fn bad_arguments_are_refused_by_name() {
 #[test]
 fn a_capture_through_the_binary_carries_its_truth_and_becomes_an_oracle_field() {
     let dir = tempfile::tempdir().unwrap();
-    let cap = dir.path().join("cap");
-    let o = frf(&[
-        "stage",
-        "--preset",
-        "tiny",
-        "--poses",
-        "0",
-        "--size",
-        "32x45",
-        "--lights-per-axis",
-        "1",
-        "--out",
-        cap.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let said = String::from_utf8_lossy(&o.stdout);
-    assert!(said.contains("36 cycles x 3 cameras, 1 poses"), "{said}");
+    let cap = staged_capture(dir.path());
     let capture = frf_core::capture::Capture::open(&cap).unwrap();
     capture.check_files().unwrap();
 

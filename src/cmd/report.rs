@@ -14,7 +14,7 @@ use std::time::Instant;
 use clap::Args;
 use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
-use frf_eval::report::{Machine, PeerPoint, Report, Row, html, plot};
+use frf_eval::report::{Machine, PeerPoint, Report, Row, STAGES, html, plot};
 use serde_json::Value;
 
 use super::progress::bar;
@@ -44,20 +44,6 @@ pub struct ReportArgs {
     #[arg(long)]
     cpu: bool,
 }
-
-/// The stages every report has (`--peers` adds the optical-flow plot).
-pub const STAGES: &[&str] = &[
-    "inter-view flow",
-    "registration and mattes",
-    "flow storage",
-    "basis compression",
-    "novel views",
-    "camera paths",
-    "frame size",
-    "renderer",
-    "shadows",
-    "composite",
-];
 
 /// Runs of this binary, each kept under `runs/` with its wall time.
 struct Runner {
@@ -543,40 +529,22 @@ pub fn run(args: ReportArgs) -> CliResult {
     // Shadows: hull voxel and shadow-map texels, on oracle fields (perfect flow), each
     // timed against a field built without shadows in the same report.
     let plain = runs.join("oracle_no_shadows.frf");
-    let a: Vec<String> = [
-        "stage",
-        "field",
-        "--capture",
-        &cap,
-        "--poses",
-        &pose_arg,
-        "--no-shadows",
-        "--out",
-    ]
-    .map(String::from)
-    .into_iter()
-    .chain([s(&plain)])
-    .collect();
-    let base = runner.run("oracle_no_shadows", &a, &[&plain])?;
+    let field_args = |extra: &[&str], out: &Path| -> Vec<String> {
+        ["stage", "field", "--capture", &cap, "--poses", &pose_arg]
+            .iter()
+            .chain(extra)
+            .map(|a| a.to_string())
+            .chain(["--out".into(), s(out)])
+            .collect()
+    };
+    let base = runner.run(
+        "oracle_no_shadows",
+        &field_args(&["--no-shadows"], &plain),
+        &[&plain],
+    )?;
     for (i, (voxel, texels)) in shadow_settings.iter().enumerate() {
         let f = runs.join(format!("oracle_shadows_{i}.frf"));
-        let a: Vec<String> = [
-            "stage",
-            "field",
-            "--capture",
-            &cap,
-            "--poses",
-            &pose_arg,
-            "--hull-voxel",
-            voxel,
-            "--shadow-texels",
-            texels,
-            "--out",
-        ]
-        .map(String::from)
-        .into_iter()
-        .chain([s(&f)])
-        .collect();
+        let a = field_args(&["--hull-voxel", voxel, "--shadow-texels", texels], &f);
         let built = runner.run(&format!("oracle_shadows_{i}"), &a, &[&f])?;
         let mut e: Vec<String> = [
             "eval",

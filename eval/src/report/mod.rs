@@ -13,6 +13,20 @@ pub mod plot;
 
 use serde::{Deserialize, Serialize};
 
+/// The stages every report of `frf report` measures (peers add their own plot).
+pub const STAGES: &[&str] = &[
+    "inter-view flow",
+    "registration and mattes",
+    "flow storage",
+    "basis compression",
+    "novel views",
+    "camera paths",
+    "frame size",
+    "renderer",
+    "shadows",
+    "composite",
+];
+
 /// Which way a metric improves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
