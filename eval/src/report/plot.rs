@@ -138,6 +138,15 @@ fn draw_panel<DB: DrawingBackend>(
     peers: &[&PeerPoint],
 ) -> Result<()> {
     let ((x0, x1), (y0, y1)) = ranges(series, peers);
+    // Labels of points in the right third of the panel go to their left (about 6 px per
+    // character at this size), so that they stay inside it.
+    let label_dx = |text: &str, seconds: f64| {
+        if lg(seconds) > x0 + 0.66 * (x1 - x0) {
+            -8 - 6 * text.chars().count() as i32
+        } else {
+            6
+        }
+    };
     let timed = series.first().map_or("", |r| r.timed.as_str());
     let mut chart = ChartBuilder::on(area)
         .caption(format!("{stage}: {metric}"), ("sans-serif", 17))
@@ -172,7 +181,11 @@ fn draw_panel<DB: DrawingBackend>(
             let dy = if i % 2 == 0 { -14 } else { 4 };
             EmptyElement::at((lg(r.seconds), r.error))
                 + Circle::new((0, 0), 4, ours.filled())
-                + Text::new(r.value.clone(), (6, dy), ("sans-serif", 11))
+                + Text::new(
+                    r.value.clone(),
+                    (label_dx(&r.value, r.seconds), dy),
+                    ("sans-serif", 11),
+                )
         }))
         .map_err(plot_error)?
         .label("settings")
@@ -193,17 +206,21 @@ fn draw_panel<DB: DrawingBackend>(
             .draw_series(peers.iter().map(|p| {
                 EmptyElement::at((lg(p.seconds), p.error))
                     + TriangleMarker::new((0, 0), 6, peer.filled())
-                    + Text::new(p.method.clone(), (6, 4), ("sans-serif", 11))
+                    + Text::new(
+                        p.method.clone(),
+                        (label_dx(&p.method, p.seconds), 4),
+                        ("sans-serif", 11),
+                    )
             }))
             .map_err(plot_error)?
             .label("peers")
             .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 5, peer.filled()));
     }
-    // The legend goes in the corner the front leaves empty: it climbs from the lower
-    // left for scores and falls from the upper left for errors.
+    // The legend goes in the corner settings leave empty: slow and poor (upper right for
+    // errors, lower right for scores).
     let corner = match Better::of(metric) {
-        Better::Higher => SeriesLabelPosition::UpperLeft,
-        Better::Lower => SeriesLabelPosition::LowerLeft,
+        Better::Higher => SeriesLabelPosition::LowerRight,
+        Better::Lower => SeriesLabelPosition::UpperRight,
     };
     chart
         .configure_series_labels()
