@@ -69,13 +69,22 @@ pub struct OracleOptions {
     pub shadows: Option<ShadowOptions>,
 }
 
+/// What writing an oracle field made.
+#[derive(Debug, Clone)]
+pub struct OracleWritten {
+    /// The field's statistics.
+    pub stats: FieldStats,
+    /// Wall seconds spent carving the visual hulls and computing the shadow maps.
+    pub shadow_seconds: f64,
+}
+
 /// Writes the oracle field of `stage` to `path`; `progress(done, total)` counts views.
 pub fn write_oracle_field(
     stage: &Stage,
     path: &std::path::Path,
     options: &OracleOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
-) -> Result<FieldStats> {
+) -> Result<OracleWritten> {
     if let Some(p) = options
         .poses
         .iter()
@@ -140,6 +149,7 @@ pub fn write_oracle_field(
             alphas.push(alpha);
         }
     }
+    let shadows_start = std::time::Instant::now();
     if let Some(s) = &options.shadows {
         let per_pose = columns * rows;
         for (i, &pose) in options.poses.iter().enumerate() {
@@ -152,6 +162,10 @@ pub fn write_oracle_field(
             writer.add_shadows(pose, &r.maps)?;
         }
     }
+    let shadow_seconds = shadows_start.elapsed().as_secs_f64();
     writer.finish()?;
-    Ok(FieldFile::open(path)?.stats())
+    Ok(OracleWritten {
+        stats: FieldFile::open(path)?.stats(),
+        shadow_seconds,
+    })
 }

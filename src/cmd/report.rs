@@ -57,7 +57,6 @@ struct Runner {
 /// What a run printed and how long it took.
 struct Ran {
     stdout: String,
-    seconds: f64,
     command: String,
 }
 
@@ -79,7 +78,6 @@ impl Runner {
             self.measured.set(self.measured.get() + seconds);
             return Ok(Ran {
                 stdout: kept["stdout"].as_str().unwrap_or_default().to_string(),
-                seconds,
                 command,
             });
         }
@@ -101,11 +99,7 @@ impl Runner {
         )?;
         self.bar.inc(1);
         self.measured.set(self.measured.get() + seconds);
-        Ok(Ran {
-            stdout,
-            seconds,
-            command,
-        })
+        Ok(Ran { stdout, command })
     }
 }
 
@@ -201,7 +195,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     } else {
         vec![(w / 2, h / 2), (w, h), (2 * w, 2 * h), (4 * w, 4 * h)]
     };
-    let total = presets.len() + lambdas.len() + 1 + 2 + 2 + 2 * shadow_settings.len() + 1;
+    let total = presets.len() + lambdas.len() + 1 + 2 + 2 + 2 * shadow_settings.len();
     let total = total + sizes.len() + 1;
     let runner = Runner {
         exe: std::env::current_exe()?,
@@ -526,9 +520,8 @@ pub fn run(args: ReportArgs) -> CliResult {
         );
     }
 
-    // Shadows: hull voxel and shadow-map texels, on oracle fields (perfect flow), each
-    // timed against a field built without shadows in the same report.
-    let plain = runs.join("oracle_no_shadows.frf");
+    // Shadows: hull voxel and shadow-map texels, on oracle fields (perfect mattes), timed
+    // as `stage field` times its hulls and maps.
     let field_args = |extra: &[&str], out: &Path| -> Vec<String> {
         ["stage", "field", "--capture", &cap, "--poses", &pose_arg]
             .iter()
@@ -537,11 +530,6 @@ pub fn run(args: ReportArgs) -> CliResult {
             .chain(["--out".into(), s(out)])
             .collect()
     };
-    let base = runner.run(
-        "oracle_no_shadows",
-        &field_args(&["--no-shadows"], &plain),
-        &[&plain],
-    )?;
     for (i, (voxel, texels)) in shadow_settings.iter().enumerate() {
         let f = runs.join(format!("oracle_shadows_{i}.frf"));
         let a = field_args(&["--hull-voxel", voxel, "--shadow-texels", texels], &f);
@@ -564,7 +552,12 @@ pub fn run(args: ReportArgs) -> CliResult {
         let o: Value = serde_json::from_str(&scored.stdout)?;
         let value = format!("{voxel} m, {texels}²");
         let default = (*voxel, *texels) == ("0.02", "128");
-        let build = (built.seconds - base.seconds).max(0.0);
+        let build = built
+            .stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(super::stage_field::SHADOW_TIME_LINE))
+            .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
+            .ok_or_else(|| format!("{}: no time of the hulls and shadow maps", built.command))?;
         let command = format!("{}; {}", built.command, scored.command);
         let mut sh = Rows {
             rows: &mut rows,

@@ -38,6 +38,10 @@ pub struct FieldArgs {
     shadows: crate::cmd::args::ShadowArgs,
 }
 
+/// How `frf stage field` starts the line giving the time of its hulls and shadow maps
+/// (`frf report` reads it).
+pub const SHADOW_TIME_LINE: &str = "visual hulls and shadow maps: ";
+
 /// Runs `frf stage field`.
 pub fn field(args: FieldArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
@@ -48,7 +52,7 @@ pub fn field(args: FieldArgs) -> CliResult {
     };
     let start = Instant::now();
     let bar = bar("oracle field: views (flows, then images)");
-    let stats = write_oracle_field(
+    let written = write_oracle_field(
         &stage,
         &args.out,
         &OracleOptions {
@@ -68,6 +72,8 @@ pub fn field(args: FieldArgs) -> CliResult {
         args.out.display(),
         start.elapsed().as_secs_f64()
     );
+    let stats = written.stats;
+    println!("{SHADOW_TIME_LINE}{:.3} s", written.shadow_seconds);
     println!(
         "flow: {:.1} % of 8-bit quantized size; basis images: {:.1}:1 against 16-bit linear; total {:.2} MB",
         100.0 * stats.flow_ratio_vs_8bit,
