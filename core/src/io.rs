@@ -20,8 +20,13 @@ use crate::image::{GrayImage, Image, Rgb, RgbImage, Rgba};
 pub mod limits {
     /// Largest width or height accepted (the largest 2D texture of the GPUs we target).
     pub const MAX_DIMENSION: u32 = 16384;
-    /// Largest decoded size in bytes.
-    pub const MAX_ALLOC_BYTES: u64 = 2 << 30;
+    /// Largest decoded size in bytes (what the decoder itself may reserve).
+    pub const MAX_ALLOC_BYTES: u64 = 1 << 30;
+    /// Largest image in pixels: 2^26, e.g. 8192 x 8192 or 16384 x 4096. Decoding holds the
+    /// decoder's buffer and then linear `f32` RGB (12 bytes a pixel, 768 MiB at this
+    /// size) at once; without this bound a 157-byte GIF claiming 8513 x 11308 pixels
+    /// (found by fuzzing) made the loader hold more than 2 GiB.
+    pub const MAX_PIXELS: u64 = 1 << 26;
 }
 
 /// `reader` with the [`limits`] applied.
@@ -47,13 +52,26 @@ fn decode_with<R: std::io::BufRead + std::io::Seek>(
     path: &Path,
     reader: ImageReader<R>,
 ) -> Result<DynamicImage> {
-    reader.decode().map_err(|e| match e {
+    use image::ImageDecoder;
+    let failed = |e: image::ImageError| match e {
         image::ImageError::Limits(l) => CoreError::LimitExceeded {
             what: path.display().to_string(),
             problem: l.to_string(),
         },
         other => CoreError::bad_file(path, format!("cannot decode image: {other}")),
-    })
+    };
+    let decoder = reader.into_decoder().map_err(failed)?;
+    let (w, h) = decoder.dimensions();
+    if u64::from(w) * u64::from(h) > limits::MAX_PIXELS {
+        return Err(CoreError::LimitExceeded {
+            what: path.display().to_string(),
+            problem: format!(
+                "{w}x{h} pixels exceed the limit of {} pixels (resample the image)",
+                limits::MAX_PIXELS
+            ),
+        });
+    }
+    DynamicImage::from_decoder(decoder).map_err(failed)
 }
 
 fn decode(path: &Path) -> Result<DynamicImage> {

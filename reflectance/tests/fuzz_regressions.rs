@@ -38,3 +38,16 @@ fn image_decoder_regressions_are_refused() {
         let _ = FieldFile::from_source(Path::new(&name), bytes);
     }
 }
+
+#[test]
+fn environment_regressions_are_refused_within_the_image_limits() {
+    let cases = inputs("env");
+    assert!(!cases.is_empty(), "the regression inputs are missing");
+    for (name, bytes) in cases {
+        let e = frf_core::io::read_rgb_bytes(Path::new(&name), &bytes)
+            .err()
+            .unwrap_or_else(|| panic!("{name} decodes"))
+            .to_string();
+        assert!(e.contains(&name) && e.contains("limit"), "{e}");
+    }
+}
