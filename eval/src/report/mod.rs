@@ -292,7 +292,7 @@ mod tests {
         for text in [
             "s: EPE px",
             "s: alpha IoU",
-            ">balanced<",
+            "\nbalanced\n",
             "Farneback",
             "Pareto front",
         ] {
