@@ -8,17 +8,21 @@
 //! stopped, and a finished one is re-plotted without measuring again.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use clap::Args;
 use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
-use frf_eval::report::{Machine, PeerPoint, Report, Row, STAGES, html, plot};
+use frf_eval::report::{Machine, Report, Row, STAGES};
 use serde_json::Value;
 
 use super::progress::bar;
 use crate::CliResult;
+use runner::Runner;
+use write::{commit, peer_rows, write_report};
+
+mod runner;
+mod write;
 
 /// Arguments of `frf report`.
 #[derive(Args)]
@@ -43,64 +47,6 @@ pub struct ReportArgs {
     /// Render with the CPU reference only (no GPU adapter needed).
     #[arg(long)]
     cpu: bool,
-}
-
-/// Runs of this binary, each kept under `runs/` with its wall time.
-struct Runner {
-    exe: PathBuf,
-    runs: PathBuf,
-    bar: indicatif::ProgressBar,
-    /// Wall seconds of every run, whether made now or kept from an earlier invocation.
-    measured: std::cell::Cell<f64>,
-}
-
-/// What a run printed and how long it took.
-struct Ran {
-    stdout: String,
-    command: String,
-}
-
-impl Runner {
-    /// Runs `frf args` unless `runs/ID.run.json` holds a finished run of the same arguments
-    /// (and `outputs` exist).
-    fn run(&self, id: &str, args: &[String], outputs: &[&Path]) -> CliResult<Ran> {
-        let record = self.runs.join(format!("{id}.run.json"));
-        let command = format!("frf {}", args.join(" "));
-        self.bar
-            .set_message(format!("frf {}", args[..2.min(args.len())].join(" ")));
-        if let Ok(text) = std::fs::read_to_string(&record)
-            && let Ok(kept) = serde_json::from_str::<Value>(&text)
-            && kept["command"] == command.as_str()
-            && outputs.iter().all(|p| p.exists())
-        {
-            self.bar.inc(1);
-            let seconds = kept["seconds"].as_f64().unwrap_or(f64::NAN);
-            self.measured.set(self.measured.get() + seconds);
-            return Ok(Ran {
-                stdout: kept["stdout"].as_str().unwrap_or_default().to_string(),
-                command,
-            });
-        }
-        let start = Instant::now();
-        let out = Command::new(&self.exe).args(args).output()?;
-        let seconds = start.elapsed().as_secs_f64();
-        if !out.status.success() {
-            return Err(format!(
-                "{command} failed:\n{}",
-                String::from_utf8_lossy(&out.stderr).trim_end()
-            )
-            .into());
-        }
-        let stdout = String::from_utf8(out.stdout)?;
-        let kept = serde_json::json!({ "command": command, "seconds": seconds, "stdout": stdout });
-        frf_core::atomic::write_bytes_atomic(
-            &record,
-            serde_json::to_string_pretty(&kept)?.as_bytes(),
-        )?;
-        self.bar.inc(1);
-        self.measured.set(self.measured.get() + seconds);
-        Ok(Ran { stdout, command })
-    }
 }
 
 fn s(p: &Path) -> String {
@@ -618,107 +564,6 @@ pub fn run(args: ReportArgs) -> CliResult {
     write_report(&report, &args.out)?;
     if !problems.is_empty() {
         return Err(format!("the report is incomplete:\n{}", problems.join("\n")).into());
-    }
-    Ok(())
-}
-
-/// The Middlebury means of the peer script: our presets as rows, the rest as peers.
-fn peer_rows(path: &Path, rows: &mut Vec<Row>, peers: &mut Vec<PeerPoint>) -> CliResult {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let json: Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let summary = json["summary"].as_object().ok_or_else(|| {
-        format!(
-            "{}: no `summary` object (run_peers.py output?)",
-            path.display()
-        )
-    })?;
-    let command = json["meta"]["command"]
-        .as_str()
-        .unwrap_or("benches/flow_peers/run_peers.py");
-    let stage = "optical flow (Middlebury)";
-    for (method, m) in summary {
-        let (Some(epe), Some(secs)) = (m["epe"].as_f64(), m["seconds"].as_f64()) else {
-            return Err(format!("{}: {method} lacks epe or seconds", path.display()).into());
-        };
-        match method.strip_prefix("frf_") {
-            Some(preset) => rows.push(Row {
-                stage: stage.into(),
-                knob: "flow preset".into(),
-                value: preset.into(),
-                metric: "EPE px".into(),
-                error: epe,
-                seconds: secs,
-                timed: "one pair, mean of the Middlebury pairs".into(),
-                default: preset == "balanced",
-                command: command.into(),
-            }),
-            None => peers.push(PeerPoint {
-                stage: stage.into(),
-                metric: "EPE px".into(),
-                method: method.clone(),
-                error: epe,
-                seconds: secs,
-            }),
-        }
-    }
-    Ok(())
-}
-
-/// `git describe` of the working directory's repository, or "unknown".
-fn commit() -> String {
-    Command::new("git")
-        .args(["describe", "--always", "--dirty"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .and_then(|o| String::from_utf8(o.stdout).ok())
-        .map(|s| s.trim().to_string())
-        .unwrap_or_else(|| "unknown".into())
-}
-
-/// Writes `report.json`, every stage's plot and `index.html` (each atomically).
-fn write_report(report: &Report, out: &Path) -> CliResult {
-    use frf_core::atomic::write_bytes_atomic;
-    write_bytes_atomic(
-        &out.join("report.json"),
-        serde_json::to_string_pretty(report)?.as_bytes(),
-    )?;
-    let mut png = true;
-    for stage in report.stages() {
-        let name = html::plot_name(stage);
-        write_bytes_atomic(
-            &out.join(format!("{name}.svg")),
-            plot::svg(report, stage)?.as_bytes(),
-        )?;
-        match plot::png(report, stage)? {
-            Some(bytes) => write_bytes_atomic(&out.join(format!("{name}.png")), &bytes)?,
-            None => png = false,
-        }
-    }
-    if !png {
-        eprintln!("no system font found for the PNG plots' text: SVG plots only");
-    }
-    write_bytes_atomic(&out.join("index.html"), html::page(report, png).as_bytes())?;
-    println!(
-        "report of {} settings over {} stages in {:.0} s: {}",
-        report.rows.len(),
-        report.stages().len(),
-        report.seconds_total,
-        out.join("index.html").display()
-    );
-    for stage in report.stages() {
-        for metric in report.metrics(stage) {
-            let series = report.series(stage, metric);
-            let front: Vec<String> = frf_eval::report::pareto_front(&series)
-                .into_iter()
-                .map(|i| {
-                    let r = series[i];
-                    format!("{} {:.3} in {:.3} s", r.value, r.error, r.seconds)
-                })
-                .collect();
-            println!("  {stage} / {metric}: front {}", front.join(" | "));
-        }
     }
     Ok(())
 }

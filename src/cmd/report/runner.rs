@@ -1,0 +1,68 @@
+//! The runs a report is made of: this binary's own verbs, each run's command, output and
+//! wall time kept under `runs/` so that an interrupted report resumes where it stopped.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use serde_json::Value;
+
+use crate::CliResult;
+
+/// Runs of this binary, each kept under `runs/` with its wall time.
+pub struct Runner {
+    pub exe: PathBuf,
+    pub runs: PathBuf,
+    pub bar: indicatif::ProgressBar,
+    /// Wall seconds of every run, whether made now or kept from an earlier invocation.
+    pub measured: std::cell::Cell<f64>,
+}
+
+/// What a run printed and how long it took.
+pub struct Ran {
+    pub stdout: String,
+    pub command: String,
+}
+
+impl Runner {
+    /// Runs `frf args` unless `runs/ID.run.json` holds a finished run of the same arguments
+    /// (and `outputs` exist).
+    pub fn run(&self, id: &str, args: &[String], outputs: &[&Path]) -> CliResult<Ran> {
+        let record = self.runs.join(format!("{id}.run.json"));
+        let command = format!("frf {}", args.join(" "));
+        self.bar
+            .set_message(format!("frf {}", args[..2.min(args.len())].join(" ")));
+        if let Ok(text) = std::fs::read_to_string(&record)
+            && let Ok(kept) = serde_json::from_str::<Value>(&text)
+            && kept["command"] == command.as_str()
+            && outputs.iter().all(|p| p.exists())
+        {
+            self.bar.inc(1);
+            let seconds = kept["seconds"].as_f64().unwrap_or(f64::NAN);
+            self.measured.set(self.measured.get() + seconds);
+            return Ok(Ran {
+                stdout: kept["stdout"].as_str().unwrap_or_default().to_string(),
+                command,
+            });
+        }
+        let start = Instant::now();
+        let out = Command::new(&self.exe).args(args).output()?;
+        let seconds = start.elapsed().as_secs_f64();
+        if !out.status.success() {
+            return Err(format!(
+                "{command} failed:\n{}",
+                String::from_utf8_lossy(&out.stderr).trim_end()
+            )
+            .into());
+        }
+        let stdout = String::from_utf8(out.stdout)?;
+        let kept = serde_json::json!({ "command": command, "seconds": seconds, "stdout": stdout });
+        frf_core::atomic::write_bytes_atomic(
+            &record,
+            serde_json::to_string_pretty(&kept)?.as_bytes(),
+        )?;
+        self.bar.inc(1);
+        self.measured.set(self.measured.get() + seconds);
+        Ok(Ran { stdout, command })
+    }
+}
