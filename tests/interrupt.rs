@@ -7,7 +7,7 @@
 
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 fn render_args(field: &Path, out: &Path, frames: &str) -> Vec<String> {
     let mut args: Vec<String> = [
@@ -64,16 +64,12 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    // Killed (SIGKILL: no chance to clean up) once its first frames are there.
-    let start = Instant::now();
+    // Killed (SIGKILL: no chance to clean up) once its first frames are there. The wait
+    // ends either way: the render writes its frames or exits (a failure here).
     while !out.join("frame_0002.png").exists() {
         assert!(
             child.try_wait().unwrap().is_none(),
             "the render ended before it could be interrupted"
-        );
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no frame in 2 min"
         );
         std::thread::sleep(Duration::from_millis(5));
     }

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use crate::camera::{Camera, Intrinsics, Rigid};
 use crate::error::{CoreError, Result};
 use crate::image::RgbImage;
-use crate::io::{image_dimensions, read_rgb_sized};
+use crate::io::{image_dimensions, read_rgb_sized_bits};
 use crate::light::DirLight;
 use crate::manifest::{
     FORMAT, MANIFEST_FILE, Manifest, PatternValues, VERSION, fill_pattern, pattern_placeholders,
@@ -362,13 +362,12 @@ impl Capture {
 
     fn load_scaled(&self, path: &Path, camera: usize) -> Result<RgbImage> {
         let cam = &self.cameras[camera];
-        let mut img = read_rgb_sized(path, cam.width as usize, cam.height as usize)?;
+        let (mut img, bits) = read_rgb_sized_bits(path, cam.width as usize, cam.height as usize)?;
         let is_float = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr") || e.eq_ignore_ascii_case("hdr"));
         if !is_float {
             let full_scale = self.manifest.files.full_scale;
-            let bits = crate::io::bits_per_channel(path)?;
             if full_scale > 255.0 && bits < 16 {
                 return Err(CoreError::bad_file(
                     path,

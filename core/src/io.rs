@@ -101,16 +101,6 @@ pub fn image_dimensions(path: &Path) -> Result<(usize, usize)> {
     Ok((w as usize, h as usize))
 }
 
-/// Bits per channel of an image file (8, 16 or 32), read from its header only.
-pub fn bits_per_channel(path: &Path) -> Result<u16> {
-    use image::ImageDecoder;
-    let decoder = reader(path)?
-        .into_decoder()
-        .map_err(|e| CoreError::bad_file(path, format!("cannot read image header: {e}")))?;
-    let color = decoder.color_type();
-    Ok(color.bits_per_pixel() / color.channel_count() as u16)
-}
-
 fn check_finite<P: crate::image::Pixel>(path: &Path, img: &Image<P>) -> Result<()> {
     if let Some(i) = img
         .pixels()
@@ -195,7 +185,15 @@ pub fn read_gray(path: &Path) -> Result<GrayImage> {
 
 /// Reads an image and checks that it is `width x height`.
 pub fn read_rgb_sized(path: &Path, width: usize, height: usize) -> Result<RgbImage> {
-    let img = read_rgb(path)?;
+    read_rgb_sized_bits(path, width, height).map(|(img, _)| img)
+}
+
+/// [`read_rgb_sized`], with the file's bits per channel (8, 16 or 32), from one decode.
+pub fn read_rgb_sized_bits(path: &Path, width: usize, height: usize) -> Result<(RgbImage, u16)> {
+    let decoded = decode(path)?;
+    let color = decoded.color();
+    let bits = color.bits_per_pixel() / u16::from(color.channel_count());
+    let img = rgb_checked(path, decoded)?;
     if img.size() != (width, height) {
         return Err(CoreError::SizeMismatch {
             path: path.to_path_buf(),
@@ -205,7 +203,7 @@ pub fn read_rgb_sized(path: &Path, width: usize, height: usize) -> Result<RgbIma
             got_height: img.height(),
         });
     }
-    Ok(img)
+    Ok((img, bits))
 }
 
 fn to_u16(v: f32) -> u16 {

@@ -300,11 +300,12 @@ pub fn run(args: ReportArgs) -> CliResult {
         &cap,
         "--env",
         &args.env,
+        "--qualities",
+        qualities,
+        "--json",
     ]
     .map(String::from)
     .to_vec();
-    let mut a = a;
-    a.extend(["--qualities".into(), qualities.into(), "--json".into()]);
     let ran = runner.run("codec_curve", &a, &[])?;
     let curve: Value = serde_json::from_str(&ran.stdout)?;
     let mut jpeg = Rows {
@@ -329,8 +330,8 @@ pub fn run(args: ReportArgs) -> CliResult {
     }
 
     // Novel views at quad centres, every variant, from the default ingest.
-    let eval = |id: &str, extra: &[&str]| -> CliResult<(Value, String)> {
-        let mut a: Vec<String> = ["eval", &s(&field), "--capture", &cap, "--env", &args.env]
+    let eval = |id: &str, field: &Path, extra: &[&str]| -> CliResult<(Value, String)> {
+        let mut a: Vec<String> = ["eval", &s(field), "--capture", &cap, "--env", &args.env]
             .map(String::from)
             .to_vec();
         a.extend(extra.iter().map(|x| x.to_string()));
@@ -341,6 +342,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     };
     let (views, command) = eval(
         "eval_views",
+        &field,
         &["--cameras", cameras, "--variants", variants],
     )?;
     if let Some(d) = views["device"].as_str() {
@@ -373,6 +375,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     // The path suite (inside, near, outside, above, below the grid).
     let (suite, command) = eval(
         "eval_suite",
+        &field,
         &["--suite", "--frames", frames, "--variants", variants],
     )?;
     let mut paths = Rows {
@@ -409,6 +412,7 @@ pub fn run(args: ReportArgs) -> CliResult {
         let size = format!("{fw}x{fh}");
         let (o, command) = eval(
             &format!("eval_size_{i}"),
+            &field,
             &[
                 "--orbit",
                 "3,1.2",
@@ -448,7 +452,7 @@ pub fn run(args: ReportArgs) -> CliResult {
         if *on_cpu && !args.cpu {
             extra.push("--cpu");
         }
-        let (o, command) = eval(&format!("eval_renderer_{name}"), &extra)?;
+        let (o, command) = eval(&format!("eval_renderer_{name}"), &field, &extra)?;
         let v = &o["variants"][0];
         let mut r = Rows {
             rows: &mut rows,
@@ -480,22 +484,11 @@ pub fn run(args: ReportArgs) -> CliResult {
         let f = runs.join(format!("oracle_shadows_{i}.frf"));
         let a = field_args(&["--hull-voxel", voxel, "--shadow-texels", texels], &f);
         let built = runner.run(&format!("oracle_shadows_{i}"), &a, &[&f])?;
-        let mut e: Vec<String> = [
-            "eval",
-            &s(&f),
-            "--capture",
-            &cap,
-            "--env",
-            &args.env,
-            "--shadows",
-        ]
-        .map(String::from)
-        .to_vec();
-        e.extend(["--cameras", cameras, "--variants", "fourway"].map(String::from));
-        e.extend(cpu.iter().cloned());
-        e.push("--json".into());
-        let scored = runner.run(&format!("eval_shadows_{i}"), &e, &[])?;
-        let o: Value = serde_json::from_str(&scored.stdout)?;
+        let (o, scored) = eval(
+            &format!("eval_shadows_{i}"),
+            &f,
+            &["--shadows", "--cameras", cameras, "--variants", "fourway"],
+        )?;
         let value = format!("{voxel} m, {texels}²");
         let default = (*voxel, *texels) == ("0.02", "128");
         let build = built
@@ -504,7 +497,7 @@ pub fn run(args: ReportArgs) -> CliResult {
             .find_map(|l| l.strip_prefix(super::stage_field::SHADOW_TIME_LINE))
             .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
             .ok_or_else(|| format!("{}: no time of the hulls and shadow maps", built.command))?;
-        let command = format!("{}; {}", built.command, scored.command);
+        let command = format!("{}; {scored}", built.command);
         let mut sh = Rows {
             rows: &mut rows,
             stage: "shadows",
