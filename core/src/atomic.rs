@@ -23,7 +23,8 @@ fn temporary_path(path: &Path) -> PathBuf {
 
 /// Writes `path` atomically: `write` fills a buffered temporary file, which is then
 /// flushed and renamed to `path`. Parent directories are created. On any error the
-/// temporary file is removed and `path` is left as it was.
+/// temporary file is removed and `path` is left as it was; errors name `path`, the output
+/// asked for, not the temporary name.
 pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<()>,
@@ -33,10 +34,10 @@ where
     }
     let tmp = temporary_path(path);
     let outcome = (|| {
-        let file = File::create(&tmp).map_err(|e| CoreError::io(&tmp, e))?;
+        let file = File::create(&tmp).map_err(|e| CoreError::io(path, e))?;
         let mut writer = BufWriter::new(file);
         write(&mut writer)?;
-        writer.flush().map_err(|e| CoreError::io(&tmp, e))?;
+        writer.flush().map_err(|e| CoreError::io(path, e))?;
         drop(writer);
         std::fs::rename(&tmp, path).map_err(|e| CoreError::io(path, e))
     })();

@@ -5,9 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-mod common;
-
-use common::{frf, staged_capture, stderr};
+use crate::common::{frf, staged_capture, stderr};
 use frf_eval::report::STAGES;
 
 #[test]

@@ -6,9 +6,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-mod common;
-
-use common::frf;
+use crate::common::frf;
 
 #[test]
 fn a_real_ring_ingests_closed_and_its_held_out_photographs_score() {

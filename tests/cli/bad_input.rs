@@ -7,8 +7,6 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-mod common;
-
 /// A case: the command (`{bad}` is the corpus directory, `{out}` a path in a fresh
 /// scratch directory that must stay empty), the file it names and the words of the problem.
 struct Case {
@@ -243,7 +241,7 @@ fn the_corpus_is_exactly_the_files_the_cases_name() {
 #[test]
 fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let cap = common::staged_capture(dir.path());
+    let cap = crate::common::staged_capture(dir.path());
     let frame = frf_core::capture::Capture::open(&cap)
         .unwrap()
         .frame_path(0, 3, 1, 5);
@@ -251,7 +249,7 @@ fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
     frf_core::io::write_png8_srgb(&frame, &linear, 1.0).unwrap();
     let out = dir.path().join("out");
     std::fs::create_dir(&out).unwrap();
-    let o = common::frf(&[
+    let o = crate::common::frf(&[
         "ingest",
         cap.to_str().unwrap(),
         "--flow-preset",

@@ -5,9 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-mod common;
-
-use common::{frf, stderr};
+use crate::common::{frf, stderr};
 
 use std::path::{Path, PathBuf};
 

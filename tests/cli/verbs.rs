@@ -7,9 +7,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-mod common;
-
-use common::frf;
+use crate::common::frf;
 
 use std::path::Path;
 use std::process::Output;

@@ -5,9 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-mod common;
-
-use common::{frf, stderr};
+use crate::common::{frf, stderr};
 
 #[test]
 fn the_bench_reports_every_variant_stage_and_the_floor_as_json() {

@@ -1,7 +1,7 @@
 //! Interruption and the disk, through the binary: a render killed mid-way leaves only
 //! whole frames under their final names and its rerun resumes the rest; a render whose
 //! disk fills (a file-size limit) reports the file and the problem, leaves no partial
-//! frame behind and does not panic.
+//! frame behind and does not panic; a read-only output directory is refused, naming it.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
@@ -144,4 +144,73 @@ fn a_full_disk_is_reported_naming_the_file_without_partial_frames() {
         temporaries.is_empty(),
         "temporary files left: {temporaries:?}"
     );
+}
+
+/// A command that obeys file permissions: as root (CI), `frf` runs without the
+/// capabilities that override them (`setpriv` from util-linux), so a read-only directory
+/// is read-only to it too.
+fn unprivileged_frf(args: &[String]) -> Command {
+    let uid = Command::new("id").arg("-u").output().unwrap();
+    let mut cmd = if String::from_utf8_lossy(&uid.stdout).trim() == "0" {
+        let mut c = Command::new("setpriv");
+        c.args([
+            "--bounding-set=-dac_override,-dac_read_search,-fowner",
+            "--",
+        ])
+        .arg(env!("CARGO_BIN_EXE_frf"));
+        c
+    } else {
+        Command::new(env!("CARGO_BIN_EXE_frf"))
+    };
+    cmd.args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    cmd
+}
+
+#[test]
+fn a_read_only_output_directory_is_refused_naming_it() {
+    use std::os::unix::fs::PermissionsExt;
+    let field = &frf_testkit::tiny_field().field;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("shot");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let o = unprivileged_frf(&render_args(field, &out, "2"))
+        .output()
+        .unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
+    // The error names an output file (not its temporary name) in the directory.
+    let named = format!("{}/settings.json:", out.display());
+    assert!(
+        stderr.contains(&named) && stderr.to_lowercase().contains("permission denied"),
+        "{stderr}"
+    );
+    assert!(std::fs::read_dir(&out).unwrap().next().is_none());
+
+    // A field written into a read-only directory: refused, nothing left there.
+    let cap = crate::common::staged_capture(dir.path());
+    let fields = dir.path().join("fields");
+    std::fs::create_dir(&fields).unwrap();
+    std::fs::set_permissions(&fields, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let target = fields.join("a.frf");
+    let args = [
+        "ingest",
+        cap.to_str().unwrap(),
+        "--out",
+        target.to_str().unwrap(),
+    ]
+    .map(String::from);
+    let o = unprivileged_frf(&args).output().unwrap();
+    std::fs::set_permissions(&fields, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
+    assert!(
+        stderr.contains(target.to_str().unwrap()) // the field, or its resumable parts
+            && stderr.to_lowercase().contains("permission denied"),
+        "{stderr}"
+    );
+    assert!(std::fs::read_dir(&fields).unwrap().next().is_none());
 }

@@ -1,0 +1,15 @@
+//! The command-line tests: every verb of the `frf` binary run as a user runs it, the
+//! bad-input corpus, and interruption. One test binary holds them all (one link of the
+//! whole program instead of one per file); each module is one verb or concern.
+
+mod common;
+
+mod bad_input;
+mod bench;
+mod interrupt;
+mod render;
+mod report;
+mod ring;
+mod scene;
+mod stage;
+mod verbs;
