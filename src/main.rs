@@ -54,7 +54,19 @@ enum Command {
     FlowBench(cmd::flow::FlowBenchArgs),
 }
 
+/// Lets a closed pipe end the program quietly, as it ends `cat` or `grep`: Rust ignores
+/// SIGPIPE, so `frf eval ... | head` would otherwise panic in `println!` once `head` exits.
+#[allow(unsafe_code)]
+fn die_quietly_on_a_closed_pipe() {
+    // SAFETY: restoring a signal's default disposition at start-up, before any thread is
+    // spawned, touches no memory of ours.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    die_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(*args),

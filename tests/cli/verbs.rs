@@ -3,7 +3,8 @@
 //! accounting against the file's size), `flow` and `flow-bench` (a synthetic pair with a
 //! known translation), `stage projection-error` and `stage codec-curve` (bounds from
 //! their measured values with headroom, and the ordering JPEG quality must give),
-//! `hull` (a mesh where the walker stands), and `render --camera --floor ground --pose`.
+//! `hull` (a mesh where the walker stands), and `render --camera --floor ground --pose`; and
+//! `info` into a closed pipe, which ends quietly.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
@@ -58,6 +59,26 @@ fn info_accounts_for_the_bytes_of_the_field_file() {
         parts <= size && parts as f64 > 0.99 * size as f64,
         "{parts} of {size}"
     );
+}
+
+/// `frf info FIELD | head`: when the reader of its output is gone, `frf` ends as a Unix
+/// tool does, by SIGPIPE, quietly, and does not panic in `println!`.
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    let field = &frf_testkit::tiny_field().field;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_frf"))
+        .args(["info", field.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader is gone before the first line is written
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.signal(), Some(13), "{:?}: {stderr}", o.status);
+    assert!(stderr.is_empty(), "{stderr}");
 }
 
 #[test]
