@@ -22,6 +22,7 @@ pub const STAGES: &[&str] = &[
     "novel views",
     "camera paths",
     "frame size",
+    "capture size",
     "renderer",
     "shadows",
     "composite",

@@ -21,6 +21,7 @@ use crate::CliResult;
 use runner::Runner;
 use write::{commit, peer_rows, write_report};
 
+mod capture_size;
 mod runner;
 mod write;
 
@@ -51,6 +52,24 @@ pub struct ReportArgs {
 
 fn s(p: &Path) -> String {
     p.display().to_string()
+}
+
+/// `frf ingest` of one pose of `cap` with a flow preset (and extra arguments), writing the
+/// field and its JSON report.
+fn ingest_args(
+    cap: &str,
+    pose: &str,
+    preset: &str,
+    extra: &[String],
+    out: &Path,
+    json: &Path,
+) -> Vec<String> {
+    let mut a: Vec<String> = ["ingest", cap, "--poses", pose, "--flow-preset", preset]
+        .map(String::from)
+        .to_vec();
+    a.extend(extra.iter().cloned());
+    a.extend(["--out".into(), s(out), "--report".into(), s(json)]);
+    a
 }
 
 fn num(v: &Value, key: &str, what: &str) -> CliResult<f64> {
@@ -142,7 +161,15 @@ pub fn run(args: ReportArgs) -> CliResult {
         vec![(w / 2, h / 2), (w, h), (2 * w, 2 * h), (4 * w, 4 * h)]
     };
     let total = presets.len() + lambdas.len() + 1 + 2 + 2 + 2 * shadow_settings.len();
-    let total = total + sizes.len() + 1;
+    // The capture filmed again at smaller sizes (a capture of every view only: one made
+    // for a scene films a subset).
+    let stage_config = frf_stage::writer::read_stage_config(&args.capture)?;
+    let smaller = if stage_config.filmed.is_empty() {
+        capture_size::smaller_sizes(w, h, quick)
+    } else {
+        Vec::new()
+    };
+    let total = total + sizes.len() + 1 + 3 * smaller.len();
     let runner = Runner {
         exe: std::env::current_exe()?,
         runs: runs.clone(),
@@ -173,18 +200,7 @@ pub fn run(args: ReportArgs) -> CliResult {
         let field = runs.join(format!("ingest_{i}.frf"));
         let json = runs.join(format!("ingest_{i}.json"));
         let preset = label.split(' ').next().unwrap_or(label);
-        let mut a: Vec<String> = [
-            "ingest",
-            &cap,
-            "--poses",
-            &pose_arg,
-            "--flow-preset",
-            preset,
-        ]
-        .map(String::from)
-        .to_vec();
-        a.extend(extra.iter().cloned());
-        a.extend(["--out".into(), s(&field), "--report".into(), s(&json)]);
+        let a = ingest_args(&cap, &pose_arg, preset, extra, &field, &json);
         let ran = runner.run(&format!("ingest_{i}"), &a, &[&field, &json])?;
         let r: Value = serde_json::from_slice(&std::fs::read(&json)?)?;
         let step = |name: &str| -> f64 {
@@ -244,10 +260,11 @@ pub fn run(args: ReportArgs) -> CliResult {
             &ran.command,
         );
         if *default {
-            default_field = Some(field);
+            let seconds = num(&r, "seconds", &what)?;
+            default_field = Some((field, (seconds, ran.command.clone())));
         }
     }
-    let field = default_field.ok_or("no default ingest")?;
+    let (field, default_ingest) = default_field.ok_or("no default ingest")?;
 
     // Flow storage: the log quantizer's scale on the true inter-view flows.
     let flows: Vec<_> = (0..capture.cycles())
@@ -408,22 +425,17 @@ pub fn run(args: ReportArgs) -> CliResult {
     }
 
     // Frame size along an orbit inside the cylinder of cameras.
+    let orbit_eval = |id: &str, field: &Path, size: &str| {
+        let a = ["--orbit", "3,1.2", "--frames", frames, "--size", size];
+        eval(id, field, &[&a[..], &["--variants", "fourway"]].concat())
+    };
+    let own_size = format!("{w}x{h}");
+    // The capture size knob's runs: (size, its field's score at the capture's size, ingest
+    // seconds, the commands that filmed and ingested it).
+    let mut filmed = Vec::new();
     for (i, (fw, fh)) in sizes.iter().enumerate() {
         let size = format!("{fw}x{fh}");
-        let (o, command) = eval(
-            &format!("eval_size_{i}"),
-            &field,
-            &[
-                "--orbit",
-                "3,1.2",
-                "--frames",
-                frames,
-                "--size",
-                &size,
-                "--variants",
-                "fourway",
-            ],
-        )?;
+        let (o, command) = orbit_eval(&format!("eval_size_{i}"), &field, &size)?;
         let v = &o["paths"][0]["variants"][0];
         let mut sized = Rows {
             rows: &mut rows,
@@ -431,14 +443,58 @@ pub fn run(args: ReportArgs) -> CliResult {
             knob: "frame size",
         };
         sized.push(
-            size,
+            &size,
             "subject PSNR dB",
             num(v, "psnr_subject", "eval --size")?,
             num(v, "seconds_per_frame", "eval --size")?,
             "per frame",
-            (*fw, *fh) == (w, h),
+            size == own_size,
             &command,
         );
+        if size == own_size {
+            filmed.push((
+                size,
+                (o, command),
+                default_ingest.0,
+                default_ingest.1.clone(),
+            ));
+        }
+    }
+
+    // Capture size: the capture filmed smaller, each ingested and scored at its own size.
+    for (i, &(cw, ch)) in smaller.iter().enumerate() {
+        let dir = runs.join(format!("capture_{i}"));
+        let a = capture_size::stage_args(&stage_config, pose, (cw, ch), &dir);
+        let staged = runner.run(&format!("capture_{i}"), &a, &[&dir])?;
+        let f = runs.join(format!("capture_{i}.frf"));
+        let json = runs.join(format!("capture_{i}.json"));
+        let a = ingest_args(&s(&dir), &pose_arg, "balanced", &[], &f, &json);
+        let ingested = runner.run(&format!("capture_{i}_ingest"), &a, &[&f, &json])?;
+        let r: Value = serde_json::from_slice(&std::fs::read(&json)?)?;
+        let seconds = num(&r, "seconds", &format!("ingest of the {cw}x{ch} capture"))?;
+        let scored = orbit_eval(&format!("eval_capture_{i}"), &f, &own_size)?;
+        let made = format!("{}; {}", staged.command, ingested.command);
+        filmed.push((format!("{cw}x{ch}"), scored, seconds, made));
+    }
+    for (value, (o, scored), seconds, made) in filmed {
+        let mut sized = Rows {
+            rows: &mut rows,
+            stage: "capture size",
+            knob: "capture size",
+        };
+        // SSIM beside PSNR: a blurrier field from a smaller capture can score a higher
+        // PSNR than a sharper one whose details are slightly misplaced; SSIM sees the loss.
+        for (metric, key) in [("PSNR dB", "psnr_subject"), ("SSIM", "ssim_subject")] {
+            sized.push(
+                &value,
+                &format!("subject {metric} at {own_size}"),
+                num(&o["paths"][0]["variants"][0], key, "eval --size")?,
+                seconds,
+                "ingest of one pose",
+                value == own_size,
+                &format!("{made}; {scored}"),
+            );
+        }
     }
 
     // The GPU renderer against the CPU reference, same cameras.
