@@ -5,7 +5,6 @@
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// A case: the command (`{bad}` is the corpus directory, `{out}` a path in a fresh
 /// scratch directory that must stay empty), the file it names and the words of the problem.
@@ -194,11 +193,7 @@ fn every_bad_input_is_refused_naming_the_file_and_the_problem() {
                     .replace("{field}", field.to_str().unwrap())
             })
             .collect();
-        let o = Command::new(env!("CARGO_BIN_EXE_frf"))
-            .args(&args)
-            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-            .output()
-            .unwrap();
+        let o = crate::common::frf_command(&args).output().unwrap();
         let stderr = String::from_utf8_lossy(&o.stderr);
         let left: Vec<_> = std::fs::read_dir(out.path()).unwrap().collect();
         let named = stderr.contains(case.file);

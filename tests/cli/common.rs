@@ -2,15 +2,20 @@
 
 #![allow(dead_code)] // each test file uses what it needs
 
+use std::ffi::OsStr;
 use std::process::{Command, Output};
 
-/// Runs `frf` with `args` (a private runtime directory for the GPU's loader).
+/// The `frf` binary of this build with `args`, not started (a private runtime directory
+/// for the GPU's loader).
+pub fn frf_command<S: AsRef<OsStr>>(args: &[S]) -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_frf"));
+    cmd.args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    cmd
+}
+
+/// Runs `frf` with `args`.
 pub fn frf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("the frf binary runs")
+    frf_command(args).output().expect("the frf binary runs")
 }
 
 /// What a run printed on stderr.

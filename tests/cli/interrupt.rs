@@ -9,6 +9,8 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
+use crate::common::frf_command;
+
 fn render_args(field: &Path, out: &Path, frames: &str) -> Vec<String> {
     let mut args: Vec<String> = [
         "render",
@@ -57,9 +59,7 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("shot");
     let args = render_args(field, &out, "40");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(&args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+    let mut child = frf_command(&args)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -86,11 +86,7 @@ fn a_killed_render_leaves_whole_frames_and_its_rerun_resumes() {
     }
     let kept = frames.iter().filter(|n| n.ends_with(".png")).count();
     // The rerun resumes: the frames already there are kept, the rest rendered.
-    let o = Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(&args)
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap();
+    let o = frf_command(&args).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
@@ -153,19 +149,32 @@ fn a_full_disk_is_reported_naming_the_file_without_partial_frames() {
 fn unprivileged_frf(args: &[String]) -> Option<Command> {
     const DROP: &str = "--bounding-set=-dac_override,-dac_read_search,-fowner";
     let uid = Command::new("id").arg("-u").output().unwrap();
-    let mut cmd = if String::from_utf8_lossy(&uid.stdout).trim() == "0" {
+    let cmd = if String::from_utf8_lossy(&uid.stdout).trim() == "0" {
         let can = Command::new("setpriv").args([DROP, "--", "true"]).status();
         if !can.is_ok_and(|s| s.success()) {
             return None;
         }
         let mut c = Command::new("setpriv");
-        c.args([DROP, "--"]).arg(env!("CARGO_BIN_EXE_frf"));
+        c.args([DROP, "--"])
+            .arg(env!("CARGO_BIN_EXE_frf"))
+            .args(args)
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir());
         c
     } else {
-        Command::new(env!("CARGO_BIN_EXE_frf"))
+        frf_command(args)
     };
-    cmd.args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir());
     Some(cmd)
+}
+
+/// Asserts that a run failed without panicking, naming `named` and "Permission denied".
+fn assert_refused_for_permission(o: &std::process::Output, named: &str) {
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
+    assert!(
+        stderr.contains(named) && stderr.to_lowercase().contains("permission denied"),
+        "{stderr}"
+    );
 }
 
 #[test]
@@ -182,15 +191,8 @@ fn a_read_only_output_directory_is_refused_naming_it() {
     };
     let o = render.output().unwrap();
     std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "{stderr}");
-    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
     // The error names an output file (not its temporary name) in the directory.
-    let named = format!("{}/settings.json:", out.display());
-    assert!(
-        stderr.contains(&named) && stderr.to_lowercase().contains("permission denied"),
-        "{stderr}"
-    );
+    assert_refused_for_permission(&o, &format!("{}/settings.json:", out.display()));
     assert!(std::fs::read_dir(&out).unwrap().next().is_none());
 
     // A field written into a read-only directory: refused, nothing left there.
@@ -208,13 +210,7 @@ fn a_read_only_output_directory_is_refused_naming_it() {
     .map(String::from);
     let o = unprivileged_frf(&args).unwrap().output().unwrap();
     std::fs::set_permissions(&fields, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "{stderr}");
-    assert_ne!(o.status.code(), Some(101), "panicked: {stderr}");
-    assert!(
-        stderr.contains(target.to_str().unwrap()) // the field, or its resumable parts
-            && stderr.to_lowercase().contains("permission denied"),
-        "{stderr}"
-    );
+    // Named: the field, or its resumable parts beside it.
+    assert_refused_for_permission(&o, target.to_str().unwrap());
     assert!(std::fs::read_dir(&fields).unwrap().next().is_none());
 }

@@ -66,16 +66,17 @@ fn info_accounts_for_the_bytes_of_the_field_file() {
 #[test]
 fn a_closed_pipe_ends_the_program_quietly() {
     use std::os::unix::process::ExitStatusExt;
-    use std::process::{Command, Stdio};
+    use std::process::Stdio;
     let field = &frf_testkit::tiny_field().field;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_frf"))
-        .args(["info", field.to_str().unwrap()])
-        .stdout(Stdio::piped())
+    // The reader is closed before `frf` starts, so no process can hold it open (with a
+    // reader the child would inherit, another test's process started meanwhile could).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let o = crate::common::frf_command(&["info", field.to_str().unwrap()])
+        .stdout(writer)
         .stderr(Stdio::piped())
-        .spawn()
+        .output()
         .unwrap();
-    drop(child.stdout.take()); // the reader is gone before the first line is written
-    let o = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.signal(), Some(13), "{:?}: {stderr}", o.status);
     assert!(stderr.is_empty(), "{stderr}");

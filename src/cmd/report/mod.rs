@@ -160,7 +160,6 @@ pub fn run(args: ReportArgs) -> CliResult {
     } else {
         vec![(w / 2, h / 2), (w, h), (2 * w, 2 * h), (4 * w, 4 * h)]
     };
-    let total = presets.len() + lambdas.len() + 1 + 2 + 2 + 2 * shadow_settings.len();
     // The capture filmed again at smaller sizes (a capture of every view only: one made
     // for a scene films a subset).
     let stage_config = frf_stage::writer::read_stage_config(&args.capture)?;
@@ -169,7 +168,16 @@ pub fn run(args: ReportArgs) -> CliResult {
     } else {
         Vec::new()
     };
-    let total = total + sizes.len() + 1 + 3 * smaller.len();
+    // Runs: ingests, codec curve, views and suite, renderers, a field and an eval per
+    // shadow setting, an eval per frame size, and filming, ingest and eval per capture size.
+    let total = presets.len()
+        + lambdas.len()
+        + 1
+        + 2
+        + 2
+        + 2 * shadow_settings.len()
+        + sizes.len()
+        + 3 * smaller.len();
     let runner = Runner {
         exe: std::env::current_exe()?,
         runs: runs.clone(),
@@ -261,10 +269,10 @@ pub fn run(args: ReportArgs) -> CliResult {
         );
         if *default {
             let seconds = num(&r, "seconds", &what)?;
-            default_field = Some((field, (seconds, ran.command.clone())));
+            default_field = Some((field, seconds, ran.command.clone()));
         }
     }
-    let (field, default_ingest) = default_field.ok_or("no default ingest")?;
+    let (field, ingest_seconds, ingest_command) = default_field.ok_or("no default ingest")?;
 
     // Flow storage: the log quantizer's scale on the true inter-view flows.
     let flows: Vec<_> = (0..capture.cycles())
@@ -452,12 +460,7 @@ pub fn run(args: ReportArgs) -> CliResult {
             &command,
         );
         if size == own_size {
-            filmed.push((
-                size,
-                (o, command),
-                default_ingest.0,
-                default_ingest.1.clone(),
-            ));
+            filmed.push((size, (o, command), ingest_seconds, ingest_command.clone()));
         }
     }
 
