@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::cylinder::{Clamp, Cylinder, CylinderHit, bilinear_weights, interpolate_camera};
 use crate::geometry::PoseGeometry;
-use crate::morph::{Variant, morph, quad_views};
+use crate::morph::{Variant, quad_views, shade};
 use crate::resident::ResidentPose;
 
 /// What happened to the pixels of a frame.
@@ -97,16 +97,10 @@ pub fn render_pixel(
     let Some(hit) = cylinder.intersect(camera.centre(), dir) else {
         return ([0.0; 4], None);
     };
-    let Some(s) = source_pixel(
-        &pose.geometry,
-        &hit,
-        camera.centre(),
-        dir,
-        variant.uses_proxy(),
-    ) else {
-        return ([0.0; 4], None);
-    };
-    (morph(pose, &hit, s, variant), Some(hit))
+    match shade(pose, &hit, camera.centre(), dir, variant) {
+        Some(px) => (px, Some(hit)),
+        None => ([0.0; 4], None),
+    }
 }
 
 /// Renders a frame of `camera` (subject frame) with `variant`.

@@ -12,9 +12,10 @@ use frf_core::grid::Neighbour;
 use frf_core::image::GrayImage;
 use glam::Vec3;
 
-use crate::cylinder::Cylinder;
+use crate::cylinder::{Cylinder, CylinderHit};
 use crate::gpu::types::{GpuQuad, GpuView};
 use crate::proxy::Proxy;
+use crate::rectified::QuadFrame;
 
 /// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
 pub const CROP_MARGIN_PX: u32 = 4;
@@ -108,6 +109,9 @@ pub struct PoseGeometry {
     pub cameras: Vec<Camera>,
     /// The cylinder of the cameras' centres.
     pub cylinder: Cylinder,
+    /// Per quad `(u, v)` of the grid (`u`-major, [`PoseGeometry::frame_rows`] per
+    /// column): its rectified frame, `None` where its centres span no plane.
+    pub frames: Vec<Option<QuadFrame>>,
     /// Per view, the layer of its flow toward each neighbour ([`Neighbour::ALL`] order)
     /// in the pose's flow array; `-1` where none is stored.
     pub flow_layers: Vec<[i32; 4]>,
@@ -133,6 +137,16 @@ impl PoseGeometry {
     ) -> Self {
         let centres: Vec<Vec3> = cameras.iter().map(|c| c.centre()).collect();
         let cylinder = Cylinder::new(&centres, columns, rows, wraps);
+        let frame_rows = rows.saturating_sub(1).max(1);
+        let view = |u: usize, v: usize| (u % columns) * rows + v.min(rows - 1);
+        let frames = (0..columns * frame_rows)
+            .map(|i| {
+                let (u, v) = (i / frame_rows, i % frame_rows);
+                let top = if rows > 1 { v + 1 } else { v };
+                let at = |u, v| &cameras[view(u, v)];
+                QuadFrame::new([at(u, v), at(u + 1, v), at(u, top), at(u + 1, top)])
+            })
+            .collect();
         let mut next = 0i32;
         let flow_layers = (0..cameras.len())
             .map(|i| {
@@ -155,6 +169,7 @@ impl PoseGeometry {
             crop,
             cameras,
             cylinder,
+            frames,
             flow_layers,
             flow_layer_count: next as usize,
             proxy: Proxy::default(),
@@ -165,6 +180,19 @@ impl PoseGeometry {
     pub fn with_proxy(mut self, proxy: Proxy) -> Self {
         self.proxy = proxy;
         self
+    }
+
+    /// Rows of quads per column of [`PoseGeometry::frames`]: the gaps between rows, or
+    /// one for a grid of one row.
+    pub fn frame_rows(&self) -> usize {
+        self.rows.saturating_sub(1).max(1)
+    }
+
+    /// The rectified frame of the quad a hit lies in (rays clamped to a row: the quad of
+    /// that row).
+    pub fn quad_frame(&self, hit: &CylinderHit) -> Option<&QuadFrame> {
+        let i = (hit.u % self.columns) * self.frame_rows() + hit.v.min(self.frame_rows() - 1);
+        self.frames.get(i)?.as_ref()
     }
 
     /// Views in the grid.

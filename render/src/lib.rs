@@ -5,8 +5,9 @@
 //! - [`resident`]: a pose made ready to render: pre-lit views, alpha, flow codes, cropped.
 //! - [`cylinder`]: light-field re-binning through the squashed cylinder of camera centres;
 //!   [`proxy`]: where rays beyond the grid's rows meet the subject (the visual hull).
-//! - [`morph`]: the four-way flowed morph (its derivation is in the module docs), and the
-//!   nearest-view, linear-blend and two-way interpolations it is measured against.
+//! - [`morph`]: the solved four-way morph (its derivation is in the module docs), and the
+//!   interpolations it is measured against (E06's flowed morphs, linear blend, nearest
+//!   view); [`rectified`]: the quads' rectified frames it solves in.
 //! - [`cpu`]: the CPU reference renderer; [`gpu`]: the wgpu renderer, its twin;
 //!   [`renderer`]: one front for both.
 //! - [`shadow`]: the subject's relit shadow on the ground; [`composite`]: backdrops and
@@ -22,11 +23,13 @@ pub mod composite;
 pub mod cpu;
 pub mod cylinder;
 pub mod error;
+pub mod extend;
 pub mod geometry;
 pub mod gpu;
 pub mod morph;
 pub mod path;
 pub mod proxy;
+pub mod rectified;
 pub mod renderer;
 pub mod resident;
 pub mod scene;

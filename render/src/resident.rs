@@ -6,8 +6,9 @@
 //! - **Pre-lit images**: RGBA8, colour as sRGB-encoded `linear / scale` with one scale per
 //!   view (its brightest value, so nothing clips), alpha linear. A GPU samples them through
 //!   an sRGB view, which decodes before it filters; the CPU decodes each texel the same way.
-//! - **Flows** stay as their 8-bit logarithmic codes, two per pixel, decoded when sampled
-//!   (unknown flow reads as zero displacement).
+//! - **Flows** stay as their 8-bit logarithmic codes, two per pixel, decoded when sampled,
+//!   extended beyond the subject ([`crate::extend`]; a flow that knows no texel reads
+//!   as zero displacement).
 //!
 //! Relighting skips conditions whose coefficient is zero for every view (none of its
 //! light reaches the subject, e.g. the floor conditions under a black lower
@@ -28,6 +29,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
+use crate::extend::extend_flow;
 use crate::geometry::{Crop, PoseGeometry};
 use crate::proxy::Proxy;
 use crate::scene::plan::PosePlan;
@@ -256,7 +258,9 @@ impl PoseSource {
                         let plane = codes.len() / 2;
                         let pairs: Vec<[i8; 2]> =
                             (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
-                        flows[n.index()] = Some(crop.rows_of(&pairs, full_w));
+                        let mut cropped = crop.rows_of(&pairs, full_w);
+                        extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
+                        flows[n.index()] = Some(cropped);
                     }
                 }
                 Ok((b, crop.rows_of(&a, full_w), flows))

@@ -11,7 +11,8 @@ use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_render::cpu::{render_cpu, render_pixel, source_pixel};
 use frf_render::cylinder::{Clamp, CylinderHit};
 use frf_render::geometry::{Crop, PoseGeometry};
-use frf_render::morph::{Variant, morph, quad_views};
+use frf_render::morph::e06::morph;
+use frf_render::morph::{Variant, quad_views};
 use frf_render::resident::{
     LightingPlan, PoseFlows, ResidentPose, decode_flow, flow_lut, srgb_lut,
 };
@@ -120,7 +121,10 @@ fn the_four_way_morph_returns_each_source_at_its_vertex() {
         let h = hit(3, 0, b, g);
         let view = quad_views(&p.geometry, &h)[k];
         assert!(
-            close(morph(&p, &h, s, Variant::FourWay), p.sample_prelit(view, s)),
+            close(
+                morph(&p, &h, s, Variant::FourWayE06),
+                p.sample_prelit(view, s)
+            ),
             "vertex {k}"
         );
     }
@@ -145,28 +149,28 @@ fn the_four_way_morph_reduces_to_the_two_way_morph_on_every_edge() {
         let [a, b, c, d] = quad_views(&p.geometry, &hit(6, 0, 0.0, 0.0));
         assert!(
             close(
-                morph(&p, &hit(6, 0, t, 0.0), s, Variant::FourWay),
+                morph(&p, &hit(6, 0, t, 0.0), s, Variant::FourWayE06),
                 two(a, b, Neighbour::Right, t)
             ),
             "γ = 0"
         );
         assert!(
             close(
-                morph(&p, &hit(6, 0, t, 1.0), s, Variant::FourWay),
+                morph(&p, &hit(6, 0, t, 1.0), s, Variant::FourWayE06),
                 two(c, d, Neighbour::Right, t)
             ),
             "γ = 1"
         );
         assert!(
             close(
-                morph(&p, &hit(6, 0, 0.0, t), s, Variant::FourWay),
+                morph(&p, &hit(6, 0, 0.0, t), s, Variant::FourWayE06),
                 two(a, c, Neighbour::Up, t)
             ),
             "β = 0"
         );
         assert!(
             close(
-                morph(&p, &hit(6, 0, 1.0, t), s, Variant::FourWay),
+                morph(&p, &hit(6, 0, 1.0, t), s, Variant::FourWayE06),
                 two(b, d, Neighbour::Up, t)
             ),
             "β = 1"

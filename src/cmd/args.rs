@@ -78,11 +78,17 @@ pub enum VariantArg {
     Linear,
     /// Two-way flowed morph along the nearer row.
     Twoway,
-    /// Four-way flowed morph.
+    /// Four-way morph, each view sampled where it shows the output's point (the
+    /// renderer's).
     Fourway,
-    /// Ablation: four-way weighing its sources by the consistency of their flows.
+    /// The four-way morph of Einarsson et al. (each view displaced by the flows into it,
+    /// read at the output pixel).
+    FourwayE06,
+    /// Ablation: E06's four-way morph weighing its sources by the consistency of their
+    /// flows.
     FourwayOcclusion,
-    /// Ablation: four-way reading rays beyond the grid's rows along their direction.
+    /// Ablation: the four-way morph without the visual hull (rays beyond the grid's rows
+    /// read along their direction).
     FourwayNoProxy,
 }
 
@@ -93,6 +99,7 @@ impl From<VariantArg> for Variant {
             VariantArg::Linear => Variant::Linear,
             VariantArg::Twoway => Variant::TwoWay,
             VariantArg::Fourway => Variant::FourWay,
+            VariantArg::FourwayE06 => Variant::FourWayE06,
             VariantArg::FourwayOcclusion => Variant::FourWayOcclusion,
             VariantArg::FourwayNoProxy => Variant::FourWayNoProxy,
         }
