@@ -9,6 +9,9 @@
 //!   [`frf_ingest::pipeline::ingest`]);
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
+//! - [`budget`]: the error budget of view interpolation: every variant at offsets along
+//!   rows, columns and toward quad centres, beside the captured views, the floor of any
+//!   flow-based morph and geometry baselines (unstructured lumigraph rendering);
 //! - [`paths`]: the suite of camera paths people render (inside, near, outside, above and
 //!   below the grid of cameras);
 //! - [`scene`]: the relit shadow, composites and matte edges against the truth;
@@ -20,6 +23,7 @@
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod budget;
 pub mod error;
 pub mod ingest;
 pub mod metrics;

@@ -87,7 +87,7 @@ pub struct EvalCamera {
 
 /// The first corners `(u, v)` of `count` grid quads, spread over the columns and
 /// alternating over the row gaps; refuses a grid without quads and absurd counts.
-fn quad_corners(geometry: &PoseGeometry, count: usize) -> Result<Vec<(usize, usize)>> {
+pub(crate) fn quad_corners(geometry: &PoseGeometry, count: usize) -> Result<Vec<(usize, usize)>> {
     let (columns, rows, wraps) = (geometry.columns, geometry.rows, geometry.wraps);
     let quads_u = if wraps {
         columns

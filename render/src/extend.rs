@@ -21,17 +21,30 @@ fn known(c: [i8; 2]) -> bool {
 }
 
 /// Gives every unknown texel of a `width x height` flow the code of its nearest known
-/// texel (breadth first from every known texel). A flow with no known texel stays
-/// unknown.
+/// texel ([`extend_nearest`]). A flow with no known texel stays unknown.
 pub fn extend_flow(codes: &mut [[i8; 2]], width: usize, height: usize) {
-    debug_assert_eq!(codes.len(), width * height);
-    let mut queue: VecDeque<usize> = (0..codes.len()).filter(|&i| known(codes[i])).collect();
+    extend_nearest(codes, width, height, |&c| known(c));
+}
+
+/// Gives every value of a `width x height` image for which `known` fails the value of
+/// the nearest one for which it holds (breadth first from every known value, 4-connected;
+/// ties to the first reached in row order). An image with nothing known is unchanged.
+pub fn extend_nearest<T: Copy>(
+    values: &mut [T],
+    width: usize,
+    height: usize,
+    known: impl Fn(&T) -> bool,
+) {
+    debug_assert_eq!(values.len(), width * height);
+    let mut done: Vec<bool> = values.iter().map(&known).collect();
+    let mut queue: VecDeque<usize> = (0..values.len()).filter(|&i| done[i]).collect();
     while let Some(i) = queue.pop_front() {
         let (x, y) = (i % width, i / width);
-        let value = codes[i];
+        let value = values[i];
         let mut visit = |j: usize| {
-            if !known(codes[j]) {
-                codes[j] = value;
+            if !done[j] {
+                done[j] = true;
+                values[j] = value;
                 queue.push_back(j);
             }
         };

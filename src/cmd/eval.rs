@@ -56,6 +56,16 @@ pub struct EvalArgs {
     /// (`frf_eval::paths`).
     #[arg(long, conflicts_with_all = ["camera", "orbit"])]
     pub(crate) suite: bool,
+    /// The error budget of view interpolation: every variant at offsets ¼, ½, ¾ along
+    /// rows, columns and toward quad centres (`--cameras` quads each) and at the captured
+    /// views, beside the floor of any flow-based morph (true correspondences) and
+    /// unstructured lumigraph rendering on the visual hull and on the true surface.
+    #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows"])]
+    pub(crate) budget: bool,
+    /// With `--budget`: also draw its plot here (`.svg` or `.png`) and its Markdown table
+    /// beside it (`.md`).
+    #[arg(long, requires = "budget")]
+    pub(crate) plot: Option<PathBuf>,
     /// Along a path: frame size `WxH` (default: the field's image size).
     #[arg(long, value_parser = parse_size)]
     pub(crate) size: Option<(u32, u32)>,
@@ -67,9 +77,10 @@ pub struct EvalArgs {
     /// Pose (default: the field's first).
     #[arg(long)]
     pose: Option<u32>,
-    /// Cameras at the centres of grid quads, spread around the grid.
+    /// Cameras at the centres of grid quads, spread around the grid (with `--budget`:
+    /// quads per offset).
     #[arg(long, default_value_t = 8)]
-    cameras: usize,
+    pub(crate) cameras: usize,
     /// Median-cut lights of the environment in the truth renders.
     #[arg(long, default_value_t = 512)]
     pub(crate) lights: usize,
@@ -170,6 +181,9 @@ pub fn run(args: EvalArgs) -> CliResult {
         .into());
     }
     let source = PoseSource::load(&field, pose, &lighting)?;
+    if args.budget {
+        return crate::cmd::eval_budget::run(&args, &source, &stage, &env, pose);
+    }
     if args.suite || args.path.orbit.is_some() || args.path.camera.is_some() {
         return crate::cmd::eval_paths::run(&args, &source, &stage, &env);
     }

@@ -3,6 +3,7 @@
 pub mod args;
 pub mod bench;
 pub mod eval;
+pub mod eval_budget;
 pub mod eval_paths;
 pub mod eval_shot;
 pub mod flow;

@@ -208,6 +208,40 @@ impl Stage {
         }
     }
 
+    /// The surface points and alpha of the unperturbed walker at pose `pose`'s reference
+    /// instant, seen by `camera` (subject frame): what [`Stage::truth_image`] shows, point
+    /// by point.
+    pub fn truth_surface(
+        &self,
+        pose: u32,
+        camera: &Camera,
+    ) -> (Image<Option<SurfacePoint>>, GrayImage) {
+        let actor = self.actor(None, self.pose_time_s(pose));
+        let scene = Scene {
+            actor: Some(&actor),
+            studio: false,
+            illumination: &Illumination::Dark,
+        };
+        let r = render(camera, &scene, self.config().samples_per_axis);
+        (r.surface, r.alpha)
+    }
+
+    /// The true flow, for the unperturbed walker at pose `pose`'s reference instant, from
+    /// the pixels of a view whose surface points are `surface` ([`Stage::truth_surface`])
+    /// to camera `to` (subject frame), with the pixels whose point `to` does not see.
+    pub fn truth_flow(
+        &self,
+        pose: u32,
+        surface: &Image<Option<SurfacePoint>>,
+        to: &Camera,
+    ) -> TrueFlow {
+        let setup = ViewSetup {
+            camera: *to,
+            actor: self.actor(None, self.pose_time_s(pose)),
+        };
+        flow_between(surface, &setup)
+    }
+
     /// The lights (subject frame) of basis conditions weighted by `weights[c]`, for a
     /// subject standing at turntable angle `turntable` (radians): the dome's lights seen
     /// from the subject frame, `R_y(-θ)` ([`frf_core::conventions`]).

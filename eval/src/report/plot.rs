@@ -37,7 +37,7 @@ pub fn fonts_available() -> bool {
     })
 }
 
-fn plot_error(e: impl std::fmt::Display) -> EvalError {
+pub(crate) fn plot_error(e: impl std::fmt::Display) -> EvalError {
     EvalError::BadParameter(format!("plot: {e}"))
 }
 

@@ -1,0 +1,87 @@
+//! `frf eval FIELD --capture C --env E --budget [--plot F.svg|F.png] [--json]`: the
+//! error budget of view interpolation ([`frf_eval::budget`]), printed as a table, and
+//! drawn with its Markdown table beside the plot.
+
+use frf_core::atomic::write_bytes_atomic;
+use frf_core::env::EnvMap;
+use frf_eval::budget::{self, BudgetInputs, BudgetReport};
+use frf_render::resident::{PoseSource, ResidentPose};
+use frf_stage::Stage;
+use frf_stage::truth::environment_lights;
+
+use crate::CliResult;
+use crate::cmd::eval::EvalArgs;
+use crate::cmd::progress::bar;
+use crate::cmd::render::open_renderer;
+
+/// Runs the budget.
+pub fn run(
+    args: &EvalArgs,
+    source: &PoseSource,
+    stage: &Stage,
+    env: &EnvMap,
+    pose: u32,
+) -> CliResult {
+    let plot_png = match &args.plot {
+        None => None,
+        Some(p) => match p.extension().and_then(|e| e.to_str()) {
+            Some(e) if e.eq_ignore_ascii_case("svg") => Some(false),
+            Some(e) if e.eq_ignore_ascii_case("png") => Some(true),
+            _ => {
+                return Err(format!("--plot {}: expected a .svg or .png file", p.display()).into());
+            }
+        },
+    };
+    let renderer = open_renderer(source, args.compare.cpu)?;
+    let resident = ResidentPose::relight_cpu(source);
+    let lights = environment_lights(env, args.lights);
+    let variants = args.compare.variants();
+    let inputs = BudgetInputs {
+        renderer: &renderer,
+        resident: &resident,
+        stage,
+        pose,
+        lights: &lights,
+    };
+    let progress = bar("budget frames");
+    progress.set_length(budget::frames(args.cameras, variants.len()) as u64);
+    let rows = budget::run(&inputs, args.cameras, &variants, &|| progress.inc(1))?;
+    progress.finish_and_clear();
+    eprintln!(
+        "{} pose {pose} under {}: subject PSNR (dB) / SSIM, {} cameras per offset, variants on {} \
+         (truth: {} median-cut lights)",
+        args.field.display(),
+        args.lighting.source()?,
+        args.cameras,
+        renderer.device(),
+        args.lights
+    );
+    eprint!("{}", budget::table(&rows));
+    if let (Some(path), Some(png)) = (&args.plot, plot_png) {
+        let bytes = if png {
+            budget::plot::png(&rows)?
+                .ok_or("no system font for the plot's text: draw it as .svg")?
+        } else {
+            budget::plot::svg(&rows)?.into_bytes()
+        };
+        write_bytes_atomic(path, &bytes)?;
+        write_bytes_atomic(
+            &path.with_extension("md"),
+            budget::markdown(&rows).as_bytes(),
+        )?;
+    }
+    if args.compare.json {
+        let report = BudgetReport {
+            field: args.field.display().to_string(),
+            capture: args.capture.display().to_string(),
+            env: args.lighting.source()?.to_string(),
+            pose,
+            device: renderer.device(),
+            truth_lights: args.lights,
+            quads: args.cameras,
+            rows,
+        };
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
