@@ -4,6 +4,7 @@
 // snippets of `sample/` (how the pre-lit views and the flows are stored and filtered:
 // `sample_prelit` and `sample_flow_layer`), chosen by `frf_render::gpu::formats`.
 //
+// The solved morph (variant 4) is in `morph/solved.wgsl`, composed after this file.
 // Entry points: `fs_main` (a full-screen triangle into a colour target), `cs_main` (the
 // same pixels from a compute pass into a storage texture, and what happened to each
 // pixel's ray counted per workgroup, then once per workgroup into `stats`), `cs_classes`
@@ -414,10 +415,12 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
 }
 
 // Where a pixel's ray samples the views: its hit on the cylinder, the position s in the
-// interpolated camera, and its class (0 inside, 1 clamped above, 2 below, 3 missed).
+// interpolated camera (the solved morph: its output camera instead), and its class (0
+// inside, 1 clamped above, 2 below, 3 missed).
 struct Classified {
     hit: Hit,
     s: vec2<f32>,
+    solved: SolvedOutput,
     kind: u32,
 }
 
@@ -428,6 +431,14 @@ fn classify(position: vec2<f32>) -> Classified {
     out.hit = hit;
     out.kind = 3u;
     if (hit.clamped == 3u) {
+        return out;
+    }
+    if (frame.variant == 4u) {
+        // The solved morph looks the ray up in the quad's rectified frame.
+        out.solved = solved_output(hit, frame.centre.xyz, dir);
+        if (out.solved.ok) {
+            out.kind = hit.clamped;
+        }
         return out;
     }
     let q = quad_views(hit, frame.columns, frame.rows);
@@ -466,13 +477,20 @@ fn classify(position: vec2<f32>) -> Classified {
     return out;
 }
 
-// The premultiplied linear RGBA of the pixel at `position` (its centre).
-fn shade(position: vec2<f32>) -> vec4<f32> {
-    let c = classify(position);
+// The premultiplied linear RGBA of a classified pixel.
+fn shade_classified(c: Classified) -> vec4<f32> {
     if (c.kind == 3u) {
         return vec4<f32>(0.0);
     }
+    if (frame.variant == 4u) {
+        return solved_morph(c.hit, c.solved);
+    }
     return morph(c.hit, c.s);
+}
+
+// The premultiplied linear RGBA of the pixel at `position` (its centre).
+fn shade(position: vec2<f32>) -> vec4<f32> {
+    return shade_classified(classify(position));
 }
 
 @fragment
@@ -506,11 +524,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocati
     clear_counts(local);
     if (id.x < frame.size.x && id.y < frame.size.y) {
         let c = classify(vec2<f32>(id.xy) + 0.5);
-        var colour = vec4<f32>(0.0);
-        if (c.kind != 3u) {
-            colour = morph(c.hit, c.s);
-        }
-        textureStore(target_image, id.xy, colour);
+        textureStore(target_image, id.xy, shade_classified(c));
         atomicAdd(&class_counts[c.kind], 1u);
     }
     flush_counts(local);

@@ -20,8 +20,11 @@
 //! the subject foreshortens the image (a 17° gap between rows scales it by about 1 %,
 //! which misplaces detail by a pixel at the subject's head and feet).
 
+use bytemuck::Zeroable;
 use frf_core::camera::{Camera, Intrinsics};
 use glam::{Mat3, Vec2, Vec3};
+
+use crate::gpu::types::GpuQuadFrame;
 
 /// The rectified frame of one quad (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,6 +167,32 @@ impl QuadFrame {
     /// per axis.
     pub fn parallax(&self, from: Vec2, to: Vec2) -> Vec2 {
         (to - from) * Vec2::new(self.intrinsics.fx, self.intrinsics.fy)
+    }
+}
+
+/// A frame as the GPU reads it (`QuadFrame` of `shaders/morph/solved.wgsl`); a quad
+/// without one is marked invalid.
+pub fn gpu_frame(frame: Option<&QuadFrame>) -> GpuQuadFrame {
+    let Some(f) = frame else {
+        return GpuQuadFrame::zeroed();
+    };
+    let columns = |m: &Mat3| [m.x_axis, m.y_axis, m.z_axis].map(|c| [c.x, c.y, c.z, 0.0]);
+    let k = &f.intrinsics;
+    let c = &f.centres;
+    GpuQuadFrame {
+        axis_x: f.rotation.x_axis.extend(0.0).to_array(),
+        axis_y: f.rotation.y_axis.extend(0.0).to_array(),
+        axis_n: f.rotation.z_axis.extend(0.0).to_array(),
+        intrinsics: [k.fx, k.fy, k.cx, k.cy],
+        to_rectified: f.to_rectified.each_ref().map(columns),
+        from_rectified: f.from_rectified.each_ref().map(columns),
+        centres: [
+            [c[0].x, c[0].y, c[1].x, c[1].y],
+            [c[2].x, c[2].y, c[3].x, c[3].y],
+        ],
+        fixation_depth: f.fixation_depth,
+        valid: 1,
+        pad: [0.0; 2],
     }
 }
 

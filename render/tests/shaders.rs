@@ -10,8 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuRelightParams,
-    GpuShadowParams, GpuView,
+    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuQuadFrame,
+    GpuRelightParams, GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -167,6 +167,23 @@ fn pod_structs_match_naga_layouts() {
             spans,
             quads_per_span,
             enabled
+        ]
+    );
+    check_layout!(
+        &rebin,
+        "QuadFrame",
+        GpuQuadFrame,
+        [
+            axis_x,
+            axis_y,
+            axis_n,
+            intrinsics,
+            to_rectified,
+            from_rectified,
+            centres,
+            fixation_depth,
+            valid,
+            pad
         ]
     );
     // The column index's ranges follow its header in one buffer.

@@ -8,10 +8,10 @@
 //! visibility were right would sample each view there; what such a morph still gets
 //! wrong is what resampling the views costs (bilinear filtering at sub-pixel positions),
 //! shading that changes between views (specular highlights, the rim of a limb seen
-//! edge-on), and points no view of the quad sees. Pixels whose ray misses the walker take
-//! the correspondence of the nearest pixel that does not, so that the anti-aliased border
-//! of the silhouette is carried with it (as the renderer extends its flows,
-//! [`frf_render::extend`]). Where no view of the quad sees a point, all of them are
+//! edge-on), and points no view of the quad sees. Pixels whose centre's ray misses the
+//! walker take the correspondence of the nearest pixel whose centre's does not, so that
+//! the anti-aliased border of the silhouette is carried with it (as the renderer extends
+//! its flows, [`frf_render::extend`]). Where no view of the quad sees a point, all of them are
 //! blended, as a morph would have to.
 
 use frf_core::camera::Camera;
@@ -20,7 +20,9 @@ use frf_core::image::{Image, Rgba};
 use frf_render::extend::extend_nearest;
 use frf_render::resident::ResidentPose;
 use frf_stage::Stage;
+use frf_stage::geometry::Ray;
 use glam::Vec2;
+use rayon::prelude::*;
 
 /// One pixel's correspondence into one view: the flow and whether the view sees it.
 type Correspondence = ([f32; 2], bool);
@@ -41,6 +43,20 @@ pub fn correspondence_floor(
 ) -> Image<Rgba> {
     let (surface, _) = stage.truth_surface(pose, camera);
     let (w, h) = surface.size();
+    // The stage records, where a pixel's centre misses, a covered sub-sample's point:
+    // its flow would be off by the sub-sample's offset.
+    let actor = stage.actor(None, stage.pose_time_s(pose));
+    let centre_hits: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let dir = camera.ray_direction(Vec2::new((i % w) as f32, (i / w) as f32));
+            let ray = Ray {
+                origin: camera.centre(),
+                dir,
+            };
+            actor.intersect(&ray, 0.0, f32::INFINITY).is_some()
+        })
+        .collect();
     let mut seen = vec![[0.0f32; 4]; w * h];
     let mut seen_weight = vec![0.0f32; w * h];
     let mut all = vec![[0.0f32; 4]; w * h];
@@ -55,7 +71,14 @@ pub fn correspondence_floor(
             .pixels()
             .iter()
             .zip(truth.occluded.pixels())
-            .map(|(f, &o)| (*f, o < 0.5))
+            .zip(&centre_hits)
+            .map(|((f, &o), &hit)| {
+                if hit {
+                    (*f, o < 0.5)
+                } else {
+                    ([f32::INFINITY; 2], false)
+                }
+            })
             .collect();
         extend_nearest(&mut cells, w, h, known);
         for (i, c) in cells.iter().enumerate() {

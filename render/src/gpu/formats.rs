@@ -159,11 +159,12 @@ impl PoseFormats {
     /// The frame pass's source with these formats' sampling.
     pub fn rebin_source(self) -> String {
         format!(
-            "{}\n{}\n{}\n{}",
+            "{}\n{}\n{}\n{}\n{}",
             shaders::COMMON,
             self.image.snippet(),
             self.flow.snippet(),
-            shaders::REBIN
+            shaders::REBIN,
+            shaders::SOLVED
         )
     }
 }

@@ -46,6 +46,9 @@ pub mod shaders {
     pub const COMPOSITE: &str = include_str!("../../../shaders/composite.wgsl");
     /// `shaders/floor.wgsl`, standalone.
     pub const FLOOR: &str = include_str!("../../../shaders/floor.wgsl");
+    /// `shaders/morph/solved.wgsl`: the solved four-way morph, composed after the frame
+    /// pass.
+    pub const SOLVED: &str = include_str!("../../../shaders/morph/solved.wgsl");
     /// `shaders/sample/prelit_codes.wgsl`: pre-lit views as integer codes.
     pub const PRELIT_CODES: &str = include_str!("../../../shaders/sample/prelit_codes.wgsl");
     /// `shaders/sample/prelit_srgb.wgsl`: pre-lit views as sRGB8, filtered in hardware.

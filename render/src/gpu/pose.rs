@@ -13,10 +13,11 @@ use wgpu::util::DeviceExt;
 
 use super::bind::{copy_to_buffer, storage, table_bytes, uniform};
 use super::rebin::RebinPass;
-use super::types::{GpuQuad, GpuRelightParams, GpuView};
+use super::types::{GpuQuad, GpuQuadFrame, GpuRelightParams, GpuView};
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
+use crate::rectified::gpu_frame;
 use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
 
 /// Workgroup size of the relighting pass (`@workgroup_size(64)`).
@@ -338,6 +339,12 @@ impl Gpu {
         let (proxy, hull_words) = geometry.proxy.gpu();
         let proxy_buffer = buffer("proxy", bytemuck::bytes_of(&proxy));
         let hull_buffer = buffer("hull", bytemuck::cast_slice(&hull_words));
+        let frames: Vec<GpuQuadFrame> = geometry
+            .frames
+            .iter()
+            .map(|f| gpu_frame(f.as_ref()))
+            .collect();
+        let frame_buffer = buffer("quad frames", bytemuck::cast_slice(&frames));
         let view_of = |t: &wgpu::Texture| {
             t.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -383,6 +390,10 @@ impl Gpu {
                 wgpu::BindGroupEntry {
                     binding: 8,
                     resource: wgpu::BindingResource::Sampler(&pass.sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: frame_buffer.as_entire_binding(),
                 },
             ],
         });

@@ -110,6 +110,7 @@ impl RebinPass {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                storage(9, true, both),
             ],
         );
         let fragment = full_screen_pipeline(

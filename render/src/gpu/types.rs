@@ -45,6 +45,33 @@ pub struct GpuQuad {
     pub pad: f32,
 }
 
+/// `QuadFrame` of `shaders/morph/solved.wgsl`: a quad's rectified frame
+/// ([`crate::rectified::QuadFrame`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuQuadFrame {
+    /// `world_from_rectified` x column (image right; w unused).
+    pub axis_x: [f32; 4],
+    /// y column (image down).
+    pub axis_y: [f32; 4],
+    /// The plane's inward normal.
+    pub axis_n: [f32; 4],
+    /// fx, fy, cx, cy.
+    pub intrinsics: [f32; 4],
+    /// Per vertex: view pixel to rectified pixel, columns padded to 16 bytes.
+    pub to_rectified: [[[f32; 4]; 3]; 4],
+    /// Per vertex: rectified pixel to view pixel.
+    pub from_rectified: [[[f32; 4]; 3]; 4],
+    /// In-plane centres: `[A.x, A.y, B.x, B.y]`, `[C.x, C.y, D.x, D.y]`.
+    pub centres: [[f32; 4]; 2],
+    /// Depth of the fixation point along the normal.
+    pub fixation_depth: f32,
+    /// 1 where the quad has a frame.
+    pub valid: u32,
+    /// Padding to 16 bytes.
+    pub pad: [f32; 2],
+}
+
 /// `Frame` of `shaders/common.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

@@ -20,7 +20,8 @@
 //! H_X(x) + D(x) = s,
 //! ```
 //!
-//! found by the fixed-point iteration `x ← H_X⁻¹(s − D(x))` ([`ITERATIONS`] steps),
+//! found by the fixed-point iteration `x ← H_X⁻¹(s − D(x))` (at most [`ITERATIONS`]
+//! steps, fewer once a step is shorter than [`SETTLED_PX`]),
 //! started at the depth the proxy gives the ray (its first hull voxel), else at the
 //! quad's fixation depth: that start picks, where a limb folds over another, the surface
 //! the ray meets first. Each step reads the view's own two flows at its own pixel, so
@@ -47,6 +48,9 @@ use frf_core::grid::Neighbour;
 /// Fixed-point steps per source. Measured on the small preset's oracle field at
 /// quad centres (issue 20): see docs/results/render.md.
 pub const ITERATIONS: usize = 4;
+/// A fixed-point step shorter than this (pixels) ends the iteration: the solution has
+/// settled far below the resolution of the stored flows.
+pub const SETTLED_PX: f32 = 1e-3;
 /// Length of the last fixed-point step, pixels, at which a source's weight falls to
 /// `1/e`: a settled solution moves by hundredths of a pixel.
 pub const SETTLE_PX: f32 = 0.5;
@@ -170,6 +174,9 @@ pub fn solve(
         let next = apply(&frame.from_rectified[k], out.s - displacement(x));
         step = (next - x).length();
         x = next;
+        if step < SETTLED_PX {
+            break;
+        }
     }
     (x, step)
 }
