@@ -27,10 +27,10 @@ struct QuadFrame {
 @group(1) @binding(9) var<storage, read> quad_frames: array<QuadFrame>;
 
 // Fixed-point steps per source (`solved::ITERATIONS`).
-const SOLVE_ITERATIONS: i32 = 4;
+const SOLVE_ITERATIONS: i32 = 2;
 // A step this short ends the iteration (`solved::SETTLED_PX`); last-step length at which
 // a source weighs 1/e, and the least factor (`solved::SETTLE_PX`, `solved::SETTLE_FLOOR`).
-const SETTLED_PX: f32 = 1e-3;
+const SETTLED_PX: f32 = 0.01;
 const SETTLE_PX: f32 = 0.5;
 const SETTLE_FLOOR: f32 = 1e-3;
 
@@ -152,11 +152,11 @@ fn solve_source(f: u32, q: vec4<u32>, k: u32, out: SolvedOutput) -> vec3<f32> {
     let toward_v = select(DOWN, UP, k < 2u);
     let view = q[k];
     let k_f = quad_frames[f].intrinsics;
-    let start = out.s + (out.centre - frame_centre(f, k)) * vec2<f32>(k_f.x, k_f.y) * out.inverse_depth;
-    var x = homography(quad_frames[f].from_rectified[k], start);
+    // `here` is H_X(x); after a step it is s - D by construction.
+    var here = out.s + (out.centre - frame_centre(f, k)) * vec2<f32>(k_f.x, k_f.y) * out.inverse_depth;
+    var x = homography(quad_frames[f].from_rectified[k], here);
     var step = 0.0;
     for (var i = 0; i < SOLVE_ITERATIONS; i++) {
-        let here = homography(quad_frames[f].to_rectified[k], x);
         var d = vec2<f32>(0.0);
         if (ac.x != 0.0) {
             let fh = sample_flow(view, toward_h, x);
@@ -166,7 +166,8 @@ fn solve_source(f: u32, q: vec4<u32>, k: u32, out: SolvedOutput) -> vec3<f32> {
             let fv = sample_flow(view, toward_v, x);
             d += ac.y * (homography(quad_frames[f].to_rectified[v], x + fv) - here);
         }
-        let next = homography(quad_frames[f].from_rectified[k], out.s - d);
+        here = out.s - d;
+        let next = homography(quad_frames[f].from_rectified[k], here);
         step = length(next - x);
         x = next;
         if (step < SETTLED_PX) {

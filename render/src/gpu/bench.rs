@@ -26,11 +26,13 @@ use crate::synthetic::bench_camera;
 /// hardware's 8-bit filter weights and half-float flows stay near 1e-2 on sharp edges.
 pub const CORRECT_MAX_ABS: f64 = 2e-2;
 
-/// The variants timed, after the floor.
-pub const VARIANTS: [Variant; 4] = [
+/// The variants timed, after the floor: the renderer's four-way morph last, E06's
+/// beside it.
+pub const VARIANTS: [Variant; 5] = [
     Variant::Nearest,
     Variant::Linear,
     Variant::TwoWay,
+    Variant::FourWayE06,
     Variant::FourWay,
 ];
 
