@@ -96,7 +96,8 @@ fn solved_output(hit: Hit, origin: vec3<f32>, dir: vec3<f32>) -> SolvedOutput {
     }
     var centre = hit.point;
     var r = vec3<f32>(0.0);
-    if (hit.clamped == 0u) {
+    if (hit.clamped == 0u || frame.rows == 1u) {
+        // On the ray: inside the grid, and anywhere on a grid of one row.
         r = project_rectified(f, dir);
     } else {
         let q = quad_views(hit, frame.columns, frame.rows);
@@ -147,20 +148,34 @@ fn solve_fractions(f: u32, k: u32, vertical: bool, to: vec2<f32>) -> vec2<f32> {
 fn solve_source(f: u32, q: vec4<u32>, k: u32, out: SolvedOutput) -> vec3<f32> {
     let h = k ^ 1u;
     let v = k ^ 2u;
-    let ac = solve_fractions(f, k, q[v] != q[k], out.centre);
+    let vertical = q[v] != q[k];
+    let ac = solve_fractions(f, k, vertical, out.centre);
     let toward_h = select(LEFT, RIGHT, k % 2u == 0u);
     let toward_v = select(DOWN, UP, k < 2u);
     let view = q[k];
     let k_f = quad_frames[f].intrinsics;
+    let focal = vec2<f32>(k_f.x, k_f.y);
+    // Without a vertical partner: the output's offset across the row, moved by the
+    // inverse depth the row's flow measures.
+    var across = vec2<f32>(0.0);
+    var along = vec2<f32>(0.0);
+    if (!vertical) {
+        let c = frame_centre(f, k);
+        let b = frame_centre(f, h) - c;
+        across = (out.centre - c - b * ac.x) * focal;
+        let p = b * focal;
+        along = p / max(dot(p, p), 1e-12);
+    }
     // `here` is H_X(x); after a step it is s - D by construction.
     var here = out.s + (out.centre - frame_centre(f, k)) * vec2<f32>(k_f.x, k_f.y) * out.inverse_depth;
     var x = homography(quad_frames[f].from_rectified[k], here);
     var step = 0.0;
     for (var i = 0; i < SOLVE_ITERATIONS; i++) {
         var d = vec2<f32>(0.0);
-        if (ac.x != 0.0) {
+        if (ac.x != 0.0 || any(across != vec2<f32>(0.0))) {
             let fh = sample_flow(view, toward_h, x);
-            d += ac.x * (homography(quad_frames[f].to_rectified[h], x + fh) - here);
+            let d_h = homography(quad_frames[f].to_rectified[h], x + fh) - here;
+            d += ac.x * d_h + across * dot(d_h, along);
         }
         if (ac.y != 0.0) {
             let fv = sample_flow(view, toward_v, x);

@@ -35,7 +35,14 @@ fn the_bench_reports_every_variant_stage_and_the_floor_as_json() {
     let rows = report["rows"].as_array().unwrap();
     for size in [(64, 48), (96, 64)] {
         for stage in ["fragment", "compute"] {
-            for variant in ["floor", "nearest", "linear", "twoway", "fourway-e06", "fourway"] {
+            for variant in [
+                "floor",
+                "nearest",
+                "linear",
+                "twoway",
+                "fourway-e06",
+                "fourway",
+            ] {
                 let row = rows
                     .iter()
                     .find(|r| {

@@ -89,7 +89,11 @@ pub fn output(
         None
     };
     let (centre, s) = match hit.clamped {
-        Clamp::None => (hit.point, frame.project_direction(dir)?),
+        // Inside the grid, and anywhere on a grid of one row (whose wall is its frame's
+        // plane): the camera at the ray's crossing of the plane, on the ray.
+        _ if hit.clamped == Clamp::None || g.rows == 1 => {
+            (hit.point, frame.project_direction(dir)?)
+        }
         _ => {
             let views = quad_views(g, hit);
             let w = bilinear_weights(hit.beta, hit.gamma);
@@ -157,12 +161,26 @@ pub fn solve(
     let (a, c) = fractions(frame, k, vertical, out.centre);
     let (to_h, to_v) = partner_flows(k);
     let view = views[k];
+    // Without a vertical partner the output may stand off the row: its offset across the
+    // row moves the point by the same inverse depth the row's flow measures.
+    let (across, along) = if vertical {
+        (Vec2::ZERO, Vec2::ZERO)
+    } else {
+        let o = out.centre - frame.centres[k];
+        let off = o - (frame.centres[h] - frame.centres[k]) * a;
+        let along = frame.parallax(frame.centres[k], frame.centres[h]);
+        (
+            frame.parallax(Vec2::ZERO, off),
+            along / along.length_squared().max(1e-12),
+        )
+    };
     // `here` is `H_X(x)`; after a step it is `s − D` by construction.
     let displacement = |x: Vec2, here: Vec2| {
         let mut d = Vec2::ZERO;
-        if a != 0.0 {
+        if a != 0.0 || across != Vec2::ZERO {
             let f = pose.sample_flow(view, to_h, x);
-            d += a * (apply(&frame.to_rectified[h], x + f) - here);
+            let d_h = apply(&frame.to_rectified[h], x + f) - here;
+            d += a * d_h + across * d_h.dot(along);
         }
         if c != 0.0 {
             let f = pose.sample_flow(view, to_v, x);
