@@ -86,7 +86,8 @@ pub struct EvalArgs {
     pub(crate) lights: usize,
     #[command(flatten)]
     pub(crate) compare: CompareArgs,
-    /// Write each camera's truth and renders as PNGs here (with `--shadows`, also the
+    /// Write each camera's truth and renders as PNGs here (with `--budget`, the first
+    /// camera's at each offset, every method's; with `--shadows`, also the
     /// relit and the true shadow of the ground patch, seen from above, +x right, +z down).
     #[arg(long)]
     pub(crate) images: Option<PathBuf>,

@@ -4,6 +4,8 @@
 
 use frf_core::atomic::write_bytes_atomic;
 use frf_core::env::EnvMap;
+use frf_core::image::{Image, Rgba};
+use frf_core::io::write_png8_srgba;
 use frf_eval::budget::{self, BudgetInputs, BudgetReport};
 use frf_render::resident::{PoseSource, ResidentPose};
 use frf_stage::Stage;
@@ -36,12 +38,27 @@ pub fn run(
     let resident = ResidentPose::relight_cpu(source);
     let lights = environment_lights(env, args.lights);
     let variants = args.compare.variants();
+    let keep = |offset: &budget::Offset, name: &str, frame: &Image<Rgba>| {
+        let Some(dir) = &args.images else {
+            return Ok(());
+        };
+        let file = format!(
+            "{}_{:.2}_{:.2}_{}.png",
+            offset.direction.name(),
+            offset.beta,
+            offset.gamma,
+            name.replace([':', ' '], "_").replace("__", "_")
+        );
+        write_png8_srgba(&dir.join(file), frame, 1.0)?;
+        Ok(())
+    };
     let inputs = BudgetInputs {
         renderer: &renderer,
         resident: &resident,
         stage,
         pose,
         lights: &lights,
+        keep: Some(&keep),
     };
     let progress = bar("budget frames");
     progress.set_length(budget::frames(args.cameras, variants.len()) as u64);

@@ -234,7 +234,14 @@ pub struct BudgetInputs<'a> {
     pub pose: u32,
     /// The environment's lights.
     pub lights: &'a [DirLight],
+    /// Called with the first camera's frames at each offset (its truth named `truth`),
+    /// to keep them.
+    pub keep: Option<&'a Keep<'a>>,
 }
+
+/// What [`BudgetInputs::keep`] is called with: the offset, the method's name (or
+/// `truth`), the frame.
+pub type Keep<'a> = dyn Fn(&Offset, &str, &Image<Rgba>) -> Result<()> + Sync + 'a;
 
 /// Frames the budget computes (for a progress bar): per offset and camera, the truth,
 /// each variant and the three baselines.
@@ -283,6 +290,13 @@ pub fn run(
                     t
                 })
                 .collect::<Result<Vec<_>>>()?;
+            let keep = |name: &str, frame: &Image<Rgba>| match inputs.keep {
+                Some(keep) => keep(&offset, name, frame),
+                None => Ok(()),
+            };
+            if let Some(t) = truths.first() {
+                keep("truth", t)?;
+            }
             let mut methods = Vec::new();
             for &variant in variants {
                 let start = Instant::now();
@@ -300,6 +314,9 @@ pub fn run(
                     &frames,
                     start.elapsed().as_secs_f64(),
                 ));
+                if let Some(f) = frames.first() {
+                    keep(variant.name(), f)?;
+                }
             }
             let baseline = |name: &str, f: &(dyn Fn(&BudgetCamera) -> Image<Rgba> + Sync)| {
                 let start = Instant::now();
@@ -311,7 +328,11 @@ pub fn run(
                         frame
                     })
                     .collect();
-                score(name, &truths, &frames, start.elapsed().as_secs_f64())
+                let seconds = start.elapsed().as_secs_f64();
+                if let Some(f) = frames.first() {
+                    keep(name, f)?;
+                }
+                Ok::<_, crate::EvalError>(score(name, &truths, &frames, seconds))
             };
             methods.push(baseline(FLOOR, &|c| {
                 floor::correspondence_floor(
@@ -322,7 +343,7 @@ pub fn run(
                     c.views,
                     c.weights,
                 )
-            }));
+            })?);
             if let Some(hull) = hull {
                 let slack = HULL_VISIBILITY_VOXELS * hull.grid().voxel_m;
                 methods.push(baseline(ULR_HULL, &|c| {
@@ -333,7 +354,7 @@ pub fn run(
                         hull.first_hit(centre, to.normalize())
                             .is_none_or(|t| t >= to.length() - slack)
                     })
-                }));
+                })?);
             }
             methods.push(baseline(ULR_TRUE, &|c| {
                 let depths = ulr::depths(&c.camera, |o, d| {
@@ -356,7 +377,7 @@ pub fn run(
                         )
                         .is_none_or(|h| h.t >= dist - TRUE_VISIBILITY_M)
                 })
-            }));
+            })?);
             Ok(BudgetRow {
                 direction: offset.direction,
                 beta: offset.beta,
