@@ -222,7 +222,9 @@ fn every_view_is_sampled_where_it_shows_the_pixels_point() {
                     (x - want).length() < 0.1,
                     "({beta}, {gamma}) {px} view {k}: {x} vs {want}"
                 );
-                assert!(step < 0.05, "not settled: {step}");
+                // Two steps from the quad's fixation depth (no proxy here) leave the last
+                // step a few hundredths of a pixel: the source keeps its whole weight.
+                assert!(step < 0.2, "not settled: {step}");
             }
         }
     }

@@ -31,7 +31,7 @@ const SOLVE_ITERATIONS: i32 = 2;
 // A step this short ends the iteration (`solved::SETTLED_PX`); last-step length at which
 // a source weighs 1/e, and the least factor (`solved::SETTLE_PX`, `solved::SETTLE_FLOOR`).
 const SETTLED_PX: f32 = 0.01;
-const SETTLE_PX: f32 = 0.5;
+const SETTLE_PX: f32 = 2.0;
 const SETTLE_FLOOR: f32 = 1e-3;
 
 // Twin of `rectified::apply`.

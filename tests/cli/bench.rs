@@ -70,7 +70,7 @@ fn the_bench_reports_every_variant_stage_and_the_floor_as_json() {
         }
     }
     let cpu = report["cpu_rows"].as_array().unwrap();
-    assert_eq!(cpu.len(), 2 * 4, "the CPU reference's rows");
+    assert_eq!(cpu.len(), 2 * 5, "the CPU reference's rows");
     assert!(report["fastest_correct_fourway"].is_string());
 }
 
