@@ -159,6 +159,81 @@ fn eval_four_way_beats_linear_and_nearest_between_grid_views() {
 }
 
 #[test]
+fn eval_budget_scores_every_offset_and_draws_its_plot() {
+    let (dir, field) = fixture();
+    let out = tempfile::tempdir().unwrap();
+    let plot = out.path().join("budget.svg");
+    let images = out.path().join("frames");
+    let mut args = vec![
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        dir.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--budget",
+        "--cameras",
+        "1",
+        "--lights",
+        "32",
+        "--variants",
+        "linear,fourway",
+        "--plot",
+        plot.to_str().unwrap(),
+        "--images",
+        images.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: frf_eval::budget::BudgetReport = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report.rows.len(), frf_eval::budget::offsets().len());
+    let names: Vec<&str> = report.rows[0]
+        .methods
+        .iter()
+        .map(|m| m.name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "linear",
+            "fourway",
+            frf_eval::budget::FLOOR,
+            frf_eval::budget::ULR_HULL,
+            frf_eval::budget::ULR_TRUE
+        ]
+    );
+    assert!(stderr(&o).contains("flow floor"), "{}", stderr(&o));
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("fourway"), "{svg}");
+    let md = std::fs::read_to_string(plot.with_extension("md")).unwrap();
+    assert!(md.starts_with("| offset |") && md.lines().count() == 2 + report.rows.len());
+    assert!(images.join("centre_0.50_0.50_truth.png").exists());
+    assert!(images.join("centre_0.50_0.50_fourway.png").exists());
+
+    // A plot of another kind is refused before anything is measured.
+    let bad = out.path().join("budget.txt");
+    let o = frf(&[
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        dir.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--budget",
+        "--plot",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("budget.txt") && stderr(&o).contains(".svg"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn bad_arguments_are_refused_naming_the_problem() {
     let (dir, field) = fixture();
     let field = field.to_str().unwrap();
