@@ -125,7 +125,7 @@ pub fn output(
 /// The flows of vertex `k` of a quad `[A, B, C, D]` toward its horizontal and vertical
 /// partners (`k ^ 1`, `k ^ 2`).
 pub fn partner_flows(k: usize) -> (Neighbour, Neighbour) {
-    let h = if k % 2 == 0 {
+    let h = if k.is_multiple_of(2) {
         Neighbour::Right
     } else {
         Neighbour::Left
