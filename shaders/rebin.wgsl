@@ -315,7 +315,7 @@ fn opposite(dir: u32) -> u32 {
 }
 
 // The occlusion cue's factor for a squared, fraction-weighted flow inconsistency
-// (twin of `morph::confidence`; sigma 2 px, floor 1e-3).
+// (twin of `morph::e06::confidence`; sigma 2 px, floor 1e-3).
 fn confidence(err2: f32) -> f32 {
     return max(exp(-err2 / 4.0), 1e-3);
 }
@@ -336,7 +336,7 @@ fn displaced(src: u32, view: u32, dir: u32, back: u32, frac: f32, s: vec2<f32>, 
     return vec3<f32>(frac * f, err2);
 }
 
-// The morph of the quad's views at s (see `render/src/morph.rs` for the derivation and
+// E06's morphs of the quad's views at s (see `render/src/morph/e06.rs` for the derivation and
 // the occlusion cue).
 fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     let q = quad_views(hit, frame.columns, frame.rows);

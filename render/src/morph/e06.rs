@@ -86,7 +86,9 @@ pub fn confidence(err2: f32) -> f32 {
 
 /// The interpolated premultiplied RGBA at pixel `s` of the camera interpolated at the
 /// hit, by `variant`'s interpolation of the images as they are read at `s` (nearest,
-/// linear blend) or displaced by the flows read there (two-way, E06's four-way).
+/// linear blend) or displaced by the flows read there (two-way, E06's four-way; the
+/// solved morph's variants, which [`super::shade`] sends to [`super::solved`], get
+/// E06's four-way here).
 pub fn morph(pose: &ResidentPose, hit: &CylinderHit, s: Vec2, variant: Variant) -> [f32; 4] {
     let [a, b_, c, d] = quad_views(&pose.geometry, hit);
     let (beta, gamma) = (hit.beta, hit.gamma);
