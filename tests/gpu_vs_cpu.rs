@@ -16,14 +16,13 @@ use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::image::Image;
 use frf_reflectance::FieldFile;
-use frf_reflectance::project::FloorModel;
 use frf_render::RenderError;
 use frf_render::composite::{Backdrop, GroundLook};
 use frf_render::cpu::render_cpu;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::renderer::{Renderer, SceneShadow};
-use frf_render::resident::{Lighting, PoseSource, ResidentPose};
+use frf_render::resident::{PoseSource, ResidentPose};
 use frf_render::shadow::ShadowMaps;
 use glam::Vec3;
 
@@ -39,12 +38,7 @@ fn gpu() -> Option<Gpu> {
 }
 
 fn tiny_source() -> PoseSource {
-    let field = FieldFile::open(&frf_testkit::tiny_field().field).unwrap();
-    let lighting = Lighting::Environment {
-        env: EnvMap::sky(),
-        floor: FloorModel::Environment,
-    };
-    PoseSource::load(&field, 0, &lighting).unwrap()
+    frf_testkit::tiny_field().source(&EnvMap::sky())
 }
 
 #[test]

@@ -8,26 +8,15 @@
 
 use frf_core::env::EnvMap;
 use frf_eval::budget::{self, BudgetInputs, Direction, FLOOR, ULR_HULL, ULR_TRUE};
-use frf_reflectance::FieldFile;
-use frf_reflectance::project::FloorModel;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
-use frf_render::resident::{Lighting, PoseSource, ResidentPose};
+use frf_render::resident::ResidentPose;
 
 #[test]
 fn the_budget_scores_every_offset_and_the_solved_morph_sits_near_the_floor() {
     let tiny = frf_testkit::tiny_field();
-    let field = FieldFile::open(&tiny.field).unwrap();
     let env = EnvMap::sky();
-    let source = PoseSource::load(
-        &field,
-        0,
-        &Lighting::Environment {
-            env: env.clone(),
-            floor: FloorModel::Environment,
-        },
-    )
-    .unwrap();
+    let source = tiny.source(&env);
     let renderer = Renderer::new(&source, None).unwrap();
     let resident = ResidentPose::relight_cpu(&source);
     let lights = env.median_cut(64);

@@ -11,26 +11,14 @@ use frf_core::filter::gaussian_blur;
 use frf_eval::metrics::max_row_jump;
 use frf_eval::paths::suite;
 use frf_eval::views::{score, truth_frame};
-use frf_reflectance::FieldFile;
-use frf_reflectance::project::FloorModel;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
-use frf_render::resident::{Lighting, PoseSource};
 
 #[test]
 fn an_orbit_inside_the_cylinder_has_no_seam() {
     let tiny = frf_testkit::tiny_field();
-    let field = FieldFile::open(&tiny.field).unwrap();
     let env = EnvMap::sky();
-    let source = PoseSource::load(
-        &field,
-        0,
-        &Lighting::Environment {
-            env: env.clone(),
-            floor: FloorModel::Environment,
-        },
-    )
-    .unwrap();
+    let source = tiny.source(&env);
     let paths = suite(&source.geometry).unwrap();
     let inside = paths.iter().find(|p| p.name == "inside-low").unwrap();
     // Frames much larger than the 64x90 views: a tear stays a tear while the true

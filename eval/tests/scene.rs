@@ -9,11 +9,9 @@ use frf_core::env::EnvMap;
 use frf_eval::scene::{composite_psnr, shadow_error, true_composite};
 use frf_eval::views::{between_view_cameras, truth_frame};
 use frf_reflectance::FieldFile;
-use frf_reflectance::project::FloorModel;
 use frf_render::composite::{Backdrop, GroundLook};
 use frf_render::morph::Variant;
 use frf_render::renderer::{Renderer, SceneShadow};
-use frf_render::resident::{Lighting, PoseSource};
 use frf_render::shadow::{ShadowMaps, traced_shadow};
 
 #[test]
@@ -25,15 +23,7 @@ fn hull_shadow_and_composite_meet_their_bounds_against_the_truth() {
     let env = EnvMap::sky();
     let lights = env.median_cut(512);
     let maps = ShadowMaps::load(&field, 0).unwrap().unwrap();
-    let source = PoseSource::load(
-        &field,
-        0,
-        &Lighting::Environment {
-            env: env.clone(),
-            floor: FloorModel::Environment,
-        },
-    )
-    .unwrap();
+    let source = tiny.source(&env);
     let relit = maps.relight(source.ground_coefficients.as_ref().unwrap());
     let maps_error = shadow_error(&relit, &tiny.stage, 0, &lights);
     let traced = traced_shadow(&hull, &env.median_cut(256), maps.spec.ground);

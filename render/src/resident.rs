@@ -16,6 +16,7 @@
 
 use std::sync::Arc;
 
+use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
@@ -347,7 +348,71 @@ pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i
     out
 }
 
+/// Views already lit, for [`ResidentPose::from_views`]: per view its camera, its RGBA8
+/// texels (sRGB colour over its scale, linear alpha) and its scale, and per view and
+/// neighbour ([`Neighbour::ALL`] order) its flow codes, all of the full image.
+#[derive(Debug, Clone)]
+pub struct LitViews {
+    /// Columns and rows of the grid (`u`-major views), and whether the columns wrap.
+    pub grid: (usize, usize, bool),
+    /// Image size.
+    pub size: (u32, u32),
+    /// Per view: its camera (subject frame).
+    pub cameras: Vec<Camera>,
+    /// Per view: its texels.
+    pub prelit: Vec<Vec<[u8; 4]>>,
+    /// Per view: its colour scale.
+    pub scales: Vec<f32>,
+    /// Per view and neighbour: flow codes, absent where none is stored.
+    pub codes: Vec<[Option<Vec<[i8; 2]>>; 4]>,
+    /// The flows' quantizer.
+    pub quantizer: LogQuantizer,
+}
+
 impl ResidentPose {
+    /// A pose of views already lit, uncropped (synthetic poses and tests), its flows
+    /// extended beyond the subject as a loaded pose's are.
+    pub fn from_views(views: LitViews) -> Self {
+        let (columns, rows, wraps) = views.grid;
+        let (w, h) = views.size;
+        let crop = Crop {
+            x0: 0,
+            y0: 0,
+            width: w,
+            height: h,
+        };
+        let mut codes = views.codes;
+        for flow in codes.iter_mut().flatten().flatten() {
+            extend_flow(flow, w as usize, h as usize);
+        }
+        let geometry = PoseGeometry::new(
+            0,
+            columns,
+            rows,
+            wraps,
+            (w, h),
+            crop,
+            views.cameras,
+            |i, n| codes[i][n.index()].is_some(),
+        );
+        Self {
+            geometry: Arc::new(geometry),
+            flows: Arc::new(PoseFlows {
+                codes,
+                quantizer: views.quantizer,
+                table: flow_lut(&views.quantizer),
+            }),
+            scales: views.scales,
+            prelit: views.prelit,
+            srgb_table: srgb_lut(),
+            plan: LightingPlan {
+                skipped_conditions: Vec::new(),
+                images_combined: 0,
+                images_total: 0,
+            },
+        }
+    }
+
     /// Relights every view on the CPU and encodes it (the GPU's relighting pass computes
     /// the same).
     pub fn relight_cpu(source: &PoseSource) -> Self {

@@ -7,18 +7,15 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::sync::Arc;
-
 use frf_core::camera::Camera;
 use frf_core::grid::Neighbour;
 use frf_core::io::linear_to_srgb;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_render::cpu::render_pixel;
 use frf_render::cylinder::{Clamp, bilinear_weights, interpolate_camera};
-use frf_render::geometry::{Crop, PoseGeometry};
-use frf_render::morph::solved::{fractions, output, solve};
+use frf_render::morph::solved::{Output, fractions, output, solve};
 use frf_render::morph::{Variant, quad_views};
-use frf_render::resident::{LightingPlan, PoseFlows, ResidentPose, flow_lut, srgb_lut};
+use frf_render::resident::{LitViews, ResidentPose};
 use glam::{Vec2, Vec3};
 
 const W: u32 = 64;
@@ -147,31 +144,15 @@ fn pose(plane: &Plane) -> ResidentPose {
                 .collect()
         })
         .collect();
-    let crop = Crop {
-        x0: 0,
-        y0: 0,
-        width: W,
-        height: H,
-    };
-    let geometry = PoseGeometry::new(0, COLUMNS, ROWS, true, (W, H), crop, cams, |i, n| {
-        codes[i][n.index()].is_some()
-    });
-    ResidentPose {
-        geometry: Arc::new(geometry),
-        flows: Arc::new(PoseFlows {
-            codes,
-            quantizer: q,
-            table: flow_lut(&q),
-        }),
-        scales: vec![1.0; COLUMNS * ROWS],
+    ResidentPose::from_views(LitViews {
+        grid: (COLUMNS, ROWS, true),
+        size: (W, H),
+        cameras: cams,
         prelit,
-        srgb_table: srgb_lut(),
-        plan: LightingPlan {
-            skipped_conditions: vec![],
-            images_combined: 0,
-            images_total: 0,
-        },
-    }
+        scales: vec![1.0; COLUMNS * ROWS],
+        codes,
+        quantizer: q,
+    })
 }
 
 /// The camera at `(β, γ)` of [`QUAD`], centred at the bilinear blend of its centres.
@@ -191,7 +172,7 @@ fn every_view_is_sampled_where_it_shows_the_pixels_point() {
     let plane = Plane::new((probe.centre() - target()).normalize());
     let p = pose(&plane);
     let g = &p.geometry;
-    let (mut worst, mut solved_rays) = (0.0f32, 0);
+    let (mut worst, mut worst_far, mut solved_rays) = (0.0f32, 0.0f32, 0);
     for (beta, gamma) in [(0.5, 0.5), (0.25, 0.02), (0.03, 0.75), (0.7, 0.3)] {
         let cam = camera_at(&p, beta, gamma);
         for px in
@@ -209,27 +190,44 @@ fn every_view_is_sampled_where_it_shows_the_pixels_point() {
             let frame = g.quad_frame(&hit).unwrap();
             let out = output(&p, frame, &hit, cam.centre(), dir, false).unwrap();
             let point = plane.hit(cam.centre(), dir);
+            // The same output started at the point's own depth, as a proxy on the
+            // surface would start it.
+            let at_depth = Output {
+                inverse_depth: 1.0 / (frame.to_plane(point).z - frame.to_plane(hit.point).z),
+                ..out
+            };
             let views = quad_views(g, &hit);
             for k in 0..4 {
                 if bilinear_weights(hit.beta, hit.gamma)[k] == 0.0 {
                     continue;
                 }
-                let (x, step) = solve(&p, frame, &views, k, &out);
                 let want = g.cameras[views[k]].project(point).unwrap();
+                // From the right depth: within the flows' codes' error (~0.03 px here),
+                // settled.
+                let (x, step) = solve(&p, frame, &views, k, &at_depth);
                 worst = worst.max((x - want).length());
-                // The flows' codes are exact to ~0.03 px here; the solve adds little.
                 assert!(
-                    (x - want).length() < 0.1,
-                    "({beta}, {gamma}) {px} view {k}: {x} vs {want}"
+                    (x - want).length() < 0.06 && step < 0.05,
+                    "({beta}, {gamma}) {px} view {k}: {x} vs {want}, step {step}"
                 );
-                // Two steps from the quad's fixation depth (no proxy here) leave the last
-                // step a few hundredths of a pixel: the source keeps its whole weight.
-                assert!(step < 0.2, "not settled: {step}");
+                // From the quad's fixation depth, 0.3 m off the plane, the two steps
+                // still land within 0.2 px (measured: 0.12), the last step under 1 px
+                // (measured: 0.71): the source keeps at least exp(−(1 / 2)²) = 0.78 of
+                // its weight.
+                let (x, step) = solve(&p, frame, &views, k, &out);
+                worst_far = worst_far.max((x - want).length());
+                assert!(
+                    (x - want).length() < 0.2 && step < 1.0,
+                    "({beta}, {gamma}) {px} view {k}, from the fixation: {x} vs {want}, step {step}"
+                );
             }
         }
     }
     assert!(solved_rays >= 50, "{solved_rays} rays inside the grid");
-    eprintln!("largest distance from the true source pixel: {worst:.4} px");
+    eprintln!(
+        "largest distance from the true source pixel: {worst:.4} px from the point's depth, \
+         {worst_far:.4} px from the fixation"
+    );
 }
 
 #[test]

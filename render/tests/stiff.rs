@@ -12,19 +12,16 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use std::sync::Arc;
-
 use frf_core::camera::Camera;
 use frf_core::grid::Neighbour;
 use frf_core::light::direction_from_azimuth_elevation;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_render::cpu::{render_cpu, render_pixel, source_pixel};
 use frf_render::cylinder::{Clamp, Cylinder, CylinderHit, bilinear_weights};
-use frf_render::geometry::{Crop, PoseGeometry};
 use frf_render::morph::e06::morph;
 use frf_render::morph::{Kind, Variant, quad_views};
 use frf_render::path::{CameraPath, Key, Orbit, Trajectory};
-use frf_render::resident::{LightingPlan, PoseFlows, ResidentPose, flow_lut, srgb_lut};
+use frf_render::resident::{LitViews, ResidentPose};
 use frf_render::scene::Scene;
 use glam::{Vec2, Vec3};
 
@@ -152,31 +149,15 @@ fn pose() -> ResidentPose {
             flows.push(f);
         }
     }
-    let crop = Crop {
-        x0: 0,
-        y0: 0,
-        width: W,
-        height: H,
-    };
-    let geometry = PoseGeometry::new(0, columns, rows, true, (W, H), crop, cameras, |i, n| {
-        flows[i][n.index()].is_some()
-    });
-    ResidentPose {
-        geometry: Arc::new(geometry),
-        flows: Arc::new(PoseFlows {
-            codes: flows,
-            quantizer: q,
-            table: flow_lut(&q),
-        }),
-        scales: (0..columns * rows).map(|i| 1.0 + i as f32 * 0.1).collect(),
+    ResidentPose::from_views(LitViews {
+        grid: (columns, rows, true),
+        size: (W, H),
+        cameras,
         prelit,
-        srgb_table: srgb_lut(),
-        plan: LightingPlan {
-            skipped_conditions: vec![],
-            images_combined: 0,
-            images_total: 0,
-        },
-    }
+        scales: (0..columns * rows).map(|i| 1.0 + i as f32 * 0.1).collect(),
+        codes: flows,
+        quantizer: q,
+    })
 }
 
 fn quad_hit(u: usize, v: usize, beta: f32, gamma: f32, point: Vec3) -> CylinderHit {

@@ -13,8 +13,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use frf_core::env::EnvMap;
 use frf_eval::oracle::{OracleOptions, write_oracle_field};
 use frf_ingest::shadows::ShadowOptions;
+use frf_reflectance::FieldFile;
+use frf_reflectance::project::FloorModel;
+use frf_render::resident::{Lighting, PoseSource};
 use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig};
 
 /// `Some("--cpu")` when command-line tests must render with the CPU reference: only when
@@ -51,6 +55,20 @@ impl TinyField {
     /// The directory holding the stage's configuration (a capture for `frf eval`).
     pub fn capture(&self) -> &Path {
         self.dir.path()
+    }
+
+    /// Pose 0 of the field loaded under `env` (the floor conditions lit by the
+    /// environment's lower hemisphere), ready to make resident.
+    ///
+    /// # Panics
+    /// If the field cannot be read: a test that needs it fails.
+    pub fn source(&self, env: &EnvMap) -> PoseSource {
+        let field = FieldFile::open(&self.field).expect("the tiny field opens");
+        let lighting = Lighting::Environment {
+            env: env.clone(),
+            floor: FloorModel::Environment,
+        };
+        PoseSource::load(&field, 0, &lighting).expect("pose 0 of the tiny field loads")
     }
 
     /// A scratch directory inside the fixture's, created empty, for one test's outputs.

@@ -1,13 +1,13 @@
 //! The budget's plot: subject PSNR against the fraction of the way to the next view, one
 //! panel per direction (along a row, along a column, toward the quad's centre), one line
 //! per method, every line starting from the captured views at 0. SVG always; PNG where a
-//! system font exists for its text ([`crate::report::plot::fonts_available`]).
+//! system font exists for its text (as the report's plots, [`crate::report::plot`]).
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::{BudgetRow, Direction};
-use crate::report::plot::{fonts_available, plot_error};
+use crate::report::plot::{plot_error, png_of, svg_of};
 use crate::{EvalError, Result};
 
 /// Pixels per panel.
@@ -21,37 +21,12 @@ fn size() -> (u32, u32) {
 
 /// The plot as SVG text.
 pub fn svg(rows: &[BudgetRow]) -> Result<String> {
-    fonts_available();
-    let mut out = String::new();
-    {
-        let root = SVGBackend::with_string(&mut out, size()).into_drawing_area();
-        draw(&root, rows)?;
-        root.present().map_err(plot_error)?;
-    }
-    Ok(out)
+    svg_of(size(), |root| draw(root, rows))
 }
 
 /// The plot as PNG bytes, or `None` without a font for its text.
 pub fn png(rows: &[BudgetRow]) -> Result<Option<Vec<u8>>> {
-    if !fonts_available() {
-        return Ok(None);
-    }
-    let (w, h) = size();
-    let mut rgb = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        draw(&root, rows)?;
-        root.present().map_err(plot_error)?;
-    }
-    let img = image::RgbImage::from_raw(w, h, rgb)
-        .ok_or_else(|| plot_error("the bitmap has the wrong size"))?;
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(plot_error)?;
-    Ok(Some(bytes))
+    png_of(size(), |root| draw(root, rows))
 }
 
 /// Per method, its points `(fraction, PSNR)` along `direction`, the captured views first.

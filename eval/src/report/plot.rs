@@ -55,26 +55,42 @@ pub fn size(report: &Report, stage: &str) -> (u32, u32) {
 
 /// A stage's plot as SVG text.
 pub fn svg(report: &Report, stage: &str) -> Result<String> {
+    svg_of(size(report, stage), |root| draw(root, report, stage))
+}
+
+/// A stage's plot as PNG bytes, or `None` without a font for its text.
+pub fn png(report: &Report, stage: &str) -> Result<Option<Vec<u8>>> {
+    png_of(size(report, stage), |root| draw(root, report, stage))
+}
+
+/// What `draw` draws on a `size` canvas, as SVG text (fonts left to the viewer).
+pub(crate) fn svg_of(
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<String> {
     fonts_available();
     let mut out = String::new();
     {
-        let root = SVGBackend::with_string(&mut out, size(report, stage)).into_drawing_area();
-        draw(&root, report, stage)?;
+        let root = SVGBackend::with_string(&mut out, size).into_drawing_area();
+        draw(&root)?;
         root.present().map_err(plot_error)?;
     }
     Ok(out)
 }
 
-/// A stage's plot as PNG bytes, or `None` without a font for its text.
-pub fn png(report: &Report, stage: &str) -> Result<Option<Vec<u8>>> {
+/// What `draw` draws on a `size` canvas, as PNG bytes; `None` without a system font
+/// for its text.
+pub(crate) fn png_of(
+    (w, h): (u32, u32),
+    draw: impl FnOnce(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+) -> Result<Option<Vec<u8>>> {
     if !fonts_available() {
         return Ok(None);
     }
-    let (w, h) = size(report, stage);
     let mut rgb = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-        draw(&root, report, stage)?;
+        draw(&root)?;
         root.present().map_err(plot_error)?;
     }
     let img = image::RgbImage::from_raw(w, h, rgb)
