@@ -1,17 +1,15 @@
 //! The CPU reference renderer (rayon): for every pixel of the virtual camera, the ray
-//! through it is re-binned through the cylinder of camera centres ([`crate::cylinder`]),
-//! the camera interpolated at the hit, the pixel `s` of that camera through which the ray
-//! passes found, and the quad's images morphed there ([`crate::morph`]). The GPU renderer
+//! through it is re-binned through the cylinder of camera centres ([`crate::cylinder`])
+//! and the quad's images morphed where they show what the ray sees ([`crate::morph`]). The GPU renderer
 //! computes the same in `shaders/rebin.wgsl` and is tested against this one.
 
 use frf_core::camera::Camera;
 use frf_core::image::{Image, Rgba};
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use rayon::prelude::*;
 
-use crate::cylinder::{Clamp, Cylinder, CylinderHit, bilinear_weights, interpolate_camera};
-use crate::geometry::PoseGeometry;
-use crate::morph::{Variant, quad_views, shade};
+use crate::cylinder::{Clamp, Cylinder, CylinderHit};
+use crate::morph::{Variant, shade};
 use crate::resident::ResidentPose;
 
 /// What happened to the pixels of a frame.
@@ -45,44 +43,6 @@ impl FrameStats {
         self.missed += o.missed;
         self
     }
-}
-
-/// The pixel of the interpolated camera of `hit` through which the ray `origin + t dir`
-/// passes, or `None` if it points behind that camera.
-///
-/// Inside the grid the camera sits at the hit, on the ray, and the ray's direction says
-/// where it crosses its image. A ray clamped to a row is, with `proxy`, looked up where
-/// its point on the subject ([`crate::proxy::Proxy::point`]) projects into the camera
-/// interpolated on the row itself (docs/design.md section 4.3); without it (or without a
-/// point), along its direction from the hit on the wall.
-pub fn source_pixel(
-    geometry: &PoseGeometry,
-    hit: &CylinderHit,
-    origin: Vec3,
-    dir: Vec3,
-    proxy: bool,
-) -> Option<Vec2> {
-    let views = quad_views(geometry, hit);
-    let cams = views.map(|i| &geometry.cameras[i]);
-    let on_row = (proxy && hit.clamped != Clamp::None)
-        .then(|| geometry.proxy.point(origin, dir))
-        .flatten()
-        .map(|p| {
-            let w = bilinear_weights(hit.beta, hit.gamma);
-            let centre: Vec3 = (0..4).map(|k| cams[k].centre() * w[k]).sum();
-            (p - centre, centre)
-        });
-    let (ray, centre) = on_row.unwrap_or((dir, hit.point));
-    let cam = interpolate_camera(cams, hit.beta, hit.gamma, centre);
-    let dc = cam.world_from_camera.rotation.transpose() * ray;
-    if dc.z <= 1e-6 * ray.length() {
-        return None;
-    }
-    let k = &cam.intrinsics;
-    Some(Vec2::new(
-        k.fx * dc.x / dc.z + k.cx,
-        k.fy * dc.y / dc.z + k.cy,
-    ))
 }
 
 /// One pixel: premultiplied RGBA and how its ray was re-binned.

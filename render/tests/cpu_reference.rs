@@ -8,9 +8,9 @@
 use frf_core::camera::Camera;
 use frf_core::grid::Neighbour;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
-use frf_render::cpu::{render_cpu, render_pixel, source_pixel};
+use frf_render::cpu::{render_cpu, render_pixel};
 use frf_render::cylinder::{Clamp, CylinderHit};
-use frf_render::morph::e06::morph;
+use frf_render::morph::e06::{morph, source_pixel};
 use frf_render::morph::{Variant, quad_views};
 use frf_render::resident::{LitViews, ResidentPose, decode_flow};
 

@@ -27,10 +27,11 @@
 //! σ²)` ([`OCCLUSION_SIGMA_PX`]), and the weights are renormalized.
 
 use frf_core::grid::Neighbour;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use super::{Kind, Variant, add, quad_views};
-use crate::cylinder::{CylinderHit, bilinear_weights};
+use crate::cylinder::{Clamp, CylinderHit, bilinear_weights, interpolate_camera};
+use crate::geometry::PoseGeometry;
 use crate::resident::ResidentPose;
 
 /// Flow inconsistency, pixels, at which the occlusion cue weighs a source at `1/e` of
@@ -82,6 +83,44 @@ pub fn confidence(err2: f32) -> f32 {
     (-err2 / (OCCLUSION_SIGMA_PX * OCCLUSION_SIGMA_PX))
         .exp()
         .max(OCCLUSION_FLOOR)
+}
+
+/// The pixel of the interpolated camera of `hit` through which the ray `origin + t dir`
+/// passes, or `None` if it points behind that camera.
+///
+/// Inside the grid the camera sits at the hit, on the ray, and the ray's direction says
+/// where it crosses its image. A ray clamped to a row is, with `proxy`, looked up where
+/// its point on the subject ([`crate::proxy::Proxy::point`]) projects into the camera
+/// interpolated on the row itself (docs/design.md section 4.3); without it (or without a
+/// point), along its direction from the hit on the wall.
+pub fn source_pixel(
+    geometry: &PoseGeometry,
+    hit: &CylinderHit,
+    origin: Vec3,
+    dir: Vec3,
+    proxy: bool,
+) -> Option<Vec2> {
+    let views = quad_views(geometry, hit);
+    let cams = views.map(|i| &geometry.cameras[i]);
+    let on_row = (proxy && hit.clamped != Clamp::None)
+        .then(|| geometry.proxy.point(origin, dir))
+        .flatten()
+        .map(|p| {
+            let w = bilinear_weights(hit.beta, hit.gamma);
+            let centre: Vec3 = (0..4).map(|k| cams[k].centre() * w[k]).sum();
+            (p - centre, centre)
+        });
+    let (ray, centre) = on_row.unwrap_or((dir, hit.point));
+    let cam = interpolate_camera(cams, hit.beta, hit.gamma, centre);
+    let dc = cam.world_from_camera.rotation.transpose() * ray;
+    if dc.z <= 1e-6 * ray.length() {
+        return None;
+    }
+    let k = &cam.intrinsics;
+    Some(Vec2::new(
+        k.fx * dc.x / dc.z + k.cx,
+        k.fy * dc.y / dc.z + k.cy,
+    ))
 }
 
 /// The interpolated premultiplied RGBA at pixel `s` of the camera interpolated at the

@@ -131,7 +131,7 @@ pub fn shade(
     if variant.kind() == Kind::FourWay {
         return solved::shade(pose, hit, origin, dir, variant.uses_proxy());
     }
-    let s: Vec2 = crate::cpu::source_pixel(&pose.geometry, hit, origin, dir, variant.uses_proxy())?;
+    let s: Vec2 = e06::source_pixel(&pose.geometry, hit, origin, dir, variant.uses_proxy())?;
     Some(e06::morph(pose, hit, s, variant))
 }
 
