@@ -36,14 +36,20 @@
 //! of the ray, unwarped: the source image. On an edge of the quad (`γ = 0`, say) only
 //! `A` and `B` weigh, each moved along its own row flow by the fraction of the edge
 //! travelled (`a = β` for `A`): a two-way morph, solved.
+//!
+//! **A grid of one row** (a ring of photographs): the camera stays on the ray anywhere
+//! on the row's wall, which is its frame's plane; its offset across the row `o⊥` moves
+//! the point by the inverse depth the row flow measures, `f o⊥ (d₁ · f b₁) / |f b₁|²`
+//! (`b₁` the baseline): a held-out photograph a few millimetres off the ring is ten pixels
+//! of parallax at dinoRing's focal length.
 
+use frf_core::grid::Neighbour;
 use glam::{Vec2, Vec3};
 
 use super::{add, quad_views};
 use crate::cylinder::{Clamp, CylinderHit, bilinear_weights};
 use crate::rectified::{QuadFrame, apply};
 use crate::resident::ResidentPose;
-use frf_core::grid::Neighbour;
 
 /// Fixed-point steps per source at most. From the proxy's depth the first step lands
 /// within a few tenths of a pixel and each step shrinks the error by the flow's gradient
