@@ -18,6 +18,11 @@ pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error + Send + Sync>>
     about = "Flowed reflectance fields: capture, store, relight and render walking people"
 )]
 struct Cli {
+    /// The GPU adapter to render with: the one whose name or backend contains NAME (also
+    /// `FRF_ADAPTER`); by default the best one that can run every pass (`frf info --gpu`
+    /// lists them).
+    #[arg(long, global = true, value_name = "NAME")]
+    adapter: Option<String>,
     #[command(subcommand)]
     command: Command,
 }
@@ -26,7 +31,8 @@ struct Cli {
 enum Command {
     /// Render a synthetic capture with the virtual light stage, or its ground truth.
     Stage(Box<cmd::stage::StageArgs>),
-    /// Show what a field file holds and how well it is compressed.
+    /// Show what a field file holds and how well it is compressed, or (`--gpu`) the GPU
+    /// adapters and which one renders.
     Info(cmd::info::InfoArgs),
     /// Write a pose's visual hull as a mesh (PLY).
     Hull(cmd::hull::HullArgs),
@@ -68,6 +74,9 @@ fn die_quietly_on_a_closed_pipe() {
 fn main() -> ExitCode {
     die_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
+    if let Some(name) = &cli.adapter {
+        frf_render::gpu::adapter::prefer(name);
+    }
     let result = match cli.command {
         Command::Stage(args) => cmd::stage::run(*args),
         Command::Info(args) => cmd::info::run(args),

@@ -109,6 +109,14 @@ impl Device {
         })
     }
 
+    /// The GPU adapter, why it was taken and what else was found; `None` on the CPU.
+    pub fn adapter_report(&self) -> Option<&crate::gpu::adapter::AdapterReport> {
+        match self {
+            Device::Gpu(gpu) => Some(gpu.adapter_report()),
+            Device::Cpu => None,
+        }
+    }
+
     /// What renders, in words.
     pub fn name(&self) -> String {
         match self {

@@ -1,10 +1,12 @@
 //! `frf info FIELD [--json]`: what a field file holds, bytes by kind, and its
-//! compression ratios.
+//! compression ratios; `frf info --gpu [--json]`: the GPU adapters, what each lacks to run
+//! the renderer's passes, and which one renders and why.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use frf_reflectance::FieldFile;
+use frf_render::gpu::adapter;
 
 use crate::CliResult;
 
@@ -12,7 +14,12 @@ use crate::CliResult;
 #[derive(Args)]
 pub struct InfoArgs {
     /// A field file.
-    field: PathBuf,
+    #[arg(required_unless_present = "gpu")]
+    field: Option<PathBuf>,
+    /// List the GPU adapters, what each lacks to run the renderer's passes, and which one
+    /// renders and why.
+    #[arg(long, conflicts_with = "field")]
+    gpu: bool,
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
@@ -20,7 +27,10 @@ pub struct InfoArgs {
 
 /// Runs `frf info`.
 pub fn run(args: InfoArgs) -> CliResult {
-    let field = FieldFile::open(&args.field)?;
+    let Some(path) = &args.field else {
+        return gpu(args.json);
+    };
+    let field = FieldFile::open(path)?;
     let s = field.stats();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&s)?);
@@ -28,7 +38,7 @@ pub fn run(args: InfoArgs) -> CliResult {
     }
     let h = field.header();
     let mb = |b: u64| b as f64 / 1e6;
-    println!("{}", args.field.display());
+    println!("{}", path.display());
     println!("  source: {}", h.description);
     println!(
         "  grid: {} x {} views ({}), {}x{} pixels, {} basis conditions ({} floor)",
@@ -95,6 +105,32 @@ pub fn run(args: InfoArgs) -> CliResult {
             s.hulls, spec.voxel_m, spec.misses
         ),
         None => println!("  visual hulls: none"),
+    }
+    Ok(())
+}
+
+/// `frf info --gpu`: the adapters and the choice (or why none can render, with a failing
+/// status).
+fn gpu(json: bool) -> CliResult {
+    let (found, choice) = adapter::survey();
+    if !json {
+        println!("GPU adapters, preferred first:");
+        for c in &found {
+            if c.lacks.is_empty() {
+                println!("  {}: can run every pass", c.adapter);
+            } else {
+                println!("  {}: lacks {}", c.adapter, c.lacks.join(", "));
+            }
+        }
+    }
+    let report = choice?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "renders on: {} ({}, {}), driver {}; {}",
+            report.name, report.backend, report.device_type, report.driver, report.why
+        );
     }
     Ok(())
 }

@@ -297,6 +297,9 @@ impl Output {
         #[derive(Serialize)]
         struct Report<'a> {
             device: String,
+            /// The GPU adapter, why it was taken, and every one considered.
+            #[serde(skip_serializing_if = "Option::is_none")]
+            adapter: Option<&'a frf_render::gpu::adapter::AdapterReport>,
             frames_total: usize,
             frames_rendered: usize,
             frames_resumed: usize,
@@ -318,6 +321,7 @@ impl Output {
         let t = self.totals;
         let report = Report {
             device: shot.device(),
+            adapter: shot.adapter(),
             frames_total: self.total,
             frames_rendered: rendered.len(),
             frames_resumed: self.records.len() - rendered.len(),

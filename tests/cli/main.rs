@@ -4,6 +4,7 @@
 
 mod common;
 
+mod adapter;
 mod bad_input;
 mod bench;
 mod interrupt;

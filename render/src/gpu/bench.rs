@@ -201,7 +201,7 @@ pub fn run(
     options: &BenchOptions,
     progress: &mut dyn FnMut(&str),
 ) -> Result<BenchReport> {
-    let info = &gpu.info;
+    let info = gpu.adapter_report();
     let mut rows = Vec::new();
     let mut floor_bandwidth = Vec::new();
     let first_size = options.sizes.first().copied();
@@ -368,10 +368,8 @@ pub fn run(
     }
     Ok(BenchReport {
         adapter: info.name.clone(),
-        backend: format!("{:?}", info.backend),
-        driver: format!("{} {}", info.driver, info.driver_info)
-            .trim()
-            .to_string(),
+        backend: info.backend.clone(),
+        driver: info.driver.clone().trim().to_string(),
         clock: gpu.clock().name().to_string(),
         rows,
         cpu_rows,

@@ -15,6 +15,7 @@
 //! request runs inside error scopes ([`scope`]). Readback pads rows to
 //! `COPY_BYTES_PER_ROW_ALIGNMENT` ([`bind`]).
 
+pub mod adapter;
 pub mod bench;
 pub mod bind;
 pub mod composite;
@@ -94,7 +95,7 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     adapter: String,
-    info: wgpu::AdapterInfo,
+    report: adapter::AdapterReport,
     uncaptured: scope::Uncaptured,
     relight: pose::RelightPass,
     rebin: rebin::RebinPass,
@@ -111,17 +112,11 @@ pub struct Gpu {
 }
 
 impl Gpu {
-    /// Opens the default adapter and builds the pipelines.
+    /// Opens the adapter [`adapter::choose`] takes and builds the pipelines.
     pub fn new() -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
-            .map_err(|e| {
-                RenderError::Gpu(format!(
-                    "no GPU adapter ({e}); on Debian `apt-get install mesa-vulkan-drivers libvulkan1` provides a software one (lavapipe), or render with --cpu"
-                ))
-            })?;
-        let info = adapter.get_info();
+        let (adapter, report) = adapter::choose(&instance)?;
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("frf"),
@@ -133,7 +128,12 @@ impl Gpu {
         let uncaptured = scope::Uncaptured::default();
         uncaptured.install(&device);
         scope::scoped(&device, &uncaptured, "building the pipelines", || {
-            Ok(Self::build(device.clone(), queue, info, uncaptured.clone()))
+            Ok(Self::build(
+                device.clone(),
+                queue,
+                report,
+                uncaptured.clone(),
+            ))
         })
     }
 
@@ -141,10 +141,13 @@ impl Gpu {
     fn build(
         device: wgpu::Device,
         queue: wgpu::Queue,
-        info: wgpu::AdapterInfo,
+        report: adapter::AdapterReport,
         uncaptured: scope::Uncaptured,
     ) -> Self {
-        let adapter = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        let adapter = format!(
+            "{} ({}, {})",
+            report.name, report.backend, report.device_type
+        );
         Self {
             relight: pose::RelightPass::new(&device),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
@@ -157,7 +160,7 @@ impl Gpu {
             device,
             queue,
             adapter,
-            info,
+            report,
             uncaptured,
         }
     }
@@ -179,6 +182,11 @@ impl Gpu {
     /// The adapter, in words.
     pub fn adapter(&self) -> &str {
         &self.adapter
+    }
+
+    /// The adapter, why it was taken, and every one considered.
+    pub fn adapter_report(&self) -> &adapter::AdapterReport {
+        &self.report
     }
 
     pub(crate) fn wait(&self) -> Result<()> {

@@ -158,6 +158,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         self.device.name()
     }
 
+    /// The GPU adapter and why it was taken; `None` on the CPU.
+    pub fn adapter(&self) -> Option<&crate::gpu::adapter::AdapterReport> {
+        self.device.adapter_report()
+    }
+
     /// The environment of `source`, loaded once.
     fn env(&mut self, source: &EnvSource) -> Result<Option<EnvMap>> {
         let key = source.to_string();

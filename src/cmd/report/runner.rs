@@ -46,7 +46,13 @@ impl Runner {
             });
         }
         let start = Instant::now();
-        let out = Command::new(&self.exe).args(args).output()?;
+        let mut child = Command::new(&self.exe);
+        child.args(args);
+        // The adapter named on this command line renders the runs too.
+        if let Some(name) = frf_render::gpu::adapter::preferred() {
+            child.env(frf_render::gpu::adapter::ADAPTER_ENV, name);
+        }
+        let out = child.output()?;
         let seconds = start.elapsed().as_secs_f64();
         if !out.status.success() {
             return Err(format!(

@@ -1,0 +1,258 @@
+//! Which adapter renders, chosen deliberately: every adapter of the backends wgpu was
+//! asked for (`WGPU_BACKEND`, else all) is checked against what the renderer's passes
+//! need, and the best one that has all of it is taken: a native backend (Vulkan, Metal,
+//! DX12) before GL, a discrete GPU before an integrated one, a virtual one, a CPU
+//! (lavapipe) and anything else. A name (`frf --adapter NAME`, or `FRF_ADAPTER`) picks
+//! the adapter whose name or backend contains it.
+//!
+//! What the passes need: `rgba32float` targets drawn into (the composite and the bench's
+//! fragment passes) and written as storage (the frame, relighting and shadow passes), the
+//! pose's integer textures (`rgba8uint`, `rg8sint`) read with `textureLoad`, and eight
+//! storage buffers in one compute stage (the frame pass's counters and seven of the
+//! pose's tables). The GL backend of Mesa, for one, cannot draw into `rgba32float`:
+//! on a machine that has both, the default adapter used to be GL and every render failed
+//! ("Format Rgba32Float is not renderable"); a machine with GL alone is told so, and to
+//! render with `--cpu`.
+
+use std::sync::OnceLock;
+
+use serde::Serialize;
+
+use crate::error::{RenderError, Result};
+
+/// The environment variable that names the adapter to take.
+pub const ADAPTER_ENV: &str = "FRF_ADAPTER";
+
+/// Storage buffers the frame pass binds in its compute stage.
+const STORAGE_BUFFERS: u32 = 8;
+
+/// The adapter named on the command line, which wins over [`ADAPTER_ENV`].
+static PREFERRED: OnceLock<String> = OnceLock::new();
+
+/// Names the adapter every GPU of this process opens ([`choose`]); the first call wins.
+pub fn prefer(name: &str) {
+    let _ = PREFERRED.set(name.to_string());
+}
+
+/// The adapter named on the command line, if one was ([`prefer`]): for the processes
+/// this one starts.
+pub fn preferred() -> Option<&'static str> {
+    PREFERRED.get().map(String::as_str)
+}
+
+/// One adapter found, and what the renderer's passes need that it lacks.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Candidate {
+    /// `name (backend, device type)`.
+    pub adapter: String,
+    /// What it lacks; empty when it can run every pass.
+    pub lacks: Vec<String>,
+}
+
+/// The adapter taken, why, and every one that was considered.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct AdapterReport {
+    /// The adapter's name.
+    pub name: String,
+    /// Its backend (`Vulkan`, `Gl`, ...).
+    pub backend: String,
+    /// Its kind (`DiscreteGpu`, `Cpu`, ...).
+    pub device_type: String,
+    /// Its driver and version, as it reports them.
+    pub driver: String,
+    /// Why it was taken.
+    pub why: String,
+    /// Every adapter found, in the order of preference.
+    pub candidates: Vec<Candidate>,
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> String {
+    format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+}
+
+/// What the renderer's passes need that `adapter` lacks.
+pub fn lacks(adapter: &wgpu::Adapter) -> Vec<String> {
+    use wgpu::TextureUsages as U;
+    let mut out = Vec::new();
+    let needs = [
+        (
+            wgpu::TextureFormat::Rgba32Float,
+            U::RENDER_ATTACHMENT,
+            "rgba32float render targets",
+        ),
+        (
+            wgpu::TextureFormat::Rgba32Float,
+            U::STORAGE_BINDING,
+            "rgba32float storage textures",
+        ),
+        (
+            wgpu::TextureFormat::Rgba8Uint,
+            U::TEXTURE_BINDING,
+            "rgba8uint textures",
+        ),
+        (
+            wgpu::TextureFormat::Rg8Sint,
+            U::TEXTURE_BINDING,
+            "rg8sint textures",
+        ),
+    ];
+    for (format, usage, what) in needs {
+        if !adapter
+            .get_texture_format_features(format)
+            .allowed_usages
+            .contains(usage)
+        {
+            out.push(what.to_string());
+        }
+    }
+    let limits = adapter.limits();
+    if limits.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
+        out.push(format!(
+            "{STORAGE_BUFFERS} storage buffers per shader stage (it has {})",
+            limits.max_storage_buffers_per_shader_stage
+        ));
+    }
+    if limits.max_storage_textures_per_shader_stage < 1 {
+        out.push("a storage texture per shader stage".into());
+    }
+    out
+}
+
+/// Rank of an adapter's backend and kind: lower is preferred.
+fn rank(info: &wgpu::AdapterInfo) -> (u8, u8) {
+    let backend = match info.backend {
+        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
+        wgpu::Backend::Gl => 1,
+        _ => 2,
+    };
+    let kind = match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Cpu => 3,
+        wgpu::DeviceType::Other => 4,
+    };
+    (backend, kind)
+}
+
+/// The name asked for: [`prefer`]'s, else [`ADAPTER_ENV`]'s (empty is none).
+fn wanted() -> Option<String> {
+    PREFERRED
+        .get()
+        .cloned()
+        .or_else(|| std::env::var(ADAPTER_ENV).ok())
+        .filter(|s| !s.trim().is_empty())
+}
+
+/// Every adapter of `instance` with what it lacks, preferred first.
+pub fn candidates(instance: &wgpu::Instance) -> Vec<(wgpu::Adapter, Candidate)> {
+    let mut all: Vec<(wgpu::Adapter, Candidate)> =
+        pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
+            .into_iter()
+            .map(|a| {
+                let c = Candidate {
+                    adapter: describe(&a.get_info()),
+                    lacks: lacks(&a),
+                };
+                (a, c)
+            })
+            .collect();
+    all.sort_by_key(|(a, c)| (!c.lacks.is_empty(), rank(&a.get_info())));
+    all
+}
+
+/// The adapter to render with (see the module docs), and the report of the choice.
+pub fn choose(instance: &wgpu::Instance) -> Result<(wgpu::Adapter, AdapterReport)> {
+    let all = candidates(instance);
+    let listed: Vec<Candidate> = all.iter().map(|(_, c)| c.clone()).collect();
+    let summary = || {
+        listed
+            .iter()
+            .map(|c| {
+                if c.lacks.is_empty() {
+                    c.adapter.clone()
+                } else {
+                    format!("{} lacks {}", c.adapter, c.lacks.join(", "))
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+    };
+    if all.is_empty() {
+        return Err(RenderError::Gpu(
+            "no GPU adapter; on Debian `apt-get install mesa-vulkan-drivers libvulkan1` provides \
+             a software one (lavapipe), or render with --cpu"
+                .into(),
+        ));
+    }
+    let name = wanted();
+    let (adapter, why) = match &name {
+        Some(n) => {
+            let needle = n.to_lowercase();
+            let Some((adapter, c)) = all.into_iter().find(|(a, _)| {
+                let info = a.get_info();
+                info.name.to_lowercase().contains(&needle)
+                    || format!("{:?}", info.backend)
+                        .to_lowercase()
+                        .contains(&needle)
+            }) else {
+                return Err(RenderError::BadParameter(format!(
+                    "no GPU adapter matches `{n}` (--adapter or {ADAPTER_ENV}); found: {}",
+                    summary()
+                )));
+            };
+            if !c.lacks.is_empty() {
+                return Err(RenderError::Gpu(format!(
+                    "the adapter `{n}` asked for, {}, cannot run the renderer's passes: it lacks \
+                     {}; pick another (found: {}) or render with --cpu",
+                    c.adapter,
+                    c.lacks.join(", "),
+                    summary()
+                )));
+            }
+            (adapter, format!("named `{n}`"))
+        }
+        None => {
+            let Some((adapter, _)) = all.into_iter().find(|(_, c)| c.lacks.is_empty()) else {
+                return Err(RenderError::Gpu(format!(
+                    "no GPU adapter can run the renderer's passes ({}); render with --cpu, or \
+                     install Mesa's Vulkan driver (`apt-get install mesa-vulkan-drivers \
+                     libvulkan1`)",
+                    summary()
+                )));
+            };
+            let able = listed.iter().filter(|c| c.lacks.is_empty()).count();
+            let why = if listed.len() == 1 {
+                "the only adapter; it can run every pass".to_string()
+            } else {
+                format!(
+                    "{able} of {} adapters can run every pass; preferred: native backends \
+                     before GL, then discrete, integrated, virtual, CPU",
+                    listed.len()
+                )
+            };
+            (adapter, why)
+        }
+    };
+    let info = adapter.get_info();
+    let report = AdapterReport {
+        name: info.name.clone(),
+        backend: format!("{:?}", info.backend),
+        device_type: format!("{:?}", info.device_type),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_string(),
+        why,
+        candidates: listed,
+    };
+    Ok((adapter, report))
+}
+
+/// Every adapter found (preferred first, with what it lacks) and the choice
+/// [`choose`] makes among them, for a report (`frf info --gpu`).
+pub fn survey() -> (Vec<Candidate>, Result<AdapterReport>) {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let found = candidates(&instance).into_iter().map(|(_, c)| c).collect();
+    (found, choose(&instance).map(|(_, report)| report))
+}

@@ -1,0 +1,96 @@
+//! Which GPU adapter renders, through the binary: `frf info --gpu` lists the adapters and
+//! the choice; on the GL backend (`WGPU_BACKEND=gl`; CI installs Mesa's GL driver for it)
+//! a render either runs or is refused naming what GL lacks and suggesting `--cpu`, and
+//! leaves no frame behind; an adapter named that does not exist is refused naming it.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use crate::common::{frf, frf_command, stderr};
+
+#[test]
+fn info_gpu_names_the_adapter_that_renders_and_why() {
+    let o = frf(&["info", "--gpu", "--json"]);
+    if !o.status.success() {
+        // No adapter at all (FRF_SKIP_GPU machines): said clearly, not a panic.
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains("--cpu"), "{}", stderr(&o));
+        return;
+    }
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(!report["name"].as_str().unwrap().is_empty());
+    assert!(report["why"].as_str().unwrap().contains("pass"), "{report}");
+    let candidates = report["candidates"].as_array().unwrap();
+    // The one taken can run every pass, and it is listed first among those that can.
+    let first_able = candidates
+        .iter()
+        .find(|c| c["lacks"].as_array().unwrap().is_empty())
+        .unwrap();
+    assert!(
+        first_able["adapter"]
+            .as_str()
+            .unwrap()
+            .starts_with(report["name"].as_str().unwrap()),
+        "{report}"
+    );
+
+    let o = frf(&["--adapter", "no-such-adapter", "info", "--gpu"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no-such-adapter"), "{}", stderr(&o));
+}
+
+#[test]
+fn on_the_gl_backend_a_render_runs_or_is_refused_suggesting_the_cpu() {
+    let field = &frf_testkit::tiny_field().field;
+    let gl = |args: &[&str]| {
+        frf_command(args)
+            .env("WGPU_BACKEND", "gl")
+            .output()
+            .unwrap()
+    };
+    let info = gl(&["info", "--gpu"]);
+    let said = String::from_utf8_lossy(&info.stdout).into_owned();
+    eprintln!("info --gpu on GL: {said}{}", stderr(&info));
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("frames");
+    let render = gl(&[
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--orbit",
+        "3.0,1.2",
+        "--frames",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    if info.status.success() {
+        // A GL adapter that can run every pass renders like any other.
+        assert!(said.contains("(Gl"), "{said}");
+        assert!(render.status.success(), "{}", stderr(&render));
+        assert!(dir.join("frame_0000.png").exists());
+    } else {
+        // GL lacks what the passes need (or there is no GL driver): refused, naming the
+        // problem and the way out, with a failing status that is not a panic's.
+        for o in [&info, &render] {
+            assert_eq!(o.status.code(), Some(1), "{}", stderr(o));
+            assert!(stderr(o).contains("--cpu"), "{}", stderr(o));
+        }
+        assert!(!dir.join("frame_0000.png").exists());
+        // The CPU reference renders where the GPU cannot.
+        let cpu = gl(&[
+            "render",
+            field.to_str().unwrap(),
+            "--env",
+            "sky",
+            "--orbit",
+            "3.0,1.2",
+            "--frames",
+            "1",
+            "--cpu",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(cpu.status.success(), "{}", stderr(&cpu));
+    }
+}
