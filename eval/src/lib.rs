@@ -9,6 +9,7 @@
 //!   [`frf_ingest::pipeline::ingest`]);
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
+//!   [`quads`]: `frf eval` at quad centres, with the scene's scores;
 //! - [`budget`]: the error budget of view interpolation: every variant at offsets along
 //!   rows, columns and toward quad centres, beside the captured views, the floor of any
 //!   flow-based morph and geometry baselines (unstructured lumigraph rendering);
@@ -19,7 +20,8 @@
 //! - [`report`]: error against run time of every stage's settings: rows, Pareto fronts,
 //!   plots and the page that shows them;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
-//!   neighbours, against the photographs.
+//!   neighbours, against the photographs;
+//! - [`progress`]: how long evaluations report how far they are.
 //!
 //! Conventions: [`frf_core::conventions`].
 
@@ -29,6 +31,8 @@ pub mod ingest;
 pub mod metrics;
 pub mod oracle;
 pub mod paths;
+pub mod progress;
+pub mod quads;
 pub mod report;
 pub mod ring;
 pub mod scene;

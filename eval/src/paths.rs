@@ -19,11 +19,22 @@
 //! For the stage's rig (4.5 m, rows at 0°, 17° and 34° about a target 0.9 m up) the first
 //! is the orbit of radius 3 m at 1.2 m on which the seam at the neck was seen.
 
+use std::path::{Path, PathBuf};
+
+use frf_core::io::write_png8_srgba;
+use frf_core::light::DirLight;
 use frf_render::geometry::PoseGeometry;
+use frf_render::morph::Variant;
 use frf_render::path::{Orbit, Trajectory};
+use frf_render::renderer::Renderer;
+use frf_stage::Stage;
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
+use crate::metrics::max_row_jump;
+use crate::progress::Progress;
+use crate::views::{EvalCamera, VariantScore, evaluate, truth_frames};
 
 /// A named trajectory of the suite.
 #[derive(Debug, Clone)]
@@ -112,6 +123,159 @@ pub fn suite(geometry: &PoseGeometry) -> Result<Vec<NamedPath>> {
             trajectory: orbit(r, y0 - 0.6),
         },
     ])
+}
+
+/// One path scored.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PathScore {
+    /// Its name.
+    pub name: String,
+    /// What it tests.
+    pub about: String,
+    /// The truth's largest row-to-row jump, per frame (the scale of a seam).
+    pub truth_max_row_jump: Vec<f64>,
+    /// Each variant.
+    pub variants: Vec<VariantScore>,
+}
+
+/// What `frf eval --json` prints along paths.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PathsReport {
+    /// The field.
+    pub field: PathBuf,
+    /// The capture whose stage gave the truth.
+    pub capture: PathBuf,
+    /// The environment.
+    pub env: String,
+    /// The pose.
+    pub pose: u32,
+    /// The renderer's device.
+    pub device: String,
+    /// Median-cut lights of the truth.
+    pub truth_lights: usize,
+    /// Seconds per true frame (CPU).
+    pub truth_seconds_per_frame: f64,
+    /// Frame width.
+    pub width: u32,
+    /// Frame height.
+    pub height: u32,
+    /// Frames of each path.
+    pub frames_per_path: usize,
+    /// Each path.
+    pub paths: Vec<PathScore>,
+    /// Per variant: the mean over the paths of their mean subject PSNR, dB.
+    pub mean_psnr_subject: Vec<(String, f64)>,
+}
+
+/// What to evaluate along paths.
+pub struct PathOptions<'a> {
+    /// The field's path, the capture's and the environment's name, for the report.
+    pub names: (PathBuf, PathBuf, String),
+    /// Frames of each path.
+    pub frames: usize,
+    /// Frame size.
+    pub size: (u32, u32),
+    /// Variants.
+    pub variants: &'a [Variant],
+    /// The truth's lights.
+    pub lights: &'a [DirLight],
+    /// Median-cut lights asked for (the report's `truth_lights`).
+    pub light_count: usize,
+    /// Write every frame and its truth as PNGs here.
+    pub images: Option<&'a Path>,
+}
+
+/// Renders `paths` of pose `pose` with every variant and scores them against the
+/// stage's truth.
+pub fn evaluate_paths(
+    renderer: &Renderer,
+    stage: &Stage,
+    pose: u32,
+    paths: &[NamedPath],
+    options: &PathOptions,
+    progress: &dyn Progress,
+) -> Result<PathsReport> {
+    let (w, h) = options.size;
+    let mut scores = Vec::new();
+    let mut truth_seconds = 0.0;
+    for p in paths {
+        let cameras: Vec<EvalCamera> = p
+            .trajectory
+            .cameras(options.frames, w, h)?
+            .into_iter()
+            .enumerate()
+            .map(|(i, camera)| EvalCamera {
+                name: format!("{} frame {i}", p.name),
+                camera,
+                view: None,
+            })
+            .collect();
+        progress.phase(&format!("{}: truth frames", p.name), cameras.len());
+        let all: Vec<_> = cameras.iter().map(|c| c.camera).collect();
+        let (truths, seconds) = truth_frames(stage, pose, &all, options.lights, progress)?;
+        truth_seconds += seconds;
+        progress.finish();
+        progress.phase(
+            &format!("{}: rendered frames", p.name),
+            cameras.len() * options.variants.len(),
+        );
+        let variant_scores = evaluate(
+            renderer,
+            &cameras,
+            &truths,
+            options.variants,
+            &mut |i, v, img| {
+                progress.step();
+                if let Some(dir) = options.images {
+                    let name = format!("{}_{i:02}_{}.png", p.name, v.name());
+                    write_png8_srgba(&dir.join(name), img, 1.0)?;
+                }
+                Ok(())
+            },
+        )?;
+        progress.finish();
+        if let Some(dir) = options.images {
+            for (i, t) in truths.iter().enumerate() {
+                let name = format!("{}_{i:02}_truth.png", p.name);
+                write_png8_srgba(&dir.join(name), t, 1.0)?;
+            }
+        }
+        scores.push(PathScore {
+            name: p.name.to_string(),
+            about: p.about.to_string(),
+            truth_max_row_jump: truths.iter().map(max_row_jump).collect(),
+            variants: variant_scores,
+        });
+    }
+    let mean_psnr_subject: Vec<(String, f64)> = options
+        .variants
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let m = scores
+                .iter()
+                .map(|p| p.variants[k].psnr_subject)
+                .sum::<f64>()
+                / scores.len().max(1) as f64;
+            (v.name().to_string(), m)
+        })
+        .collect();
+    let truth_frames = (paths.len() * options.frames).max(1) as f64;
+    let (field, capture, env) = options.names.clone();
+    Ok(PathsReport {
+        field,
+        capture,
+        env,
+        pose,
+        device: renderer.device(),
+        truth_lights: options.light_count,
+        truth_seconds_per_frame: truth_seconds / truth_frames,
+        width: w,
+        height: h,
+        frames_per_path: options.frames,
+        paths: scores,
+        mean_psnr_subject,
+    })
 }
 
 #[cfg(test)]

@@ -9,22 +9,27 @@
 //! ([`frf_render::composite::compose`]), so that only the walker and its shadow differ.
 //! Scenes of one walker only: the stage films one person.
 
+use std::path::PathBuf;
 use std::time::Instant;
 
+use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 use frf_render::composite::compose;
+use frf_render::renderer::Device;
+use frf_render::scene::Scene;
 use frf_render::scene::plan::ShotFrame;
-use frf_render::scene::shot::Shot;
+use frf_render::scene::shot::{Shot, ShotOptions};
 use frf_stage::Stage;
 use frf_stage::ground::relative_irradiance;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{psnr, ssim, subject_mask};
+use crate::progress::Progress;
 use crate::views::truth_frame;
 
 /// One frame of a shot against its truth.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ShotFrameScore {
     /// Index in the shot.
     pub index: usize,
@@ -96,6 +101,105 @@ pub fn score_frame<R: ReadAt>(
         ssim_subject: ssim(&subject, &layers.subject, Some(&mask)),
         seconds_render,
         seconds_truth,
+    })
+}
+
+/// Memory budget of the poses kept resident while scoring a shot, bytes (a few frames
+/// only).
+const BUDGET_BYTES: u64 = 4_000_000_000;
+
+/// What `frf eval SCENE.toml --json` prints.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ShotReport {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The field rendered.
+    pub field: PathBuf,
+    /// The capture whose stage gave the truth.
+    pub capture: PathBuf,
+    /// The renderer's device.
+    pub device: String,
+    /// Median-cut lights of the truth.
+    pub truth_lights: usize,
+    /// Frames of the shot.
+    pub frames_total: usize,
+    /// Each frame scored.
+    pub frames: Vec<ShotFrameScore>,
+    /// Mean PSNR of the whole frames, dB.
+    pub psnr_frame_mean: f64,
+    /// Mean PSNR of the walker, dB.
+    pub psnr_subject_mean: f64,
+    /// Mean SSIM of the walker.
+    pub ssim_subject_mean: f64,
+    /// Mean seconds to render a frame.
+    pub seconds_render_mean: f64,
+    /// Mean seconds for a true frame.
+    pub seconds_truth_mean: f64,
+    /// Seconds in all.
+    pub seconds: f64,
+}
+
+/// Scores `count` frames spread over the shot of `scene` (rendered from `field`, which
+/// `paths.1` names, on `device`) against the truth of `stage` under `lights` median-cut
+/// lights; `paths` = (scene file, field, capture) for the report.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_shot<R: ReadAt>(
+    scene: &Scene,
+    field: &FieldFile<R>,
+    device: Device,
+    stage: &Stage,
+    count: usize,
+    lights: usize,
+    paths: (PathBuf, PathBuf, PathBuf),
+    progress: &dyn Progress,
+) -> Result<ShotReport> {
+    let start = Instant::now();
+    let h = field.header();
+    let size = scene.size.unwrap_or((h.width, h.height));
+    let total = scene.frame_times().len();
+    let frames: Vec<ShotFrame> = spread_frames(total, count)
+        .into_iter()
+        .map(|i| Ok(scene.shot_frames(i..i + 1, size)?[0]))
+        .collect::<Result<_>>()?;
+    let options = ShotOptions {
+        memory_budget: BUDGET_BYTES,
+        planned: true,
+        traced_lights: lights,
+    };
+    let mut shot = Shot::new(scene, field, device, &frames, options)?;
+    for f in &shot.plan().frames {
+        if let Some(p) = f.poses.iter().find(|p| !stage.config().poses.contains(p)) {
+            return Err(EvalError::BadParameter(format!(
+                "{}: frame {} draws pose {p}, which the capture did not film",
+                paths.2.display(),
+                f.index
+            )));
+        }
+    }
+    progress.phase("frames scored", frames.len());
+    let mut scores = Vec::new();
+    for f in &frames {
+        scores.push(score_frame(stage, &mut shot, f, lights)?);
+        progress.step();
+    }
+    progress.finish();
+    let mean =
+        |g: fn(&ShotFrameScore) -> f64| scores.iter().map(g).sum::<f64>() / scores.len() as f64;
+    let (scene_path, field_path, capture) = paths;
+    Ok(ShotReport {
+        scene: scene_path,
+        field: field_path,
+        capture,
+        device: shot.device(),
+        truth_lights: lights,
+        frames_total: total,
+        psnr_frame_mean: mean(|s| s.psnr_frame),
+        psnr_subject_mean: mean(|s| s.psnr_subject),
+        ssim_subject_mean: mean(|s| s.ssim_subject),
+        seconds_render_mean: mean(|s| s.seconds_render),
+        seconds_truth_mean: mean(|s| s.seconds_truth),
+        frames: scores,
+        seconds: start.elapsed().as_secs_f64(),
     })
 }
 

@@ -23,13 +23,15 @@ use frf_render::geometry::PoseGeometry;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
 use frf_stage::Stage;
-use serde::Serialize;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{alpha_mae, alpha_of, max_row_jump, psnr, ssim, subject_mask};
+use crate::progress::Progress;
 
 /// The scores of one frame.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FrameScore {
     /// Which camera.
     pub camera: String,
@@ -52,7 +54,7 @@ pub struct FrameScore {
 }
 
 /// One variant: means over the frames, and the frames.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct VariantScore {
     /// `nearest`, `linear`, `twoway` or `fourway`.
     pub name: String,
@@ -152,6 +154,46 @@ pub fn truth_frame(
 ) -> Result<Image<Rgba>> {
     let t = stage.truth_image(pose, camera, lights);
     Ok(rgba_from(&t.color, &t.alpha)?)
+}
+
+/// The stage's true frames of `cameras` (in parallel, one progress step each) and the
+/// seconds they took together.
+pub fn truth_frames(
+    stage: &Stage,
+    pose: u32,
+    cameras: &[Camera],
+    lights: &[DirLight],
+    progress: &dyn Progress,
+) -> Result<(Vec<Image<Rgba>>, f64)> {
+    let start = Instant::now();
+    let frames = cameras
+        .par_iter()
+        .map(|c| {
+            let t = truth_frame(stage, pose, c, lights);
+            progress.step();
+            t
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((frames, start.elapsed().as_secs_f64()))
+}
+
+/// The header of the variants' table ([`table_row`]).
+pub const TABLE_HEADER: &str = "variant                 PSNR subject  SSIM subject  PSNR frame  \
+                                SSIM frame  alpha MAE  clamped  s/frame";
+
+/// One row of the variants' table.
+pub fn table_row(s: &VariantScore) -> String {
+    format!(
+        "{:<21} {:>11.2} dB {:>13.4} {:>8.2} dB {:>11.4} {:>10.4} {:>7.1}% {:>8.4}",
+        s.name,
+        s.psnr_subject,
+        s.ssim_subject,
+        s.psnr_frame,
+        s.ssim_frame,
+        s.alpha_mae,
+        100.0 * s.clamped_share,
+        s.seconds_per_frame
+    )
 }
 
 /// Scores `test` against `truth`; `stats` says how its pixels were re-binned.

@@ -6,11 +6,31 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use frf_core::env::EnvMap;
 use frf_eval::budget::{self, BudgetInputs, Direction, FLOOR, ULR_HULL, ULR_TRUE};
+use frf_eval::progress::Progress;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
 use frf_render::resident::ResidentPose;
+
+/// Counts the phases announced and the steps done.
+#[derive(Default)]
+struct Steps {
+    phases: Mutex<Vec<usize>>,
+    done: AtomicUsize,
+}
+
+impl Progress for Steps {
+    fn phase(&self, _what: &str, total: usize) {
+        self.phases.lock().unwrap().push(total);
+    }
+    fn step(&self) {
+        self.done.fetch_add(1, Ordering::Relaxed);
+    }
+}
 
 #[test]
 fn the_budget_scores_every_offset_and_the_solved_morph_sits_near_the_floor() {
@@ -28,15 +48,17 @@ fn the_budget_scores_every_offset_and_the_solved_morph_sits_near_the_floor() {
         lights: &lights,
         keep: None,
     };
-    let steps = std::sync::atomic::AtomicUsize::new(0);
+    let steps = Steps::default();
     let variants = [Variant::FourWayE06, Variant::FourWay];
-    let rows = budget::run(&inputs, 2, &variants, &|| {
-        steps.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    })
-    .unwrap();
+    let rows = budget::run(&inputs, 2, &variants, &steps).unwrap();
     eprint!("{}", budget::table(&rows));
     assert_eq!(rows.len(), budget::offsets().len());
-    assert_eq!(steps.into_inner(), budget::frames(2, variants.len()));
+    // One phase, as many steps as it announced.
+    assert_eq!(
+        steps.phases.into_inner().unwrap(),
+        vec![budget::frames(2, variants.len())]
+    );
+    assert_eq!(steps.done.into_inner(), budget::frames(2, variants.len()));
     let psnr = |row: &budget::BudgetRow, name: &str| row.method(name).unwrap().psnr_subject;
     for row in &rows {
         for name in ["fourway-e06", "fourway", FLOOR, ULR_HULL, ULR_TRUE] {

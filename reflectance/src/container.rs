@@ -409,6 +409,18 @@ impl<R: ReadAt> FieldFile<R> {
         &self.path
     }
 
+    /// `requested`, or the field's first pose; an error naming the file when it holds none.
+    pub fn pose_or_first(&self, requested: Option<u32>) -> Result<u32> {
+        requested
+            .or_else(|| self.header.poses.first().map(|p| p.pose))
+            .ok_or_else(|| {
+                ReflectanceError::BadParameter(format!(
+                    "{}: the field holds no pose",
+                    self.path.display()
+                ))
+            })
+    }
+
     /// All chunk entries, in key order.
     pub fn chunks(&self) -> impl Iterator<Item = &ChunkEntry> {
         self.chunks.values()

@@ -297,6 +297,12 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// Makes `source` resident on the GPU ([`Gpu::new`]'s adapter), or on the CPU when
+    /// `cpu`.
+    pub fn open(source: &PoseSource, cpu: bool) -> Result<Self> {
+        Self::new(source, if cpu { None } else { Some(Gpu::new()?) })
+    }
+
     /// Makes `source` resident on `gpu` (relit there), or relights it on the CPU when
     /// `gpu` is `None`.
     pub fn new(source: &PoseSource, gpu: Option<Gpu>) -> Result<Self> {

@@ -8,7 +8,6 @@ use clap::Args;
 use frf_reflectance::FieldFile;
 
 use crate::CliResult;
-use crate::cmd::render::pose_of;
 
 /// Arguments of `frf hull`.
 #[derive(Args)]
@@ -26,7 +25,7 @@ pub struct HullArgs {
 /// Runs `frf hull`.
 pub fn run(args: HullArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
-    let pose = pose_of(field.header(), args.pose, &args.field)?;
+    let pose = field.pose_or_first(args.pose)?;
     let hull = field.hull(pose)?.ok_or_else(|| {
         format!(
             "{}: pose {pose} has no visual hull (ingest it without --no-shadows)",

@@ -3,9 +3,6 @@
 pub mod args;
 pub mod bench;
 pub mod eval;
-pub mod eval_budget;
-pub mod eval_paths;
-pub mod eval_shot;
 pub mod flow;
 pub mod for_scene;
 pub mod hull;

@@ -1,6 +1,9 @@
 //! Progress bars for long commands (indicatif), drawn on stderr and hidden when stderr
 //! is not a terminal.
 
+use std::sync::Mutex;
+
+use frf_eval::progress::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// A bar with a message, position/length, elapsed time and ETA.
@@ -13,4 +16,51 @@ pub fn bar(message: &str) -> ProgressBar {
     );
     bar.set_message(message.to_string());
     bar
+}
+
+/// An evaluation's progress as one bar per phase ([`bar`]).
+#[derive(Default)]
+pub struct Bars(Mutex<Option<ProgressBar>>);
+
+impl Bars {
+    fn with(&self, f: impl FnOnce(&mut Option<ProgressBar>)) {
+        // A poisoned lock only means a bar was being drawn when a thread panicked.
+        let mut guard = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        f(&mut guard);
+    }
+}
+
+impl Progress for Bars {
+    fn phase(&self, what: &str, total: usize) {
+        self.with(|b| {
+            if let Some(old) = b.take() {
+                old.finish_and_clear();
+            }
+            let new = bar(what);
+            new.set_length(total as u64);
+            *b = Some(new);
+        });
+    }
+
+    fn step(&self) {
+        self.with(|b| {
+            if let Some(b) = b {
+                b.inc(1);
+            }
+        });
+    }
+
+    fn finish(&self) {
+        self.with(|b| {
+            if let Some(old) = b.take() {
+                old.finish_and_clear();
+            }
+        });
+    }
+}
+
+impl Drop for Bars {
+    fn drop(&mut self) {
+        self.finish();
+    }
 }

@@ -11,17 +11,16 @@
 //! contact sheet, an animated preview and `render.json`; `--frames A..B` renders part of
 //! a shot (for a farm), and a rerun resumes ([`crate::cmd::output`]).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
 use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
-use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::path::Trajectory;
-use frf_render::renderer::{Device, Renderer};
+use frf_render::renderer::Device;
 use frf_render::resident::{Lighting, PoseSource};
 use frf_render::scene::plan::{Plan, ShotFrame};
 use frf_render::scene::shot::{Shot, ShotOptions};
@@ -36,20 +35,6 @@ use crate::cmd::args::{
 };
 use crate::cmd::output::{FrameFiles, FrameRange, Output};
 use crate::cmd::progress::bar;
-
-/// Makes `source` resident on the GPU, or for the CPU reference when `cpu`.
-pub fn open_renderer(source: &PoseSource, cpu: bool) -> CliResult<Renderer> {
-    let gpu = if cpu { None } else { Some(Gpu::new()?) };
-    Ok(Renderer::new(source, gpu)?)
-}
-
-/// The requested pose, or the field's first.
-pub fn pose_of(header: &FieldHeader, requested: Option<u32>, field: &Path) -> CliResult<u32> {
-    let pose = requested
-        .or_else(|| header.poses.first().map(|p| p.pose))
-        .ok_or_else(|| format!("{}: the field holds no pose", field.display()))?;
-    Ok(pose)
-}
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;
@@ -195,7 +180,7 @@ fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
     if !is_scene {
         let field = args.field.clone().unwrap_or_else(|| args.input.clone());
         let f = FieldFile::open(&field)?;
-        let pose = pose_of(f.header(), args.pose, &field)?;
+        let pose = f.pose_or_first(args.pose)?;
         return Ok((scene_of_flags(args, f.header(), pose)?, field));
     }
     if args.camera.camera.is_some() || args.camera.orbit.is_some() || args.pose.is_some() {
@@ -211,19 +196,8 @@ fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
             k.env = env.clone();
         }
     }
-    let field = scene_field(&scene, &args.input, args.field.as_ref())?;
+    let field = scene.field_or(args.field.as_deref())?;
     Ok((scene, field))
-}
-
-/// The field a scene file at `path` renders from: `given` (`--field`) or the scene's own.
-pub fn scene_field(scene: &Scene, path: &Path, given: Option<&PathBuf>) -> CliResult<PathBuf> {
-    given.or(scene.field.as_ref()).cloned().ok_or_else(|| {
-        format!(
-            "{}: no field (give field = \"...\" or --field)",
-            path.display()
-        )
-        .into()
-    })
 }
 
 /// The frames of `scene` the arguments ask for, of `size`.

@@ -49,6 +49,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::metrics::{psnr, ssim, subject_mask};
+use crate::progress::Progress;
 use crate::views::{quad_corners, truth_frame};
 
 /// Which way from the quad's first corner the cameras are moved.
@@ -265,9 +266,22 @@ fn score(name: &str, truths: &[Image<Rgba>], frames: &[Image<Rgba>], seconds: f6
     }
 }
 
-/// Runs the budget at every offset with `quads` cameras each; `step()` is called once per
-/// frame computed ([`frames`] in all).
+/// Runs the budget at every offset with `quads` cameras each, in one progress phase of
+/// [`frames`] steps.
 pub fn run(
+    inputs: &BudgetInputs,
+    quads: usize,
+    variants: &[Variant],
+    progress: &dyn Progress,
+) -> Result<Vec<BudgetRow>> {
+    progress.phase("budget frames", frames(quads, variants.len()));
+    let step = || progress.step();
+    let rows = run_offsets(inputs, quads, variants, &step);
+    progress.finish();
+    rows
+}
+
+fn run_offsets(
     inputs: &BudgetInputs,
     quads: usize,
     variants: &[Variant],

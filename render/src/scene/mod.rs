@@ -214,6 +214,20 @@ fn ground(r: &Reporter, v: &At<toml::Value>) -> Result<GroundLook> {
 }
 
 impl Scene {
+    /// The field to render the scene from: `given` (the command line's), else the one the
+    /// file names; an error naming the file when neither does.
+    pub fn field_or(&self, given: Option<&Path>) -> Result<PathBuf> {
+        given
+            .map(Path::to_path_buf)
+            .or_else(|| self.field.clone())
+            .ok_or_else(|| {
+                RenderError::BadParameter(format!(
+                    "{}: no field (give field = \"...\" or --field)",
+                    self.path.display()
+                ))
+            })
+    }
+
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path)

@@ -3,27 +3,21 @@
 //! drawn with its Markdown table beside the plot.
 
 use frf_core::atomic::write_bytes_atomic;
-use frf_core::env::EnvMap;
 use frf_core::image::{Image, Rgba};
 use frf_core::io::write_png8_srgba;
 use frf_eval::budget::{self, BudgetInputs, BudgetReport};
-use frf_render::resident::{PoseSource, ResidentPose};
-use frf_stage::Stage;
+use frf_render::renderer::Renderer;
+use frf_render::resident::ResidentPose;
 use frf_stage::truth::environment_lights;
 
+use super::args::EvalArgs;
+use super::input::EvalInput;
 use crate::CliResult;
-use crate::cmd::eval::EvalArgs;
-use crate::cmd::progress::bar;
-use crate::cmd::render::open_renderer;
+use crate::cmd::progress::Bars;
 
 /// Runs the budget.
-pub fn run(
-    args: &EvalArgs,
-    source: &PoseSource,
-    stage: &Stage,
-    env: &EnvMap,
-    pose: u32,
-) -> CliResult {
+pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
+    let (source, stage, env, pose) = (&input.source, &input.stage, &input.env, input.pose);
     let plot_png = match &args.plot {
         None => None,
         Some(p) => match p.extension().and_then(|e| e.to_str()) {
@@ -34,7 +28,7 @@ pub fn run(
             }
         },
     };
-    let renderer = open_renderer(source, args.compare.cpu)?;
+    let renderer = Renderer::open(source, args.compare.cpu)?;
     let resident = ResidentPose::relight_cpu(source);
     let lights = environment_lights(env, args.lights);
     let variants = args.compare.variants();
@@ -60,10 +54,7 @@ pub fn run(
         lights: &lights,
         keep: Some(&keep),
     };
-    let progress = bar("budget frames");
-    progress.set_length(budget::frames(args.cameras, variants.len()) as u64);
-    let rows = budget::run(&inputs, args.cameras, &variants, &|| progress.inc(1))?;
-    progress.finish_and_clear();
+    let rows = budget::run(&inputs, args.cameras, &variants, &Bars::default())?;
     eprintln!(
         "{} pose {pose} under {}: subject PSNR (dB) / SSIM, {} cameras per offset, variants on {} \
          (truth: {} median-cut lights)",

@@ -1,0 +1,129 @@
+//! The arguments of `frf eval` and `frf eval-ring`, and what they compare.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use frf_render::morph::Variant;
+
+use crate::cmd::args::{CameraArgs, GroundArg, LightingArgs, VariantArg, parse_ground, parse_size};
+
+/// Arguments of `frf eval`.
+#[derive(Args)]
+pub struct EvalArgs {
+    /// A field of a virtual-stage capture (`frf stage field` or `frf ingest`), or a scene
+    /// file (`.toml`): then frames of its shot are scored against their true composites.
+    pub field: PathBuf,
+    /// With a scene: the field to render it from (default: the scene's `field`).
+    #[arg(long = "field")]
+    pub scene_field: Option<PathBuf>,
+    /// With a scene: frames scored, spread evenly over the shot (default 4); along a
+    /// path (`--orbit`, `--camera`, `--suite`): frames of each path (default 8).
+    #[arg(long)]
+    pub frames: Option<usize>,
+    /// Score frames along a camera path against the truth instead of cameras at quad
+    /// centres.
+    #[command(flatten)]
+    pub path: CameraArgs,
+    /// Score the suite of camera paths people render: inside the cylinder of cameras low
+    /// and high, just inside it, outside it, above the top camera and below the bottom one
+    /// (`frf_eval::paths`).
+    #[arg(long, conflicts_with_all = ["camera", "orbit"])]
+    pub suite: bool,
+    /// The error budget of view interpolation: every variant at offsets ¼, ½, ¾ along
+    /// rows, columns and toward quad centres (`--cameras` quads each) and at the captured
+    /// views, beside the floor of any flow-based morph (true correspondences) and
+    /// unstructured lumigraph rendering on the visual hull and on the true surface.
+    #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows"])]
+    pub budget: bool,
+    /// With `--budget`: also draw its plot here (`.svg` or `.png`) and its Markdown table
+    /// beside it (`.md`).
+    #[arg(long, requires = "budget")]
+    pub plot: Option<PathBuf>,
+    /// Along a path: frame size `WxH` (default: the field's image size).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// The capture the field was made from (its stage renders the truth).
+    #[arg(long)]
+    pub capture: PathBuf,
+    #[command(flatten)]
+    pub lighting: LightingArgs,
+    /// Pose (default: the field's first).
+    #[arg(long)]
+    pub pose: Option<u32>,
+    /// Cameras at the centres of grid quads, spread around the grid (with `--budget`:
+    /// quads per offset).
+    #[arg(long, default_value_t = 8)]
+    pub cameras: usize,
+    /// Median-cut lights of the environment in the truth renders.
+    #[arg(long, default_value_t = 512)]
+    pub lights: usize,
+    #[command(flatten)]
+    pub compare: CompareArgs,
+    /// Write each camera's truth and renders as PNGs here (with `--budget`, the first
+    /// camera's at each offset, every method's; with `--shadows`, also the
+    /// relit and the true shadow of the ground patch, seen from above, +x right, +z down).
+    #[arg(long)]
+    pub images: Option<PathBuf>,
+    /// Also score the subject in a scene: the relit shadow against the true one over the
+    /// ground patch, composites over the environment against true composites, and the
+    /// matte edges at the captured views.
+    #[arg(long)]
+    pub shadows: bool,
+    /// Ground of the composites' environment backdrop: `env` or an albedo `A` / `R,G,B`.
+    #[arg(long, value_parser = parse_ground, default_value = "env")]
+    pub ground: GroundArg,
+}
+
+/// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.
+#[derive(Args)]
+pub struct CompareArgs {
+    /// Variants to compare (default: all four).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub variants: Vec<VariantArg>,
+    /// Also score the four-way morph's ablations (with the occlusion cue; without the
+    /// proxy for rays beyond the grid's rows).
+    #[arg(long)]
+    pub ablations: bool,
+    /// Render with the CPU reference instead of the GPU.
+    #[arg(long)]
+    pub cpu: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl CompareArgs {
+    pub fn variants(&self) -> Vec<Variant> {
+        let mut v: Vec<Variant> = if self.variants.is_empty() {
+            Variant::ALL.to_vec()
+        } else {
+            self.variants.iter().map(|&v| v.into()).collect()
+        };
+        if self.ablations {
+            v.extend(
+                Variant::ABLATIONS
+                    .iter()
+                    .filter(|a| !v.contains(a))
+                    .collect::<Vec<_>>(),
+            );
+        }
+        v
+    }
+}
+
+/// Arguments of `frf eval-ring`.
+#[derive(Args)]
+pub struct RingEvalArgs {
+    /// A field made by `frf ingest-ring --stride S` from the same ring.
+    pub field: PathBuf,
+    /// The ring's calibration (Middlebury `*_par.txt`).
+    #[arg(long)]
+    pub par: PathBuf,
+    /// The stride the field was ingested with: the view halfway between two kept views
+    /// is rendered (2: view i from i±1; 4: from i±2; 3: view i+1 from i and i+3); any
+    /// stride from 2 and any number of views.
+    #[arg(long)]
+    pub stride: usize,
+    #[command(flatten)]
+    pub compare: CompareArgs,
+}

@@ -1,0 +1,42 @@
+//! `frf eval FIELD --capture CAPTURE`: renders between the grid's views, along camera
+//! paths (`--orbit`, `--camera`, `--suite`), as an error budget (`--budget`), or a scene's
+//! shot (`SCENE.toml`), scored against the virtual stage's truth; `frf eval-ring FIELD
+//! --par PAR --stride S`: views held out of a ring of photographs rendered from their
+//! neighbours and scored against the photographs. The evaluations are `frf_eval`'s; each
+//! module here parses, calls one and prints its report.
+
+mod args;
+mod budget;
+mod input;
+mod paths;
+mod quads;
+mod ring;
+mod shot;
+
+pub use args::{EvalArgs, RingEvalArgs};
+
+use crate::CliResult;
+
+/// Runs `frf eval`.
+pub fn run(args: EvalArgs) -> CliResult {
+    if args
+        .field
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    {
+        return shot::run(&args);
+    }
+    let input = input::load(&args)?;
+    if args.budget {
+        budget::run(&args, &input)
+    } else if args.suite || args.path.orbit.is_some() || args.path.camera.is_some() {
+        paths::run(&args, &input)
+    } else {
+        quads::run(&args, &input)
+    }
+}
+
+/// Runs `frf eval-ring`.
+pub fn run_ring(args: RingEvalArgs) -> CliResult {
+    ring::run(args)
+}
