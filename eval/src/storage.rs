@@ -17,7 +17,7 @@ use frf_reflectance::project::{FloorModel, Projector};
 use frf_reflectance::relight::relight;
 use frf_stage::Stage;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{ImageError, alpha_mask, compare};
@@ -99,8 +99,8 @@ pub fn projection_error(
         .collect()
 }
 
-/// One point of the compression curve.
-#[derive(Debug, Clone, Serialize)]
+/// One point of the compression curve (`frf stage codec-curve --json`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CodecPoint {
     /// JPEG quality.
     pub quality: u8,

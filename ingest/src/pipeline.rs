@@ -170,8 +170,8 @@ pub struct PoseReport {
     pub errors: Option<PoseErrors>,
 }
 
-/// The result of an ingest.
-#[derive(Debug, Clone, Serialize)]
+/// The result of an ingest (`frf ingest --report`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct IngestReport {
     /// The capture directory.
     pub capture: String,

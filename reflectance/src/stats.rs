@@ -2,12 +2,12 @@
 //! the original reported (docs/design.md section 3.6): flow against its 8-bit quantized size
 //! (the original: 34 %), basis images against 16-bit linear RGB (the original: 16:1).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::container::{ChunkKind, FieldFile, ReadAt};
 
 /// Bytes of the file by kind of content.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 pub struct Bytes {
     /// Flow maps.
     pub flow: u64,
@@ -24,7 +24,7 @@ pub struct Bytes {
 }
 
 /// Contents and compression of a field file.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FieldStats {
     /// Bytes by kind.
     pub bytes: Bytes,

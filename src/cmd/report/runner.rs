@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use serde_json::Value;
+use serde::{Deserialize, Serialize};
 
 use crate::CliResult;
 
@@ -16,6 +16,17 @@ pub struct Runner {
     pub bar: indicatif::ProgressBar,
     /// Wall seconds of every run, whether made now or kept from an earlier invocation.
     pub measured: std::cell::Cell<f64>,
+}
+
+/// A finished run as kept under `runs/ID.run.json`.
+#[derive(Serialize, Deserialize)]
+struct RunRecord {
+    /// The command, as `frf ARGS`.
+    command: String,
+    /// Its wall seconds.
+    seconds: f64,
+    /// What it printed on stdout.
+    stdout: String,
 }
 
 /// What a run printed and how long it took.
@@ -33,15 +44,14 @@ impl Runner {
         self.bar
             .set_message(format!("frf {}", args[..2.min(args.len())].join(" ")));
         if let Ok(text) = std::fs::read_to_string(&record)
-            && let Ok(kept) = serde_json::from_str::<Value>(&text)
-            && kept["command"] == command.as_str()
+            && let Ok(kept) = serde_json::from_str::<RunRecord>(&text)
+            && kept.command == command
             && outputs.iter().all(|p| p.exists())
         {
             self.bar.inc(1);
-            let seconds = kept["seconds"].as_f64().unwrap_or(f64::NAN);
-            self.measured.set(self.measured.get() + seconds);
+            self.measured.set(self.measured.get() + kept.seconds);
             return Ok(Ran {
-                stdout: kept["stdout"].as_str().unwrap_or_default().to_string(),
+                stdout: kept.stdout,
                 command,
             });
         }
@@ -62,7 +72,11 @@ impl Runner {
             .into());
         }
         let stdout = String::from_utf8(out.stdout)?;
-        let kept = serde_json::json!({ "command": command, "seconds": seconds, "stdout": stdout });
+        let kept = RunRecord {
+            command: command.clone(),
+            seconds,
+            stdout: stdout.clone(),
+        };
         frf_core::atomic::write_bytes_atomic(
             &record,
             serde_json::to_string_pretty(&kept)?.as_bytes(),

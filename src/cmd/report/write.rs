@@ -1,33 +1,54 @@
 //! What a report writes, and what it reads besides its runs: `report.json`, the plots
 //! and the page; the peer script's JSON; the commit.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
 use frf_eval::report::{PeerPoint, Report, Row, html, plot};
-use serde_json::Value;
+use serde::Deserialize;
 
 use crate::CliResult;
+
+/// The peer script's JSON (`benches/flow_peers/run_peers.py`), as far as a report reads
+/// it.
+#[derive(Deserialize)]
+struct PeersFile {
+    #[serde(default)]
+    meta: PeersMeta,
+    /// Per method: its Middlebury means.
+    summary: BTreeMap<String, PeerMeans>,
+}
+
+#[derive(Deserialize, Default)]
+struct PeersMeta {
+    command: Option<String>,
+}
+
+#[derive(Deserialize)]
+struct PeerMeans {
+    epe: f64,
+    seconds: f64,
+}
 
 /// The Middlebury means of the peer script: our presets as rows, the rest as peers.
 pub fn peer_rows(path: &Path, rows: &mut Vec<Row>, peers: &mut Vec<PeerPoint>) -> CliResult {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let json: Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let summary = json["summary"].as_object().ok_or_else(|| {
+    let file: PeersFile = serde_json::from_str(&text).map_err(|e| {
         format!(
-            "{}: no `summary` object (run_peers.py output?)",
+            "{}: not the peer script's output (a `summary` of methods, each with epe and \
+             seconds): {e}",
             path.display()
         )
     })?;
-    let command = json["meta"]["command"]
-        .as_str()
+    let command = file
+        .meta
+        .command
+        .as_deref()
         .unwrap_or("benches/flow_peers/run_peers.py");
     let stage = "optical flow (Middlebury)";
-    for (method, m) in summary {
-        let (Some(epe), Some(secs)) = (m["epe"].as_f64(), m["seconds"].as_f64()) else {
-            return Err(format!("{}: {method} lacks epe or seconds", path.display()).into());
-        };
+    for (method, m) in file.summary {
+        let (epe, secs) = (m.epe, m.seconds);
         match method.strip_prefix("frf_") {
             Some(preset) => rows.push(Row {
                 stage: stage.into(),
