@@ -22,6 +22,7 @@ pub mod io;
 pub mod light;
 pub mod manifest;
 pub mod preview;
+pub mod progress;
 pub mod shared_data;
 pub mod volume;
 

@@ -20,8 +20,7 @@
 //! - [`report`]: error against run time of every stage's settings: rows, Pareto fronts,
 //!   plots and the page that shows them;
 //! - [`ring`]: views held out of a ring of real photographs, rendered from their
-//!   neighbours, against the photographs;
-//! - [`progress`]: how long evaluations report how far they are.
+//!   neighbours, against the photographs.
 //!
 //! Conventions: [`frf_core::conventions`].
 
@@ -31,7 +30,6 @@ pub mod ingest;
 pub mod metrics;
 pub mod oracle;
 pub mod paths;
-pub mod progress;
 pub mod quads;
 pub mod report;
 pub mod ring;

@@ -33,8 +33,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::max_row_jump;
-use crate::progress::Progress;
 use crate::views::{EvalCamera, VariantScore, evaluate, truth_frames};
+use frf_core::progress::Progress;
 
 /// A named trajectory of the suite.
 #[derive(Debug, Clone)]

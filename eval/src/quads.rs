@@ -19,9 +19,9 @@ use frf_stage::Stage;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
-use crate::progress::Progress;
 use crate::scene::{SceneScore, score_scene};
 use crate::views::{VariantScore, between_view_cameras, evaluate, grid_view_cameras, truth_frames};
+use frf_core::progress::Progress;
 
 /// What `frf eval --json` prints at quad centres.
 #[derive(Debug, Clone, Serialize, Deserialize)]

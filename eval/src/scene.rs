@@ -35,9 +35,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{edge_band_error_rgba, psnr};
-use crate::progress::Progress;
 use crate::storage::env_lights_for_view;
 use crate::views::EvalCamera;
+use frf_core::progress::Progress;
 
 /// Mean absolute error of a relit shadow against the stage's true relative irradiance of
 /// the same ground texels, pose `pose`, under `lights` (subject frame).

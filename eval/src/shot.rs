@@ -25,8 +25,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{psnr, ssim, subject_mask};
-use crate::progress::Progress;
 use crate::views::truth_frame;
+use frf_core::progress::Progress;
 
 /// One frame of a shot against its truth.
 #[derive(Debug, Clone, Serialize, Deserialize)]

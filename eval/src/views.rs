@@ -28,7 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{alpha_mae, alpha_of, max_row_jump, psnr, ssim, subject_mask};
-use crate::progress::Progress;
+use frf_core::progress::Progress;
 
 /// The scores of one frame.
 #[derive(Debug, Clone, Serialize, Deserialize)]

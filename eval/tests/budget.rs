@@ -10,8 +10,8 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use frf_core::env::EnvMap;
+use frf_core::progress::Progress;
 use frf_eval::budget::{self, BudgetInputs, Direction, FLOOR, ULR_HULL, ULR_TRUE};
-use frf_eval::progress::Progress;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
 use frf_render::resident::ResidentPose;

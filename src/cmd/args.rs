@@ -408,6 +408,32 @@ pub enum ShadowArg {
     None,
 }
 
+/// A half-open range of frame indices.
+pub struct FrameRange;
+
+impl FrameRange {
+    /// Parses `--frames`: `N` (frames 0 to N − 1) or `A..B`, within a shot of `total`
+    /// frames; all of them when absent.
+    pub fn parse(s: Option<&str>, total: usize) -> CliResult<std::ops::Range<usize>> {
+        let Some(s) = s else {
+            return Ok(0..total);
+        };
+        let bad = || format!("--frames {s:?}: expected N or A..B within the shot's {total} frames");
+        let range = match s.split_once("..") {
+            Some((a, b)) => {
+                let a: usize = a.trim().parse().map_err(|_| bad())?;
+                let b: usize = b.trim().parse().map_err(|_| bad())?;
+                a..b
+            }
+            None => 0..s.trim().parse::<usize>().map_err(|_| bad())?,
+        };
+        if range.start >= range.end || range.end > total {
+            return Err(bad().into());
+        }
+        Ok(range)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -151,7 +151,7 @@ pub fn run(args: IngestArgs) -> CliResult {
     if let Some(scene) = &args.for_scene {
         let capture = frf_core::capture::Capture::open_manifest(&args.capture)?;
         let plan = crate::cmd::for_scene::plan(scene, &capture)?;
-        println!("{}", crate::cmd::for_scene::summary(&plan));
+        println!("{}", plan.summary());
         let wanted: Vec<u32> = plan.poses.iter().map(|p| p.pose).collect();
         options.poses = if options.poses.is_empty() {
             wanted

@@ -9,7 +9,6 @@ pub mod hull;
 pub mod info;
 pub mod ingest;
 pub mod merge;
-pub mod output;
 pub mod progress;
 pub mod render;
 pub mod report;

@@ -3,7 +3,7 @@
 
 use std::sync::Mutex;
 
-use frf_eval::progress::Progress;
+use frf_core::progress::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// A bar with a message, position/length, elapsed time and ETA.

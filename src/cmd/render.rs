@@ -22,19 +22,21 @@ use frf_render::morph::Variant;
 use frf_render::path::Trajectory;
 use frf_render::renderer::Device;
 use frf_render::resident::{Lighting, PoseSource};
+use frf_render::scene::output::Output;
 use frf_render::scene::plan::{Plan, ShotFrame};
+use frf_render::scene::render_shot::render_shot;
 use frf_render::scene::shot::{Shot, ShotOptions};
 use frf_render::scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
 use glam::Vec3;
 use serde::Serialize;
 
 use crate::CliResult;
+use crate::cmd::args::FrameRange;
 use crate::cmd::args::{
     BackdropArg, BackdropArgs, CameraArgs, GroundArg, LightingArgs, ShadowArg, VariantArg,
     parse_size,
 };
-use crate::cmd::output::{FrameFiles, FrameRange, Output};
-use crate::cmd::progress::bar;
+use crate::cmd::progress::Bars;
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;
@@ -474,58 +476,13 @@ pub fn run(args: RenderArgs) -> CliResult {
         "shadow: {}",
         shadow_words(&scene, &shot, options.traced_lights)
     );
-    let bar = bar("frames");
-    bar.set_length(frames.len() as u64);
-    // Frames are encoded and written on a thread of their own while the next one renders
-    // (at most two waiting), so a sequence is limited by the slower of the two.
-    let (to_writer, from_loop) = std::sync::mpsc::sync_channel::<FrameFiles>(2);
-    let (to_loop, written) = std::sync::mpsc::channel::<(usize, f64)>();
-    let exposure = scene.exposure;
-    let rendered: CliResult = std::thread::scope(|scope| {
-        let writer = scope.spawn(move || -> CliResult {
-            for files in from_loop {
-                let t = Instant::now();
-                files.write(exposure)?;
-                let _ = to_loop.send((files.index(), t.elapsed().as_secs_f64()));
-            }
-            Ok(())
-        });
-        let mut result = Ok(());
-        for f in &frames {
-            if output.done(f.index) {
-                if let Err(e) = output.resumed(f.index, &shot.plan().frames) {
-                    result = Err(e);
-                    break;
-                }
-                bar.inc(1);
-                continue;
-            }
-            let t = Instant::now();
-            let r = match shot.render(f, scene.layers) {
-                Ok(r) => r,
-                Err(e) => {
-                    result = Err(e.into());
-                    break;
-                }
-            };
-            let files = output.accept(f, r, t.elapsed().as_secs_f64());
-            if to_writer.send(files).is_err() {
-                // The writer stopped on an error: it says which below.
-                break;
-            }
-            bar.inc(1);
-        }
-        drop(to_writer);
-        let wrote = writer
-            .join()
-            .unwrap_or_else(|_| Err("the frame writer panicked".into()));
-        result.and(wrote)
-    });
-    for (i, seconds) in written.try_iter() {
-        output.written(i, seconds);
-    }
-    rendered?;
-    bar.finish_and_clear();
+    render_shot(
+        &mut shot,
+        &frames,
+        &mut output,
+        (scene.layers, scene.exposure),
+        &Bars::default(),
+    )?;
     let wall_seconds = start.elapsed().as_secs_f64();
     let summary = output.finish(
         &scene,

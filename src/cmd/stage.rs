@@ -192,9 +192,9 @@ fn capture(args: CaptureArgs) -> CliResult {
         let stage = frf_stage::Stage::new(all)?;
         let capture = frf_core::capture::Capture::from_manifest(&out, stage.manifest())?;
         let plan = crate::cmd::for_scene::plan(scene, &capture)?;
-        println!("{}", crate::cmd::for_scene::summary(&plan));
+        println!("{}", plan.summary());
         config.poses = plan.poses.iter().map(|p| p.pose).collect();
-        config.filmed = crate::cmd::for_scene::filmed(&plan, stage.cameras().len());
+        config.filmed = plan.filmed(stage.cameras().len());
     }
     config.perturbation = args.perturbation;
     let stage = frf_stage::Stage::new(config)?;

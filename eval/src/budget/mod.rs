@@ -49,8 +49,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::metrics::{psnr, ssim, subject_mask};
-use crate::progress::Progress;
 use crate::views::{quad_corners, truth_frame};
+use frf_core::progress::Progress;
 
 /// Which way from the quad's first corner the cameras are moved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -5,7 +5,10 @@
 //! - [`Scene`]: the checked scene, and what it asks for at each frame time (camera,
 //!   lighting, and the pose of each walker: the walk cycle at that time, looping);
 //! - [`plan`]: what a scene needs from a field, computed before any work, so that only
-//!   that is read, relit and drawn.
+//!   that is read, relit and drawn;
+//! - [`shot`]: the poses made resident as the frames need them, and a frame drawn;
+//!   [`render_shot::render_shot`]: the loop over a shot's frames, writing each (and
+//!   resuming) through an [`output::Output`] directory.
 //!
 //! **Frames.** The scene frame is the world of the shot (metres, `+y` up, the ground
 //! `y = 0`). Each walker (an *instance*) stands at its position, turned by its heading
@@ -14,7 +17,9 @@
 //! origin the scene frame is the subject frame of the field.
 
 pub mod file;
+pub mod output;
 pub mod plan;
+pub mod render_shot;
 pub mod shot;
 
 use std::path::{Path, PathBuf};

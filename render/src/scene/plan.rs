@@ -26,6 +26,7 @@ use std::collections::BTreeSet;
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
+use frf_core::manifest::FilmedSpec;
 use frf_reflectance::container::{ChunkKind, ReadAt};
 use frf_reflectance::project::{FloorModel, Projector};
 use frf_reflectance::{FieldFile, FieldHeader};
@@ -262,7 +263,75 @@ impl Scene {
     }
 }
 
+/// Every [`HULL_RING_STEP`]-th column of the middle row is filmed and ingested for a
+/// scene that draws a shadow, whether its camera sees them or not: the visual hull the
+/// shadow maps are traced from needs silhouettes from all around. Measured on the demo
+/// scene (small preset, 10 poses), hull IoU against the true body: 0.57 from the 29
+/// views per pose a wider camera move reached alone, 0.79 with a ring every 40 degrees
+/// (0.84 from all 108 views).
+pub const HULL_RING_STEP: usize = 6;
+
 impl Plan {
+    /// What filming or ingesting a capture for `scene` must keep (`frf stage --for`,
+    /// `frf ingest --for`): the plan of every frame of the shot, at the scene's size or
+    /// `image_size`, on the field `header` the capture would make, with the hull's ring of
+    /// views ([`HULL_RING_STEP`]) when the scene draws a shadow the camera sees.
+    pub fn for_capture(
+        scene: &Scene,
+        header: &FieldHeader,
+        image_size: (u32, u32),
+    ) -> Result<Self> {
+        let size = scene.size.unwrap_or(image_size);
+        let frames = scene.shot_frames(0..scene.frame_times().len(), size)?;
+        let mut plan = Self::from_header(scene, header, &frames)?;
+        if plan.ground_seen && scene.shadow != ShadowSpec::None {
+            let (columns, rows) = (header.columns, header.rows);
+            for p in &mut plan.poses {
+                for u in (0..columns).step_by(HULL_RING_STEP) {
+                    p.views[u * rows + rows / 2] = true;
+                }
+            }
+            plan.counts.views_used = plan
+                .poses
+                .iter()
+                .map(|p| p.views.iter().filter(|&&v| v).count())
+                .sum();
+        }
+        Ok(plan)
+    }
+
+    /// The views the plan keeps, per pose, as a capture manifest lists what was filmed
+    /// (`rows` cameras per column).
+    pub fn filmed(&self, rows: usize) -> Vec<FilmedSpec> {
+        self.poses
+            .iter()
+            .map(|p| FilmedSpec {
+                pose: p.pose,
+                views: p
+                    .views
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v)
+                    .map(|(i, _)| [(i / rows) as u32, (i % rows) as u32])
+                    .collect(),
+            })
+            .collect()
+    }
+
+    /// A line for people: what the plan keeps.
+    pub fn summary(&self) -> String {
+        let c = &self.counts;
+        format!(
+            "for the scene: {} of {} poses ({:?}), {} of {} views, {} flows",
+            c.poses_used,
+            c.poses_total,
+            self.poses.iter().map(|p| p.pose).collect::<Vec<_>>(),
+            c.views_used,
+            c.views_total,
+            c.flows_used
+        )
+    }
+
     /// The plan of `scene` on `field` for `frames`, with the bytes it reads.
     pub fn new<R: ReadAt>(
         scene: &Scene,

@@ -8,7 +8,6 @@
 //! interrupted render resumes and the tasks of a farm job can share one directory; other
 //! settings are refused rather than mixed in.
 
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use frf_core::atomic::write_bytes_atomic;
@@ -17,44 +16,22 @@ use frf_core::image::{Image, RgbImage, Rgba};
 use frf_core::io::{read_rgba, write_exr_rgb, write_exr_rgba, write_png8_srgb, write_png8_srgba};
 use frf_core::preview::{fit_width, write_apng, write_gif};
 use frf_reflectance::container::ReadAt;
-use frf_render::cpu::FrameStats;
-use frf_render::scene::plan::{FramePlan, ShotFrame};
-use frf_render::scene::shot::{Shot, ShotCounters, ShotResult};
-use frf_render::scene::{Preview, Scene};
 use serde::Serialize;
 
-use crate::CliResult;
+use super::plan::{FramePlan, ShotFrame};
+use super::shot::{Shot, ShotCounters, ShotResult};
+use super::{Preview, Scene};
+use crate::cpu::FrameStats;
+use crate::error::{RenderError, Result};
+
+fn json_error(e: serde_json::Error) -> RenderError {
+    RenderError::BadParameter(format!("a render's report does not serialize: {e}"))
+}
 
 /// Frames on the contact sheet (evenly spaced).
 const SHEET_FRAMES: usize = 12;
 /// Widest animated preview, pixels.
 const PREVIEW_WIDTH: usize = 480;
-
-/// A half-open range of frame indices.
-pub struct FrameRange;
-
-impl FrameRange {
-    /// Parses `--frames`: `N` (frames 0 to N − 1) or `A..B`, within a shot of `total`
-    /// frames; all of them when absent.
-    pub fn parse(s: Option<&str>, total: usize) -> CliResult<Range<usize>> {
-        let Some(s) = s else {
-            return Ok(0..total);
-        };
-        let bad = || format!("--frames {s:?}: expected N or A..B within the shot's {total} frames");
-        let range = match s.split_once("..") {
-            Some((a, b)) => {
-                let a: usize = a.trim().parse().map_err(|_| bad())?;
-                let b: usize = b.trim().parse().map_err(|_| bad())?;
-                a..b
-            }
-            None => 0..s.trim().parse::<usize>().map_err(|_| bad())?,
-        };
-        if range.start >= range.end || range.end > total {
-            return Err(bad().into());
-        }
-        Ok(range)
-    }
-}
 
 /// One frame, as the report lists it.
 #[derive(Serialize)]
@@ -78,7 +55,7 @@ struct FrameRecord {
 pub struct FrameFiles {
     dir: PathBuf,
     index: usize,
-    frame: frf_render::renderer::Frame,
+    frame: crate::renderer::Frame,
 }
 
 impl FrameFiles {
@@ -89,7 +66,7 @@ impl FrameFiles {
 
     /// Encodes and writes them (each file atomically), exposed by `exposure_stops` for
     /// the PNG.
-    pub fn write(&self, exposure_stops: f32) -> CliResult {
+    pub fn write(&self, exposure_stops: f32) -> Result<()> {
         let scale = 2f32.powf(exposure_stops);
         let (dir, i) = (&self.dir, self.index);
         if let Some(l) = &self.frame.layers {
@@ -138,9 +115,10 @@ impl Output {
         settings: &serde_json::Value,
         overwrite: bool,
         total: usize,
-    ) -> CliResult<Self> {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("output directory {}: {e}", dir.display()))?;
+    ) -> Result<Self> {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            RenderError::BadParameter(format!("output directory {}: {e}", dir.display()))
+        })?;
         let mut settings = settings.clone();
         // A frame range may change between runs into one directory (array jobs); the
         // shot's frame count may not.
@@ -148,15 +126,14 @@ impl Output {
             args.remove("frames");
         }
         settings["frames_total"] = total.into();
-        let text = serde_json::to_string_pretty(&settings)?;
+        let text = serde_json::to_string_pretty(&settings).map_err(json_error)?;
         let path = dir.join("settings.json");
         let same = std::fs::read_to_string(&path).is_ok_and(|s| s == text);
         if !same && !overwrite && frame_path(dir, 0, "png").exists() {
-            return Err(format!(
+            return Err(RenderError::BadParameter(format!(
                 "{} holds frames of a render with other settings; use --overwrite or another --out",
                 dir.display()
-            )
-            .into());
+            )));
         }
         write_bytes_atomic(&path, text.as_bytes())?;
         Ok(Self {
@@ -176,11 +153,11 @@ impl Output {
     }
 
     /// Notes that frame `i` was kept from an earlier run.
-    pub fn resumed(&mut self, i: usize, plan: &[FramePlan]) -> CliResult {
+    pub fn resumed(&mut self, i: usize, plan: &[FramePlan]) -> Result<()> {
         let fp = plan
             .iter()
             .find(|f| f.index == i)
-            .ok_or("a frame that was not planned")?;
+            .ok_or_else(|| RenderError::BadParameter(format!("frame {i} was not planned")))?;
         self.records.push(FrameRecord {
             index: i,
             time: fp.time,
@@ -238,7 +215,7 @@ impl Output {
         setup_seconds: f64,
         wall_seconds: f64,
         bytes_read: u64,
-    ) -> CliResult<String> {
+    ) -> Result<String> {
         let scale = 2f32.powf(scene.exposure);
         let all_there = (0..self.total).all(|i| frame_path(&self.dir, i, "exr").exists());
         let mut extras = Vec::new();
@@ -299,7 +276,7 @@ impl Output {
             device: String,
             /// The GPU adapter, why it was taken, and every one considered.
             #[serde(skip_serializing_if = "Option::is_none")]
-            adapter: Option<&'a frf_render::gpu::adapter::AdapterReport>,
+            adapter: Option<&'a crate::gpu::adapter::AdapterReport>,
             frames_total: usize,
             frames_rendered: usize,
             frames_resumed: usize,
@@ -308,7 +285,7 @@ impl Output {
             seconds_per_frame_mean: f64,
             seconds_writing_per_frame_mean: f64,
             seconds_wall: f64,
-            plan: &'a frf_render::scene::plan::PlanCounts,
+            plan: &'a super::plan::PlanCounts,
             planned: bool,
             bytes_read_measured: u64,
             residency: &'a ShotCounters,
@@ -342,7 +319,9 @@ impl Output {
         };
         write_bytes_atomic(
             &self.dir.join(&name),
-            serde_json::to_string_pretty(&report)?.as_bytes(),
+            serde_json::to_string_pretty(&report)
+                .map_err(json_error)?
+                .as_bytes(),
         )?;
         let all = (t.inside + t.clamped_above + t.clamped_below + t.missed).max(1);
         let pct = |n: usize| 100.0 * n as f64 / all as f64;

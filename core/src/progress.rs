@@ -1,8 +1,8 @@
-//! How long evaluations say how far they are: a phase of so many steps, then each step
-//! done. The command line draws bars ([`Progress`] for indicatif in `frf`); tests pass
-//! [`Silent`].
+//! How long work says how far it is: a phase of so many steps, then each step done. The
+//! libraries (evaluation, the shot loop) take a `&dyn Progress` from their callers; the
+//! command line draws bars (indicatif, in `frf`); tests pass [`Silent`].
 
-/// Progress of a long evaluation.
+/// Progress of long work.
 pub trait Progress: Sync {
     /// A new phase of `total` steps, named `what` (e.g. `truth frames`).
     fn phase(&self, what: &str, total: usize);
