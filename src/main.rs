@@ -5,6 +5,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use frf_core::Fault;
 
 mod cmd;
 
@@ -101,7 +102,32 @@ fn main() -> ExitCode {
                 eprintln!("  caused by: {s}");
                 source = s.source();
             }
-            ExitCode::FAILURE
+            ExitCode::from(fault_of(e.as_ref()).exit_code())
         }
     }
+}
+
+/// Who is at fault for a failed command: the libraries' errors say; what the command line
+/// itself refuses is a usage error; an error of the operating system is I/O.
+fn fault_of(e: &(dyn std::error::Error + 'static)) -> Fault {
+    macro_rules! by_type {
+        ($($t:ty),*) => {
+            $(if let Some(e) = e.downcast_ref::<$t>() {
+                return e.fault();
+            })*
+        };
+    }
+    by_type!(
+        frf_core::CoreError,
+        frf_flow::FlowError,
+        frf_reflectance::ReflectanceError,
+        frf_ingest::IngestError,
+        frf_render::RenderError,
+        frf_stage::StageError,
+        frf_eval::EvalError
+    );
+    if e.downcast_ref::<std::io::Error>().is_some() {
+        return Fault::Io;
+    }
+    Fault::Usage
 }

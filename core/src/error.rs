@@ -3,6 +3,39 @@
 
 use std::path::{Path, PathBuf};
 
+/// Who is at fault when something fails: what the program's exit status tells (see
+/// [`Fault::exit_code`]), so that a script can tell a mistake in its own call from a
+/// damaged file or a machine without a usable GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// A bad argument, or input that is well formed but wrong (a size that does not fit, a
+    /// pose the field lacks, a scene out of range): the caller can correct it.
+    Usage,
+    /// A file whose bytes are damaged or truncated, or not of the format it claims.
+    Damaged,
+    /// The GPU: no adapter that can run the passes, a request it refused, its memory.
+    Gpu,
+    /// The operating system: a file that cannot be opened, read or written, a full disk.
+    Io,
+    /// The user interrupted a long run; a rerun resumes it.
+    Interrupted,
+}
+
+impl Fault {
+    /// The exit status of a run that failed with this fault: 2 usage (as for a command
+    /// line clap refuses), 3 damaged data, 4 GPU, 5 I/O, 130 interrupted (as a shell
+    /// reports an interrupt). 1 is left for anything else and 101 is a panic's.
+    pub fn exit_code(self) -> u8 {
+        match self {
+            Fault::Usage => 2,
+            Fault::Damaged => 3,
+            Fault::Gpu => 4,
+            Fault::Io => 5,
+            Fault::Interrupted => 130,
+        }
+    }
+}
+
 /// Result alias of this crate.
 pub type Result<T, E = CoreError> = std::result::Result<T, E>;
 
@@ -69,6 +102,18 @@ pub enum CoreError {
 }
 
 impl CoreError {
+    /// Who is at fault ([`Fault`]).
+    pub fn fault(&self) -> Fault {
+        match self {
+            CoreError::Io { .. } => Fault::Io,
+            CoreError::BadFile { .. } => Fault::Damaged,
+            CoreError::SizeMismatch { .. }
+            | CoreError::Manifest { .. }
+            | CoreError::LimitExceeded { .. }
+            | CoreError::InvalidArgument { .. } => Fault::Usage,
+        }
+    }
+
     /// An [`CoreError::Io`] error for `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         Self::Io {

@@ -26,4 +26,4 @@ pub mod progress;
 pub mod shared_data;
 pub mod volume;
 
-pub use error::{CoreError, Result};
+pub use error::{CoreError, Fault, Result};

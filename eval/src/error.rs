@@ -25,3 +25,17 @@ pub enum EvalError {
     #[error(transparent)]
     Render(#[from] frf_render::RenderError),
 }
+
+impl EvalError {
+    /// Who is at fault ([`frf_core::Fault`]).
+    pub fn fault(&self) -> frf_core::Fault {
+        match self {
+            EvalError::BadParameter(_) => frf_core::Fault::Usage,
+            EvalError::Core(e) => e.fault(),
+            EvalError::Stage(e) => e.fault(),
+            EvalError::Reflectance(e) => e.fault(),
+            EvalError::Ingest(e) => e.fault(),
+            EvalError::Render(e) => e.fault(),
+        }
+    }
+}

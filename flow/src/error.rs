@@ -82,3 +82,13 @@ impl FlowError {
         }
     }
 }
+
+impl FlowError {
+    /// Who is at fault ([`frf_core::Fault`]).
+    pub fn fault(&self) -> frf_core::Fault {
+        match self {
+            FlowError::Core(e) => e.fault(),
+            _ => frf_core::Fault::Usage,
+        }
+    }
+}

@@ -25,3 +25,18 @@ pub enum IngestError {
     #[error(transparent)]
     Flow(#[from] frf_flow::FlowError),
 }
+
+impl IngestError {
+    /// Who is at fault ([`frf_core::Fault`]); a failed evaluation is the caller's (its
+    /// truth does not fit the capture).
+    pub fn fault(&self) -> frf_core::Fault {
+        use frf_core::Fault;
+        match self {
+            IngestError::BadParameter(_) | IngestError::Evaluation(_) => Fault::Usage,
+            IngestError::Interrupted => Fault::Interrupted,
+            IngestError::Core(e) => e.fault(),
+            IngestError::Reflectance(e) => e.fault(),
+            IngestError::Flow(e) => e.fault(),
+        }
+    }
+}

@@ -58,3 +58,18 @@ pub enum ReflectanceError {
         source: std::io::Error,
     },
 }
+
+impl ReflectanceError {
+    /// Who is at fault ([`frf_core::Fault`]).
+    pub fn fault(&self) -> frf_core::Fault {
+        use frf_core::Fault;
+        match self {
+            ReflectanceError::Corrupt(_)
+            | ReflectanceError::BadChunk { .. }
+            | ReflectanceError::BadFile { .. } => Fault::Damaged,
+            ReflectanceError::BadParameter(_) | ReflectanceError::Mismatch { .. } => Fault::Usage,
+            ReflectanceError::Core(e) => e.fault(),
+            ReflectanceError::Io { .. } => Fault::Io,
+        }
+    }
+}

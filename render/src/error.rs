@@ -35,3 +35,18 @@ pub enum RenderError {
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
 }
+
+impl RenderError {
+    /// Who is at fault ([`frf_core::Fault`]).
+    pub fn fault(&self) -> frf_core::Fault {
+        use frf_core::Fault;
+        match self {
+            RenderError::BadParameter(_) => Fault::Usage,
+            RenderError::Gpu(_)
+            | RenderError::GpuValidation { .. }
+            | RenderError::GpuOutOfMemory { .. } => Fault::Gpu,
+            RenderError::Field(e) => e.fault(),
+            RenderError::Core(e) => e.fault(),
+        }
+    }
+}

@@ -31,3 +31,13 @@ pub enum StageError {
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
 }
+
+impl StageError {
+    /// Who is at fault ([`frf_core::Fault`]).
+    pub fn fault(&self) -> frf_core::Fault {
+        match self {
+            StageError::Core(e) => e.fault(),
+            _ => frf_core::Fault::Usage,
+        }
+    }
+}

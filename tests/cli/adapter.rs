@@ -11,8 +11,8 @@ use crate::common::{frf, frf_command, stderr};
 fn info_gpu_names_the_adapter_that_renders_and_why() {
     let o = frf(&["info", "--gpu", "--json"]);
     if !o.status.success() {
-        // No adapter at all (FRF_SKIP_GPU machines): said clearly, not a panic.
-        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        // No adapter at all (FRF_SKIP_GPU machines): said clearly, the GPU's status.
+        assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
         assert!(stderr(&o).contains("--cpu"), "{}", stderr(&o));
         return;
     }
@@ -33,8 +33,9 @@ fn info_gpu_names_the_adapter_that_renders_and_why() {
         "{report}"
     );
 
+    // Naming an adapter that does not exist is the caller's mistake (status 2).
     let o = frf(&["--adapter", "no-such-adapter", "info", "--gpu"]);
-    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("no-such-adapter"), "{}", stderr(&o));
 }
 
@@ -71,9 +72,9 @@ fn on_the_gl_backend_a_render_runs_or_is_refused_suggesting_the_cpu() {
         assert!(dir.join("frame_0000.png").exists());
     } else {
         // GL lacks what the passes need (or there is no GL driver): refused, naming the
-        // problem and the way out, with a failing status that is not a panic's.
+        // problem and the way out, with the GPU's status (4).
         for o in [&info, &render] {
-            assert_eq!(o.status.code(), Some(1), "{}", stderr(o));
+            assert_eq!(o.status.code(), Some(4), "{}", stderr(o));
             assert!(stderr(o).contains("--cpu"), "{}", stderr(o));
         }
         assert!(!dir.join("frame_0000.png").exists());

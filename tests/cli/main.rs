@@ -13,4 +13,5 @@ mod report;
 mod ring;
 mod scene;
 mod stage;
+mod status;
 mod verbs;
