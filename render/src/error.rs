@@ -9,9 +9,18 @@ pub enum RenderError {
     /// A parameter is out of range (camera path, size, frames, pose).
     #[error("{0}")]
     BadParameter(String),
-    /// No GPU adapter or device, or waiting on the GPU failed.
+    /// No GPU adapter that can run the passes (what each lacks), or the GPU misbehaved.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// A request to wgpu failed: opening the device, waiting on it, mapping a buffer.
+    #[error("GPU: {operation}: {source}")]
+    Wgpu {
+        /// What the renderer was doing.
+        operation: &'static str,
+        /// wgpu's error.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// The GPU refused a request (a wgpu validation error).
     #[error("GPU refused a request while {operation}: {message}")]
     GpuValidation {
@@ -43,6 +52,7 @@ impl RenderError {
         match self {
             RenderError::BadParameter(_) => Fault::Usage,
             RenderError::Gpu(_)
+            | RenderError::Wgpu { .. }
             | RenderError::GpuValidation { .. }
             | RenderError::GpuOutOfMemory { .. } => Fault::Gpu,
             RenderError::Field(e) => e.fault(),

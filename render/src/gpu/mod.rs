@@ -83,8 +83,14 @@ pub mod shaders {
     }
 }
 
-fn gpu_err(e: impl std::fmt::Display) -> RenderError {
-    RenderError::Gpu(e.to_string())
+/// A wgpu error of `operation`, its source kept.
+fn wgpu_err<E: std::error::Error + Send + Sync + 'static>(
+    operation: &'static str,
+) -> impl FnOnce(E) -> RenderError {
+    move |e| RenderError::Wgpu {
+        operation,
+        source: Box::new(e),
+    }
 }
 
 /// Resources kept per key (the last few keys used), shared with the frames using them.
@@ -124,7 +130,7 @@ impl Gpu {
             required_limits: limits,
             ..Default::default()
         }))
-        .map_err(gpu_err)?;
+        .map_err(wgpu_err("opening the device"))?;
         let uncaptured = scope::Uncaptured::default();
         uncaptured.install(&device);
         scope::scoped(&device, &uncaptured, "building the pipelines", || {
@@ -192,7 +198,7 @@ impl Gpu {
     pub(crate) fn wait(&self) -> Result<()> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(gpu_err)?;
+            .map_err(wgpu_err("waiting on the device"))?;
         Ok(())
     }
 
@@ -203,8 +209,13 @@ impl Gpu {
             let _ = tx.send(r);
         });
         self.wait()?;
-        rx.recv().map_err(gpu_err)?.map_err(gpu_err)?;
-        let bytes = slice.get_mapped_range().map_err(gpu_err)?.to_vec();
+        rx.recv()
+            .map_err(wgpu_err("mapping a buffer"))?
+            .map_err(wgpu_err("mapping a buffer"))?;
+        let bytes = slice
+            .get_mapped_range()
+            .map_err(wgpu_err("reading a mapped buffer"))?
+            .to_vec();
         buffer.unmap();
         Ok(bytes)
     }

@@ -5,8 +5,9 @@
 
 use std::time::Instant;
 
+use super::Gpu;
 use super::bind::readback_buffer;
-use super::{Gpu, gpu_err};
+use crate::error::RenderError;
 use crate::error::Result;
 
 /// What a recorded pass is given: the query set and the index of its first timestamp.
@@ -100,7 +101,9 @@ impl Gpu {
                 .map(|i| ticks[2 * i + 1].saturating_sub(ticks[2 * i]) as f64 * period / 1e6)
                 .collect::<Vec<_>>();
             if times.iter().all(|&t| t == 0.0) {
-                return Err(gpu_err("the adapter's timestamps did not advance"));
+                return Err(RenderError::Gpu(
+                    "the adapter's timestamps did not advance".into(),
+                ));
             }
             Ok(times)
         })

@@ -235,8 +235,7 @@ impl Scene {
 
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| RenderError::BadParameter(format!("scene {}: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?;
         Self::parse(path, &text)
     }
 

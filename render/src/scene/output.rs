@@ -116,9 +116,7 @@ impl Output {
         overwrite: bool,
         total: usize,
     ) -> Result<Self> {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            RenderError::BadParameter(format!("output directory {}: {e}", dir.display()))
-        })?;
+        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
         let mut settings = settings.clone();
         // A frame range may change between runs into one directory (array jobs); the
         // shot's frame count may not.

@@ -38,7 +38,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     let renderer = Renderer::open(&input.source, args.compare.cpu)?;
     let variants = args.compare.variants();
     if let Some(dir) = &args.images {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
     }
     let options = PathOptions {
         names: (

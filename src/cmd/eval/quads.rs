@@ -18,7 +18,7 @@ use crate::cmd::progress::Bars;
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     let lights = environment_lights(&input.env, args.lights);
     if let Some(dir) = &args.images {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
     }
     let mut renderer = Renderer::open(&input.source, args.compare.cpu)?;
     let variants = args.compare.variants();

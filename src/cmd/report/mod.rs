@@ -64,8 +64,7 @@ pub fn run(args: ReportArgs) -> CliResult {
         peer_rows(p, &mut peer_flow_rows, &mut peers)?;
     }
     let runs = args.out.join("runs");
-    std::fs::create_dir_all(&runs)
-        .map_err(|e| format!("{}: cannot create it: {e}", runs.display()))?;
+    std::fs::create_dir_all(&runs).map_err(|e| frf_core::CoreError::io(&runs, e))?;
     let (w, h) = (capture.cameras()[0].width, capture.cameras()[0].height);
     // The capture filmed again at smaller sizes, when it films every view.
     let stage_config = frf_stage::writer::read_stage_config(&args.capture)?;

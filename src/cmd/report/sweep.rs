@@ -49,6 +49,11 @@ fn parse<T: DeserializeOwned>(text: &str, ran: &str) -> CliResult<T> {
     serde_json::from_str(text).map_err(|e| format!("{ran}: its report does not read: {e}").into())
 }
 
+/// A run's report file.
+fn read(path: &Path) -> CliResult<String> {
+    Ok(std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?)
+}
+
 /// A figure a report may lack (no truth to judge by).
 fn need(value: Option<f64>, what: &str, ran: &str) -> CliResult<f64> {
     value.ok_or_else(|| format!("{ran}: no {what} in its report").into())
@@ -192,7 +197,7 @@ impl Sweep<'_> {
             let ran = self
                 .runner
                 .run(&format!("ingest_{i}"), &a, &[&field, &json])?;
-            let r: IngestReport = parse(&std::fs::read_to_string(&json)?, &ran.command)?;
+            let r: IngestReport = parse(&read(&json)?, &ran.command)?;
             let step = |name: &str| -> f64 {
                 r.steps
                     .iter()
@@ -434,7 +439,7 @@ impl Sweep<'_> {
             let ingested = self
                 .runner
                 .run(&format!("capture_{i}_ingest"), &a, &[&f, &json])?;
-            let r: IngestReport = parse(&std::fs::read_to_string(&json)?, &ingested.command)?;
+            let r: IngestReport = parse(&read(&json)?, &ingested.command)?;
             let (v, scored) = self.orbit_eval(&format!("eval_capture_{i}"), &f, &own_size)?;
             let made = format!("{}; {}", staged.command, ingested.command);
             filmed.push((format!("{cw}x{ch}"), v, scored.command, r.seconds, made));

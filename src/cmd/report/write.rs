@@ -33,7 +33,7 @@ struct PeerMeans {
 
 /// The Middlebury means of the peer script: our presets as rows, the rest as peers.
 pub fn peer_rows(path: &Path, rows: &mut Vec<Row>, peers: &mut Vec<PeerPoint>) -> CliResult {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?;
     let file: PeersFile = serde_json::from_str(&text).map_err(|e| {
         format!(
             "{}: not the peer script's output (a `summary` of methods, each with epe and \
