@@ -26,7 +26,7 @@ fn module(source: &str, name: &str) -> naga::Module {
 
 #[test]
 fn every_wgsl_file_parses_and_validates_as_compiled() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     let mut passes = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
@@ -60,6 +60,31 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
     for (name, pass) in shaders::PASSES {
         module(&shaders::composed(pass), name);
     }
+}
+
+#[test]
+fn every_piece_of_the_frame_pass_is_compiled_into_it() {
+    // The pieces in the folders (sampling snippets, re-binning, morphs) are validated as
+    // part of the frame pass: each must be in it for some choice of storage.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let sources: Vec<String> = ImageFormat::ALL
+        .into_iter()
+        .flat_map(|image| FlowFormat::ALL.map(|flow| PoseFormats { image, flow }.rebin_source()))
+        .collect();
+    let mut pieces = 0;
+    for folder in ["sample", "rebin", "morph"] {
+        for entry in std::fs::read_dir(dir.join(folder)).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            assert!(
+                sources.iter().any(|s| s.contains(&text)),
+                "{} is in no frame pass",
+                path.display()
+            );
+            pieces += 1;
+        }
+    }
+    assert!(pieces >= 9, "{pieces} pieces");
 }
 
 #[test]

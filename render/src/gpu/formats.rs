@@ -158,13 +158,16 @@ impl PoseFormats {
 
     /// The frame pass's source with these formats' sampling.
     pub fn rebin_source(self) -> String {
-        format!(
-            "{}\n{}\n{}\n{}\n{}",
+        [
             shaders::COMMON,
             self.image.snippet(),
             self.flow.snippet(),
             shaders::REBIN,
-            shaders::SOLVED
-        )
+            shaders::CYLINDER,
+            shaders::PROXY,
+            shaders::E06,
+            shaders::SOLVED,
+        ]
+        .join("\n")
     }
 }

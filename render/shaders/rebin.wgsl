@@ -1,0 +1,205 @@
+// The frame pass: for every pixel of the virtual camera, re-bin its ray through the
+// cylinder of camera centres and morph the quad's pre-lit images there; the twin of
+// `render/src/cpu.rs` (`render_pixel`). Compiled after `common.wgsl` and two sampling
+// snippets of `sample/` (how the pre-lit views and the flows are stored and filtered:
+// `sample_prelit` and `sample_flow_layer`), chosen by `frf_render::gpu::formats`.
+//
+// Composed after it: the re-binning through the cylinder (`rebin/cylinder.wgsl`), the
+// geometric proxy (`rebin/proxy.wgsl`), E06's morphs (`morph/e06.wgsl`) and the solved
+// morph (`morph/solved.wgsl`, variant 4).
+// Entry points: `fs_main` (a full-screen triangle into a colour target), `cs_main` (the
+// same pixels from a compute pass into a storage texture, and what happened to each
+// pixel's ray counted per workgroup, then once per workgroup into `stats`), `cs_classes`
+// (those counts alone, for frames drawn by `fs_main`).
+// Bind group 0 holds per-frame data, bind group 1 the resident pose.
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+// Pixels inside the grid, clamped above, clamped below, missed (compute entry points).
+@group(0) @binding(1) var<storage, read_write> stats: array<atomic<u32>, 4>;
+// The compute pass's target (`cs_main` only).
+@group(0) @binding(2) var target_image: texture_storage_2d<rgba32float, write>;
+
+@group(1) @binding(2) var<storage, read> views: array<View>;
+@group(1) @binding(3) var<storage, read> quads: array<Quad>;
+@group(1) @binding(4) var<storage, read> tables: Tables;
+@group(1) @binding(5) var<storage, read> proxy: Proxy;
+// The hull's occupancy: voxel i at bit i % 32 of word i / 32.
+@group(1) @binding(6) var<storage, read> hull_bits: array<u32>;
+@group(1) @binding(7) var<storage, read> column_index: ColumnLookup;
+
+// The column index, and per span its range of azimuths [lo, hi].
+struct ColumnLookup {
+    header: ColumnIndex,
+    ranges: array<vec2<f32>>,
+}
+
+// Bilinear, clamped to the edge: for the formats the hardware filters.
+@group(1) @binding(8) var bilinear: sampler;
+
+// The four texels (in the crop) and weights of a bilinear sample at full-image
+// coordinates s, texel centres at integers, the edge repeated.
+struct CropSample {
+    texel: array<vec2<i32>, 4>,
+    weight: vec4<f32>,
+}
+
+fn crop_position(s: vec2<f32>) -> CropSample {
+    let size = vec2<f32>(frame.crop_size);
+    let p = clamp(s - vec2<f32>(frame.crop_origin), vec2<f32>(-1.0), size);
+    let p0 = floor(p);
+    let f = p - p0;
+    let last = vec2<i32>(frame.crop_size) - vec2<i32>(1);
+    let a = clamp(vec2<i32>(p0), vec2<i32>(0), last);
+    let b = clamp(vec2<i32>(p0) + vec2<i32>(1), vec2<i32>(0), last);
+    var out: CropSample;
+    out.texel = array<vec2<i32>, 4>(a, vec2<i32>(b.x, a.y), vec2<i32>(a.x, b.y), b);
+    out.weight = vec4<f32>((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    return out;
+}
+
+// The sampler's coordinates of full-image position s (texel centres at integers).
+fn crop_uv(s: vec2<f32>) -> vec2<f32> {
+    return (s - vec2<f32>(frame.crop_origin) + 0.5) / vec2<f32>(frame.crop_size);
+}
+
+// Bilinear sample of the flow from a view toward `dir` (0 right, 1 left, 2 up, 3 down);
+// absent flows displace by zero.
+fn sample_flow(view: u32, dir: u32, s: vec2<f32>) -> vec2<f32> {
+    let layer = views[view].flow_layers[dir];
+    if (layer < 0) {
+        return vec2<f32>(0.0);
+    }
+    return sample_flow_layer(layer, s);
+}
+
+// The neighbour directions, as `Neighbour::index` numbers them.
+const RIGHT: u32 = 0u;
+const LEFT: u32 = 1u;
+const UP: u32 = 2u;
+const DOWN: u32 = 3u;
+
+// Where a pixel's ray samples the views: its hit on the cylinder, the position s in the
+// interpolated camera (the solved morph: its output camera instead), and its class (0
+// inside, 1 clamped above, 2 below, 3 missed).
+struct Classified {
+    hit: Hit,
+    s: vec2<f32>,
+    solved: SolvedOutput,
+    kind: u32,
+}
+
+fn classify(position: vec2<f32>) -> Classified {
+    var out: Classified;
+    let dir = pixel_ray(frame, vec4<f32>(position, 0.0, 1.0));
+    let hit = intersect(frame.centre.xyz, dir);
+    out.hit = hit;
+    out.kind = 3u;
+    if (hit.clamped == 3u) {
+        return out;
+    }
+    if (frame.variant == 4u) {
+        // The solved morph looks the ray up in the quad's rectified frame.
+        out.solved = solved_output(hit, frame.centre.xyz, dir);
+        if (out.solved.ok) {
+            out.kind = hit.clamped;
+        }
+        return out;
+    }
+    let q = quad_views(hit, frame.columns, frame.rows);
+    // The camera at (beta, gamma), centred at the hit.
+    let w = bilinear_weights(hit.beta, hit.gamma);
+    let q0 = views[q.x].rotation;
+    var quat = vec4<f32>(0.0);
+    var intr = vec4<f32>(0.0);
+    for (var i = 0u; i < 4u; i++) {
+        var qi = views[q[i]].rotation;
+        if (dot(qi, q0) < 0.0) {
+            qi = -qi;
+        }
+        quat += qi * w[i];
+        intr += views[q[i]].intrinsics * w[i];
+    }
+    // Clamped to a row: the ray's point on the proxy, seen from the camera on the row.
+    var ray = dir;
+    if ((frame.flags & 1u) != 0u && hit.clamped != 0u) {
+        let point = proxy_point(frame.centre.xyz, dir);
+        if (point.w > 0.0) {
+            var centre = vec3<f32>(0.0);
+            for (var i = 0u; i < 4u; i++) {
+                centre += views[q[i]].centre * w[i];
+            }
+            ray = point.xyz - centre;
+        }
+    }
+    let axes = quat_to_axes(quat * (1.0 / length(quat)));
+    let dcam = vec3<f32>(dot(axes[0], ray), dot(axes[1], ray), dot(axes[2], ray));
+    if (dcam.z <= 1e-6 * length(ray)) {
+        return out;
+    }
+    out.s = vec2<f32>(intr.x * dcam.x / dcam.z + intr.z, intr.y * dcam.y / dcam.z + intr.w);
+    out.kind = hit.clamped;
+    return out;
+}
+
+// The premultiplied linear RGBA of a classified pixel.
+fn shade_classified(c: Classified) -> vec4<f32> {
+    if (c.kind == 3u) {
+        return vec4<f32>(0.0);
+    }
+    if (frame.variant == 4u) {
+        return solved_morph(c.hit, c.solved);
+    }
+    return morph(c.hit, c.s);
+}
+
+// The premultiplied linear RGBA of the pixel at `position` (its centre).
+fn shade(position: vec2<f32>) -> vec4<f32> {
+    return shade_classified(classify(position));
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    return shade(position.xy);
+}
+
+// Per workgroup, how many of its pixels fell in each class; added to `stats` once.
+var<workgroup> class_counts: array<atomic<u32>, 4>;
+
+fn clear_counts(local: u32) {
+    if (local < 4u) {
+        atomicStore(&class_counts[local], 0u);
+    }
+    workgroupBarrier();
+}
+
+fn flush_counts(local: u32) {
+    workgroupBarrier();
+    if (local < 4u) {
+        let n = atomicLoad(&class_counts[local]);
+        if (n > 0u) {
+            atomicAdd(&stats[local], n);
+        }
+    }
+}
+
+// The frame pass as a compute dispatch: shades and counts the pixel classes.
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    clear_counts(local);
+    if (id.x < frame.size.x && id.y < frame.size.y) {
+        let c = classify(vec2<f32>(id.xy) + 0.5);
+        textureStore(target_image, id.xy, shade_classified(c));
+        atomicAdd(&class_counts[c.kind], 1u);
+    }
+    flush_counts(local);
+}
+
+// The pixel classes alone, for frames drawn by the fragment pass.
+@compute @workgroup_size(8, 8)
+fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    clear_counts(local);
+    if (id.x < frame.size.x && id.y < frame.size.y) {
+        atomicAdd(&class_counts[classify(vec2<f32>(id.xy) + 0.5).kind], 1u);
+    }
+    flush_counts(local);
+}
