@@ -247,7 +247,7 @@ pub fn run(
         .max_by_key(|s| u64::from(s.0) * u64::from(s.1));
     // The floor, once per size and stage, on the codes' texture.
     let codes_pass = RebinPass::new(&gpu.device, PoseFormats::DEFAULT);
-    let codes_pose = gpu.upload_resident(pose, &codes_pass)?;
+    let codes_pose = gpu.upload_resident(pose, &codes_pass.pose)?;
     let floor = FloorPass::new(&gpu.device, &codes_pass);
     let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
     for &size in &options.sizes {
@@ -285,7 +285,7 @@ pub fn run(
     drop(codes_pose);
     for &formats in &options.formats {
         let pass = RebinPass::new(&gpu.device, formats);
-        let gpu_pose = gpu.upload_resident(pose, &pass)?;
+        let gpu_pose = gpu.upload_resident(pose, &pass.pose)?;
         for &size in &options.sizes {
             let camera = bench_camera(size)?;
             let targets = SubjectTargets::new(&gpu.device, &pass, size, 1);

@@ -1,12 +1,15 @@
-//! Small pieces every pass uses: bind-group layout entries, texture creation and
-//! readback with rows padded to `COPY_BYTES_PER_ROW_ALIGNMENT`, decoding tables as
-//! storage, and full-screen render pipelines.
+//! Small pieces every pass uses: bind-group layout entries (buffers with their least
+//! size), texture creation and readback with rows padded to
+//! `COPY_BYTES_PER_ROW_ALIGNMENT`, decoding tables as storage, and full-screen render and
+//! compute pipelines.
 
-/// A storage-buffer binding.
-pub fn storage(
+/// A storage-buffer binding of at least `min_bytes` (checked once, when a bind group is
+/// made, instead of at every dispatch).
+pub fn storage_min(
     binding: u32,
     read_only: bool,
     visibility: wgpu::ShaderStages,
+    min_bytes: u64,
 ) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -14,22 +17,41 @@ pub fn storage(
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only },
             has_dynamic_offset: false,
-            min_binding_size: None,
+            min_binding_size: wgpu::BufferSize::new(min_bytes),
         },
         count: None,
     }
 }
 
-/// A uniform-buffer binding.
-pub fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+/// A storage-buffer binding of `T`s (at least one).
+pub fn storage<T>(
+    binding: u32,
+    read_only: bool,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    storage_min(binding, read_only, visibility, size_of::<T>() as u64)
+}
+
+/// A uniform-buffer binding of a `T`.
+pub fn uniform<T>(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
         ty: wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Uniform,
             has_dynamic_offset: false,
-            min_binding_size: None,
+            min_binding_size: wgpu::BufferSize::new(size_of::<T>() as u64),
         },
+        count: None,
+    }
+}
+
+/// A filtering sampler binding.
+pub fn sampler(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
         count: None,
     }
 }

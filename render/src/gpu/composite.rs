@@ -15,7 +15,7 @@ use super::bind::{
 };
 use super::pose::GpuPose;
 use super::rebin::frame_uniform;
-use super::types::{GpuComposite, GpuInstance};
+use super::types::{GpuComposite, GpuFrame, GpuInstance};
 use super::{Gpu, shaders};
 use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
@@ -37,7 +37,11 @@ impl CompositePass {
         let f = wgpu::ShaderStages::FRAGMENT;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite frame"),
-            entries: &[uniform(0, f), uniform(1, f), storage(2, true, f)],
+            entries: &[
+                uniform::<GpuFrame>(0, f),
+                uniform::<GpuComposite>(1, f),
+                storage::<GpuInstance>(2, true, f),
+            ],
         });
         let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite images"),
@@ -74,6 +78,8 @@ pub struct GpuInstanceRef<'a> {
 
 /// A backdrop resident on the GPU.
 pub struct GpuBackdrop {
+    /// Names the backdrop in the keys of bind groups made of it ([`super::kept`]).
+    id: u64,
     params: GpuComposite,
     env: wgpu::Texture,
     plate: wgpu::Texture,
@@ -162,6 +168,7 @@ impl Gpu {
                 }
             };
             Ok(GpuBackdrop {
+                id: super::kept::unique_id(),
                 params,
                 env,
                 plate,
@@ -280,30 +287,34 @@ impl Gpu {
             );
             write(&t.params, bytemuck::bytes_of(&params));
             write(&t.instances, bytemuck::cast_slice(&gpu_instances));
-            let array_view = |t: &wgpu::Texture| {
-                t.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    ..Default::default()
-                })
-            };
-            let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-            let views = [
-                array_view(subjects.texture()),
-                view(&backdrop.env),
-                view(&backdrop.plate),
-                array_view(&t.shadows),
-            ];
-            let image_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("composite images"),
-                layout: &self.composite.image_layout,
-                entries: &views
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| wgpu::BindGroupEntry {
-                        binding: i as u32,
-                        resource: wgpu::BindingResource::TextureView(v),
+            // Made once per drawn subjects and backdrop, and kept with the targets.
+            let image_group = t.image_groups.get((subjects.id(), backdrop.id), || {
+                let array_view = |t: &wgpu::Texture| {
+                    t.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        ..Default::default()
                     })
-                    .collect::<Vec<_>>(),
+                };
+                let view =
+                    |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+                let views = [
+                    array_view(subjects.texture()),
+                    view(&backdrop.env),
+                    view(&backdrop.plate),
+                    array_view(&t.shadows),
+                ];
+                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("composite images"),
+                    layout: &self.composite.image_layout,
+                    entries: &views
+                        .iter()
+                        .enumerate()
+                        .map(|(i, v)| wgpu::BindGroupEntry {
+                            binding: i as u32,
+                            resource: wgpu::BindingResource::TextureView(v),
+                        })
+                        .collect::<Vec<_>>(),
+                })
             });
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -316,7 +327,7 @@ impl Gpu {
                 });
                 pass.set_pipeline(&self.composite.pipeline);
                 pass.set_bind_group(0, &t.frame_group, &[]);
-                pass.set_bind_group(1, &image_group, &[]);
+                pass.set_bind_group(1, &*image_group, &[]);
                 pass.draw(0..3, 0..1);
             }
             // Composite, then (with layers) subject, shadow and backdrop.

@@ -9,8 +9,12 @@ use std::sync::Arc;
 use super::Gpu;
 use super::bind::{rgba32f, uniform_buffer};
 use super::composite::CompositePass;
+use super::kept::Kept;
 use super::readback::Readback;
 use super::types::{GpuComposite, GpuFrame, GpuInstance};
+
+/// Image bind groups kept per set of targets: a shot alternates between few backdrops.
+const IMAGE_GROUPS: usize = 2;
 
 /// The key of a set of composite targets: size, walkers, shadow-map texels.
 pub(super) type CompositeKey = ((u32, u32), u32, u32);
@@ -28,6 +32,9 @@ pub(super) struct CompositeTargets {
     pub(super) frame_group: wgpu::BindGroup,
     /// One staging buffer per target, in the order of `targets`.
     pub(super) readback: [Readback; 4],
+    /// The image bind groups made for these targets, per drawn subjects and backdrop
+    /// (their ids).
+    pub(super) image_groups: Kept<(u64, u64), wgpu::BindGroup>,
 }
 
 impl CompositeTargets {
@@ -94,25 +101,17 @@ impl CompositeTargets {
             instances,
             frame_group,
             readback,
+            image_groups: Kept::new(IMAGE_GROUPS),
         }
     }
 }
 
 impl Gpu {
-    /// The kept composite targets for `key` (made on first use; the last few kept).
+    /// The kept composite targets for `key` (made on first use; the few most recently
+    /// used are kept).
     pub(super) fn composite_targets(&self, key: CompositeKey) -> Arc<CompositeTargets> {
-        let mut cache = self
-            .composite_targets
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        if let Some((_, t)) = cache.iter().find(|(k, _)| *k == key) {
-            return t.clone();
-        }
-        let t = Arc::new(CompositeTargets::new(&self.device, &self.composite, key));
-        if cache.len() >= 4 {
-            cache.remove(0);
-        }
-        cache.push((key, t.clone()));
-        t
+        self.composite_targets.get(key, || {
+            CompositeTargets::new(&self.device, &self.composite, key)
+        })
     }
 }

@@ -21,6 +21,7 @@ pub mod bind;
 pub mod composite;
 mod composite_targets;
 pub mod formats;
+pub mod kept;
 pub mod pose;
 mod readback;
 pub mod rebin;
@@ -100,8 +101,8 @@ fn wgpu_err<E: std::error::Error + Send + Sync + 'static>(
     }
 }
 
-/// Resources kept per key (the last few keys used), shared with the frames using them.
-type Kept<K, T> = std::sync::Mutex<Vec<(K, std::sync::Arc<T>)>>;
+/// Frame sizes (and walker counts) whose targets a GPU keeps.
+const KEPT_TARGETS: usize = 4;
 
 /// An open GPU with the renderer's pipelines.
 pub struct Gpu {
@@ -115,9 +116,10 @@ pub struct Gpu {
     /// How the frame pass runs.
     stage: rebin::Stage,
     /// Frame targets kept per size and number of walkers.
-    targets: Kept<((u32, u32), u32), rebin::SubjectTargets>,
+    targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
     /// Composite targets kept per size, number of walkers and shadow-map size.
-    composite_targets: Kept<composite_targets::CompositeKey, composite_targets::CompositeTargets>,
+    composite_targets:
+        kept::Kept<composite_targets::CompositeKey, composite_targets::CompositeTargets>,
     /// Whether passes can be timed on the GPU (`Features::TIMESTAMP_QUERY`).
     timestamps: bool,
     shadow: shadow::ShadowPass,
@@ -165,8 +167,8 @@ impl Gpu {
             relight: pose::RelightPass::new(&device),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::Stage::Compute,
-            targets: Default::default(),
-            composite_targets: Default::default(),
+            targets: kept::Kept::new(KEPT_TARGETS),
+            composite_targets: kept::Kept::new(KEPT_TARGETS),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             shadow: shadow::ShadowPass::new(&device),
             composite: composite::CompositePass::new(&device),

@@ -11,8 +11,10 @@ use frf_core::volume::GroundGrid;
 use glam::Quat;
 use wgpu::util::DeviceExt;
 
-use super::bind::{copy_to_buffer, storage, table_bytes, uniform};
-use super::rebin::RebinPass;
+use super::bind::{
+    compute_pipeline, copy_to_buffer, storage, storage_texture, table_bytes, uniform,
+};
+use super::formats::PoseFormats;
 use super::types::{GpuQuad, GpuQuadFrame, GpuRelightParams, GpuView};
 use super::{Gpu, shaders};
 use crate::error::Result;
@@ -38,39 +40,17 @@ impl RelightPass {
         let relight_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("relight"),
             entries: &[
-                uniform(0, c),
-                storage(1, true, c),
-                storage(2, true, c),
-                storage(3, true, c),
-                storage(4, false, c),
-                storage(5, false, c),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 6,
-                    visibility: c,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba8Uint,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                uniform::<GpuRelightParams>(0, c),
+                storage::<u32>(1, true, c),
+                storage::<[f32; 4]>(2, true, c),
+                storage::<[[f32; 4]; 64]>(3, true, c),
+                storage::<[f32; 4]>(4, false, c),
+                storage::<u32>(5, false, c),
+                storage_texture(6, wgpu::TextureFormat::Rgba8Uint),
             ],
         });
-        let relight_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("relight"),
-                bind_group_layouts: &[Some(&relight_layout)],
-                immediate_size: 0,
-            });
         let compute = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&relight_pipeline_layout),
-                module: &relight_module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+            compute_pipeline(device, entry, &[&relight_layout], &relight_module, entry)
         };
         let (relight, encode) = (compute("relight"), compute("encode"));
 
@@ -80,6 +60,15 @@ impl RelightPass {
             encode,
         }
     }
+}
+
+/// How the frame pass binds a resident pose (made by [`super::rebin::RebinPass`]): the
+/// storage it reads ([`super::formats`]), the layout of bind group 1 and the sampler in it.
+pub struct PoseBinding {
+    /// The storage of the pre-lit views and flows.
+    pub formats: PoseFormats,
+    pub(super) layout: wgpu::BindGroupLayout,
+    pub(super) sampler: wgpu::Sampler,
 }
 
 /// A pose resident on the GPU.
@@ -191,7 +180,7 @@ impl Gpu {
         });
         let scales = self.relight_views(source, &prelit)?;
         Ok(self.bind_pose(
-            &self.rebin,
+            &self.rebin.pose,
             &source.geometry,
             scales,
             prelit,
@@ -203,7 +192,7 @@ impl Gpu {
     /// Makes a pose relit on the CPU resident with the storage `pass` reads
     /// ([`super::formats`]): its pre-lit codes and flows uploaded in those formats (the
     /// benchmark's way to compare them; the renderer relights on the GPU).
-    pub fn upload_resident(&self, resident: &ResidentPose, pass: &RebinPass) -> Result<GpuPose> {
+    pub fn upload_resident(&self, resident: &ResidentPose, pass: &PoseBinding) -> Result<GpuPose> {
         self.scoped("making a CPU-relit pose resident", || {
             let geometry = &resident.geometry;
             let crop = geometry.crop;
@@ -280,7 +269,7 @@ impl Gpu {
     /// The pose's tables uploaded and bound with its textures for `pass`.
     fn bind_pose(
         &self,
-        pass: &RebinPass,
+        pass: &PoseBinding,
         geometry: &Arc<PoseGeometry>,
         scales: Vec<f32>,
         prelit: wgpu::Texture,
@@ -353,7 +342,7 @@ impl Gpu {
         };
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pose"),
-            layout: &pass.pose_layout,
+            layout: &pass.layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,

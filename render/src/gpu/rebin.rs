@@ -11,13 +11,13 @@ use frf_core::image::{Image, Rgba};
 
 use super::Gpu;
 use super::bind::{
-    cleared, compute_pipeline, full_screen_pipeline, readback_buffer, storage, storage_texture,
-    texture_array, uniform, uniform_buffer,
+    cleared, compute_pipeline, full_screen_pipeline, readback_buffer, sampler, storage,
+    storage_min, storage_texture, texture_array, uniform, uniform_buffer,
 };
 use super::formats::PoseFormats;
-use super::pose::GpuPose;
+use super::pose::{GpuPose, PoseBinding};
 use super::readback::Readback;
-use super::types::GpuFrame;
+use super::types::{GpuColumnIndex, GpuFrame, GpuProxy, GpuQuad, GpuQuadFrame, GpuView};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::morph::Variant;
@@ -51,16 +51,15 @@ pub(super) fn workgroups(size: (u32, u32)) -> (u32, u32) {
 
 /// The frame pass's layouts and pipelines for one [`PoseFormats`].
 pub struct RebinPass {
-    /// The storage these pipelines read.
-    pub formats: PoseFormats,
+    /// How a pose is bound for these pipelines: the storage they read, the layout and
+    /// sampler of bind group 1.
+    pub pose: PoseBinding,
     pub(super) frame_layout: wgpu::BindGroupLayout,
     pub(super) compute_layout: wgpu::BindGroupLayout,
     pub(super) classes_layout: wgpu::BindGroupLayout,
-    pub(super) pose_layout: wgpu::BindGroupLayout,
     pub(super) fragment: wgpu::RenderPipeline,
     pub(super) compute: wgpu::ComputePipeline,
     pub(super) classes: wgpu::ComputePipeline,
-    pub(super) sampler: wgpu::Sampler,
 }
 
 impl RebinPass {
@@ -77,20 +76,20 @@ impl RebinPass {
                 entries,
             })
         };
-        let frame_layout = layout("frame", &[uniform(0, both)]);
+        let frame_layout = layout("frame", &[uniform::<GpuFrame>(0, both)]);
         let compute_layout = layout(
             "frame (compute)",
             &[
-                uniform(0, both),
-                storage(1, false, wgpu::ShaderStages::COMPUTE),
+                uniform::<GpuFrame>(0, both),
+                storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
                 storage_texture(2, wgpu::TextureFormat::Rgba32Float),
             ],
         );
         let classes_layout = layout(
             "frame (classes)",
             &[
-                uniform(0, both),
-                storage(1, false, wgpu::ShaderStages::COMPUTE),
+                uniform::<GpuFrame>(0, both),
+                storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
             ],
         );
         let pose_layout = layout(
@@ -98,19 +97,15 @@ impl RebinPass {
             &[
                 texture_array(0, formats.image.sample_type()),
                 texture_array(1, formats.flow.sample_type()),
-                storage(2, true, both),
-                storage(3, true, both),
-                storage(4, true, both),
-                storage(5, true, both),
-                storage(6, true, both),
-                storage(7, true, both),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: both,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                storage(9, true, both),
+                storage::<GpuView>(2, true, both),
+                storage::<GpuQuad>(3, true, both),
+                storage::<[[f32; 256]; 2]>(4, true, both),
+                storage::<GpuProxy>(5, true, both),
+                storage::<u32>(6, true, both),
+                // The column index's header and at least one span's range.
+                storage_min(7, true, both, (size_of::<GpuColumnIndex>() + 8) as u64),
+                sampler(8, both),
+                storage::<GpuQuadFrame>(9, true, both),
             ],
         );
         let fragment = full_screen_pipeline(
@@ -142,15 +137,17 @@ impl RebinPass {
             ..Default::default()
         });
         Self {
-            formats,
+            pose: PoseBinding {
+                formats,
+                layout: pose_layout,
+                sampler,
+            },
             frame_layout,
             compute_layout,
             classes_layout,
-            pose_layout,
             fragment,
             compute,
             classes,
-            sampler,
         }
     }
 }
@@ -166,6 +163,11 @@ impl Subjects {
     /// The texture array of the subjects.
     pub fn texture(&self) -> &wgpu::Texture {
         self.targets.texture()
+    }
+
+    /// The id of the targets they are drawn into ([`SubjectTargets::id`]).
+    pub fn id(&self) -> u64 {
+        self.targets.id
     }
 }
 
@@ -205,6 +207,8 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
 /// pixel-class counters, staging buffers to read them back through, and per layer a frame uniform (written with `write_buffer`)
 /// with the bind groups of the fragment, compute and class passes.
 pub(super) struct SubjectTargets {
+    /// Names these targets in the keys of bind groups made of them ([`super::kept`]).
+    pub(super) id: u64,
     texture: wgpu::Texture,
     layers: Vec<LayerTargets>,
     stats: wgpu::Buffer,
@@ -307,6 +311,7 @@ impl SubjectTargets {
             })
             .collect();
         Self {
+            id: super::kept::unique_id(),
             texture,
             layers,
             stats,
@@ -413,18 +418,11 @@ impl RebinPass {
 
 impl Gpu {
     /// The kept targets of frames of `size` with `layers` walkers (made on first use;
-    /// the last few sizes are kept).
+    /// the few most recently used are kept).
     pub(super) fn subject_targets(&self, size: (u32, u32), layers: u32) -> Arc<SubjectTargets> {
-        let mut cache = self.targets.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, t)) = cache.iter().find(|(k, _)| *k == (size, layers)) {
-            return t.clone();
-        }
-        let t = Arc::new(SubjectTargets::new(&self.device, &self.rebin, size, layers));
-        if cache.len() >= 4 {
-            cache.remove(0);
-        }
-        cache.push(((size, layers), t.clone()));
-        t
+        self.targets.get((size, layers), || {
+            SubjectTargets::new(&self.device, &self.rebin, size, layers)
+        })
     }
 
     /// Records the frame pass of every instance into `encoder`: each pose drawn by its

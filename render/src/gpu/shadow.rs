@@ -6,7 +6,7 @@
 use frf_core::image::{Rgb, RgbImage};
 use wgpu::util::DeviceExt;
 
-use super::bind::{rgba32f, storage, storage_texture, uniform};
+use super::bind::{compute_pipeline, rgba32f, storage, storage_texture, uniform};
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::types::GpuShadowParams;
 use super::{Gpu, shaders};
@@ -30,25 +30,13 @@ impl ShadowPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow"),
             entries: &[
-                uniform(0, c),
-                storage(1, true, c),
-                storage(2, true, c),
+                uniform::<GpuShadowParams>(0, c),
+                storage::<f32>(1, true, c),
+                storage::<[f32; 4]>(2, true, c),
                 storage_texture(3, wgpu::TextureFormat::Rgba32Float),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("shadow"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("shadow"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("relight_shadow"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(device, "shadow", &[&layout], &module, "relight_shadow");
         Self { layout, pipeline }
     }
 }
