@@ -9,7 +9,7 @@ use frf_reflectance::FieldFile;
 use frf_render::gpu::Gpu;
 use frf_render::gpu::bench::{BenchOptions, BenchReport, all_formats, run};
 use frf_render::gpu::formats::PoseFormats;
-use frf_render::gpu::rebin::Stage;
+use frf_render::gpu::rebin::PassKind;
 use frf_render::resident::{Lighting, PoseSource, ResidentPose};
 use frf_render::synthetic::synthetic_pose;
 
@@ -132,9 +132,9 @@ fn interp(args: InterpArgs) -> CliResult {
             FormatsArg::Default => vec![PoseFormats::DEFAULT],
         },
         stages: match args.stages {
-            StagesArg::Both => Stage::ALL.to_vec(),
-            StagesArg::Fragment => vec![Stage::Fragment],
-            StagesArg::Compute => vec![Stage::Compute],
+            StagesArg::Both => PassKind::ALL.to_vec(),
+            StagesArg::Fragment => vec![PassKind::Fragment],
+            StagesArg::Compute => vec![PassKind::Compute],
         },
         warmup: args.warmup,
         repeats: args.repeats,

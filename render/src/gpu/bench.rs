@@ -2,7 +2,7 @@
 //! views, frames of several sizes, and per size the time of a floor pass (one texel
 //! fetch and one write per pixel: the least any frame pass can cost on the device) and of
 //! the nearest-view, linear-blend, two-way and four-way passes, for every storage format
-//! of the pose ([`super::formats`]) and as fragment and compute passes ([`Stage`]); the
+//! of the pose ([`super::formats`]) and as fragment and compute passes ([`PassKind`]); the
 //! CPU reference renders the same frames in the same run. Each GPU combination's frame is
 //! compared with the CPU reference's at the first size: a combination is correct when it
 //! stays within [`CORRECT_MAX_ABS`] of it.
@@ -13,7 +13,7 @@ use super::Gpu;
 use super::bind::{compute_pipeline, full_screen_pipeline, texture_array};
 use super::formats::{FlowFormat, ImageFormat, PoseFormats};
 use super::pose::GpuPose;
-use super::rebin::{RebinPass, Stage, SubjectTargets, frame_uniform, workgroups};
+use super::rebin::{PassKind, RebinPass, SubjectTargets, frame_uniform, workgroups};
 use super::timing::{Timestamps, median_min};
 use crate::cpu::render_cpu;
 use crate::error::Result;
@@ -44,7 +44,7 @@ pub struct BenchOptions {
     /// Storage formats.
     pub formats: Vec<PoseFormats>,
     /// Fragment and/or compute.
-    pub stages: Vec<Stage>,
+    pub stages: Vec<PassKind>,
     /// Passes run before timing.
     pub warmup: u32,
     /// Passes timed.
@@ -390,7 +390,7 @@ pub fn run(
 fn row(
     variant: &str,
     formats: PoseFormats,
-    stage: Stage,
+    stage: PassKind,
     size: (u32, u32),
     (ms_median, ms_min): (f64, f64),
     floor_ms: f64,
@@ -427,13 +427,13 @@ fn record_floor(
     floor: &FloorPass,
     targets: &SubjectTargets,
     group: &wgpu::BindGroup,
-    stage: Stage,
+    stage: PassKind,
     size: (u32, u32),
     encoder: &mut wgpu::CommandEncoder,
     timestamps: Timestamps,
 ) {
     match stage {
-        Stage::Fragment => {
+        PassKind::Fragment => {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("floor"),
                 color_attachments: &[super::bind::cleared(targets.layer_view(0))],
@@ -451,7 +451,7 @@ fn record_floor(
             pass.set_bind_group(1, group, &[]);
             pass.draw(0..3, 0..1);
         }
-        Stage::Compute => {
+        PassKind::Compute => {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("floor"),
                 timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {

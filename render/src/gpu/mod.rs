@@ -114,7 +114,7 @@ pub struct Gpu {
     relight: pose::RelightPass,
     rebin: rebin::RebinPass,
     /// How the frame pass runs.
-    stage: rebin::Stage,
+    stage: rebin::PassKind,
     /// Frame targets kept per size and number of walkers.
     targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
     /// Composite targets kept per size, number of walkers and shadow-map size.
@@ -166,7 +166,7 @@ impl Gpu {
         Self {
             relight: pose::RelightPass::new(&device),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
-            stage: rebin::Stage::Compute,
+            stage: rebin::PassKind::Compute,
             targets: kept::Kept::new(KEPT_TARGETS),
             composite_targets: kept::Kept::new(KEPT_TARGETS),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),

@@ -24,22 +24,22 @@ use crate::morph::Variant;
 
 /// Whether a pass runs as a full-screen triangle or as a compute dispatch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Stage {
+pub enum PassKind {
     /// Fragment shader into a colour attachment.
     Fragment,
     /// Compute shader (8 x 8 workgroups) into a storage texture.
     Compute,
 }
 
-impl Stage {
+impl PassKind {
     /// Both.
-    pub const ALL: [Stage; 2] = [Stage::Fragment, Stage::Compute];
+    pub const ALL: [PassKind; 2] = [PassKind::Fragment, PassKind::Compute];
 
     /// Its name in reports.
     pub fn name(self) -> &'static str {
         match self {
-            Stage::Fragment => "fragment",
-            Stage::Compute => "compute",
+            PassKind::Fragment => "fragment",
+            PassKind::Compute => "compute",
         }
     }
 }
@@ -360,14 +360,14 @@ impl RebinPass {
         targets: &SubjectTargets,
         layer: usize,
         pose_group: &wgpu::BindGroup,
-        stage: Stage,
+        stage: PassKind,
         size: (u32, u32),
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
         let t = &targets.layers[layer];
         match stage {
-            Stage::Fragment => {
+            PassKind::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("rebin"),
                     color_attachments: &[cleared(&t.view)],
@@ -385,7 +385,7 @@ impl RebinPass {
                 pass.set_bind_group(1, pose_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            Stage::Compute => {
+            PassKind::Compute => {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("rebin"),
                     timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
@@ -402,7 +402,7 @@ impl RebinPass {
             }
         }
         // The compute pass counts as it shades; a fragment pass needs its own.
-        if classes && stage == Stage::Fragment {
+        if classes && stage == PassKind::Fragment {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("classes"),
                 timestamp_writes: None,
