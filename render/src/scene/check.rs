@@ -1,0 +1,346 @@
+//! The checks of a scene file, section by section: each turns the parsed TOML
+//! ([`super::file`]) into the scene's values, or refuses it naming the file, the key and
+//! the line ([`Reporter`]).
+
+use frf_core::env::EnvSource;
+use frf_reflectance::project::FloorModel;
+use glam::Vec3;
+
+use super::file::{At, CameraToml, CompositeToml, LightingToml, OutputToml, Reporter, SceneToml};
+use super::{BackdropSpec, Instance, LightKey, MAX_FRAMES, MAX_SIDE_PX, Preview, ShadowSpec};
+use crate::composite::GroundLook;
+use crate::error::Result;
+use crate::morph::Variant;
+use crate::path::{CameraPath, Orbit, Trajectory};
+
+/// Albedo of `floor = "ground"`: a mid-grey ground.
+const GROUND_FLOOR_ALBEDO: f32 = 0.3;
+
+fn word<'w>(r: &Reporter, field: &str, v: &'w At<String>, allowed: &[&str]) -> Result<&'w str> {
+    let s = v.get_ref().as_str();
+    if allowed.contains(&s) {
+        Ok(s)
+    } else {
+        Err(r.error(
+            field,
+            v.span(),
+            format!("`{s}`: expected one of {allowed:?}"),
+        ))
+    }
+}
+
+fn finite(r: &Reporter, field: &str, v: &At<f32>) -> Result<f32> {
+    let x = *v.get_ref();
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(r.error(field, v.span(), format!("{x} is not a finite number")))
+    }
+}
+
+fn env(r: &Reporter, field: &str, v: &At<String>) -> Result<EnvSource> {
+    let source: EnvSource = v
+        .get_ref()
+        .parse()
+        .map_err(|e: String| r.error(field, v.span(), e))?;
+    Ok(match source {
+        EnvSource::File(p) => EnvSource::File(r.resolve(&p.to_string_lossy())),
+        other => other,
+    })
+}
+
+fn ground(r: &Reporter, v: &At<toml::Value>) -> Result<GroundLook> {
+    let number = |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64));
+    let albedo = match v.get_ref() {
+        toml::Value::String(s) if s == "env" => return Ok(GroundLook::Environment),
+        toml::Value::Array(a) if a.len() == 3 => {
+            let c: Vec<f64> = a.iter().filter_map(number).collect();
+            (c.len() == 3).then(|| [c[0] as f32, c[1] as f32, c[2] as f32])
+        }
+        other => number(other).map(|a| [a as f32; 3]),
+    };
+    match albedo {
+        Some(a) if a.iter().all(|x| (0.0..=1.0).contains(x)) => Ok(GroundLook::Albedo(a)),
+        _ => Err(r.error(
+            "composite.ground",
+            v.span(),
+            "expected \"env\", an albedo in 0 to 1, or [r, g, b]",
+        )),
+    }
+}
+
+/// `time`: start, end and frame rate.
+pub fn time(r: &Reporter, raw: &SceneToml) -> Result<(f32, f32, f32)> {
+    let t = raw.time.get_ref();
+    let (start, end, fps) = (
+        finite(r, "time.start", &t.start)?,
+        finite(r, "time.end", &t.end)?,
+        finite(r, "time.fps", &t.fps)?,
+    );
+    if end < start {
+        return Err(r.error(
+            "time.end",
+            t.end.span(),
+            format!("{end} s is before start {start} s"),
+        ));
+    }
+    if !(fps > 0.0 && fps <= 1000.0) {
+        return Err(r.error(
+            "time.fps",
+            t.fps.span(),
+            format!("{fps}: expected (0, 1000]"),
+        ));
+    }
+    if ((end - start) * fps) as f64 > MAX_FRAMES as f64 {
+        return Err(r.error(
+            "time",
+            raw.time.span(),
+            format!("{} frames: at most {MAX_FRAMES}", (end - start) * fps),
+        ));
+    }
+    Ok((start, end, fps))
+}
+
+/// What `output` sets: frame size (if given), exposure in stops, preview, variant.
+pub type OutputSettings = (Option<(u32, u32)>, f32, Preview, Variant);
+
+/// `output`: size, exposure, preview and variant.
+pub fn output(r: &Reporter, o: &OutputToml) -> Result<OutputSettings> {
+    let size = match &o.size {
+        Some(s) => {
+            let [w, h] = *s.get_ref();
+            if !(1..=MAX_SIDE_PX).contains(&w) || !(1..=MAX_SIDE_PX).contains(&h) {
+                return Err(r.error(
+                    "output.size",
+                    s.span(),
+                    format!("{w}x{h}: each side 1 to {MAX_SIDE_PX}"),
+                ));
+            }
+            Some((w, h))
+        }
+        None => None,
+    };
+    let exposure = finite(r, "output.exposure", &o.exposure)?;
+    if exposure.abs() > 30.0 {
+        return Err(r.error(
+            "output.exposure",
+            o.exposure.span(),
+            format!("{exposure} stops: expected -30 to 30"),
+        ));
+    }
+    let preview = match word(r, "output.preview", &o.preview, &["apng", "gif", "none"])? {
+        "apng" => Preview::Apng,
+        "gif" => Preview::Gif,
+        _ => Preview::None,
+    };
+    let variant = Variant::ALL
+        .into_iter()
+        .find(|v| v.name() == o.variant.get_ref())
+        .ok_or_else(|| {
+            r.error(
+                "output.variant",
+                o.variant.span(),
+                format!(
+                    "`{}`: expected one of {}",
+                    o.variant.get_ref(),
+                    Variant::ALL.map(Variant::name).join(", ")
+                ),
+            )
+        })?;
+    Ok((size, exposure, preview, variant))
+}
+
+/// `lighting`: its keys (the base first) and what lights the floor conditions.
+pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, FloorModel)> {
+    let l = l.get_ref();
+    let mut lighting = vec![LightKey {
+        time: f32::NEG_INFINITY,
+        env: env(r, "lighting.env", &l.env)?,
+        yaw: finite(r, "lighting.yaw_deg", &l.yaw_deg)?.to_radians(),
+        intensity: finite(r, "lighting.intensity", &l.intensity)?,
+    }];
+    for (i, k) in l.key.iter().enumerate() {
+        let key = k.get_ref();
+        let field = |name: &str| format!("lighting.key[{i}].{name}");
+        let prev = lighting.last().expect("at least the base").clone();
+        let time = finite(r, &field("time"), &key.time)?;
+        if time <= prev.time {
+            return Err(r.error(
+                &field("time"),
+                key.time.span(),
+                format!("{time} s does not follow the previous key"),
+            ));
+        }
+        lighting.push(LightKey {
+            time,
+            env: match &key.env {
+                Some(e) => env(r, &field("env"), e)?,
+                None => prev.env.clone(),
+            },
+            yaw: match &key.yaw_deg {
+                Some(y) => finite(r, &field("yaw_deg"), y)?.to_radians(),
+                None => prev.yaw,
+            },
+            intensity: match &key.intensity {
+                Some(v) => finite(r, &field("intensity"), v)?,
+                None => prev.intensity,
+            },
+        });
+    }
+    for (i, k) in lighting.iter().enumerate() {
+        if !(k.intensity >= 0.0 && k.intensity <= 1e6) {
+            let span = if i == 0 {
+                l.intensity.span()
+            } else {
+                l.key[i - 1].span()
+            };
+            return Err(r.error(
+                "lighting.intensity",
+                span,
+                format!("{}: expected 0 to 10^6", k.intensity),
+            ));
+        }
+    }
+    if lighting.iter().any(|k| k.env == EnvSource::None) && lighting.len() > 1 {
+        return Err(r.error("lighting.env", l.env.span(), "`none` cannot be keyframed"));
+    }
+    let floor = match word(r, "lighting.floor", &l.floor, &["env", "ground"])? {
+        "env" => FloorModel::Environment,
+        _ => FloorModel::LambertianGround {
+            albedo: [GROUND_FLOOR_ALBEDO; 3],
+        },
+    };
+    Ok((lighting, floor))
+}
+
+/// `camera`: an orbit or keys.
+pub fn camera(r: &Reporter, camera: &At<CameraToml>) -> Result<Trajectory> {
+    let c = camera.get_ref();
+    let camera = match (&c.orbit, c.key.is_empty()) {
+        (Some(o), true) => {
+            let orbit = o.get_ref();
+            let orbit = Orbit {
+                radius: orbit.radius,
+                height: orbit.height,
+                start_deg: orbit.start_deg,
+                sweep_deg: orbit.sweep_deg,
+                look_at: Vec3::from(orbit.look_at),
+                fov_deg: orbit.fov_deg,
+            };
+            orbit
+                .validate()
+                .map_err(|e| r.error("camera.orbit", o.span(), e))?;
+            Trajectory::Orbit(orbit)
+        }
+        (None, false) => {
+            let keys = c.key.iter().map(|k| *k.get_ref()).collect();
+            Trajectory::Path(
+                CameraPath::new(keys).map_err(|e| r.error("camera.key", camera.span(), e))?,
+            )
+        }
+        _ => {
+            return Err(r.error(
+                "camera",
+                camera.span(),
+                "give either an orbit or keys ([[camera.key]])",
+            ));
+        }
+    };
+    Ok(camera)
+}
+
+/// `composite`: the backdrop and the shadow, checked against the camera and lighting.
+pub fn composite(
+    r: &Reporter,
+    comp: &CompositeToml,
+    (camera, camera_span): (&Trajectory, &At<CameraToml>),
+    lighting: &[LightKey],
+) -> Result<(BackdropSpec, ShadowSpec)> {
+    let backdrop = match word(
+        r,
+        "composite.backdrop",
+        &comp.backdrop,
+        &["env", "plate", "none"],
+    )? {
+        "env" => BackdropSpec::Environment(match &comp.ground {
+            Some(g) => ground(r, g)?,
+            None => GroundLook::Environment,
+        }),
+        "plate" => {
+            let plate = comp.plate.as_ref().ok_or_else(|| {
+                r.error(
+                    "composite.plate",
+                    comp.backdrop.span(),
+                    "backdrop = \"plate\" needs plate = \"FILE\"",
+                )
+            })?;
+            if !matches!(camera, Trajectory::Path(p) if p.keys.len() == 1) {
+                return Err(r.error(
+                    "camera",
+                    camera_span.span(),
+                    "a plate is seen by its own camera: give one camera key",
+                ));
+            }
+            BackdropSpec::Plate(r.resolve(plate.get_ref()))
+        }
+        _ => BackdropSpec::None,
+    };
+    if matches!(backdrop, BackdropSpec::Environment(_))
+        && lighting.iter().any(|k| k.env == EnvSource::None)
+    {
+        return Err(r.error(
+            "composite.backdrop",
+            comp.backdrop.span(),
+            "an environment backdrop needs an environment (lighting.env)",
+        ));
+    }
+    let shadow = match word(
+        r,
+        "composite.shadow",
+        &comp.shadow,
+        &["maps", "traced", "none"],
+    )? {
+        "maps" => ShadowSpec::Maps,
+        "traced" => ShadowSpec::Traced,
+        _ => ShadowSpec::None,
+    };
+    Ok((backdrop, shadow))
+}
+
+/// `instance`: the walkers (one at the origin when none is given).
+pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
+    let mut instances = Vec::new();
+    for (i, inst) in raw.instance.iter().enumerate() {
+        let v = inst.get_ref();
+        let finite_all = v.position.iter().all(|c| c.is_finite())
+            && v.heading_deg.is_finite()
+            && v.time_offset.is_finite();
+        if !finite_all || v.position.iter().any(|c| c.abs() > 1e4) || v.time_offset.abs() > 1e6 {
+            return Err(r.error(
+                &format!("instance[{i}]"),
+                inst.span(),
+                "values must be finite (positions within 10 km)",
+            ));
+        }
+        if v.position[1] != 0.0 {
+            return Err(r.error(
+                &format!("instance[{i}].position"),
+                inst.span(),
+                "walkers stand on the ground: y must be 0",
+            ));
+        }
+        instances.push(Instance {
+            position: Vec3::from(v.position),
+            heading: v.heading_deg.to_radians(),
+            time_offset: v.time_offset,
+        });
+    }
+    if instances.is_empty() {
+        instances.push(Instance {
+            position: Vec3::ZERO,
+            heading: 0.0,
+            time_offset: 0.0,
+        });
+    }
+    Ok(instances)
+}
