@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::max_row_jump;
-use crate::views::{EvalCamera, VariantScore, evaluate, truth_frames};
+use crate::views::{EvalCamera, ReportHeader, VariantScore, evaluate, truth_frames};
 use frf_core::progress::Progress;
 
 /// A named trajectory of the suite.
@@ -141,20 +141,9 @@ pub struct PathScore {
 /// What `frf eval --json` prints along paths.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PathsReport {
-    /// The field.
-    pub field: PathBuf,
-    /// The capture whose stage gave the truth.
-    pub capture: PathBuf,
-    /// The environment.
-    pub env: String,
-    /// The pose.
-    pub pose: u32,
-    /// The renderer's device.
-    pub device: String,
-    /// Median-cut lights of the truth.
-    pub truth_lights: usize,
-    /// Seconds per true frame (CPU).
-    pub truth_seconds_per_frame: f64,
+    /// What was rendered, and how the truth was made.
+    #[serde(flatten)]
+    pub header: ReportHeader,
     /// Frame width.
     pub width: u32,
     /// Frame height.
@@ -263,13 +252,15 @@ pub fn evaluate_paths(
     let truth_frames = (paths.len() * options.frames).max(1) as f64;
     let (field, capture, env) = options.names.clone();
     Ok(PathsReport {
-        field,
-        capture,
-        env,
-        pose,
-        device: renderer.device(),
-        truth_lights: options.light_count,
-        truth_seconds_per_frame: truth_seconds / truth_frames,
+        header: ReportHeader {
+            field,
+            capture,
+            env,
+            pose,
+            device: renderer.device(),
+            truth_lights: options.light_count,
+            truth_seconds_per_frame: truth_seconds / truth_frames,
+        },
         width: w,
         height: h,
         frames_per_path: options.frames,

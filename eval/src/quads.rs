@@ -20,26 +20,17 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Result;
 use crate::scene::{SceneScore, score_scene};
-use crate::views::{VariantScore, between_view_cameras, evaluate, grid_view_cameras, truth_frames};
+use crate::views::{
+    ReportHeader, VariantScore, between_view_cameras, evaluate, grid_view_cameras, truth_frames,
+};
 use frf_core::progress::Progress;
 
 /// What `frf eval --json` prints at quad centres.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct QuadsReport {
-    /// The field.
-    pub field: PathBuf,
-    /// The capture whose stage gave the truth.
-    pub capture: PathBuf,
-    /// The environment.
-    pub env: String,
-    /// The pose.
-    pub pose: u32,
-    /// The renderer's device.
-    pub device: String,
-    /// Median-cut lights of the truth.
-    pub truth_lights: usize,
-    /// Seconds per true frame (CPU).
-    pub truth_seconds_per_frame: f64,
+    /// What was rendered, and how the truth was made.
+    #[serde(flatten)]
+    pub header: ReportHeader,
     /// The cameras' names.
     pub cameras: Vec<String>,
     /// Each variant.
@@ -141,13 +132,15 @@ pub fn evaluate_quads<R: ReadAt>(
     };
     let (field_name, capture, env) = options.names.clone();
     Ok(QuadsReport {
-        field: field_name,
-        capture,
-        env,
-        pose,
-        device: renderer.device(),
-        truth_lights: options.light_count,
-        truth_seconds_per_frame: seconds / all.len().max(1) as f64,
+        header: ReportHeader {
+            field: field_name,
+            capture,
+            env,
+            pose,
+            device: renderer.device(),
+            truth_lights: options.light_count,
+            truth_seconds_per_frame: seconds / all.len().max(1) as f64,
+        },
         cameras: cameras.iter().map(|c| c.name.clone()).collect(),
         variants,
         at_captured_views: floor,

@@ -11,6 +11,7 @@
 //! shows that cycle's perturbed walker (docs/design.md section 5.2): captures with perturbation 0
 //! isolate the interpolation error.
 
+use std::path::PathBuf;
 use std::time::Instant;
 
 use frf_core::camera::Camera;
@@ -74,6 +75,26 @@ pub struct VariantScore {
     pub seconds_per_frame: f64,
     /// Each frame.
     pub frames: Vec<FrameScore>,
+}
+
+/// What every report of renders against the truth begins with: what was rendered, from
+/// which capture's truth, under which environment, on which device.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ReportHeader {
+    /// The field.
+    pub field: PathBuf,
+    /// The capture whose stage gave the truth.
+    pub capture: PathBuf,
+    /// The environment.
+    pub env: String,
+    /// The pose.
+    pub pose: u32,
+    /// The renderer's device.
+    pub device: String,
+    /// Median-cut lights of the truth.
+    pub truth_lights: usize,
+    /// Seconds per true frame (CPU).
+    pub truth_seconds_per_frame: f64,
 }
 
 /// A camera to evaluate at, named.

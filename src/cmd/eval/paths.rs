@@ -68,9 +68,9 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         input.pose,
         args.lighting.source()?,
         args.lights,
-        report.truth_seconds_per_frame,
+        report.header.truth_seconds_per_frame,
         paths.len(),
-        report.device
+        report.header.device
     );
     for p in &report.paths {
         let jump = p.truth_max_row_jump.iter().cloned().fold(0.0, f64::max);

@@ -55,9 +55,9 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         input.pose,
         args.lighting.source()?,
         args.lights,
-        report.truth_seconds_per_frame,
+        report.header.truth_seconds_per_frame,
         report.cameras.len(),
-        report.device
+        report.header.device
     );
     eprintln!("{TABLE_HEADER}");
     for s in report.variants.iter().chain([&report.at_captured_views]) {

@@ -337,7 +337,7 @@ impl Sweep<'_> {
             field,
             &["--cameras", self.cameras(), "--variants", VARIANTS],
         )?;
-        self.adapter = views.device.clone();
+        self.adapter = views.header.device.clone();
         for v in &views.variants {
             for (metric, error) in [
                 ("subject PSNR dB", v.psnr_subject),
