@@ -78,6 +78,10 @@ pub struct OracleWritten {
     pub shadow_seconds: f64,
 }
 
+/// How `frf stage field` starts the line giving the seconds of its hulls and shadow maps
+/// ([`OracleWritten::shadow_seconds`]), which `frf report` reads.
+pub const SHADOW_TIME_LINE: &str = "visual hulls and shadow maps: ";
+
 /// Writes the oracle field of `stage` to `path`; `progress(done, total)` counts views.
 pub fn write_oracle_field(
     stage: &Stage,

@@ -9,7 +9,7 @@
 //! that is read, relit and drawn (`--no-plan`: everything). Frames are written as 8-bit
 //! sRGB PNG (straight alpha) and linear premultiplied EXR, with EXR layers on request, a
 //! contact sheet, an animated preview and `render.json`; `--frames A..B` renders part of
-//! a shot (for a farm), and a rerun resumes ([`crate::cmd::output`]).
+//! a shot (for a farm), and a rerun resumes (`frf_render::scene::output`).
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::Args;
 use frf_core::env::{EnvMap, EnvSource};
-use frf_eval::oracle::{OracleOptions, write_oracle_field};
+use frf_eval::oracle::{OracleOptions, SHADOW_TIME_LINE, write_oracle_field};
 use frf_eval::storage::{codec_curve, projection_error, stage_projector};
 use frf_reflectance::project::FloorModel;
 
@@ -37,10 +37,6 @@ pub struct FieldArgs {
     #[command(flatten)]
     shadows: crate::cmd::args::ShadowArgs,
 }
-
-/// How `frf stage field` starts the line giving the time of its hulls and shadow maps
-/// (`frf report` reads it).
-pub const SHADOW_TIME_LINE: &str = "visual hulls and shadow maps: ";
 
 /// Runs `frf stage field`.
 pub fn field(args: FieldArgs) -> CliResult {

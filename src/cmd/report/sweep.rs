@@ -549,7 +549,7 @@ impl Sweep<'_> {
             let build = built
                 .stdout
                 .lines()
-                .find_map(|l| l.strip_prefix(crate::cmd::stage_field::SHADOW_TIME_LINE))
+                .find_map(|l| l.strip_prefix(frf_eval::oracle::SHADOW_TIME_LINE))
                 .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
                 .ok_or_else(|| {
                     format!("{}: no time of the hulls and shadow maps", built.command)
