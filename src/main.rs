@@ -53,6 +53,9 @@ enum Command {
     /// Error against run time of every stage's settings on a stage capture: JSON, plots,
     /// and one page.
     Report(cmd::report::ReportArgs),
+    /// Look at a field or a scene in a window: move the camera, play the walk, turn the
+    /// light; record a camera move as a scene file.
+    View(Box<cmd::view::ViewArgs>),
     /// Benchmarks: `frf bench interp` times the GPU interpolation passes.
     Bench(cmd::bench::BenchArgs),
     /// Optical flow from image A to image B, written as a Middlebury .flo file.
@@ -89,6 +92,7 @@ fn main() -> ExitCode {
         Command::Eval(args) => cmd::eval::run(*args),
         Command::EvalRing(args) => cmd::eval::run_ring(args),
         Command::Report(args) => cmd::report::run(args),
+        Command::View(args) => cmd::view::run(*args),
         Command::Bench(args) => cmd::bench::run_bench(args),
         Command::Flow(args) => cmd::flow::run(args),
         Command::FlowBench(args) => cmd::flow::run_bench(args),
@@ -124,7 +128,8 @@ fn fault_of(e: &(dyn std::error::Error + 'static)) -> Fault {
         frf_ingest::IngestError,
         frf_render::RenderError,
         frf_stage::StageError,
-        frf_eval::EvalError
+        frf_eval::EvalError,
+        frf_view::ViewError
     );
     if e.downcast_ref::<std::io::Error>().is_some() {
         return Fault::Io;

@@ -70,12 +70,37 @@ impl Resident {
     pub fn has_shadow(&self) -> bool {
         self.shadow
     }
+
+    /// The walker of a GPU frame this pose is, standing at `world_from_subject`.
+    pub fn gpu_instance(&self, world_from_subject: Rigid) -> Result<GpuInstanceRef<'_>> {
+        match &self.kind {
+            ResidentKind::Gpu(pose) => Ok(GpuInstanceRef {
+                pose,
+                world_from_subject,
+            }),
+            ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
+                "a CPU-resident pose given to the GPU renderer".into(),
+            )),
+        }
+    }
 }
 
 /// A backdrop made resident on a [`Device`].
 pub struct DeviceBackdrop {
     cpu: Backdrop,
     gpu: Option<GpuBackdrop>,
+}
+
+impl DeviceBackdrop {
+    /// The backdrop resident on the GPU; `None` on the CPU.
+    pub fn gpu(&self) -> Option<&GpuBackdrop> {
+        self.gpu.as_ref()
+    }
+
+    /// Whether `camera` can see it (a plate is seen by its own camera's size).
+    pub fn check(&self, camera: &Camera) -> Result<()> {
+        self.cpu.check(camera)
+    }
 }
 
 /// A walker of a frame: a resident pose and where it stands.
@@ -228,15 +253,7 @@ impl Device {
         if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
             let instances = walkers
                 .iter()
-                .map(|w| match &w.resident.kind {
-                    ResidentKind::Gpu(pose) => Ok(GpuInstanceRef {
-                        pose,
-                        world_from_subject: w.world_from_subject,
-                    }),
-                    ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
-                        "a CPU-resident pose given to the GPU renderer".into(),
-                    )),
-                })
+                .map(|w| w.resident.gpu_instance(w.world_from_subject))
                 .collect::<Result<Vec<_>>>()?;
             let (composite, l, stats) =
                 gpu.render_composite(&instances, b, camera, variant, layers)?;

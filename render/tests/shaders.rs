@@ -10,8 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
-    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuProxy, GpuQuad, GpuQuadFrame,
-    GpuRelightParams, GpuShadowParams, GpuView,
+    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuPresent, GpuProxy, GpuQuad,
+    GpuQuadFrame, GpuRelightParams, GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -231,6 +231,13 @@ fn pod_structs_match_naga_layouts() {
         "ShadowParams",
         GpuShadowParams,
         [texels, maps, pad]
+    );
+    let present = module(&shaders::composed(shaders::PRESENT), "present");
+    check_layout!(
+        &present,
+        "Present",
+        GpuPresent,
+        [origin, extent, layer, encode, exposure, pad]
     );
     let composite = module(&shaders::composed(shaders::COMPOSITE), "composite");
     check_layout!(

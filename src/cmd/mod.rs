@@ -14,3 +14,4 @@ pub mod render;
 pub mod report;
 pub mod stage;
 pub mod stage_field;
+pub mod view;

@@ -146,13 +146,26 @@ fn wanted() -> Option<String> {
 
 /// Every adapter of `instance` with what it lacks, preferred first.
 pub fn candidates(instance: &wgpu::Instance) -> Vec<(wgpu::Adapter, Candidate)> {
+    candidates_for(instance, None)
+}
+
+/// Every adapter of `instance` with what it lacks (with `surface`, presenting to it too),
+/// preferred first.
+fn candidates_for(
+    instance: &wgpu::Instance,
+    surface: Option<&wgpu::Surface>,
+) -> Vec<(wgpu::Adapter, Candidate)> {
     let mut all: Vec<(wgpu::Adapter, Candidate)> =
         pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
             .into_iter()
             .map(|a| {
+                let mut lacks = lacks(&a);
+                if surface.is_some_and(|s| !a.is_surface_supported(s)) {
+                    lacks.push("presenting to the window".into());
+                }
                 let c = Candidate {
                     adapter: describe(&a.get_info()),
-                    lacks: lacks(&a),
+                    lacks,
                 };
                 (a, c)
             })
@@ -163,7 +176,16 @@ pub fn candidates(instance: &wgpu::Instance) -> Vec<(wgpu::Adapter, Candidate)> 
 
 /// The adapter to render with (see the module docs), and the report of the choice.
 pub fn choose(instance: &wgpu::Instance) -> Result<(wgpu::Adapter, AdapterReport)> {
-    let all = candidates(instance);
+    choose_for(instance, None)
+}
+
+/// The adapter to render with that can also present to `surface` (a window's), when one
+/// is given, and the report of the choice.
+pub fn choose_for(
+    instance: &wgpu::Instance,
+    surface: Option<&wgpu::Surface>,
+) -> Result<(wgpu::Adapter, AdapterReport)> {
+    let all = candidates_for(instance, surface);
     let listed: Vec<Candidate> = all.iter().map(|(_, c)| c.clone()).collect();
     let summary = || {
         listed

@@ -9,6 +9,11 @@ use frf_core::image::{Image, Rgba};
 use wgpu::util::DeviceExt;
 
 use frf_core::camera::Rigid;
+use std::sync::Arc;
+
+use super::composite_targets::CompositeTargets;
+use super::rebin::Subjects;
+use super::timing::Timestamps;
 
 use super::bind::{
     FLOAT, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
@@ -74,6 +79,21 @@ pub struct GpuInstanceRef<'a> {
     pub pose: &'a GpuPose,
     /// Its subject frame in the world.
     pub world_from_subject: Rigid,
+}
+
+/// A frame drawn into the kept targets of its size and not read back
+/// ([`Gpu::encode_composite`]).
+pub struct DrawnFrame {
+    pub(super) targets: Arc<CompositeTargets>,
+    subjects: Subjects,
+}
+
+impl DrawnFrame {
+    /// Width and height, pixels.
+    pub fn size(&self) -> (u32, u32) {
+        let t = &self.targets.targets[0];
+        (t.width(), t.height())
+    }
 }
 
 /// A backdrop resident on the GPU.
@@ -189,6 +209,61 @@ impl Gpu {
         variant: Variant,
         layers: bool,
     ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("composite"),
+            });
+        let drawn =
+            self.encode_composite(&mut encoder, instances, backdrop, camera, variant, None)?;
+        self.read_drawn(encoder, &drawn, layers)
+    }
+
+    /// Reads back the frame `encoder` draws (`drawn`, [`Gpu::encode_composite`]): submits
+    /// it with the copies, and returns the composite, the layers when `layers`, and what
+    /// happened to the walkers' pixels.
+    pub fn read_drawn(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        drawn: &DrawnFrame,
+        layers: bool,
+    ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
+        self.scoped("reading a frame back", || {
+            let t = &drawn.targets;
+            // Composite, then (with layers) subject, shadow and backdrop.
+            let read: &[usize] = if layers { &[0, 3, 1, 2] } else { &[0] };
+            for &k in read {
+                t.readback[k].copy(&mut encoder, &t.targets[k]);
+            }
+            self.copy_stats(&mut encoder, &drawn.subjects);
+            self.queue.submit([encoder.finish()]);
+            let image = self.read_rgba(&t.readback[0])?;
+            let layers = if layers {
+                Some(Layers {
+                    subject: self.read_rgba(&t.readback[3])?,
+                    shadow: self.read_rgba(&t.readback[1])?.map(|p| [p[0], p[1], p[2]]),
+                    backdrop: self.read_rgba(&t.readback[2])?,
+                })
+            } else {
+                None
+            };
+            Ok((image, layers, self.read_stats(&drawn.subjects)?))
+        })
+    }
+
+    /// Records into `encoder` a frame of `camera` as [`Gpu::render_composite`] draws it,
+    /// into kept targets, and reads nothing back: what a window shows
+    /// ([`super::present`]), or [`Gpu::read_drawn`] reads. The first walker's frame pass
+    /// writes `timestamps` (two queries) when given.
+    pub fn encode_composite(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        instances: &[GpuInstanceRef],
+        backdrop: &GpuBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        timestamps: Timestamps,
+    ) -> Result<DrawnFrame> {
         if let Some((w, h)) = backdrop.plate_size
             && (w, h) != (camera.width, camera.height)
         {
@@ -231,12 +306,7 @@ impl Gpu {
                     (i.pose, camera.transformed(&i.world_from_subject.inverse()))
                 })
                 .collect();
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("composite"),
-                });
-            let subjects = self.draw_subjects(&mut encoder, &drawn, size, variant);
+            let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let mut gpu_instances = Vec::with_capacity(order.len());
@@ -330,24 +400,10 @@ impl Gpu {
                 pass.set_bind_group(1, &*image_group, &[]);
                 pass.draw(0..3, 0..1);
             }
-            // Composite, then (with layers) subject, shadow and backdrop.
-            let read: &[usize] = if layers { &[0, 3, 1, 2] } else { &[0] };
-            for &k in read {
-                t.readback[k].copy(&mut encoder, &t.targets[k]);
-            }
-            self.copy_stats(&mut encoder, &subjects);
-            self.queue.submit([encoder.finish()]);
-            let image = self.read_rgba(&t.readback[0])?;
-            let layers = if layers {
-                Some(Layers {
-                    subject: self.read_rgba(&t.readback[3])?,
-                    shadow: self.read_rgba(&t.readback[1])?.map(|p| [p[0], p[1], p[2]]),
-                    backdrop: self.read_rgba(&t.readback[2])?,
-                })
-            } else {
-                None
-            };
-            Ok((image, layers, self.read_stats(&subjects)?))
+            Ok(DrawnFrame {
+                targets: t,
+                subjects,
+            })
         })
     }
 }

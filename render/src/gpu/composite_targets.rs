@@ -21,6 +21,8 @@ pub(super) type CompositeKey = ((u32, u32), u32, u32);
 
 /// The composite pass's kept targets and buffers for one [`CompositeKey`].
 pub(super) struct CompositeTargets {
+    /// Names the targets in the keys of bind groups made of them ([`super::kept`]).
+    pub(super) id: u64,
     /// Composite, relative irradiance (shadow), backdrop, subjects alone.
     pub(super) targets: [wgpu::Texture; 4],
     pub(super) target_views: [wgpu::TextureView; 4],
@@ -40,7 +42,10 @@ pub(super) struct CompositeTargets {
 impl CompositeTargets {
     fn new(device: &wgpu::Device, pass: &CompositePass, key: CompositeKey) -> Self {
         let (size, walkers, texels) = key;
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        // Bound as textures by a window's present pass ([`super::present`]).
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::TEXTURE_BINDING;
         let labels = [
             "composite",
             "shadow layer",
@@ -93,6 +98,7 @@ impl CompositeTargets {
         });
         let readback = labels.map(|label| Readback::new(device, label, size));
         Self {
+            id: super::kept::unique_id(),
             targets,
             target_views,
             shadows,

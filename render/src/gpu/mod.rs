@@ -8,7 +8,9 @@
 //! - [`shadow`]: the pose's shadow maps relit (`shaders/shadow.wgsl`; twin of
 //!   [`crate::shadow::ShadowMaps::relight`]);
 //! - [`composite`]: the subject over a shadowed backdrop (`shaders/composite.wgsl`; twin
-//!   of [`crate::composite::compose`]).
+//!   of [`crate::composite::compose`]);
+//! - [`present`]: a composited frame shown in a window, nothing read back
+//!   (`shaders/present.wgsl`).
 //!
 //! [`Gpu::new`] opens an adapter (on machines without a GPU, Mesa's lavapipe; the
 //! `WGPU_BACKEND` variable chooses a backend) and builds every pipeline once. Every
@@ -23,6 +25,7 @@ mod composite_targets;
 pub mod formats;
 pub mod kept;
 pub mod pose;
+pub mod present;
 mod readback;
 pub mod rebin;
 pub mod scope;
@@ -46,6 +49,8 @@ pub mod shaders {
     pub const SHADOW: &str = include_str!("../../shaders/shadow.wgsl");
     /// `shaders/composite.wgsl`, standalone.
     pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
+    /// `shaders/present.wgsl`: a frame shown in a window.
+    pub const PRESENT: &str = include_str!("../../shaders/present.wgsl");
     /// `shaders/floor.wgsl`, standalone.
     pub const FLOOR: &str = include_str!("../../shaders/floor.wgsl");
     /// `shaders/rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera
@@ -70,11 +75,12 @@ pub mod shaders {
     pub const FLOW_F32: &str = include_str!("../../shaders/sample/flow_f32.wgsl");
 
     /// Every pass but the frame pass (composed by [`super::formats::PoseFormats`]), named.
-    pub const PASSES: [(&str, &str); 4] = [
+    pub const PASSES: [(&str, &str); 5] = [
         ("relight", RELIGHT),
         ("shadow", SHADOW),
         ("composite", COMPOSITE),
         ("floor", FLOOR),
+        ("present", PRESENT),
     ];
 
     /// A pass's shader module on `device`.
@@ -109,6 +115,8 @@ pub struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     adapter: String,
+    /// The adapter opened.
+    wgpu_adapter: wgpu::Adapter,
     report: adapter::AdapterReport,
     uncaptured: scope::Uncaptured,
     relight: pose::RelightPass,
@@ -131,7 +139,13 @@ impl Gpu {
     pub fn new() -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let (adapter, report) = adapter::choose(&instance)?;
+        Self::on(&instance, None)
+    }
+
+    /// Opens the adapter of `instance` [`adapter::choose_for`] takes (one that can present
+    /// to `surface`, a window's, when one is given) and builds the pipelines.
+    pub fn on(instance: &wgpu::Instance, surface: Option<&wgpu::Surface>) -> Result<Self> {
+        let (adapter, report) = adapter::choose_for(instance, surface)?;
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("frf"),
@@ -144,6 +158,7 @@ impl Gpu {
         uncaptured.install(&device);
         scope::scoped(&device, &uncaptured, "building the pipelines", || {
             Ok(Self::build(
+                adapter,
                 device.clone(),
                 queue,
                 report,
@@ -154,6 +169,7 @@ impl Gpu {
 
     /// The pipelines and layouts of the renderer on `device`.
     fn build(
+        wgpu_adapter: wgpu::Adapter,
         device: wgpu::Device,
         queue: wgpu::Queue,
         report: adapter::AdapterReport,
@@ -175,6 +191,7 @@ impl Gpu {
             device,
             queue,
             adapter,
+            wgpu_adapter,
             report,
             uncaptured,
         }
@@ -187,6 +204,27 @@ impl Gpu {
         f: impl FnOnce() -> Result<T>,
     ) -> Result<T> {
         scope::scoped(&self.device, &self.uncaptured, operation, f)
+    }
+
+    /// The device, for a caller drawing its own passes beside the renderer's (a
+    /// viewer's user interface).
+    pub fn device(&self) -> &wgpu::Device {
+        &self.device
+    }
+
+    /// The adapter the device was opened on (what a window's surface is configured for).
+    pub fn wgpu_adapter(&self) -> &wgpu::Adapter {
+        &self.wgpu_adapter
+    }
+
+    /// The queue of [`Gpu::device`].
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.queue
+    }
+
+    /// Whether the device can time passes with timestamp queries.
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamps
     }
 
     /// The largest texture side the device takes, pixels.

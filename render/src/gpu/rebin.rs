@@ -435,6 +435,7 @@ impl Gpu {
         instances: &[(&GpuPose, Camera)],
         size: (u32, u32),
         variant: Variant,
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> Subjects {
         let targets = self.subject_targets(size, instances.len().max(1) as u32);
         encoder.clear_buffer(&targets.stats, 0, None);
@@ -452,7 +453,7 @@ impl Gpu {
                 &pose.bind_group,
                 self.stage,
                 size,
-                None,
+                timestamps.filter(|_| layer == 0),
                 true,
             );
         }
@@ -505,7 +506,7 @@ impl Gpu {
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("frame"),
                 });
-            let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant);
+            let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant, None);
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
             self.copy_stats(&mut encoder, &subject);

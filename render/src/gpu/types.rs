@@ -217,3 +217,21 @@ pub struct GpuColumnIndex {
     /// 1 when the index is used; 0: every quad is solved.
     pub enabled: u32,
 }
+
+/// `Present` of `shaders/present.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuPresent {
+    /// Top-left corner of the frame in the window, pixels.
+    pub origin: [f32; 2],
+    /// Size of the frame in the window, pixels.
+    pub extent: [f32; 2],
+    /// The layer shown ([`super::present::ShownLayer`]).
+    pub layer: u32,
+    /// 1 when the shader encodes sRGB (the target format does not).
+    pub encode: u32,
+    /// `2^stops`.
+    pub exposure: f32,
+    /// Padding.
+    pub pad: u32,
+}

@@ -115,7 +115,7 @@ pub struct Plan {
 }
 
 /// The nearest pose `field_poses` holds to `wanted`, going round the cycle of `n` poses.
-fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
+pub(crate) fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
     *field_poses
         .iter()
         .min_by_key(|&&p| {

@@ -4,11 +4,16 @@
 //! resident poses fit in a stated memory budget (the least recently used leaves first),
 //! and relit again only when the lighting it was relit with changes.
 //!
+//! A shot is also what a viewer draws ([`Shot::live`]): frames at any time and camera,
+//! drawn into kept targets without a readback ([`Shot::draw_at`]), the scene edited
+//! between frames ([`Shot::edit`]; what an edit changes is made again, nothing else).
+//!
 //! The lighting of a frame is the scene's at its time: a mix of at most two maps (a
 //! cross-fade), turned by the yaw and scaled by the intensity, in the scene frame. A
 //! walker turned by heading `h` sees it turned by `−h`. The environment backdrop is the
 //! same lighting, seen from the scene frame.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -18,10 +23,11 @@ use frf_core::io::read_photo;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 
-use super::plan::{FramePlan, Plan, ShotFrame};
+use super::plan::{FramePlan, Plan, ShotFrame, nearest_pose};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
+use crate::gpu::composite::DrawnFrame;
 use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
 use crate::resident::{Lighting, PoseSource};
 use crate::shadow::{ShadowMaps, traced_shadow};
@@ -96,7 +102,7 @@ pub struct ShotResult {
 
 /// A scene being rendered on a field (see the module docs).
 pub struct Shot<'a, R: ReadAt> {
-    scene: &'a Scene,
+    scene: Cow<'a, Scene>,
     field: &'a FieldFile<R>,
     device: Device,
     plan: Plan,
@@ -107,6 +113,8 @@ pub struct Shot<'a, R: ReadAt> {
     plate: Option<RgbImage>,
     cache: Vec<Cached>,
     counters: ShotCounters,
+    /// Frames drawn at a time and camera of the caller's ([`Shot::draw_at`]).
+    live_frames: usize,
 }
 
 impl<'a, R: ReadAt> Shot<'a, R> {
@@ -118,7 +126,37 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         frames: &[ShotFrame],
         options: ShotOptions,
     ) -> Result<Self> {
-        let plan = Plan::new(scene, field, frames)?;
+        Self::with_scene(Cow::Borrowed(scene), field, device, frames, options)
+    }
+
+    /// A shot of `scene` on `field` drawn at any time and camera ([`Shot::draw_at`],
+    /// [`Shot::render_at`]): every view, flow and condition of the poses drawn is read
+    /// (nothing is planned), and the scene may change between frames ([`Shot::edit`]).
+    pub fn live(
+        scene: Scene,
+        field: &'a FieldFile<R>,
+        device: Device,
+        options: ShotOptions,
+    ) -> Result<Self> {
+        let size = scene
+            .size
+            .unwrap_or((field.header().width, field.header().height));
+        let frames = scene.shot_frames(0..1, size)?;
+        let options = ShotOptions {
+            planned: false,
+            ..options
+        };
+        Self::with_scene(Cow::Owned(scene), field, device, &frames, options)
+    }
+
+    fn with_scene(
+        scene: Cow<'a, Scene>,
+        field: &'a FieldFile<R>,
+        device: Device,
+        frames: &[ShotFrame],
+        options: ShotOptions,
+    ) -> Result<Self> {
+        let plan = Plan::new(&scene, field, frames)?;
         let plate = match &scene.backdrop {
             BackdropSpec::Plate(p) => Some(read_photo(p)?),
             _ => None,
@@ -135,6 +173,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             plate,
             cache: Vec::new(),
             counters: ShotCounters::default(),
+            live_frames: 0,
         })
     }
 
@@ -204,8 +243,124 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The scene shot.
-    pub fn scene(&self) -> &'a Scene {
-        self.scene
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The field drawn.
+    pub fn field(&self) -> &'a FieldFile<R> {
+        self.field
+    }
+
+    /// The device frames are drawn on.
+    pub fn render_device(&self) -> &Device {
+        &self.device
+    }
+
+    /// Bytes the resident poses hold now.
+    pub fn resident_bytes(&self) -> u64 {
+        self.cache.iter().map(|c| c.resident.bytes()).sum()
+    }
+
+    /// Changes the scene by `f`; what the change makes stale is made again when a frame
+    /// next needs it (poses relit and shadowed anew when the floor or the shadow changes,
+    /// the backdrop when it changes; a new lighting is told by its key anyway).
+    pub fn edit(&mut self, f: impl FnOnce(&mut Scene)) -> Result<()> {
+        let before = (
+            self.scene.floor,
+            self.scene.shadow,
+            self.scene.backdrop.clone(),
+        );
+        f(self.scene.to_mut());
+        let scene = &self.scene;
+        if (scene.floor, scene.shadow) != (before.0, before.1) {
+            self.cache.clear();
+        }
+        if scene.backdrop != before.2 {
+            self.backdrop = None;
+            self.plate = match &scene.backdrop {
+                BackdropSpec::Plate(p) => Some(read_photo(p)?),
+                _ => None,
+            };
+        }
+        Ok(())
+    }
+
+    /// The pose each walker shows at `time`: the walk's pose at that time, or the nearest
+    /// one the field holds.
+    pub fn poses_at(&self, time: f32) -> Vec<u32> {
+        let h = self.field.header();
+        let held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+        (0..self.scene.instances.len())
+            .map(|i| {
+                let wanted = self
+                    .scene
+                    .pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                nearest_pose(wanted, &held, h.poses_per_cycle)
+            })
+            .collect()
+    }
+
+    /// Draws the frame of `camera` at `time` into the kept targets of its size (on the
+    /// GPU; nothing is read back): what a window shows. Poses are made resident and
+    /// relit as [`Shot::render`] does; the first pass writes `timestamps` when given.
+    pub fn draw_at(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        time: f32,
+        camera: &frf_core::camera::Camera,
+        timestamps: crate::gpu::timing::Timestamps,
+    ) -> Result<DrawnFrame> {
+        let Device::Gpu(_) = &self.device else {
+            return Err(RenderError::BadParameter(
+                "a frame drawn without a readback needs the GPU".into(),
+            ));
+        };
+        self.live_frames += 1;
+        let fp = FramePlan {
+            index: self.live_frames,
+            time,
+            poses: self.poses_at(time),
+        };
+        let slots = self.prepare(&fp)?.0;
+        let walkers = self.walkers(&slots);
+        let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
+        let Device::Gpu(gpu) = &self.device else {
+            unreachable!("checked above")
+        };
+        let instances = walkers
+            .iter()
+            .map(|w| w.resident.gpu_instance(w.world_from_subject))
+            .collect::<Result<Vec<_>>>()?;
+        let b = backdrop.gpu().ok_or_else(|| {
+            RenderError::BadParameter("a backdrop made resident on the CPU".into())
+        })?;
+        backdrop.check(camera)?;
+        gpu.encode_composite(
+            encoder,
+            &instances,
+            b,
+            camera,
+            self.scene.variant,
+            timestamps,
+        )
+    }
+
+    /// Renders the frame of `camera` at `time` and reads it back, as [`Shot::draw_at`]
+    /// draws it (a viewer's screenshot; on the CPU too).
+    pub fn render_at(
+        &mut self,
+        time: f32,
+        camera: &frf_core::camera::Camera,
+        layers: bool,
+    ) -> Result<ShotResult> {
+        self.live_frames += 1;
+        let fp = FramePlan {
+            index: self.live_frames,
+            time,
+            poses: self.poses_at(time),
+        };
+        self.render_plan(&fp, camera, layers)
     }
 
     /// The environment lighting the scene (scene frame) at `t` seconds: `None` when the
@@ -246,7 +401,46 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .ok_or_else(|| {
                 RenderError::BadParameter(format!("frame {} was not planned", frame.index))
             })?;
-        let lighting = self.scene.lighting_at(frame.time);
+        self.render_plan(&fp, &frame.camera, layers)
+    }
+
+    /// Renders the frame `fp` plans, seen by `camera`.
+    fn render_plan(
+        &mut self,
+        fp: &FramePlan,
+        camera: &frf_core::camera::Camera,
+        layers: bool,
+    ) -> Result<ShotResult> {
+        let (slots, made_resident) = self.prepare(fp)?;
+        let walkers = self.walkers(&slots);
+        let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
+        let frame_out =
+            self.device
+                .render_frame(&walkers, backdrop, camera, self.scene.variant, layers)?;
+        Ok(ShotResult {
+            frame: frame_out,
+            poses: fp.poses.clone(),
+            made_resident,
+        })
+    }
+
+    /// The walkers of a frame whose poses are the cache's `slots`.
+    fn walkers(&self, slots: &[usize]) -> Vec<Walker<'_>> {
+        slots
+            .iter()
+            .zip(&self.scene.instances)
+            .map(|(&k, inst)| Walker {
+                resident: &self.cache[k].resident,
+                world_from_subject: inst.world_from_subject(),
+            })
+            .collect()
+    }
+
+    /// Makes every pose of `fp` resident and relit for the frame's lighting, and the
+    /// backdrop of that lighting: the cache slots of the walkers' poses, and the poses made
+    /// resident for it.
+    fn prepare(&mut self, fp: &FramePlan) -> Result<(Vec<usize>, Vec<u32>)> {
+        let lighting = self.scene.lighting_at(fp.time);
         let key = LightingKey::of(&lighting);
         let world = self.world_lighting(&lighting)?;
 
@@ -272,7 +466,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         heading: heading.to_bits(),
                         lighting: key.clone(),
                         resident,
-                        last_frame: frame.index,
+                        last_frame: fp.index,
                     };
                     match found {
                         Some(k) => {
@@ -287,10 +481,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     }
                 }
             };
-            self.cache[slot].last_frame = frame.index;
+            self.cache[slot].last_frame = fp.index;
             slots.push(slot);
         }
-        self.keep_within_budget(frame.index, &mut slots)?;
+        self.keep_within_budget(fp.index, &mut slots)?;
 
         // The backdrop of this lighting.
         let stale = self.backdrop.as_ref().is_none_or(|(k, _)| *k != key);
@@ -298,27 +492,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             let backdrop = self.backdrop_of(world.as_ref())?;
             self.backdrop = Some((key, self.device.backdrop(backdrop)?));
         }
-        let walkers: Vec<Walker> = slots
-            .iter()
-            .zip(&self.scene.instances)
-            .map(|(&k, inst)| Walker {
-                resident: &self.cache[k].resident,
-                world_from_subject: inst.world_from_subject(),
-            })
-            .collect();
-        let backdrop = &self.backdrop.as_ref().expect("set above").1;
-        let frame_out = self.device.render_frame(
-            &walkers,
-            backdrop,
-            &frame.camera,
-            self.scene.variant,
-            layers,
-        )?;
-        Ok(ShotResult {
-            frame: frame_out,
-            poses: fp.poses,
-            made_resident,
-        })
+        Ok((slots, made_resident))
     }
 
     /// Reads pose `pose` (as planned), relights it for a walker of `heading` under the

@@ -1,0 +1,202 @@
+//! `frf view INPUT`: a field or a scene in a window ([`frf_view`]). A field is shown as
+//! one walker at the origin, its walk playing from pose 0, lit by the first `--env`
+//! (else the built-in sky) over that environment with its shadow, the camera at a
+//! captured view; a scene file as written. `--script` runs commands without a person,
+//! `--record` writes the camera keys set as a scene file for `frf render`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use frf_core::env::EnvSource;
+use frf_reflectance::FieldFile;
+use frf_render::composite::GroundLook;
+use frf_render::morph::Variant;
+use frf_render::path::{Orbit, Trajectory};
+use frf_render::scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+use frf_view::{Ended, ViewOptions};
+use glam::Vec3;
+
+use crate::CliResult;
+use crate::cmd::args::{FloorArg, VariantArg, parse_env, parse_size};
+
+/// Memory the resident poses may hold by default, MB.
+const DEFAULT_BUDGET_MB: u64 = 2048;
+/// Frames per second of a recorded move of a field.
+const RECORD_FPS: f32 = 24.0;
+
+/// Arguments of `frf view`.
+#[derive(Args)]
+pub struct ViewArgs {
+    /// A field file, or a scene file (`.toml`).
+    pub input: PathBuf,
+    /// The field (overrides the scene's).
+    #[arg(long)]
+    pub field: Option<PathBuf>,
+    /// Environments to offer (repeat): `.hdr`/`.exr` files, `sky`, `uniform`. A field is
+    /// lit by the first (default: the built-in sky).
+    #[arg(long, value_parser = parse_env)]
+    pub env: Vec<EnvSource>,
+    /// Yaw of a field's environment, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub yaw: f32,
+    /// What lights a field's subject from below.
+    #[arg(long, value_enum, default_value = "env")]
+    pub floor: FloorArg,
+    /// Window size `WxH` (the frame size while the window keeps it).
+    #[arg(long, value_parser = parse_size, default_value = "960x540")]
+    pub size: (u32, u32),
+    /// Interpolation to start with (default: the scene's, else four-way).
+    #[arg(long, value_enum)]
+    pub variant: Option<VariantArg>,
+    /// Run the commands of FILE without a person (see `frf_view::script`), then close.
+    #[arg(long)]
+    pub script: Option<PathBuf>,
+    /// When the viewer closes, write the camera keys set (K) as a scene file that `frf
+    /// render FILE --out DIR` renders.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// Most memory the resident poses may hold together, MB.
+    #[arg(long, default_value_t = DEFAULT_BUDGET_MB)]
+    pub memory_budget: u64,
+    /// Draw frames as fast as possible, not at the display's rate (to measure).
+    #[arg(long)]
+    pub no_vsync: bool,
+    /// Print what the session measured as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The scene of a field: one walker at the origin walking from pose 0.
+fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
+    let h = field.header();
+    let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
+    let lit = env != EnvSource::None;
+    Ok(Scene {
+        path: args.input.clone(),
+        field: Some(args.input.clone()),
+        start: 0.0,
+        end: h.cycle_seconds as f32,
+        fps: RECORD_FPS,
+        size: Some(args.size),
+        exposure: 0.0,
+        layers: false,
+        preview: Preview::Apng,
+        variant: args.variant.map_or(Variant::FourWay, Into::into),
+        lighting: vec![LightKey {
+            time: f32::NEG_INFINITY,
+            env,
+            yaw: args.yaw.to_radians(),
+            intensity: 1.0,
+        }],
+        floor: args.floor.into(),
+        // Where the plan of the live shot looks from; the viewer starts at a captured view.
+        camera: Trajectory::Orbit(Orbit {
+            radius: 3.2,
+            height: 1.4,
+            start_deg: 0.0,
+            sweep_deg: 360.0,
+            look_at: Vec3::new(0.0, 0.9, 0.0),
+            fov_deg: 35.0,
+        }),
+        backdrop: if lit {
+            BackdropSpec::Environment(GroundLook::Environment)
+        } else {
+            BackdropSpec::None
+        },
+        shadow: ShadowSpec::Maps,
+        instances: vec![Instance {
+            position: Vec3::ZERO,
+            heading: 0.0,
+            time_offset: 0.0,
+        }],
+    })
+}
+
+/// Runs `frf view`.
+pub fn run(args: ViewArgs) -> CliResult {
+    let is_scene = args
+        .input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let script = match &args.script {
+        Some(p) => Some((p.clone(), frf_view::script::load(p)?)),
+        None => None,
+    };
+    let (scene, field_path) = if is_scene {
+        let mut scene = Scene::load(&args.input)?;
+        if let Some(v) = args.variant {
+            scene.variant = v.into();
+        }
+        let field = scene.field_or(args.field.as_deref())?;
+        (scene, field)
+    } else {
+        let field_path = args.field.clone().unwrap_or_else(|| args.input.clone());
+        let field = FieldFile::open(&field_path)?;
+        (field_scene(&args, &field)?, field_path)
+    };
+    let mut envs = args.env.clone();
+    for e in [EnvSource::Sky, EnvSource::Uniform] {
+        if !envs.contains(&e) {
+            envs.push(e);
+        }
+    }
+    envs.retain(|e| *e != EnvSource::None);
+    let outcome = frf_view::run(ViewOptions {
+        scene,
+        field: field_path,
+        size: args.size,
+        envs,
+        script,
+        record: args.record.clone(),
+        memory_budget: args.memory_budget.saturating_mul(1_000_000),
+        start_at_captured_view: !is_scene,
+        no_vsync: args.no_vsync,
+    })?;
+    let median = |v: &[f64]| {
+        let mut s = v.to_vec();
+        s.sort_by(f64::total_cmp);
+        s.get(s.len() / 2).copied()
+    };
+    let gpu = median(&outcome.gpu_ms);
+    let frame = median(&outcome.frame_ms);
+    eprintln!(
+        "frf view: {} on {}: {} frames; GPU time per frame (timestamps) median {}; time between frames median {} ({})",
+        match outcome.ended {
+            Ended::Quit => "closed",
+            Ended::WindowClosed => "the window was closed",
+        },
+        outcome.adapter,
+        outcome.frames,
+        gpu.map_or("n/a".into(), |ms| format!("{ms:.2} ms")),
+        frame.map_or("n/a".into(), |ms| format!("{ms:.1} ms")),
+        frame.map_or("n/a".into(), |ms| format!("{:.1} fps", 1e3 / ms)),
+    );
+    for s in &outcome.screenshots {
+        eprintln!("  wrote {}", s.display());
+    }
+    if let Some((path, keys, note)) = &outcome.recorded {
+        eprintln!(
+            "  recorded {keys} camera keys to {}: `frf render {} --out DIR` renders the move",
+            path.display(),
+            path.display()
+        );
+        if let Some(n) = note {
+            eprintln!("  note: {n}");
+        }
+    }
+    if args.json {
+        let report = serde_json::json!({
+            "ended": format!("{:?}", outcome.ended),
+            "adapter": outcome.adapter,
+            "frames": outcome.frames,
+            "gpu_ms_median": gpu,
+            "gpu_ms": outcome.gpu_ms,
+            "frame_ms_median": frame,
+            "fps_median": frame.map(|ms| 1e3 / ms),
+            "screenshots": outcome.screenshots,
+            "recorded": outcome.recorded.as_ref().map(|r| &r.0),
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}

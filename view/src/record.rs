@@ -1,0 +1,244 @@
+//! Recording a camera move: keys set while moving (the camera at the scene time when the
+//! key was set) become the camera path of a scene file (`frf view ... --record
+//! shot.toml`) that `frf render shot.toml` renders. The file carries what the viewer
+//! shows besides: field, frame size, exposure, interpolation, the lighting (its keys, or
+//! the environment, yaw and intensity the viewer set), floor, backdrop, shadow and the
+//! walkers. Its time range runs from the first key to one frame past the last, so that
+//! the frames at key times are the keys' cameras. Paths are absolute: the file renders
+//! from any directory.
+
+use std::path::Path;
+
+use frf_core::env::EnvSource;
+use frf_reflectance::project::FloorModel;
+use frf_render::composite::GroundLook;
+use frf_render::path::Key;
+use frf_render::scene::{BackdropSpec, Scene, ShadowSpec};
+use serde::Serialize;
+
+use crate::ViewError;
+
+/// The keys recorded so far, in time order; a key set at the time of another replaces it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Recording {
+    keys: Vec<Key>,
+}
+
+impl Recording {
+    /// Adds `key` (replacing one at the same time).
+    pub fn add(&mut self, key: Key) {
+        self.keys.retain(|k| k.time != key.time);
+        let at = self.keys.partition_point(|k| k.time < key.time);
+        self.keys.insert(at, key);
+    }
+
+    /// The keys, in time order.
+    pub fn keys(&self) -> &[Key] {
+        &self.keys
+    }
+}
+
+#[derive(Serialize)]
+struct SceneOut {
+    field: String,
+    time: TimeOut,
+    output: OutputOut,
+    lighting: LightingOut,
+    camera: CameraOut,
+    composite: CompositeOut,
+    instance: Vec<InstanceOut>,
+}
+
+#[derive(Serialize)]
+struct TimeOut {
+    start: f32,
+    end: f32,
+    fps: f32,
+}
+
+#[derive(Serialize)]
+struct OutputOut {
+    size: [u32; 2],
+    exposure: f32,
+    variant: &'static str,
+}
+
+#[derive(Serialize)]
+struct LightingOut {
+    env: String,
+    yaw_deg: f32,
+    intensity: f32,
+    floor: &'static str,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    key: Vec<LightKeyOut>,
+}
+
+#[derive(Serialize)]
+struct LightKeyOut {
+    time: f32,
+    env: String,
+    yaw_deg: f32,
+    intensity: f32,
+}
+
+#[derive(Serialize)]
+struct CameraOut {
+    key: Vec<Key>,
+}
+
+#[derive(Serialize)]
+struct CompositeOut {
+    backdrop: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ground: Option<toml::Value>,
+    shadow: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    plate: Option<String>,
+}
+
+#[derive(Serialize)]
+struct InstanceOut {
+    position: [f32; 3],
+    heading_deg: f32,
+    time_offset: f32,
+}
+
+/// `path` made absolute (resolved where it exists), as text.
+fn absolute(path: &Path) -> String {
+    let p = path.canonicalize().unwrap_or_else(|_| {
+        std::env::current_dir()
+            .map(|d| d.join(path))
+            .unwrap_or_else(|_| path.to_path_buf())
+    });
+    p.display().to_string()
+}
+
+fn env_text(env: &EnvSource) -> String {
+    match env {
+        EnvSource::File(p) => absolute(p),
+        other => other.to_string(),
+    }
+}
+
+/// The scene file of `recording` over `scene` on `field`, frames of `size`, exposed by
+/// `exposure` stops; and a note when the backdrop had to change (a plate is seen by one
+/// camera only).
+pub fn scene_toml(
+    scene: &Scene,
+    field: &Path,
+    recording: &Recording,
+    size: (u32, u32),
+    exposure: f32,
+) -> Result<(String, Option<String>), ViewError> {
+    let keys = recording.keys();
+    let (Some(first), Some(last)) = (keys.first(), keys.last()) else {
+        return Err(ViewError::NothingRecorded);
+    };
+    let fps = scene.fps;
+    let base = &scene.lighting[0];
+    let mut note = None;
+    let (backdrop, ground, plate) = match &scene.backdrop {
+        BackdropSpec::None => ("none", None, None),
+        BackdropSpec::Environment(g) => (
+            "env",
+            match g {
+                GroundLook::Environment => None,
+                GroundLook::Albedo(a) => Some(toml::Value::Array(
+                    a.iter().map(|&v| toml::Value::Float(v.into())).collect(),
+                )),
+            },
+            None,
+        ),
+        BackdropSpec::Plate(p) if keys.len() == 1 => ("plate", None, Some(absolute(p))),
+        BackdropSpec::Plate(_) => {
+            note = Some(
+                "the plate is seen by one camera only: the recorded move of several keys has no backdrop"
+                    .to_string(),
+            );
+            ("none", None, None)
+        }
+    };
+    let out = SceneOut {
+        field: absolute(field),
+        time: TimeOut {
+            start: first.time,
+            // One frame past the last key, so that it is a frame too; a single key is a
+            // still.
+            end: if keys.len() > 1 {
+                last.time + 1.0 / fps
+            } else {
+                first.time
+            },
+            fps,
+        },
+        output: OutputOut {
+            size: [size.0, size.1],
+            exposure,
+            variant: scene.variant.name(),
+        },
+        lighting: LightingOut {
+            env: env_text(&base.env),
+            yaw_deg: base.yaw.to_degrees(),
+            intensity: base.intensity,
+            floor: match scene.floor {
+                FloorModel::Environment => "env",
+                FloorModel::LambertianGround { .. } => "ground",
+            },
+            key: scene.lighting[1..]
+                .iter()
+                .map(|k| LightKeyOut {
+                    time: k.time,
+                    env: env_text(&k.env),
+                    yaw_deg: k.yaw.to_degrees(),
+                    intensity: k.intensity,
+                })
+                .collect(),
+        },
+        camera: CameraOut { key: keys.to_vec() },
+        composite: CompositeOut {
+            backdrop,
+            ground,
+            shadow: match scene.shadow {
+                ShadowSpec::Maps => "maps",
+                ShadowSpec::Traced => "traced",
+                ShadowSpec::None => "none",
+            },
+            plate,
+        },
+        instance: scene
+            .instances
+            .iter()
+            .map(|i| InstanceOut {
+                position: i.position.to_array(),
+                heading_deg: i.heading.to_degrees(),
+                time_offset: i.time_offset,
+            })
+            .collect(),
+    };
+    let text = toml::to_string(&out).map_err(|e| ViewError::Record(e.to_string()))?;
+    Ok((
+        format!(
+            "# Recorded by `frf view`: render with `frf render {{this file}} --out DIR`.\n{text}"
+        ),
+        note,
+    ))
+}
+
+/// Writes the scene file of `recording` to `path` atomically; the note of
+/// [`scene_toml`], if any.
+pub fn write(
+    path: &Path,
+    scene: &Scene,
+    field: &Path,
+    recording: &Recording,
+    size: (u32, u32),
+    exposure: f32,
+) -> Result<Option<String>, ViewError> {
+    let (text, note) = scene_toml(scene, field, recording, size, exposure)?;
+    frf_core::atomic::write_atomic(path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes())
+            .map_err(|e| frf_core::CoreError::io(path, e))
+    })?;
+    Ok(note)
+}
