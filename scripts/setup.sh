@@ -3,12 +3,12 @@
 # that is already there:
 # - Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, the GPU of machines
 #   without one (the wgpu renderer runs on it);
-# - Xvfb (a display without a screen) and xauth, for the viewer's tests (`frf view`
+# - Xvfb (a display without a screen), xauth and xdotool, for the viewer's tests (`frf view`
 #   under `xvfb-run`);
 # - the rustfmt and clippy components, for the checks in .ci/run.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth)
+packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

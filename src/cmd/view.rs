@@ -160,15 +160,15 @@ pub fn run(args: ViewArgs) -> CliResult {
     let gpu = median(&outcome.gpu_ms);
     let frame = median(&outcome.frame_ms);
     eprintln!(
-        "frf view: {} on {}: {} frames; GPU time per frame (timestamps) median {}; time between frames median {} ({})",
+        "frf view: {}. {} frames drawn on {}; GPU time per frame {} (timestamps); time between frames {} ({})",
         match outcome.ended {
             Ended::Quit => "closed",
             Ended::WindowClosed => "the window was closed",
         },
-        outcome.adapter,
         outcome.frames,
-        gpu.map_or("n/a".into(), |ms| format!("{ms:.2} ms")),
-        frame.map_or("n/a".into(), |ms| format!("{ms:.1} ms")),
+        outcome.adapter,
+        gpu.map_or("n/a".into(), |ms| format!("{ms:.2} ms median")),
+        frame.map_or("n/a".into(), |ms| format!("{ms:.1} ms median")),
         frame.map_or("n/a".into(), |ms| format!("{:.1} fps", 1e3 / ms)),
     );
     for s in &outcome.screenshots {

@@ -15,3 +15,4 @@ mod scene;
 mod stage;
 mod status;
 mod verbs;
+mod view;

@@ -388,7 +388,7 @@ impl<'a> App<'a> {
         let mut actions = panel::Actions::default();
         let message = &mut self.message;
         let viewer = &mut live.viewer;
-        let output = live.egui.egui_ctx().clone().run_ui(input, |ui| {
+        let mut output = live.egui.egui_ctx().clone().run_ui(input, |ui| {
             if show_panel {
                 actions = panel::show(ui, viewer, &figures, message);
             }
@@ -408,10 +408,12 @@ impl<'a> App<'a> {
             Device::Gpu(g) => (g.device().clone(), g.queue().clone()),
             Device::Cpu => unreachable!("the viewer opens a GPU"),
         };
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
+        // Every texture change is applied (egui checks that none is dropped unapplied).
+        let mut textures = std::mem::take(&mut output.textures_delta);
+        for (id, deltas) in textures.set.drain() {
+            for delta in &deltas {
                 live.egui_renderer
-                    .update_texture(&device, &queue, *id, delta);
+                    .update_texture(&device, &queue, id, delta);
             }
         }
         let extra =
@@ -437,8 +439,8 @@ impl<'a> App<'a> {
             live.egui_renderer
                 .render(&mut pass.forget_lifetime(), &jobs, &screen);
         }
-        for id in &output.textures_delta.free {
-            live.egui_renderer.free_texture(id);
+        for id in textures.free.drain() {
+            live.egui_renderer.free_texture(&id);
         }
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         queue.present(texture);

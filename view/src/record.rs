@@ -3,9 +3,10 @@
 //! shot.toml`) that `frf render shot.toml` renders. The file carries what the viewer
 //! shows besides: field, frame size, exposure, interpolation, the lighting (its keys, or
 //! the environment, yaw and intensity the viewer set), floor, backdrop, shadow and the
-//! walkers. Its time range runs from the first key to one frame past the last, so that
-//! the frames at key times are the keys' cameras. Paths are absolute: the file renders
-//! from any directory.
+//! walkers. Its time range runs from the first key to one frame past the last, at the
+//! scene's rate: a key set a whole number of frames after the first is exactly a frame
+//! (set keys while the walk plays, or step it pose by pose, and the frames fall between).
+//! Paths are absolute: the file renders from any directory.
 
 use std::path::Path;
 
@@ -241,4 +242,92 @@ pub fn write(
             .map_err(|e| frf_core::CoreError::io(path, e))
     })?;
     Ok(note)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = r#"
+[time]
+end = 2.0
+fps = 12.0
+
+[output]
+variant = "linear"
+
+[lighting]
+env = "sky"
+yaw_deg = 30.0
+intensity = 1.5
+floor = "ground"
+[[lighting.key]]
+time = 1.0
+env = "uniform"
+yaw_deg = 90.0
+
+[camera]
+orbit = { radius = 3.0, height = 1.4, start_deg = 0.0, sweep_deg = 90.0, look_at = [0.0, 0.9, 0.0], fov_deg = 35.0 }
+
+[composite]
+backdrop = "env"
+ground = [0.3, 0.25, 0.2]
+shadow = "traced"
+
+[[instance]]
+position = [0.0, 0.0, 0.0]
+[[instance]]
+position = [1.0, 0.0, -0.5]
+heading_deg = 90.0
+time_offset = 0.25
+"#;
+
+    fn key(time: f32, x: f32) -> Key {
+        Key {
+            time,
+            position: [x, 1.4, 3.0],
+            look_at: [0.0, 0.9, 0.0],
+            fov_deg: 30.0,
+        }
+    }
+
+    #[test]
+    fn a_recorded_scene_reads_back_as_the_scene_with_the_keys() {
+        let dir = tempfile::tempdir().expect("a directory");
+        let scene = Scene::parse(&dir.path().join("s.toml"), SCENE).expect("a scene");
+        let mut rec = Recording::default();
+        rec.add(key(0.5, 1.0));
+        rec.add(key(0.0, 2.0));
+        rec.add(key(0.5, 3.0)); // replaces the key at 0.5
+        assert_eq!(rec.keys().len(), 2);
+        let field = dir.path().join("walker.frf");
+        let (text, note) = scene_toml(&scene, &field, &rec, (64, 48), 1.0).expect("text");
+        assert!(note.is_none());
+        let back = Scene::parse(&dir.path().join("shot.toml"), &text).expect("it parses");
+        assert_eq!(back.field.as_deref(), Some(field.as_path()));
+        assert_eq!(
+            (back.start, back.end, back.fps),
+            (0.0, 0.5 + 1.0 / 12.0, 12.0)
+        );
+        assert_eq!(back.size, Some((64, 48)));
+        assert_eq!(back.exposure, 1.0);
+        assert_eq!(back.variant, scene.variant);
+        assert_eq!(back.lighting, scene.lighting);
+        assert_eq!(back.floor, scene.floor);
+        assert_eq!(back.backdrop, scene.backdrop);
+        assert_eq!(back.shadow, scene.shadow);
+        assert_eq!(back.instances.len(), 2);
+        for (a, b) in back.instances.iter().zip(&scene.instances) {
+            assert_eq!(a.position, b.position);
+            assert!((a.heading - b.heading).abs() < 1e-6);
+            assert_eq!(a.time_offset, b.time_offset);
+        }
+        let frf_render::path::Trajectory::Path(p) = &back.camera else {
+            panic!("keys become a path");
+        };
+        assert_eq!(p.keys, vec![key(0.0, 2.0), key(0.5, 3.0)]);
+        // Nothing recorded: refused.
+        let empty = scene_toml(&scene, &field, &Recording::default(), (64, 48), 0.0);
+        assert!(matches!(empty, Err(ViewError::NothingRecorded)));
+    }
 }
