@@ -8,8 +8,11 @@
 #                      libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2
 #   device/field.frf   a field to render (e.g. frf stage field --capture small ...)
 #   device/env.hdr     an HDR environment
+#   device/x/*.deb     optional, for the viewer's frame time: apt-get download xvfb xauth
+#                      and the X libraries it lacks there (`frf view` needs a display)
 # Results go to $OUT (default ./nvidia-out): gpu.csv, bench.json, bench.log, and per
-# size render_WxH.json with the render log.
+# size render_WxH.json with the render log; with Xvfb, view_frame_time.md (the viewer's
+# GPU time per frame and frames per second at 1080p and 4K, benches/view_frame_time.sh).
 set -u
 OUT=${OUT:-nvidia-out}
 mkdir -p "$OUT"
@@ -32,3 +35,14 @@ for s in 320x448 1920x1080; do
   cp /tmp/render_$s/render.json "$OUT/render_$s.json" 2>/dev/null
   tail -4 "$OUT/render_$s.log"
 done
+if ! command -v xvfb-run >/dev/null 2>&1; then
+  for f in device/x/*.deb; do [ -e "$f" ] && dpkg -x "$f" /; done
+  ldconfig
+fi
+if command -v xvfb-run >/dev/null 2>&1; then
+  FRF=$F benches/view_frame_time.sh device/field.frf 24 1920x1080 3840x2160 \
+    > "$OUT/view_frame_time.md" 2> "$OUT/view_frame_time.log"
+  cat "$OUT/view_frame_time.md"
+else
+  echo "no xvfb-run: the viewer's frame time is not measured (device/x/*.deb)"
+fi

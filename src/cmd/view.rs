@@ -171,6 +171,13 @@ pub fn run(args: ViewArgs) -> CliResult {
         frame.map_or("n/a".into(), |ms| format!("{ms:.1} ms median")),
         frame.map_or("n/a".into(), |ms| format!("{:.1} fps", 1e3 / ms)),
     );
+    let (made, seconds) = outcome.residency;
+    if made > 0 {
+        eprintln!(
+            "  poses made resident (read and relit for a light): {made}, {:.2} s each",
+            seconds / made as f64
+        );
+    }
     for s in &outcome.screenshots {
         eprintln!("  wrote {}", s.display());
     }
@@ -195,6 +202,8 @@ pub fn run(args: ViewArgs) -> CliResult {
             "fps_median": frame.map(|ms| 1e3 / ms),
             "screenshots": outcome.screenshots,
             "recorded": outcome.recorded.as_ref().map(|r| &r.0),
+            "poses_made_resident": made,
+            "residency_seconds": seconds,
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
     }

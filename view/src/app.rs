@@ -160,6 +160,10 @@ pub(crate) fn run(mut options: ViewOptions) -> Result<Outcome, ViewError> {
         frame_ms: app.frame_ms,
         screenshots: app.screenshots,
         recorded,
+        residency: (
+            live.viewer.shot.counters().poses_made_resident,
+            live.viewer.shot.counters().residency_seconds,
+        ),
         adapter: live.adapter,
     })
 }

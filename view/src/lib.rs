@@ -156,6 +156,9 @@ pub struct Outcome {
     pub recorded: Option<(PathBuf, usize, Option<String>)>,
     /// The adapter that drew, in words.
     pub adapter: String,
+    /// Poses made resident (read and relit, counting relights for a new light), and the
+    /// seconds it took.
+    pub residency: (usize, f64),
 }
 
 /// Opens the window and runs the viewer until it is closed or a script ends.

@@ -119,10 +119,10 @@ fn controls(
         if ui.button(format!("{label} (space)")).clicked() {
             v.playing = !v.playing;
         }
-        if ui.button("◀ pose (,)").clicked() {
+        if ui.button("< pose (,)").clicked() {
             v.step(-1);
         }
-        if ui.button("pose ▶ (.)").clicked() {
+        if ui.button("pose > (.)").clicked() {
             v.step(1);
         }
     });
