@@ -3,7 +3,8 @@
 //! the GPU-vs-CPU tolerance, on a field and on a scene of two walkers; a recorded move
 //! renders to the frames it was recorded at; every control a script has changes the
 //! frame as it should; keys and the mouse (sent by xdotool) work as a person's; closing
-//! the window, a lost display and no display end with a message, never a panic.
+//! the window (destroyed by another client, as `xdotool windowclose` does), a lost
+//! display and no display end with a message, never a panic.
 //!
 //! Needs `xvfb-run` and `xdotool` (scripts/setup.sh installs them) and a GPU adapter; on
 //! a machine without one (`FRF_SKIP_GPU=1`) the viewer cannot run and these tests say so.
@@ -444,8 +445,13 @@ fn closing_the_window_or_losing_the_display_ends_with_a_message() {
         "{started}xdotool windowclose $W\nwait $P; echo \"rc=$?\""
     ));
     let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), stderr(&o));
-    assert!(said.contains("rc=0"), "{said}");
-    assert!(said.contains("the window was closed"), "{said}");
+    // Seen closed (exit 0), or used in the moment it went away (said, exit 5).
+    assert!(
+        (said.contains("rc=0") && said.contains("the window was closed"))
+            || (said.contains("rc=5") && said.contains("the window went away")),
+        "{said}"
+    );
+    assert!(!said.contains("panicked"), "{said}");
     // The display going away (its connection killed): Xlib's message, no panic.
     let o = under_xvfb(&format!(
         "{started}xdotool windowkill $W\nwait $P; echo \"rc=$?\""

@@ -641,6 +641,68 @@ impl ApplicationHandler for App<'_> {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // Events queued before the end (a redraw after the window was destroyed) are not
+        // handled: the window may be gone.
+        if self.ended.is_some() || self.error.is_some() {
+            return;
+        }
+        let handled = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            quietly(|| self.handle(event_loop, event))
+        }));
+        if let Err(panic) = handled {
+            self.fail(
+                event_loop,
+                ViewError::Window(format!(
+                    "the window went away while in use ({})",
+                    panic_message(&panic)
+                )),
+            );
+        }
+    }
+}
+
+thread_local! {
+    /// Whether a panic on this thread is caught and said as an error (see [`quietly`]).
+    static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f` with panics not printed: the window system's library panics when a window
+/// another client destroyed is used before its destruction is known (winit's X11
+/// backend unwraps a failed `GetGeometry`); the caller catches it and says it as an
+/// error instead.
+fn quietly<T>(f: impl FnOnce() -> T) -> T {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let default = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(std::cell::Cell::get) {
+                default(info);
+            }
+        }));
+    });
+    QUIET.with(|q| q.set(true));
+    struct Loud;
+    impl Drop for Loud {
+        fn drop(&mut self) {
+            QUIET.with(|q| q.set(false));
+        }
+    }
+    let _loud = Loud;
+    f()
+}
+
+/// The message of a caught panic.
+fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
+    panic
+        .downcast_ref::<String>()
+        .cloned()
+        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+        .unwrap_or_else(|| "no message".into())
+}
+
+impl App<'_> {
+    /// Handles a window event (see [`ApplicationHandler::window_event`]).
+    fn handle(&mut self, event_loop: &ActiveEventLoop, event: WindowEvent) {
         let Some(live) = &mut self.live else {
             return;
         };

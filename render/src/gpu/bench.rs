@@ -438,11 +438,7 @@ fn record_floor(
                 label: Some("floor"),
                 color_attachments: &[super::bind::cleared(targets.layer_view(0))],
                 depth_stencil_attachment: None,
-                timestamp_writes: timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(i),
-                    end_of_pass_write_index: Some(i + 1),
-                }),
+                timestamp_writes: super::timing::render_pass_writes(timestamps),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -454,11 +450,7 @@ fn record_floor(
         PassKind::Compute => {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("floor"),
-                timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: Some(i),
-                    end_of_pass_write_index: Some(i + 1),
-                }),
+                timestamp_writes: super::timing::compute_pass_writes(timestamps),
             });
             pass.set_pipeline(&floor.compute);
             pass.set_bind_group(0, targets.compute_group(0), &[]);

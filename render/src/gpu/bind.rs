@@ -202,7 +202,7 @@ pub fn rgba_pixels(bytes: &[u8], (w, h): (u32, u32), row: u32) -> Vec<[f32; 4]> 
 }
 
 /// A render pipeline drawing one full-screen triangle (`vs_main` of `common.wgsl`) with
-/// fragment entry `entry` into RGBA32F targets, no blending.
+/// fragment entry `entry` into `targets` RGBA32F targets, no blending.
 pub fn full_screen_pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -211,16 +211,34 @@ pub fn full_screen_pipeline(
     entry: &str,
     targets: usize,
 ) -> wgpu::RenderPipeline {
+    let formats = vec![wgpu::TextureFormat::Rgba32Float; targets];
+    full_screen_pipeline_into(device, label, layouts, module, entry, &formats)
+}
+
+/// [`full_screen_pipeline`] into targets of `formats`.
+pub fn full_screen_pipeline_into(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    formats: &[wgpu::TextureFormat],
+) -> wgpu::RenderPipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
         immediate_size: 0,
     });
-    let target = Some(wgpu::ColorTargetState {
-        format: wgpu::TextureFormat::Rgba32Float,
-        blend: None,
-        write_mask: wgpu::ColorWrites::ALL,
-    });
+    let targets: Vec<_> = formats
+        .iter()
+        .map(|&format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        })
+        .collect();
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(&layout),
@@ -237,7 +255,7 @@ pub fn full_screen_pipeline(
             module,
             entry_point: Some(entry),
             compilation_options: Default::default(),
-            targets: &vec![target; targets],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,

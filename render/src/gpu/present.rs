@@ -4,7 +4,7 @@
 //! letterboxed to keep its aspect, sRGB-encoded in the shader when the surface format is
 //! not an sRGB one. Built per surface format; its bind groups are kept per set of targets.
 
-use super::bind::{FLOAT, texture_2d, uniform, uniform_buffer};
+use super::bind::{FLOAT, full_screen_pipeline_into, texture_2d, uniform, uniform_buffer};
 use super::composite::DrawnFrame;
 use super::kept::Kept;
 use super::timing::Timestamps;
@@ -93,36 +93,14 @@ impl PresentPass {
                 texture_2d(4, FLOAT),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("present"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("present"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_present"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = full_screen_pipeline_into(
+            device,
+            "present",
+            &[&layout],
+            &module,
+            "fs_present",
+            &[format],
+        );
         Self {
             layout,
             pipeline,
@@ -190,11 +168,7 @@ impl PresentPass {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: Some(i),
-                end_of_pass_write_index: Some(i + 1),
-            }),
+            timestamp_writes: super::timing::render_pass_writes(timestamps),
             occlusion_query_set: None,
             multiview_mask: None,
         });

@@ -372,11 +372,7 @@ impl RebinPass {
                     label: Some("rebin"),
                     color_attachments: &[cleared(&t.view)],
                     depth_stencil_attachment: None,
-                    timestamp_writes: timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
-                        query_set: q,
-                        beginning_of_pass_write_index: Some(i),
-                        end_of_pass_write_index: Some(i + 1),
-                    }),
+                    timestamp_writes: super::timing::render_pass_writes(timestamps),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -388,11 +384,7 @@ impl RebinPass {
             PassKind::Compute => {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("rebin"),
-                    timestamp_writes: timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
-                        query_set: q,
-                        beginning_of_pass_write_index: Some(i),
-                        end_of_pass_write_index: Some(i + 1),
-                    }),
+                    timestamp_writes: super::timing::compute_pass_writes(timestamps),
                 });
                 pass.set_pipeline(&self.compute);
                 pass.set_bind_group(0, &t.compute, &[]);

@@ -13,6 +13,30 @@ use crate::error::Result;
 /// What a recorded pass is given: the query set and the index of its first timestamp.
 pub type Timestamps<'a> = Option<(&'a wgpu::QuerySet, u32)>;
 
+/// The timestamp writes of a render pass timed into `timestamps` (its beginning at the
+/// first query, its end at the next).
+pub fn render_pass_writes(
+    timestamps: Timestamps<'_>,
+) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    timestamps.map(|(q, i)| wgpu::RenderPassTimestampWrites {
+        query_set: q,
+        beginning_of_pass_write_index: Some(i),
+        end_of_pass_write_index: Some(i + 1),
+    })
+}
+
+/// The timestamp writes of a compute pass timed into `timestamps`, as
+/// [`render_pass_writes`].
+pub fn compute_pass_writes(
+    timestamps: Timestamps<'_>,
+) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+    timestamps.map(|(q, i)| wgpu::ComputePassTimestampWrites {
+        query_set: q,
+        beginning_of_pass_write_index: Some(i),
+        end_of_pass_write_index: Some(i + 1),
+    })
+}
+
 /// How a pass was timed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Clock {
