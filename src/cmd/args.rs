@@ -122,6 +122,32 @@ pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
     <[f32; 3]>::try_from(v).map_err(|_| format!("point `{s}`: expected x,y,z"))
 }
 
+/// Parses an angle in degrees: a finite number (a scene file refuses the same values).
+pub fn parse_degrees(s: &str) -> Result<f32, String> {
+    let v: f32 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: {e} (degrees)"))?;
+    if !v.is_finite() {
+        return Err(format!("`{s}` degrees: an angle is a finite number"));
+    }
+    Ok(v)
+}
+
+/// Writes a path into JSON as text, any invalid UTF-8 replaced: settings and reports
+/// name paths, and a path is not always a string.
+pub fn path_text<S: serde::Serializer>(p: &std::path::Path, s: S) -> Result<S::Ok, S::Error> {
+    s.collect_str(&p.display())
+}
+
+/// [`path_text`] of an optional path.
+pub fn opt_path_text<S: serde::Serializer>(p: &Option<PathBuf>, s: S) -> Result<S::Ok, S::Error> {
+    match p {
+        Some(p) => s.serialize_some(&p.display().to_string()),
+        None => s.serialize_none(),
+    }
+}
+
 /// Parses `WxH`, each side 1 to [`MAX_SIDE_PX`].
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -173,7 +199,7 @@ pub struct LightingArgs {
     #[arg(long, value_parser = parse_env)]
     pub env: Option<EnvSource>,
     /// Yaw of the environment about the vertical axis, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
     pub yaw: f32,
     /// What lights the subject from below.
     #[arg(long, value_enum, default_value = "env")]
@@ -246,6 +272,7 @@ pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
 pub struct CameraArgs {
     /// Keyframed camera path (TOML; see `frf_render::path`).
     #[arg(long, conflicts_with = "orbit")]
+    #[serde(serialize_with = "opt_path_text")]
     pub camera: Option<PathBuf>,
     /// Orbit about the vertical axis through --look-at: `RADIUS,HEIGHT[,SWEEP_DEG]`,
     /// metres and degrees (default sweep 360, a loop).
@@ -381,6 +408,7 @@ pub struct BackdropArgs {
     /// EXR, HDR linear) taken by the camera, which must then be a `--camera` path of one
     /// key; frames take its size.
     #[arg(long)]
+    #[serde(serialize_with = "opt_path_text")]
     pub plate: Option<PathBuf>,
     /// Ground of `--backdrop env`: `env` (the environment below the horizon) or a
     /// Lambertian albedo `A` or `R,G,B` lit by the environment's upper hemisphere.

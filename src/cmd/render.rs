@@ -48,9 +48,11 @@ const DEFAULT_BUDGET_MB: u64 = 4096;
 pub struct RenderArgs {
     /// A scene file (`.toml`) or a field file (`frf ingest`, `frf stage field`, `frf
     /// ingest-ring`).
+    #[serde(serialize_with = "crate::cmd::args::path_text")]
     pub input: PathBuf,
     /// The field (overrides the scene's).
     #[arg(long)]
+    #[serde(serialize_with = "crate::cmd::args::opt_path_text")]
     pub field: Option<PathBuf>,
     #[command(flatten)]
     pub lighting: LightingArgs,
@@ -61,6 +63,7 @@ pub struct RenderArgs {
     /// Output directory: frame_NNNN.png (8-bit sRGB, straight alpha), frame_NNNN.exr
     /// (linear, premultiplied), contact.png, the animated preview and render.json.
     #[arg(long)]
+    #[serde(serialize_with = "crate::cmd::args::opt_path_text")]
     pub out: Option<PathBuf>,
     /// Also write each frame's layers for compositing tools: frame_NNNN_subject.exr
     /// (premultiplied RGBA), frame_NNNN_shadow.exr (relative irradiance of the ground, 1
@@ -429,8 +432,10 @@ pub fn run(args: RenderArgs) -> CliResult {
         return print_plan(&plan, args.json);
     }
     let out_dir = args.out.clone().ok_or("give --out DIR (or --plan)")?;
+    // `json!` would unwrap the conversion: a failure is an error here, not a panic.
+    let args_json = serde_json::to_value(&args)?;
     let settings = serde_json::json!({
-        "args": &args,
+        "args": args_json,
         "scene": std::fs::read_to_string(&args.input).ok().filter(|_| !field_render),
         "size": size,
     });

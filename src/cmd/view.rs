@@ -17,7 +17,7 @@ use frf_view::{Ended, ViewOptions};
 use glam::Vec3;
 
 use crate::CliResult;
-use crate::cmd::args::{FloorArg, VariantArg, parse_env, parse_size};
+use crate::cmd::args::{FloorArg, VariantArg, parse_degrees, parse_env, parse_size};
 
 /// Memory the resident poses may hold by default, MB.
 const DEFAULT_BUDGET_MB: u64 = 2048;
@@ -37,7 +37,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = parse_env)]
     pub env: Vec<EnvSource>,
     /// Yaw of a field's environment, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
     pub yaw: f32,
     /// What lights a field's subject from below.
     #[arg(long, value_enum, default_value = "env")]
@@ -200,8 +200,8 @@ pub fn run(args: ViewArgs) -> CliResult {
             "gpu_ms": outcome.gpu_ms,
             "frame_ms_median": frame,
             "fps_median": frame.map(|ms| 1e3 / ms),
-            "screenshots": outcome.screenshots,
-            "recorded": outcome.recorded.as_ref().map(|r| &r.0),
+            "screenshots": outcome.screenshots.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
+            "recorded": outcome.recorded.as_ref().map(|r| r.0.display().to_string()),
             "poses_made_resident": made,
             "residency_seconds": seconds,
         });

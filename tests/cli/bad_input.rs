@@ -270,3 +270,77 @@ fn an_8_bit_frame_in_a_16_bit_capture_is_refused() {
         "ingest left output"
     );
 }
+
+/// A path is a path, not a string: a field and an output directory whose names are not
+/// UTF-8 render, and the settings and report name them (issue 23: this ended in a panic
+/// while writing the settings).
+#[cfg(unix)]
+#[test]
+fn paths_that_are_not_utf8_render_and_are_named() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = tempfile::tempdir().unwrap();
+    let field = dir.path().join(OsStr::from_bytes(b"walker\xff.frf"));
+    std::fs::copy(&frf_testkit::tiny_field().field, &field).unwrap();
+    let out = dir.path().join(OsStr::from_bytes(b"shot\xfe"));
+    let mut args: Vec<&OsStr> = vec![OsStr::new("render"), field.as_os_str()];
+    args.extend(
+        [
+            "--orbit", "3,1.2", "--env", "sky", "--frames", "1", "--size", "24x24", "--cpu",
+            "--out",
+        ]
+        .map(OsStr::new),
+    );
+    args.push(out.as_os_str());
+    let o = crate::common::frf_command(&args).output().unwrap();
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{said}");
+    assert!(!said.contains("panicked"), "{said}");
+    let settings: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("settings.json")).unwrap()).unwrap();
+    let named = settings["args"]["input"].as_str().unwrap();
+    assert!(named.ends_with("walker\u{fffd}.frf"), "{named}");
+    assert!(out.join("frame_0000.png").exists());
+}
+
+/// An angle that is not a finite number is refused on the command line as the scene file
+/// refuses it (issue 23: `--yaw nan` rendered a wrong picture with exit 0).
+#[test]
+fn a_yaw_that_is_not_finite_is_refused_by_every_command() {
+    let field = frf_testkit::tiny_field()
+        .field
+        .to_str()
+        .unwrap()
+        .to_string();
+    let out = tempfile::tempdir().unwrap();
+    let o_dir = out.path().join("o");
+    for yaw in ["nan", "inf", "-inf"] {
+        // `--yaw=-inf`: clap reads `-inf` alone as flags.
+        let yaw = format!("--yaw={yaw}");
+        let yaw = yaw.as_str();
+        for args in [
+            vec![
+                "render",
+                &field,
+                "--orbit",
+                "3,1.2",
+                "--env",
+                "sky",
+                yaw,
+                "--out",
+                o_dir.to_str().unwrap(),
+            ],
+            vec!["bench", "interp", "--field", &field, "--env", "sky", yaw],
+            vec!["view", &field, yaw],
+        ] {
+            let o = crate::common::frf(&args);
+            let said = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {said}");
+            assert!(
+                said.contains("--yaw") && said.contains("finite"),
+                "{args:?}: {said}"
+            );
+        }
+    }
+    assert!(!o_dir.exists(), "nothing is written");
+}
