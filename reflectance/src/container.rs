@@ -409,16 +409,31 @@ impl<R: ReadAt> FieldFile<R> {
         &self.path
     }
 
-    /// `requested`, or the field's first pose; an error naming the file when it holds none.
+    /// `requested` (an error naming the file and the poses it holds when it lacks it), or
+    /// the field's first pose; an error naming the file when it holds none.
     pub fn pose_or_first(&self, requested: Option<u32>) -> Result<u32> {
-        requested
-            .or_else(|| self.header.poses.first().map(|p| p.pose))
-            .ok_or_else(|| {
+        let held: Vec<u32> = self.header.poses.iter().map(|p| p.pose).collect();
+        match requested {
+            Some(p) if held.contains(&p) => Ok(p),
+            Some(p) => Err(ReflectanceError::BadParameter(format!(
+                "{}: pose {p} is not in the field (it holds {})",
+                self.path.display(),
+                if held.is_empty() {
+                    "none".to_string()
+                } else {
+                    held.iter()
+                        .map(u32::to_string)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                }
+            ))),
+            None => held.first().copied().ok_or_else(|| {
                 ReflectanceError::BadParameter(format!(
                     "{}: the field holds no pose",
                     self.path.display()
                 ))
-            })
+            }),
+        }
     }
 
     /// All chunk entries, in key order.

@@ -481,6 +481,11 @@ pub fn run(args: RenderArgs) -> CliResult {
         "shadow: {}",
         shadow_words(&scene, &shot, options.traced_lights)
     );
+    for (wanted, held) in &shot.plan().poses_substituted {
+        eprintln!(
+            "pose {wanted} is not in the field: pose {held} stands in for it (render.json: poses_substituted)"
+        );
+    }
     render_shot(
         &mut shot,
         &frames,

@@ -461,3 +461,63 @@ fn negative_numbers_are_accepted_where_coordinates_and_angles_are_expected() {
     let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(plan.is_object(), "{plan}");
 }
+
+/// A pose the field lacks: `--pose` is refused naming the poses it holds; a scene whose
+/// walk reaches it says which pose stands in, in every render and in render.json (issue
+/// 23: `--pose 99` rendered pose 0 without a word).
+#[test]
+fn a_pose_the_field_lacks_is_refused_or_said() {
+    let (_, field) = fixture();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let o = frf(&[
+        "render",
+        field.to_str().unwrap(),
+        "--orbit",
+        "3,1.2",
+        "--env",
+        "sky",
+        "--pose",
+        "99",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("pose 99 is not in the field (it holds 0)"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    // A walk over half a cycle reaches poses the one-pose field lacks.
+    let scene = dir.path().join("walk.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "field = \"{}\"\n[time]\nend = 0.5\nfps = 4.0\n[output]\nsize = [24, 24]\n\
+             [lighting]\nenv = \"sky\"\n[camera]\n[[camera.key]]\ntime = 0.0\n\
+             position = [2.5, 1.4, 3.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 40.0\n",
+            field.display()
+        ),
+    )
+    .unwrap();
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("pose 0 stands in for it"),
+        "{}",
+        stderr(&o)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+    let substituted = report["poses_substituted"].as_array().unwrap();
+    assert!(!substituted.is_empty(), "{report}");
+    assert!(substituted.iter().all(|p| p[1] == 0), "{report}");
+}

@@ -285,6 +285,8 @@ impl Output {
             seconds_wall: f64,
             plan: &'a super::plan::PlanCounts,
             planned: bool,
+            /// Poses the scene asks for that the field lacks, and the pose drawn instead.
+            poses_substituted: &'a [(u32, u32)],
             bytes_read_measured: u64,
             residency: &'a ShotCounters,
             pixels_inside: usize,
@@ -307,6 +309,7 @@ impl Output {
             seconds_wall: wall_seconds,
             plan: &shot.plan().counts,
             planned: shot.planned(),
+            poses_substituted: &shot.plan().poses_substituted,
             bytes_read_measured: bytes_read,
             residency: shot.counters(),
             pixels_inside: t.inside,
