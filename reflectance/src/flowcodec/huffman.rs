@@ -337,10 +337,10 @@ mod tests {
             let bits = table.encode(&symbols).unwrap();
             let mut table_bytes = table.to_bytes();
             table_bytes[table_bit / 8] ^= 1 << (table_bit % 8);
-            if let Ok(t) = HuffmanTable::from_bytes(&table_bytes) {
-                if let Ok(out) = t.decode(&bits, symbols.len()) {
-                    prop_assert_eq!(out.len(), symbols.len());
-                }
+            if let Ok(t) = HuffmanTable::from_bytes(&table_bytes)
+                && let Ok(out) = t.decode(&bits, symbols.len())
+            {
+                prop_assert_eq!(out.len(), symbols.len());
             }
             let mut stream = bits.clone();
             for (at, bit) in stream_flips.iter().filter(|_| !bits.is_empty()) {
