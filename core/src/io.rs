@@ -90,6 +90,36 @@ pub fn read_rgb_bytes(name: &Path, bytes: &[u8]) -> Result<RgbImage> {
     rgb_checked(name, decode_with(name, limited(reader))?)
 }
 
+/// Checks that `path` is a regular file (a directory, a FIFO or a device is refused by
+/// name: reading a FIFO would wait for a writer, a device might never end) and returns
+/// its size in bytes.
+pub fn regular_file(path: &Path) -> Result<u64> {
+    let meta = std::fs::metadata(path).map_err(|e| CoreError::io(path, e))?;
+    if !meta.is_file() {
+        let kind = if meta.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file (a FIFO, a socket or a device)"
+        };
+        return Err(CoreError::bad_file(path, format!("{kind}: give a file")));
+    }
+    Ok(meta.len())
+}
+
+/// Reads the text file at `path`, refusing what is not a regular file
+/// ([`regular_file`]) and a file larger than `limit` bytes (a hand-written file is
+/// small; a larger one is something else).
+pub fn read_text(path: &Path, limit: u64) -> Result<String> {
+    let size = regular_file(path)?;
+    if size > limit {
+        return Err(CoreError::bad_file(
+            path,
+            format!("{size} bytes, more than the {limit} a file of this kind may have"),
+        ));
+    }
+    std::fs::read_to_string(path).map_err(|e| CoreError::io(path, e))
+}
+
 /// Width and height of an image file, read from its header only.
 pub fn image_dimensions(path: &Path) -> Result<(usize, usize)> {
     if !path.exists() {

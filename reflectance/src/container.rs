@@ -295,6 +295,8 @@ pub struct FieldFile<R: ReadAt = FileSource> {
 impl FieldFile<FileSource> {
     /// Opens a field file.
     pub fn open(path: &Path) -> Result<Self> {
+        // Checked before opening: opening a FIFO waits for a writer.
+        frf_core::io::regular_file(path)?;
         let file = File::open(path).map_err(|e| io(path, e))?;
         let size = file.metadata().map_err(|e| io(path, e))?.len();
         Self::from_source(

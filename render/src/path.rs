@@ -134,8 +134,8 @@ impl CameraPath {
 
     /// Reads and validates a TOML path file; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;
+        let text = frf_core::io::read_text(path, crate::scene::MAX_FILE_BYTES)
+            .map_err(|e| bad(format!("camera path: {e}")))?;
         let raw: Self = toml::from_str(&text)
             .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;
         Self::new(raw.keys).map_err(|e| bad(format!("camera path {}: {e}", path.display())))

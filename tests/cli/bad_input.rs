@@ -16,6 +16,41 @@ struct Case {
 
 const CASES: &[Case] = &[
     Case {
+        args: &["render", "{bad}/scene_size_not_a_pair.toml", "--plan"],
+        file: "scene_size_not_a_pair.toml",
+        problem: &["output.size", "3 values"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_size_not_numbers.toml", "--plan"],
+        file: "scene_size_not_numbers.toml",
+        problem: &["invalid type", "\"x\"", "line 19"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_nan_offset.toml", "--plan"],
+        file: "scene_nan_offset.toml",
+        problem: &["instance[0].time_offset", "NaN"],
+    },
+    Case {
+        args: &["render", "{bad}/scene_device.toml", "--plan"],
+        file: "scene_device.toml",
+        problem: &["not a regular file"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2",
+            "--env",
+            "sky",
+            "--cpu",
+            "--out",
+            "{bad}/good4.png",
+        ],
+        file: "good4.png",
+        problem: &["a file is there, not a directory"],
+    },
+    Case {
         args: &["render", "{bad}/scene_unknown_key.toml", "--plan"],
         file: "scene_unknown_key.toml",
         problem: &["unknown field `colour_grade`", "line 2"],
@@ -343,4 +378,27 @@ fn a_yaw_that_is_not_finite_is_refused_by_every_command() {
         }
     }
     assert!(!o_dir.exists(), "nothing is written");
+}
+
+/// A FIFO given as a field or a scene is refused by name at once: opening it would wait
+/// for a writer (issue 23: it hung).
+#[cfg(unix)]
+#[test]
+fn a_fifo_given_as_a_field_or_a_scene_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["pipe.frf", "pipe.toml"] {
+        let fifo = dir.path().join(name);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let o = crate::common::frf(&["render", fifo.to_str().unwrap(), "--plan"]);
+        let said = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(3), "{said}");
+        assert!(
+            said.contains(name) && said.contains("not a regular file"),
+            "{said}"
+        );
+    }
 }

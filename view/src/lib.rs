@@ -38,14 +38,6 @@ pub enum ViewError {
     /// The window system failed while the viewer ran.
     #[error("the window system failed: {0}")]
     Window(String),
-    /// A file could not be read.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
     /// A script's line is wrong.
     #[error("{}:{line}: {problem}", path.display())]
     Script {
@@ -95,7 +87,7 @@ impl ViewError {
     pub fn fault(&self) -> frf_core::Fault {
         use frf_core::Fault;
         match self {
-            ViewError::NoDisplay(_) | ViewError::Window(_) | ViewError::Io { .. } => Fault::Io,
+            ViewError::NoDisplay(_) | ViewError::Window(_) => Fault::Io,
             ViewError::Script { .. }
             | ViewError::Bad(_)
             | ViewError::NothingRecorded

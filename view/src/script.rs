@@ -106,10 +106,7 @@ pub struct Line {
 /// Reads and checks the script at `path`; relative screenshot paths are relative to the
 /// working directory, as a command line's.
 pub fn load(path: &Path) -> Result<Vec<Line>, ViewError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ViewError::Io {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
+    let text = frf_core::io::read_text(path, frf_render::scene::MAX_FILE_BYTES)?;
     parse(path, &text)
 }
 

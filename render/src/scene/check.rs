@@ -108,7 +108,13 @@ pub type OutputSettings = (Option<(u32, u32)>, f32, Preview, Variant);
 pub fn output(r: &Reporter, o: &OutputToml) -> Result<OutputSettings> {
     let size = match &o.size {
         Some(s) => {
-            let [w, h] = *s.get_ref();
+            let &[w, h] = s.get_ref().as_slice() else {
+                return Err(r.error(
+                    "output.size",
+                    s.span(),
+                    format!("{} values: a size is [width, height]", s.get_ref().len()),
+                ));
+            };
             if !(1..=MAX_SIDE_PX).contains(&w) || !(1..=MAX_SIDE_PX).contains(&h) {
                 return Err(r.error(
                     "output.size",
@@ -312,15 +318,26 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
     let mut instances = Vec::new();
     for (i, inst) in raw.instance.iter().enumerate() {
         let v = inst.get_ref();
-        let finite_all = v.position.iter().all(|c| c.is_finite())
-            && v.heading_deg.is_finite()
-            && v.time_offset.is_finite();
-        if !finite_all || v.position.iter().any(|c| c.abs() > 1e4) || v.time_offset.abs() > 1e6 {
-            return Err(r.error(
-                &format!("instance[{i}]"),
-                inst.span(),
-                "values must be finite (positions within 10 km)",
-            ));
+        let key = |name: &str| format!("instance[{i}].{name}");
+        let bad = |name: &str, value: String, range: &str| {
+            Err(r.error(&key(name), inst.span(), format!("{value}: {range}")))
+        };
+        if !v.position.iter().all(|c| c.is_finite() && c.abs() <= 1e4) {
+            return bad(
+                "position",
+                format!("{:?}", v.position),
+                "finite metres within 10 km",
+            );
+        }
+        if !v.heading_deg.is_finite() {
+            return bad("heading_deg", v.heading_deg.to_string(), "a finite angle");
+        }
+        if !(v.time_offset.is_finite() && v.time_offset.abs() <= 1e6) {
+            return bad(
+                "time_offset",
+                v.time_offset.to_string(),
+                "finite seconds within 10^6",
+            );
         }
         if v.position[1] != 0.0 {
             return Err(r.error(

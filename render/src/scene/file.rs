@@ -97,8 +97,9 @@ pub struct TimeToml {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputToml {
-    /// Frame width and height.
-    pub size: Option<At<[u32; 2]>>,
+    /// Frame width and height (read as a list: a fixed-size array would take the first
+    /// two of a longer one).
+    pub size: Option<At<Vec<u32>>>,
     /// Stops, PNG only.
     #[serde(default = "zero")]
     pub exposure: At<f32>,

@@ -38,6 +38,8 @@ use file::{Reporter, SceneToml};
 
 /// Most frames a scene may have (an hour at 30 fps and more).
 pub const MAX_FRAMES: usize = 200_000;
+/// Largest scene (or camera path) file, bytes: hand-written text.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
 /// Largest frame side, pixels (8K).
 pub const MAX_SIDE_PX: u32 = 8192;
 
@@ -180,7 +182,7 @@ impl Scene {
 
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?;
+        let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;
         Self::parse(path, &text)
     }
 

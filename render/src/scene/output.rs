@@ -116,6 +116,12 @@ impl Output {
         overwrite: bool,
         total: usize,
     ) -> Result<Self> {
+        if dir.exists() && !dir.is_dir() {
+            return Err(RenderError::BadParameter(format!(
+                "--out {}: a file is there, not a directory",
+                dir.display()
+            )));
+        }
         std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
         let mut settings = settings.clone();
         // A frame range may change between runs into one directory (array jobs); the
