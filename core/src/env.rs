@@ -36,13 +36,30 @@ pub struct EnvMap {
 }
 
 impl EnvMap {
-    /// Loads a `.hdr` (Radiance RGBE) or `.exr` map.
+    /// Loads a `.hdr` (Radiance RGBE) or `.exr` map (an 8-bit image is refused,
+    /// [`crate::io::read_hdr_rgb`]); a map whose every texel is zero or negative is
+    /// refused too: it lights nothing (`none` shows a field unlit).
     pub fn load(path: &Path) -> Result<Self> {
-        let img = crate::io::read_rgb(path)?;
-        Self::from_image(img).map_err(|e| match e {
+        let img = crate::io::read_hdr_rgb(path)?;
+        let env = Self::from_image(img).map_err(|e| match e {
             CoreError::InvalidArgument { problem, .. } => CoreError::bad_file(path, problem),
             other => other,
-        })
+        })?;
+        if env
+            .radiance
+            .pixels()
+            .iter()
+            .all(|p| p.iter().all(|&c| c <= 0.0))
+        {
+            return Err(CoreError::bad_file(
+                path,
+                format!(
+                    "every texel is zero or negative ({} clamped to zero): the environment lights nothing",
+                    env.clamped_texels
+                ),
+            ));
+        }
+        Ok(env)
     }
 
     /// Wraps a radiance image (width should be twice the height, but any size of at least

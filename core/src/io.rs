@@ -152,6 +152,22 @@ pub fn read_rgb(path: &Path) -> Result<RgbImage> {
     rgb_checked(path, decode(path)?)
 }
 
+/// Reads a high-dynamic-range image (Radiance `.hdr`, float or half EXR, 16-bit PNG) as
+/// linear RGB; an 8-bit image is refused naming `path`: it is display-encoded and clipped
+/// (the sun at 1.0), not radiance.
+pub fn read_hdr_rgb(path: &Path) -> Result<RgbImage> {
+    let img = decode(path)?;
+    use image::ColorType as C;
+    if matches!(img.color(), C::L8 | C::La8 | C::Rgb8 | C::Rgba8) {
+        return Err(CoreError::bad_file(
+            path,
+            "an 8-bit image is not a high-dynamic-range environment (display-encoded, \
+             clipped at 1): give a .hdr or .exr",
+        ));
+    }
+    rgb_checked(path, img)
+}
+
 /// A decoded image as linear RGB, alpha dropped, non-finite values refused naming `path`.
 fn rgb_checked(path: &Path, img: DynamicImage) -> Result<RgbImage> {
     let img = img.into_rgb32f();

@@ -16,6 +16,36 @@ struct Case {
 
 const CASES: &[Case] = &[
     Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2",
+            "--env",
+            "{bad}/env_black.hdr",
+            "--cpu",
+            "--out",
+            "{out}/o",
+        ],
+        file: "env_black.hdr",
+        problem: &["every texel is zero or negative", "lights nothing"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2",
+            "--env",
+            "{bad}/good4.png",
+            "--cpu",
+            "--out",
+            "{out}/o",
+        ],
+        file: "good4.png",
+        problem: &["8-bit image is not a high-dynamic-range environment"],
+    },
+    Case {
         args: &["render", "{bad}/scene_size_not_a_pair.toml", "--plan"],
         file: "scene_size_not_a_pair.toml",
         problem: &["output.size", "3 values"],
