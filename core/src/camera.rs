@@ -144,6 +144,13 @@ impl Camera {
                 format!("eye {eye}, target {target} and up {up} must be finite"),
             ));
         }
+        if !(target - eye).length().is_finite() {
+            // Each finite, but their distance overflows: a position in light years.
+            return Err(CoreError::invalid(
+                "camera",
+                format!("eye {eye} and target {target} are too far apart to compute with"),
+            ));
+        }
         let forward = (target - eye).normalize_or_zero();
         if forward == Vec3::ZERO {
             return Err(CoreError::invalid(
@@ -232,6 +239,22 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_camera_too_far_away_is_said_so_not_called_coincident() {
+        let far = Camera::look_at(
+            Vec3::splat(1e30),
+            Vec3::new(0.0, 0.9, 0.0),
+            Vec3::Y,
+            0.6,
+            64,
+            48,
+        );
+        let said = far.expect_err("refused").to_string();
+        assert!(said.contains("too far apart"), "{said}");
+        let same = Camera::look_at(Vec3::ONE, Vec3::ONE, Vec3::Y, 0.6, 64, 48);
+        assert!(same.expect_err("refused").to_string().contains("equals"));
+    }
 
     fn cam() -> Camera {
         Camera::look_at(

@@ -128,17 +128,31 @@ impl Capture {
     /// Reads and validates `DIR/capture.toml` without looking at the frame files.
     pub fn open_manifest(dir: &Path) -> Result<Self> {
         let path = dir.join(MANIFEST_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| CoreError::io(&path, e))?;
+        // A manifest is a page of text; a larger file is something else.
+        let text = crate::io::read_text(&path, 64 << 20)?;
         Self::parse_manifest(dir, &text)
     }
 
     /// Parses and validates the text of `DIR/capture.toml` (the files are not checked).
     pub fn parse_manifest(dir: &Path, text: &str) -> Result<Self> {
         let path = dir.join(MANIFEST_FILE);
-        let manifest: Manifest = toml::from_str(text).map_err(|e| CoreError::Manifest {
-            path,
-            field: "(syntax)".into(),
-            problem: e.to_string().trim().to_string(),
+        let manifest: Manifest = toml::from_str(text).map_err(|e| {
+            // What kind of mistake it is: only a file TOML cannot read is a syntax error.
+            let message = e.message();
+            let field = if message.starts_with("missing field") {
+                "(a section or key is missing)"
+            } else if message.starts_with("unknown field") {
+                "(a key the format does not have)"
+            } else if message.starts_with("invalid") {
+                "(a value of the wrong type or length)"
+            } else {
+                "(syntax)"
+            };
+            CoreError::Manifest {
+                path,
+                field: field.into(),
+                problem: e.to_string().trim().to_string(),
+            }
         })?;
         Self::from_manifest(dir, manifest)
     }

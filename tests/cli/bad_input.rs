@@ -113,7 +113,7 @@ const CASES: &[Case] = &[
     Case {
         args: &["ingest", "{bad}/cap_missing", "--out", "{out}/f.frf"],
         file: "capture.toml",
-        problem: &["missing field `timing`"],
+        problem: &["missing field `timing`", "(a section or key is missing)"],
     },
     Case {
         args: &["ingest", "{bad}/cap_range", "--out", "{out}/f.frf"],
