@@ -378,8 +378,15 @@ fn shadow_words<R: frf_reflectance::container::ReadAt>(
     traced_lights: usize,
 ) -> String {
     let plan = shot.plan();
+    let has_maps = shot.field().header().shadows.is_some();
     match scene.shadow {
         ShadowSpec::None => "none (--shadow none)".into(),
+        // Without maps there is no ground patch to see: say why first.
+        ShadowSpec::Maps if !has_maps => {
+            "none (the field has no shadow maps, e.g. ingested with --no-shadows: --shadow \
+             traced traces the hull)"
+                .into()
+        }
         _ if !plan.ground_seen => "none drawn (no frame sees the ground patch)".into(),
         ShadowSpec::Maps if plan.poses.iter().any(|p| p.shadow_maps) => {
             "relit from the pose's maps".into()

@@ -521,3 +521,47 @@ fn a_pose_the_field_lacks_is_refused_or_said() {
     assert!(!substituted.is_empty(), "{report}");
     assert!(substituted.iter().all(|p| p[1] == 0), "{report}");
 }
+
+/// A field made without shadow maps, rendered with `--shadow maps`, says that it has no
+/// maps, not that no frame sees the ground (issue 23).
+#[test]
+fn a_field_without_shadow_maps_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = crate::common::staged_capture(dir.path());
+    let field = dir.path().join("plain.frf");
+    let o = frf(&[
+        "stage",
+        "field",
+        "--capture",
+        cap.to_str().unwrap(),
+        "--no-shadows",
+        "--out",
+        field.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.path().join("o");
+    let mut args = vec![
+        "render",
+        field.to_str().unwrap(),
+        "--orbit",
+        "3,2.5",
+        "--env",
+        "sky",
+        "--backdrop",
+        "env",
+        "--shadow",
+        "maps",
+        "--frames",
+        "1",
+        "--size",
+        "24x24",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(gpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stderr(&o);
+    assert!(said.contains("the field has no shadow maps"), "{said}");
+    assert!(!said.contains("no frame sees the ground patch"), "{said}");
+}
