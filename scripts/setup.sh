@@ -4,11 +4,12 @@
 # - Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, the GPU of machines
 #   without one (the wgpu renderer runs on it);
 # - Xvfb (a display without a screen), xauth and xdotool, for the viewer's tests (`frf view`
-#   under `xvfb-run`);
+#   under `xvfb-run`), and the X libraries winit opens at run time (cursor, input,
+#   keyboard) that they do not bring;
 # - the rustfmt and clippy components, for the checks in .ci/run.
 set -euo pipefail
 
-packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool)
+packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool libxcursor1 libxi6 libxkbcommon-x11-0)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
