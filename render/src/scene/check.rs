@@ -158,10 +158,23 @@ pub fn output(r: &Reporter, o: &OutputToml) -> Result<OutputSettings> {
 
 /// `lighting`: its keys (the base first) and what lights the floor conditions.
 pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, FloorModel)> {
+    let span = l.span();
     let l = l.get_ref();
+    // Keyed lighting may leave the base environment to its first key.
+    let base_env = match (&l.env, l.key.first().and_then(|k| k.get_ref().env.as_ref())) {
+        (Some(e), _) => env(r, "lighting.env", e)?,
+        (None, Some(e)) => env(r, "lighting.key[0].env", e)?,
+        (None, None) => {
+            return Err(r.error(
+                "lighting.env",
+                span,
+                "no environment: give env = \"FILE\" (or \"sky\", \"uniform\", \"none\"), or an env in the first [[lighting.key]]",
+            ));
+        }
+    };
     let mut lighting = vec![LightKey {
         time: f32::NEG_INFINITY,
-        env: env(r, "lighting.env", &l.env)?,
+        env: base_env,
         yaw: finite(r, "lighting.yaw_deg", &l.yaw_deg)?.to_radians(),
         intensity: finite(r, "lighting.intensity", &l.intensity)?,
     }];
@@ -208,7 +221,7 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
         }
     }
     if lighting.iter().any(|k| k.env == EnvSource::None) && lighting.len() > 1 {
-        return Err(r.error("lighting.env", l.env.span(), "`none` cannot be keyframed"));
+        return Err(r.error("lighting.env", span, "`none` cannot be keyframed"));
     }
     let floor = match word(r, "lighting.floor", &l.floor, &["env", "ground"])? {
         "env" => FloorModel::Environment,

@@ -138,8 +138,8 @@ fn default_variant() -> At<String> {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightingToml {
-    /// Environment.
-    pub env: At<String>,
+    /// Environment (with keys, the first key's when omitted).
+    pub env: Option<At<String>>,
     /// Degrees.
     #[serde(default = "zero")]
     pub yaw_deg: At<f32>,

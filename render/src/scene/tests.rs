@@ -147,3 +147,23 @@ fn a_plate_needs_one_camera_key() {
         BackdropSpec::Plate(Path::new("/shots/a/p.png").to_path_buf())
     );
 }
+
+#[test]
+fn keyed_lighting_may_leave_the_base_environment_to_its_first_key() {
+    // Issue 23: the base `env` was demanded even when the keys name the maps.
+    let keyed = MINIMAL.replace(
+        "env = \"sky\"",
+        "[[lighting.key]]\ntime = 0.0\nenv = \"uniform\"\n[[lighting.key]]\ntime = 1.0\nenv = \"sky\"",
+    );
+    let s = scene(&keyed).unwrap();
+    assert_eq!(s.lighting[0].env, EnvSource::Uniform);
+    assert_eq!(s.lighting_at(0.0).maps, vec![(EnvSource::Uniform, 1.0)]);
+    assert_eq!(s.lighting_at(1.0).maps, vec![(EnvSource::Sky, 1.0)]);
+    // Neither a base environment nor one in the first key: said, with the way out.
+    let none = MINIMAL.replace("env = \"sky\"", "yaw_deg = 10.0");
+    let e = error(&none);
+    assert!(
+        e.contains("lighting.env") && e.contains("no environment"),
+        "{e}"
+    );
+}
