@@ -27,6 +27,11 @@ use crate::error::{CoreError, Result};
 use crate::image::{Border, Image, Rgb, RgbImage, luminance};
 use crate::light::DirLight;
 
+/// The largest total light (`∫ L dω`, any channel) a loaded map may carry: far above any
+/// real scene (the sun's is about 1e5 in units of sky radiance), far below f32's 3.4e38, so
+/// that relit sums and exposures stay finite.
+pub const MAX_TOTAL_LIGHT: f64 = 1e30;
+
 /// A latitude–longitude HDR environment of radiance.
 #[derive(Debug, Clone)]
 pub struct EnvMap {
@@ -56,6 +61,20 @@ impl EnvMap {
                 format!(
                     "every texel is zero or negative ({} clamped to zero): the environment lights nothing",
                     env.clamped_texels
+                ),
+            ));
+        }
+        // Relighting sums radiance × solid angle × reflectance in 32-bit floats: a map
+        // whose total light nears f32's range (a Radiance exponent near 255) would
+        // overflow there to infinite or black pixels.
+        let total = env.total_light_f64();
+        if let Some(c) = total.iter().position(|&t| t > MAX_TOTAL_LIGHT) {
+            return Err(CoreError::bad_file(
+                path,
+                format!(
+                    "its total light ({:.1e} in channel {c}) is beyond what relighting can sum \
+                     in 32-bit floats (at most {MAX_TOTAL_LIGHT:.0e}): scale the map down",
+                    total[c]
                 ),
             ));
         }
@@ -240,6 +259,11 @@ impl EnvMap {
 
     /// `∫ L dω` over the whole sphere, per channel.
     pub fn total_light(&self) -> Rgb {
+        self.total_light_f64().map(|v| v as f32)
+    }
+
+    /// [`EnvMap::total_light`] summed and kept in f64 (it may exceed f32's range).
+    fn total_light_f64(&self) -> [f64; 3] {
         let mut sum = [0.0f64; 3];
         for y in 0..self.radiance.height() {
             let omega = self.texel_solid_angle(y) as f64;
@@ -249,7 +273,7 @@ impl EnvMap {
                 }
             }
         }
-        sum.map(|v| v as f32)
+        sum
     }
 
     /// Irradiance on an unshadowed horizontal surface facing up, `∫_{upper} L cos θ dω`,

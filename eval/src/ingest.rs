@@ -57,7 +57,7 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
     let rows = stage.cameras().len();
     // Per view: (alpha IoU, alpha MAE) and (sum, count) of flow errors, horizontal and
     // vertical.
-    type ViewErrors = ((f64, f64), [(f64, usize); 2]);
+    type ViewErrors = ((Option<f64>, f64), [(f64, usize); 2]);
     let per_view: Vec<ViewErrors> = (0..evidence.alphas.len())
         .into_par_iter()
         .filter(|&i| evidence.alphas[i].is_some())
@@ -81,12 +81,11 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
             Ok((alpha, epe))
         })
         .collect::<Result<_>>()?;
-    let n = per_view.len().max(1) as f64;
     let sum_epe = |k: usize| {
         let (s, c) = per_view
             .iter()
             .fold((0.0, 0), |acc, p| (acc.0 + p.1[k].0, acc.1 + p.1[k].1));
-        if c > 0 { s / c as f64 } else { 0.0 }
+        (c > 0).then(|| s / c as f64)
     };
     // Per evaluated view and condition: registered and unregistered PSNR, and the edge
     // band errors of the stored and the undecontaminated frames.
@@ -124,22 +123,32 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         .map(|p| p.0)
         .filter(|(a, b)| a.is_finite() && b.is_finite())
         .collect();
-    let m = registration.len().max(1) as f64;
+    let mean = |values: &[f64]| {
+        (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+    };
+    let column = |k: usize| {
+        registration
+            .iter()
+            .map(|r| [r.0, r.1][k])
+            .collect::<Vec<_>>()
+    };
+    let ious: Vec<f64> = per_view.iter().filter_map(|p| p.0.0).collect();
+    let maes: Vec<f64> = per_view.iter().map(|p| p.0.1).collect();
     let edges: Vec<(EdgeBandError, EdgeBandError)> = per_image.iter().filter_map(|p| p.1).collect();
     let edge_mean = |f: fn(&(EdgeBandError, EdgeBandError)) -> f64| {
         (!edges.is_empty()).then(|| edges.iter().map(f).sum::<f64>() / edges.len() as f64)
     };
     Ok(PoseErrors {
-        alpha_iou: per_view.iter().map(|p| p.0.0).sum::<f64>() / n,
-        alpha_mae: per_view.iter().map(|p| p.0.1).sum::<f64>() / n,
-        registration_psnr: registration.iter().map(|r| r.0).sum::<f64>() / m,
-        unregistered_psnr: registration.iter().map(|r| r.1).sum::<f64>() / m,
+        alpha_iou: mean(&ious),
+        alpha_mae: mean(&maes).unwrap_or(0.0),
+        registration_psnr: mean(&column(0)),
+        unregistered_psnr: mean(&column(1)),
         flow_epe_horizontal: sum_epe(0),
         flow_epe_vertical: sum_epe(1),
         registration_views: evidence.registered.len(),
         hull_iou: evidence
             .hull
-            .map(|h| h.iou(&stage.true_occupancy(pose, h.grid()))),
+            .and_then(|h| h.iou(&stage.true_occupancy(pose, h.grid()))),
         edge_band_error_dark: edge_mean(|e| e.0.dark),
         edge_band_error_bright: edge_mean(|e| e.0.bright),
         edge_band_error_dark_raw: edge_mean(|e| e.1.dark),

@@ -241,19 +241,15 @@ pub fn alpha_mae(reference: &GrayImage, test: &GrayImage) -> f64 {
 }
 
 /// Intersection over union of the binary mattes `alpha ≥ SUBJECT_ALPHA` of two alpha
-/// images (1 when both are empty).
-pub fn alpha_iou(reference: &GrayImage, test: &GrayImage) -> f64 {
+/// images (`None` when both are empty: there is nothing to measure).
+pub fn alpha_iou(reference: &GrayImage, test: &GrayImage) -> Option<f64> {
     let (mut inter, mut union) = (0usize, 0usize);
     for (&r, &t) in reference.pixels().iter().zip(test.pixels()) {
         let (a, b) = (r >= SUBJECT_ALPHA, t >= SUBJECT_ALPHA);
         inter += (a && b) as usize;
         union += (a || b) as usize;
     }
-    if union > 0 {
-        inter as f64 / union as f64
-    } else {
-        1.0
-    }
+    (union > 0).then(|| inter as f64 / union as f64)
 }
 
 /// Columns of subject a pair of rows needs for [`max_row_jump`] to count it.
@@ -379,6 +375,6 @@ mod tests {
         d.pixels_mut().iter_mut().for_each(|p| p[3] = 1.0);
         assert!((alpha_mae(&alpha_of(&a), &alpha_of(&d)) - 11.0 / 40.0).abs() < 1e-6);
         // 29 of 40 columns are subject in a, all of them in d.
-        assert!((alpha_iou(&alpha_of(&a), &alpha_of(&d)) - 29.0 / 40.0).abs() < 1e-9);
+        assert!((alpha_iou(&alpha_of(&a), &alpha_of(&d)).unwrap() - 29.0 / 40.0).abs() < 1e-9);
     }
 }

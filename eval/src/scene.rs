@@ -137,7 +137,7 @@ pub fn score_scene<R: ReadAt>(
     let hull = field.hull(pose)?;
     let hull_iou = hull
         .as_ref()
-        .map(|h| h.iou(&stage.true_occupancy(pose, h.grid())));
+        .and_then(|h| h.iou(&stage.true_occupancy(pose, h.grid())));
     let (shadow_mae_traced, traced_seconds) = match (hull, &maps) {
         (Some(hull), Some(m)) => {
             let t = Instant::now();

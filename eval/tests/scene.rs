@@ -19,7 +19,9 @@ fn hull_shadow_and_composite_meet_their_bounds_against_the_truth() {
     let tiny = frf_testkit::tiny_field();
     let field = FieldFile::open(&tiny.field).unwrap();
     let hull = field.hull(0).unwrap().unwrap();
-    let iou = hull.iou(&tiny.stage.true_occupancy(0, hull.grid()));
+    let iou = hull
+        .iou(&tiny.stage.true_occupancy(0, hull.grid()))
+        .unwrap();
     let env = EnvMap::sky();
     let lights = env.median_cut(512);
     let maps = ShadowMaps::load(&field, 0).unwrap().unwrap();

@@ -9,25 +9,28 @@ use serde::{Deserialize, Serialize};
 /// Errors of one pose against a ground truth.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct PoseErrors {
-    /// Intersection over union of estimated and true mattes (alpha ≥ 0.5), mean over views.
-    pub alpha_iou: f64,
+    /// Intersection over union of estimated and true mattes (alpha ≥ 0.5), mean over the
+    /// views where either matte holds a pixel (`None`: no view does, nothing measured).
+    pub alpha_iou: Option<f64>,
     /// Mean absolute alpha error over the image, mean over views.
     pub alpha_mae: f64,
     /// PSNR (dB, subject pixels, peak = the truth's brightest value) of the registered
     /// basis images against the true images at the reference instant, mean over the
-    /// evaluated views and conditions.
-    pub registration_psnr: f64,
+    /// evaluated views and conditions (`None`: no view was evaluated, or none holds a
+    /// subject pixel).
+    pub registration_psnr: Option<f64>,
     /// The same for the frames matted without registration.
-    pub unregistered_psnr: f64,
+    pub unregistered_psnr: Option<f64>,
     /// Mean end-point error (px) of horizontal-neighbour flow, inside the true matte where
-    /// the point is visible in the neighbour.
-    pub flow_epe_horizontal: f64,
+    /// the point is visible in the neighbour (`None`: no such pixel, as in a capture too
+    /// small for any pixel to lie wholly inside the subject).
+    pub flow_epe_horizontal: Option<f64>,
     /// The same for vertical neighbours.
-    pub flow_epe_vertical: f64,
+    pub flow_epe_vertical: Option<f64>,
     /// Views whose registration was evaluated.
     pub registration_views: usize,
     /// Intersection over union of the visual hull's voxels with the true occupancy of
-    /// the same grid (`None` without a hull).
+    /// the same grid (`None` without a hull, or when both are empty).
     #[serde(default)]
     pub hull_iou: Option<f64>,
     /// Error over the edge band (true alpha strictly between 0.05 and 0.95) of the

@@ -192,19 +192,15 @@ impl VoxelHull {
     }
 
     /// Intersection over union with a reference occupancy of the same grid
-    /// (`reference[index]`); 1 when both are empty.
-    pub fn iou(&self, reference: &[bool]) -> f64 {
+    /// (`reference[index]`); `None` when both are empty (nothing to measure).
+    pub fn iou(&self, reference: &[bool]) -> Option<f64> {
         let (mut inter, mut union) = (0usize, 0usize);
         for (index, &r) in reference.iter().enumerate().take(self.grid.len()) {
             let h = self.occupied(index);
             inter += (h && r) as usize;
             union += (h || r) as usize;
         }
-        if union == 0 {
-            1.0
-        } else {
-            inter as f64 / union as f64
-        }
+        (union > 0).then(|| inter as f64 / union as f64)
     }
 
     /// Whether the ray `origin + t dir` (`t ≥ 0`) passes through an occupied voxel.
@@ -477,8 +473,9 @@ mod tests {
                 (hull.grid().centre(a, b, c) - Vec3::new(0.0, 1.0, 0.0)).length() <= 0.3
             })
             .collect();
-        eprintln!("IoU {:.3}", hull.iou(&truth));
-        assert!(hull.iou(&truth) > 0.9, "IoU {}", hull.iou(&truth));
+        let iou = hull.iou(&truth).unwrap();
+        eprintln!("IoU {iou:.3}");
+        assert!(iou > 0.9, "IoU {iou}");
     }
 
     #[test]

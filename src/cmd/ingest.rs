@@ -207,7 +207,9 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
     println!("  whole run: {:.1} s wall", r.seconds);
     let f = |v: Option<f64>, unit: &str, digits: usize| match v {
         Some(v) => format!("{v:.digits$}{unit}"),
-        None => "not measured (no stage truth, or --no-eval)".into(),
+        None => {
+            "not measured (no stage truth, --no-eval, or nothing to measure at this size)".into()
+        }
     };
     println!("  against the virtual stage's truth:");
     println!(

@@ -282,3 +282,39 @@ fn a_capture_through_the_binary_carries_its_truth_and_becomes_an_oracle_field() 
         }
     }
 }
+
+/// A capture too small for any pixel to lie wholly inside the subject (8x12) ingests, and
+/// its report says the flow errors were not measured instead of a perfect 0 px.
+#[test]
+fn an_ingest_too_small_to_measure_says_so_instead_of_a_perfect_score() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = dir.path().join("cap");
+    let field = dir.path().join("f.frf");
+    let o = frf(&[
+        "stage",
+        "--poses",
+        "0",
+        "--size",
+        "8x12",
+        "--lights-per-axis",
+        "1",
+        "--out",
+        cap.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = frf(&[
+        "ingest",
+        cap.to_str().unwrap(),
+        "--out",
+        field.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = String::from_utf8_lossy(&o.stdout);
+    for line in [
+        "flow EPE inside matte, horizontal",
+        "flow EPE inside matte, vertical",
+    ] {
+        let line = said.lines().find(|l| l.contains(line)).unwrap();
+        assert!(line.contains("not measured"), "{line}");
+    }
+}
