@@ -106,6 +106,25 @@ pub fn regular_file(path: &Path) -> Result<u64> {
     Ok(meta.len())
 }
 
+/// What identifies the content of the regular file at `path`: its size in bytes and the
+/// CRC-32 of its bytes (read in blocks: any size).
+pub fn content_identity(path: &Path) -> Result<(u64, u32)> {
+    use std::io::Read;
+    let size = regular_file(path)?;
+    let mut file = std::fs::File::open(path).map_err(|e| CoreError::io(path, e))?;
+    let mut hasher = crc32fast::Hasher::new();
+    let mut block = vec![0u8; 1 << 20];
+    loop {
+        match file.read(&mut block) {
+            Ok(0) => break,
+            Ok(n) => hasher.update(&block[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(CoreError::io(path, e)),
+        }
+    }
+    Ok((size, hasher.finalize()))
+}
+
 /// Reads the text file at `path`, refusing what is not a regular file
 /// ([`regular_file`]) and a file larger than `limit` bytes (a hand-written file is
 /// small; a larger one is something else).

@@ -10,6 +10,7 @@
 pub mod atomic;
 pub mod camera;
 pub mod capture;
+pub mod claim;
 pub mod contact;
 pub mod conventions;
 pub mod env;

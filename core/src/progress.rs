@@ -10,6 +10,11 @@ pub trait Progress: Sync {
     fn step(&self);
     /// The current phase is over.
     fn finish(&self) {}
+    /// Something a person should read while the work goes on (e.g. a frame rendered
+    /// again); on standard error by default.
+    fn note(&self, what: &str) {
+        eprintln!("{what}");
+    }
 }
 
 /// Progress that shows nothing.
@@ -19,4 +24,5 @@ pub struct Silent;
 impl Progress for Silent {
     fn phase(&self, _what: &str, _total: usize) {}
     fn step(&self) {}
+    fn note(&self, _what: &str) {}
 }

@@ -288,6 +288,8 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     source: R,
     header: FieldHeader,
     chunks: BTreeMap<ChunkKey, ChunkEntry>,
+    /// CRC-32 of the packed index, as the footer holds it.
+    index_crc: u32,
     /// Bytes of chunks read so far (what a plan saves is measured on it).
     bytes_read: std::sync::atomic::AtomicU64,
 }
@@ -392,6 +394,7 @@ impl<R: ReadAt> FieldFile<R> {
             source,
             header: index.header,
             chunks,
+            index_crc,
             bytes_read: std::sync::atomic::AtomicU64::new(0),
         })
     }
@@ -409,6 +412,13 @@ impl<R: ReadAt> FieldFile<R> {
     /// The file's path.
     pub fn path(&self) -> &Path {
         &self.path
+    }
+
+    /// What identifies the file's content: its size in bytes and the CRC-32 of its
+    /// index, which holds the header and every chunk's place, length and CRC-32 (two
+    /// fields that differ anywhere differ here but with odds of 2⁻³²).
+    pub fn identity(&self) -> (u64, u32) {
+        (self.source.size(), self.index_crc)
     }
 
     /// `requested` (an error naming the file and the poses it holds when it lacks it), or

@@ -130,8 +130,19 @@ fn env_radiance(d_in: vec3<f32>) -> vec3<f32> {
     return bilinear(env, vec2<f32>(x, ty)).xyz;
 }
 
-// The relative irradiance at the world's ground point p under walker i's shadow: 1 off
-// its patch. Twin of `RelitShadow::at` in the walker's subject frame.
+// Where the fade toward the patch's edge begins, as a fraction of the half side: twin of
+// `EDGE_FADE_FROM` in render/src/shadow.rs.
+const EDGE_FADE_FROM: f32 = 0.8;
+
+// The weight of 1 (unshadowed) at subject-frame ground point q: twin of `edge_fade`.
+fn edge_fade(q: vec3<f32>, half: f32) -> f32 {
+    let t = clamp((max(abs(q.x), abs(q.z)) / half - EDGE_FADE_FROM) / (1.0 - EDGE_FADE_FROM), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+// The relative irradiance at the world's ground point p under walker i's shadow: faded to
+// 1 toward the edge of its patch, 1 off it. Twin of `RelitShadow::at` in the walker's
+// subject frame.
 fn shadow_at(i: u32, p: vec3<f32>) -> vec3<f32> {
     let m = instances[i];
     let q = m.col_x.xyz * p.x + m.col_y.xyz * p.y + m.col_z.xyz * p.z + m.translation.xyz;
@@ -140,7 +151,8 @@ fn shadow_at(i: u32, p: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(1.0);
     }
     let s = params.shadow_extent / f32(params.shadow_texels);
-    return bilinear_layer(shadows, i, vec2<f32>((q.x + half) / s - 0.5, (q.z + half) / s - 0.5)).xyz;
+    let map = bilinear_layer(shadows, i, vec2<f32>((q.x + half) / s - 0.5, (q.z + half) / s - 0.5)).xyz;
+    return mix(map, vec3<f32>(1.0), edge_fade(q, half));
 }
 
 fn luminance(c: vec3<f32>) -> f32 {

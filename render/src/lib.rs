@@ -34,6 +34,7 @@ pub mod renderer;
 pub mod resident;
 pub mod scene;
 pub mod shadow;
+pub mod shadow_reach;
 pub mod synthetic;
 
 pub use error::{RenderError, Result};

@@ -9,8 +9,11 @@
 //! frame, turntable angle 0: the maps are traced with the dome's lights as the subject
 //! frame sees them at angle 0), `E_k` the irradiance condition `k` delivers to the
 //! unshadowed ground and `A_k` its map. `S = 1` is unshadowed; where nothing lights the
-//! ground from above (the sum is 0) `S = 1`, and off the patch `S = 1`. This is the CPU
-//! reference; `shaders/shadow.wgsl` computes the same on the GPU.
+//! ground from above (the sum is 0) `S = 1`, and off the patch `S = 1`. Toward the edge
+//! of the patch the maps fade to 1 ([`edge_fade`]): a shadow longer than the patch (a low
+//! sun's) thins out instead of ending on a straight line, and the patch leaves no square
+//! behind. This is the CPU reference; `shaders/shadow.wgsl` relights the maps and
+//! `shaders/composite.wgsl` samples them with the same fade on the GPU.
 
 use frf_core::image::{Border, GrayImage, Image, Rgb, RgbImage};
 use frf_core::light::DirLight;
@@ -106,15 +109,32 @@ pub struct RelitShadow {
     pub image: RgbImage,
 }
 
+/// Where the fade toward the patch's edge begins, as a fraction of the half side.
+pub const EDGE_FADE_FROM: f32 = 0.8;
+
+/// The weight of 1 (unshadowed) at ground point `(x, z)` of a patch of side `extent_m`
+/// centred on the subject: 0 inside [`EDGE_FADE_FROM`] of the half side (the maps as
+/// they are), rising smoothly (smoothstep of the larger of `|x|` and `|z|`) to 1 at the
+/// edge. `shaders/composite.wgsl`'s `edge_fade` is its twin.
+pub fn edge_fade(x: f32, z: f32, extent_m: f32) -> f32 {
+    let half = 0.5 * extent_m;
+    let t =
+        ((x.abs().max(z.abs()) / half - EDGE_FADE_FROM) / (1.0 - EDGE_FADE_FROM)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 impl RelitShadow {
     /// The relative irradiance at ground point `(x, z)`: bilinear between texel centres,
-    /// the edge texels held out to the patch's border, 1 off the patch.
+    /// the edge texels held out to the patch's border, faded to 1 toward the edge
+    /// ([`edge_fade`]), 1 off the patch.
     pub fn at(&self, x: f32, z: f32) -> Rgb {
         if !self.ground.contains(x, z) {
             return [1.0; 3];
         }
         let t = self.ground.texel_of(x, z);
-        self.image.sample_bilinear(t.x, t.y, Border::Clamp)
+        let s = self.image.sample_bilinear(t.x, t.y, Border::Clamp);
+        let w = edge_fade(x, z, self.ground.extent_m);
+        s.map(|c| c + (1.0 - c) * w)
     }
 }
 
@@ -220,6 +240,19 @@ mod tests {
         assert_eq!(relit.at(1.5, 0.0), [1.0; 3]);
         // At texel (1, 1)'s centre, (-0.25, -0.25).
         assert_eq!(relit.at(-0.25, -0.25), q);
+    }
+
+    #[test]
+    fn the_maps_fade_to_one_toward_the_patch_edge() {
+        // Red is 2/3 everywhere but texel (1, 1); the patch's half side is 1 m.
+        let relit = maps().relight(&[[1.0; 3], [50.0; 3], [1.0; 3]]);
+        let red = |x: f32| relit.at(x, 0.3)[0];
+        assert!((red(0.79) - 2.0 / 3.0).abs() < 1e-6, "{}", red(0.79));
+        // Half way through the fade band: smoothstep(1/2) = 1/2 of the way to 1.
+        assert!((red(0.9) - 5.0 / 6.0).abs() < 1e-5, "{}", red(0.9));
+        assert!(red(0.999) > 0.999 && red(0.85) < red(0.9) && red(0.9) < red(0.95));
+        // The same along z and on the other side.
+        assert!((relit.at(0.3, -0.9)[0] - 5.0 / 6.0).abs() < 1e-5);
     }
 
     #[test]

@@ -311,6 +311,11 @@ impl CameraArgs {
     }
 }
 
+/// Most texels per side of a patch sized for a scene without `--shadow-texels` (6 m at the
+/// original's density): tracing the maps costs as the square of it, and a long shadow's
+/// far end is soft.
+pub const MAX_AUTO_TEXELS: u32 = 256;
+
 /// The visual hull and shadow maps made in ingest (`frf ingest`, `frf stage field`).
 #[derive(Args)]
 pub struct ShadowArgs {
@@ -324,12 +329,13 @@ pub struct ShadowArgs {
     /// walk cycles).
     #[arg(long, default_value_t = DEFAULT_MISSES)]
     hull_misses: usize,
-    /// Texels per side of the shadow maps.
-    #[arg(long, default_value_t = GroundGrid::ORIGINAL.texels)]
-    shadow_texels: u32,
-    /// Side of the ground patch under the subject the shadow maps cover, metres.
-    #[arg(long, default_value_t = GroundGrid::ORIGINAL.extent_m)]
-    shadow_extent: f32,
+    /// Texels per side of the shadow maps [default: 128 per 3 m of patch].
+    #[arg(long)]
+    shadow_texels: Option<u32>,
+    /// Side of the ground patch under the subject the shadow maps cover, metres [default:
+    /// 3; with `frf ingest --for SCENE`, enough for the shadow of the scene's lighting].
+    #[arg(long)]
+    shadow_extent: Option<f32>,
     /// Directions traced per light of a condition, spread over the solid angle it stands
     /// for (1: toward the light only).
     #[arg(long, default_value_t = DEFAULT_LIGHT_SAMPLES)]
@@ -339,18 +345,31 @@ pub struct ShadowArgs {
 impl ShadowArgs {
     /// The options, checked; `None` with `--no-shadows`.
     pub fn options(&self) -> CliResult<Option<ShadowOptions>> {
+        self.options_for(None)
+    }
+
+    /// [`ShadowArgs::options`] with a patch of side `needed` metres (a scene's need, at
+    /// least the original's) where `--shadow-extent` is not given; the texels follow the
+    /// side where `--shadow-texels` is not given (128 per 3 m, at most
+    /// [`MAX_AUTO_TEXELS`]).
+    pub fn options_for(&self, needed: Option<f32>) -> CliResult<Option<ShadowOptions>> {
         if self.no_shadows {
             return Ok(None);
         }
+        let original = GroundGrid::ORIGINAL;
+        let extent_m = self
+            .shadow_extent
+            .unwrap_or_else(|| needed.map_or(original.extent_m, |n| n.max(original.extent_m)));
+        let texels = self.shadow_texels.unwrap_or_else(|| {
+            let per_metre = original.texels as f32 / original.extent_m;
+            ((extent_m * per_metre).ceil() as u32).clamp(original.texels, MAX_AUTO_TEXELS)
+        });
         let o = ShadowOptions {
             hull: HullSpec {
                 voxel_m: self.hull_voxel,
                 misses: self.hull_misses,
             },
-            ground: GroundGrid {
-                extent_m: self.shadow_extent,
-                texels: self.shadow_texels,
-            },
+            ground: GroundGrid { extent_m, texels },
             light_samples: self.shadow_samples,
         };
         o.validate()?;

@@ -112,6 +112,8 @@ impl Progress for Bars {
 
 /// Runs `frf ingest`.
 pub fn run(args: IngestArgs) -> CliResult {
+    let _claim =
+        crate::cmd::claim::claim(&args.out, &[&frf_ingest::pipeline::parts_dir(&args.out)])?;
     let mut options = IngestOptions {
         poses: args
             .poses
@@ -150,7 +152,23 @@ pub fn run(args: IngestArgs) -> CliResult {
     let evaluator = judge.as_ref().map(|j| j as &dyn Evaluator);
     if let Some(scene) = &args.for_scene {
         let capture = frf_core::capture::Capture::open_manifest(&args.capture)?;
-        let plan = crate::cmd::for_scene::plan(scene, &capture)?;
+        if let Some((side, elevation)) = crate::cmd::for_scene::shadow_patch(scene)? {
+            options.shadows = args.shadows.options_for(Some(side))?;
+            if let Some(s) = &options.shadows {
+                println!(
+                    "shadow maps: a {:.1} m patch of {} texels (the scene's shadow-making lights \
+                     reach down to {elevation:.0}°{})",
+                    s.ground.extent_m,
+                    s.ground.texels,
+                    if side >= crate::cmd::for_scene::MAX_SCENE_PATCH_M {
+                        ": their shadow is longer than the largest patch made unasked"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
+        let plan = crate::cmd::for_scene::plan(scene, &capture, options.shadows.as_ref())?;
         println!("{}", plan.summary());
         let wanted: Vec<u32> = plan.poses.iter().map(|p| p.pose).collect();
         options.poses = if options.poses.is_empty() {
@@ -288,6 +306,7 @@ pub struct RingArgs {
 
 /// Runs `frf ingest-ring`.
 pub fn run_ring(args: RingArgs) -> CliResult {
+    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
     let r = frf_ingest::ring::ingest_ring(
         &args.par,
         &args.out,

@@ -1,7 +1,9 @@
 //! `frf merge PART... --out FIELD`: fields holding disjoint poses of the same capture and
 //! settings (e.g. `frf ingest --poses P` on the machines of a farm) joined into one
 //! field, chunks copied byte for byte, in pose order: the same bytes as one ingest of
-//! every pose.
+//! every pose. It says which poses the result holds; with `--expect` (a pose list, or the
+//! capture directory the parts were ingested from) a missing pose is refused by number
+//! before anything is written.
 
 use std::path::PathBuf;
 
@@ -20,13 +22,33 @@ pub struct MergeArgs {
     /// The field to write.
     #[arg(long)]
     out: PathBuf,
+    /// The poses the result must hold: `0,3,6`, `0..30`, or a capture directory (its
+    /// poses, or those it filmed).
+    #[arg(long)]
+    expect: Option<String>,
+}
+
+/// The poses `--expect` names, and where they come from.
+fn expected(spec: &str) -> CliResult<(Vec<u32>, String)> {
+    let dir = std::path::Path::new(spec);
+    if dir.is_dir() {
+        let capture = frf_core::capture::Capture::open_manifest(dir)?;
+        return Ok((capture.poses().to_vec(), format!("the capture {spec}")));
+    }
+    let poses = crate::cmd::args::parse_poses(spec)
+        .map_err(|e| e.replace("--poses", "--expect") + ", or a capture directory")?;
+    Ok((poses, format!("--expect {spec}")))
 }
 
 /// Runs `frf merge`.
 pub fn run(args: MergeArgs) -> CliResult {
+    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
+    let expect = args.expect.as_deref().map(expected).transpose()?;
     let mut parts = Vec::with_capacity(args.parts.len());
+    let mut held: Vec<u32> = Vec::new();
     for p in &args.parts {
         let f = FieldFile::open(p)?;
+        held.extend(f.header().poses.iter().map(|r| r.pose));
         let first = f
             .header()
             .poses
@@ -37,14 +59,38 @@ pub fn run(args: MergeArgs) -> CliResult {
         parts.push((first, p.clone()));
     }
     parts.sort();
+    held.sort_unstable();
+    if let Some((poses, from)) = &expect {
+        let missing: Vec<u32> = poses
+            .iter()
+            .copied()
+            .filter(|p| !held.contains(p))
+            .collect();
+        if !missing.is_empty() {
+            return Err(format!(
+                "the parts hold poses {held:?}, {from} expects {poses:?}: poses {missing:?} are \
+                 missing (ingest them, e.g. frf ingest CAPTURE --poses {}); nothing written",
+                missing
+                    .iter()
+                    .map(u32::to_string)
+                    .collect::<Vec<_>>()
+                    .join(",")
+            )
+            .into());
+        }
+    }
     let paths: Vec<PathBuf> = parts.into_iter().map(|(_, p)| p).collect();
     merge_fields(&paths, &args.out)?;
     let s = FieldFile::open(&args.out)?.stats();
     println!(
-        "{} parts merged into {}: {} poses, {:.2} MB",
+        "{} parts merged into {}: {} poses {held:?}{}, {:.2} MB",
         paths.len(),
         args.out.display(),
         s.poses,
+        match &expect {
+            Some((poses, from)) => format!(" (every one of the {} {from} expects)", poses.len()),
+            None => " (give --expect to check that none is missing)".into(),
+        },
         std::fs::metadata(&args.out)?.len() as f64 / 1e6
     );
     Ok(())

@@ -2,6 +2,7 @@
 
 pub mod args;
 pub mod bench;
+pub mod claim;
 pub mod eval;
 pub mod flow;
 pub mod for_scene;
@@ -11,6 +12,7 @@ pub mod ingest;
 pub mod merge;
 pub mod progress;
 pub mod render;
+pub mod render_settings;
 pub mod report;
 pub mod stage;
 pub mod stage_field;

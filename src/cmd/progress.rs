@@ -57,6 +57,13 @@ impl Progress for Bars {
             }
         });
     }
+
+    fn note(&self, what: &str) {
+        self.with(|b| match b {
+            Some(b) => b.suspend(|| eprintln!("{what}")),
+            None => eprintln!("{what}"),
+        });
+    }
 }
 
 impl Drop for Bars {

@@ -37,6 +37,7 @@ use crate::cmd::args::{
     parse_size,
 };
 use crate::cmd::progress::Bars;
+use crate::cmd::render_settings::render_settings;
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;
@@ -439,13 +440,7 @@ pub fn run(args: RenderArgs) -> CliResult {
         return print_plan(&plan, args.json);
     }
     let out_dir = args.out.clone().ok_or("give --out DIR (or --plan)")?;
-    // `json!` would unwrap the conversion: a failure is an error here, not a panic.
-    let args_json = serde_json::to_value(&args)?;
-    let settings = serde_json::json!({
-        "args": args_json,
-        "scene": std::fs::read_to_string(&args.input).ok().filter(|_| !field_render),
-        "size": size,
-    });
+    let settings = render_settings(&args, &scene, &field, !field_render, size)?;
 
     let start = Instant::now();
     let device = Device::open(args.cpu)?;
@@ -488,6 +483,18 @@ pub fn run(args: RenderArgs) -> CliResult {
         "shadow: {}",
         shadow_words(&scene, &shot, options.traced_lights)
     );
+    if let Some(r) = shot.shadow_reach()?.filter(|r| r.cut()) {
+        eprintln!(
+            "warning: the lights that make the shadow are as low as {:.0}°: it reaches {:.1} m \
+             from the walker, past the field's {:.1} m patch of shadow maps (they fade out from \
+             {:.1} m): ingest with --shadow-extent {:.0} (or --for this scene) to hold it whole",
+            r.elevation_deg,
+            r.reach_m,
+            r.patch_side_m,
+            0.5 * r.patch_side_m * frf_render::shadow::EDGE_FADE_FROM,
+            r.side_needed_m().ceil()
+        );
+    }
     for (wanted, held) in &shot.plan().poses_substituted {
         eprintln!(
             "pose {wanted} is not in the field: pose {held} stands in for it (render.json: poses_substituted)"

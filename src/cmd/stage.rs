@@ -191,7 +191,7 @@ fn capture(args: CaptureArgs) -> CliResult {
         all.poses = (0..all.poses_per_cycle()).collect();
         let stage = frf_stage::Stage::new(all)?;
         let capture = frf_core::capture::Capture::from_manifest(&out, stage.manifest())?;
-        let plan = crate::cmd::for_scene::plan(scene, &capture)?;
+        let plan = crate::cmd::for_scene::plan(scene, &capture, None)?;
         println!("{}", plan.summary());
         config.poses = plan.poses.iter().map(|p| p.pose).collect();
         config.filmed = plan.filmed(stage.cameras().len());

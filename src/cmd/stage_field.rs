@@ -40,6 +40,7 @@ pub struct FieldArgs {
 
 /// Runs `frf stage field`.
 pub fn field(args: FieldArgs) -> CliResult {
+    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
     let stage = frf_stage::open_stage(&args.capture)?;
     let poses = if args.poses.is_empty() {
         stage.config().poses.clone()

@@ -7,7 +7,8 @@
 use std::path::{Path, PathBuf};
 
 /// A case: the command (`{bad}` is the corpus directory, `{out}` a path in a fresh
-/// scratch directory that must stay empty), the file it names and the words of the problem.
+/// scratch directory that must stay empty, `{field}` and `{capture}` the tiny stage's
+/// field and capture), the file it names and the words of the problem.
 struct Case {
     args: &'static [&'static str],
     file: &'static str,
@@ -15,6 +16,72 @@ struct Case {
 }
 
 const CASES: &[Case] = &[
+    Case {
+        args: &[
+            "render",
+            "{bad}/not_a_field.frf",
+            "--orbit",
+            "3,1.2",
+            "--env",
+            "sky",
+            "--out",
+            "{out}/o",
+        ],
+        file: "not_a_field.frf",
+        problem: &["not a field file"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{bad}/short.frf",
+            "--orbit",
+            "3,1.2",
+            "--env",
+            "sky",
+            "--out",
+            "{out}/o",
+        ],
+        file: "short.frf",
+        problem: &["too short for a field file"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--camera",
+            "{bad}/camera_backwards.toml",
+            "--env",
+            "sky",
+            "--out",
+            "{out}/o",
+        ],
+        file: "camera_backwards.toml",
+        problem: &["key 1", "does not follow"],
+    },
+    // An output that is a directory, refused before the work (each used to do all of it,
+    // then fail at the rename leaving a full-size temporary file beside it).
+    Case {
+        args: &[
+            "stage",
+            "field",
+            "--capture",
+            "{capture}",
+            "--out",
+            "{bad}/cap_missing",
+        ],
+        file: "cap_missing",
+        problem: &["a directory is there"],
+    },
+    Case {
+        args: &["ingest", "{capture}", "--out", "{bad}/cap_missing"],
+        file: "cap_missing",
+        problem: &["a directory is there"],
+    },
+    Case {
+        args: &["merge", "{field}", "--out", "{bad}/cap_missing"],
+        file: "cap_missing",
+        problem: &["a directory is there"],
+    },
     Case {
         args: &[
             "render",
@@ -261,6 +328,7 @@ fn corpus() -> PathBuf {
 #[test]
 fn every_bad_input_is_refused_naming_the_file_and_the_problem() {
     let field = &frf_testkit::tiny_field().field;
+    let capture = frf_testkit::tiny_field().capture();
     let mut failures = Vec::new();
     for case in CASES {
         let out = tempfile::tempdir().unwrap();
@@ -271,6 +339,7 @@ fn every_bad_input_is_refused_naming_the_file_and_the_problem() {
                 a.replace("{bad}", corpus().to_str().unwrap())
                     .replace("{out}", out.path().to_str().unwrap())
                     .replace("{field}", field.to_str().unwrap())
+                    .replace("{capture}", capture.to_str().unwrap())
             })
             .collect();
         let o = crate::common::frf_command(&args).output().unwrap();
@@ -378,7 +447,7 @@ fn paths_that_are_not_utf8_render_and_are_named() {
     assert!(!said.contains("panicked"), "{said}");
     let settings: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("settings.json")).unwrap()).unwrap();
-    let named = settings["args"]["input"].as_str().unwrap();
+    let named = settings["files"]["field"]["path"].as_str().unwrap();
     assert!(named.ends_with("walker\u{fffd}.frf"), "{named}");
     assert!(out.join("frame_0000.png").exists());
 }

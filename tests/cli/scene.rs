@@ -7,7 +7,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use crate::common::frf;
+use crate::common::{frf, stderr};
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -309,7 +309,7 @@ fn stage_and_ingest_for_a_scene_and_merged_parts_are_one_ingest() {
         "the manifest does not say what was filmed"
     );
 
-    let ingest = |out: &Path, extra: &[&str]| {
+    let ingest = |out: &Path, extra: &[&str]| -> String {
         let mut args = vec![
             "ingest",
             capture.to_str().unwrap(),
@@ -322,10 +322,13 @@ fn stage_and_ingest_for_a_scene_and_merged_parts_are_one_ingest() {
             out.to_str().unwrap(),
         ];
         args.extend(extra);
-        ok(&args);
+        String::from_utf8_lossy(&ok(&args).stdout).into_owned()
     };
     let whole = d.join("whole.frf");
-    ingest(&whole, &[]);
+    // The built-in sky's sun, 40° high, casts a person's shadow 2.7 m long: the patch of
+    // maps is made large enough for it to end before the maps fade (6.9 m).
+    let said = ingest(&whole, &[]);
+    assert!(said.contains("shadow maps: a 6.9 m patch"), "{said}");
     let parts = [d.join("p0.frf"), d.join("p3.frf")];
     ingest(&parts[0], &["--poses", "0"]);
     ingest(&parts[1], &["--poses", "3"]);
@@ -353,8 +356,76 @@ fn stage_and_ingest_for_a_scene_and_merged_parts_are_one_ingest() {
         out.to_str().unwrap(),
     ];
     args.extend(gpu_flag());
-    ok(&args);
+    let o = ok(&args);
     assert!(out.join("frame_0001.png").exists());
+    let warning = "warning: the lights that make the shadow are as low as";
+    assert!(!stderr(&o).contains(warning), "{}", stderr(&o));
+    // The tiny field's 3 m patch cuts that shadow: said, with the extent that holds it.
+    let mut args = vec!["render", scene.to_str().unwrap(), "--frames", "1"];
+    let cut = d.join("cut");
+    args.extend(["--out", cut.to_str().unwrap()]);
+    args.extend(gpu_flag());
+    let said = stderr(&ok(&args));
+    assert!(said.contains(warning), "{said}");
+    assert!(said.contains("--shadow-extent 7"), "{said}");
+
+    // A scene seen from behind needs views the field was not made with: its plan names
+    // them, and its render is refused before it writes anything (it used to fail after
+    // writing its settings).
+    let behind = d.join("behind.toml");
+    std::fs::write(
+        &behind,
+        std::fs::read_to_string(&scene)
+            .unwrap()
+            .replace("[0.5, 1.3, 3.0]", "[0.5, 1.3, -3.0]")
+            .replace("[-0.5, 1.3, 3.0]", "[-0.5, 1.3, -3.0]"),
+    )
+    .unwrap();
+    let behind_out = d.join("behind_shot");
+    for extra in [&["--plan"][..], &["--out", behind_out.to_str().unwrap()]] {
+        let mut args = vec![
+            "render",
+            behind.to_str().unwrap(),
+            "--field",
+            whole.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = frf(&args);
+        let said = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{said}");
+        assert!(said.contains("whole.frf: lacks"), "{said}");
+        assert!(said.contains("pose 0 view ("), "{said}");
+    }
+    assert!(!behind_out.exists(), "a refused render left its directory");
+
+    // A merge says which poses it holds; expecting the capture's, a missing pose is named
+    // and nothing is written.
+    let o = frf(&[
+        "merge",
+        parts[0].to_str().unwrap(),
+        "--expect",
+        capture.to_str().unwrap(),
+        "--out",
+        d.join("half.frf").to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert!(said.contains("poses [3] are missing"), "{said}");
+    assert!(!d.join("half.frf").exists());
+    let o = ok(&[
+        "merge",
+        parts[0].to_str().unwrap(),
+        parts[1].to_str().unwrap(),
+        "--expect",
+        "0,3",
+        "--out",
+        d.join("again.frf").to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.contains("2 poses [0, 3] (every one of the 2"),
+        "{said}"
+    );
 
     // Parts that share a pose are refused, naming it.
     let o = frf(&[

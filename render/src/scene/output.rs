@@ -4,9 +4,16 @@
 //! report (`render.json`, or `render_frames_A-B.json` for part of a shot).
 //!
 //! A directory remembers the settings it was rendered with (`settings.json`, without the
-//! frame range): a rerun with the same settings skips the frames already written, so an
-//! interrupted render resumes and the tasks of a farm job can share one directory; other
-//! settings are refused rather than mixed in.
+//! frame range; the caller makes them say what the frames are made from): a rerun with the
+//! same settings skips the frames already written, so an interrupted render resumes and
+//! the tasks of a farm job can share one directory; other settings are refused, naming
+//! what differs, while any frame is there, rather than mixed in.
+//!
+//! Each frame ends with its record, `frame_NNNN.json` (its time, poses, timings, pixel
+//! statistics and the sizes of its files), written after its files: a frame is kept only
+//! when its record is there and its files have the sizes it lists, so a frame cut short
+//! (or without a record) is rendered again, and a report of a resumed run counts the kept
+//! frames' statistics and timings from their records.
 
 use std::path::{Path, PathBuf};
 
@@ -16,9 +23,9 @@ use frf_core::image::{Image, RgbImage, Rgba};
 use frf_core::io::{read_rgba, write_exr_rgb, write_exr_rgba, write_png8_srgb, write_png8_srgba};
 use frf_core::preview::{fit_width, write_apng, write_gif};
 use frf_reflectance::container::ReadAt;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-use super::plan::{FramePlan, ShotFrame};
+use super::plan::ShotFrame;
 use super::shot::{Shot, ShotCounters, ShotResult};
 use super::{Preview, Scene};
 use crate::cpu::FrameStats;
@@ -33,13 +40,14 @@ const SHEET_FRAMES: usize = 12;
 /// Widest animated preview, pixels.
 const PREVIEW_WIDTH: usize = 480;
 
-/// One frame, as the report lists it.
-#[derive(Serialize)]
+/// One frame, as the report lists it and as its record (`frame_NNNN.json`) keeps it.
+#[derive(Serialize, Deserialize, Clone)]
 struct FrameRecord {
     index: usize,
     time: f32,
     poses: Vec<u32>,
     made_resident: Vec<u32>,
+    /// Kept from an earlier run (its timings are that run's).
     resumed: bool,
     /// Rendering it, read back included.
     seconds: Option<f64>,
@@ -49,36 +57,80 @@ struct FrameRecord {
     pixels_clamped_above: usize,
     pixels_clamped_below: usize,
     pixels_missed: usize,
+    /// The frame's files and their sizes in bytes (in the record only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    files: Vec<(String, u64)>,
+}
+
+impl FrameRecord {
+    fn stats(&self) -> FrameStats {
+        FrameStats {
+            inside: self.pixels_inside,
+            clamped_above: self.pixels_clamped_above,
+            clamped_below: self.pixels_clamped_below,
+            missed: self.pixels_missed,
+        }
+    }
 }
 
 /// The files of one rendered frame, not yet written.
 pub struct FrameFiles {
     dir: PathBuf,
-    index: usize,
     frame: crate::renderer::Frame,
+    record: FrameRecord,
 }
 
 impl FrameFiles {
     /// Which frame.
     pub fn index(&self) -> usize {
-        self.index
+        self.record.index
     }
 
     /// Encodes and writes them (each file atomically), exposed by `exposure_stops` for
-    /// the PNG.
+    /// the PNG, then the frame's record (`seconds_writing` is the time taken so far).
     pub fn write(&self, exposure_stops: f32) -> Result<()> {
+        let t = std::time::Instant::now();
         let scale = 2f32.powf(exposure_stops);
-        let (dir, i) = (&self.dir, self.index);
+        let (dir, i) = (&self.dir, self.record.index);
+        let mut written = Vec::new();
         if let Some(l) = &self.frame.layers {
+            written.push(layer_path(dir, i, "subject"));
             write_exr_rgba(&layer_path(dir, i, "subject"), &l.subject)?;
+            written.push(layer_path(dir, i, "shadow"));
             write_exr_rgb(&layer_path(dir, i, "shadow"), &l.shadow)?;
+            written.push(layer_path(dir, i, "backdrop"));
             write_exr_rgba(&layer_path(dir, i, "backdrop"), &l.backdrop)?;
         }
         write_exr_rgba(&frame_path(dir, i, "exr"), &self.frame.composite)?;
         write_png8_srgba(&frame_path(dir, i, "png"), &self.frame.composite, scale)?;
+        written.extend([frame_path(dir, i, "exr"), frame_path(dir, i, "png")]);
+        let mut record = self.record.clone();
+        for path in written {
+            let bytes = std::fs::metadata(&path)
+                .map_err(|e| frf_core::CoreError::io(&path, e))?
+                .len();
+            let name = path.file_name().unwrap_or_default().to_string_lossy();
+            record.files.push((name.into_owned(), bytes));
+        }
+        record.seconds_writing = Some(t.elapsed().as_secs_f64());
+        let text = serde_json::to_string_pretty(&record).map_err(json_error)?;
+        write_bytes_atomic(&record_path(dir, i), text.as_bytes())?;
         Ok(())
     }
 }
+
+/// Whether a frame already in the directory may be kept.
+pub enum Kept {
+    /// Yes: its record.
+    Yes(Box<FrameRecordRef>),
+    /// No: not there (or not resuming).
+    No,
+    /// No, and why: its files are there but differ from its record.
+    Damaged(String),
+}
+
+/// A kept frame's record, opaque outside this module.
+pub struct FrameRecordRef(FrameRecord);
 
 /// An output directory being filled.
 pub struct Output {
@@ -95,6 +147,55 @@ fn frame_path(dir: &Path, i: usize, ext: &str) -> PathBuf {
 
 fn layer_path(dir: &Path, i: usize, layer: &str) -> PathBuf {
     dir.join(format!("frame_{i:04}_{layer}.exr"))
+}
+
+fn record_path(dir: &Path, i: usize) -> PathBuf {
+    frame_path(dir, i, "json")
+}
+
+/// Whether `dir` holds any frame file (a frame, a layer or a record).
+fn holds_frames(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.flatten().any(|e| {
+            let name = e.file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("frame_")
+                && [".png", ".exr", ".json"].iter().any(|x| name.ends_with(x))
+        })
+    })
+}
+
+/// The keys (dotted paths) at which two settings differ, at most a few.
+fn differences(old: &serde_json::Value, new: &serde_json::Value) -> Vec<String> {
+    fn walk(a: &serde_json::Value, b: &serde_json::Value, at: &str, out: &mut Vec<String>) {
+        use serde_json::Value::Object;
+        if out.len() >= 4 || a == b {
+            return;
+        }
+        match (a, b) {
+            (Object(a), Object(b)) => {
+                let keys: std::collections::BTreeSet<&String> = a.keys().chain(b.keys()).collect();
+                for k in keys {
+                    let null = serde_json::Value::Null;
+                    let at = if at.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{at}.{k}")
+                    };
+                    walk(
+                        a.get(k).unwrap_or(&null),
+                        b.get(k).unwrap_or(&null),
+                        &at,
+                        out,
+                    );
+                }
+            }
+            _ => out.push(at.to_string()),
+        }
+    }
+    let mut out = Vec::new();
+    walk(old, new, "", &mut out);
+    out
 }
 
 /// Premultiplied RGBA over a mid-gray backdrop, for the contact sheet.
@@ -132,10 +233,17 @@ impl Output {
         settings["frames_total"] = total.into();
         let text = serde_json::to_string_pretty(&settings).map_err(json_error)?;
         let path = dir.join("settings.json");
-        let same = std::fs::read_to_string(&path).is_ok_and(|s| s == text);
-        if !same && !overwrite && frame_path(dir, 0, "png").exists() {
+        let old: Option<serde_json::Value> = std::fs::read_to_string(&path)
+            .ok()
+            .and_then(|s| serde_json::from_str(&s).ok());
+        let same = old.as_ref() == Some(&settings);
+        if !same && !overwrite && holds_frames(dir) {
+            let what = match &old {
+                Some(old) => format!("they differ in {}", differences(old, &settings).join(", ")),
+                None => "its settings.json is missing or unreadable".into(),
+            };
             return Err(RenderError::BadParameter(format!(
-                "{} holds frames of a render with other settings; use --overwrite or another --out",
+                "{} holds frames of a render with other settings ({what}); use --overwrite or another --out",
                 dir.display()
             )));
         }
@@ -149,33 +257,47 @@ impl Output {
         })
     }
 
-    /// Whether frame `i` is there already (and may be kept).
-    pub fn done(&self, i: usize) -> bool {
-        self.resume
-            && frame_path(&self.dir, i, "png").exists()
-            && frame_path(&self.dir, i, "exr").exists()
+    /// Whether frame `i` is there already and may be kept: its record is there and its
+    /// files have the sizes the record lists.
+    pub fn kept(&self, i: usize) -> Kept {
+        if !self.resume {
+            return Kept::No;
+        }
+        let path = record_path(&self.dir, i);
+        let Some(record) = std::fs::read(&path)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<FrameRecord>(&b).ok())
+            .filter(|r| r.index == i && !r.files.is_empty())
+        else {
+            return match frame_path(&self.dir, i, "png").exists() {
+                true => Kept::Damaged(format!("{} is missing or unreadable", path.display())),
+                false => Kept::No,
+            };
+        };
+        for (name, bytes) in &record.files {
+            let file = self.dir.join(name);
+            match std::fs::metadata(&file) {
+                Ok(m) if m.len() == *bytes => {}
+                Ok(m) => {
+                    return Kept::Damaged(format!(
+                        "{} holds {} bytes, its record says {bytes} (cut short?)",
+                        file.display(),
+                        m.len()
+                    ));
+                }
+                Err(_) => return Kept::Damaged(format!("{} is missing", file.display())),
+            }
+        }
+        Kept::Yes(Box::new(FrameRecordRef(record)))
     }
 
-    /// Notes that frame `i` was kept from an earlier run.
-    pub fn resumed(&mut self, i: usize, plan: &[FramePlan]) -> Result<()> {
-        let fp = plan
-            .iter()
-            .find(|f| f.index == i)
-            .ok_or_else(|| RenderError::BadParameter(format!("frame {i} was not planned")))?;
-        self.records.push(FrameRecord {
-            index: i,
-            time: fp.time,
-            poses: fp.poses.clone(),
-            made_resident: Vec::new(),
-            resumed: true,
-            seconds: None,
-            seconds_writing: None,
-            pixels_inside: 0,
-            pixels_clamped_above: 0,
-            pixels_clamped_below: 0,
-            pixels_missed: 0,
-        });
-        Ok(())
+    /// Notes that frame `i` was kept from an earlier run, with its record.
+    pub fn resumed(&mut self, kept: FrameRecordRef) {
+        let mut record = kept.0;
+        record.resumed = true;
+        record.files.clear();
+        self.totals = self.totals.merge(record.stats());
+        self.records.push(record);
     }
 
     /// Records a rendered frame (`seconds` to render it) and returns its files, to be
@@ -183,7 +305,7 @@ impl Output {
     pub fn accept(&mut self, f: &ShotFrame, r: ShotResult, seconds: f64) -> FrameFiles {
         let s = r.frame.stats;
         self.totals = self.totals.merge(s);
-        self.records.push(FrameRecord {
+        let record = FrameRecord {
             index: f.index,
             time: f.time,
             poses: r.poses,
@@ -195,11 +317,13 @@ impl Output {
             pixels_clamped_above: s.clamped_above,
             pixels_clamped_below: s.clamped_below,
             pixels_missed: s.missed,
-        });
+            files: Vec::new(),
+        };
+        self.records.push(record.clone());
         FrameFiles {
             dir: self.dir.clone(),
-            index: f.index,
             frame: r.frame,
+            record,
         }
     }
 
@@ -251,21 +375,31 @@ impl Output {
                 }
             }
         }
-        let rendered: Vec<f64> = self.records.iter().filter_map(|r| r.seconds).collect();
-        let mut sorted = rendered.clone();
-        sorted.sort_by(f64::total_cmp);
-        let median = match sorted.len() {
-            0 => 0.0,
-            n if n % 2 == 1 => sorted[n / 2],
-            n => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
-        };
-        let mean = rendered.iter().sum::<f64>() / rendered.len().max(1) as f64;
+        let rendered = self.records.iter().filter(|r| !r.resumed).count();
+        // Timings of the frames this run rendered; when it rendered none, those its
+        // records kept from the runs that did.
+        let timed_now = rendered > 0;
+        let timed = |r: &&FrameRecord| r.resumed != timed_now;
+        let seconds: Vec<f64> = self
+            .records
+            .iter()
+            .filter(timed)
+            .filter_map(|r| r.seconds)
+            .collect();
         let writing: Vec<f64> = self
             .records
             .iter()
+            .filter(timed)
             .filter_map(|r| r.seconds_writing)
             .collect();
-        let writing_mean = writing.iter().sum::<f64>() / writing.len().max(1) as f64;
+        let timings_of = match (timed_now, seconds.is_empty()) {
+            (true, _) => "the frames this run rendered",
+            (false, false) => "the resumed frames, when earlier runs rendered them",
+            (false, true) => "no frame (nothing timed)",
+        };
+        let median = (!seconds.is_empty()).then(|| crate::gpu::timing::median_min(&seconds).0);
+        let mean_of = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+        let (mean, writing_mean) = (mean_of(&seconds), mean_of(&writing));
         let (first, last) = (
             self.records.iter().map(|r| r.index).min().unwrap_or(0),
             self.records.iter().map(|r| r.index).max().unwrap_or(0),
@@ -285,9 +419,11 @@ impl Output {
             frames_rendered: usize,
             frames_resumed: usize,
             seconds_setup: f64,
-            seconds_per_frame_median: f64,
-            seconds_per_frame_mean: f64,
-            seconds_writing_per_frame_mean: f64,
+            /// Which frames the timings below are of.
+            timings_of: &'a str,
+            seconds_per_frame_median: Option<f64>,
+            seconds_per_frame_mean: Option<f64>,
+            seconds_writing_per_frame_mean: Option<f64>,
             seconds_wall: f64,
             plan: &'a super::plan::PlanCounts,
             planned: bool,
@@ -306,9 +442,10 @@ impl Output {
             device: shot.device(),
             adapter: shot.adapter(),
             frames_total: self.total,
-            frames_rendered: rendered.len(),
-            frames_resumed: self.records.len() - rendered.len(),
+            frames_rendered: rendered,
+            frames_resumed: self.records.len() - rendered,
             seconds_setup: setup_seconds,
+            timings_of,
             seconds_per_frame_median: median,
             seconds_per_frame_mean: mean,
             seconds_writing_per_frame_mean: writing_mean,
@@ -333,14 +470,26 @@ impl Output {
         let all = (t.inside + t.clamped_above + t.clamped_below + t.missed).max(1);
         let pct = |n: usize| 100.0 * n as f64 / all as f64;
         let c = shot.counters();
+        let timings = match (median, mean, writing_mean) {
+            (Some(median), Some(mean), writing) => format!(
+                "{median:.3} s/frame median to render ({mean:.3} mean), {} s mean to write \
+                 (on its own thread){}",
+                writing.map_or("?".into(), |w| format!("{w:.3}")),
+                if timed_now {
+                    ""
+                } else {
+                    ", as the resumed frames' earlier runs measured"
+                }
+            ),
+            _ => "no frame timed".into(),
+        };
         Ok(format!(
-            "{} frames in {}: {median:.3} s/frame median to render ({mean:.3} mean), {writing_mean:.3} s mean to write \
-             (on its own thread), {wall_seconds:.2} s wall; setup {setup_seconds:.2} s; \
+            "{} frames in {}: {timings}, {wall_seconds:.2} s wall; setup {setup_seconds:.2} s; \
              {} resumed; poses made resident {} ({} relit for a new lighting, {} dropped for the memory budget, \
              peak {:.1} MB, {:.2} s); {:.2} MB read from the field\n\
              pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row, {:.1} % to the bottom row, \
              {:.1} % missed; {} written{}",
-            rendered.len(),
+            rendered,
             self.dir.display(),
             report.frames_resumed,
             c.poses_made_resident,

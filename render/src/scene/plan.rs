@@ -342,7 +342,11 @@ impl Plan {
         let rows = field.header().rows;
         let counts = &mut plan.counts;
         (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
+        let mut held = BTreeSet::new();
         for c in field.chunks() {
+            if c.key.kind == ChunkKind::Basis {
+                held.insert((c.key.pose, c.key.u as usize, c.key.v as usize));
+            }
             counts.bytes_total += c.length;
             let Some(p) = plan.poses.iter().find(|p| p.pose == c.key.pose) else {
                 continue;
@@ -369,7 +373,50 @@ impl Plan {
                 counts.bytes_read += c.length;
             }
         }
+        plan.check_views_held(field.path(), rows, &held)?;
         Ok(plan)
+    }
+
+    /// An error naming the views the frames need that the field lacks (a field made for
+    /// another scene, `frf ingest --for`), before anything is rendered or written.
+    fn check_views_held(
+        &self,
+        field: &std::path::Path,
+        rows: usize,
+        held: &BTreeSet<(u32, usize, usize)>,
+    ) -> Result<()> {
+        let (mut missing, mut needed) = (Vec::new(), 0);
+        for p in &self.poses {
+            for (i, _) in p.views.iter().enumerate().filter(|(_, needed)| **needed) {
+                needed += 1;
+                let (u, v) = (i / rows, i % rows);
+                if !held.contains(&(p.pose, u, v)) {
+                    missing.push((p.pose, u, v));
+                }
+            }
+        }
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let listed: Vec<String> = missing
+            .iter()
+            .take(8)
+            .map(|(p, u, v)| format!("pose {p} view ({u}, {v})"))
+            .collect();
+        Err(RenderError::BadParameter(format!(
+            "{}: lacks {} of the {} views the frames need ({}{}): it was made for another \
+             scene or camera (frf ingest --for); film and ingest these views (frf stage --for, \
+             frf ingest --for this scene) or render from a field that holds them",
+            field.display(),
+            missing.len(),
+            needed,
+            listed.join(", "),
+            if missing.len() > listed.len() {
+                ", ..."
+            } else {
+                ""
+            }
+        )))
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and

@@ -1,7 +1,7 @@
 //! The shot loop every front end runs: each frame of a shot rendered ([`Shot::render`])
 //! and its files encoded and written on a thread of their own while the next frame
 //! renders (at most two waiting), so that a sequence runs at the slower of rendering and
-//! encoding; frames already in the output are kept ([`Output::done`]).
+//! encoding; frames already in the output are kept ([`Output::kept`]).
 
 use std::sync::mpsc::{channel, sync_channel};
 use std::time::Instant;
@@ -9,7 +9,7 @@ use std::time::Instant;
 use frf_core::progress::Progress;
 use frf_reflectance::container::ReadAt;
 
-use super::output::{FrameFiles, Output};
+use super::output::{FrameFiles, Kept, Output};
 use super::plan::ShotFrame;
 use super::shot::Shot;
 use crate::error::{RenderError, Result};
@@ -38,13 +38,16 @@ pub fn render_shot<R: ReadAt>(
         });
         let mut result = Ok(());
         for f in frames {
-            if output.done(f.index) {
-                if let Err(e) = output.resumed(f.index, &shot.plan().frames) {
-                    result = Err(e);
-                    break;
+            match output.kept(f.index) {
+                Kept::Yes(record) => {
+                    output.resumed(*record);
+                    progress.step();
+                    continue;
                 }
-                progress.step();
-                continue;
+                Kept::Damaged(why) => {
+                    progress.note(&format!("frame {}: {why}; rendering it again", f.index));
+                }
+                Kept::No => {}
             }
             let t = Instant::now();
             let r = match shot.render(f, layers) {

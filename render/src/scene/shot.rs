@@ -100,6 +100,29 @@ pub struct ShotResult {
     pub made_resident: Vec<u32>,
 }
 
+/// How far a shot's shadow reaches ([`Shot::shadow_reach`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowReach {
+    /// Elevation of the lowest light that makes the shadow, degrees.
+    pub elevation_deg: f32,
+    /// How far from the subject's axis its shadow reaches, metres.
+    pub reach_m: f32,
+    /// Side of the field's patch of maps, metres.
+    pub patch_side_m: f32,
+}
+
+impl ShadowReach {
+    /// Whether the shadow reaches past where the maps begin to fade.
+    pub fn cut(&self) -> bool {
+        self.reach_m > 0.5 * self.patch_side_m * crate::shadow::EDGE_FADE_FROM
+    }
+
+    /// The patch side that would hold the shadow whole, metres.
+    pub fn side_needed_m(&self) -> f32 {
+        crate::shadow_reach::patch_side_holding(self.reach_m)
+    }
+}
+
 /// A scene being rendered on a field (see the module docs).
 pub struct Shot<'a, R: ReadAt> {
     scene: Cow<'a, Scene>,
@@ -180,6 +203,49 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// The plan.
     pub fn plan(&self) -> &Plan {
         &self.plan
+    }
+
+    /// How far the shot's shadow reaches against the field's patch of maps
+    /// ([`crate::shadow_reach`]), under the lowest of its lighting keys' shadow-making
+    /// lights, for the hull of the first pose drawn (a nominal person without one);
+    /// `None` when no map is drawn or nothing lights the ground from above.
+    pub fn shadow_reach(&mut self) -> Result<Option<ShadowReach>> {
+        use crate::shadow_reach::{NOMINAL_SUBJECT, shadow_light_elevation, shadow_reach};
+        let Some(spec) = &self.field.header().shadows else {
+            return Ok(None);
+        };
+        let patch_side_m = spec.ground.extent_m;
+        if self.scene.shadow != super::ShadowSpec::Maps || !self.plan.ground_seen {
+            return Ok(None);
+        }
+        let mut lowest: Option<f32> = None;
+        let sources: Vec<EnvSource> = self.scene.lighting.iter().map(|k| k.env.clone()).collect();
+        for source in &sources {
+            if let Some(e) = self.env(source)?.as_ref().and_then(shadow_light_elevation) {
+                lowest = Some(lowest.map_or(e, |l| l.min(e)));
+            }
+        }
+        let Some(elevation) = lowest else {
+            return Ok(None);
+        };
+        let hull = match self.plan.poses.first() {
+            Some(p) => self.field.hull(p.pose)?,
+            None => None,
+        };
+        let subject = hull
+            .and_then(|h| h.bounds())
+            .map_or(NOMINAL_SUBJECT, |(lo, hi)| {
+                let radius = [lo.x, hi.x]
+                    .iter()
+                    .flat_map(|&x| [lo.z, hi.z].map(|z| x.hypot(z)))
+                    .fold(0.0f32, f32::max);
+                (hi.y, radius)
+            });
+        Ok(Some(ShadowReach {
+            elevation_deg: elevation.to_degrees(),
+            reach_m: shadow_reach(elevation, subject),
+            patch_side_m,
+        }))
     }
 
     /// What happened so far.

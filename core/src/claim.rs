@@ -1,0 +1,166 @@
+//! Claiming a file output before the work that makes it. A command that writes one large
+//! file (a field) claims it first, so that what would make it fail at the end fails at
+//! once instead, and nothing of its own is left behind from earlier runs:
+//!
+//! - a directory at the output's path is refused before any work (it used to be found
+//!   only at the final rename, after minutes of work, leaving a full-size temporary file);
+//! - the output is locked while the command runs: a lock file `.NAME.lock` beside it,
+//!   held with an advisory lock (`flock`) that the system releases when the process ends,
+//!   however it ends; a second writer of the same output is refused by name;
+//! - under the lock, temporary files of the same output left by earlier runs that were
+//!   interrupted (`.NAME.*.tmp`, see [`crate::atomic`]) are removed: no live writer
+//!   can own them any more.
+
+use std::fs::{File, OpenOptions, TryLockError};
+use std::path::{Path, PathBuf};
+
+use crate::error::{CoreError, Result};
+
+/// A claimed output; the lock is released (and its file removed) when it is dropped.
+#[derive(Debug)]
+pub struct OutputClaim {
+    lock_path: PathBuf,
+    lock: Option<File>,
+    removed: Vec<PathBuf>,
+}
+
+impl OutputClaim {
+    /// Temporary files of earlier, interrupted runs that the claim removed.
+    pub fn removed(&self) -> &[PathBuf] {
+        &self.removed
+    }
+
+    /// Removes every temporary file (`.*.tmp`) in `dir`, a directory only this output's
+    /// writer uses (e.g. the per-pose parts of an ingest), and counts them in
+    /// [`OutputClaim::removed`].
+    pub fn clear_temporaries_in(&mut self, dir: &Path) {
+        self.removed.extend(remove_temporaries(dir, ""));
+    }
+}
+
+impl Drop for OutputClaim {
+    fn drop(&mut self) {
+        // Removed while still held, so that no other process can take the lock on a file
+        // that is about to disappear unnoticed (they check the name after locking).
+        let _ = std::fs::remove_file(&self.lock_path);
+        drop(self.lock.take());
+    }
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Removes the temporaries `.PREFIX*.tmp` in `dir`; returns what it removed.
+fn remove_temporaries(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let start = format!(".{prefix}");
+    entries
+        .flatten()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| e.path())
+        .filter(|p| {
+            let name = file_name(p);
+            name.starts_with(&start) && name.ends_with(".tmp")
+        })
+        .filter(|p| std::fs::remove_file(p).is_ok())
+        .collect()
+}
+
+/// Whether `file` (open) is still the file at `path` (not removed or replaced since).
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Claims the file output `path` (see the module text): refuses a directory there, creates
+/// its parent directories, locks it against a second writer and removes the temporaries
+/// earlier runs left. Errors name `path`.
+pub fn claim_output(path: &Path) -> Result<OutputClaim> {
+    if path.is_dir() {
+        return Err(CoreError::bad_file(
+            path,
+            "a directory is there: give the path of the file to write",
+        ));
+    }
+    let name = file_name(path);
+    if name.is_empty() {
+        return Err(CoreError::bad_file(path, "names no file"));
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| CoreError::io(parent, e))?;
+    let lock_path = parent.join(format!(".{name}.lock"));
+    let lock = loop {
+        let file = OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&lock_path)
+            // Named by the output asked for (e.g. a directory one may not write).
+            .map_err(|e| CoreError::io(path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) => {
+                return Err(CoreError::bad_file(
+                    path,
+                    format!(
+                        "another process is writing it (it holds {}): wait for it to end, or \
+                         give another output",
+                        lock_path.display()
+                    ),
+                ));
+            }
+            Err(TryLockError::Error(e)) => return Err(CoreError::io(&lock_path, e)),
+        }
+        // The holder before us may have removed the file between our open and our lock:
+        // then ours is a lock on nothing, and we take the new one.
+        if same_file(&file, &lock_path) {
+            break file;
+        }
+    };
+    let _ = std::fs::write(&lock_path, format!("{}\n", std::process::id()));
+    let removed = remove_temporaries(parent, &format!("{name}."));
+    Ok(OutputClaim {
+        lock_path,
+        lock: Some(lock),
+        removed,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_claim_refuses_a_second_writer_and_a_directory_and_clears_old_temporaries() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("sub").join("f.frf");
+        std::fs::create_dir_all(out.parent().unwrap()).unwrap();
+        let stale = out.with_file_name(".f.frf.4242.tmp");
+        let other = out.with_file_name(".g.frf.4242.tmp");
+        std::fs::write(&stale, b"half a field").unwrap();
+        std::fs::write(&other, b"another output's").unwrap();
+        let claim = claim_output(&out).unwrap();
+        assert_eq!(claim.removed(), [stale.clone()]);
+        assert!(!stale.exists() && other.exists());
+        let again = claim_output(&out).unwrap_err().to_string();
+        assert!(again.contains("another process is writing it"), "{again}");
+        assert!(again.contains("f.frf"), "{again}");
+        drop(claim);
+        assert!(!out.with_file_name(".f.frf.lock").exists());
+        let claim = claim_output(&out).unwrap();
+        drop(claim);
+        let e = claim_output(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("a directory is there"), "{e}");
+    }
+}
