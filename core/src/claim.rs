@@ -151,7 +151,7 @@ mod tests {
         std::fs::write(&stale, b"half a field").unwrap();
         std::fs::write(&other, b"another output's").unwrap();
         let claim = claim_output(&out).unwrap();
-        assert_eq!(claim.removed(), [stale.clone()]);
+        assert_eq!(claim.removed(), std::slice::from_ref(&stale));
         assert!(!stale.exists() && other.exists());
         let again = claim_output(&out).unwrap_err().to_string();
         assert!(again.contains("another process is writing it"), "{again}");
