@@ -2,10 +2,13 @@
 //! renderer draws (walker, shadow and backdrop) against the true composite of the same
 //! camera, time and lighting.
 //!
-//! The truth of a frame: the stage's true walker in the pose the plan draws, seen by the
-//! frame's camera (moved into the walker's frame), lit by the frame's environment reduced
-//! to median-cut lights; its true shadow traced against the true body; both composited
-//! over the frame's own backdrop by the product's compositing
+//! The truth of a frame: the stage's true walker at the frame's instant of its walk
+//! ([`TruthAt::Instant`], the default: between two captured poses the walker is in
+//! between, which a render of the nearest pose is not) or at the instant of the pose the
+//! plan draws ([`TruthAt::Pose`]: the renderer's view error alone), seen by the frame's
+//! camera (moved into the walker's frame), lit by the frame's environment reduced to
+//! median-cut lights; its true shadow traced against the true body; both composited over
+//! the frame's own backdrop by the product's compositing
 //! ([`frf_render::composite::compose`]), so that only the walker and its shadow differ.
 //! Scenes of one walker only: the stage films one person.
 
@@ -25,8 +28,18 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{psnr, ssim, subject_mask};
-use crate::views::truth_frame;
+use frf_core::io::rgba_from;
 use frf_core::progress::Progress;
+
+/// Which instant of the walk a frame's truth shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TruthAt {
+    /// The frame's own instant (what a viewer expects to see).
+    Instant,
+    /// The instant of the captured pose the frame draws (the view's error alone).
+    Pose,
+}
 
 /// One frame of a shot against its truth.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -37,6 +50,11 @@ pub struct ShotFrameScore {
     pub time: f32,
     /// The pose drawn.
     pub pose: u32,
+    /// The instant of the walk the truth shows, seconds into its cycle.
+    pub truth_time_s: f64,
+    /// How far the frame's instant is from the drawn pose's, seconds (wrapped to the
+    /// nearest cycle; 0 when the truth is at the pose).
+    pub time_from_pose_s: f64,
     /// PSNR of the whole frame (walker, shadow, backdrop) against the true composite, dB.
     pub psnr_frame: f64,
     /// PSNR of the walker layer where it or the truth covers the pixel, dB.
@@ -56,6 +74,7 @@ pub fn score_frame<R: ReadAt>(
     shot: &mut Shot<'_, R>,
     frame: &ShotFrame,
     lights: usize,
+    truth_at: TruthAt,
 ) -> Result<ShotFrameScore> {
     let scene = shot.scene();
     if scene.instances.len() != 1 {
@@ -65,6 +84,8 @@ pub fn score_frame<R: ReadAt>(
         )));
     }
     let instance = scene.instances[0];
+    let cycle = stage.config().gait.cycle_seconds();
+    let instant = scene.phase_at(0, frame.time, cycle) * cycle;
     let world = shot.lighting_at(frame.time)?.ok_or_else(|| {
         EvalError::BadParameter("an unlit scene has no true lighting to compare with".into())
     })?;
@@ -83,8 +104,18 @@ pub fn score_frame<R: ReadAt>(
     let t = Instant::now();
     let subject_camera = instance.camera_in_subject_frame(&frame.camera);
     let lights = world.rotated(-instance.heading).median_cut(lights);
-    let subject = truth_frame(stage, pose, &subject_camera, &lights)?;
-    let actor = stage.true_actor(pose);
+    let pose_time = stage.pose_time_s(pose);
+    let truth_time_s = match truth_at {
+        TruthAt::Pose => pose_time,
+        TruthAt::Instant => instant,
+    };
+    let time_from_pose_s = {
+        let d = (truth_time_s - pose_time).rem_euclid(cycle);
+        if d > 0.5 * cycle { d - cycle } else { d }
+    };
+    let truth = stage.truth_image_at(truth_time_s, &subject_camera, &lights);
+    let subject = rgba_from(&truth.color, &truth.alpha)?;
+    let actor = stage.true_actor_at(truth_time_s);
     let subject_from_world = instance.world_from_subject().inverse();
     let shadow =
         |p: glam::Vec3| relative_irradiance(&actor, &lights, subject_from_world.transform_point(p));
@@ -96,6 +127,8 @@ pub fn score_frame<R: ReadAt>(
         index: frame.index,
         time: frame.time,
         pose,
+        truth_time_s,
+        time_from_pose_s,
         psnr_frame: psnr(&truth, &rendered.frame.composite, None),
         psnr_subject: psnr(&subject, &layers.subject, Some(&mask)),
         ssim_subject: ssim(&subject, &layers.subject, Some(&mask)),
@@ -121,6 +154,8 @@ pub struct ShotReport {
     pub device: String,
     /// Median-cut lights of the truth.
     pub truth_lights: usize,
+    /// Which instant the truth shows.
+    pub truth_at: TruthAt,
     /// Frames of the shot.
     pub frames_total: usize,
     /// Each frame scored.
@@ -149,7 +184,7 @@ pub fn evaluate_shot<R: ReadAt>(
     device: Device,
     stage: &Stage,
     count: usize,
-    lights: usize,
+    (lights, truth_at): (usize, TruthAt),
     paths: (PathBuf, PathBuf, PathBuf),
     progress: &dyn Progress,
 ) -> Result<ShotReport> {
@@ -179,7 +214,7 @@ pub fn evaluate_shot<R: ReadAt>(
     progress.phase("frames scored", frames.len());
     let mut scores = Vec::new();
     for f in &frames {
-        scores.push(score_frame(stage, &mut shot, f, lights)?);
+        scores.push(score_frame(stage, &mut shot, f, lights, truth_at)?);
         progress.step();
     }
     progress.finish();
@@ -192,6 +227,7 @@ pub fn evaluate_shot<R: ReadAt>(
         capture,
         device: shot.device(),
         truth_lights: lights,
+        truth_at,
         frames_total: total,
         psnr_frame_mean: mean(|s| s.psnr_frame),
         psnr_subject_mean: mean(|s| s.psnr_subject),

@@ -106,6 +106,11 @@ struct TruthArgs {
     /// Pose to render (default: the capture's first).
     #[arg(long)]
     pose: Option<u32>,
+    /// Render the walker at this instant of its cycle instead, seconds (pose `k` is at
+    /// `k / 30` s; between two poses it is in between). `--view` still takes the camera of
+    /// `--pose`.
+    #[arg(long, allow_negative_numbers = true)]
+    time: Option<f64>,
     /// Use the camera of capture view `U,V` (as seen from the subject).
     #[arg(long, conflicts_with_all = ["eye", "look_at"])]
     view: Option<String>,
@@ -295,7 +300,12 @@ fn truth(args: TruthArgs) -> CliResult {
             "basis combination".to_string(),
         )
     };
-    let image = stage.truth_image(pose, &camera, &lights);
+    let instant = match args.time {
+        Some(t) if !t.is_finite() => return Err(format!("--time {t}: not a finite number").into()),
+        Some(t) => t.rem_euclid(config.gait.cycle_seconds()),
+        None => stage.pose_time_s(pose),
+    };
+    let image = stage.truth_image_at(instant, &camera, &lights);
     let rgba = rgba_from(&image.color, &image.alpha)?;
     let is_exr = args
         .out

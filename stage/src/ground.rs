@@ -62,6 +62,11 @@ impl Stage {
         self.actor(None, self.pose_time_s(pose))
     }
 
+    /// The unperturbed walker `time_s` seconds into its cycle, subject frame.
+    pub fn true_actor_at(&self, time_s: f64) -> Actor {
+        self.actor(None, time_s)
+    }
+
     /// Which voxels of `grid` the walker of pose `pose` fills (voxel centre inside).
     pub fn true_occupancy(&self, pose: u32, grid: &VoxelGrid) -> Vec<bool> {
         let actor = self.true_actor(pose);

@@ -194,7 +194,14 @@ impl Stage {
     /// The true image of the unperturbed walker at pose `pose`'s reference instant, seen by
     /// `camera` (subject frame) under `lights` (subject frame), without studio or noise.
     pub fn truth_image(&self, pose: u32, camera: &Camera, lights: &[DirLight]) -> TruthImage {
-        let actor = self.actor(None, self.pose_time_s(pose));
+        self.truth_image_at(self.pose_time_s(pose), camera, lights)
+    }
+
+    /// [`Stage::truth_image`] at any instant of the walk: `time_s` seconds into its cycle
+    /// (pose `k`'s instant is `k / 30` s; between two poses the walker is in between,
+    /// as the gait is a continuous function of time).
+    pub fn truth_image_at(&self, time_s: f64, camera: &Camera, lights: &[DirLight]) -> TruthImage {
+        let actor = self.actor(None, time_s);
         let illumination = Illumination::Lights(lights.to_vec());
         let scene = Scene {
             actor: Some(&actor),

@@ -1,7 +1,8 @@
 //! Ground truth of the virtual light stage checked against itself: true flow warps one
 //! true image onto its neighbour, forward and backward flows agree, capture views and
 //! novel-view truth share one turntable convention, and an environment equal to a basis
-//! condition renders like that condition.
+//! condition renders like that condition, and the walker between two poses' instants is
+//! between them.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
@@ -275,4 +276,35 @@ fn environment_equal_to_a_condition_renders_like_it() {
         wrong > 0.3,
         "a mirrored environment should not match: {wrong}"
     );
+}
+
+/// The truth at any instant: at a pose's instant it is that pose's truth, bit for bit; half
+/// way to the next pose the walker differs from both and lies between them (its matte is
+/// closer to each than they are to each other).
+#[test]
+fn the_truth_between_two_poses_lies_between_them() {
+    let stage = stage(48, 64);
+    let camera = stage.subject_camera(0, 0, 1).unwrap();
+    let lights = subject_lights(&stage);
+    let (t3, t4) = (stage.pose_time_s(3), stage.pose_time_s(4));
+    let at3 = stage.truth_image(3, &camera, &lights);
+    assert!(stage.truth_image_at(t3, &camera, &lights).alpha == at3.alpha);
+    let at4 = stage.truth_image(4, &camera, &lights);
+    let mid = stage.truth_image_at(0.5 * (t3 + t4), &camera, &lights);
+    let l1 = |a: &TruthImage, b: &TruthImage| -> f32 {
+        a.alpha
+            .pixels()
+            .iter()
+            .zip(b.alpha.pixels())
+            .map(|(x, y)| (x - y).abs())
+            .sum()
+    };
+    let (apart, to3, to4) = (l1(&at3, &at4), l1(&mid, &at3), l1(&mid, &at4));
+    assert!(to3 > 0.0 && to4 > 0.0, "{to3} {to4}");
+    assert!(to3 < apart && to4 < apart, "{to3} {to4} vs {apart}");
+    // A whole cycle later the walker is where it was.
+    let cycle = stage.config().gait.cycle_seconds();
+    let again = stage.truth_image_at(t3 + cycle, &camera, &lights);
+    let back = l1(&again, &at3);
+    assert!(back < 1e-3 * apart, "{back}");
 }

@@ -438,3 +438,58 @@ fn stage_and_ingest_for_a_scene_and_merged_parts_are_one_ingest() {
     assert!(!o.status.success());
     assert!(!d.join("bad.frf").exists(), "a refused merge left a file");
 }
+
+/// `frf eval SCENE` judges each frame against the true walker at the frame's instant: on
+/// the tiny field, which holds pose 0 only, a frame 0.1 s or more into the walk draws pose
+/// 0 and scores far below the same frame judged at the pose's instant (`--truth-at
+/// pose`); at 0 s the two truths are one.
+#[test]
+fn eval_judges_a_scene_against_the_walker_at_each_frames_instant() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "s.toml",
+        "",
+        "[0.4, 1.3, 3.0]",
+        "[-0.4, 1.3, 3.0]",
+    );
+    let capture = frf_testkit::tiny_field()
+        .capture()
+        .to_str()
+        .unwrap()
+        .to_string();
+    let eval = |truth_at: &str| -> frf_eval::shot::ShotReport {
+        let mut args = vec![
+            "eval",
+            scene.to_str().unwrap(),
+            "--capture",
+            &capture,
+            "--frames",
+            "4",
+            "--lights",
+            "32",
+            "--truth-at",
+            truth_at,
+            "--json",
+        ];
+        args.extend(gpu_flag());
+        serde_json::from_slice(&ok(&args).stdout).unwrap()
+    };
+    let (instant, pose) = (eval("instant"), eval("pose"));
+    assert_eq!(instant.frames.len(), 4);
+    for (a, b) in instant.frames.iter().zip(&pose.frames) {
+        assert_eq!(a.pose, 0);
+        assert!((a.time_from_pose_s - a.time as f64).abs() < 1e-6, "{a:?}");
+        assert!((a.truth_time_s - a.time as f64).abs() < 1e-6, "{a:?}");
+        assert_eq!(b.time_from_pose_s, 0.0);
+        if a.index == 0 {
+            assert!(
+                (a.psnr_subject - b.psnr_subject).abs() < 1e-9,
+                "{a:?} {b:?}"
+            );
+        } else {
+            // The walker moved for 0.1 s or more; its nearest captured pose did not.
+            assert!(a.psnr_subject + 3.0 < b.psnr_subject, "{a:?} {b:?}");
+        }
+    }
+}

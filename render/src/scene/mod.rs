@@ -278,8 +278,14 @@ impl Scene {
     /// instance `i` shows at time `t`: the nearest pose to its phase, looping.
     pub fn pose_at(&self, i: usize, t: f32, cycle_seconds: f64, poses_per_cycle: u32) -> u32 {
         let n = poses_per_cycle.max(1) as f64;
-        let phase = ((t + self.instances[i].time_offset) as f64 / cycle_seconds).rem_euclid(1.0);
+        let phase = self.phase_at(i, t, cycle_seconds);
         ((phase * n).round() as u32) % poses_per_cycle.max(1)
+    }
+
+    /// Where in its walk cycle (of `cycle_seconds`) instance `i` is at time `t`, in cycles,
+    /// `[0, 1)`: pose `k` of `n` per cycle is at phase `k / n`.
+    pub fn phase_at(&self, i: usize, t: f32, cycle_seconds: f64) -> f64 {
+        ((t + self.instances[i].time_offset) as f64 / cycle_seconds).rem_euclid(1.0)
     }
 
     /// Every environment the scene names.

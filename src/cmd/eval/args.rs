@@ -57,6 +57,11 @@ pub struct EvalArgs {
     /// Median-cut lights of the environment in the truth renders.
     #[arg(long, default_value_t = 512)]
     pub lights: usize,
+    /// With a scene: the instant of the walk the truth shows, the frame's own (`instant`:
+    /// a frame between two captured poses is judged against the walker in between) or the
+    /// drawn pose's (`pose`: the error of the view alone).
+    #[arg(long, value_enum, default_value = "instant")]
+    pub truth_at: TruthAtArg,
     #[command(flatten)]
     pub compare: CompareArgs,
     /// Write each camera's truth and renders as PNGs here (with `--budget`, the first
@@ -72,6 +77,24 @@ pub struct EvalArgs {
     /// Ground of the composites' environment backdrop: `env` or an albedo `A` / `R,G,B`.
     #[arg(long, value_parser = parse_ground, default_value = "env")]
     pub ground: GroundArg,
+}
+
+/// [`frf_eval::shot::TruthAt`] on the command line.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum TruthAtArg {
+    /// The frame's own instant.
+    Instant,
+    /// The instant of the pose drawn.
+    Pose,
+}
+
+impl From<TruthAtArg> for frf_eval::shot::TruthAt {
+    fn from(a: TruthAtArg) -> Self {
+        match a {
+            TruthAtArg::Instant => Self::Instant,
+            TruthAtArg::Pose => Self::Pose,
+        }
+    }
 }
 
 /// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.

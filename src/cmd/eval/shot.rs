@@ -34,7 +34,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
         Device::open(args.compare.cpu)?,
         &stage,
         args.frames.unwrap_or(DEFAULT_FRAMES),
-        args.lights,
+        (args.lights, args.truth_at.into()),
         (args.field.clone(), field_path, args.capture.clone()),
         &Bars::default(),
     )?;
@@ -43,20 +43,27 @@ pub fn run(args: &EvalArgs) -> CliResult {
         return Ok(());
     }
     println!(
-        "{}: {} of {} frames against the stage's truth ({} median-cut lights), {}",
+        "{}: {} of {} frames against the stage's truth ({} median-cut lights, the walker at {}), {}",
         report.scene.display(),
         report.frames.len(),
         report.frames_total,
         args.lights,
+        match report.truth_at {
+            frf_eval::shot::TruthAt::Instant => "each frame's instant",
+            frf_eval::shot::TruthAt::Pose => "the instant of the pose drawn",
+        },
         report.device
     );
-    println!("frame   time  pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s");
+    println!(
+        "frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s"
+    );
     for s in &report.frames {
         println!(
-            "{:>5} {:>6.2} {:>5} {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
+            "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
             s.index,
             s.time,
             s.pose,
+            1e3 * s.time_from_pose_s,
             s.psnr_frame,
             s.psnr_subject,
             s.ssim_subject,
