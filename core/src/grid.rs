@@ -1,6 +1,7 @@
 //! The grid of views ([`crate::conventions`]): view `(u, v)` with `u` the cycle
 //! (horizontal, wrapping around a turntable) and `v` the camera (vertical), and the
-//! neighbour relation that flows are stored for.
+//! neighbour relation that flows are stored for; and the step in time from a pose to the
+//! next or previous captured one ([`PoseStep`]), which pose-to-pose flows are stored for.
 
 use serde::{Deserialize, Serialize};
 
@@ -73,9 +74,99 @@ impl Neighbour {
     }
 }
 
+/// A step in time from a pose to the next or the previous captured one, in the same view.
+///
+/// The views of one column `u` of a pose are one walk cycle, and consecutive poses are
+/// consecutive instants of it; past the end of the cycle the walk goes on in the next
+/// cycle, which the turntable has turned by one column: so the step from the last
+/// captured pose to the first goes to column `u + 1` (and back from the first to the
+/// last, to `u − 1`), where the same camera films the next instant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PoseStep {
+    /// To the next captured pose.
+    Next,
+    /// To the previous captured pose.
+    Prev,
+}
+
+impl PoseStep {
+    /// Both, in storage order.
+    pub const ALL: [PoseStep; 2] = [PoseStep::Next, PoseStep::Prev];
+
+    /// The name used in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            PoseStep::Next => "to the next pose",
+            PoseStep::Prev => "to the previous pose",
+        }
+    }
+
+    /// Index in [`PoseStep::ALL`].
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The opposite step (the flow back).
+    pub fn opposite(self) -> PoseStep {
+        match self {
+            PoseStep::Next => PoseStep::Prev,
+            PoseStep::Prev => PoseStep::Next,
+        }
+    }
+
+    /// The pose and column this step leads to from `pose` in column `u`, among the
+    /// captured `poses` (sorted) of a grid of `columns` (wrapping when `wraps`): `None`
+    /// with fewer than two poses, or when the column it needs does not exist.
+    pub fn of(
+        self,
+        pose: u32,
+        u: usize,
+        poses: &[u32],
+        columns: usize,
+        wraps: bool,
+    ) -> Option<(u32, usize)> {
+        if poses.len() < 2 {
+            return None;
+        }
+        let i = poses.iter().position(|&p| p == pose)?;
+        let (to, column) = match self {
+            PoseStep::Next if i + 1 < poses.len() => (poses[i + 1], Some(u)),
+            PoseStep::Next => (
+                poses[0],
+                Neighbour::Right.of(u, 0, columns, 1, wraps).map(|c| c.0),
+            ),
+            PoseStep::Prev if i > 0 => (poses[i - 1], Some(u)),
+            PoseStep::Prev => (
+                poses[poses.len() - 1],
+                Neighbour::Left.of(u, 0, columns, 1, wraps).map(|c| c.0),
+            ),
+        };
+        column.map(|c| (to, c))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pose_steps_go_on_into_the_next_cycle_one_column_on() {
+        let poses = [0, 3, 6];
+        assert_eq!(PoseStep::Next.of(3, 5, &poses, 36, true), Some((6, 5)));
+        assert_eq!(PoseStep::Prev.of(3, 5, &poses, 36, true), Some((0, 5)));
+        assert_eq!(PoseStep::Next.of(6, 35, &poses, 36, true), Some((0, 0)));
+        assert_eq!(PoseStep::Prev.of(0, 0, &poses, 36, true), Some((6, 35)));
+        assert_eq!(PoseStep::Next.of(6, 35, &poses, 36, false), None);
+        assert_eq!(PoseStep::Next.of(0, 0, &[0], 36, true), None);
+        assert_eq!(PoseStep::Next.of(1, 0, &poses, 36, true), None);
+        for step in PoseStep::ALL {
+            for (pose, u) in [(0, 0), (3, 7), (6, 35)] {
+                let (p, c) = step.of(pose, u, &poses, 36, true).unwrap();
+                assert_eq!(step.opposite().of(p, c, &poses, 36, true), Some((pose, u)));
+            }
+        }
+    }
 
     #[test]
     fn neighbours_wrap_in_u_only() {

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::FlowImage;
 use frf_ingest::evidence::{EvaluationError, Evaluator, PoseErrors, PoseEvidence};
 use frf_stage::Stage;
@@ -21,22 +21,18 @@ use crate::metrics::{EdgeBandError, alpha_iou, alpha_mae, alpha_mask, compare, e
 /// True alpha at least this counts as inside the matte for flow errors: the flow of a
 /// pixel only partly covered is ill-defined.
 const INSIDE_MATTE: f32 = 0.99;
-/// Mean end-point error of `estimated` against the true flow of view `(u, v)` toward
-/// `n`, and the pixels compared.
+/// Mean end-point error of `estimated` against the true flow of view `(u, v)` of `pose`
+/// toward view `(u2, v2)` of `to_pose`: summed over the pixels compared, the error and
+/// the true motion's length, and the pixels compared.
 fn flow_epe(
     stage: &Stage,
-    pose: u32,
-    u: usize,
-    v: usize,
-    n: Neighbour,
+    (pose, u, v): (u32, usize, usize),
+    (to_pose, u2, v2): (u32, usize, usize),
     estimated: &FlowImage,
-) -> Result<(f64, usize)> {
-    let Some((u2, v2)) = n.of(u, v, stage.cycles(), stage.cameras().len(), true) else {
-        return Ok((0.0, 0));
-    };
+) -> Result<(f64, f64, usize)> {
     let (surface, alpha) = stage.reference_surface(pose, u, v)?;
-    let truth = flow_between(&surface, &stage.view_setup(pose, u2, v2, 0.0)?);
-    let (mut sum, mut count) = (0.0f64, 0usize);
+    let truth = flow_between(&surface, &stage.view_setup(to_pose, u2, v2, 0.0)?);
+    let (mut sum, mut motion, mut count) = (0.0f64, 0.0f64, 0usize);
     for i in 0..alpha.pixels().len() {
         let (t, e) = (truth.flow.pixels()[i], estimated.pixels()[i]);
         if alpha.pixels()[i] < INSIDE_MATTE
@@ -47,9 +43,10 @@ fn flow_epe(
             continue;
         }
         sum += (((e[0] - t[0]).powi(2) + (e[1] - t[1]).powi(2)) as f64).sqrt();
+        motion += t[0].hypot(t[1]) as f64;
         count += 1;
     }
-    Ok((sum, count))
+    Ok((sum, motion, count))
 }
 
 /// Evaluates a pose against the stage's truth.
@@ -57,7 +54,9 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
     let rows = stage.cameras().len();
     // Per view: (alpha IoU, alpha MAE) and (sum, count) of flow errors, horizontal and
     // vertical.
-    type ViewErrors = ((Option<f64>, f64), [(f64, usize); 2]);
+    type ViewErrors = ((Option<f64>, f64), [(f64, usize); 4]);
+    let mut poses = stage.config().poses.clone();
+    poses.sort_unstable();
     let per_view: Vec<ViewErrors> = (0..evidence.alphas.len())
         .into_par_iter()
         .filter(|&i| evidence.alphas[i].is_some())
@@ -69,14 +68,37 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
                 alpha_iou(&true_alpha, estimated),
                 alpha_mae(&true_alpha, estimated),
             );
-            let mut epe = [(0.0, 0usize); 2];
+            // Horizontal, vertical, pose to pose, and the true motion of the last.
+            let mut epe = [(0.0, 0usize); 4];
+            let columns = stage.cycles();
             for n in Neighbour::ALL {
-                if let Some(f) = &evidence.flows[i][n.index()] {
-                    let (s, c) = flow_epe(stage, pose, u, v, n, f)?;
-                    let k = matches!(n, Neighbour::Up | Neighbour::Down) as usize;
-                    epe[k].0 += s;
-                    epe[k].1 += c;
-                }
+                let (Some(f), Some((u2, v2))) = (
+                    &evidence.flows[i][n.index()],
+                    n.of(u, v, columns, rows, true),
+                ) else {
+                    continue;
+                };
+                let (s, _, c) = flow_epe(stage, (pose, u, v), (pose, u2, v2), f)?;
+                let k = matches!(n, Neighbour::Up | Neighbour::Down) as usize;
+                epe[k].0 += s;
+                epe[k].1 += c;
+            }
+            for step in PoseStep::ALL {
+                let (Some(f), Some((to_pose, u2))) = (
+                    evidence
+                        .pose_flows
+                        .get(i)
+                        .and_then(|p| p[step.index()].as_ref()),
+                    step.of(pose, u, &poses, columns, true),
+                ) else {
+                    continue;
+                };
+                let (s, m, c) = flow_epe(stage, (pose, u, v), (to_pose, u2, v), f)?;
+                epe[2].0 += s;
+                epe[2].1 += c;
+                // The error of no flow at all: the true motion's length.
+                epe[3].0 += m;
+                epe[3].1 += c;
             }
             Ok((alpha, epe))
         })
@@ -145,6 +167,8 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
         unregistered_psnr: mean(&column(1)),
         flow_epe_horizontal: sum_epe(0),
         flow_epe_vertical: sum_epe(1),
+        pose_flow_epe: sum_epe(2),
+        pose_flow_motion: sum_epe(3),
         registration_views: evidence.registered.len(),
         hull_iou: evidence
             .hull

@@ -37,6 +37,7 @@ fn options(poses: Vec<u32>) -> IngestOptions {
         shadows: Some(ShadowOptions::default()),
         selection: None,
         edge: EdgeMethod::Solve,
+        pose_flows: false,
     }
 }
 

@@ -27,6 +27,13 @@ pub struct PoseErrors {
     pub flow_epe_horizontal: Option<f64>,
     /// The same for vertical neighbours.
     pub flow_epe_vertical: Option<f64>,
+    /// The same for the flows to the next and previous captured pose of each view
+    /// (`None` where there are none).
+    #[serde(default)]
+    pub pose_flow_epe: Option<f64>,
+    /// The mean length of the true motion over the same pixels (the error of no flow).
+    #[serde(default)]
+    pub pose_flow_motion: Option<f64>,
     /// Views whose registration was evaluated.
     pub registration_views: usize,
     /// Intersection over union of the visual hull's voxels with the true occupancy of
@@ -77,6 +84,8 @@ pub struct PoseEvidence<'a> {
     pub alphas: &'a [Option<GrayImage>],
     /// Estimated flows per view, in [`frf_core::grid::Neighbour::ALL`] order.
     pub flows: &'a [[Option<FlowImage>; 4]],
+    /// Estimated pose-to-pose flows per view, in [`frf_core::grid::PoseStep::ALL`] order.
+    pub pose_flows: &'a [[Option<FlowImage>; 2]],
     /// The views the evaluator asked for ([`Evaluator::wants_unregistered`]).
     pub registered: &'a [SampledView],
     /// The pose's visual hull, when ingest carved one.

@@ -20,6 +20,7 @@ pub mod evidence;
 pub mod interview;
 pub mod matte;
 pub mod pipeline;
+pub mod poseflow;
 pub mod rectify;
 pub mod registration;
 pub mod ring;

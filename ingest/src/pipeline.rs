@@ -20,7 +20,7 @@ use frf_flow::{FlowParams, Preset};
 use frf_reflectance::container::merge_fields;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::stats::FieldStats;
-use frf_reflectance::store::{EncodedView, encode_flows, encode_images};
+use frf_reflectance::store::{EncodedView, encode_flows, encode_images, encode_pose_flows};
 use frf_reflectance::{FieldFile, FieldHeader, FieldWriter};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -55,6 +55,9 @@ pub struct IngestOptions {
     pub selection: Option<Selection>,
     /// What to do about backdrop light at the subject's edges.
     pub edge: EdgeMethod,
+    /// Also measure and store each view's flows to the next and previous captured pose
+    /// ([`crate::poseflow`]; issue 24: no renderer reads them yet).
+    pub pose_flows: bool,
 }
 
 /// The views and flows of each pose to ingest (a field made for one scene, `frf ingest
@@ -148,6 +151,9 @@ pub struct Settings {
     /// were made without.
     #[serde(default = "no_edge_method")]
     pub edge: String,
+    /// Pose-to-pose flows measured; parts written before they existed have none.
+    #[serde(default)]
+    pub pose_flows: bool,
 }
 
 fn no_edge_method() -> String {
@@ -197,6 +203,12 @@ pub struct IngestReport {
     pub flow_epe_horizontal: Option<f64>,
     /// See [`PoseErrors::flow_epe_vertical`].
     pub flow_epe_vertical: Option<f64>,
+    /// See [`PoseErrors::pose_flow_epe`].
+    #[serde(default)]
+    pub pose_flow_epe: Option<f64>,
+    /// See [`PoseErrors::pose_flow_motion`].
+    #[serde(default)]
+    pub pose_flow_motion: Option<f64>,
     /// See [`PoseErrors::hull_iou`].
     pub hull_iou: Option<f64>,
     /// See [`PoseErrors::edge_band_error_dark`].
@@ -261,6 +273,7 @@ fn settings(options: &IngestOptions) -> Settings {
             },
         ),
         edge: options.edge.name().into(),
+        pose_flows: options.pose_flows,
         selection: options
             .selection
             .as_ref()
@@ -467,6 +480,28 @@ fn ingest_pose(
     ));
     let flows = grid.flows;
 
+    let pose_flows = if options.pose_flows {
+        progress.begin(
+            pose,
+            "pose-to-pose flow",
+            present.iter().filter(|&&p| p).count(),
+        );
+        let start = Instant::now();
+        let (pose_flows, _) =
+            crate::poseflow::pose_flows(capture, pose, header.wraps, &alphas, &params, &|| {
+                check_stop(progress)?;
+                progress.advance();
+                Ok(())
+            })?;
+        steps.push(Step {
+            name: "pose-to-pose flow".into(),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        pose_flows
+    } else {
+        vec![Default::default(); columns * rows]
+    };
+
     let shadows = match &options.shadows {
         Some(s) => {
             progress.begin(pose, "visual hull and shadow maps", 1);
@@ -499,11 +534,17 @@ fn ingest_pose(
         flows
             .iter()
             .flat_map(|f| f.iter().flatten())
+            .chain(pose_flows.iter().flat_map(|f| f.iter().flatten()))
             .flat_map(|f| f.pixels().iter().flatten().copied()),
     );
     let encoded: Vec<EncodedView> = flows
         .par_iter()
-        .map(|f| Ok(encode_flows(&header, pose, f)?))
+        .zip(&pose_flows)
+        .map(|(f, p)| {
+            let mut e = encode_flows(&header, pose, f)?;
+            e.extend(encode_pose_flows(&header, pose, p)?);
+            Ok(e)
+        })
         .collect::<Result<_>>()?;
     let (part, json) = part_paths(out, pose);
     let mut writer = FieldWriter::create(&part, header)?;
@@ -541,6 +582,7 @@ fn ingest_pose(
                     &PoseEvidence {
                         alphas: &alphas,
                         flows: &flows,
+                        pose_flows: &pose_flows,
                         registered: &registered,
                         hull: shadows.as_ref().map(|s| &s.hull),
                     },
@@ -635,6 +677,8 @@ pub fn ingest(
         unregistered_psnr: mean(|e| e.unregistered_psnr),
         flow_epe_horizontal: mean(|e| e.flow_epe_horizontal),
         flow_epe_vertical: mean(|e| e.flow_epe_vertical),
+        pose_flow_epe: mean(|e| e.pose_flow_epe),
+        pose_flow_motion: mean(|e| e.pose_flow_motion),
         hull_iou: mean(|e| e.hull_iou),
         edge_band_error_dark: mean(|e| e.edge_band_error_dark),
         edge_band_error_bright: mean(|e| e.edge_band_error_bright),

@@ -20,7 +20,7 @@ use std::io::{BufWriter, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ReflectanceError, Result};
@@ -48,6 +48,9 @@ pub enum ChunkKind {
     Alpha,
     /// The flow from a view to a neighbour.
     Flow(Neighbour),
+    /// The flow from a view to the same camera's view of the next or previous captured
+    /// pose ([`PoseStep::of`]).
+    PoseFlow(PoseStep),
     /// The shadow attenuation maps of a pose (`u = v = 0`).
     Shadows,
     /// The visual hull of a pose (`u = v = 0`).
@@ -84,6 +87,14 @@ impl std::fmt::Display for ChunkKey {
                 f,
                 "flow {} of pose {} view ({}, {})",
                 n.name(),
+                self.pose,
+                self.u,
+                self.v
+            ),
+            ChunkKind::PoseFlow(s) => write!(
+                f,
+                "flow {} of pose {} view ({}, {})",
+                s.name(),
                 self.pose,
                 self.u,
                 self.v

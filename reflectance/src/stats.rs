@@ -19,6 +19,9 @@ pub struct Bytes {
     pub shadows: u64,
     /// Visual hulls.
     pub hulls: u64,
+    /// Pose-to-pose flow maps.
+    #[serde(default)]
+    pub pose_flow: u64,
     /// Preamble, index and footer.
     pub other: u64,
 }
@@ -46,6 +49,9 @@ pub struct FieldStats {
     pub shadow_maps: usize,
     /// Visual hulls stored (one per pose).
     pub hulls: usize,
+    /// Pose-to-pose flow maps stored.
+    #[serde(default)]
+    pub pose_flow_maps: usize,
 }
 
 impl<R: ReadAt> FieldFile<R> {
@@ -54,8 +60,8 @@ impl<R: ReadAt> FieldFile<R> {
         let h = self.header();
         let pixels = h.width as u64 * h.height as u64;
         let mut bytes = Bytes::default();
-        let (mut flow_maps, mut basis_views, mut shadow_poses, mut hulls) =
-            (0usize, 0usize, 0usize, 0usize);
+        let (mut flow_maps, mut basis_views, mut shadow_poses, mut hulls, mut pose_flow_maps) =
+            (0usize, 0usize, 0usize, 0usize, 0usize);
         for c in self.chunks() {
             match c.key.kind {
                 ChunkKind::Flow(_) => {
@@ -75,10 +81,19 @@ impl<R: ReadAt> FieldFile<R> {
                     bytes.hulls += c.length;
                     hulls += 1;
                 }
+                ChunkKind::PoseFlow(_) => {
+                    bytes.pose_flow += c.length;
+                    pose_flow_maps += 1;
+                }
             }
         }
-        bytes.other =
-            self.size() - (bytes.flow + bytes.images + bytes.alpha + bytes.shadows + bytes.hulls);
+        bytes.other = self.size()
+            - (bytes.flow
+                + bytes.images
+                + bytes.alpha
+                + bytes.shadows
+                + bytes.hulls
+                + bytes.pose_flow);
         let shadow_maps = shadow_poses * h.shadows.as_ref().map_or(0, |s| s.conditions.len());
         let basis_images = basis_views * h.conditions.len();
         let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
@@ -95,6 +110,7 @@ impl<R: ReadAt> FieldFile<R> {
             basis_images,
             shadow_maps,
             hulls,
+            pose_flow_maps,
         }
     }
 }

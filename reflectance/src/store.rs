@@ -3,7 +3,7 @@
 //! encoded in parallel and written in order), and reading one view back from only its
 //! own chunks.
 
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 
 use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt};
@@ -20,6 +20,11 @@ use crate::imagecodec::{
 pub struct EncodedView(Vec<(ChunkKind, Vec<u8>)>);
 
 impl EncodedView {
+    /// Appends another encoding's chunks (of the same view).
+    pub fn extend(&mut self, other: EncodedView) {
+        self.0.extend(other.0);
+    }
+
     /// Total encoded bytes.
     pub fn bytes(&self) -> usize {
         self.0.iter().map(|c| c.1.len()).sum()
@@ -84,6 +89,28 @@ pub fn encode_flows(
             check_size(header, "flow", w, h, flow)?;
             chunks.push((
                 ChunkKind::Flow(*n),
+                flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
+            ));
+        }
+    }
+    Ok(EncodedView(chunks))
+}
+
+/// Encodes a view's pose-to-pose flows (in [`PoseStep::ALL`] order) with pose `pose`'s
+/// quantizer.
+pub fn encode_pose_flows(
+    header: &FieldHeader,
+    pose: u32,
+    flows: &[Option<FlowImage>; 2],
+) -> Result<EncodedView> {
+    let quantizer = header.pose(pose)?.flow_quantizer;
+    let (w, h) = (header.width as usize, header.height as usize);
+    let mut chunks = Vec::new();
+    for (step, flow) in PoseStep::ALL.iter().zip(flows) {
+        if let Some(flow) = flow {
+            check_size(header, "pose flow", w, h, flow)?;
+            chunks.push((
+                ChunkKind::PoseFlow(*step),
                 flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
             ));
         }
@@ -238,6 +265,28 @@ impl<R: ReadAt> FieldFile<R> {
         self.flow_codes(pose, u, v, n)?
             .map(|codes| flowcodec::dequantize(w, h, &codes, &quantizer))
             .transpose()
+    }
+
+    /// The flow from a view to the same camera's view of the next or previous captured
+    /// pose ([`PoseStep::of`]), `None` where the field holds none.
+    pub fn pose_flow(
+        &self,
+        pose: u32,
+        u: usize,
+        v: usize,
+        step: PoseStep,
+    ) -> Result<Option<FlowImage>> {
+        let k = key(pose, u, v, ChunkKind::PoseFlow(step));
+        if !self.has(&k) {
+            return Ok(None);
+        }
+        let (w, h) = (self.header().width as usize, self.header().height as usize);
+        let quantizer = self.header().pose(pose)?.flow_quantizer;
+        let (cw, ch, codes) = self.decode_chunk(&k, flowcodec::decode_codes)?;
+        if (cw, ch) != (w, h) {
+            return Err(self.chunk_error(&k, format!("flow map is {cw}x{ch}")));
+        }
+        Ok(Some(flowcodec::dequantize(w, h, &codes, &quantizer)?))
     }
 
     /// Everything of one view, read from that view's chunks only.

@@ -14,7 +14,7 @@ use frf_reflectance::field::{ConditionRecord, LightRecord};
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::shadow::{attenuation_maps, ground_irradiance, shadow_spec};
 use frf_render::composite::{Backdrop, GroundLook, compose};
-use frf_render::shadow::{ShadowMaps, traced_shadow};
+use frf_render::shadow::{ShadowMaps, edge_fade, traced_shadow};
 use glam::Vec3;
 
 const GROUND: GroundGrid = GroundGrid {
@@ -128,8 +128,16 @@ fn a_light_exactly_at_the_horizon_adds_nothing() {
     }];
     let long = traced_shadow(&hull, &low, GROUND);
     assert!(bounded(&long.image));
-    // 1.8 m tall, 0.05 rise per run: the shadow reaches the patch's edge at x = -1.5.
-    assert_eq!(long.at(-1.45, 0.0), [0.0; 3]);
+    // 1.8 m tall, 0.05 rise per run: the shadow reaches the patch's edge at x = -1.5; the
+    // maps fade to 1 over the patch's outer fifth, and the shadow with them.
+    assert_eq!(long.at(-1.15, 0.0), [0.0; 3]);
+    let t = GROUND.texel_of(-1.45, 0.0);
+    assert_eq!(
+        long.image.get(t.x.round() as usize, t.y.round() as usize),
+        [0.0; 3]
+    );
+    let w = edge_fade(-1.45, 0.0, GROUND.extent_m);
+    assert!(w > 0.5 && w < 1.0 && (long.at(-1.45, 0.0)[0] - w).abs() < 1e-6);
 }
 
 #[test]
@@ -184,7 +192,14 @@ fn a_subject_partly_outside_the_ground_patch_is_shadowed_where_the_patch_reaches
         ground: GROUND,
         image: s,
     };
-    // Inside the patch under the pillar: dark; beyond the patch: 1, by definition.
-    assert_eq!(shadow.at(1.45, 0.0), [0.0; 3]);
+    // Inside the patch under the pillar the map is dark, faded toward 1 as the patch's
+    // edge nears; beyond the patch: 1, by definition.
+    let t = GROUND.texel_of(1.45, 0.0);
+    assert_eq!(
+        shadow.image.get(t.x.round() as usize, t.y.round() as usize),
+        [0.0; 3]
+    );
+    let w = edge_fade(1.45, 0.0, GROUND.extent_m);
+    assert!((shadow.at(1.45, 0.0)[0] - w).abs() < 1e-6);
     assert_eq!(shadow.at(1.6, 0.0), [1.0; 3]);
 }

@@ -71,6 +71,7 @@ pub fn run(args: InfoArgs) -> CliResult {
     for (kind, b) in [
         ("basis images", s.bytes.images),
         ("flow maps", s.bytes.flow),
+        ("pose flow maps", s.bytes.pose_flow),
         ("alpha", s.bytes.alpha),
         ("shadow maps", s.bytes.shadows),
         ("visual hulls", s.bytes.hulls),
@@ -82,6 +83,10 @@ pub fn run(args: InfoArgs) -> CliResult {
         "  flow: {} maps, {:.1} % of their 8-bit quantized size",
         s.flow_maps,
         100.0 * s.flow_ratio_vs_8bit
+    );
+    println!(
+        "  pose-to-pose flow: {} maps (to the next and the previous captured pose of each view)",
+        s.pose_flow_maps
     );
     println!(
         "  basis images: {} images, {:.1}:1 against 16-bit linear RGB",

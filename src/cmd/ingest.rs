@@ -50,6 +50,10 @@ pub struct IngestArgs {
     /// under the edge) or `none` (the blurred binary matte, as the original).
     #[arg(long, value_enum, default_value = "solve")]
     edge: EdgeArg,
+    /// Also measure and store each view's flow to the next and the previous captured pose
+    /// (experimental: the time between poses, issue 24; no renderer reads them yet).
+    #[arg(long)]
+    pose_flow: bool,
     /// Ingest only the poses, views and flows this scene file needs (`frf render
     /// SCENE.toml` renders from the field).
     #[arg(long = "for", value_name = "SCENE")]
@@ -140,6 +144,7 @@ pub fn run(args: IngestArgs) -> CliResult {
             MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
         },
         edge: args.edge.into(),
+        pose_flows: args.pose_flow,
     };
     let bars = Bars {
         current: Mutex::new(None),
@@ -265,6 +270,13 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
     println!(
         "    flow EPE inside matte, vertical     {}",
         f(r.flow_epe_vertical, " px", 3)
+    );
+    println!(
+        "    flow EPE inside matte, pose to pose {}",
+        match (r.pose_flow_epe, r.pose_flow_motion) {
+            (Some(e), Some(m)) => format!("{e:.3} px (the true motion: {m:.3} px)"),
+            (e, _) => f(e, " px", 3),
+        }
     );
     println!(
         "    visual hull IoU (voxels)            {}",

@@ -16,5 +16,6 @@ mod ring;
 mod scene;
 mod stage;
 mod status;
+mod time;
 mod verbs;
 mod view;

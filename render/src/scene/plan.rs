@@ -366,6 +366,8 @@ impl Plan {
                     counts.flows_used += used as usize;
                     used
                 }
+                // Not drawn yet: a shot shows the nearest pose (issue 24 will read them).
+                ChunkKind::PoseFlow(_) => false,
                 ChunkKind::Shadows => p.shadow_maps,
                 ChunkKind::Hull => p.hull,
             };
