@@ -75,25 +75,36 @@ pub fn encode_images(
     ]))
 }
 
+/// Encodes the flows present among `flows` as chunks of their kinds, with pose `pose`'s
+/// quantizer.
+fn encode_flow_chunks<'a>(
+    header: &FieldHeader,
+    pose: u32,
+    flows: impl Iterator<Item = (ChunkKind, &'a Option<FlowImage>)>,
+) -> Result<EncodedView> {
+    let quantizer = header.pose(pose)?.flow_quantizer;
+    let (w, h) = (header.width as usize, header.height as usize);
+    let mut chunks = Vec::new();
+    for (kind, flow) in flows {
+        if let Some(flow) = flow {
+            check_size(header, "flow", w, h, flow)?;
+            chunks.push((
+                kind,
+                flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
+            ));
+        }
+    }
+    Ok(EncodedView(chunks))
+}
+
 /// Encodes a view's flows (in [`Neighbour::ALL`] order) with pose `pose`'s quantizer.
 pub fn encode_flows(
     header: &FieldHeader,
     pose: u32,
     flows: &[Option<FlowImage>; 4],
 ) -> Result<EncodedView> {
-    let quantizer = header.pose(pose)?.flow_quantizer;
-    let (w, h) = (header.width as usize, header.height as usize);
-    let mut chunks = Vec::new();
-    for (n, flow) in Neighbour::ALL.iter().zip(flows) {
-        if let Some(flow) = flow {
-            check_size(header, "flow", w, h, flow)?;
-            chunks.push((
-                ChunkKind::Flow(*n),
-                flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
-            ));
-        }
-    }
-    Ok(EncodedView(chunks))
+    let kinds = Neighbour::ALL.iter().map(|&n| ChunkKind::Flow(n));
+    encode_flow_chunks(header, pose, kinds.zip(flows))
 }
 
 /// Encodes a view's pose-to-pose flows (in [`PoseStep::ALL`] order) with pose `pose`'s
@@ -103,19 +114,8 @@ pub fn encode_pose_flows(
     pose: u32,
     flows: &[Option<FlowImage>; 2],
 ) -> Result<EncodedView> {
-    let quantizer = header.pose(pose)?.flow_quantizer;
-    let (w, h) = (header.width as usize, header.height as usize);
-    let mut chunks = Vec::new();
-    for (step, flow) in PoseStep::ALL.iter().zip(flows) {
-        if let Some(flow) = flow {
-            check_size(header, "pose flow", w, h, flow)?;
-            chunks.push((
-                ChunkKind::PoseFlow(*step),
-                flowcodec::encode(flow, &quantizer, header.flow_predicted)?,
-            ));
-        }
-    }
-    Ok(EncodedView(chunks))
+    let kinds = PoseStep::ALL.iter().map(|&s| ChunkKind::PoseFlow(s));
+    encode_flow_chunks(header, pose, kinds.zip(flows))
 }
 
 /// Encodes one view of pose `pose` with the header's codec parameters.
@@ -247,7 +247,11 @@ impl<R: ReadAt> FieldFile<R> {
         v: usize,
         n: Neighbour,
     ) -> Result<Option<Vec<i8>>> {
-        let k = key(pose, u, v, ChunkKind::Flow(n));
+        self.flow_codes_of(key(pose, u, v, ChunkKind::Flow(n)))
+    }
+
+    /// The 8-bit log codes of the flow chunk `k`, `None` where the field lacks it.
+    fn flow_codes_of(&self, k: ChunkKey) -> Result<Option<Vec<i8>>> {
         if !self.has(&k) {
             return Ok(None);
         }
@@ -276,17 +280,11 @@ impl<R: ReadAt> FieldFile<R> {
         v: usize,
         step: PoseStep,
     ) -> Result<Option<FlowImage>> {
-        let k = key(pose, u, v, ChunkKind::PoseFlow(step));
-        if !self.has(&k) {
-            return Ok(None);
-        }
         let (w, h) = (self.header().width as usize, self.header().height as usize);
         let quantizer = self.header().pose(pose)?.flow_quantizer;
-        let (cw, ch, codes) = self.decode_chunk(&k, flowcodec::decode_codes)?;
-        if (cw, ch) != (w, h) {
-            return Err(self.chunk_error(&k, format!("flow map is {cw}x{ch}")));
-        }
-        Ok(Some(flowcodec::dequantize(w, h, &codes, &quantizer)?))
+        self.flow_codes_of(key(pose, u, v, ChunkKind::PoseFlow(step)))?
+            .map(|codes| flowcodec::dequantize(w, h, &codes, &quantizer))
+            .transpose()
     }
 
     /// Everything of one view, read from that view's chunks only.

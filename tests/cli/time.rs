@@ -59,6 +59,19 @@ fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
     let o = frf(&["info", whole.to_str().unwrap(), "--json"]);
     let info: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(info["pose_flow_maps"], 3 * 108 * 2, "{info}");
+    // They read back at the field's size, finite where known, with motion near the body.
+    let field = frf_reflectance::FieldFile::open(&whole).unwrap();
+    for step in frf_core::grid::PoseStep::ALL {
+        let f = field.pose_flow(1, 4, 1, step).unwrap().unwrap();
+        assert_eq!(f.size(), (32, 45));
+        let known: Vec<_> = f
+            .pixels()
+            .iter()
+            .filter(|p| frf_core::flo::is_known(**p))
+            .collect();
+        assert!(known.len() > 50 && known.iter().all(|p| p[0].is_finite() && p[1].is_finite()));
+        assert!(known.iter().any(|p| p[0].hypot(p[1]) > 0.1));
+    }
     // Each pose on its own (a farm's task reads its neighbours' frames from the capture),
     // then merged: the same bytes as one ingest.
     let parts: Vec<_> = (0..3).map(|p| d.join(format!("p{p}.frf"))).collect();
