@@ -631,9 +631,15 @@ pub(crate) fn median(v: &[f64]) -> Option<f64> {
 
 impl ApplicationHandler for App<'_> {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
-        if let Err(e) = self.open(event_loop) {
-            self.fail(event_loop, e);
-            return;
+        // The window may be closed while it is still being set up (opening the field and
+        // the GPU takes seconds): caught as in `window_event`.
+        let opened = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            quietly(|| self.open(event_loop))
+        }));
+        match opened {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return self.fail(event_loop, e),
+            Err(panic) => return self.went_away(event_loop, &panic),
         }
         if let Some(live) = &self.live {
             live.window.request_redraw();
@@ -650,14 +656,22 @@ impl ApplicationHandler for App<'_> {
             quietly(|| self.handle(event_loop, event))
         }));
         if let Err(panic) = handled {
-            self.fail(
-                event_loop,
-                ViewError::Window(format!(
-                    "the window went away while in use ({})",
-                    panic_message(&panic)
-                )),
-            );
+            self.went_away(event_loop, &panic);
         }
+    }
+}
+
+impl App<'_> {
+    /// Ends on a panic of the window system's library caught while the window was used
+    /// (see [`quietly`]).
+    fn went_away(&mut self, event_loop: &ActiveEventLoop, panic: &Box<dyn std::any::Any + Send>) {
+        self.fail(
+            event_loop,
+            ViewError::Window(format!(
+                "the window went away while in use ({})",
+                panic_message(panic)
+            )),
+        );
     }
 }
 
