@@ -38,7 +38,7 @@ step stage $frf stage --preset small --size 96x136 --lights-per-axis 2 --for "$s
 step ingest $frf ingest "$out/capture" --for "$scene" --flow-preset fast \
   --out "$out/walker.frf" --report "$out/ingest_report.json"
 step plan $frf render "$scene" --field "$out/walker.frf" --plan
-step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot"
+step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot" --overwrite
 step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 2 \
   --lights 256
 

@@ -111,7 +111,9 @@ pub fn score_frame<R: ReadAt>(
     };
     let time_from_pose_s = {
         let d = (truth_time_s - pose_time).rem_euclid(cycle);
-        if d > 0.5 * cycle { d - cycle } else { d }
+        let d = if d > 0.5 * cycle { d - cycle } else { d };
+        // Rounding at a pose's own instant is no time at all (not -0.0 ms).
+        if d.abs() < 1e-9 { 0.0 } else { d }
     };
     let truth = stage.truth_image_at(truth_time_s, &subject_camera, &lights);
     let subject = rgba_from(&truth.color, &truth.alpha)?;

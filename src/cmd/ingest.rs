@@ -271,13 +271,15 @@ fn print_report(r: &IngestReport, out: &std::path::Path) {
         "    flow EPE inside matte, vertical     {}",
         f(r.flow_epe_vertical, " px", 3)
     );
-    println!(
-        "    flow EPE inside matte, pose to pose {}",
-        match (r.pose_flow_epe, r.pose_flow_motion) {
-            (Some(e), Some(m)) => format!("{e:.3} px (the true motion: {m:.3} px)"),
-            (e, _) => f(e, " px", 3),
-        }
-    );
+    if r.settings.pose_flows {
+        println!(
+            "    flow EPE inside matte, pose to pose {}",
+            match (r.pose_flow_epe, r.pose_flow_motion) {
+                (Some(e), Some(m)) => format!("{e:.3} px (the true motion: {m:.3} px)"),
+                (e, _) => f(e, " px", 3),
+            }
+        );
+    }
     println!(
         "    visual hull IoU (voxels)            {}",
         f(r.hull_iou, "", 4)
