@@ -487,7 +487,7 @@ fn ingest_pose(
             present.iter().filter(|&&p| p).count(),
         );
         let start = Instant::now();
-        let (pose_flows, _) =
+        let pose_flows =
             crate::poseflow::pose_flows(capture, pose, header.wraps, &alphas, &params, &|| {
                 check_stop(progress)?;
                 progress.advance();

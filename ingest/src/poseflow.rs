@@ -13,8 +13,6 @@
 //! pose): the pair is rectified as the inter-view flows are ([`rectified_flow`]). Kept
 //! near the subject like them ([`keep_near_subject`]).
 
-use std::time::Instant;
-
 use frf_core::capture::Capture;
 use frf_core::grid::PoseStep;
 use frf_core::image::{FlowImage, GrayImage};
@@ -27,8 +25,8 @@ use crate::interview::{keep_near_subject, rectified_flow};
 /// The pose-to-pose flows of every view of `pose` that `alphas` holds (`u`-major; the
 /// columns close into a ring when `wraps`), in
 /// [`PoseStep::ALL`] order (`None` where the step's view was not filmed, or the capture
-/// holds one pose), and the thread seconds they took. `each_view` is called once per view
-/// (progress, and stopping: an error it returns ends the step).
+/// holds one pose). `each_view` is called once per view (progress, and stopping: an error
+/// it returns ends the step).
 pub fn pose_flows(
     capture: &Capture,
     pose: u32,
@@ -36,20 +34,19 @@ pub fn pose_flows(
     alphas: &[Option<&GrayImage>],
     params: &FlowParams,
     each_view: &(dyn Fn() -> Result<()> + Sync),
-) -> Result<(Vec<[Option<FlowImage>; 2]>, f64)> {
+) -> Result<Vec<[Option<FlowImage>; 2]>> {
     let (columns, rows) = (capture.cycles(), capture.cameras().len());
     let slot = capture.reference_track().track_slot;
     let mut poses = capture.poses().to_vec();
     poses.sort_unstable();
-    let out: Vec<([Option<FlowImage>; 2], f64)> = (0..columns * rows)
+    (0..columns * rows)
         .into_par_iter()
         .map(|i| {
             let mut flows: [Option<FlowImage>; 2] = Default::default();
             let Some(alpha) = alphas[i] else {
-                return Ok((flows, 0.0));
+                return Ok(flows);
             };
             let (u, v) = (i / rows, i % rows);
-            let t = Instant::now();
             let mut from = None;
             for step in PoseStep::ALL {
                 let Some((to_pose, to_u)) = step.of(pose, u, &poses, columns, wraps) else {
@@ -73,9 +70,7 @@ pub fn pose_flows(
                 flows[step.index()] = Some(keep_near_subject(&f, alpha));
             }
             each_view()?;
-            Ok((flows, t.elapsed().as_secs_f64()))
+            Ok(flows)
         })
-        .collect::<Result<_>>()?;
-    let seconds = out.iter().map(|o| o.1).sum();
-    Ok((out.into_iter().map(|o| o.0).collect(), seconds))
+        .collect()
 }

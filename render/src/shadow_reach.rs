@@ -56,6 +56,16 @@ pub fn shadow_light_elevation(env: &EnvMap) -> Option<f32> {
     None
 }
 
+/// The lowest [`shadow_light_elevation`] of `envs` (a scene's lighting keys): `None`
+/// when none lights the ground from above.
+pub fn lowest_shadow_light_elevation<'a>(
+    envs: impl IntoIterator<Item = &'a EnvMap>,
+) -> Option<f32> {
+    envs.into_iter()
+        .filter_map(shadow_light_elevation)
+        .reduce(f32::min)
+}
+
 /// How far from the subject's axis its shadow reaches (metres) under a light at
 /// `elevation` (radians), for a subject of `(height, radius)`.
 pub fn shadow_reach(elevation: f32, (height, radius): (f32, f32)) -> f32 {

@@ -25,16 +25,14 @@ pub const MAX_SCENE_PATCH_M: f32 = 12.0;
 /// lights the ground from above.
 pub fn shadow_patch(scene: &Path) -> CliResult<Option<(f32, f32)>> {
     use frf_render::shadow_reach::{
-        NOMINAL_SUBJECT, patch_side_holding, shadow_light_elevation, shadow_reach,
+        NOMINAL_SUBJECT, lowest_shadow_light_elevation, patch_side_holding, shadow_reach,
     };
     let scene = Scene::load(scene)?;
-    let mut lowest: Option<f32> = None;
-    for key in &scene.lighting {
-        if let Some(e) = key.env.load()?.as_ref().and_then(shadow_light_elevation) {
-            lowest = Some(lowest.map_or(e, |l| l.min(e)));
-        }
+    let mut envs = Vec::new();
+    for env in scene.environments() {
+        envs.extend(env.load()?);
     }
-    Ok(lowest.map(|e| {
+    Ok(lowest_shadow_light_elevation(&envs).map(|e| {
         let side = patch_side_holding(shadow_reach(e, NOMINAL_SUBJECT));
         (side.min(MAX_SCENE_PATCH_M), e.to_degrees())
     }))

@@ -210,7 +210,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// lights, for the hull of the first pose drawn (a nominal person without one);
     /// `None` when no map is drawn or nothing lights the ground from above.
     pub fn shadow_reach(&mut self) -> Result<Option<ShadowReach>> {
-        use crate::shadow_reach::{NOMINAL_SUBJECT, shadow_light_elevation, shadow_reach};
+        use crate::shadow_reach::{NOMINAL_SUBJECT, lowest_shadow_light_elevation, shadow_reach};
         let Some(spec) = &self.field.header().shadows else {
             return Ok(None);
         };
@@ -218,14 +218,12 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         if self.scene.shadow != super::ShadowSpec::Maps || !self.plan.ground_seen {
             return Ok(None);
         }
-        let mut lowest: Option<f32> = None;
         let sources: Vec<EnvSource> = self.scene.lighting.iter().map(|k| k.env.clone()).collect();
+        let mut envs = Vec::new();
         for source in &sources {
-            if let Some(e) = self.env(source)?.as_ref().and_then(shadow_light_elevation) {
-                lowest = Some(lowest.map_or(e, |l| l.min(e)));
-            }
+            envs.extend(self.env(source)?);
         }
-        let Some(elevation) = lowest else {
+        let Some(elevation) = lowest_shadow_light_elevation(&envs) else {
             return Ok(None);
         };
         let hull = match self.plan.poses.first() {
