@@ -208,6 +208,20 @@ impl Camera {
         ))
     }
 
+    /// The point on the subject's axis (the world `y` axis: the turntable's) nearest to
+    /// the camera's optical axis: where the camera looks at the subject.
+    pub fn axis_point(&self) -> Vec3 {
+        // Closest points of the lines C + s f and (0, y, 0).
+        let (c, f) = (self.centre(), self.forward());
+        let horizontal = Vec3::new(f.x, 0.0, f.z);
+        let s = if horizontal.length_squared() > 1e-12 {
+            -(Vec3::new(c.x, 0.0, c.z).dot(horizontal)) / horizontal.length_squared()
+        } else {
+            0.0
+        };
+        Vec3::new(0.0, c.y + s * f.y, 0.0)
+    }
+
     /// Depth (camera `z`) of a world point.
     #[inline]
     pub fn depth(&self, p_world: Vec3) -> f32 {

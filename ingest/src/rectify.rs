@@ -40,20 +40,6 @@ fn intrinsics(c: &Camera) -> Mat3 {
     )
 }
 
-/// The point on the turntable axis (the world `y` axis) nearest to `camera`'s optical
-/// axis: where the camera looks at the subject.
-pub fn axis_point(camera: &Camera) -> Vec3 {
-    // Closest points of the lines C + s f and (0, y, 0).
-    let (c, f) = (camera.centre(), camera.forward());
-    let horizontal = Vec3::new(f.x, 0.0, f.z);
-    let s = if horizontal.length_squared() > 1e-12 {
-        -(Vec3::new(c.x, 0.0, c.z).dot(horizontal)) / horizontal.length_squared()
-    } else {
-        0.0
-    };
-    Vec3::new(0.0, c.y + s * f.y, 0.0)
-}
-
 /// The homography from `reference`'s pixels to `other`'s induced by the plane through
 /// `point` with normal `normal`.
 pub fn plane_homography(
@@ -86,9 +72,14 @@ pub fn plane_homography(
 }
 
 /// The rectifying homography of a vertical pair: the plane fronto-parallel to
-/// `reference` through its [`axis_point`].
+/// `reference` through its [`Camera::axis_point`].
 pub fn rectifying_homography(reference: &Camera, other: &Camera) -> Result<Homography> {
-    plane_homography(reference, other, axis_point(reference), reference.forward())
+    plane_homography(
+        reference,
+        other,
+        reference.axis_point(),
+        reference.forward(),
+    )
 }
 
 /// `other` resampled on the reference grid through `h`: `out(s) = other(H s)`.
@@ -140,7 +131,7 @@ mod tests {
     fn points_on_the_plane_map_exactly() {
         let (a, b) = cameras();
         let h = rectifying_homography(&a, &b).unwrap();
-        let p0 = axis_point(&a);
+        let p0 = a.axis_point();
         assert!((p0 - Vec3::new(0.0, 0.9, 0.0)).length() < 1e-4, "{p0}");
         let n = a.forward();
         // Two directions in the plane.
@@ -172,7 +163,7 @@ mod tests {
         let g = |p: Vec2| [0.01 * p.x + 0.002 * p.y * p.y / 90.0, 0.3];
         let other = Image::from_fn(64, 90, |x, y| g(Vec2::new(x as f32, y as f32)));
         let rectified = rectify(&other, &h, 64, 90);
-        let (p0, n) = (axis_point(&a), a.forward());
+        let (p0, n) = (a.axis_point(), a.forward());
         for (x, y) in [(10, 70), (32, 45), (5, 5), (60, 20)] {
             let s = Vec2::new(x as f32, y as f32);
             let d = a.ray_direction(s);

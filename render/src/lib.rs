@@ -27,6 +27,7 @@ pub mod extend;
 pub mod geometry;
 pub mod gpu;
 pub mod morph;
+pub mod motion;
 pub mod path;
 pub mod proxy;
 pub mod rectified;

@@ -15,11 +15,13 @@ use frf_core::image::{Image, Rgb, Rgba};
 use crate::composite::{Backdrop, Layers, back_to_front, compose, stack};
 use crate::cpu::{FrameStats, render_cpu};
 use crate::error::Result;
-use crate::gpu::composite::{GpuBackdrop, GpuInstanceRef};
+use crate::gpu::composite::{GpuBackdrop, GpuBetween, GpuInstanceRef};
 use crate::gpu::{Gpu, GpuPose};
 use crate::morph::Variant;
+use crate::motion::{TimePair, motion_to_image, time_morph};
 use crate::resident::{PoseSource, ResidentPose};
 use crate::shadow::{RelitShadow, ShadowMaps};
+use frf_core::grid::PoseStep;
 
 /// Where rendering happens.
 pub enum Device {
@@ -51,6 +53,9 @@ enum ResidentKind {
 /// A pose made resident on a [`Device`], relit.
 pub struct Resident {
     kind: ResidentKind,
+    /// Its motion toward the next and the previous pose ([`frf_core::grid::PoseStep`]
+    /// order), when made ([`Device::set_motion`]).
+    motion: [Option<ResidentKind>; 2],
     ground_coefficients: Option<Vec<Rgb>>,
     shadow: bool,
     /// The pose.
@@ -60,10 +65,16 @@ pub struct Resident {
 impl Resident {
     /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy).
     pub fn bytes(&self) -> u64 {
-        match &self.kind {
+        let bytes = |k: &ResidentKind| match k {
             ResidentKind::Gpu(p) => p.geometry.resident_bytes(),
             ResidentKind::Cpu { pose, .. } => pose.resident_bytes(),
-        }
+        };
+        bytes(&self.kind) + self.motion.iter().flatten().map(bytes).sum::<u64>()
+    }
+
+    /// Whether its motion toward `step`'s pose is resident.
+    pub fn has_motion(&self, step: PoseStep) -> bool {
+        self.motion[step.index()].is_some()
     }
 
     /// Whether the pose carries a shadow.
@@ -77,6 +88,7 @@ impl Resident {
             ResidentKind::Gpu(pose) => Ok(GpuInstanceRef {
                 pose,
                 world_from_subject,
+                between: None,
             }),
             ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
                 "a CPU-resident pose given to the GPU renderer".into(),
@@ -110,6 +122,41 @@ pub struct Walker<'a> {
     pub resident: &'a Resident,
     /// Its subject frame in the world.
     pub world_from_subject: Rigid,
+    /// Between `resident`'s pose and a later one: that pose (relit alike, with its motion
+    /// toward `resident`'s, which has its motion toward it), and the fraction of the way
+    /// ([`crate::motion`]).
+    pub between: Option<(&'a Resident, f32)>,
+}
+
+impl<'a> Walker<'a> {
+    /// The walker of a GPU frame (its poses resident on the GPU).
+    pub fn gpu_instance(&self) -> Result<GpuInstanceRef<'a>> {
+        let mut i = self.resident.gpu_instance(self.world_from_subject)?;
+        if let Some((after, s)) = self.between {
+            let gpu = |k: Option<&'a ResidentKind>, step| match k {
+                Some(ResidentKind::Gpu(p)) => Ok(&**p),
+                Some(ResidentKind::Cpu { .. }) => Err(crate::RenderError::BadParameter(
+                    "a CPU-resident pose given to the GPU renderer".into(),
+                )),
+                None => Err(no_motion(step)),
+            };
+            i.between = Some(GpuBetween {
+                after: gpu(Some(&after.kind), PoseStep::Next)?,
+                before_motion: gpu(self.resident.motion[0].as_ref(), PoseStep::Next)?,
+                after_motion: gpu(after.motion[1].as_ref(), PoseStep::Prev)?,
+                s,
+            });
+        }
+        Ok(i)
+    }
+
+    /// The pose whose shadow the walker casts: the nearer of the two between poses.
+    fn shadow_source(&self) -> &Resident {
+        match self.between {
+            Some((after, s)) if s >= 0.5 => after,
+            _ => self.resident,
+        }
+    }
 }
 
 /// A composited frame.
@@ -164,7 +211,30 @@ impl Device {
             ground_coefficients: source.ground_coefficients.clone(),
             shadow: false,
             pose: source.geometry.pose,
+            motion: [None, None],
         })
+    }
+
+    /// Sets the motion `resident` carries toward its next and previous poses
+    /// ([`frf_core::grid::PoseStep`] order; [`crate::motion::pose_motion`]).
+    pub fn set_motion(
+        &self,
+        resident: &mut Resident,
+        motion: [Option<ResidentPose>; 2],
+    ) -> Result<()> {
+        for (slot, m) in resident.motion.iter_mut().zip(motion) {
+            *slot = match (m, self) {
+                (None, _) => None,
+                (Some(m), Device::Gpu(gpu)) => {
+                    Some(ResidentKind::Gpu(Box::new(gpu.upload_motion(&m)?)))
+                }
+                (Some(m), Device::Cpu) => Some(ResidentKind::Cpu {
+                    pose: Box::new(m),
+                    shadow: None,
+                }),
+            };
+        }
+        Ok(())
     }
 
     /// Sets the shadow `resident` casts (maps without an environment give none).
@@ -253,7 +323,7 @@ impl Device {
         if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
             let instances = walkers
                 .iter()
-                .map(|w| w.resident.gpu_instance(w.world_from_subject))
+                .map(Walker::gpu_instance)
                 .collect::<Result<Vec<_>>>()?;
             let (composite, l, stats) =
                 gpu.render_composite(&instances, b, camera, variant, layers)?;
@@ -273,16 +343,37 @@ impl Device {
         let mut shadows = Vec::new();
         for k in back_to_front(camera, &positions) {
             let w = &walkers[k];
-            let ResidentKind::Cpu { pose, shadow } = &w.resident.kind else {
-                return Err(crate::RenderError::BadParameter(
-                    "a GPU-resident pose given to the CPU renderer".into(),
-                ));
-            };
             let subject_from_world = w.world_from_subject.inverse();
-            let (img, s) = render_cpu(pose, &camera.transformed(&subject_from_world), variant);
+            let seen = camera.transformed(&subject_from_world);
+            let (img, s) = render_cpu(cpu_pose(&w.resident.kind)?, &seen, variant);
             stats = stats.merge(s);
-            drawn.push(img);
-            if let Some(relit) = shadow {
+            drawn.push(match w.between {
+                None => img,
+                Some((after, s)) => {
+                    let [next, prev] = [PoseStep::Next, PoseStep::Prev].map(|step| {
+                        let m = match step {
+                            PoseStep::Next => &w.resident.motion[0],
+                            PoseStep::Prev => &after.motion[1],
+                        };
+                        m.as_ref().ok_or_else(|| no_motion(step))
+                    });
+                    let after_img = render_cpu(cpu_pose(&after.kind)?, &seen, variant).0;
+                    let before_motion = render_cpu(cpu_pose(next?)?, &seen, variant).0;
+                    let after_motion = render_cpu(cpu_pose(prev?)?, &seen, variant).0;
+                    let pair = TimePair {
+                        before: &img,
+                        after: &after_img,
+                        before_motion: &before_motion,
+                        after_motion: &after_motion,
+                    };
+                    time_morph(&pair, s, motion_to_image(&seen))?
+                }
+            });
+            if let ResidentKind::Cpu {
+                shadow: Some(relit),
+                ..
+            } = &w.shadow_source().kind
+            {
                 shadows.push((subject_from_world, relit));
             }
         }
@@ -304,6 +395,24 @@ impl Device {
             stats,
         })
     }
+}
+
+/// The CPU reference's copy of a resident pose.
+fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
+    match kind {
+        ResidentKind::Cpu { pose, .. } => Ok(pose),
+        ResidentKind::Gpu(_) => Err(crate::RenderError::BadParameter(
+            "a GPU-resident pose given to the CPU renderer".into(),
+        )),
+    }
+}
+
+/// The error of a frame between poses whose motion toward `step` was not made.
+fn no_motion(step: PoseStep) -> crate::RenderError {
+    crate::RenderError::BadParameter(format!(
+        "a frame between poses lacks a pose's motion {}",
+        step.name()
+    ))
 }
 
 /// A resident pose and the renderer that draws it: one walker at the origin.
@@ -375,6 +484,7 @@ impl Renderer {
                 rotation: glam::Mat3::IDENTITY,
                 translation: glam::Vec3::ZERO,
             },
+            between: None,
         };
         self.device
             .render_frame(&[walker], backdrop, camera, variant, layers)

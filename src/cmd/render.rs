@@ -150,6 +150,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
         end: 0.0,
         // The preview of a field render plays at a typical video rate.
         fps: 12.0,
+        interpolate: None,
         size: None,
         exposure: 0.0,
         layers: false,

@@ -77,6 +77,7 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
         start: 0.0,
         end: h.cycle_seconds as f32,
         fps: RECORD_FPS,
+        interpolate: None,
         size: Some(args.size),
         exposure: 0.0,
         layers: false,

@@ -13,6 +13,7 @@ use std::sync::Arc;
 
 use super::composite_targets::CompositeTargets;
 use super::rebin::Subjects;
+use super::time_morph::BetweenDraw;
 use super::timing::Timestamps;
 
 use super::bind::{
@@ -79,6 +80,31 @@ pub struct GpuInstanceRef<'a> {
     pub pose: &'a GpuPose,
     /// Its subject frame in the world.
     pub world_from_subject: Rigid,
+    /// Between `pose` and a later pose ([`crate::motion`]).
+    pub between: Option<GpuBetween<'a>>,
+}
+
+/// A walker between two captured poses: the later pose, both poses' motion toward the
+/// other, and the fraction of the way.
+pub struct GpuBetween<'a> {
+    /// Pose `k'`, relit alike.
+    pub after: &'a GpuPose,
+    /// Pose `k`'s motion toward `k'`.
+    pub before_motion: &'a GpuPose,
+    /// Pose `k'`'s motion toward `k`.
+    pub after_motion: &'a GpuPose,
+    /// The fraction of the way from `k` to `k'`.
+    pub s: f32,
+}
+
+impl GpuInstanceRef<'_> {
+    /// The pose whose shadow the walker casts: the nearer of two between poses.
+    fn shadow_pose(&self) -> &GpuPose {
+        match &self.between {
+            Some(b) if b.s >= 0.5 => b.after,
+            _ => self.pose,
+        }
+    }
 }
 
 /// A frame drawn into the kept targets of its size and not read back
@@ -277,10 +303,10 @@ impl Gpu {
         }
         let shadow_info = instances
             .iter()
-            .find_map(|i| i.pose.shadow.as_ref().map(|s| s.1));
+            .find_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1));
         if let Some(info) = shadow_info
             && instances.iter().any(|i| {
-                i.pose
+                i.shadow_pose()
                     .shadow
                     .as_ref()
                     .is_some_and(|s| s.1.texels != info.texels)
@@ -307,14 +333,27 @@ impl Gpu {
                 })
                 .collect();
             let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);
+            let between: Vec<BetweenDraw> = order
+                .iter()
+                .enumerate()
+                .filter_map(|(layer, &k)| {
+                    let b = instances[k].between.as_ref()?;
+                    Some(BetweenDraw {
+                        layer,
+                        between: b,
+                        camera: drawn[layer].1,
+                    })
+                })
+                .collect();
+            self.morph_in_time(encoder, &subjects, &between, size, variant);
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let mut gpu_instances = Vec::with_capacity(order.len());
             for (layer, &k) in order.iter().enumerate() {
                 let i = &instances[k];
                 let m = i.world_from_subject.inverse();
-                let has = i.pose.shadow.is_some();
-                if let Some((texture, _)) = &i.pose.shadow {
+                let has = i.shadow_pose().shadow.is_some();
+                if let Some((texture, _)) = &i.shadow_pose().shadow {
                     encoder.copy_texture_to_texture(
                         texture.as_image_copy(),
                         wgpu::TexelCopyTextureInfo {

@@ -30,6 +30,7 @@ mod readback;
 pub mod rebin;
 pub mod scope;
 pub mod shadow;
+pub mod time_morph;
 pub mod timing;
 pub mod types;
 
@@ -51,6 +52,8 @@ pub mod shaders {
     pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
     /// `shaders/present.wgsl`: a frame shown in a window.
     pub const PRESENT: &str = include_str!("../../shaders/present.wgsl");
+    /// The morph in time of a frame between two poses.
+    pub const TIME_MORPH: &str = include_str!("../../shaders/time_morph.wgsl");
     /// `shaders/floor.wgsl`, standalone.
     pub const FLOOR: &str = include_str!("../../shaders/floor.wgsl");
     /// `shaders/rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera
@@ -75,12 +78,13 @@ pub mod shaders {
     pub const FLOW_F32: &str = include_str!("../../shaders/sample/flow_f32.wgsl");
 
     /// Every pass but the frame pass (composed by [`super::formats::PoseFormats`]), named.
-    pub const PASSES: [(&str, &str); 5] = [
+    pub const PASSES: [(&str, &str); 6] = [
         ("relight", RELIGHT),
         ("shadow", SHADOW),
         ("composite", COMPOSITE),
         ("floor", FLOOR),
         ("present", PRESENT),
+        ("time_morph", TIME_MORPH),
     ];
 
     /// A pass's shader module on `device`.
@@ -125,6 +129,11 @@ pub struct Gpu {
     stage: rebin::PassKind,
     /// Frame targets kept per size and number of walkers.
     targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
+    /// The renders of frames between poses kept per size and number of such walkers
+    /// (four layers each, [`time_morph`]).
+    between_targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
+    /// The morph in time of walkers between poses.
+    time_morph: time_morph::TimeMorphPass,
     /// Composite targets kept per size, number of walkers and shadow-map size.
     composite_targets:
         kept::Kept<composite_targets::CompositeKey, composite_targets::CompositeTargets>,
@@ -184,6 +193,8 @@ impl Gpu {
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,
             targets: kept::Kept::new(KEPT_TARGETS),
+            between_targets: kept::Kept::new(KEPT_TARGETS),
+            time_morph: time_morph::TimeMorphPass::new(&device),
             composite_targets: kept::Kept::new(KEPT_TARGETS),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             shadow: shadow::ShadowPass::new(&device),

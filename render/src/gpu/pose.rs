@@ -266,6 +266,12 @@ impl Gpu {
         })
     }
 
+    /// Makes a pose of motion views ([`crate::motion::pose_motion`]) resident as the
+    /// renderer's frame pass reads poses.
+    pub fn upload_motion(&self, motion: &ResidentPose) -> Result<GpuPose> {
+        self.upload_resident(motion, &self.rebin.pose)
+    }
+
     /// The pose's tables uploaded and bound with its textures for `pass`.
     fn bind_pose(
         &self,

@@ -169,6 +169,11 @@ impl Subjects {
     pub fn id(&self) -> u64 {
         self.targets.id
     }
+
+    /// The view of walker `layer`'s layer.
+    pub(super) fn layer_view(&self, layer: usize) -> &wgpu::TextureView {
+        self.targets.layer_view(layer)
+    }
 }
 
 /// The frame uniform of `camera` for `pose` (`pose` `None`: the camera alone, for passes
@@ -246,6 +251,7 @@ impl SubjectTargets {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST
                 | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });

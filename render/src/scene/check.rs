@@ -7,7 +7,10 @@ use frf_reflectance::project::FloorModel;
 use glam::Vec3;
 
 use super::file::{At, CameraToml, CompositeToml, LightingToml, OutputToml, Reporter, SceneToml};
-use super::{BackdropSpec, Instance, LightKey, MAX_FRAMES, MAX_SIDE_PX, Preview, ShadowSpec};
+use super::{
+    BackdropSpec, Instance, LightKey, MAX_FRAMES, MAX_SIDE_PX, Preview, ShadowSpec,
+    TimeInterpolation,
+};
 use crate::composite::GroundLook;
 use crate::error::Result;
 use crate::morph::Variant;
@@ -99,6 +102,19 @@ pub fn time(r: &Reporter, raw: &SceneToml) -> Result<(f32, f32, f32)> {
         ));
     }
     Ok((start, end, fps))
+}
+
+/// `time.interpolate`: `None` when not given.
+pub fn interpolate(r: &Reporter, raw: &SceneToml) -> Result<Option<TimeInterpolation>> {
+    let Some(v) = &raw.time.get_ref().interpolate else {
+        return Ok(None);
+    };
+    Ok(Some(
+        match word(r, "time.interpolate", v, &["flow", "nearest"])? {
+            "flow" => TimeInterpolation::Flow,
+            _ => TimeInterpolation::Nearest,
+        },
+    ))
 }
 
 /// What `output` sets: frame size (if given), exposure in stops, preview, variant.

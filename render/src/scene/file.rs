@@ -8,6 +8,8 @@
 //! start = 0.0                         # (a still when end equals start)
 //! end = 2.0                           # exclusive
 //! fps = 12.0
+//! interpolate = "flow"                # between captured poses: "flow" (default, when
+//!                                     # the field holds pose-to-pose flows) or "nearest"
 //!
 //! [output]
 //! size = [480, 270]
@@ -91,6 +93,8 @@ pub struct TimeToml {
     pub end: At<f32>,
     /// Frames per second.
     pub fps: At<f32>,
+    /// What a frame between captured poses shows.
+    pub interpolate: Option<At<String>>,
 }
 
 /// `[output]`.

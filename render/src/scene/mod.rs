@@ -128,6 +128,26 @@ impl Instance {
     }
 }
 
+/// What a frame between two captured poses shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum TimeInterpolation {
+    /// The captured pose nearest its instant.
+    Nearest,
+    /// Both poses' renders morphed in time by the motion between them
+    /// ([`crate::motion`]).
+    Flow,
+}
+
+impl TimeInterpolation {
+    /// Its name in scene files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            TimeInterpolation::Nearest => "nearest",
+            TimeInterpolation::Flow => "flow",
+        }
+    }
+}
+
 /// A checked scene (see the module docs and [`file`]).
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -141,6 +161,9 @@ pub struct Scene {
     pub end: f32,
     /// Frames per second.
     pub fps: f32,
+    /// What a frame between captured poses shows; `None`: the morph in time when the
+    /// field holds pose-to-pose flows, else the nearest pose.
+    pub interpolate: Option<TimeInterpolation>,
     /// Frame size, if the file gives one.
     pub size: Option<(u32, u32)>,
     /// Stops.
@@ -191,6 +214,7 @@ impl Scene {
         let raw: SceneToml = file::parse(path, text)?;
         let r = Reporter::new(path, text);
         let (start, end, fps) = check::time(&r, &raw)?;
+        let interpolate = check::interpolate(&r, &raw)?;
         let (size, exposure, preview, variant) = check::output(&r, &raw.output)?;
         let (lighting, floor) = check::lighting(&r, &raw.lighting)?;
         let camera = check::camera(&r, &raw.camera)?;
@@ -204,6 +228,7 @@ impl Scene {
             start,
             end,
             fps,
+            interpolate,
             size,
             exposure,
             layers: o.layers,

@@ -25,7 +25,7 @@ use std::collections::BTreeSet;
 
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::manifest::FilmedSpec;
 use frf_reflectance::container::{ChunkKind, ReadAt};
 use frf_reflectance::project::{FloorModel, Projector};
@@ -33,7 +33,7 @@ use frf_reflectance::{FieldFile, FieldHeader};
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
-use super::{Scene, ShadowSpec};
+use super::{Scene, ShadowSpec, TimeInterpolation};
 use crate::cylinder::{Clamp, Cylinder};
 use crate::error::{RenderError, Result};
 use crate::shadow::ground_hit;
@@ -56,6 +56,9 @@ pub struct PosePlan {
     pub shadow_maps: bool,
     /// The visual hull is read.
     pub hull: bool,
+    /// The pose's motion toward the next and the previous pose
+    /// ([`frf_core::grid::PoseStep`] order) is read, for the views read.
+    pub pose_flows: [bool; 2],
 }
 
 /// One frame: its time and the pose each walker shows.
@@ -65,8 +68,11 @@ pub struct FramePlan {
     pub index: usize,
     /// Seconds.
     pub time: f32,
-    /// Per instance: the pose drawn.
+    /// Per instance: the pose drawn (the earlier of two between poses).
     pub poses: Vec<u32>,
+    /// Per instance, between two poses: the later pose and the fraction of the way to it
+    /// ([`crate::motion`]).
+    pub between: Vec<Option<(u32, f32)>>,
 }
 
 /// The counts a person reads (and `frf render --plan --json` prints).
@@ -112,6 +118,43 @@ pub struct Plan {
     pub floor_conditions_left_out: usize,
     /// Whether some frame sees the ground patch (a shadow is drawn).
     pub ground_seen: bool,
+    /// What frames between captured poses show.
+    pub interpolate: TimeInterpolation,
+}
+
+/// Fractions of a pose's step this close to a pose draw that pose alone.
+const AT_POSE: f64 = 1e-3;
+
+/// The pose `field_poses` (sorted) holds at or before the continuous pose `at` (a phase
+/// of the cycle times its `n` poses), going round the cycle, and, unless `at` falls on
+/// it, the next pose held with the fraction of the way to it.
+pub(crate) fn poses_around(at: f64, field_poses: &[u32], n: u32) -> (u32, Option<(u32, f32)>) {
+    let n = n.max(1) as f64;
+    let before = field_poses
+        .iter()
+        .rev()
+        .find(|&&p| p as f64 <= at)
+        .or(field_poses.last())
+        .copied()
+        .expect("a field holds at least one pose");
+    let after = field_poses
+        .iter()
+        .find(|&&p| p > before)
+        .or(field_poses.first())
+        .copied()
+        .expect("a field holds at least one pose");
+    let gap = (after as f64 - before as f64).rem_euclid(n);
+    if field_poses.len() < 2 || gap == 0.0 {
+        return (before, None);
+    }
+    let s = (at - before as f64).rem_euclid(n) / gap;
+    if s < AT_POSE {
+        (before, None)
+    } else if s > 1.0 - AT_POSE {
+        (after, None)
+    } else {
+        (before, Some((after, s as f32)))
+    }
 }
 
 /// The nearest pose `field_poses` holds to `wanted`, going round the cycle of `n` poses.
@@ -283,7 +326,8 @@ impl Plan {
     ) -> Result<Self> {
         let size = scene.size.unwrap_or(image_size);
         let frames = scene.shot_frames(0..scene.frame_times().len(), size)?;
-        let mut plan = Self::from_header(scene, header, &frames)?;
+        let interpolate = scene.interpolate.unwrap_or(TimeInterpolation::Nearest);
+        let mut plan = Self::from_header(scene, header, &frames, interpolate)?;
         if plan.ground_seen && scene.shadow != ShadowSpec::None {
             let (columns, rows) = (header.columns, header.rows);
             for p in &mut plan.poses {
@@ -338,7 +382,23 @@ impl Plan {
         field: &FieldFile<R>,
         frames: &[ShotFrame],
     ) -> Result<Self> {
-        let mut plan = Self::from_header(scene, field.header(), frames)?;
+        let holds_pose_flows = field
+            .chunks()
+            .any(|c| matches!(c.key.kind, ChunkKind::PoseFlow(_)));
+        let interpolate = match scene.interpolate {
+            Some(TimeInterpolation::Flow) if !holds_pose_flows => {
+                return Err(RenderError::BadParameter(format!(
+                    "{}: the scene morphs between poses (time.interpolate = \"flow\") and the \
+                     field holds no pose-to-pose flow: ingest with --pose-flow, or set \
+                     interpolate = \"nearest\"",
+                    field.path().display()
+                )));
+            }
+            Some(i) => i,
+            None if holds_pose_flows => TimeInterpolation::Flow,
+            None => TimeInterpolation::Nearest,
+        };
+        let mut plan = Self::from_header(scene, field.header(), frames, interpolate)?;
         let rows = field.header().rows;
         let counts = &mut plan.counts;
         (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
@@ -366,8 +426,9 @@ impl Plan {
                     counts.flows_used += used as usize;
                     used
                 }
-                // Not drawn yet: a shot shows the nearest pose (issue 24 will read them).
-                ChunkKind::PoseFlow(_) => false,
+                ChunkKind::PoseFlow(step) => {
+                    p.pose_flows[step.index()] && p.views.get(view).copied().unwrap_or(false)
+                }
                 ChunkKind::Shadows => p.shadow_maps,
                 ChunkKind::Hull => p.hull,
             };
@@ -422,29 +483,48 @@ impl Plan {
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
-    /// poses, for `frames`; the counts of views and flows are those the plan asks for
-    /// (no chunk is known, so no byte either).
-    pub fn from_header(scene: &Scene, h: &FieldHeader, frames: &[ShotFrame]) -> Result<Self> {
+    /// poses, for `frames`, frames between poses drawn as `interpolate` says; the counts
+    /// of views and flows are those the plan asks for (no chunk is known, so no byte
+    /// either).
+    pub fn from_header(
+        scene: &Scene,
+        h: &FieldHeader,
+        frames: &[ShotFrame],
+        interpolate: TimeInterpolation,
+    ) -> Result<Self> {
         if frames.is_empty() {
             return Err(RenderError::BadParameter("a shot of no frame".into()));
         }
-        let field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+        let mut field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+        field_poses.sort_unstable();
         let mut substituted = BTreeSet::new();
         let frame_plans: Vec<FramePlan> = frames
             .iter()
             .map(|f| {
                 let (index, time) = (f.index, f.time);
-                let poses = (0..scene.instances.len())
-                    .map(|i| {
-                        let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                        let held = nearest_pose(wanted, &field_poses, h.poses_per_cycle);
-                        if held != wanted {
-                            substituted.insert((wanted, held));
+                let (poses, between) = (0..scene.instances.len())
+                    .map(|i| match interpolate {
+                        TimeInterpolation::Nearest => {
+                            let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                            let held = nearest_pose(wanted, &field_poses, h.poses_per_cycle);
+                            if held != wanted {
+                                substituted.insert((wanted, held));
+                            }
+                            (held, None)
                         }
-                        held
+                        TimeInterpolation::Flow => {
+                            let at = scene.phase_at(i, time, h.cycle_seconds)
+                                * h.poses_per_cycle.max(1) as f64;
+                            poses_around(at, &field_poses, h.poses_per_cycle)
+                        }
                     })
-                    .collect();
-                FramePlan { index, time, poses }
+                    .unzip();
+                FramePlan {
+                    index,
+                    time,
+                    poses,
+                    between,
+                }
             })
             .collect();
 
@@ -457,7 +537,14 @@ impl Plan {
         let mut poses: Vec<PosePlan> = Vec::new();
         for (fp, frame) in frame_plans.iter().zip(frames) {
             let camera = frame.camera;
-            for (i, &pose) in fp.poses.iter().enumerate() {
+            let drawn = fp.poses.iter().enumerate().flat_map(|(i, &pose)| {
+                let between = fp.between[i];
+                // Pose k, with its motion on to k'; and k', with its motion back to k.
+                [(i, pose, between.map(|_| PoseStep::Next))]
+                    .into_iter()
+                    .chain(between.map(|(after, _)| (i, after, Some(PoseStep::Prev))))
+            });
+            for (i, pose, motion) in drawn {
                 let record = h.pose(pose)?;
                 let centres: Vec<Vec3> = record
                     .views
@@ -483,10 +570,14 @@ impl Plan {
                             conditions: lit.clone(),
                             shadow_maps: false,
                             hull: false,
+                            pose_flows: [false; 2],
                         });
                         poses.last_mut().expect("just pushed")
                     }
                 };
+                if let Some(step) = motion {
+                    plan.pose_flows[step.index()] = true;
+                }
                 let spans = if h.wraps {
                     columns
                 } else {
@@ -548,6 +639,7 @@ impl Plan {
                 .collect(),
             floor_conditions_left_out: left_out.iter().filter(|&&k| h.conditions[k].floor).count(),
             ground_seen,
+            interpolate,
         })
     }
 

@@ -23,14 +23,16 @@ use frf_core::io::read_photo;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 
-use super::plan::{FramePlan, Plan, ShotFrame, nearest_pose};
-use super::{BackdropSpec, LightingAt, Scene, ShadowSpec};
+use super::plan::{FramePlan, Plan, ShotFrame, nearest_pose, poses_around};
+use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
 use crate::gpu::composite::DrawnFrame;
+use crate::motion::pose_motion;
 use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
 use crate::resident::{Lighting, PoseSource};
 use crate::shadow::{ShadowMaps, traced_shadow};
+use frf_core::grid::PoseStep;
 
 /// How a shot is rendered.
 #[derive(Debug, Clone, Copy)]
@@ -43,6 +45,10 @@ pub struct ShotOptions {
     /// Median-cut lights of a traced shadow.
     pub traced_lights: usize,
 }
+
+/// A walker's cache slot in a frame, and between two poses the later pose's slot and the
+/// fraction of the way to it.
+type Slot = (usize, Option<(usize, f32)>);
 
 /// A lighting, as a key that tells two apart.
 #[derive(Debug, Clone, PartialEq)]
@@ -351,18 +357,38 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The pose each walker shows at `time`: the walk's pose at that time, or the nearest
-    /// one the field holds.
+    /// one the field holds; between two poses when the shot morphs in time, the earlier.
     pub fn poses_at(&self, time: f32) -> Vec<u32> {
+        self.frame_at(0, time).poses
+    }
+
+    /// The plan of a frame at `time` drawn as frame `index`: per walker, its pose (or the
+    /// two it is between) as the shot's plan would give it.
+    fn frame_at(&self, index: usize, time: f32) -> FramePlan {
         let h = self.field.header();
-        let held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
-        (0..self.scene.instances.len())
-            .map(|i| {
-                let wanted = self
-                    .scene
-                    .pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                nearest_pose(wanted, &held, h.poses_per_cycle)
+        let mut held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+        held.sort_unstable();
+        let (poses, between) = (0..self.scene.instances.len())
+            .map(|i| match self.plan.interpolate {
+                TimeInterpolation::Nearest => {
+                    let wanted = self
+                        .scene
+                        .pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                    (nearest_pose(wanted, &held, h.poses_per_cycle), None)
+                }
+                TimeInterpolation::Flow => {
+                    let at = self.scene.phase_at(i, time, h.cycle_seconds)
+                        * h.poses_per_cycle.max(1) as f64;
+                    poses_around(at, &held, h.poses_per_cycle)
+                }
             })
-            .collect()
+            .unzip();
+        FramePlan {
+            index,
+            time,
+            poses,
+            between,
+        }
     }
 
     /// Draws the frame of `camera` at `time` into the kept targets of its size (on the
@@ -381,11 +407,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             ));
         };
         self.live_frames += 1;
-        let fp = FramePlan {
-            index: self.live_frames,
-            time,
-            poses: self.poses_at(time),
-        };
+        let fp = self.frame_at(self.live_frames, time);
         let slots = self.prepare(&fp)?.0;
         let walkers = self.walkers(&slots);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
@@ -394,7 +416,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         };
         let instances = walkers
             .iter()
-            .map(|w| w.resident.gpu_instance(w.world_from_subject))
+            .map(Walker::gpu_instance)
             .collect::<Result<Vec<_>>>()?;
         let b = backdrop.gpu().ok_or_else(|| {
             RenderError::BadParameter("a backdrop made resident on the CPU".into())
@@ -419,11 +441,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         layers: bool,
     ) -> Result<ShotResult> {
         self.live_frames += 1;
-        let fp = FramePlan {
-            index: self.live_frames,
-            time,
-            poses: self.poses_at(time),
-        };
+        let fp = self.frame_at(self.live_frames, time);
         self.render_plan(&fp, camera, layers)
     }
 
@@ -489,13 +507,14 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The walkers of a frame whose poses are the cache's `slots`.
-    fn walkers(&self, slots: &[usize]) -> Vec<Walker<'_>> {
+    fn walkers(&self, slots: &[Slot]) -> Vec<Walker<'_>> {
         slots
             .iter()
             .zip(&self.scene.instances)
-            .map(|(&k, inst)| Walker {
+            .map(|(&(k, between), inst)| Walker {
                 resident: &self.cache[k].resident,
                 world_from_subject: inst.world_from_subject(),
+                between: between.map(|(after, s)| (&self.cache[after].resident, s)),
             })
             .collect()
     }
@@ -503,15 +522,20 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// Makes every pose of `fp` resident and relit for the frame's lighting, and the
     /// backdrop of that lighting: the cache slots of the walkers' poses, and the poses made
     /// resident for it.
-    fn prepare(&mut self, fp: &FramePlan) -> Result<(Vec<usize>, Vec<u32>)> {
+    fn prepare(&mut self, fp: &FramePlan) -> Result<(Vec<Slot>, Vec<u32>)> {
         let lighting = self.scene.lighting_at(fp.time);
         let key = LightingKey::of(&lighting);
         let world = self.world_lighting(&lighting)?;
 
-        // Every walker's pose, resident and relit for this lighting.
+        // Every walker's pose (both, between two), resident and relit for this lighting.
         let mut made_resident = Vec::new();
         let mut slots = Vec::with_capacity(fp.poses.len());
-        for (i, &pose) in fp.poses.iter().enumerate() {
+        let drawn = fp.poses.iter().enumerate().flat_map(|(i, &pose)| {
+            [(i, pose)]
+                .into_iter()
+                .chain(fp.between[i].map(|(after, _)| (i, after)))
+        });
+        for (i, pose) in drawn {
             let heading = self.scene.instances[i].heading;
             let found = self
                 .cache
@@ -549,6 +573,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             slots.push(slot);
         }
         self.keep_within_budget(fp.index, &mut slots)?;
+        let mut flat = slots.into_iter();
+        let slots = fp
+            .between
+            .iter()
+            .map(|b| {
+                let k = flat.next().expect("a slot per pose drawn");
+                (
+                    k,
+                    b.map(|(_, s)| (flat.next().expect("a slot per pose drawn"), s)),
+                )
+            })
+            .collect();
 
         // The backdrop of this lighting.
         let stale = self.backdrop.as_ref().is_none_or(|(k, _)| *k != key);
@@ -573,6 +609,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let plan = self.plan.pose(pose).filter(|_| self.options.planned);
         let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?;
         let mut resident = self.device.make_resident(&source)?;
+        if self.plan.interpolate == TimeInterpolation::Flow {
+            let motion = PoseStep::ALL.map(|step| {
+                let wanted = match plan {
+                    Some(p) => p.pose_flows[step.index()],
+                    None => true,
+                };
+                wanted.then(|| pose_motion(self.field, &source, step))
+            });
+            let [next, prev] = motion;
+            let motion = [next.transpose()?.flatten(), prev.transpose()?.flatten()];
+            self.device.set_motion(&mut resident, motion)?;
+        }
         let wants = |planned: bool| if self.options.planned { planned } else { true };
         match self.scene.shadow {
             ShadowSpec::Maps if wants(plan.is_some_and(|p| p.shadow_maps)) => {

@@ -1,0 +1,63 @@
+// The frame between two captured poses (render/src/motion.rs, `time_morph`, its CPU
+// twin): pose k's render sampled back along k''s motion toward k, a fraction s of it,
+// pose k''s render sampled on along k's motion, a fraction 1 - s, mixed (1 - s, s).
+// Motion renders hold (across, along) the subject's axis in metres as
+// ((r - b) / a, (g - b) / a); `to_image` takes metres to the frame's pixels.
+
+struct TimeMorph {
+    // Columns of the 2x2 map from metres to pixels.
+    to_image: vec4<f32>,
+    size: vec2<u32>,
+    s: f32,
+    _pad: f32,
+}
+
+@group(0) @binding(0) var<uniform> tm: TimeMorph;
+@group(0) @binding(1) var before: texture_2d<f32>;
+@group(0) @binding(2) var after: texture_2d<f32>;
+@group(0) @binding(3) var before_motion: texture_2d<f32>;
+@group(0) @binding(4) var after_motion: texture_2d<f32>;
+@group(0) @binding(5) var morphed: texture_storage_2d<rgba32float, write>;
+
+fn motion_at(t: texture_2d<f32>, p: vec2<i32>) -> vec2<f32> {
+    let m = textureLoad(t, p, 0);
+    if (m.a < 1e-3) {
+        return vec2<f32>(0.0);
+    }
+    let metres = vec2<f32>(m.r - m.b, m.g - m.b) / m.a;
+    return tm.to_image.xy * metres.x + tm.to_image.zw * metres.y;
+}
+
+// Bilinear, pixel centres at integers, transparent beyond the edge (the CPU's
+// `Border::Zero`).
+fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
+    let size = vec2<i32>(tm.size);
+    let limit = f32(max(size.x, size.y) + 2);
+    let c = clamp(q, vec2<f32>(-limit), vec2<f32>(size) + limit);
+    let f0 = floor(c);
+    let fr = c - f0;
+    let i0 = vec2<i32>(f0);
+    var acc = vec4<f32>(0.0);
+    for (var dy = 0; dy < 2; dy++) {
+        for (var dx = 0; dx < 2; dx++) {
+            let w = select(1.0 - fr.x, fr.x, dx == 1) * select(1.0 - fr.y, fr.y, dy == 1);
+            let p = i0 + vec2<i32>(dx, dy);
+            if (w != 0.0 && all(p >= vec2<i32>(0)) && all(p < size)) {
+                acc += w * textureLoad(t, p, 0);
+            }
+        }
+    }
+    return acc;
+}
+
+@compute @workgroup_size(8, 8)
+fn morph_in_time(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= tm.size.x || id.y >= tm.size.y) {
+        return;
+    }
+    let p = vec2<i32>(id.xy);
+    let at = vec2<f32>(id.xy);
+    let a = bilinear_zero(before, at + tm.s * motion_at(after_motion, p));
+    let b = bilinear_zero(after, at + (1.0 - tm.s) * motion_at(before_motion, p));
+    textureStore(morphed, p, (1.0 - tm.s) * a + tm.s * b);
+}

@@ -1,0 +1,206 @@
+//! The GPU twin of [`crate::motion::time_morph`]: walkers between two captured poses.
+//! Pose `k`'s render is drawn into the walker's own layer of the frame's subjects, as any
+//! walker's; pose `k'`'s render and both poses' motion renders into three layers of
+//! targets kept for frames between poses; `shaders/time_morph.wgsl` morphs them in time
+//! into a fourth, which is copied over the walker's layer before the composite reads it.
+
+use bytemuck::{Pod, Zeroable};
+use frf_core::camera::Camera;
+use glam::Mat2;
+use wgpu::util::DeviceExt;
+
+use super::composite::GpuBetween;
+use super::rebin::{SubjectTargets, Subjects, frame_uniform, workgroups};
+use super::{Gpu, shaders};
+use crate::morph::Variant;
+
+/// The uniform of `shaders/time_morph.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+struct TimeMorphUniform {
+    to_image: [f32; 4],
+    size: [u32; 2],
+    s: f32,
+    _pad: f32,
+}
+
+/// The pipeline of the morph in time.
+pub struct TimeMorphPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl TimeMorphPass {
+    /// Compiles the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "time morph", shaders::TIME_MORPH);
+        let texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("time morph"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                texture(1),
+                texture(2),
+                texture(3),
+                texture(4),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("time morph"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("time morph"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("morph_in_time"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { layout, pipeline }
+    }
+}
+
+/// A walker between poses: its layer in the frame's subjects, its poses, and the camera
+/// that sees it (its subject frame).
+pub(super) struct BetweenDraw<'a> {
+    pub layer: usize,
+    pub between: &'a GpuBetween<'a>,
+    pub camera: Camera,
+}
+
+impl Gpu {
+    /// Records the morph in time of every walker of `walkers` into `encoder`, over its
+    /// layer of `subjects` (where pose `k` is already drawn; see the module docs).
+    pub(super) fn morph_in_time(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        subjects: &Subjects,
+        walkers: &[BetweenDraw],
+        size: (u32, u32),
+        variant: Variant,
+    ) {
+        if walkers.is_empty() {
+            return;
+        }
+        let scratch = self
+            .between_targets
+            .get((size, 4 * walkers.len() as u32), || {
+                SubjectTargets::new(&self.device, &self.rebin, size, 4 * walkers.len() as u32)
+            });
+        for (j, w) in walkers.iter().enumerate() {
+            let b = w.between;
+            for (k, pose) in [(1, b.after), (2, b.before_motion), (3, b.after_motion)] {
+                let layer = 4 * j + k;
+                let frame = frame_uniform(Some(pose), &w.camera, variant);
+                self.queue
+                    .write_buffer(scratch.uniform(layer), 0, bytemuck::bytes_of(&frame));
+                self.rebin.record(
+                    encoder,
+                    &scratch,
+                    layer,
+                    &pose.bind_group,
+                    self.stage,
+                    size,
+                    None,
+                    false,
+                );
+            }
+            let m: Mat2 = crate::motion::motion_to_image(&w.camera);
+            let uniform = TimeMorphUniform {
+                to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
+                size: [size.0, size.1],
+                s: b.s,
+                _pad: 0.0,
+            };
+            let buffer = self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("time morph"),
+                    contents: bytemuck::bytes_of(&uniform),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+            fn view(v: &wgpu::TextureView, binding: u32) -> wgpu::BindGroupEntry<'_> {
+                wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(v),
+                }
+            }
+            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("time morph"),
+                layout: &self.time_morph.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: buffer.as_entire_binding(),
+                    },
+                    view(subjects.layer_view(w.layer), 1),
+                    view(scratch.layer_view(4 * j + 1), 2),
+                    view(scratch.layer_view(4 * j + 2), 3),
+                    view(scratch.layer_view(4 * j + 3), 4),
+                    view(scratch.layer_view(4 * j), 5),
+                ],
+            });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("time morph"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.time_morph.pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                let (x, y) = workgroups(size);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            fn layer_copy(texture: &wgpu::Texture, z: usize) -> wgpu::TexelCopyTextureInfo<'_> {
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: z as u32,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                }
+            }
+            encoder.copy_texture_to_texture(
+                layer_copy(scratch.texture(), 4 * j),
+                layer_copy(subjects.texture(), w.layer),
+                wgpu::Extent3d {
+                    width: size.0,
+                    height: size.1,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+    }
+}

@@ -1,0 +1,362 @@
+//! Time between captured poses (docs/design.md section 4.6): the subject's motion from
+//! one captured pose to the next, carried into the novel view, and the morph in time of
+//! the two poses' renders by it.
+//!
+//! A field's pose-to-pose flow of view `(u, v)` maps each pixel of pose `k`'s image to
+//! where it lies in the next (or previous) pose's image of the same camera, in true
+//! pixels of both, so it holds the turntable's turn between the two instants as well as
+//! the walk. [`pose_motion`] takes the turn out (the later camera's ray through the
+//! flow's end meets the plane through the subject's axis facing the earlier camera, as
+//! the inter-view flows are rectified; that point, seen by the earlier camera, is where
+//! the subject moved), and turns the pixels into metres in the two directions every
+//! camera round the grid sees alike: across the subject's axis and along it
+//! ([`motion_to_image`]).
+//!
+//! Those two components are stored as the views of a pose (red and green: each plus an
+//! offset that keeps it positive; blue: the offset; alpha 1 everywhere), so the renderer
+//! morphs them into the novel view exactly as it morphs colour, with the same
+//! inter-view flows, on the GPU and the CPU alike. Whatever the views' offsets and
+//! weights, the novel view reads its motion as `((r − b) / a, (g − b) / a)`
+//! ([`decode_motion`]).
+//!
+//! [`time_morph`]: the frame at fraction `s` of the way from pose `k` to `k'` samples the
+//! render of `k` where the point was at `k` (back along `k'`'s motion toward `k`, a
+//! fraction `s` of it) and the render of `k'` where it will be (along `k`'s motion, a
+//! fraction `1 − s`), and mixes them `(1 − s, s)`: each motion is taken at the frame's
+//! pixel rather than at the point's, which holds where motion varies slowly across a
+//! fraction of a pose's step. `shaders/time_morph.wgsl` is its twin on the GPU.
+
+use frf_core::camera::Camera;
+use frf_core::flo::UNKNOWN_THRESHOLD;
+use frf_core::grid::PoseStep;
+use frf_core::image::{Border, Image, Rgba};
+use frf_core::io::linear_to_srgb;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
+use glam::{Mat2, Vec2, Vec3};
+use rayon::prelude::*;
+
+use crate::error::{RenderError, Result};
+use crate::resident::{PoseSource, ResidentPose, srgb_lut};
+
+/// The code of the offset texel (blue): its decoded value times the view's scale is the
+/// offset exactly, so that `r − b` is the motion without a rounding bias.
+const OFFSET_CODE: u8 = 188;
+
+/// The map from a subject motion at the axis (metres across the axis, tangential to the
+/// circle of cameras, and metres up it) to the displacement `camera` sees (pixels),
+/// linearised at its [`Camera::axis_point`]; zero where the camera does not see that
+/// point.
+pub fn motion_to_image(camera: &Camera) -> Mat2 {
+    let p = camera.axis_point();
+    let c = camera.centre();
+    let radial = Vec3::new(c.x, 0.0, c.z);
+    let across = if radial.length_squared() > 1e-8 {
+        Vec3::Y.cross(radial).normalize()
+    } else {
+        // Straight above or below the axis: across is the camera's own right.
+        let r = camera.world_from_camera.rotation.x_axis;
+        Vec3::new(r.x, 0.0, r.z).try_normalize().unwrap_or(Vec3::X)
+    };
+    const STEP_M: f32 = 0.01;
+    match (
+        camera.project(p),
+        camera.project(p + across * STEP_M),
+        camera.project(p + Vec3::Y * STEP_M),
+    ) {
+        (Some(p0), Some(pa), Some(py)) => Mat2::from_cols((pa - p0) / STEP_M, (py - p0) / STEP_M),
+        _ => Mat2::ZERO,
+    }
+}
+
+/// The subject's motion in `camera`'s pixels seen at pixel `x` whose pose-to-pose flow is
+/// `flow` toward the image of `later` (the turn between the cameras taken out; see the
+/// module docs); `None` where the flow is unknown or the ray misses the plane.
+pub fn subject_motion(camera: &Camera, later: &Camera, x: Vec2, flow: [f32; 2]) -> Option<Vec2> {
+    if !(flow[0].abs() < UNKNOWN_THRESHOLD && flow[1].abs() < UNKNOWN_THRESHOLD) {
+        return None;
+    }
+    let (point, normal) = (camera.axis_point(), camera.forward());
+    let dir = later.ray_direction(x + Vec2::from(flow));
+    let along = dir.dot(normal);
+    if along.abs() < 1e-6 {
+        return None;
+    }
+    let t = (point - later.centre()).dot(normal) / along;
+    camera
+        .project(later.centre() + dir * t)
+        .map(|seen| seen - x)
+        .filter(|m| m.is_finite())
+}
+
+/// The motion of every view of `source`'s pose toward its `step` neighbour among the
+/// field's poses, as a pose of motion views sharing `source`'s geometry and inter-view
+/// flows (see the module docs); `None` when the field holds no such flow for any view
+/// `source` read. Views not read (transparent in `source`) stay transparent; a view read
+/// without a stored flow, or a pixel whose flow is unknown, moves by nothing.
+pub fn pose_motion<R: ReadAt>(
+    field: &FieldFile<R>,
+    source: &PoseSource,
+    step: PoseStep,
+) -> Result<Option<ResidentPose>> {
+    let h = field.header();
+    let g = &source.geometry;
+    let (pose, rows, crop) = (g.pose, g.rows, g.crop);
+    let mut poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+    poses.sort_unstable();
+    let read: Vec<bool> = source
+        .alpha
+        .iter()
+        .map(|a| a.iter().any(|&x| x > 0))
+        .collect();
+    let views: Vec<Option<(f32, Vec<[u8; 4]>)>> = (0..g.views())
+        .into_par_iter()
+        .map(|i| -> Result<Option<(f32, Vec<[u8; 4]>)>> {
+            if !read[i] {
+                return Ok(None);
+            }
+            let (u, v) = (i / rows, i % rows);
+            let Some((to_pose, to_u)) = step.of(pose, u, &poses, g.columns, g.wraps) else {
+                return Ok(None);
+            };
+            let Some(flow) = field.pose_flow(pose, u, v, step)? else {
+                return Ok(None);
+            };
+            let camera = &g.cameras[i];
+            let later = h.pose(to_pose)?.views[to_u * rows + v]
+                .camera
+                .to_camera()
+                .map_err(RenderError::BadParameter)?;
+            let to_metres = motion_to_image(camera).inverse();
+            if !to_metres.is_finite() {
+                return Ok(None);
+            }
+            let metres: Vec<Vec2> = (0..crop.texels())
+                .map(|k| {
+                    let (x, y) = (
+                        crop.x0 as usize + k % crop.width as usize,
+                        crop.y0 as usize + k / crop.width as usize,
+                    );
+                    let at = Vec2::new(x as f32, y as f32);
+                    subject_motion(camera, &later, at, flow.get(x, y))
+                        .map_or(Vec2::ZERO, |m| to_metres * m)
+                })
+                .collect();
+            Ok(Some(encode_view(&metres)))
+        })
+        .collect::<Result<_>>()?;
+    if views.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    let texels = crop.texels();
+    let (scales, prelit) = views
+        .into_iter()
+        .zip(&read)
+        .map(|(view, &read)| match view {
+            Some(v) => v,
+            // A view read without motion: still, and opaque, so it weighs in the mix.
+            None if read => encode_view(&vec![Vec2::ZERO; texels]),
+            None => (1.0, vec![[0; 4]; texels]),
+        })
+        .unzip();
+    Ok(Some(ResidentPose {
+        geometry: source.geometry.clone(),
+        flows: source.flows.clone(),
+        scales,
+        prelit,
+        srgb_table: srgb_lut(),
+        plan: source.plan.clone(),
+    }))
+}
+
+/// One view's motion (metres) as pre-lit texels and their scale (see the module docs).
+fn encode_view(metres: &[Vec2]) -> (f32, Vec<[u8; 4]>) {
+    let reach = metres
+        .iter()
+        .map(|m| m.abs().max_element())
+        .fold(0.0f32, f32::max)
+        .max(1e-4);
+    let lut = srgb_lut();
+    let offset_fraction = lut[OFFSET_CODE as usize];
+    // `reach + offset` must stay at or below the scale, `offset − reach` at or above zero.
+    let scale = reach / (1.0 - offset_fraction);
+    let offset = scale * offset_fraction;
+    let e = |x: f32| (linear_to_srgb((x / scale).clamp(0.0, 1.0)) * 255.0).round() as u8;
+    let texels = metres
+        .iter()
+        .map(|m| [e(m.x + offset), e(m.y + offset), OFFSET_CODE, 255])
+        .collect();
+    (scale, texels)
+}
+
+/// The motion (metres across and along the axis) a rendered motion pixel holds; none
+/// where no view reached it.
+#[inline]
+pub fn decode_motion(p: Rgba) -> Vec2 {
+    if p[3] < 1e-3 {
+        return Vec2::ZERO;
+    }
+    Vec2::new(p[0] - p[2], p[1] - p[2]) / p[3]
+}
+
+/// The four renders of one frame between two poses (premultiplied RGBA, all of one size):
+/// each pose's colour and its motion toward the other.
+pub struct TimePair<'a> {
+    /// Pose `k`'s colour.
+    pub before: &'a Image<Rgba>,
+    /// Pose `k'`'s colour.
+    pub after: &'a Image<Rgba>,
+    /// Pose `k`'s motion toward `k'`.
+    pub before_motion: &'a Image<Rgba>,
+    /// Pose `k'`'s motion toward `k`.
+    pub after_motion: &'a Image<Rgba>,
+}
+
+/// The frame a fraction `s` of the way from pose `k` to `k'` (see the module docs);
+/// `to_image` is the novel camera's [`motion_to_image`].
+pub fn time_morph(pair: &TimePair, s: f32, to_image: Mat2) -> Result<Image<Rgba>> {
+    let (w, h) = pair.before.size();
+    if [pair.after, pair.before_motion, pair.after_motion]
+        .iter()
+        .any(|i| i.size() != (w, h))
+    {
+        return Err(RenderError::BadParameter(
+            "the renders of a frame between poses differ in size".into(),
+        ));
+    }
+    let rows: Vec<Vec<Rgba>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            (0..w)
+                .map(|x| {
+                    let at = Vec2::new(x as f32, y as f32);
+                    let back = to_image * decode_motion(pair.after_motion.get(x, y));
+                    let on = to_image * decode_motion(pair.before_motion.get(x, y));
+                    let a = at + s * back;
+                    let b = at + (1.0 - s) * on;
+                    let pa = pair.before.sample_bilinear(a.x, a.y, Border::Zero);
+                    let pb = pair.after.sample_bilinear(b.x, b.y, Border::Zero);
+                    std::array::from_fn(|c| (1.0 - s) * pa[c] + s * pb[c])
+                })
+                .collect()
+        })
+        .collect();
+    Ok(Image::from_vec(w, h, rows.into_iter().flatten().collect()).expect("w*h pixels"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(azimuth_deg: f32, elevation_deg: f32) -> Camera {
+        let target = Vec3::new(0.0, 0.9, 0.0);
+        let eye = target
+            + frf_core::light::direction_from_azimuth_elevation(
+                azimuth_deg.to_radians(),
+                elevation_deg.to_radians(),
+            ) * 4.5;
+        Camera::look_at(eye, target, Vec3::Y, 0.48, 64, 90).unwrap()
+    }
+
+    /// A point moving up the axis and across it is seen to move by what projecting it
+    /// before and after says, by cameras anywhere round it.
+    #[test]
+    fn motion_maps_to_what_the_camera_sees() {
+        for (az, el) in [(0.0, 0.0), (95.0, 10.0), (200.0, -20.0)] {
+            let c = camera(az, el);
+            let m = motion_to_image(&c);
+            let p = c.axis_point();
+            let radial = Vec3::new(c.centre().x, 0.0, c.centre().z);
+            let across = Vec3::Y.cross(radial).normalize();
+            let d = Vec2::new(0.004, -0.003);
+            let seen = c.project(p + across * d.x + Vec3::Y * d.y).unwrap() - c.project(p).unwrap();
+            assert!(
+                (m * d - seen).length() < 0.01 * seen.length(),
+                "{az}: {} vs {seen}",
+                m * d
+            );
+        }
+    }
+
+    /// The turn between two cameras is no motion: a point on the plane stays put.
+    #[test]
+    fn the_turntables_turn_is_not_motion() {
+        let (a, b) = (camera(17.0, 5.0), camera(17.4, 5.0));
+        // A point of the plane through the axis facing `a` (across is square to its view).
+        let across = Vec3::Y.cross(a.forward()).normalize();
+        let p = a.axis_point() + across * 0.2;
+        let x = a.project(p).unwrap();
+        let flow = b.project(p).unwrap() - x;
+        let m = subject_motion(&a, &b, x, flow.into()).unwrap();
+        assert!(m.length() < 1e-3, "{m}");
+        assert!(subject_motion(&a, &b, x, [2e10, 0.0]).is_none());
+    }
+
+    /// Encoded and decoded through the sRGB table, a motion comes back to within the
+    /// texels' precision, and any offset cancels.
+    #[test]
+    fn motion_survives_its_encoding() {
+        let metres: Vec<Vec2> = (0..50)
+            .map(|i| Vec2::new(0.06 * (i as f32 / 49.0 - 0.5), -0.02 + 0.001 * i as f32))
+            .collect();
+        let (scale, texels) = encode_view(&metres);
+        let lut = srgb_lut();
+        for (m, t) in metres.iter().zip(&texels) {
+            let p = [
+                scale * lut[t[0] as usize],
+                scale * lut[t[1] as usize],
+                scale * lut[t[2] as usize],
+                1.0,
+            ];
+            let got = decode_motion(p);
+            assert!((got - *m).length() < 0.0015, "{m} -> {got}");
+        }
+    }
+
+    /// A disc moving right by 4 px: half-way, the morph puts it 2 px on, whole.
+    #[test]
+    fn half_way_the_morph_moves_a_disc_half_as_far() {
+        let disc = |cx: f32| {
+            Image::from_fn(32, 16, |x, y| {
+                let r = ((x as f32 - cx).powi(2) + (y as f32 - 8.0).powi(2)).sqrt();
+                let a = (4.0 - r).clamp(0.0, 1.0);
+                [a, 0.5 * a, 0.0, a]
+            })
+        };
+        let to_image = Mat2::from_diagonal(Vec2::splat(100.0));
+        // 4 px right is 0.04 m across.
+        let moving = |dx: f32| {
+            let v = dx / 100.0;
+            Image::from_fn(32, 16, move |_, _| {
+                let o = 1.0;
+                [v + o, o, o, 1.0]
+            })
+        };
+        let (before, after) = (disc(12.0), disc(16.0));
+        let (fwd, back) = (moving(4.0), moving(-4.0));
+        let pair = TimePair {
+            before: &before,
+            after: &after,
+            before_motion: &fwd,
+            after_motion: &back,
+        };
+        let mid = time_morph(&pair, 0.5, to_image).unwrap();
+        let truth = disc(14.0);
+        let err = mid
+            .pixels()
+            .iter()
+            .zip(truth.pixels())
+            .map(|(a, b)| (a[3] - b[3]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(err < 0.05, "{err}");
+        // A cross-fade would leave two half discs.
+        let fade = time_morph(&pair, 0.5, Mat2::ZERO).unwrap();
+        let fade_err = fade
+            .pixels()
+            .iter()
+            .zip(truth.pixels())
+            .map(|(a, b)| (a[3] - b[3]).abs())
+            .fold(0.0f32, f32::max);
+        assert!(fade_err > 0.4, "{fade_err}");
+    }
+}
