@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{psnr, ssim, subject_mask};
+use frf_core::image::{Image, Rgba};
 use frf_core::io::rgba_from;
 use frf_core::progress::Progress;
 
@@ -48,8 +49,10 @@ pub struct ShotFrameScore {
     pub index: usize,
     /// Seconds into the shot.
     pub time: f32,
-    /// The pose drawn.
+    /// The pose drawn (the earlier, between two).
     pub pose: u32,
+    /// Between two poses: the later and the fraction of the way to it.
+    pub between: Option<(u32, f32)>,
     /// The instant of the walk the truth shows, seconds into its cycle.
     pub truth_time_s: f64,
     /// How far the frame's instant is from the drawn pose's, seconds (wrapped to the
@@ -76,6 +79,20 @@ pub fn score_frame<R: ReadAt>(
     lights: usize,
     truth_at: TruthAt,
 ) -> Result<ShotFrameScore> {
+    Ok(score_frame_walkers(stage, shot, frame, lights, truth_at)?.0)
+}
+
+/// The rendered and the true walker of a frame (premultiplied RGBA).
+type Walkers = (Image<Rgba>, Image<Rgba>);
+
+/// [`score_frame`], with the frame's rendered and true walker.
+fn score_frame_walkers<R: ReadAt>(
+    stage: &Stage,
+    shot: &mut Shot<'_, R>,
+    frame: &ShotFrame,
+    lights: usize,
+    truth_at: TruthAt,
+) -> Result<(ShotFrameScore, Walkers)> {
     let scene = shot.scene();
     if scene.instances.len() != 1 {
         return Err(EvalError::BadParameter(format!(
@@ -125,10 +142,11 @@ pub fn score_frame<R: ReadAt>(
     let seconds_truth = t.elapsed().as_secs_f64();
 
     let mask = subject_mask(&subject, &layers.subject);
-    Ok(ShotFrameScore {
+    let score = ShotFrameScore {
         index: frame.index,
         time: frame.time,
         pose,
+        between: rendered.between[0],
         truth_time_s,
         time_from_pose_s,
         psnr_frame: psnr(&truth, &rendered.frame.composite, None),
@@ -136,6 +154,60 @@ pub fn score_frame<R: ReadAt>(
         ssim_subject: ssim(&subject, &layers.subject, Some(&mask)),
         seconds_render,
         seconds_truth,
+    };
+    Ok((score, (layers.subject, subject)))
+}
+
+/// How the walker changes from frame to frame, against how the true walker does: over
+/// the pairs of consecutive frames scored, the mean absolute change of its premultiplied
+/// RGBA per pixel. A shot that steps from pose to pose changes by nothing, then by a
+/// whole pose's step: its largest change is about twice the truth's.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct Steadiness {
+    /// Pairs of consecutive frames compared.
+    pub pairs: usize,
+    /// The rendered walker's largest change between two consecutive frames.
+    pub largest_change: f64,
+    /// The true walker's largest change.
+    pub truth_largest_change: f64,
+    /// The first over the second (1: as steady as the truth).
+    pub ratio: f64,
+}
+
+/// The mean absolute difference per pixel of two images (all channels summed).
+fn change(a: &Image<Rgba>, b: &Image<Rgba>) -> f64 {
+    let sum: f64 = a
+        .pixels()
+        .iter()
+        .zip(b.pixels())
+        .map(|(p, q)| {
+            p.iter()
+                .zip(q)
+                .map(|(x, y)| (x - y).abs() as f64)
+                .sum::<f64>()
+        })
+        .sum();
+    sum / a.pixels().len().max(1) as f64
+}
+
+/// The steadiness of `frames` (scores and walkers, in shot order): `None` without two
+/// consecutive frames.
+fn steadiness(frames: &[(ShotFrameScore, Walkers)]) -> Option<Steadiness> {
+    let (mut pairs, mut largest, mut truth_largest) = (0, 0.0f64, 0.0f64);
+    for w in frames.windows(2) {
+        let ((a, (ra, ta)), (b, (rb, tb))) = (&w[0], &w[1]);
+        if b.index != a.index + 1 || ra.size() != rb.size() {
+            continue;
+        }
+        pairs += 1;
+        largest = largest.max(change(ra, rb));
+        truth_largest = truth_largest.max(change(ta, tb));
+    }
+    (pairs > 0).then(|| Steadiness {
+        pairs,
+        largest_change: largest,
+        truth_largest_change: truth_largest,
+        ratio: largest / truth_largest.max(1e-12),
     })
 }
 
@@ -172,6 +244,9 @@ pub struct ShotReport {
     pub seconds_render_mean: f64,
     /// Mean seconds for a true frame.
     pub seconds_truth_mean: f64,
+    /// How the walker changes from frame to frame against the truth (consecutive frames
+    /// only).
+    pub steadiness: Option<Steadiness>,
     /// Seconds in all.
     pub seconds: f64,
 }
@@ -214,12 +289,14 @@ pub fn evaluate_shot<R: ReadAt>(
         }
     }
     progress.phase("frames scored", frames.len());
-    let mut scores = Vec::new();
+    let mut scored = Vec::new();
     for f in &frames {
-        scores.push(score_frame(stage, &mut shot, f, lights, truth_at)?);
+        scored.push(score_frame_walkers(stage, &mut shot, f, lights, truth_at)?);
         progress.step();
     }
     progress.finish();
+    let steadiness = steadiness(&scored);
+    let scores: Vec<ShotFrameScore> = scored.into_iter().map(|(s, _)| s).collect();
     let mean =
         |g: fn(&ShotFrameScore) -> f64| scores.iter().map(g).sum::<f64>() / scores.len() as f64;
     let (scene_path, field_path, capture) = paths;
@@ -237,6 +314,7 @@ pub fn evaluate_shot<R: ReadAt>(
         seconds_render_mean: mean(|s| s.seconds_render),
         seconds_truth_mean: mean(|s| s.seconds_truth),
         frames: scores,
+        steadiness,
         seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -1,24 +1,23 @@
 //! The walk between captured poses, through the binary: `frf ingest --pose-flow` stores
 //! each view's flow to the next and the previous captured pose, reports its error against
-//! the stage's truth, and its per-pose parts still merge into the single ingest.
+//! the stage's truth, and its per-pose parts still merge into the single ingest; a 60 fps
+//! shot of a 30-pose walk moves without steps when it morphs in time, and steps when it
+//! shows the nearest pose, against the true walker at every frame's instant.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
 use crate::common::{frf, stderr};
 
-#[test]
-fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
-    let cap = d.join("cap");
+/// Stages the tiny preset's `poses` (cycles repeating exactly) at `size` into `cap`.
+fn stage(cap: &std::path::Path, poses: &str, size: &str) {
     let o = frf(&[
         "stage",
         "--preset",
         "tiny",
         "--poses",
-        "0,1,2",
+        poses,
         "--size",
-        "32x45",
+        size,
         "--perturbation",
         "0",
         "--lights-per-axis",
@@ -27,6 +26,14 @@ fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
         cap.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cap = d.join("cap");
+    stage(&cap, "0,1,2", "32x45");
     let ingest = |out: &std::path::Path, extra: &[&str]| {
         let mut args = vec![
             "ingest",
@@ -90,4 +97,112 @@ fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
     let o = frf(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(std::fs::read(&whole).unwrap() == std::fs::read(&merged).unwrap());
+}
+
+/// The motion criterion of issue 24: at 60 fps, twice the capture's pose rate, the frame
+/// half-way between two poses morphed in time scores above the nearest pose against the
+/// true walker of its instant, the walker changes from frame to frame as the truth does
+/// (largest change at most 1.5x the truth's), and the nearest pose's shot steps (about
+/// 2x: no change, then a whole pose's). The GPU draws what the CPU reference does.
+#[test]
+fn a_shot_between_poses_moves_as_the_truth_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let cap = d.join("cap");
+    stage(&cap, "0,1,2,3", "64x90");
+    let field = d.join("f.frf");
+    let o = frf(&[
+        "ingest",
+        cap.to_str().unwrap(),
+        "--flow-preset",
+        "fast",
+        "--pose-flow",
+        "--no-shadows",
+        "--out",
+        field.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = |name: &str, interpolate: &str| {
+        let path = d.join(name);
+        std::fs::write(
+            &path,
+            format!(
+                "field = \"f.frf\"\n[time]\nend = 0.1\nfps = 60.0\n{interpolate}\n\
+                 [output]\nsize = [64, 90]\n[lighting]\nenv = \"uniform\"\n\
+                 [camera]\n[[camera.key]]\ntime = 0.0\nposition = [0.5, 1.2, 3.2]\n\
+                 look_at = [0.0, 0.9, 0.0]\nfov_deg = 40.0\n\
+                 [composite]\nbackdrop = \"none\"\nshadow = \"none\"\n"
+            ),
+        )
+        .unwrap();
+        path
+    };
+    let eval = |scene: &std::path::Path, device: Option<&str>| -> frf_eval::shot::ShotReport {
+        let mut args = vec![
+            "eval",
+            scene.to_str().unwrap(),
+            "--capture",
+            cap.to_str().unwrap(),
+            "--frames",
+            "6",
+            "--lights",
+            "64",
+            "--json",
+        ];
+        args.extend(device);
+        let o = frf(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    // The default morphs in time: the field holds pose flows.
+    let flow = eval(&scene("flow.toml", ""), Some("--cpu"));
+    let nearest = eval(
+        &scene("nearest.toml", "interpolate = \"nearest\""),
+        Some("--cpu"),
+    );
+    let half_way = |r: &frf_eval::shot::ShotReport| {
+        let odd: Vec<f64> = r
+            .frames
+            .iter()
+            .filter(|f| f.index % 2 == 1)
+            .map(|f| f.psnr_subject)
+            .collect();
+        odd.iter().sum::<f64>() / odd.len() as f64
+    };
+    for f in &flow.frames {
+        assert_eq!(f.between.is_some(), f.index % 2 == 1, "{f:?}");
+    }
+    // Measured: half-way 20.9 against 18.2 dB; largest change 0.97x and 1.75x the truth's.
+    assert!(
+        half_way(&flow) > half_way(&nearest) + 1.0,
+        "{} vs {}",
+        half_way(&flow),
+        half_way(&nearest)
+    );
+    let (sf, sn) = (flow.steadiness.unwrap(), nearest.steadiness.unwrap());
+    assert_eq!(sf.pairs, 5);
+    assert!(sf.ratio <= 1.5, "{sf:?}");
+    assert!(sn.ratio > 1.5, "{sn:?}");
+    // At the poses' own instants both draw the captured pose alike.
+    for (a, b) in flow
+        .frames
+        .iter()
+        .zip(&nearest.frames)
+        .filter(|(a, _)| a.index % 2 == 0)
+    {
+        assert!(
+            (a.psnr_subject - b.psnr_subject).abs() < 1e-6,
+            "{a:?} {b:?}"
+        );
+    }
+    // The GPU's morph in time draws the CPU reference's frames.
+    if frf_testkit::cpu_flag().is_none() {
+        let gpu = eval(&scene("flow.toml", ""), None);
+        for (a, b) in gpu.frames.iter().zip(&flow.frames) {
+            assert!(
+                (a.psnr_subject - b.psnr_subject).abs() < 0.05,
+                "{a:?} {b:?}"
+            );
+        }
+    }
 }

@@ -100,8 +100,10 @@ pub struct ShotCounters {
 pub struct ShotResult {
     /// The frame.
     pub frame: Frame,
-    /// Per walker: the pose drawn.
+    /// Per walker: the pose drawn (the earlier, between two).
     pub poses: Vec<u32>,
+    /// Per walker, between two poses: the later and the fraction of the way to it.
+    pub between: Vec<Option<(u32, f32)>>,
     /// Poses made resident (read and relit) for this frame.
     pub made_resident: Vec<u32>,
 }
@@ -502,6 +504,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(ShotResult {
             frame: frame_out,
             poses: fp.poses.clone(),
+            between: fp.between.clone(),
             made_resident,
         })
     }

@@ -58,11 +58,16 @@ pub fn run(args: &EvalArgs) -> CliResult {
         "frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s"
     );
     for s in &report.frames {
+        // Between two poses: both, the earlier first.
+        let pose = match s.between {
+            Some((after, _)) => format!("{}-{after}", s.pose),
+            None => s.pose.to_string(),
+        };
         println!(
             "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
             s.index,
             s.time,
-            s.pose,
+            pose,
             1e3 * s.time_from_pose_s,
             s.psnr_frame,
             s.psnr_subject,
@@ -79,5 +84,12 @@ pub fn run(args: &EvalArgs) -> CliResult {
         report.seconds_render_mean,
         report.seconds_truth_mean
     );
+    if let Some(m) = &report.steadiness {
+        println!(
+            "motion: the walker's largest change between consecutive frames {:.5} (mean |ΔRGBA| a pixel), \
+             the truth's {:.5}: {:.2}x ({} pairs)",
+            m.largest_change, m.truth_largest_change, m.ratio, m.pairs
+        );
+    }
     Ok(())
 }
