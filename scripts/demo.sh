@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # The demo, end to end on built-in data, in about ten minutes on two cores (build
 # included): the virtual light stage films the walker for the shot of scenes/demo.toml
-# only (10 poses of the walk cycle, the views its camera reaches and a ring for the
-# visual hull, 96x136 pixels), ingest turns the capture into a flowed reflectance field
-# (each step's error against the stage's truth), `frf render scenes/demo.toml` draws the
-# shot (the walker walking, the camera moving around it, relit by the sunrise shipped in
-# assets/envmaps, its shadow on the ground, composited over the environment), and
-# `frf eval` scores frames of the shot against their true composites. Output in demo-out/
+# only (every third pose of the walk cycle, the views its camera reaches and a ring for
+# the visual hull, 96x136 pixels), ingest turns the capture into a flowed reflectance
+# field with the flow between consecutive poses (each step's error against the stage's
+# truth), `frf render scenes/demo.toml` draws the shot at 30 fps, three frames a pose,
+# morphed in time between them (the walker walking, the camera moving around it, relit
+# by the forest shipped in assets/envmaps, its shadow on the ground, composited over the
+# environment), and `frf eval` scores frames of the shot against their true composites,
+# each against the walker at its own instant. Output in demo-out/
 # (every step resumes: a rerun continues an interrupted one); demo-out/report.txt holds
 # the error and the time of each step.
 set -euo pipefail
@@ -34,12 +36,12 @@ step() {
 step build cargo build --release --quiet
 frf=./target/release/frf
 step stage $frf stage --preset small --size 96x136 --lights-per-axis 2 --for "$scene" \
-  --out "$out/capture"
-step ingest $frf ingest "$out/capture" --for "$scene" --flow-preset fast \
+  --poses 0,3,6,9,12,15,18,21,24,27 --out "$out/capture"
+step ingest $frf ingest "$out/capture" --for "$scene" --flow-preset fast --pose-flow \
   --out "$out/walker.frf" --report "$out/ingest_report.json"
 step plan $frf render "$scene" --field "$out/walker.frf" --plan
 step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot" --overwrite
-step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 2 \
+step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 3 \
   --lights 256
 
 {

@@ -7,12 +7,12 @@
 
 use frf_core::camera::Camera;
 use frf_core::capture::Capture;
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{FlowImage, GrayImage};
 use frf_ingest::shadows::{ShadowOptions, pose_shadows};
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::stats::FieldStats;
-use frf_reflectance::store::{EncodedView, encode_view};
+use frf_reflectance::store::{EncodedView, encode_pose_flows, encode_view};
 use frf_reflectance::{FieldFile, FieldHeader, FieldWriter, ViewData};
 use frf_stage::Stage;
 use frf_stage::render::{Scene, render};
@@ -29,6 +29,27 @@ pub fn true_flows(stage: &Stage, pose: u32, u: usize, v: usize) -> Result<[Optio
         if let Some((u2, v2)) = n.of(u, v, stage.cycles(), stage.cameras().len(), true) {
             let to = stage.view_setup(pose, u2, v2, 0.0)?;
             flows[n.index()] = Some(frf_stage::truth::flow_between(&surface, &to).flow);
+        }
+    }
+    Ok(flows)
+}
+
+/// The true flows of view `(u, v)` of `pose` to the same camera's image at the next and
+/// the previous of `poses` (sorted; [`PoseStep::ALL`] order, [`PoseStep::of`]): how the
+/// walker moves between them, in true pixels of both images, as ingest stores them.
+pub fn true_pose_flows(
+    stage: &Stage,
+    poses: &[u32],
+    pose: u32,
+    u: usize,
+    v: usize,
+) -> Result<[Option<FlowImage>; 2]> {
+    let (surface, _) = stage.reference_surface(pose, u, v)?;
+    let mut flows: [Option<FlowImage>; 2] = Default::default();
+    for step in PoseStep::ALL {
+        if let Some((to_pose, to_u)) = step.of(pose, u, poses, stage.cycles(), true) {
+            let to = stage.view_setup(to_pose, to_u, v, 0.0)?;
+            flows[step.index()] = Some(frf_stage::truth::flow_between(&surface, &to).flow);
         }
     }
     Ok(flows)
@@ -67,6 +88,9 @@ pub struct OracleOptions {
     pub predict_flow: bool,
     /// Visual hulls and shadow maps, carved from the true mattes (`None`: neither).
     pub shadows: Option<ShadowOptions>,
+    /// The true flows between consecutive poses of the field, as `frf ingest
+    /// --pose-flow` stores estimated ones.
+    pub pose_flows: bool,
 }
 
 /// What writing an oracle field made.
@@ -114,14 +138,25 @@ pub fn write_oracle_field(
             total,
         )
     };
+    let mut sorted = options.poses.clone();
+    sorted.sort_unstable();
+    let pose_flows = |p, u, v| -> Result<[Option<FlowImage>; 2]> {
+        if options.pose_flows {
+            true_pose_flows(stage, &sorted, p, u, v)
+        } else {
+            Ok(Default::default())
+        }
+    };
     // Pass 1: every true flow, to fit the quantizer to the whole field.
     let magnitudes: Vec<Vec<f32>> = views
         .par_iter()
         .map(|&(p, u, v)| {
             let flows = true_flows(stage, p, u, v)?;
+            let between = pose_flows(p, u, v)?;
             tick();
             Ok(flows
                 .iter()
+                .chain(&between)
                 .flatten()
                 .flat_map(|f| f.pixels().iter().flatten().copied())
                 .collect())
@@ -143,7 +178,10 @@ pub fn write_oracle_field(
             .par_iter()
             .map(|&(p, u, v)| {
                 let view = oracle_view(stage, p, u, v)?;
-                let e = encode_view(&header, p, &view)?;
+                let mut e = encode_view(&header, p, &view)?;
+                if options.pose_flows {
+                    e.extend(encode_pose_flows(&header, p, &pose_flows(p, u, v)?)?);
+                }
                 tick();
                 Ok((e, view.alpha))
             })

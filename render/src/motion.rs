@@ -1,4 +1,4 @@
-//! Time between captured poses (docs/design.md section 4.6): the subject's motion from
+//! Time between captured poses (docs/design.md section 4.7): the subject's motion from
 //! one captured pose to the next, carried into the novel view, and the morph in time of
 //! the two poses' renders by it.
 //!

@@ -79,7 +79,9 @@ struct CaptureArgs {
     /// Which true flows from T1 to the other slots of each set to write.
     #[arg(long, value_enum)]
     set_flow: Option<SetFlowArg>,
-    /// Film only the poses and views this scene file needs (with all its frames).
+    /// Film only the poses and views this scene file needs (with all its frames); with
+    /// `--poses`, of those poses (a scene that morphs between poses draws its frames
+    /// between the ones kept).
     #[arg(long = "for", value_name = "SCENE")]
     for_scene: Option<PathBuf>,
     /// Image size `WxH` instead of the preset's (the cameras keep their field of view).
@@ -191,9 +193,13 @@ fn capture(args: CaptureArgs) -> CliResult {
         config.lights_per_axis = n;
     }
     if let Some(scene) = &args.for_scene {
-        // Plan on every pose of the cycle, then film what the plan keeps.
+        // Plan on every pose of the cycle (or on the poses `--poses` keeps: a scene that
+        // morphs between poses then draws its frames between those), then film what the
+        // plan keeps.
         let mut all = config.clone();
-        all.poses = (0..all.poses_per_cycle()).collect();
+        if args.poses.is_none() {
+            all.poses = (0..all.poses_per_cycle()).collect();
+        }
         let stage = frf_stage::Stage::new(all)?;
         let capture = frf_core::capture::Capture::from_manifest(&out, stage.manifest())?;
         let plan = crate::cmd::for_scene::plan(scene, &capture, None)?;

@@ -34,6 +34,10 @@ pub struct FieldArgs {
     /// Poses to include, e.g. `0,1` (default: all of the capture's).
     #[arg(long, value_delimiter = ',')]
     poses: Vec<u32>,
+    /// Store the true flows between consecutive poses too (time between poses, as
+    /// `frf ingest --pose-flow` stores estimated ones).
+    #[arg(long)]
+    pose_flow: bool,
     #[command(flatten)]
     shadows: crate::cmd::args::ShadowArgs,
 }
@@ -57,6 +61,7 @@ pub fn field(args: FieldArgs) -> CliResult {
             jpeg_quality: args.jpeg_quality,
             predict_flow: !args.no_flow_prediction,
             shadows: args.shadows.options()?,
+            pose_flows: args.pose_flow,
         },
         &|done, total| {
             bar.set_length(total as u64);

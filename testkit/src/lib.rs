@@ -110,6 +110,7 @@ pub fn tiny_field() -> &'static TinyField {
             jpeg_quality: 95,
             predict_flow: true,
             shadows: Some(ShadowOptions::default()),
+            pose_flows: false,
         };
         write_oracle_field(&stage, &field, &options, &|_, _| {})
             .expect("the tiny oracle field is written");

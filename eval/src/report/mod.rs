@@ -26,6 +26,7 @@ pub const STAGES: &[&str] = &[
     "renderer",
     "shadows",
     "composite",
+    "time between poses",
 ];
 
 /// Which way a metric improves.

@@ -90,6 +90,8 @@ pub struct PlanCounts {
     pub flows_used: usize,
     /// Flow maps the poses used hold.
     pub flows_total: usize,
+    /// Pose-to-pose flow maps read (for frames between poses).
+    pub pose_flows_used: usize,
     /// Basis conditions relit.
     pub conditions_used: usize,
     /// Basis conditions of the field.
@@ -365,8 +367,22 @@ impl Plan {
     /// A line for people: what the plan keeps.
     pub fn summary(&self) -> String {
         let c = &self.counts;
+        let between = match self.interpolate {
+            TimeInterpolation::Flow
+                if self
+                    .frames
+                    .iter()
+                    .any(|f| f.between.iter().any(Option::is_some)) =>
+            {
+                format!(
+                    ", {} pose-to-pose flows (frames between poses morphed in time)",
+                    c.pose_flows_used
+                )
+            }
+            _ => String::new(),
+        };
         format!(
-            "for the scene: {} of {} poses ({:?}), {} of {} views, {} flows",
+            "for the scene: {} of {} poses ({:?}), {} of {} views, {} flows{between}",
             c.poses_used,
             c.poses_total,
             self.poses.iter().map(|p| p.pose).collect::<Vec<_>>(),
@@ -402,6 +418,7 @@ impl Plan {
         let rows = field.header().rows;
         let counts = &mut plan.counts;
         (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
+        counts.pose_flows_used = 0;
         let mut held = BTreeSet::new();
         for c in field.chunks() {
             if c.key.kind == ChunkKind::Basis {
@@ -427,7 +444,10 @@ impl Plan {
                     used
                 }
                 ChunkKind::PoseFlow(step) => {
-                    p.pose_flows[step.index()] && p.views.get(view).copied().unwrap_or(false)
+                    let used =
+                        p.pose_flows[step.index()] && p.views.get(view).copied().unwrap_or(false);
+                    counts.pose_flows_used += used as usize;
+                    used
                 }
                 ChunkKind::Shadows => p.shadow_maps,
                 ChunkKind::Hull => p.hull,
@@ -622,6 +642,13 @@ impl Plan {
                 .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
                 .sum(),
             flows_total: 0,
+            pose_flows_used: poses
+                .iter()
+                .map(|p| {
+                    let views = p.views.iter().filter(|&&v| v).count();
+                    p.pose_flows.iter().filter(|&&f| f).count() * views
+                })
+                .sum(),
             conditions_used: lit.iter().filter(|&&l| l).count(),
             conditions_total: h.conditions.len(),
             bytes_read: 0,

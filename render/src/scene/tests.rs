@@ -167,3 +167,35 @@ fn keyed_lighting_may_leave_the_base_environment_to_its_first_key() {
         "{e}"
     );
 }
+
+#[test]
+fn time_interpolation_is_read_and_a_bad_one_refused() {
+    assert_eq!(scene(MINIMAL).unwrap().interpolate, None);
+    let with = |v: &str| MINIMAL.replace("fps = 10", &format!("fps = 10\ninterpolate = \"{v}\""));
+    assert_eq!(
+        scene(&with("flow")).unwrap().interpolate,
+        Some(TimeInterpolation::Flow)
+    );
+    assert_eq!(
+        scene(&with("nearest")).unwrap().interpolate,
+        Some(TimeInterpolation::Nearest)
+    );
+    let e = error(&with("blend"));
+    assert!(e.contains("time.interpolate") && e.contains("blend"), "{e}");
+}
+
+#[test]
+fn a_time_between_poses_finds_both_and_the_fraction() {
+    use super::plan::poses_around;
+    let held = [0, 3, 6, 27];
+    assert_eq!(poses_around(0.0, &held, 30), (0, None));
+    assert_eq!(poses_around(1.5, &held, 30), (0, Some((3, 0.5))));
+    assert_eq!(poses_around(4.0, &held, 30), (3, Some((6, 1.0 / 3.0))));
+    // Round the cycle: from the last pose held to the first.
+    assert_eq!(poses_around(28.5, &held, 30), (27, Some((0, 0.5))));
+    // At a pose, to a thousandth of its step, that pose alone.
+    assert_eq!(poses_around(5.9999, &held, 30), (6, None));
+    assert_eq!(poses_around(3.0001, &held, 30), (3, None));
+    // One pose held: that pose at every instant.
+    assert_eq!(poses_around(12.5, &[4], 30), (4, None));
+}

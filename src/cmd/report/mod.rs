@@ -23,6 +23,7 @@ use write::{commit, peer_rows, write_report};
 mod capture_size;
 mod runner;
 mod sweep;
+mod time;
 mod write;
 
 /// Arguments of `frf report`.
@@ -86,7 +87,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     };
     // Runs: ingests (presets and λs), codec curve, views and suite, renderers, a field
     // and an eval per shadow setting, an eval per frame size, and filming, ingest and
-    // eval per capture size.
+    // eval per capture size; filming, ingest and two evals per set of poses kept.
     let (ingests, sizes) = if args.quick { (2, 2) } else { (5, 4) };
     let total = ingests
         + 1
@@ -94,7 +95,8 @@ pub fn run(args: ReportArgs) -> CliResult {
         + if args.cpu { 1 } else { 2 }
         + 2 * sweep.shadow_settings().len()
         + sizes
-        + 3 * sweep.smaller(&stage_config, w, h).len();
+        + 3 * sweep.smaller(&stage_config, w, h).len()
+        + 2 * 4;
     runner.bar.set_length(total as u64);
 
     let (field, ingest_seconds, ingest_command) = sweep.ingest(&runs)?;
@@ -111,6 +113,7 @@ pub fn run(args: ReportArgs) -> CliResult {
     )?;
     sweep.renderers(&field, args.cpu)?;
     sweep.shadows(&runs)?;
+    sweep.time_between_poses(&runs, &stage_config, (w, h))?;
     runner.bar.finish_and_clear();
 
     let mut rows = sweep.rows;

@@ -45,12 +45,12 @@ pub struct Sweep<'a> {
 }
 
 /// A run's report, read as `T`.
-fn parse<T: DeserializeOwned>(text: &str, ran: &str) -> CliResult<T> {
+pub(super) fn parse<T: DeserializeOwned>(text: &str, ran: &str) -> CliResult<T> {
     serde_json::from_str(text).map_err(|e| format!("{ran}: its report does not read: {e}").into())
 }
 
 /// A run's report file.
-fn read(path: &Path) -> CliResult<String> {
+pub(super) fn read(path: &Path) -> CliResult<String> {
     Ok(std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?)
 }
 
@@ -59,13 +59,13 @@ fn need(value: Option<f64>, what: &str, ran: &str) -> CliResult<f64> {
     value.ok_or_else(|| format!("{ran}: no {what} in its report").into())
 }
 
-fn s(p: &Path) -> String {
+pub(super) fn s(p: &Path) -> String {
     p.display().to_string()
 }
 
 /// `frf ingest` of one pose of `cap` with a flow preset (and extra arguments), writing the
 /// field and its JSON report.
-fn ingest_args(
+pub(super) fn ingest_args(
     cap: &str,
     pose: &str,
     preset: &str,
@@ -103,7 +103,7 @@ impl Sweep<'_> {
     }
 
     #[allow(clippy::too_many_arguments)] // one row's fields
-    fn push(
+    pub(super) fn push(
         &mut self,
         (stage, knob): (&str, &str),
         value: impl Into<String>,
