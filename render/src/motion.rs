@@ -37,6 +37,7 @@ use glam::{Mat2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
+use crate::extend::extend_nearest;
 use crate::resident::{PoseSource, ResidentPose, srgb_lut};
 
 /// The code of the offset texel (blue): its decoded value times the view's scale is the
@@ -93,7 +94,8 @@ pub fn subject_motion(camera: &Camera, later: &Camera, x: Vec2, flow: [f32; 2]) 
 /// field's poses, as a pose of motion views sharing `source`'s geometry and inter-view
 /// flows (see the module docs); `None` when the field holds no such flow for any view
 /// `source` read. Views not read (transparent in `source`) stay transparent; a view read
-/// without a stored flow, or a pixel whose flow is unknown, moves by nothing.
+/// without a stored flow moves by nothing; a pixel whose flow is unknown (beyond the
+/// subject) moves as the nearest pixel whose flow is known.
 pub fn pose_motion<R: ReadAt>(
     field: &FieldFile<R>,
     source: &PoseSource,
@@ -131,16 +133,23 @@ pub fn pose_motion<R: ReadAt>(
             if !to_metres.is_finite() {
                 return Ok(None);
             }
-            let metres: Vec<Vec2> = (0..crop.texels())
+            let mut metres: Vec<Option<Vec2>> = (0..crop.texels())
                 .map(|k| {
                     let (x, y) = (
                         crop.x0 as usize + k % crop.width as usize,
                         crop.y0 as usize + k / crop.width as usize,
                     );
                     let at = Vec2::new(x as f32, y as f32);
-                    subject_motion(camera, &later, at, flow.get(x, y))
-                        .map_or(Vec2::ZERO, |m| to_metres * m)
+                    subject_motion(camera, &later, at, flow.get(x, y)).map(|m| to_metres * m)
                 })
+                .collect();
+            // Beyond the stored flow, the nearest edge's motion (as the inter-view flows
+            // are extended, crate::extend): a limb's border moves with the limb.
+            let (w, h) = (crop.width as usize, crop.height as usize);
+            extend_nearest(&mut metres, w, h, Option::is_some);
+            let metres: Vec<Vec2> = metres
+                .into_iter()
+                .map(|m| m.unwrap_or(Vec2::ZERO))
                 .collect();
             Ok(Some(encode_view(&metres)))
         })

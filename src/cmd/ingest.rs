@@ -50,8 +50,10 @@ pub struct IngestArgs {
     /// under the edge) or `none` (the blurred binary matte, as the original).
     #[arg(long, value_enum, default_value = "solve")]
     edge: EdgeArg,
-    /// Also measure and store each view's flow to the next and the previous captured pose
-    /// (experimental: the time between poses, issue 24; no renderer reads them yet).
+    /// Also measure and store each view's flow to the capture's next and previous pose,
+    /// which shots between two poses morph by (docs/design.md §4.7). A field of every
+    /// second pose is made from a capture filmed at those poses (`frf stage --poses
+    /// 0,2,4,...`), so that the field's neighbouring poses are the capture's.
     #[arg(long)]
     pose_flow: bool,
     /// Ingest only the poses, views and flows this scene file needs (`frf render
