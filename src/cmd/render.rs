@@ -253,6 +253,9 @@ struct PlanReport<'a> {
     floor_conditions_left_out: usize,
     ground_seen: bool,
     shadow_maps_read: bool,
+    /// Per walker: the poses it draws and the views and flows its own rays reach (what
+    /// it is made resident with).
+    walker_counts: &'a [frf_render::scene::plan::WalkerCounts],
 }
 
 fn print_plan(plan: &Plan, json: bool) -> CliResult {
@@ -266,6 +269,7 @@ fn print_plan(plan: &Plan, json: bool) -> CliResult {
             floor_conditions_left_out: plan.floor_conditions_left_out,
             ground_seen: plan.ground_seen,
             shadow_maps_read: plan.poses.iter().any(|p| p.shadow_maps),
+            walker_counts: &plan.walker_counts,
         };
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
@@ -304,6 +308,17 @@ fn print_plan(plan: &Plan, json: bool) -> CliResult {
             "not read (no frame sees the ground patch)"
         }
     );
+    if plan.walker_counts.len() > 1 {
+        // Each walker is made resident with what its own rays reach.
+        let views: Vec<usize> = plan.walker_counts.iter().map(|w| w.views).collect();
+        println!(
+            "  per walker  {} walkers, views made resident {} to {} (mean {:.1}) over their poses",
+            views.len(),
+            views.iter().min().copied().unwrap_or(0),
+            views.iter().max().copied().unwrap_or(0),
+            views.iter().sum::<usize>() as f64 / views.len() as f64
+        );
+    }
     for (wanted, held) in &plan.poses_substituted {
         println!("  pose {wanted} is not in the field: pose {held} stands in for it");
     }

@@ -118,6 +118,14 @@ fn the_planner_leaves_work_out_and_the_frames_do_not_change() {
     assert!(n("views_used") < n("views_total"), "{plan}");
     assert!(n("flows_used") < n("flows_total"), "{plan}");
     assert!(n("bytes_read") < n("bytes_total"), "{plan}");
+    // Per walker: what its own rays reach, within what the shot reads (each walker is
+    // made resident with its own views only; the frames below must not change for it).
+    let walkers = plan["walker_counts"].as_array().unwrap();
+    assert_eq!(walkers.len(), 2, "{plan}");
+    for w in walkers {
+        let views = w["views"].as_u64().unwrap();
+        assert!(views > 0 && views <= n("views_used"), "{plan}");
+    }
 
     let mut frames = Vec::new();
     for (out, flag) in [("planned", None), ("unplanned", Some("--no-plan"))] {

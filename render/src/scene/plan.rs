@@ -3,12 +3,15 @@
 //!
 //! - **Poses**: the poses the walkers show at the frames rendered (the nearest pose the
 //!   field holds stands in for one it lacks, and the plan says so).
-//! - **Views and flows**: the quads of the grid the camera's rays reach. Rays are traced
-//!   through the cylinder of the pose's camera centres on a grid of pixels every
-//!   [`RAY_STEP_PX`] pixels (and along the frame's border), and every quad hit is grown by
-//!   its neighbours, so that a ray between two samples, which meets the cylinder between
-//!   their quads, is covered. A quad needs its four views and the eight flows between
-//!   them.
+//! - **Views and flows**, per walker: the quads of the grid reached by the camera's rays
+//!   that may see the walker (that pass within [`SUBJECT_RADIUS_M`] of its axis, between
+//!   [`SUBJECT_HEIGHTS_M`]: a ray that misses those bounds shows nothing of it). Rays are
+//!   traced through the cylinder of the pose's camera centres on a grid of pixels every
+//!   [`RAY_STEP_PX`] pixels over the box where the camera sees those bounds (finer for a
+//!   small box, and along its border), and every quad hit is grown by its neighbours, so
+//!   that a ray between two samples, which meets the cylinder between their quads, is
+//!   covered. A quad needs its four views and the eight flows between them. Each walker is
+//!   made resident with its own needs; the field must provide every walker's together.
 //! - **Conditions**: a basis condition whose coefficient is zero at every frame is not
 //!   relit. Turned by any yaw, heading or turntable angle, a condition's region of the
 //!   sphere stays in its band of elevations; so it is left out when every environment of
@@ -102,6 +105,34 @@ pub struct PlanCounts {
     pub bytes_total: u64,
 }
 
+/// What one walker draws: the poses, and of them the views and flows its own rays reach
+/// (summed over its poses).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct WalkerCounts {
+    /// Poses it draws.
+    pub poses: Vec<u32>,
+    /// Views made resident for it, over its poses.
+    pub views: usize,
+    /// Flow maps made resident for it, over its poses.
+    pub flows: usize,
+}
+
+impl WalkerCounts {
+    fn of(plans: &[PosePlan]) -> Self {
+        Self {
+            poses: plans.iter().map(|p| p.pose).collect(),
+            views: plans
+                .iter()
+                .map(|p| p.views.iter().filter(|&&v| v).count())
+                .sum(),
+            flows: plans
+                .iter()
+                .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
+                .sum(),
+        }
+    }
+}
+
 /// The plan of a scene on a field (see the module docs).
 #[derive(Debug, Clone, Serialize)]
 pub struct Plan {
@@ -110,8 +141,14 @@ pub struct Plan {
     pub counts: PlanCounts,
     /// Per frame rendered.
     pub frames: Vec<FramePlan>,
-    /// Per pose used.
+    /// Per pose used: what the field must provide (every walker's needs together).
     pub poses: Vec<PosePlan>,
+    /// Per walker, per pose it draws: what its own rays reach, which is all its poses
+    /// are made resident with.
+    #[serde(skip)]
+    pub walkers: Vec<Vec<PosePlan>>,
+    /// Per walker: what it reads and draws.
+    pub walker_counts: Vec<WalkerCounts>,
     /// Poses the scene asks for that the field lacks, and the pose drawn instead.
     pub poses_substituted: Vec<(u32, u32)>,
     /// Conditions left out, by name.
@@ -122,6 +159,30 @@ pub struct Plan {
     pub ground_seen: bool,
     /// What frames between captured poses show.
     pub interpolate: TimeInterpolation,
+}
+
+/// The plan of `pose` in `plans`, added (needing nothing yet) when absent.
+fn entry<'p>(
+    plans: &'p mut Vec<PosePlan>,
+    pose: u32,
+    views: usize,
+    lit: &[bool],
+) -> &'p mut PosePlan {
+    match plans.iter().position(|p| p.pose == pose) {
+        Some(k) => &mut plans[k],
+        None => {
+            plans.push(PosePlan {
+                pose,
+                views: vec![false; views],
+                flows: vec![[false; 4]; views],
+                conditions: lit.to_vec(),
+                shadow_maps: false,
+                hull: false,
+                pose_flows: [false; 2],
+            });
+            plans.last_mut().expect("just pushed")
+        }
+    }
 }
 
 /// Fractions of a pose's step this close to a pose draw that pose alone.
@@ -170,32 +231,135 @@ pub(crate) fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
         .expect("a field holds at least one pose")
 }
 
-/// The quads `(u, v)` of `cylinder` the rays of `camera` reach, sampled every
-/// [`RAY_STEP_PX`] pixels and along the border; and whether a ray meets the ground
-/// within `ground_half` metres of the subject's axis (in the same frame).
+/// Where the subject can be, in its own frame: within this distance of its axis (metres;
+/// a walker's reach, 0.4 m, with its limbs' swing and a margin for the flows that carry
+/// its edges)...
+pub const SUBJECT_RADIUS_M: f32 = 1.2;
+/// ... and between these heights (metres).
+pub const SUBJECT_HEIGHTS_M: (f32, f32) = (-0.2, 2.3);
+
+/// Whether the ray from `origin` along `dir` passes through the cylinder
+/// [`SUBJECT_RADIUS_M`] round the subject's axis between [`SUBJECT_HEIGHTS_M`]: only such
+/// rays can show the subject.
+pub(crate) fn may_see_subject(origin: Vec3, dir: Vec3) -> bool {
+    let (a, b) = (
+        dir.x * dir.x + dir.z * dir.z,
+        origin.x * dir.x + origin.z * dir.z,
+    );
+    let c = origin.x * origin.x + origin.z * origin.z - SUBJECT_RADIUS_M * SUBJECT_RADIUS_M;
+    let (t0, t1) = if a < 1e-12 {
+        // Along the axis: inside the cylinder or never.
+        if c > 0.0 {
+            return false;
+        }
+        (0.0, f32::INFINITY)
+    } else {
+        let disc = b * b - a * c;
+        if disc < 0.0 {
+            return false;
+        }
+        let r = disc.sqrt();
+        ((-b - r) / a, (-b + r) / a)
+    };
+    let t0 = t0.max(0.0);
+    if t1 < t0 {
+        return false;
+    }
+    // Heights over the span inside the cylinder.
+    let (lo, hi) = SUBJECT_HEIGHTS_M;
+    let y0 = origin.y + dir.y * t0;
+    let y1 = if t1.is_finite() {
+        origin.y + dir.y * t1
+    } else if dir.y > 0.0 {
+        f32::INFINITY
+    } else if dir.y < 0.0 {
+        f32::NEG_INFINITY
+    } else {
+        y0
+    };
+    y0.min(y1) <= hi && y0.max(y1) >= lo
+}
+
+/// The pixel box (`x0, y0, x1, y1`, inclusive, within the frame) where `camera` sees the
+/// subject's bounds ([`may_see_subject`]); `None` when it sees none of them.
+fn subject_box(camera: &Camera) -> Option<(u32, u32, u32, u32)> {
+    let (lo, hi) = SUBJECT_HEIGHTS_M;
+    let mut corners = Vec::new();
+    for k in 0..16 {
+        let a = k as f32 * std::f32::consts::TAU / 16.0;
+        // The polygon's circumradius, so that it holds the circle.
+        let r = SUBJECT_RADIUS_M / (std::f32::consts::PI / 16.0).cos();
+        for y in [lo, hi] {
+            corners.push(Vec3::new(r * a.cos(), y, r * a.sin()));
+        }
+    }
+    let projected: Vec<Vec2> = corners.iter().filter_map(|&p| camera.project(p)).collect();
+    if projected.len() < corners.len() {
+        // Part of the bounds is behind the camera: the whole frame may see it.
+        return Some((0, 0, camera.width - 1, camera.height - 1));
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (f32::MAX, f32::MAX, f32::MIN, f32::MIN);
+    for p in projected {
+        (x0, y0, x1, y1) = (x0.min(p.x), y0.min(p.y), x1.max(p.x), y1.max(p.y));
+    }
+    let (w, h) = (camera.width as f32, camera.height as f32);
+    if x1 < 0.0 || y1 < 0.0 || x0 > w - 1.0 || y0 > h - 1.0 {
+        return None;
+    }
+    let clamp = |v: f32, max: f32| v.clamp(0.0, max) as u32;
+    Some((
+        clamp(x0.floor(), w - 1.0),
+        clamp(y0.floor(), h - 1.0),
+        clamp(x1.ceil(), w - 1.0),
+        clamp(y1.ceil(), h - 1.0),
+    ))
+}
+
+/// Every `step`-th of `lo..=hi`, and `hi`.
+fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
+    let mut v: Vec<u32> = (lo..=hi).step_by(step.max(1) as usize).collect();
+    if v.last() != Some(&hi) {
+        v.push(hi);
+    }
+    v
+}
+
+/// The quads `(u, v)` of `cylinder` the rays of `camera` that may see the subject reach
+/// ([`may_see_subject`]), sampled over the box where it sees the subject's bounds every
+/// [`RAY_STEP_PX`] pixels (finer for a box of few pixels, so that a distant walker is
+/// sampled at all) and along its border; and whether a ray of the whole frame (sampled
+/// every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of the subject's
+/// axis (in the same frame).
 fn reached(
     cylinder: &Cylinder,
     camera: &Camera,
     ground_half: f32,
 ) -> (BTreeSet<(usize, usize)>, bool) {
     let (w, h) = (camera.width, camera.height);
-    let mut xs: Vec<u32> = (0..w).step_by(RAY_STEP_PX as usize).collect();
-    let mut ys: Vec<u32> = (0..h).step_by(RAY_STEP_PX as usize).collect();
-    xs.push(w - 1);
-    ys.push(h - 1);
     let mut quads = BTreeSet::new();
-    let mut ground = false;
-    for &y in &ys {
-        for &x in &xs {
-            let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
-            if let Some(hit) = cylinder.intersect(camera.centre(), dir) {
-                let v = if hit.clamped == Clamp::None {
-                    hit.v
-                } else {
-                    hit.v.min(cylinder.rows().saturating_sub(2))
-                };
-                quads.insert((hit.u, v));
+    if let Some((x0, y0, x1, y1)) = subject_box(camera) {
+        let step = ((x1 - x0).min(y1 - y0) / 8).clamp(1, RAY_STEP_PX);
+        for &y in &samples(y0, y1, step) {
+            for &x in &samples(x0, x1, step) {
+                let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
+                if !may_see_subject(camera.centre(), dir) {
+                    continue;
+                }
+                if let Some(hit) = cylinder.intersect(camera.centre(), dir) {
+                    let v = if hit.clamped == Clamp::None {
+                        hit.v
+                    } else {
+                        hit.v.min(cylinder.rows().saturating_sub(2))
+                    };
+                    quads.insert((hit.u, v));
+                }
             }
+        }
+    }
+    let mut ground = false;
+    for &y in &samples(0, h - 1, RAY_STEP_PX) {
+        for &x in &samples(0, w - 1, RAY_STEP_PX) {
+            let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
             if let Some(p) = ground_hit(camera.centre(), dir) {
                 ground |= p.x.abs() <= ground_half && p.z.abs() <= ground_half;
             }
@@ -554,7 +718,8 @@ impl Plan {
         let projector = Projector::new(&h.conditions)?;
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
         let mut ground_seen = false;
-        let mut poses: Vec<PosePlan> = Vec::new();
+        // Per walker, the poses it draws and what its own rays reach of them.
+        let mut walkers: Vec<Vec<PosePlan>> = vec![Vec::new(); scene.instances.len()];
         for (fp, frame) in frame_plans.iter().zip(frames) {
             let camera = frame.camera;
             let drawn = fp.poses.iter().enumerate().flat_map(|(i, &pose)| {
@@ -580,21 +745,7 @@ impl Plan {
                 let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
                 let (quads, ground) = reached(&cylinder, &subject_camera, half);
                 ground_seen |= ground;
-                let plan = match poses.iter_mut().position(|p| p.pose == pose) {
-                    Some(k) => &mut poses[k],
-                    None => {
-                        poses.push(PosePlan {
-                            pose,
-                            views: vec![false; views],
-                            flows: vec![[false; 4]; views],
-                            conditions: lit.clone(),
-                            shadow_maps: false,
-                            hull: false,
-                            pose_flows: [false; 2],
-                        });
-                        poses.last_mut().expect("just pushed")
-                    }
-                };
+                let plan = entry(&mut walkers[i], pose, views, &lit);
                 if let Some(step) = motion {
                     plan.pose_flows[step.index()] = true;
                 }
@@ -621,13 +772,36 @@ impl Plan {
                 }
             }
         }
+        // Every walker's plans together: what the field must provide for the shot.
+        let mut poses: Vec<PosePlan> = Vec::new();
+        for w in &walkers {
+            for p in w {
+                let union = entry(&mut poses, p.pose, views, &lit);
+                union
+                    .views
+                    .iter_mut()
+                    .zip(&p.views)
+                    .for_each(|(u, &v)| *u |= v);
+                for (u, f) in union.flows.iter_mut().zip(&p.flows) {
+                    for k in 0..4 {
+                        u[k] |= f[k];
+                    }
+                }
+                for k in 0..2 {
+                    union.pose_flows[k] |= p.pose_flows[k];
+                }
+            }
+        }
         let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;
-        for p in &mut poses {
+        for p in poses.iter_mut().chain(walkers.iter_mut().flatten()) {
             p.shadow_maps = wants_shadow && scene.shadow == ShadowSpec::Maps && h.shadows.is_some();
             // The hull is the proxy of rays beyond the grid's rows, and traced shadows'.
             p.hull = h.hulls.is_some();
         }
         poses.sort_by_key(|p| p.pose);
+        for w in &mut walkers {
+            w.sort_by_key(|p| p.pose);
+        }
 
         let counts = PlanCounts {
             poses_used: poses.len(),
@@ -659,6 +833,8 @@ impl Plan {
             counts,
             frames: frame_plans,
             poses,
+            walker_counts: walkers.iter().map(|w| WalkerCounts::of(w)).collect(),
+            walkers,
             poses_substituted: substituted.into_iter().collect(),
             conditions_left_out: left_out
                 .iter()
@@ -673,5 +849,10 @@ impl Plan {
     /// The plan of pose `pose`.
     pub fn pose(&self, pose: u32) -> Option<&PosePlan> {
         self.poses.iter().find(|p| p.pose == pose)
+    }
+
+    /// The plan of pose `pose` as walker `walker` draws it (its own rays' needs).
+    pub fn walker_pose(&self, walker: usize, pose: u32) -> Option<&PosePlan> {
+        self.walkers.get(walker)?.iter().find(|p| p.pose == pose)
     }
 }

@@ -23,7 +23,7 @@ use frf_core::io::read_photo;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 
-use super::plan::{FramePlan, Plan, ShotFrame, nearest_pose, poses_around};
+use super::plan::{FramePlan, Plan, PosePlan, ShotFrame, nearest_pose, poses_around};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
@@ -44,6 +44,24 @@ pub struct ShotOptions {
     pub planned: bool,
     /// Median-cut lights of a traced shadow.
     pub traced_lights: usize,
+}
+
+/// Whether a resident made from `have` serves a walker that needs `want` (`None`:
+/// everything).
+fn covers(have: &Option<PosePlan>, want: &Option<PosePlan>) -> bool {
+    let within = |w: &[bool], h: &[bool]| w.iter().zip(h).all(|(&w, &h)| !w || h);
+    match (have, want) {
+        (None, _) => true,
+        (Some(_), None) => false,
+        (Some(h), Some(w)) => {
+            within(&w.views, &h.views)
+                && w.flows.iter().zip(&h.flows).all(|(w, h)| within(w, h))
+                && within(&w.pose_flows, &h.pose_flows)
+                && within(&w.conditions, &h.conditions)
+                && (!w.shadow_maps || h.shadow_maps)
+                && (!w.hull || h.hull)
+        }
+    }
 }
 
 /// A walker's cache slot in a frame, and between two poses the later pose's slot and the
@@ -75,6 +93,8 @@ impl LightingKey {
 struct Cached {
     pose: u32,
     heading: u32,
+    /// What it was made from (`None`: every view, flow and condition).
+    plan: Option<PosePlan>,
     lighting: LightingKey,
     resident: Resident,
     last_frame: usize,
@@ -540,21 +560,25 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         });
         for (i, pose) in drawn {
             let heading = self.scene.instances[i].heading;
-            let found = self
-                .cache
-                .iter()
-                .position(|c| c.pose == pose && c.heading == heading.to_bits());
+            // The walker's own needs of the pose: a resident that covers them serves it
+            // (walkers of one heading seeing the same quads share one).
+            let wanted = self.walker_plan(i, pose).cloned();
+            let found = self.cache.iter().position(|c| {
+                c.pose == pose && c.heading == heading.to_bits() && covers(&c.plan, &wanted)
+            });
             let slot = match found {
                 Some(k) if self.cache[k].lighting == key => k,
                 found => {
                     let t = Instant::now();
-                    let resident = self.make_resident(pose, heading, world.as_ref())?;
+                    let resident =
+                        self.make_resident(pose, heading, world.as_ref(), wanted.as_ref())?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     self.counters.poses_made_resident += 1;
                     made_resident.push(pose);
                     let entry = Cached {
                         pose,
                         heading: heading.to_bits(),
+                        plan: wanted,
                         lighting: key.clone(),
                         resident,
                         last_frame: fp.index,
@@ -598,9 +622,25 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok((slots, made_resident))
     }
 
-    /// Reads pose `pose` (as planned), relights it for a walker of `heading` under the
-    /// scene frame's lighting `world`, and sets its shadow.
-    fn make_resident(&self, pose: u32, heading: f32, world: Option<&EnvMap>) -> Result<Resident> {
+    /// What walker `walker` needs of pose `pose` when the shot is planned (`None`:
+    /// everything).
+    fn walker_plan(&self, walker: usize, pose: u32) -> Option<&PosePlan> {
+        if self.options.planned {
+            self.plan.walker_pose(walker, pose)
+        } else {
+            None
+        }
+    }
+
+    /// Reads pose `pose` as `plan` says (everything when `None`), relights it for a walker
+    /// of `heading` under the scene frame's lighting `world`, and sets its shadow.
+    fn make_resident(
+        &self,
+        pose: u32,
+        heading: f32,
+        world: Option<&EnvMap>,
+        plan: Option<&PosePlan>,
+    ) -> Result<Resident> {
         let env = world.map(|e| e.rotated(-heading));
         let lighting = match &env {
             Some(e) => Lighting::Environment {
@@ -609,7 +649,6 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             },
             None => Lighting::Unlit,
         };
-        let plan = self.plan.pose(pose).filter(|_| self.options.planned);
         let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?;
         let mut resident = self.device.make_resident(&source)?;
         if self.plan.interpolate == TimeInterpolation::Flow {

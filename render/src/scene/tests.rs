@@ -199,3 +199,29 @@ fn a_time_between_poses_finds_both_and_the_fraction() {
     // One pose held: that pose at every instant.
     assert_eq!(poses_around(12.5, &[4], 30), (4, None));
 }
+
+#[test]
+fn only_rays_near_the_subject_may_see_it() {
+    use super::plan::may_see_subject;
+    let eye = Vec3::new(0.0, 1.5, 12.0);
+    // Straight at the body, over its head, beside it, and down onto its feet.
+    assert!(may_see_subject(
+        eye,
+        (Vec3::new(0.0, 1.0, 0.0) - eye).normalize()
+    ));
+    assert!(!may_see_subject(
+        eye,
+        (Vec3::new(0.0, 3.5, 0.0) - eye).normalize()
+    ));
+    assert!(!may_see_subject(
+        eye,
+        (Vec3::new(2.0, 1.0, 0.0) - eye).normalize()
+    ));
+    assert!(may_see_subject(
+        eye,
+        (Vec3::new(0.5, 0.0, 0.3) - eye).normalize()
+    ));
+    // Looking away, and from inside the bounds.
+    assert!(!may_see_subject(eye, Vec3::Z));
+    assert!(may_see_subject(Vec3::new(0.2, 1.0, 0.0), Vec3::Z));
+}
