@@ -30,10 +30,10 @@ PY
   done
 done
 printf "%-24s %-8s %6s %9s %9s %10s %10s %10s\n" binary walkers light wall_s resident resident_s read_MB peak_MB
-for bin in "${bins[@]}"; do
-  for n in 1 10 40; do
-    for light in constant turning; do
-      out="$work/out_$(basename "$bin")_${n}_$light"
+for n in 1 10 40; do
+  for light in constant turning; do
+    for bin in "${bins[@]}"; do
+      out="$work/out_$(echo "$bin" | tr / _)_${n}_$light"
       rm -rf "$out"
       "$bin" render "$work/crowd_${n}_$light.toml" --field "$field" --out "$out" > /dev/null 2>&1
       python3 - "$out/render.json" "$bin" "$n" "$light" <<'PY'

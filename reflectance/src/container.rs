@@ -303,6 +303,8 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     index_crc: u32,
     /// Bytes of chunks read so far (what a plan saves is measured on it).
     bytes_read: std::sync::atomic::AtomicU64,
+    /// Views' basis images kept decoded ([`FieldFile::keep_decoded`]).
+    pub(crate) decoded: crate::decoded::DecodedBasis,
 }
 
 impl FieldFile<FileSource> {
@@ -407,6 +409,7 @@ impl<R: ReadAt> FieldFile<R> {
             chunks,
             index_crc,
             bytes_read: std::sync::atomic::AtomicU64::new(0),
+            decoded: Default::default(),
         })
     }
 

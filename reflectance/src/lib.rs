@@ -13,11 +13,13 @@
 //!   Voronoi regions of the lights, turntable rotation, two floor models) and CPU
 //!   relighting.
 //! - [`container`], [`store`]: the field file, an indexed and checksummed container that
-//!   reads one view without the rest; [`stats`]: its contents and compression ratios.
+//!   reads one view without the rest; [`decoded`]: views' basis images kept decoded
+//!   between reads; [`stats`]: its contents and compression ratios.
 //!
 //! Conventions: [`frf_core::conventions`].
 
 pub mod container;
+pub mod decoded;
 pub mod error;
 pub mod field;
 pub mod flowcodec;

@@ -216,15 +216,39 @@ impl<R: ReadAt> FieldFile<R> {
     /// The basis images of a view as their mosaic's 8-bit codes and tile scales (what a
     /// GPU relights from).
     pub fn basis_codes(&self, pose: u32, u: usize, v: usize) -> Result<BasisCodes> {
+        Ok((*self.basis_codes_shared(pose, u, v)?).clone())
+    }
+
+    /// [`FieldFile::basis_codes`], shared: kept decoded within the budget
+    /// [`FieldFile::keep_decoded`] sets, so that a view read again is not decoded again.
+    pub fn basis_codes_shared(
+        &self,
+        pose: u32,
+        u: usize,
+        v: usize,
+    ) -> Result<std::sync::Arc<BasisCodes>> {
         let k = key(pose, u, v, ChunkKind::Basis);
-        let codes = self.decode_chunk(&k, decode_basis_codes)?;
-        let (w, h) = (self.header().width as usize, self.header().height as usize);
-        if codes.tiles.len() != self.header().conditions.len()
-            || (codes.width, codes.height) != (w, h)
-        {
-            return Err(self.chunk_error(&k, "images of the wrong size or count".into()));
-        }
-        Ok(codes)
+        self.decoded.get_or(k, || {
+            let codes = self.decode_chunk(&k, decode_basis_codes)?;
+            let (w, h) = (self.header().width as usize, self.header().height as usize);
+            if codes.tiles.len() != self.header().conditions.len()
+                || (codes.width, codes.height) != (w, h)
+            {
+                return Err(self.chunk_error(&k, "images of the wrong size or count".into()));
+            }
+            Ok(codes)
+        })
+    }
+
+    /// Keeps up to `bytes` of views' decoded basis images between reads (0, the default:
+    /// none), the least recently used leaving first.
+    pub fn keep_decoded(&self, bytes: u64) {
+        self.decoded.set_budget(bytes);
+    }
+
+    /// Basis reads served from views kept decoded, and decodes made, so far.
+    pub fn decoded_counts(&self) -> (u64, u64) {
+        self.decoded.counts()
     }
 
     /// The alpha of a view.

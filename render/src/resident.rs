@@ -99,6 +99,16 @@ pub struct PoseSource {
 }
 
 impl PoseSource {
+    /// Whether view `i` holds nothing (a view the plan did not read): zero alpha and zero
+    /// codes, which relight to a transparent view.
+    pub fn is_blank(&self, i: usize) -> bool {
+        self.alpha[i].iter().all(|&a| a == 0)
+            && self.basis[i]
+                .tiles
+                .iter()
+                .all(|t| t.iter().all(|p| *p == [0; 3]))
+    }
+
     /// Loads pose `pose` of a field and the relighting coefficients of `lighting`.
     pub fn load<R: ReadAt>(field: &FieldFile<R>, pose: u32, lighting: &Lighting) -> Result<Self> {
         Self::load_planned(field, pose, lighting, None)
@@ -241,10 +251,19 @@ impl PoseSource {
                     };
                     return Ok((blank, vec![0u8; texels], Default::default()));
                 }
-                let mut b = field.basis_codes(pose, u, v)?;
-                b.tiles = b.tiles.iter().map(|t| crop.rows_of(t, full_w)).collect();
-                b.width = crop.width as usize;
-                b.height = crop.height as usize;
+                // Shared with every other read of the view (kept decoded, when the
+                // caller set a budget for it), cropped here.
+                let whole = field.basis_codes_shared(pose, u, v)?;
+                let b = BasisCodes {
+                    width: crop.width as usize,
+                    height: crop.height as usize,
+                    tiles: whole
+                        .tiles
+                        .iter()
+                        .map(|t| crop.rows_of(t, full_w))
+                        .collect(),
+                    scales: whole.scales.clone(),
+                };
                 let a: Vec<u8> = alphas[i]
                     .pixels()
                     .iter()

@@ -454,6 +454,11 @@ impl Gpu {
         });
         let groups = (texels as u32).div_ceil(WORKGROUP);
         for (i, basis) in source.basis.iter().enumerate() {
+            if source.is_blank(i) {
+                // A view not read: its layer stays as made, zero (transparent), as the
+                // CPU relights it, and its peak zero (scale 1).
+                continue;
+            }
             let mut packed = Vec::with_capacity(tiles * texels);
             for (k, tile) in basis.tiles.iter().enumerate() {
                 packed.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {

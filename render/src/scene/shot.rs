@@ -34,10 +34,15 @@ use crate::resident::{Lighting, PoseSource};
 use crate::shadow::{ShadowMaps, traced_shadow};
 use frf_core::grid::PoseStep;
 
+/// The share of the memory budget, `1 / DECODED_SHARE`, that keeps views' basis images
+/// decoded between reads ([`FieldFile::keep_decoded`]), besides the resident poses'.
+pub const DECODED_SHARE: u64 = 4;
+
 /// How a shot is rendered.
 #[derive(Debug, Clone, Copy)]
 pub struct ShotOptions {
-    /// Most bytes the resident poses may hold together.
+    /// Most bytes the resident poses may hold together (and a quarter of it again for
+    /// views kept decoded, [`DECODED_SHARE`]).
     pub memory_budget: u64,
     /// Read, relight and draw only what the plan says (else every view, flow and
     /// condition of the poses drawn).
@@ -113,6 +118,11 @@ pub struct ShotCounters {
     pub peak_resident_bytes: u64,
     /// Seconds reading and relighting poses.
     pub residency_seconds: f64,
+    /// Views' basis images read from those kept decoded, and decoded, for the field so
+    /// far ([`DECODED_SHARE`]).
+    pub basis_views_reused: u64,
+    /// (See `basis_views_reused`.)
+    pub basis_views_decoded: u64,
 }
 
 /// One rendered frame of a shot.
@@ -208,6 +218,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         options: ShotOptions,
     ) -> Result<Self> {
         let plan = Plan::new(&scene, field, frames)?;
+        // Views read again (by another walker's heading, or a new light) are not decoded
+        // again: a quarter of the budget keeps them decoded.
+        field.keep_decoded(options.memory_budget / DECODED_SHARE);
         let plate = match &scene.backdrop {
             BackdropSpec::Plate(p) => Some(read_photo(p)?),
             _ => None,
@@ -573,6 +586,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     let resident =
                         self.make_resident(pose, heading, world.as_ref(), wanted.as_ref())?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
+                    (
+                        self.counters.basis_views_reused,
+                        self.counters.basis_views_decoded,
+                    ) = self.field.decoded_counts();
                     self.counters.poses_made_resident += 1;
                     made_resident.push(pose);
                     let entry = Cached {
