@@ -168,14 +168,7 @@ pub fn pose_motion<R: ReadAt>(
             None => (1.0, vec![[0; 4]; texels]),
         })
         .unzip();
-    Ok(Some(ResidentPose {
-        geometry: source.geometry.clone(),
-        flows: source.flows.clone(),
-        scales,
-        prelit,
-        srgb_table: srgb_lut(),
-        plan: source.plan.clone(),
-    }))
+    Ok(Some(ResidentPose::with_views(source, scales, prelit)))
 }
 
 /// One view's motion (metres) as pre-lit texels and their scale (see the module docs).

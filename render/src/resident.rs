@@ -458,6 +458,13 @@ impl ResidentPose {
             })
             .collect();
         let (scales, prelit) = views.into_iter().unzip();
+        Self::with_views(source, scales, prelit)
+    }
+
+    /// The pose of `source`'s geometry, flows and lighting plan with the pre-lit views
+    /// `prelit` of `scales` (its relit colour, or what else its views carry:
+    /// [`crate::motion::pose_motion`]).
+    pub fn with_views(source: &PoseSource, scales: Vec<f32>, prelit: Vec<Vec<[u8; 4]>>) -> Self {
         Self {
             geometry: source.geometry.clone(),
             flows: source.flows.clone(),

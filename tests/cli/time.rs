@@ -8,6 +8,25 @@
 
 use crate::common::{frf, stderr};
 
+/// Ingests `cap` into `out` with its pose flows (fast flow, no shadows) and `extra`
+/// arguments: what the ingest printed.
+fn ingest(cap: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "ingest",
+        cap.to_str().unwrap(),
+        "--flow-preset",
+        "fast",
+        "--pose-flow",
+        "--no-shadows",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
 /// Stages the tiny preset's `poses` (cycles repeating exactly) at `size` into `cap`.
 fn stage(cap: &std::path::Path, poses: &str, size: &str) {
     let o = frf(&[
@@ -34,22 +53,7 @@ fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
     let d = dir.path();
     let cap = d.join("cap");
     stage(&cap, "0,1,2", "32x45");
-    let ingest = |out: &std::path::Path, extra: &[&str]| {
-        let mut args = vec![
-            "ingest",
-            cap.to_str().unwrap(),
-            "--flow-preset",
-            "fast",
-            "--pose-flow",
-            "--no-shadows",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = frf(&args);
-        assert!(o.status.success(), "{}", stderr(&o));
-        String::from_utf8_lossy(&o.stdout).into_owned()
-    };
+    let ingest = |out: &std::path::Path, extra: &[&str]| ingest(&cap, out, extra);
     let whole = d.join("whole.frf");
     let said = ingest(&whole, &[]);
     // Judged against the truth: at 32x45 the walker moves a third of a pixel between
@@ -110,18 +114,7 @@ fn a_shot_between_poses_moves_as_the_truth_does() {
     let d = dir.path();
     let cap = d.join("cap");
     stage(&cap, "0,1,2,3", "64x90");
-    let field = d.join("f.frf");
-    let o = frf(&[
-        "ingest",
-        cap.to_str().unwrap(),
-        "--flow-preset",
-        "fast",
-        "--pose-flow",
-        "--no-shadows",
-        "--out",
-        field.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    ingest(&cap, &d.join("f.frf"), &[]);
     let scene = |name: &str, interpolate: &str| {
         let path = d.join(name);
         std::fs::write(

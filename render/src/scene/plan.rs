@@ -78,6 +78,39 @@ pub struct FramePlan {
     pub between: Vec<Option<(u32, f32)>>,
 }
 
+impl FramePlan {
+    /// Frame `index` at `time` of `scene` on a field of header `h` holding `field_poses`
+    /// (sorted): each walker's pose, the nearest held, or, morphing in time, the held
+    /// poses around its instant ([`poses_around`]).
+    pub fn at(
+        scene: &Scene,
+        h: &FieldHeader,
+        field_poses: &[u32],
+        interpolate: TimeInterpolation,
+        (index, time): (usize, f32),
+    ) -> Self {
+        let (poses, between) = (0..scene.instances.len())
+            .map(|i| match interpolate {
+                TimeInterpolation::Nearest => {
+                    let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                    (nearest_pose(wanted, field_poses, h.poses_per_cycle), None)
+                }
+                TimeInterpolation::Flow => {
+                    let at =
+                        scene.phase_at(i, time, h.cycle_seconds) * h.poses_per_cycle.max(1) as f64;
+                    poses_around(at, field_poses, h.poses_per_cycle)
+                }
+            })
+            .unzip();
+        Self {
+            index,
+            time,
+            poses,
+            between,
+        }
+    }
+}
+
 /// The counts a person reads (and `frf render --plan --json` prints).
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct PlanCounts {
@@ -686,29 +719,14 @@ impl Plan {
             .iter()
             .map(|f| {
                 let (index, time) = (f.index, f.time);
-                let (poses, between) = (0..scene.instances.len())
-                    .map(|i| match interpolate {
-                        TimeInterpolation::Nearest => {
-                            let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                            let held = nearest_pose(wanted, &field_poses, h.poses_per_cycle);
-                            if held != wanted {
-                                substituted.insert((wanted, held));
-                            }
-                            (held, None)
-                        }
-                        TimeInterpolation::Flow => {
-                            let at = scene.phase_at(i, time, h.cycle_seconds)
-                                * h.poses_per_cycle.max(1) as f64;
-                            poses_around(at, &field_poses, h.poses_per_cycle)
-                        }
-                    })
-                    .unzip();
-                FramePlan {
-                    index,
-                    time,
-                    poses,
-                    between,
+                let fp = FramePlan::at(scene, h, &field_poses, interpolate, (index, time));
+                for (i, &held) in fp.poses.iter().enumerate() {
+                    let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                    if interpolate == TimeInterpolation::Nearest && held != wanted {
+                        substituted.insert((wanted, held));
+                    }
                 }
+                fp
             })
             .collect();
 

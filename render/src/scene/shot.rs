@@ -23,7 +23,7 @@ use frf_core::io::read_photo;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 
-use super::plan::{FramePlan, Plan, PosePlan, ShotFrame, nearest_pose, poses_around};
+use super::plan::{FramePlan, Plan, PosePlan, ShotFrame};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
@@ -403,27 +403,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let h = self.field.header();
         let mut held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
         held.sort_unstable();
-        let (poses, between) = (0..self.scene.instances.len())
-            .map(|i| match self.plan.interpolate {
-                TimeInterpolation::Nearest => {
-                    let wanted = self
-                        .scene
-                        .pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                    (nearest_pose(wanted, &held, h.poses_per_cycle), None)
-                }
-                TimeInterpolation::Flow => {
-                    let at = self.scene.phase_at(i, time, h.cycle_seconds)
-                        * h.poses_per_cycle.max(1) as f64;
-                    poses_around(at, &held, h.poses_per_cycle)
-                }
-            })
-            .unzip();
-        FramePlan {
-            index,
-            time,
-            poses,
-            between,
-        }
+        FramePlan::at(&self.scene, h, &held, self.plan.interpolate, (index, time))
     }
 
     /// Draws the frame of `camera` at `time` into the kept targets of its size (on the
