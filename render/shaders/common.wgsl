@@ -14,6 +14,11 @@ struct View {
     intrinsics: vec4<f32>,
     // Flow texture layer toward right, left, up, down; -1 where there is none.
     flow_layers: vec4<i32>,
+    // Pre-lit texture layer; -1 for a view not held (transparent).
+    prelit_layer: i32,
+    pad0: i32,
+    pad1: i32,
+    pad2: i32,
 }
 
 // A quad of the cylinder of camera centres (or a wall above / below the grid).
@@ -66,6 +71,9 @@ struct Frame {
     // Refinements: 1 rays beyond the rows through the proxy, 2 occlusion-aware morphs.
     flags: u32,
     pad: u32,
+    // The pixels shaded, [x0, y0, x1, y1] (ends exclusive): the walker is transparent
+    // outside them (`render/src/footprint.rs`).
+    bounds: vec4<u32>,
 }
 
 // The pose's geometric proxy: the visual hull's grid (its bits are bound beside it) and

@@ -34,12 +34,14 @@ struct Composite {
 }
 
 // A walker's subject frame: `subject_from_world`, as columns and translation; the
-// translation's w is 1 when the walker has a relit shadow.
+// translation's w is 1 when the walker has a relit shadow. Its layer is transparent
+// outside `bounds` ([x0, y0, x1, y1], ends exclusive), and not read there.
 struct Instance {
     col_x: vec4<f32>,
     col_y: vec4<f32>,
     col_z: vec4<f32>,
     translation: vec4<f32>,
+    bounds: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -193,6 +195,10 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
     // The walkers, each over the ones behind it.
     var front = vec4<f32>(0.0);
     for (var i = 0u; i < params.instances; i++) {
+        let b = instances[i].bounds;
+        if (any(vec2<u32>(pixel) < b.xy) || any(vec2<u32>(pixel) >= b.zw)) {
+            continue;
+        }
         let layer = textureLoad(subjects, pixel, i32(i), 0);
         front = layer + (1.0 - clamp(layer.w, 0.0, 1.0)) * front;
     }

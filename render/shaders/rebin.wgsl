@@ -7,10 +7,11 @@
 // Composed after it: the re-binning through the cylinder (`rebin/cylinder.wgsl`), the
 // geometric proxy (`rebin/proxy.wgsl`), E06's morphs (`morph/e06.wgsl`) and the solved
 // morph (`morph/solved.wgsl`, variant 4).
-// Entry points: `fs_main` (a full-screen triangle into a colour target), `cs_main` (the
-// same pixels from a compute pass into a storage texture, and what happened to each
-// pixel's ray counted per workgroup, then once per workgroup into `stats`), `cs_classes`
-// (those counts alone, for frames drawn by `fs_main`).
+// Entry points: `fs_main` (a full-screen triangle into a colour target, scissored to the
+// frame's bounds), `cs_main` (the pixels of the frame's bounds from a compute pass into a
+// storage texture, and what happened to each pixel's ray counted per workgroup, then once
+// per workgroup into `stats`), `cs_classes` (those counts alone, for frames drawn by
+// `fs_main`).
 // Bind group 0 holds per-frame data, bind group 1 the resident pose.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -186,9 +187,10 @@ fn flush_counts(local: u32) {
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     clear_counts(local);
-    if (id.x < frame.size.x && id.y < frame.size.y) {
-        let c = classify(vec2<f32>(id.xy) + 0.5);
-        textureStore(target_image, id.xy, shade_classified(c));
+    let p = id.xy + frame.bounds.xy;
+    if (all(p < frame.bounds.zw)) {
+        let c = classify(vec2<f32>(p) + 0.5);
+        textureStore(target_image, p, shade_classified(c));
         atomicAdd(&class_counts[c.kind], 1u);
     }
     flush_counts(local);
@@ -198,8 +200,9 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocati
 @compute @workgroup_size(8, 8)
 fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     clear_counts(local);
-    if (id.x < frame.size.x && id.y < frame.size.y) {
-        atomicAdd(&class_counts[classify(vec2<f32>(id.xy) + 0.5).kind], 1u);
+    let p = id.xy + frame.bounds.xy;
+    if (all(p < frame.bounds.zw)) {
+        atomicAdd(&class_counts[classify(vec2<f32>(p) + 0.5).kind], 1u);
     }
     flush_counts(local);
 }

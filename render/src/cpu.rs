@@ -9,6 +9,7 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use crate::cylinder::{Clamp, Cylinder, CylinderHit};
+use crate::footprint::PixelBox;
 use crate::morph::{Variant, shade};
 use crate::resident::ResidentPose;
 
@@ -69,14 +70,30 @@ pub fn render_cpu(
     camera: &Camera,
     variant: Variant,
 ) -> (Image<Rgba>, FrameStats) {
+    render_cpu_within(pose, camera, variant, None)
+}
+
+/// [`render_cpu`] shading only the pixels `within` (the whole frame when `None`): the
+/// others are transparent and counted as missed, as the GPU's frame pass leaves them.
+pub fn render_cpu_within(
+    pose: &ResidentPose,
+    camera: &Camera,
+    variant: Variant,
+    within: Option<PixelBox>,
+) -> (Image<Rgba>, FrameStats) {
     let cylinder = &pose.geometry.cylinder;
     let (w, h) = (camera.width as usize, camera.height as usize);
+    let within = within.unwrap_or(PixelBox::whole(camera.width, camera.height));
     let rows: Vec<(Vec<Rgba>, FrameStats)> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut stats = FrameStats::default();
             let row = (0..w)
                 .map(|x| {
+                    if !within.contains(x as u32, y as u32) {
+                        stats.count(None);
+                        return [0.0; 4];
+                    }
                     let (px, hit) = render_pixel(
                         pose,
                         cylinder,

@@ -117,6 +117,11 @@ pub struct PoseGeometry {
     pub flow_layers: Vec<[i32; 4]>,
     /// Stored flows (layers of the flow array).
     pub flow_layer_count: usize,
+    /// Per view, its layer in the pose's pre-lit array; `-1` for a view not held (one a
+    /// plan left out: transparent, and no memory spent on it).
+    pub prelit_layers: Vec<i32>,
+    /// Held views (layers of the pre-lit array).
+    pub prelit_layer_count: usize,
     /// Where rays beyond the grid's rows meet the subject.
     pub proxy: Proxy,
 }
@@ -136,6 +141,7 @@ impl PoseGeometry {
         has_flow: impl Fn(usize, Neighbour) -> bool,
     ) -> Self {
         let centres: Vec<Vec3> = cameras.iter().map(|c| c.centre()).collect();
+        let cameras_len = cameras.len();
         let cylinder = Cylinder::new(&centres, columns, rows, wraps);
         let frame_rows = rows.saturating_sub(1).max(1);
         let view = |u: usize, v: usize| (u % columns) * rows + v.min(rows - 1);
@@ -172,8 +178,31 @@ impl PoseGeometry {
             frames,
             flow_layers,
             flow_layer_count: next as usize,
+            prelit_layers: (0..cameras_len as i32).collect(),
+            prelit_layer_count: cameras_len,
             proxy: Proxy::default(),
         }
+    }
+
+    /// The same geometry holding only the views for which `held(view)` holds (the
+    /// others are transparent and have no pre-lit layer).
+    pub fn with_held(mut self, held: impl Fn(usize) -> bool) -> Self {
+        let mut next = 0i32;
+        for (i, layer) in self.prelit_layers.iter_mut().enumerate() {
+            *layer = if held(i) {
+                next += 1;
+                next - 1
+            } else {
+                -1
+            };
+        }
+        self.prelit_layer_count = next as usize;
+        self
+    }
+
+    /// Whether view `i` is held (has a pre-lit layer).
+    pub fn holds(&self, i: usize) -> bool {
+        self.prelit_layers[i] >= 0
     }
 
     /// The same geometry with `proxy` as its geometric proxy.
@@ -206,14 +235,15 @@ impl PoseGeometry {
     }
 
     /// Bytes the pose holds where it is rendered, on the GPU or in the CPU's copy (the
-    /// same layout): pre-lit RGBA8 texels per view, RG8 flow codes per stored flow (at
+    /// same layout): pre-lit RGBA8 texels per held view (at least one layer), RG8 flow codes per stored flow (at
     /// least one layer), the view and quad tables, the cylinder's column index, the
     /// decoding tables and the proxy.
     pub fn resident_bytes(&self) -> u64 {
         let texels = self.crop.texels() as u64;
         let quads = self.cylinder.quads().len() as u64;
         let (index, ranges) = self.cylinder.column_index_gpu();
-        texels * (4 * self.views() as u64 + 2 * self.flow_layer_count.max(1) as u64)
+        texels
+            * (4 * self.prelit_layer_count.max(1) as u64 + 2 * self.flow_layer_count.max(1) as u64)
             + self.views() as u64 * std::mem::size_of::<GpuView>() as u64
             + quads * std::mem::size_of::<GpuQuad>() as u64
             + (std::mem::size_of_val(&index) + std::mem::size_of_val(ranges.as_slice())) as u64

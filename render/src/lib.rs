@@ -24,6 +24,7 @@ pub mod cpu;
 pub mod cylinder;
 pub mod error;
 pub mod extend;
+pub mod footprint;
 pub mod geometry;
 pub mod gpu;
 pub mod morph;

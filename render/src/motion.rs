@@ -165,7 +165,7 @@ pub fn pose_motion<R: ReadAt>(
             Some(v) => v,
             // A view read without motion: still, and opaque, so it weighs in the mix.
             None if read => encode_view(&vec![Vec2::ZERO; texels]),
-            None => (1.0, vec![[0; 4]; texels]),
+            None => (1.0, Vec::new()),
         })
         .unzip();
     Ok(Some(ResidentPose::with_views(source, scales, prelit)))

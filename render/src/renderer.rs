@@ -13,8 +13,9 @@ use frf_core::camera::{Camera, Rigid};
 use frf_core::image::{Image, Rgb, Rgba};
 
 use crate::composite::{Backdrop, Layers, back_to_front, compose, stack};
-use crate::cpu::{FrameStats, render_cpu};
+use crate::cpu::{FrameStats, render_cpu, render_cpu_within};
 use crate::error::Result;
+use crate::footprint::PixelBox;
 use crate::gpu::composite::{GpuBackdrop, GpuBetween, GpuInstanceRef};
 use crate::gpu::{Gpu, GpuPose};
 use crate::morph::Variant;
@@ -89,6 +90,7 @@ impl Resident {
                 pose,
                 world_from_subject,
                 between: None,
+                within: None,
             }),
             ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
                 "a CPU-resident pose given to the GPU renderer".into(),
@@ -126,12 +128,16 @@ pub struct Walker<'a> {
     /// toward `resident`'s, which has its motion toward it), and the fraction of the way
     /// ([`crate::motion`]).
     pub between: Option<(&'a Resident, f32)>,
+    /// The pixels where it may show ([`crate::footprint::subject_box`]): only these are
+    /// shaded; `None`, the whole frame.
+    pub within: Option<PixelBox>,
 }
 
 impl<'a> Walker<'a> {
     /// The walker of a GPU frame (its poses resident on the GPU).
     pub fn gpu_instance(&self) -> Result<GpuInstanceRef<'a>> {
         let mut i = self.resident.gpu_instance(self.world_from_subject)?;
+        i.within = self.within;
         if let Some((after, s)) = self.between {
             let gpu = |k: Option<&'a ResidentKind>, step| match k {
                 Some(ResidentKind::Gpu(p)) => Ok(&**p),
@@ -345,7 +351,8 @@ impl Device {
             let w = &walkers[k];
             let subject_from_world = w.world_from_subject.inverse();
             let seen = camera.transformed(&subject_from_world);
-            let (img, s) = render_cpu(cpu_pose(&w.resident.kind)?, &seen, variant);
+            let render = |pose, seen: &Camera| render_cpu_within(pose, seen, variant, w.within);
+            let (img, s) = render(cpu_pose(&w.resident.kind)?, &seen);
             stats = stats.merge(s);
             drawn.push(match w.between {
                 None => img,
@@ -357,9 +364,9 @@ impl Device {
                         };
                         m.as_ref().ok_or_else(|| no_motion(step))
                     });
-                    let after_img = render_cpu(cpu_pose(&after.kind)?, &seen, variant).0;
-                    let before_motion = render_cpu(cpu_pose(next?)?, &seen, variant).0;
-                    let after_motion = render_cpu(cpu_pose(prev?)?, &seen, variant).0;
+                    let after_img = render(cpu_pose(&after.kind)?, &seen).0;
+                    let before_motion = render(cpu_pose(next?)?, &seen).0;
+                    let after_motion = render(cpu_pose(prev?)?, &seen).0;
                     let pair = TimePair {
                         before: &img,
                         after: &after_img,
@@ -485,6 +492,7 @@ impl Renderer {
                 translation: glam::Vec3::ZERO,
             },
             between: None,
+            within: None,
         };
         self.device
             .render_frame(&[walker], backdrop, camera, variant, layers)

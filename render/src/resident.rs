@@ -85,9 +85,10 @@ pub struct PoseSource {
     pub geometry: Arc<PoseGeometry>,
     /// The flows.
     pub flows: Arc<PoseFlows>,
-    /// Per view: the basis mosaic's codes and scales, cropped.
+    /// Per view: the basis mosaic's codes and scales, cropped (no tiles for a view not
+    /// read).
     pub basis: Vec<BasisCodes>,
-    /// Per view: alpha codes (`round(255 α)`), cropped.
+    /// Per view: alpha codes (`round(255 α)`), cropped (none for a view not read).
     pub alpha: Vec<Vec<u8>>,
     /// Per view and condition: relighting coefficients (RGB).
     pub coefficients: Vec<Vec<Rgb>>,
@@ -99,14 +100,10 @@ pub struct PoseSource {
 }
 
 impl PoseSource {
-    /// Whether view `i` holds nothing (a view the plan did not read): zero alpha and zero
-    /// codes, which relight to a transparent view.
+    /// Whether view `i` holds nothing (a view the plan did not read): no alpha and no
+    /// codes, and no pre-lit layer once resident (it samples as transparent).
     pub fn is_blank(&self, i: usize) -> bool {
-        self.alpha[i].iter().all(|&a| a == 0)
-            && self.basis[i]
-                .tiles
-                .iter()
-                .all(|t| t.iter().all(|p| *p == [0; 3]))
+        self.alpha[i].is_empty()
     }
 
     /// Loads pose `pose` of a field and the relighting coefficients of `lighting`.
@@ -242,14 +239,13 @@ impl PoseSource {
             .map(|i| {
                 let (u, v) = (i / rows, i % rows);
                 if !view_used(i) {
-                    let texels = crop.texels();
                     let blank = BasisCodes {
                         width: crop.width as usize,
                         height: crop.height as usize,
-                        tiles: vec![vec![[0u8; 3]; texels]; h.conditions.len()],
-                        scales: vec![1.0; h.conditions.len()],
+                        tiles: Vec::new(),
+                        scales: Vec::new(),
                     };
-                    return Ok((blank, vec![0u8; texels], Default::default()));
+                    return Ok((blank, Vec::new(), Default::default()));
                 }
                 // Shared with every other read of the view (kept decoded, when the
                 // caller set a budget for it), cropped here.
@@ -298,7 +294,8 @@ impl PoseSource {
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
             })
-            .with_proxy(Proxy::new(hull));
+            .with_proxy(Proxy::new(hull))
+            .with_held(|i| read[i]);
         Ok(Self {
             geometry: Arc::new(geometry),
             flows: Arc::new(PoseFlows {
@@ -324,7 +321,8 @@ pub struct ResidentPose {
     pub flows: Arc<PoseFlows>,
     /// Per view: colour scale.
     pub scales: Vec<f32>,
-    /// Per view: RGBA8 texels (sRGB colour / scale, linear alpha), cropped.
+    /// Per view: RGBA8 texels (sRGB colour / scale, linear alpha), cropped; none for a
+    /// view not held.
     pub prelit: Vec<Vec<[u8; 4]>>,
     /// Decoding table of the pre-lit texels ([`srgb_lut`]).
     pub srgb_table: [f32; 256],
@@ -439,6 +437,9 @@ impl ResidentPose {
         let views: Vec<(f32, Vec<[u8; 4]>)> = (0..source.basis.len())
             .into_par_iter()
             .map(|i| {
+                if source.is_blank(i) {
+                    return (1.0, Vec::new());
+                }
                 let b = &source.basis[i];
                 let n = b.width * b.height;
                 let relit: Vec<Rgb> = (0..n)
@@ -494,6 +495,10 @@ impl ResidentPose {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let texels = &self.prelit[view];
+        if texels.is_empty() {
+            // A view not held: transparent.
+            return [0.0; 4];
+        }
         let scale = self.scales[view];
         let lut = &self.srgb_table;
         let mut out = [0.0f32; 4];

@@ -10,11 +10,15 @@ fn srgb_value(code: u32) -> f32 {
 
 // Bilinear sample of a pre-lit view at full-image coordinates s (edge repeated).
 fn sample_prelit(view: u32, s: vec2<f32>) -> vec4<f32> {
+    let layer = views[view].prelit_layer;
+    if (layer < 0) {
+        return vec4<f32>(0.0);
+    }
     let c = crop_position(s);
     let scale = views[view].scale;
     var out = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
-        let t = textureLoad(prelit, c.texel[k], i32(view), 0);
+        let t = textureLoad(prelit, c.texel[k], layer, 0);
         let wt = c.weight[k];
         out.x += wt * (scale * srgb_value(t.x));
         out.y += wt * (scale * srgb_value(t.y));

@@ -289,6 +289,7 @@ pub fn run(
         for &size in &options.sizes {
             let camera = bench_camera(size)?;
             let targets = SubjectTargets::new(&gpu.device, &pass, size, 1);
+            let whole = crate::footprint::PixelBox::whole(size.0, size.1);
             for &stage in &options.stages {
                 let floor_ms = rows
                     .iter()
@@ -313,7 +314,7 @@ pub fn run(
                         bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
                     );
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                        pass.record(e, &targets, 0, &gpu_pose.bind_group, stage, size, t, false)
+                        pass.record(e, &targets, 0, &gpu_pose.bind_group, stage, whole, t, false)
                     })?;
                     let timing = median_min(&times);
                     let error = match reference.iter().find(|(rv, _)| *rv == v) {
@@ -325,7 +326,7 @@ pub fn run(
                                 0,
                                 &gpu_pose.bind_group,
                                 stage,
-                                size,
+                                whole,
                                 None,
                                 false,
                             );

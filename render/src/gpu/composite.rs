@@ -27,6 +27,7 @@ use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
 use crate::error::Result;
+use crate::footprint::PixelBox;
 use crate::morph::Variant;
 
 /// The pass's layouts and pipeline.
@@ -82,6 +83,8 @@ pub struct GpuInstanceRef<'a> {
     pub world_from_subject: Rigid,
     /// Between `pose` and a later pose ([`crate::motion`]).
     pub between: Option<GpuBetween<'a>>,
+    /// The pixels where it may show: only these are shaded; `None`, the whole frame.
+    pub within: Option<PixelBox>,
 }
 
 /// A walker between two captured poses: the later pose, both poses' motion toward the
@@ -325,11 +328,13 @@ impl Gpu {
                     .map(|i| i.world_from_subject.translation)
                     .collect::<Vec<_>>(),
             );
-            let drawn: Vec<(&GpuPose, Camera)> = order
+            let whole = PixelBox::whole(size.0, size.1);
+            let drawn: Vec<(&GpuPose, Camera, PixelBox)> = order
                 .iter()
                 .map(|&k| {
                     let i = &instances[k];
-                    (i.pose, camera.transformed(&i.world_from_subject.inverse()))
+                    let seen = camera.transformed(&i.world_from_subject.inverse());
+                    (i.pose, seen, i.within.unwrap_or(whole))
                 })
                 .collect();
             let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);
@@ -342,6 +347,7 @@ impl Gpu {
                         layer,
                         between: b,
                         camera: drawn[layer].1,
+                        within: drawn[layer].2,
                     })
                 })
                 .collect();
@@ -378,6 +384,7 @@ impl Gpu {
                     col_y: m.rotation.y_axis.extend(0.0).to_array(),
                     col_z: m.rotation.z_axis.extend(0.0).to_array(),
                     translation: m.translation.extend(if has { 1.0 } else { 0.0 }).to_array(),
+                    bounds: drawn[layer].2.to_array(),
                 });
             }
             let mut params = backdrop.params;

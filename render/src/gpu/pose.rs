@@ -134,7 +134,6 @@ impl Gpu {
     fn upload_pose_unscoped(&self, source: &PoseSource) -> Result<GpuPose> {
         let geometry = &source.geometry;
         let crop = geometry.crop;
-        let views = geometry.views();
         let texels = crop.texels();
         let extent = |layers: u32| wgpu::Extent3d {
             width: crop.width,
@@ -168,7 +167,7 @@ impl Gpu {
         );
         let prelit = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("prelit"),
-            size: extent(views as u32),
+            size: extent(geometry.prelit_layer_count as u32),
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -218,17 +217,26 @@ impl Gpu {
                     bytes,
                 )
             };
-            let prelit_bytes: Vec<u8> = resident
-                .prelit
-                .iter()
-                .flatten()
-                .flatten()
-                .copied()
-                .collect();
+            // The held views' texels, layer by layer (a held view without texels: zero).
+            let mut prelit_bytes: Vec<u8> =
+                Vec::with_capacity(geometry.prelit_layer_count.max(1) * texels * 4);
+            for (i, view) in resident.prelit.iter().enumerate() {
+                if !geometry.holds(i) {
+                    continue;
+                }
+                if view.is_empty() {
+                    prelit_bytes.resize(prelit_bytes.len() + texels * 4, 0);
+                } else {
+                    prelit_bytes.extend(view.iter().flatten());
+                }
+            }
+            if prelit_bytes.is_empty() {
+                prelit_bytes = vec![0; texels * 4];
+            }
             let prelit = texture(
                 "prelit",
                 pass.formats.image.texture(),
-                resident.prelit.len(),
+                geometry.prelit_layer_count,
                 &prelit_bytes,
             );
             let stored = resident.flows.codes.iter().flat_map(|f| f.iter().flatten());
@@ -287,7 +295,8 @@ impl Gpu {
             .iter()
             .zip(&scales)
             .zip(&geometry.flow_layers)
-            .map(|((cam, &scale), l)| {
+            .zip(&geometry.prelit_layers)
+            .map(|(((cam, &scale), l), &prelit_layer)| {
                 let q = Quat::from_mat3(&cam.world_from_camera.rotation);
                 let k = &cam.intrinsics;
                 GpuView {
@@ -296,6 +305,8 @@ impl Gpu {
                     scale,
                     intrinsics: [k.fx, k.fy, k.cx, k.cy],
                     flow_layers: *l,
+                    prelit_layer,
+                    pad: [0; 3],
                 }
             })
             .collect();
@@ -406,7 +417,12 @@ impl Gpu {
     fn relight_views(&self, source: &PoseSource, prelit: &wgpu::Texture) -> Result<Vec<f32>> {
         let crop = source.geometry.crop;
         let texels = crop.texels();
-        let tiles = source.basis.first().map_or(0, |b| b.tiles.len());
+        let tiles = source
+            .basis
+            .iter()
+            .map(|b| b.tiles.len())
+            .max()
+            .unwrap_or(0);
         let views = source.basis.len();
         let basis_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("basis"),
@@ -454,9 +470,10 @@ impl Gpu {
         });
         let groups = (texels as u32).div_ceil(WORKGROUP);
         for (i, basis) in source.basis.iter().enumerate() {
-            if source.is_blank(i) {
-                // A view not read: its layer stays as made, zero (transparent), as the
-                // CPU relights it, and its peak zero (scale 1).
+            let layer = source.geometry.prelit_layers[i];
+            if source.is_blank(i) || layer < 0 {
+                // A view not read: it has no layer (it samples as transparent, as the
+                // CPU's does), and its peak stays zero (scale 1).
                 continue;
             }
             let mut packed = Vec::with_capacity(tiles * texels);
@@ -494,7 +511,7 @@ impl Gpu {
             );
             let layer = prelit.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: i as u32,
+                base_array_layer: layer as u32,
                 array_layer_count: Some(1),
                 ..Default::default()
             });
@@ -566,7 +583,8 @@ impl Gpu {
             .collect())
     }
 
-    /// Reads back the pre-lit texels of every view (for tests and inspection).
+    /// Reads back the pre-lit texels of every view (for tests and inspection; a view not
+    /// held reads as no texels).
     pub fn read_prelit(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
         self.scoped("reading pre-lit views back", || {
             self.read_prelit_unscoped(pose)
@@ -575,7 +593,8 @@ impl Gpu {
 
     fn read_prelit_unscoped(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
         let (w, h) = (pose.geometry.crop.width, pose.geometry.crop.height);
-        let layers = pose.scales.len() as u32;
+        let g = &pose.geometry;
+        let layers = g.prelit_layer_count.max(1) as u32;
         let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -592,8 +611,13 @@ impl Gpu {
         copy_to_buffer(&mut encoder, &pose.prelit, &buffer, row, (w, h, layers));
         self.queue.submit([encoder.finish()]);
         let bytes = self.read_buffer(&buffer)?;
-        Ok((0..layers as usize)
-            .map(|l| {
+        Ok(g.prelit_layers
+            .iter()
+            .map(|&l| {
+                if l < 0 {
+                    return Vec::new();
+                }
+                let l = l as usize;
                 (0..h as usize)
                     .flat_map(|y| {
                         let start = (l * h as usize + y) * row as usize;

@@ -20,6 +20,7 @@ use super::readback::Readback;
 use super::types::{GpuColumnIndex, GpuFrame, GpuProxy, GpuQuad, GpuQuadFrame, GpuView};
 use crate::cpu::FrameStats;
 use crate::error::Result;
+use crate::footprint::PixelBox;
 use crate::morph::Variant;
 
 /// Whether a pass runs as a full-screen triangle or as a compute dispatch.
@@ -157,6 +158,8 @@ impl RebinPass {
 /// pixel-class counters summed over the instances.
 pub(super) struct Subjects {
     targets: Arc<SubjectTargets>,
+    /// Pixels outside the walkers' bounds, summed over the walkers: not shaded, missed.
+    outside: usize,
 }
 
 impl Subjects {
@@ -196,6 +199,7 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         crop_size: [1, 1],
         flags: variant.flags(),
         pad: 0,
+        bounds: PixelBox::whole(camera.width, camera.height).to_array(),
     };
     if let Some(pose) = pose {
         f.quad_count = pose.quad_count;
@@ -355,10 +359,12 @@ impl SubjectTargets {
 }
 
 impl RebinPass {
-    /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer,
-    /// into `layer` of `targets`, by `stage`, with the pass's timestamps when given. Its
-    /// pixel classes are counted into the targets' counters by the compute pass itself,
-    /// and after a fragment pass by a pass of their own when `classes`.
+    /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer
+    /// (whose bounds are `within`), into `layer` of `targets`, by `stage`, with the pass's
+    /// timestamps when given: the pixels `within` are shaded, the rest of the layer is
+    /// cleared. Its pixel classes (of the pixels within) are counted into the targets'
+    /// counters by the compute pass itself, and after a fragment pass by a pass of their
+    /// own when `classes`.
     #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
     pub(super) fn record(
         &self,
@@ -367,11 +373,16 @@ impl RebinPass {
         layer: usize,
         pose_group: &wgpu::BindGroup,
         stage: PassKind,
-        size: (u32, u32),
+        within: PixelBox,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
         let t = &targets.layers[layer];
+        let size = within.size();
+        let whole = {
+            let s = targets.texture.size();
+            within == PixelBox::whole(s.width, s.height)
+        };
         match stage {
             PassKind::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -382,12 +393,26 @@ impl RebinPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                pass.set_pipeline(&self.fragment);
-                pass.set_bind_group(0, &t.fragment, &[]);
-                pass.set_bind_group(1, pose_group, &[]);
-                pass.draw(0..3, 0..1);
+                if within.pixels() > 0 {
+                    pass.set_scissor_rect(within.x0, within.y0, size.0, size.1);
+                    pass.set_pipeline(&self.fragment);
+                    pass.set_bind_group(0, &t.fragment, &[]);
+                    pass.set_bind_group(1, pose_group, &[]);
+                    pass.draw(0..3, 0..1);
+                }
             }
             PassKind::Compute => {
+                if !whole {
+                    // The pixels outside the bounds are not shaded: transparent.
+                    drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("rebin clear"),
+                        color_attachments: &[cleared(&t.view)],
+                        depth_stencil_attachment: None,
+                        timestamp_writes: None,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    }));
+                }
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("rebin"),
                     timestamp_writes: super::timing::compute_pass_writes(timestamps),
@@ -396,11 +421,13 @@ impl RebinPass {
                 pass.set_bind_group(0, &t.compute, &[]);
                 pass.set_bind_group(1, pose_group, &[]);
                 let (x, y) = workgroups(size);
-                pass.dispatch_workgroups(x, y, 1);
+                if x * y > 0 {
+                    pass.dispatch_workgroups(x, y, 1);
+                }
             }
         }
         // The compute pass counts as it shades; a fragment pass needs its own.
-        if classes && stage == PassKind::Fragment {
+        if classes && stage == PassKind::Fragment && within.pixels() > 0 {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("classes"),
                 timestamp_writes: None,
@@ -424,21 +451,25 @@ impl Gpu {
     }
 
     /// Records the frame pass of every instance into `encoder`: each pose drawn by its
-    /// camera (in its subject frame) into its own layer of one texture array of `size`,
-    /// in the order given (back to front; the composite pass puts each over the ones
-    /// before it), and their pixel classes counted.
+    /// camera (in its subject frame) within its pixel box into its own layer of one
+    /// texture array of `size`, in the order given (back to front; the composite pass
+    /// puts each over the ones before it), and their pixel classes counted (the pixels
+    /// outside a box as missed).
     pub(super) fn draw_subjects(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        instances: &[(&GpuPose, Camera)],
+        instances: &[(&GpuPose, Camera, PixelBox)],
         size: (u32, u32),
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> Subjects {
         let targets = self.subject_targets(size, instances.len().max(1) as u32);
         encoder.clear_buffer(&targets.stats, 0, None);
-        for (layer, (pose, camera)) in instances.iter().enumerate() {
-            let frame = frame_uniform(Some(pose), camera, variant);
+        let mut outside = 0;
+        for (layer, &(pose, camera, within)) in instances.iter().enumerate() {
+            let mut frame = frame_uniform(Some(pose), &camera, variant);
+            frame.bounds = within.to_array();
+            outside += size.0 as usize * size.1 as usize - within.pixels();
             self.queue.write_buffer(
                 &targets.layers[layer].uniform,
                 0,
@@ -450,12 +481,12 @@ impl Gpu {
                 layer,
                 &pose.bind_group,
                 self.stage,
-                size,
+                within,
                 timestamps.filter(|_| layer == 0),
                 true,
             );
         }
-        Subjects { targets }
+        Subjects { targets, outside }
     }
 
     /// Copies the pixel-class counters of a drawn frame into its staging buffer.
@@ -472,7 +503,7 @@ impl Gpu {
             inside: counts[0] as usize,
             clamped_above: counts[1] as usize,
             clamped_below: counts[2] as usize,
-            missed: counts[3] as usize,
+            missed: counts[3] as usize + subject.outside,
         })
     }
 
@@ -504,7 +535,9 @@ impl Gpu {
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("frame"),
                 });
-            let subject = self.draw_subjects(&mut encoder, &[(pose, *camera)], size, variant, None);
+            let whole = PixelBox::whole(size.0, size.1);
+            let subject =
+                self.draw_subjects(&mut encoder, &[(pose, *camera, whole)], size, variant, None);
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
             self.copy_stats(&mut encoder, &subject);

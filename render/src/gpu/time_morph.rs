@@ -96,6 +96,8 @@ pub(super) struct BetweenDraw<'a> {
     pub layer: usize,
     pub between: &'a GpuBetween<'a>,
     pub camera: Camera,
+    /// The pixels it may show in.
+    pub within: crate::footprint::PixelBox,
 }
 
 impl Gpu {
@@ -121,7 +123,8 @@ impl Gpu {
             let b = w.between;
             for (k, pose) in [(1, b.after), (2, b.before_motion), (3, b.after_motion)] {
                 let layer = 4 * j + k;
-                let frame = frame_uniform(Some(pose), &w.camera, variant);
+                let mut frame = frame_uniform(Some(pose), &w.camera, variant);
+                frame.bounds = w.within.to_array();
                 self.queue
                     .write_buffer(scratch.uniform(layer), 0, bytemuck::bytes_of(&frame));
                 self.rebin.record(
@@ -130,7 +133,7 @@ impl Gpu {
                     layer,
                     &pose.bind_group,
                     self.stage,
-                    size,
+                    w.within,
                     None,
                     false,
                 );

@@ -17,6 +17,10 @@ pub struct GpuView {
     pub intrinsics: [f32; 4],
     /// Flow layers toward right, left, up, down; -1 none.
     pub flow_layers: [i32; 4],
+    /// Pre-lit layer; -1 for a view not held (transparent).
+    pub prelit_layer: i32,
+    /// Padding to 16 bytes.
+    pub pad: [i32; 3],
 }
 
 /// `Quad` of `shaders/common.wgsl`.
@@ -104,6 +108,9 @@ pub struct GpuFrame {
     pub flags: u32,
     /// Padding to 16 bytes.
     pub pad: u32,
+    /// The pixels shaded, `[x0, y0, x1, y1]` (ends exclusive; [`crate::footprint`]):
+    /// the walker is transparent outside them.
+    pub bounds: [u32; 4],
 }
 
 /// `Proxy` of `shaders/common.wgsl`: the pose's geometric proxy ([`crate::proxy`]).
@@ -192,6 +199,9 @@ pub struct GpuInstance {
     pub col_z: [f32; 4],
     /// Translation.
     pub translation: [f32; 4],
+    /// The pixels its frame pass shaded, `[x0, y0, x1, y1]` (ends exclusive): elsewhere
+    /// its layer is transparent and not read.
+    pub bounds: [u32; 4],
 }
 
 /// `ColumnIndex` of `shaders/common.wgsl`: the header of a cylinder's column index

@@ -39,6 +39,8 @@ use serde::Serialize;
 use super::{Scene, ShadowSpec, TimeInterpolation};
 use crate::cylinder::{Clamp, Cylinder};
 use crate::error::{RenderError, Result};
+pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
+use crate::footprint::{may_see_subject, subject_box};
 use crate::shadow::ground_hit;
 
 /// Spacing of the rays traced to find the quads a frame reaches, pixels.
@@ -264,90 +266,6 @@ pub(crate) fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
         .expect("a field holds at least one pose")
 }
 
-/// Where the subject can be, in its own frame: within this distance of its axis (metres;
-/// a walker's reach, 0.4 m, with its limbs' swing and a margin for the flows that carry
-/// its edges)...
-pub const SUBJECT_RADIUS_M: f32 = 1.2;
-/// ... and between these heights (metres).
-pub const SUBJECT_HEIGHTS_M: (f32, f32) = (-0.2, 2.3);
-
-/// Whether the ray from `origin` along `dir` passes through the cylinder
-/// [`SUBJECT_RADIUS_M`] round the subject's axis between [`SUBJECT_HEIGHTS_M`]: only such
-/// rays can show the subject.
-pub(crate) fn may_see_subject(origin: Vec3, dir: Vec3) -> bool {
-    let (a, b) = (
-        dir.x * dir.x + dir.z * dir.z,
-        origin.x * dir.x + origin.z * dir.z,
-    );
-    let c = origin.x * origin.x + origin.z * origin.z - SUBJECT_RADIUS_M * SUBJECT_RADIUS_M;
-    let (t0, t1) = if a < 1e-12 {
-        // Along the axis: inside the cylinder or never.
-        if c > 0.0 {
-            return false;
-        }
-        (0.0, f32::INFINITY)
-    } else {
-        let disc = b * b - a * c;
-        if disc < 0.0 {
-            return false;
-        }
-        let r = disc.sqrt();
-        ((-b - r) / a, (-b + r) / a)
-    };
-    let t0 = t0.max(0.0);
-    if t1 < t0 {
-        return false;
-    }
-    // Heights over the span inside the cylinder.
-    let (lo, hi) = SUBJECT_HEIGHTS_M;
-    let y0 = origin.y + dir.y * t0;
-    let y1 = if t1.is_finite() {
-        origin.y + dir.y * t1
-    } else if dir.y > 0.0 {
-        f32::INFINITY
-    } else if dir.y < 0.0 {
-        f32::NEG_INFINITY
-    } else {
-        y0
-    };
-    y0.min(y1) <= hi && y0.max(y1) >= lo
-}
-
-/// The pixel box (`x0, y0, x1, y1`, inclusive, within the frame) where `camera` sees the
-/// subject's bounds ([`may_see_subject`]); `None` when it sees none of them.
-fn subject_box(camera: &Camera) -> Option<(u32, u32, u32, u32)> {
-    let (lo, hi) = SUBJECT_HEIGHTS_M;
-    let mut corners = Vec::new();
-    for k in 0..16 {
-        let a = k as f32 * std::f32::consts::TAU / 16.0;
-        // The polygon's circumradius, so that it holds the circle.
-        let r = SUBJECT_RADIUS_M / (std::f32::consts::PI / 16.0).cos();
-        for y in [lo, hi] {
-            corners.push(Vec3::new(r * a.cos(), y, r * a.sin()));
-        }
-    }
-    let projected: Vec<Vec2> = corners.iter().filter_map(|&p| camera.project(p)).collect();
-    if projected.len() < corners.len() {
-        // Part of the bounds is behind the camera: the whole frame may see it.
-        return Some((0, 0, camera.width - 1, camera.height - 1));
-    }
-    let (mut x0, mut y0, mut x1, mut y1) = (f32::MAX, f32::MAX, f32::MIN, f32::MIN);
-    for p in projected {
-        (x0, y0, x1, y1) = (x0.min(p.x), y0.min(p.y), x1.max(p.x), y1.max(p.y));
-    }
-    let (w, h) = (camera.width as f32, camera.height as f32);
-    if x1 < 0.0 || y1 < 0.0 || x0 > w - 1.0 || y0 > h - 1.0 {
-        return None;
-    }
-    let clamp = |v: f32, max: f32| v.clamp(0.0, max) as u32;
-    Some((
-        clamp(x0.floor(), w - 1.0),
-        clamp(y0.floor(), h - 1.0),
-        clamp(x1.ceil(), w - 1.0),
-        clamp(y1.ceil(), h - 1.0),
-    ))
-}
-
 /// Every `step`-th of `lo..=hi`, and `hi`.
 fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
     let mut v: Vec<u32> = (lo..=hi).step_by(step.max(1) as usize).collect();
@@ -370,7 +288,8 @@ fn reached(
 ) -> (BTreeSet<(usize, usize)>, bool) {
     let (w, h) = (camera.width, camera.height);
     let mut quads = BTreeSet::new();
-    if let Some((x0, y0, x1, y1)) = subject_box(camera) {
+    if let Some(b) = subject_box(camera) {
+        let (x0, y0, x1, y1) = (b.x0, b.y0, b.x1 - 1, b.y1 - 1);
         let step = ((x1 - x0).min(y1 - y0) / 8).clamp(1, RAY_STEP_PX);
         for &y in &samples(y0, y1, step) {
             for &x in &samples(x0, x1, step) {

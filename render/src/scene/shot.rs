@@ -27,11 +27,13 @@ use super::plan::{FramePlan, Plan, PosePlan, ShotFrame};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
+use crate::footprint::{PixelBox, subject_box};
 use crate::gpu::composite::DrawnFrame;
 use crate::motion::pose_motion;
 use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
 use crate::resident::{Lighting, PoseSource};
 use crate::shadow::{ShadowMaps, traced_shadow};
+use frf_core::camera::Camera;
 use frf_core::grid::PoseStep;
 
 /// The share of the memory budget, `1 / DECODED_SHARE`, that keeps views' basis images
@@ -424,7 +426,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         self.live_frames += 1;
         let fp = self.frame_at(self.live_frames, time);
         let slots = self.prepare(&fp)?.0;
-        let walkers = self.walkers(&slots);
+        let walkers = self.walkers(&slots, camera);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
         let Device::Gpu(gpu) = &self.device else {
             unreachable!("checked above")
@@ -509,7 +511,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         layers: bool,
     ) -> Result<ShotResult> {
         let (slots, made_resident) = self.prepare(fp)?;
-        let walkers = self.walkers(&slots);
+        let walkers = self.walkers(&slots, camera);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
         let frame_out =
             self.device
@@ -522,15 +524,30 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         })
     }
 
-    /// The walkers of a frame whose poses are the cache's `slots`.
-    fn walkers(&self, slots: &[Slot]) -> Vec<Walker<'_>> {
+    /// The walkers of a frame of `camera` whose poses are the cache's `slots`; a planned
+    /// shot shades each within the pixels where it may show ([`subject_box`]).
+    fn walkers(&self, slots: &[Slot], camera: &Camera) -> Vec<Walker<'_>> {
         slots
             .iter()
             .zip(&self.scene.instances)
-            .map(|(&(k, between), inst)| Walker {
-                resident: &self.cache[k].resident,
-                world_from_subject: inst.world_from_subject(),
-                between: between.map(|(after, s)| (&self.cache[after].resident, s)),
+            .map(|(&(k, between), inst)| {
+                let world_from_subject = inst.world_from_subject();
+                let within = self.options.planned.then(|| {
+                    subject_box(&camera.transformed(&world_from_subject.inverse())).unwrap_or(
+                        PixelBox {
+                            x0: 0,
+                            y0: 0,
+                            x1: 0,
+                            y1: 0,
+                        },
+                    )
+                });
+                Walker {
+                    resident: &self.cache[k].resident,
+                    world_from_subject,
+                    between: between.map(|(after, s)| (&self.cache[after].resident, s)),
+                    within,
+                }
             })
             .collect()
     }
