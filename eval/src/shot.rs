@@ -277,6 +277,7 @@ pub fn evaluate_shot<R: ReadAt>(
         memory_budget: BUDGET_BYTES,
         planned: true,
         traced_lights: lights,
+        detail: None,
     };
     let mut shot = Shot::new(scene, field, device, &frames, options)?;
     for f in &shot.plan().frames {

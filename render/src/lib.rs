@@ -22,6 +22,7 @@
 pub mod composite;
 pub mod cpu;
 pub mod cylinder;
+pub mod detail;
 pub mod error;
 pub mod extend;
 pub mod footprint;

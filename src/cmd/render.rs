@@ -111,6 +111,11 @@ pub struct RenderArgs {
     /// Read, relight and draw everything of the poses drawn, not only what the plan says.
     #[arg(long)]
     pub no_plan: bool,
+    /// Draw every walker at this level of detail (0: full; each level halves the
+    /// captured views' resolution). By default each walker's is chosen from its size in
+    /// the frame (full detail with --no-plan).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=frf_render::detail::MAX_LEVEL as i64))]
+    pub detail: Option<u8>,
     /// Most memory the resident poses may hold together, MB (the least recently used
     /// leave first).
     #[arg(long, default_value_t = DEFAULT_BUDGET_MB)]
@@ -464,6 +469,7 @@ pub fn run(args: RenderArgs) -> CliResult {
         memory_budget: args.memory_budget.saturating_mul(1_000_000),
         planned: !args.no_plan,
         traced_lights: args.scene.shadow_lights,
+        detail: args.detail,
     };
     let mut shot = Shot::new(&scene, &field, device, &frames, options)?;
     let setup_seconds = start.elapsed().as_secs_f64();

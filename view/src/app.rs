@@ -218,6 +218,7 @@ impl<'a> App<'a> {
                 memory_budget: options.memory_budget,
                 planned: false,
                 traced_lights: TRACED_LIGHTS,
+                detail: None,
             },
         )?;
         let mut viewer = Viewer::new(shot, options.field.clone(), options.envs);

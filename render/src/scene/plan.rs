@@ -38,6 +38,7 @@ use serde::Serialize;
 
 use super::{Scene, ShadowSpec, TimeInterpolation};
 use crate::cylinder::{Clamp, Cylinder};
+use crate::detail::{detail_level, pixels_per_metre};
 use crate::error::{RenderError, Result};
 pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
 use crate::footprint::{may_see_subject, subject_box};
@@ -64,6 +65,9 @@ pub struct PosePlan {
     /// The pose's motion toward the next and the previous pose
     /// ([`frf_core::grid::PoseStep`] order) is read, for the views read.
     pub pose_flows: [bool; 2],
+    /// The level of detail it is drawn at ([`crate::detail`]): the finest any frame
+    /// needs (0, full detail, for a shot morphed between poses).
+    pub level: u8,
 }
 
 /// One frame: its time and the pose each walker shows.
@@ -150,6 +154,8 @@ pub struct WalkerCounts {
     pub views: usize,
     /// Flow maps made resident for it, over its poses.
     pub flows: usize,
+    /// Per pose: its level of detail ([`crate::detail`]).
+    pub levels: Vec<u8>,
 }
 
 impl WalkerCounts {
@@ -164,6 +170,7 @@ impl WalkerCounts {
                 .iter()
                 .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
                 .sum(),
+            levels: plans.iter().map(|p| p.level).collect(),
         }
     }
 }
@@ -214,6 +221,7 @@ fn entry<'p>(
                 shadow_maps: false,
                 hull: false,
                 pose_flows: [false; 2],
+                level: u8::MAX,
             });
             plans.last_mut().expect("just pushed")
         }
@@ -264,6 +272,23 @@ pub(crate) fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
             d.min(n.max(1) - d.min(n.max(1)))
         })
         .expect("a field holds at least one pose")
+}
+
+/// Pixels per metre the pose's views captured the subject at: the median over its views
+/// ([`pixels_per_metre`]).
+fn captured_ppm(record: &frf_reflectance::field::PoseRecord) -> Result<f32> {
+    let mut ppm = record
+        .views
+        .iter()
+        .map(|v| {
+            v.camera
+                .to_camera()
+                .map(|c| pixels_per_metre(&c))
+                .map_err(RenderError::BadParameter)
+        })
+        .collect::<Result<Vec<f32>>>()?;
+    ppm.sort_by(f32::total_cmp);
+    Ok(ppm.get(ppm.len() / 2).copied().unwrap_or(0.0))
 }
 
 /// Every `step`-th of `lo..=hi`, and `hi`.
@@ -682,7 +707,14 @@ impl Plan {
                 let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
                 let (quads, ground) = reached(&cylinder, &subject_camera, half);
                 ground_seen |= ground;
+                let level = if interpolate == TimeInterpolation::Flow {
+                    // Motion views are made at the captured resolution.
+                    0
+                } else {
+                    detail_level(captured_ppm(record)?, pixels_per_metre(&subject_camera))
+                };
                 let plan = entry(&mut walkers[i], pose, views, &lit);
+                plan.level = plan.level.min(level);
                 if let Some(step) = motion {
                     plan.pose_flows[step.index()] = true;
                 }
@@ -727,6 +759,7 @@ impl Plan {
                 for k in 0..2 {
                     union.pose_flows[k] |= p.pose_flows[k];
                 }
+                union.level = union.level.min(p.level);
             }
         }
         let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;

@@ -51,6 +51,9 @@ pub struct ShotOptions {
     pub planned: bool,
     /// Median-cut lights of a traced shadow.
     pub traced_lights: usize,
+    /// Every walker at this level of detail ([`crate::detail`]); `None`: the plan's
+    /// choice per walker (full detail without a plan).
+    pub detail: Option<u8>,
 }
 
 /// Whether a resident made from `have` serves a walker that needs `want` (`None`:
@@ -67,6 +70,7 @@ fn covers(have: &Option<PosePlan>, want: &Option<PosePlan>) -> bool {
                 && within(&w.conditions, &h.conditions)
                 && (!w.shadow_maps || h.shadow_maps)
                 && (!w.hull || h.hull)
+                && w.level == h.level
         }
     }
 }
@@ -663,7 +667,17 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             },
             None => Lighting::Unlit,
         };
-        let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?;
+        let level = self
+            .options
+            .detail
+            .unwrap_or_else(|| plan.map_or(0, |p| p.level));
+        if level > 0 && self.plan.interpolate == TimeInterpolation::Flow {
+            return Err(RenderError::BadParameter(format!(
+                "level of detail {level} in a shot morphed between poses: its motion views \
+                 are made at full detail (interpolate = \"nearest\", or detail 0)"
+            )));
+        }
+        let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?.reduced(level);
         let mut resident = self.device.make_resident(&source)?;
         if self.plan.interpolate == TimeInterpolation::Flow {
             let motion = PoseStep::ALL.map(|step| {

@@ -1,0 +1,282 @@
+//! Level of detail: a pose's views at a reduced resolution, for walkers whose projected
+//! size is a fraction of the captured view's. Level `L` box-filters every `2^L x 2^L`
+//! block of the pre-lit basis images (in linear light), the alpha and the flows (the
+//! known ones, averaged, then divided by `2^L`: a flow is a displacement in pixels), and
+//! scales the cameras' intrinsics to the reduced image (a reduced texel's centre is its
+//! block's centre). Geometry in metres (the cylinder of camera centres, the hull) is
+//! unchanged. The renderer reads a reduced pose exactly as a full one.
+//!
+//! [`detail_level`] chooses the level from the pixels per metre a walker covers in the
+//! frame against the captured views' own: the coarsest level whose texels are still no
+//! larger than [`DETAIL_MARGIN`] of the frame's pixels (the margin measured against full
+//! detail: docs/results/render.md, "Level of detail").
+
+use std::sync::Arc;
+
+use frf_core::camera::Camera;
+use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
+use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::geometry::{Crop, PoseGeometry};
+use crate::resident::{PoseFlows, PoseSource, decode_flow};
+
+/// The coarsest level used.
+pub const MAX_LEVEL: u8 = 3;
+
+/// A level's texel may cover up to this many of the frame's pixels, along each axis.
+pub const DETAIL_MARGIN: f32 = 1.0;
+
+/// Where on the subject's axis pixels per metre are measured (metres up: mid-body).
+const AXIS_POINT_M: f32 = 1.0;
+
+/// Pixels per metre `camera` (in the subject's frame) sees at the subject's axis.
+pub fn pixels_per_metre(camera: &Camera) -> f32 {
+    let d = (Vec3::new(0.0, AXIS_POINT_M, 0.0) - camera.centre()).length();
+    camera.intrinsics.fx.abs().max(camera.intrinsics.fy.abs()) / d.max(1e-3)
+}
+
+/// The level of detail for a walker seen at `seen` pixels per metre from views that
+/// captured it at `captured` (see the module docs).
+pub fn detail_level(captured: f32, seen: f32) -> u8 {
+    if !(captured.is_finite() && seen.is_finite()) || seen <= 0.0 || captured <= 0.0 {
+        return 0;
+    }
+    let mut level = 0;
+    while level < MAX_LEVEL && seen * (1u32 << (level + 1)) as f32 <= captured * DETAIL_MARGIN {
+        level += 1;
+    }
+    level
+}
+
+/// `camera` seeing the image reduced to `level` (same pose, intrinsics scaled so that a
+/// reduced texel's centre sits at its block's centre).
+pub fn reduced_camera(camera: &Camera, level: u8) -> Camera {
+    let f = (1u32 << level) as f32;
+    let mut c = *camera;
+    c.intrinsics.fx /= f;
+    c.intrinsics.fy /= f;
+    c.intrinsics.cx = (camera.intrinsics.cx + 0.5) / f - 0.5;
+    c.intrinsics.cy = (camera.intrinsics.cy + 0.5) / f - 0.5;
+    c.width = camera.width.div_ceil(1 << level);
+    c.height = camera.height.div_ceil(1 << level);
+    c
+}
+
+/// The crop of the reduced image covering `crop`'s blocks.
+fn reduced_crop(crop: Crop, level: u8) -> Crop {
+    let x0 = crop.x0 >> level;
+    let y0 = crop.y0 >> level;
+    let x1 = (crop.x0 + crop.width).div_ceil(1 << level);
+    let y1 = (crop.y0 + crop.height).div_ceil(1 << level);
+    Crop {
+        x0,
+        y0,
+        width: x1 - x0,
+        height: y1 - y0,
+    }
+}
+
+/// Box-filters `texels` (cropped by `from`) into the crop `to` of the image reduced by
+/// `level`: per reduced texel, `combine` of the full texels of its block inside `from`.
+fn reduce<T: Send + Sync, U: Send>(
+    texels: &[T],
+    from: Crop,
+    to: Crop,
+    level: u8,
+    combine: impl Fn(&mut dyn Iterator<Item = &T>) -> U + Sync,
+) -> Vec<U> {
+    let n = 1u32 << level;
+    (0..to.texels())
+        .into_par_iter()
+        .map(|k| {
+            let (x, y) = (to.x0 + k as u32 % to.width, to.y0 + k as u32 / to.width);
+            let mut block = (0..n * n).filter_map(|j| {
+                let (fx, fy) = (x * n + j % n, y * n + j / n);
+                let inside = (from.x0..from.x0 + from.width).contains(&fx)
+                    && (from.y0..from.y0 + from.height).contains(&fy);
+                inside.then(|| &texels[((fy - from.y0) * from.width + (fx - from.x0)) as usize])
+            });
+            combine(&mut block)
+        })
+        .collect()
+}
+
+/// The 8-bit gamma code nearest to the linear value `x` (in `[0, 1]`), through `lut`.
+fn gamma_code(lut: &[f32; 256], x: f32) -> u8 {
+    let i = lut.partition_point(|&v| v < x).min(255);
+    if i > 0 && (x - lut[i - 1]) < (lut[i] - x) {
+        (i - 1) as u8
+    } else {
+        i as u8
+    }
+}
+
+impl PoseSource {
+    /// The pose at level of detail `level` (itself at level 0; see the module docs).
+    pub fn reduced(&self, level: u8) -> PoseSource {
+        if level == 0 {
+            return self.clone();
+        }
+        let g = &self.geometry;
+        let (from, to) = (g.crop, reduced_crop(g.crop, level));
+        let lut = gamma_lut();
+        let mean = |sum: f32, n: usize| if n > 0 { sum / n as f32 } else { 0.0 };
+        let basis = self
+            .basis
+            .iter()
+            .map(|b| BasisCodes {
+                width: to.width as usize,
+                height: to.height as usize,
+                tiles: b
+                    .tiles
+                    .iter()
+                    .map(|tile| {
+                        reduce(tile, from, to, level, &|block: &mut dyn Iterator<
+                            Item = &[u8; 3],
+                        >| {
+                            let (mut sum, mut n) = ([0.0f32; 3], 0);
+                            for t in block {
+                                for c in 0..3 {
+                                    sum[c] += lut[t[c] as usize];
+                                }
+                                n += 1;
+                            }
+                            sum.map(|s| gamma_code(&lut, mean(s, n)))
+                        })
+                    })
+                    .collect(),
+                scales: b.scales.clone(),
+            })
+            .collect();
+        let alpha = self
+            .alpha
+            .iter()
+            .map(|a| {
+                if a.is_empty() {
+                    return Vec::new();
+                }
+                reduce(a, from, to, level, &|block: &mut dyn Iterator<
+                    Item = &u8,
+                >| {
+                    let (mut sum, mut n) = (0u32, 0u32);
+                    for &v in block {
+                        sum += v as u32;
+                        n += 1;
+                    }
+                    ((sum + n / 2) / n.max(1)) as u8
+                })
+            })
+            .collect();
+        let q = self.flows.quantizer;
+        let scale = 1.0 / (1u32 << level) as f32;
+        let codes = self
+            .flows
+            .codes
+            .iter()
+            .map(|per_view| {
+                per_view.clone().map(|flow| {
+                    flow.map(|flow| {
+                        reduce(&flow, from, to, level, &|block: &mut dyn Iterator<
+                            Item = &[i8; 2],
+                        >| {
+                            let (mut sum, mut n) = (glam::Vec2::ZERO, 0);
+                            for &c in block {
+                                if c[0] != UNKNOWN_CODE && c[1] != UNKNOWN_CODE {
+                                    sum += decode_flow(c, &q);
+                                    n += 1;
+                                }
+                            }
+                            if n == 0 {
+                                return [UNKNOWN_CODE; 2];
+                            }
+                            let d = sum * (scale / n as f32);
+                            [q.encode(d.x), q.encode(d.y)]
+                        })
+                    })
+                })
+            })
+            .collect::<Vec<_>>();
+        let cameras = g.cameras.iter().map(|c| reduced_camera(c, level)).collect();
+        let size = (
+            g.image_size.0.div_ceil(1 << level),
+            g.image_size.1.div_ceil(1 << level),
+        );
+        let geometry = PoseGeometry::new(
+            g.pose,
+            g.columns,
+            g.rows,
+            g.wraps,
+            size,
+            to,
+            cameras,
+            |i, n| codes[i][n.index()].is_some(),
+        )
+        .with_proxy(g.proxy.clone())
+        .with_held(|i| g.holds(i));
+        PoseSource {
+            geometry: Arc::new(geometry),
+            flows: Arc::new(PoseFlows {
+                codes,
+                quantizer: q,
+                table: self.flows.table,
+            }),
+            basis,
+            alpha,
+            coefficients: self.coefficients.clone(),
+            ground_coefficients: self.ground_coefficients.clone(),
+            plan: self.plan.clone(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_level_halves_with_the_pixels_per_metre() {
+        assert_eq!(detail_level(100.0, 100.0), 0);
+        assert_eq!(detail_level(100.0, 60.0), 0);
+        assert_eq!(detail_level(100.0, 50.0), 1);
+        assert_eq!(detail_level(100.0, 25.0), 2);
+        assert_eq!(detail_level(100.0, 1.0), MAX_LEVEL);
+        assert_eq!(detail_level(100.0, 0.0), 0);
+        assert_eq!(detail_level(f32::NAN, 10.0), 0);
+    }
+
+    #[test]
+    fn a_reduced_crop_covers_the_blocks_of_the_full_one() {
+        let c = reduced_crop(
+            Crop {
+                x0: 3,
+                y0: 4,
+                width: 10,
+                height: 7,
+            },
+            1,
+        );
+        // Columns 3..13 are in blocks 1..7, rows 4..11 in blocks 2..6.
+        assert_eq!((c.x0, c.y0, c.width, c.height), (1, 2, 6, 4));
+    }
+
+    #[test]
+    fn gamma_codes_invert_the_table() {
+        let lut = gamma_lut();
+        for c in 0..=255u8 {
+            assert_eq!(gamma_code(&lut, lut[c as usize]), c);
+        }
+    }
+
+    #[test]
+    fn a_reduced_camera_sees_a_point_at_the_block_it_fell_in() {
+        let cam = crate::synthetic::bench_camera((160, 120)).unwrap();
+        let p = Vec3::new(0.1, 1.2, 0.05);
+        let full = cam.project(p).unwrap();
+        let half = reduced_camera(&cam, 1).project(p).unwrap();
+        // Full pixel x (centre at x) lies in block floor((x + 0.5) / 2), centre 2k + 0.5.
+        assert!(((full.x + 0.5) / 2.0 - 0.5 - half.x).abs() < 1e-4);
+        assert!(((full.y + 0.5) / 2.0 - 0.5 - half.y).abs() < 1e-4);
+    }
+}
