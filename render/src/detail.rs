@@ -20,7 +20,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::geometry::{Crop, PoseGeometry};
-use crate::resident::{PoseFlows, PoseSource, decode_flow};
+use crate::resident::{PoseFlows, PoseSource};
 
 /// The coarsest level used.
 pub const MAX_LEVEL: u8 = 3;
@@ -113,6 +113,44 @@ fn gamma_code(lut: &[f32; 256], x: f32) -> u8 {
     }
 }
 
+/// Entries of [`gamma_codes`]' table, over `sqrt(x)` (fine enough near black to tell
+/// every code apart).
+const GAMMA_STEPS: usize = 1 << 16;
+
+/// [`gamma_code`] of `x` by table: the code nearest to `x` at the table's resolution.
+fn gamma_codes() -> &'static [u8] {
+    static TABLE: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let lut = gamma_lut();
+        (0..GAMMA_STEPS)
+            .map(|i| {
+                let r = i as f32 / (GAMMA_STEPS - 1) as f32;
+                gamma_code(&lut, r * r)
+            })
+            .collect()
+    })
+}
+
+/// The gamma code of linear `x` through [`gamma_codes`]' table.
+fn fast_gamma_code(table: &[u8], x: f32) -> u8 {
+    let r = x.clamp(0.0, 1.0).sqrt();
+    table[(r * (GAMMA_STEPS - 1) as f32).round() as usize]
+}
+
+/// The flow code whose displacement in `table` ([`crate::resident::flow_lut`],
+/// increasing with the code) is nearest to `x`.
+fn flow_code(table: &[f32; 256], x: f32) -> i8 {
+    // Index 0 is the unknown code's.
+    let known = &table[1..];
+    let i = known.partition_point(|&v| v < x).min(known.len() - 1);
+    let i = if i > 0 && (x - known[i - 1]) < (known[i] - x) {
+        i - 1
+    } else {
+        i
+    };
+    (i as i32 + 1 - 128) as i8
+}
+
 impl PoseSource {
     /// The pose at level of detail `level` (itself at level 0; see the module docs).
     pub fn reduced(&self, level: u8) -> PoseSource {
@@ -122,6 +160,7 @@ impl PoseSource {
         let g = &self.geometry;
         let (from, to) = (g.crop, reduced_crop(g.crop, level));
         let lut = gamma_lut();
+        let codes = gamma_codes();
         let mean = |sum: f32, n: usize| if n > 0 { sum / n as f32 } else { 0.0 };
         let basis = self
             .basis
@@ -133,18 +172,22 @@ impl PoseSource {
                     .tiles
                     .iter()
                     .map(|tile| {
-                        reduce(tile, from, to, level, &|block: &mut dyn Iterator<
-                            Item = &[u8; 3],
-                        >| {
-                            let (mut sum, mut n) = ([0.0f32; 3], 0);
-                            for t in block {
-                                for c in 0..3 {
-                                    sum[c] += lut[t[c] as usize];
+                        reduce(
+                            tile,
+                            from,
+                            to,
+                            level,
+                            |block: &mut dyn Iterator<Item = &[u8; 3]>| {
+                                let (mut sum, mut n) = ([0.0f32; 3], 0);
+                                for t in block {
+                                    for c in 0..3 {
+                                        sum[c] += lut[t[c] as usize];
+                                    }
+                                    n += 1;
                                 }
-                                n += 1;
-                            }
-                            sum.map(|s| gamma_code(&lut, mean(s, n)))
-                        })
+                                sum.map(|s| fast_gamma_code(codes, mean(s, n)))
+                            },
+                        )
                     })
                     .collect(),
                 scales: b.scales.clone(),
@@ -157,19 +200,24 @@ impl PoseSource {
                 if a.is_empty() {
                     return Vec::new();
                 }
-                reduce(a, from, to, level, &|block: &mut dyn Iterator<
-                    Item = &u8,
-                >| {
-                    let (mut sum, mut n) = (0u32, 0u32);
-                    for &v in block {
-                        sum += v as u32;
-                        n += 1;
-                    }
-                    ((sum + n / 2) / n.max(1)) as u8
-                })
+                reduce(
+                    a,
+                    from,
+                    to,
+                    level,
+                    |block: &mut dyn Iterator<Item = &u8>| {
+                        let (mut sum, mut n) = (0u32, 0u32);
+                        for &v in block {
+                            sum += v as u32;
+                            n += 1;
+                        }
+                        ((sum + n / 2) / n.max(1)) as u8
+                    },
+                )
             })
             .collect();
         let q = self.flows.quantizer;
+        let table = &self.flows.table;
         let scale = 1.0 / (1u32 << level) as f32;
         let codes = self
             .flows
@@ -178,22 +226,27 @@ impl PoseSource {
             .map(|per_view| {
                 per_view.clone().map(|flow| {
                     flow.map(|flow| {
-                        reduce(&flow, from, to, level, &|block: &mut dyn Iterator<
-                            Item = &[i8; 2],
-                        >| {
-                            let (mut sum, mut n) = (glam::Vec2::ZERO, 0);
-                            for &c in block {
-                                if c[0] != UNKNOWN_CODE && c[1] != UNKNOWN_CODE {
-                                    sum += decode_flow(c, &q);
-                                    n += 1;
+                        reduce(
+                            &flow,
+                            from,
+                            to,
+                            level,
+                            |block: &mut dyn Iterator<Item = &[i8; 2]>| {
+                                let (mut sum, mut n) = ([0.0f32; 2], 0);
+                                for &c in block {
+                                    if c[0] != UNKNOWN_CODE && c[1] != UNKNOWN_CODE {
+                                        for k in 0..2 {
+                                            sum[k] += table[(c[k] as i32 + 128) as usize];
+                                        }
+                                        n += 1;
+                                    }
                                 }
-                            }
-                            if n == 0 {
-                                return [UNKNOWN_CODE; 2];
-                            }
-                            let d = sum * (scale / n as f32);
-                            [q.encode(d.x), q.encode(d.y)]
-                        })
+                                if n == 0 {
+                                    return [UNKNOWN_CODE; 2];
+                                }
+                                sum.map(|s| flow_code(table, s * scale / n as f32))
+                            },
+                        )
                     })
                 })
             })
@@ -262,10 +315,21 @@ mod tests {
     }
 
     #[test]
+    fn flow_codes_invert_the_table() {
+        let q = frf_reflectance::flowcodec::quant::LogQuantizer::new(0.05, 40.0).unwrap();
+        let table = crate::resident::flow_lut(&q);
+        for c in -127..=127i8 {
+            assert_eq!(flow_code(&table, table[(c as i32 + 128) as usize]), c);
+        }
+    }
+
+    #[test]
     fn gamma_codes_invert_the_table() {
         let lut = gamma_lut();
+        let table = gamma_codes();
         for c in 0..=255u8 {
             assert_eq!(gamma_code(&lut, lut[c as usize]), c);
+            assert_eq!(fast_gamma_code(table, lut[c as usize]), c);
         }
     }
 
