@@ -129,7 +129,9 @@ fn the_planner_leaves_work_out_and_the_frames_do_not_change() {
     }
 
     let mut frames = Vec::new();
-    for (out, flag) in [("planned", None), ("unplanned", Some("--no-plan"))] {
+    // At full detail (the level of detail has its own test below).
+    let planned = ["--detail", "0"];
+    for (out, flags) in [("planned", &planned[..]), ("unplanned", &["--no-plan"][..])] {
         let out = dir.path().join(out);
         let mut args = vec![
             "render",
@@ -137,7 +139,7 @@ fn the_planner_leaves_work_out_and_the_frames_do_not_change() {
             "--out",
             out.to_str().unwrap(),
         ];
-        args.extend(flag);
+        args.extend(flags);
         args.extend(gpu_flag());
         ok(&args);
         let report: serde_json::Value =

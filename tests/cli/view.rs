@@ -200,6 +200,9 @@ time_offset = 0.1
         "--frames",
         "2..3",
         "--cpu",
+        // The viewer draws every walker at full detail.
+        "--detail",
+        "0",
         "--out",
         out.to_str().unwrap(),
     ]);
