@@ -305,6 +305,9 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     bytes_read: std::sync::atomic::AtomicU64,
     /// Views' basis images kept decoded ([`FieldFile::keep_decoded`]).
     pub(crate) decoded: crate::decoded::DecodedBasis,
+    /// The projector of the field's conditions, made on first use
+    /// ([`FieldFile::projector`]).
+    pub(crate) projector: std::sync::OnceLock<crate::project::Projector>,
 }
 
 impl FieldFile<FileSource> {
@@ -410,6 +413,7 @@ impl<R: ReadAt> FieldFile<R> {
             index_crc,
             bytes_read: std::sync::atomic::AtomicU64::new(0),
             decoded: Default::default(),
+            projector: Default::default(),
         })
     }
 

@@ -240,6 +240,16 @@ impl<R: ReadAt> FieldFile<R> {
         })
     }
 
+    /// The projector of the field's conditions ([`crate::project::Projector`]: environments to
+    /// relighting coefficients), made once and shared by every pose relit.
+    pub fn projector(&self) -> Result<&crate::project::Projector> {
+        if let Some(p) = self.projector.get() {
+            return Ok(p);
+        }
+        let made = crate::project::Projector::new(&self.header().conditions)?;
+        Ok(self.projector.get_or_init(|| made))
+    }
+
     /// Keeps up to `bytes` of views' decoded basis images between reads (0, the default:
     /// none), the least recently used leaving first.
     pub fn keep_decoded(&self, bytes: u64) {

@@ -1,31 +1,48 @@
-// The relighting pass (docs/design.md section 4.1), one view at a time: the weighted sum of the
-// view's basis images (JPEG-decoded 8-bit gamma-2.2 codes, linearized through the table
-// the CPU uses), then its encoding into the pre-lit texture layer as sRGB codes of
-// colour / scale, the scale being the view's brightest value. Twin of
-// `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
+// The relighting pass (docs/design.md section 4.1), a batch of views at once (one row of
+// workgroups per view): the weighted sum of each view's basis images (JPEG-decoded 8-bit
+// gamma-2.2 codes, linearized through the table the CPU uses), then its encoding into its
+// layer of the pre-lit texture as sRGB codes of colour / scale, the scale being the
+// view's brightest value. Twin of `ResidentPose::relight_cpu` in
+// `render/src/resident.rs`. Compiled after `common.wgsl`.
 
 struct RelightParams {
+    // Texels per view (the pose's crop) and its row length.
     texels: u32,
-    tiles: u32,
     width: u32,
+    // Views in the batch.
+    jobs: u32,
+    pad: u32,
+}
+
+// One view of the batch: where its codes and coefficients start, how many basis images
+// it has, its index (for its peak) and its layer of the pre-lit texture.
+struct Job {
+    basis_offset: u32,
+    coefficient_offset: u32,
+    tiles: u32,
     view: u32,
+    layer: u32,
+    relit_offset: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: RelightParams;
-// Tiles x texels, packed RGBA8: the basis codes; tile 0's alpha byte holds the view's
-// alpha code.
+// Per view, tiles x texels, packed RGBA8: the basis codes; tile 0's alpha byte holds the
+// view's alpha code.
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
-// Per tile: rgb = coefficient x tile scale; w = 0 when the condition is not used.
+// Per view and tile: rgb = coefficient x tile scale; w = 0 when the condition is not used.
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
-// The relit colour (and alpha code) of every texel, between the two passes.
+// The relit colour (and alpha code) of every texel of every view, between the passes.
 @group(0) @binding(4) var<storage, read_write> relit: array<vec4<f32>>;
 // Per view: the largest relit value, as the bits of a non-negative f32 (whose order
 // `atomicMax` on u32 preserves).
 @group(0) @binding(5) var<storage, read_write> peaks: array<atomic<u32>>;
-// The view's layer of the pre-lit texture.
-@group(0) @binding(6) var output: texture_storage_2d<rgba8uint, write>;
+// The pre-lit texture, every layer.
+@group(0) @binding(6) var output: texture_storage_2d_array<rgba8uint, write>;
+@group(0) @binding(7) var<storage, read> jobs: array<Job>;
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
@@ -34,23 +51,24 @@ fn gamma_value(code: u32) -> f32 {
 @compute @workgroup_size(64)
 fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i >= params.texels) {
+    if (i >= params.texels || id.y >= params.jobs) {
         return;
     }
+    let job = jobs[id.y];
     var out = vec3<f32>(0.0);
-    for (var k = 0u; k < params.tiles; k++) {
-        let c = coefficients[k];
+    for (var k = 0u; k < job.tiles; k++) {
+        let c = coefficients[job.coefficient_offset + k];
         if (c.w == 0.0) {
             continue;
         }
-        let code = basis[k * params.texels + i];
+        let code = basis[job.basis_offset + k * params.texels + i];
         out.x += c.x * gamma_value(code & 255u);
         out.y += c.y * gamma_value((code >> 8u) & 255u);
         out.z += c.z * gamma_value((code >> 16u) & 255u);
     }
-    let alpha = f32(basis[i] >> 24u);
-    relit[i] = vec4<f32>(out, alpha);
-    atomicMax(&peaks[params.view], bitcast<u32>(max(out.x, max(out.y, out.z))));
+    let alpha = f32(basis[job.basis_offset + i] >> 24u);
+    relit[job.relit_offset + i] = vec4<f32>(out, alpha);
+    atomicMax(&peaks[job.view], bitcast<u32>(max(out.x, max(out.y, out.z))));
 }
 
 fn srgb_encode(v: f32) -> f32 {
@@ -64,19 +82,21 @@ fn srgb_encode(v: f32) -> f32 {
 @compute @workgroup_size(64)
 fn encode(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if (i >= params.texels) {
+    if (i >= params.texels || id.y >= params.jobs) {
         return;
     }
-    var scale = bitcast<f32>(atomicLoad(&peaks[params.view]));
+    let job = jobs[id.y];
+    var scale = bitcast<f32>(atomicLoad(&peaks[job.view]));
     if (scale <= 0.0) {
         scale = 1.0;
     }
-    let r = relit[i];
+    let r = relit[job.relit_offset + i];
     let code = vec4<u32>(
         u32(round(srgb_encode(r.x / scale) * 255.0)),
         u32(round(srgb_encode(r.y / scale) * 255.0)),
         u32(round(srgb_encode(r.z / scale) * 255.0)),
         u32(r.w),
     );
-    textureStore(output, vec2<i32>(i32(i % params.width), i32(i / params.width)), code);
+    let p = vec2<i32>(i32(i % params.width), i32(i / params.width));
+    textureStore(output, p, i32(job.layer), code);
 }

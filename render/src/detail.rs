@@ -4,23 +4,21 @@
 //! known ones, averaged, then divided by `2^L`: a flow is a displacement in pixels), and
 //! scales the cameras' intrinsics to the reduced image (a reduced texel's centre is its
 //! block's centre). Geometry in metres (the cylinder of camera centres, the hull) is
-//! unchanged. The renderer reads a reduced pose exactly as a full one.
+//! unchanged. The renderer reads a reduced pose exactly as a full one
+//! ([`crate::resident::PoseSource::load_at`]); reduced views are kept between the poses
+//! made resident ([`crate::reduced_views`]).
 //!
 //! [`detail_level`] chooses the level from the pixels per metre a walker covers in the
 //! frame against the captured views' own: the coarsest level whose texels are still no
 //! larger than [`DETAIL_MARGIN`] of the frame's pixels (the margin measured against full
 //! detail: docs/results/render.md, "Level of detail").
 
-use std::sync::Arc;
-
 use frf_core::camera::Camera;
 use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use glam::Vec3;
-use rayon::prelude::*;
 
-use crate::geometry::{Crop, PoseGeometry};
-use crate::resident::{PoseFlows, PoseSource};
+use crate::geometry::Crop;
 
 /// The coarsest level used.
 pub const MAX_LEVEL: u8 = 3;
@@ -79,28 +77,36 @@ fn reduced_crop(crop: Crop, level: u8) -> Crop {
 }
 
 /// Box-filters `texels` (cropped by `from`) into the crop `to` of the image reduced by
-/// `level`: per reduced texel, `combine` of the full texels of its block inside `from`.
-fn reduce<T: Send + Sync, U: Send>(
+/// `level`: per reduced texel, the full texels of its block inside `from` are `add`ed
+/// into an accumulator (from its default) and `finish`ed with their count.
+fn reduce<T, A: Default, U>(
     texels: &[T],
     from: Crop,
     to: Crop,
     level: u8,
-    combine: impl Fn(&mut dyn Iterator<Item = &T>) -> U + Sync,
+    add: impl Fn(&mut A, &T),
+    finish: impl Fn(A, u32) -> U,
 ) -> Vec<U> {
     let n = 1u32 << level;
-    (0..to.texels())
-        .into_par_iter()
-        .map(|k| {
-            let (x, y) = (to.x0 + k as u32 % to.width, to.y0 + k as u32 / to.width);
-            let mut block = (0..n * n).filter_map(|j| {
-                let (fx, fy) = (x * n + j % n, y * n + j / n);
-                let inside = (from.x0..from.x0 + from.width).contains(&fx)
-                    && (from.y0..from.y0 + from.height).contains(&fy);
-                inside.then(|| &texels[((fy - from.y0) * from.width + (fx - from.x0)) as usize])
-            });
-            combine(&mut block)
-        })
-        .collect()
+    let (fx1, fy1) = (from.x0 + from.width, from.y0 + from.height);
+    let mut out = Vec::with_capacity(to.texels());
+    for y in to.y0..to.y0 + to.height {
+        let rows = (y * n).max(from.y0)..((y + 1) * n).min(fy1);
+        for x in to.x0..to.x0 + to.width {
+            let cols = (x * n).max(from.x0)..((x + 1) * n).min(fx1);
+            let mut acc = A::default();
+            let mut count = 0;
+            for fy in rows.clone() {
+                let row = ((fy - from.y0) * from.width) as usize;
+                for fx in cols.clone() {
+                    add(&mut acc, &texels[row + (fx - from.x0) as usize]);
+                    count += 1;
+                }
+            }
+            out.push(finish(acc, count));
+        }
+    }
+    out
 }
 
 /// The 8-bit gamma code nearest to the linear value `x` (in `[0, 1]`), through `lut`.
@@ -151,137 +157,74 @@ fn flow_code(table: &[f32; 256], x: f32) -> i8 {
     (i as i32 + 1 - 128) as i8
 }
 
-impl PoseSource {
-    /// The pose at level of detail `level` (itself at level 0; see the module docs).
-    pub fn reduced(&self, level: u8) -> PoseSource {
-        if level == 0 {
-            return self.clone();
+/// Basis codes `b` (cropped by `from`) reduced by `level` into the crop `to`: each
+/// block averaged in linear light and coded again.
+pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8) -> BasisCodes {
+    let lut = gamma_lut();
+    let codes = gamma_codes();
+    let add = |sum: &mut [f32; 3], t: &[u8; 3]| {
+        for c in 0..3 {
+            sum[c] += lut[t[c] as usize];
         }
-        let g = &self.geometry;
-        let (from, to) = (g.crop, reduced_crop(g.crop, level));
-        let lut = gamma_lut();
-        let codes = gamma_codes();
-        let mean = |sum: f32, n: usize| if n > 0 { sum / n as f32 } else { 0.0 };
-        let basis = self
-            .basis
+    };
+    let finish = |sum: [f32; 3], n: u32| sum.map(|s| fast_gamma_code(codes, s / n.max(1) as f32));
+    BasisCodes {
+        width: to.width as usize,
+        height: to.height as usize,
+        tiles: b
+            .tiles
             .iter()
-            .map(|b| BasisCodes {
-                width: to.width as usize,
-                height: to.height as usize,
-                tiles: b
-                    .tiles
-                    .iter()
-                    .map(|tile| {
-                        reduce(
-                            tile,
-                            from,
-                            to,
-                            level,
-                            |block: &mut dyn Iterator<Item = &[u8; 3]>| {
-                                let (mut sum, mut n) = ([0.0f32; 3], 0);
-                                for t in block {
-                                    for c in 0..3 {
-                                        sum[c] += lut[t[c] as usize];
-                                    }
-                                    n += 1;
-                                }
-                                sum.map(|s| fast_gamma_code(codes, mean(s, n)))
-                            },
-                        )
-                    })
-                    .collect(),
-                scales: b.scales.clone(),
-            })
-            .collect();
-        let alpha = self
-            .alpha
-            .iter()
-            .map(|a| {
-                if a.is_empty() {
-                    return Vec::new();
-                }
-                reduce(
-                    a,
-                    from,
-                    to,
-                    level,
-                    |block: &mut dyn Iterator<Item = &u8>| {
-                        let (mut sum, mut n) = (0u32, 0u32);
-                        for &v in block {
-                            sum += v as u32;
-                            n += 1;
-                        }
-                        ((sum + n / 2) / n.max(1)) as u8
-                    },
-                )
-            })
-            .collect();
-        let q = self.flows.quantizer;
-        let table = &self.flows.table;
-        let scale = 1.0 / (1u32 << level) as f32;
-        let codes = self
-            .flows
-            .codes
-            .iter()
-            .map(|per_view| {
-                per_view.clone().map(|flow| {
-                    flow.map(|flow| {
-                        reduce(
-                            &flow,
-                            from,
-                            to,
-                            level,
-                            |block: &mut dyn Iterator<Item = &[i8; 2]>| {
-                                let (mut sum, mut n) = ([0.0f32; 2], 0);
-                                for &c in block {
-                                    if c[0] != UNKNOWN_CODE && c[1] != UNKNOWN_CODE {
-                                        for k in 0..2 {
-                                            sum[k] += table[(c[k] as i32 + 128) as usize];
-                                        }
-                                        n += 1;
-                                    }
-                                }
-                                if n == 0 {
-                                    return [UNKNOWN_CODE; 2];
-                                }
-                                sum.map(|s| flow_code(table, s * scale / n as f32))
-                            },
-                        )
-                    })
-                })
-            })
-            .collect::<Vec<_>>();
-        let cameras = g.cameras.iter().map(|c| reduced_camera(c, level)).collect();
-        let size = (
-            g.image_size.0.div_ceil(1 << level),
-            g.image_size.1.div_ceil(1 << level),
-        );
-        let geometry = PoseGeometry::new(
-            g.pose,
-            g.columns,
-            g.rows,
-            g.wraps,
-            size,
-            to,
-            cameras,
-            |i, n| codes[i][n.index()].is_some(),
-        )
-        .with_proxy(g.proxy.clone())
-        .with_held(|i| g.holds(i));
-        PoseSource {
-            geometry: Arc::new(geometry),
-            flows: Arc::new(PoseFlows {
-                codes,
-                quantizer: q,
-                table: self.flows.table,
-            }),
-            basis,
-            alpha,
-            coefficients: self.coefficients.clone(),
-            ground_coefficients: self.ground_coefficients.clone(),
-            plan: self.plan.clone(),
-        }
+            .map(|tile| reduce(tile, from, to, level, add, finish))
+            .collect(),
+        scales: b.scales.clone(),
     }
+}
+
+/// Alpha codes (cropped by `from`) reduced by `level` into the crop `to`.
+pub fn reduce_alpha(a: &[u8], from: Crop, to: Crop, level: u8) -> Vec<u8> {
+    let add = |sum: &mut u32, &v: &u8| *sum += v as u32;
+    let finish = |sum: u32, n: u32| ((sum + n / 2) / n.max(1)) as u8;
+    reduce(a, from, to, level, add, finish)
+}
+
+/// Flow codes (cropped by `from`, decoded and coded again through `table`,
+/// [`crate::resident::flow_lut`]) reduced by `level` into the crop `to`: the known texels
+/// of each block averaged and divided by `2^level`; unknown where none is known.
+pub fn reduce_flow(
+    flow: &[[i8; 2]],
+    table: &[f32; 256],
+    from: Crop,
+    to: Crop,
+    level: u8,
+) -> Vec<[i8; 2]> {
+    let scale = 1.0 / (1u32 << level) as f32;
+    let add = |acc: &mut (f32, f32, u32), c: &[i8; 2]| {
+        if c[0] != UNKNOWN_CODE && c[1] != UNKNOWN_CODE {
+            acc.0 += table[(c[0] as i32 + 128) as usize];
+            acc.1 += table[(c[1] as i32 + 128) as usize];
+            acc.2 += 1;
+        }
+    };
+    let finish = |(u, v, known): (f32, f32, u32), _| {
+        if known == 0 {
+            return [UNKNOWN_CODE; 2];
+        }
+        let f = scale / known as f32;
+        [flow_code(table, u * f), flow_code(table, v * f)]
+    };
+    reduce(flow, from, to, level, add, finish)
+}
+
+/// The whole image of `size` reduced by `level`, as a crop (and its size).
+pub fn reduced_image(size: (u32, u32), level: u8) -> ((u32, u32), Crop) {
+    let whole = Crop {
+        x0: 0,
+        y0: 0,
+        width: size.0,
+        height: size.1,
+    };
+    let to = reduced_crop(whole, level);
+    ((to.width, to.height), to)
 }
 
 #[cfg(test)]

@@ -40,11 +40,36 @@ impl Crop {
     /// The union of the non-zero pixels of `alphas` (full images of `size`), grown by
     /// [`CROP_MARGIN_PX`]; one pixel when every alpha is zero.
     pub fn of_mattes(alphas: &[GrayImage], size: (u32, u32)) -> Self {
+        Self::of_covered(
+            alphas
+                .iter()
+                .map(|a| (a.width(), a.pixels().iter().map(|&v| v > 0.0))),
+            size,
+        )
+    }
+
+    /// [`Crop::of_mattes`] of 8-bit alpha codes (full images of `size`; an empty one
+    /// covers nothing).
+    pub fn of_alpha_codes(alphas: &[&[u8]], size: (u32, u32)) -> Self {
+        Self::of_covered(
+            alphas
+                .iter()
+                .map(|a| (size.0 as usize, a.iter().map(|&v| v > 0))),
+            size,
+        )
+    }
+
+    /// The union of the covered pixels of images (row length, and per pixel whether it
+    /// is covered), grown by [`CROP_MARGIN_PX`] within `size`.
+    fn of_covered<I: Iterator<Item = bool>>(
+        images: impl Iterator<Item = (usize, I)>,
+        size: (u32, u32),
+    ) -> Self {
         let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0u32, 0u32);
-        for a in alphas {
-            for (i, &v) in a.pixels().iter().enumerate() {
-                if v > 0.0 {
-                    let (x, y) = ((i % a.width()) as u32, (i / a.width()) as u32);
+        for (width, covered) in images {
+            for (i, c) in covered.enumerate() {
+                if c {
+                    let (x, y) = ((i % width) as u32, (i / width) as u32);
                     x0 = x0.min(x);
                     y0 = y0.min(y);
                     x1 = x1.max(x);

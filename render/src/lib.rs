@@ -33,6 +33,7 @@ pub mod motion;
 pub mod path;
 pub mod proxy;
 pub mod rectified;
+pub mod reduced_views;
 pub mod renderer;
 pub mod resident;
 pub mod scene;

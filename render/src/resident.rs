@@ -25,14 +25,16 @@ use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
-use frf_reflectance::project::{FloorModel, Projector};
+use frf_reflectance::project::FloorModel;
 use glam::Vec2;
 use rayon::prelude::*;
 
+use crate::detail::{reduce_alpha, reduce_basis, reduce_flow, reduced_camera, reduced_image};
 use crate::error::{RenderError, Result};
 use crate::extend::extend_flow;
 use crate::geometry::{Crop, PoseGeometry};
 use crate::proxy::Proxy;
+use crate::reduced_views::{ReducedImage, ReducedViews};
 use crate::scene::plan::PosePlan;
 
 /// How the field is lit.
@@ -120,6 +122,20 @@ impl PoseSource {
         lighting: &Lighting,
         plan: Option<&PosePlan>,
     ) -> Result<Self> {
+        Self::load_at(field, pose, lighting, plan, 0, None)
+    }
+
+    /// [`PoseSource::load_planned`] at level of detail `level` ([`crate::detail`]): above
+    /// 0, the views and flows read are reduced (taken from `kept` when it holds them, and
+    /// kept there), and the crop is the whole reduced image.
+    pub fn load_at<R: ReadAt>(
+        field: &FieldFile<R>,
+        pose: u32,
+        lighting: &Lighting,
+        plan: Option<&PosePlan>,
+        level: u8,
+        kept: Option<&ReducedViews>,
+    ) -> Result<Self> {
         let h = field.header();
         let record = h.pose(pose)?;
         let (columns, rows) = (h.columns, h.rows);
@@ -171,22 +187,10 @@ impl PoseSource {
         } else {
             None
         };
-        let size = (h.width, h.height);
-        let alphas: Vec<GrayImage> = (0..views)
-            .into_par_iter()
-            .map(|i| {
-                if view_used(i) {
-                    Ok(field.alpha(pose, i / rows, i % rows)?)
-                } else {
-                    Ok(GrayImage::new(size.0 as usize, size.1 as usize, 0.0))
-                }
-            })
-            .collect::<Result<_>>()?;
-        let crop = Crop::of_mattes(&alphas, size);
         let (coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
             Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
             Lighting::Environment { env, floor } => {
-                let projector = Projector::new(&h.conditions)?;
+                let projector = field.projector()?;
                 // One pass over the map for every view's turntable angle and the
                 // subject's own frame (angle 0), the last.
                 // Views not read keep angle 0 (their coefficients are never used).
@@ -233,55 +237,159 @@ impl PoseSource {
             images_combined: views * used.iter().filter(|&&u| u).count(),
             images_total: views * h.conditions.len(),
         };
-        let full_w = h.width as usize;
-        let per_view: Vec<ViewCodes> = (0..views)
-            .into_par_iter()
-            .map(|i| {
-                let (u, v) = (i / rows, i % rows);
-                if !view_used(i) {
-                    let blank = BasisCodes {
+        let table = flow_lut(&record.flow_quantizer);
+        let (size, crop, cameras, per_view) = if level == 0 {
+            let size = (h.width, h.height);
+            let alphas: Vec<GrayImage> = (0..views)
+                .into_par_iter()
+                .map(|i| {
+                    if view_used(i) {
+                        Ok(field.alpha(pose, i / rows, i % rows)?)
+                    } else {
+                        Ok(GrayImage::new(size.0 as usize, size.1 as usize, 0.0))
+                    }
+                })
+                .collect::<Result<_>>()?;
+            let crop = Crop::of_mattes(&alphas, size);
+            let full_w = h.width as usize;
+            let per_view: Vec<ViewCodes> = (0..views)
+                .into_par_iter()
+                .map(|i| {
+                    let (u, v) = (i / rows, i % rows);
+                    if !view_used(i) {
+                        let blank = BasisCodes {
+                            width: crop.width as usize,
+                            height: crop.height as usize,
+                            tiles: Vec::new(),
+                            scales: Vec::new(),
+                        };
+                        return Ok((blank, Vec::new(), Default::default()));
+                    }
+                    // Shared with every other read of the view (kept decoded, when the
+                    // caller set a budget for it), cropped here.
+                    let whole = field.basis_codes_shared(pose, u, v)?;
+                    let b = BasisCodes {
                         width: crop.width as usize,
                         height: crop.height as usize,
-                        tiles: Vec::new(),
-                        scales: Vec::new(),
+                        tiles: whole
+                            .tiles
+                            .iter()
+                            .map(|t| crop.rows_of(t, full_w))
+                            .collect(),
+                        scales: whole.scales.clone(),
                     };
-                    return Ok((blank, Vec::new(), Default::default()));
-                }
-                // Shared with every other read of the view (kept decoded, when the
-                // caller set a budget for it), cropped here.
-                let whole = field.basis_codes_shared(pose, u, v)?;
-                let b = BasisCodes {
-                    width: crop.width as usize,
-                    height: crop.height as usize,
-                    tiles: whole
-                        .tiles
+                    let a: Vec<u8> = alphas[i]
+                        .pixels()
                         .iter()
-                        .map(|t| crop.rows_of(t, full_w))
-                        .collect(),
-                    scales: whole.scales.clone(),
-                };
-                let a: Vec<u8> = alphas[i]
-                    .pixels()
-                    .iter()
-                    .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
-                    .collect();
-                let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
-                for n in Neighbour::ALL {
-                    if !flow_used(i, n) {
-                        continue;
+                        .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+                        .collect();
+                    let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
+                    for n in Neighbour::ALL {
+                        if !flow_used(i, n) {
+                            continue;
+                        }
+                        if let Some(codes) = field.flow_codes(pose, u, v, n)? {
+                            let plane = codes.len() / 2;
+                            let pairs: Vec<[i8; 2]> =
+                                (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
+                            let mut cropped = crop.rows_of(&pairs, full_w);
+                            extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
+                            flows[n.index()] = Some(cropped);
+                        }
                     }
-                    if let Some(codes) = field.flow_codes(pose, u, v, n)? {
-                        let plane = codes.len() / 2;
-                        let pairs: Vec<[i8; 2]> =
-                            (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
-                        let mut cropped = crop.rows_of(&pairs, full_w);
-                        extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
-                        flows[n.index()] = Some(cropped);
+                    Ok((b, crop.rows_of(&a, full_w), flows))
+                })
+                .collect::<Result<_>>()?;
+            (size, crop, cameras, per_view)
+        } else {
+            let none = ReducedViews::default();
+            let kept = kept.unwrap_or(&none);
+            let (size, to) = reduced_image((h.width, h.height), level);
+            let full = Crop {
+                x0: 0,
+                y0: 0,
+                width: h.width,
+                height: h.height,
+            };
+            // Per view read: its reduced image and flows (of the whole reduced image).
+            type Reduced = (Arc<ReducedImage>, [Option<Arc<Vec<[i8; 2]>>>; 4]);
+            let reduced: Vec<Option<Reduced>> = (0..views)
+                .into_par_iter()
+                .map(|i| {
+                    let (u, v) = (i / rows, i % rows);
+                    if !view_used(i) {
+                        return Ok(None);
                     }
-                }
-                Ok((b, crop.rows_of(&a, full_w), flows))
-            })
-            .collect::<Result<_>>()?;
+                    let image = kept.image((pose, i, level), || {
+                        let alpha: Vec<u8> = field
+                            .alpha(pose, u, v)?
+                            .pixels()
+                            .iter()
+                            .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+                            .collect();
+                        let basis = field.basis_codes_shared(pose, u, v)?;
+                        Ok(ReducedImage {
+                            basis: reduce_basis(&basis, full, to, level),
+                            alpha: reduce_alpha(&alpha, full, to, level),
+                        })
+                    })?;
+                    let mut flows: [Option<Arc<Vec<[i8; 2]>>>; 4] = Default::default();
+                    for n in Neighbour::ALL {
+                        if !flow_used(i, n) {
+                            continue;
+                        }
+                        // An absent flow (at the grid's edge) is kept as no codes.
+                        let flow = kept.flow((pose, i, n.index(), level), || {
+                            let Some(codes) = field.flow_codes(pose, u, v, n)? else {
+                                return Ok(Vec::new());
+                            };
+                            let plane = codes.len() / 2;
+                            let pairs: Vec<[i8; 2]> =
+                                (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
+                            let mut reduced = reduce_flow(&pairs, &table, full, to, level);
+                            extend_flow(&mut reduced, to.width as usize, to.height as usize);
+                            Ok(reduced)
+                        })?;
+                        flows[n.index()] = (!flow.is_empty()).then_some(flow);
+                    }
+                    Ok(Some((image, flows)))
+                })
+                .collect::<Result<_>>()?;
+            // Cropped to the views' mattes, as at full detail.
+            let alphas: Vec<&[u8]> = reduced
+                .iter()
+                .map(|r| r.as_ref().map_or(&[][..], |(i, _)| &i.alpha[..]))
+                .collect();
+            let crop = Crop::of_alpha_codes(&alphas, size);
+            let w = size.0 as usize;
+            let per_view: Vec<ViewCodes> = reduced
+                .iter()
+                .map(|r| {
+                    let Some((image, flows)) = r else {
+                        let blank = BasisCodes {
+                            width: crop.width as usize,
+                            height: crop.height as usize,
+                            tiles: Vec::new(),
+                            scales: Vec::new(),
+                        };
+                        return (blank, Vec::new(), Default::default());
+                    };
+                    let b = &image.basis;
+                    let basis = BasisCodes {
+                        width: crop.width as usize,
+                        height: crop.height as usize,
+                        tiles: b.tiles.iter().map(|t| crop.rows_of(t, w)).collect(),
+                        scales: b.scales.clone(),
+                    };
+                    let flows = flows
+                        .each_ref()
+                        .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
+                    (basis, crop.rows_of(&image.alpha, w), flows)
+                })
+                .collect();
+            let cameras = cameras.iter().map(|c| reduced_camera(c, level)).collect();
+            (size, crop, cameras, per_view)
+        };
         let mut basis = Vec::with_capacity(views);
         let mut alpha = Vec::with_capacity(views);
         let mut flows = Vec::with_capacity(views);
@@ -301,7 +409,7 @@ impl PoseSource {
             flows: Arc::new(PoseFlows {
                 codes: flows,
                 quantizer: record.flow_quantizer,
-                table: flow_lut(&record.flow_quantizer),
+                table,
             }),
             basis,
             alpha,

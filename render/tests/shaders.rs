@@ -11,7 +11,7 @@ use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
 use frf_render::gpu::shaders;
 use frf_render::gpu::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuPresent, GpuProxy, GpuQuad,
-    GpuQuadFrame, GpuRelightParams, GpuShadowParams, GpuView,
+    GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -144,7 +144,17 @@ fn pod_structs_match_naga_layouts() {
         &rebin,
         "View",
         GpuView,
-        [rotation, centre, scale, intrinsics, flow_layers]
+        [
+            rotation,
+            centre,
+            scale,
+            intrinsics,
+            flow_layers,
+            prelit_layer,
+            pad0,
+            pad1,
+            pad2
+        ]
     );
     check_layout!(
         &rebin,
@@ -170,7 +180,8 @@ fn pod_structs_match_naga_layouts() {
             crop_origin,
             crop_size,
             flags,
-            pad
+            pad,
+            bounds
         ]
     );
     check_layout!(
@@ -223,7 +234,22 @@ fn pod_structs_match_naga_layouts() {
         &relight,
         "RelightParams",
         GpuRelightParams,
-        [texels, tiles, width, view]
+        [texels, width, jobs, pad]
+    );
+    check_layout!(
+        &relight,
+        "Job",
+        GpuRelightJob,
+        [
+            basis_offset,
+            coefficient_offset,
+            tiles,
+            view,
+            layer,
+            relit_offset,
+            pad0,
+            pad1
+        ]
     );
     let shadow = module(&shaders::composed(shaders::SHADOW), "shadow");
     check_layout!(
@@ -263,6 +289,6 @@ fn pod_structs_match_naga_layouts() {
         &composite,
         "Instance",
         GpuInstance,
-        [col_x, col_y, col_z, translation]
+        [col_x, col_y, col_z, translation, bounds]
     );
 }

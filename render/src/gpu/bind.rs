@@ -139,6 +139,23 @@ pub fn storage_texture(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindG
     }
 }
 
+/// A write-only storage texture array of `format` for compute shaders.
+pub fn storage_texture_array(
+    binding: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
+        },
+        count: None,
+    }
+}
+
 /// Unfilterable 32-bit float texels (read with `textureLoad`, filtered in the shader).
 pub const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
 

@@ -1,8 +1,8 @@
 //! Making a pose resident on the GPU: its flows as RG8 integer texture arrays (the 8-bit
 //! log codes, decoded in the shader), the view and quad tables and the cylinder's column
 //! index as storage buffers, and every view relit on the GPU into an RGBA8 texture array
-//! (`shaders/relight.wgsl`), one dispatch pair per view: the weighted sum of its basis
-//! images, then its encoding with the view's peak. Twin of
+//! (`shaders/relight.wgsl`), one dispatch pair per batch of views: the weighted sum of
+//! each view's basis images, then its encoding with the view's peak. Twin of
 //! [`crate::resident::ResidentPose::relight_cpu`].
 
 use std::sync::Arc;
@@ -12,10 +12,10 @@ use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::bind::{
-    compute_pipeline, copy_to_buffer, storage, storage_texture, table_bytes, uniform,
+    compute_pipeline, copy_to_buffer, storage, storage_texture_array, table_bytes, uniform,
 };
 use super::formats::PoseFormats;
-use super::types::{GpuQuad, GpuQuadFrame, GpuRelightParams, GpuView};
+use super::types::{GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuView};
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
@@ -24,6 +24,9 @@ use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
 
 /// Workgroup size of the relighting pass (`@workgroup_size(64)`).
 const WORKGROUP: u32 = 64;
+
+/// Most bytes of basis codes the relighting records into one batch.
+const RELIGHT_BATCH_BYTES: usize = 64 << 20;
 
 /// The relighting pipelines.
 pub struct RelightPass {
@@ -46,7 +49,8 @@ impl RelightPass {
                 storage::<[[f32; 4]; 64]>(3, true, c),
                 storage::<[f32; 4]>(4, false, c),
                 storage::<u32>(5, false, c),
-                storage_texture(6, wgpu::TextureFormat::Rgba8Uint),
+                storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
+                storage::<GpuRelightJob>(7, true, c),
             ],
         });
         let compute = |entry: &str| {
@@ -306,7 +310,9 @@ impl Gpu {
                     intrinsics: [k.fx, k.fy, k.cx, k.cy],
                     flow_layers: *l,
                     prelit_layer,
-                    pad: [0; 3],
+                    pad0: 0,
+                    pad1: 0,
+                    pad2: 0,
                 }
             })
             .collect();
@@ -413,164 +419,54 @@ impl Gpu {
         }
     }
 
-    /// Relights every view into its layer of `prelit`; returns the views' scales.
+    /// Relights every view into its layer of `prelit`; returns the views' scales. Views
+    /// are relit in batches (one dispatch pair each) of up to [`RELIGHT_BATCH_BYTES`] of
+    /// basis codes.
     fn relight_views(&self, source: &PoseSource, prelit: &wgpu::Texture) -> Result<Vec<f32>> {
-        let crop = source.geometry.crop;
-        let texels = crop.texels();
-        let tiles = source
-            .basis
-            .iter()
-            .map(|b| b.tiles.len())
-            .max()
-            .unwrap_or(0);
         let views = source.basis.len();
-        let basis_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("basis"),
-            size: (tiles.max(1) * texels * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+        let storage = wgpu::BufferUsages::STORAGE;
+        let gamma = self.init_buffer(
+            "gamma",
+            &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
+            storage,
+        );
+        let peaks = self.init_buffer(
+            "peaks",
+            &vec![0u8; views.max(1) * 4],
+            storage | wgpu::BufferUsages::COPY_SRC,
+        );
+        let target = prelit.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
         });
-        let coefficient_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("coefficients"),
-            size: (tiles.max(1) * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let params = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("relight params"),
-            size: std::mem::size_of::<GpuRelightParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let gamma = self
+        let mut encoder = self
             .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("gamma"),
-                contents: &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
-                usage: wgpu::BufferUsages::STORAGE,
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("relight"),
             });
-        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("relit"),
-            size: (texels * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
-        let peaks = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("peaks"),
-                contents: &vec![0u8; views.max(1) * 4],
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            });
+        // The views read (a view not read has no layer: it samples as transparent, as
+        // the CPU's does, and its peak stays zero, scale 1), in batches.
+        let texels = source.geometry.crop.texels();
+        let read: Vec<usize> = (0..views)
+            .filter(|&i| !source.is_blank(i) && source.geometry.prelit_layers[i] >= 0)
+            .collect();
+        let mut batch: Vec<usize> = Vec::new();
+        let mut bytes = 0;
+        for (k, &i) in read.iter().enumerate() {
+            batch.push(i);
+            bytes += source.basis[i].tiles.len() * texels * 4;
+            if bytes >= RELIGHT_BATCH_BYTES || k + 1 == read.len() {
+                self.record_relight(&mut encoder, source, &batch, [&gamma, &peaks], &target);
+                batch.clear();
+                bytes = 0;
+            }
+        }
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("peaks readback"),
             size: (views.max(1) * 4) as u64,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let groups = (texels as u32).div_ceil(WORKGROUP);
-        for (i, basis) in source.basis.iter().enumerate() {
-            let layer = source.geometry.prelit_layers[i];
-            if source.is_blank(i) || layer < 0 {
-                // A view not read: it has no layer (it samples as transparent, as the
-                // CPU's does), and its peak stays zero (scale 1).
-                continue;
-            }
-            let mut packed = Vec::with_capacity(tiles * texels);
-            for (k, tile) in basis.tiles.iter().enumerate() {
-                packed.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
-                    let alpha = if k == 0 { a as u32 } else { 0 };
-                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
-                }));
-            }
-            let coefficients: Vec<[f32; 4]> = source.coefficients[i]
-                .iter()
-                .zip(&basis.scales)
-                .map(|(c, &s)| {
-                    let used = if c.iter().all(|&x| x == 0.0) {
-                        0.0
-                    } else {
-                        1.0
-                    };
-                    [c[0] * s, c[1] * s, c[2] * s, used]
-                })
-                .collect();
-            self.queue
-                .write_buffer(&basis_buffer, 0, bytemuck::cast_slice(&packed));
-            self.queue
-                .write_buffer(&coefficient_buffer, 0, bytemuck::cast_slice(&coefficients));
-            self.queue.write_buffer(
-                &params,
-                0,
-                bytemuck::bytes_of(&GpuRelightParams {
-                    texels: texels as u32,
-                    tiles: tiles as u32,
-                    width: crop.width,
-                    view: i as u32,
-                }),
-            );
-            let layer = prelit.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer as u32,
-                array_layer_count: Some(1),
-                ..Default::default()
-            });
-            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("relight"),
-                layout: &self.relight.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: basis_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: coefficient_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: gamma.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: relit.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: peaks.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: wgpu::BindingResource::TextureView(&layer),
-                    },
-                ],
-            });
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("relight"),
-                });
-            for pipeline in [&self.relight.relight, &self.relight.encode] {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("relight"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups(groups, 1, 1);
-            }
-            // Each view's uploads must land before its dispatches and after the last ones.
-            self.queue.submit([encoder.finish()]);
-        }
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("peaks"),
-            });
         encoder.copy_buffer_to_buffer(&peaks, 0, &readback, 0, (views.max(1) * 4) as u64);
         self.queue.submit([encoder.finish()]);
         let bytes = self.read_buffer(&readback)?;
@@ -581,6 +477,127 @@ impl Gpu {
                 if p > 0.0 { p } else { 1.0 }
             })
             .collect())
+    }
+
+    /// A buffer holding `contents`.
+    fn init_buffer(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+    }
+
+    /// Records the relighting of views `batch` of `source` into `encoder`: their codes,
+    /// coefficients and jobs uploaded, then the two passes over every view at once,
+    /// writing the views' peaks into `gamma_peaks[1]` and their texels into `target`.
+    fn record_relight(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        source: &PoseSource,
+        batch: &[usize],
+        [gamma, peaks]: [&wgpu::Buffer; 2],
+        target: &wgpu::TextureView,
+    ) {
+        let crop = source.geometry.crop;
+        let texels = crop.texels();
+        let mut codes: Vec<u32> = Vec::new();
+        let mut coefficients: Vec<[f32; 4]> = Vec::new();
+        let mut jobs = Vec::with_capacity(batch.len());
+        for (j, &i) in batch.iter().enumerate() {
+            let basis = &source.basis[i];
+            jobs.push(GpuRelightJob {
+                basis_offset: codes.len() as u32,
+                coefficient_offset: coefficients.len() as u32,
+                tiles: basis.tiles.len() as u32,
+                view: i as u32,
+                layer: source.geometry.prelit_layers[i] as u32,
+                relit_offset: (j * texels) as u32,
+                pad0: 0,
+                pad1: 0,
+            });
+            for (k, tile) in basis.tiles.iter().enumerate() {
+                codes.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
+                    let alpha = if k == 0 { a as u32 } else { 0 };
+                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
+                }));
+            }
+            coefficients.extend(
+                source.coefficients[i]
+                    .iter()
+                    .zip(&basis.scales)
+                    .map(|(c, &s)| {
+                        let used = if c.iter().all(|&x| x == 0.0) {
+                            0.0
+                        } else {
+                            1.0
+                        };
+                        [c[0] * s, c[1] * s, c[2] * s, used]
+                    }),
+            );
+        }
+        if codes.is_empty() {
+            codes.push(0);
+        }
+        if coefficients.is_empty() {
+            coefficients.push([0.0; 4]);
+        }
+        let params = GpuRelightParams {
+            texels: texels as u32,
+            width: crop.width,
+            jobs: batch.len() as u32,
+            pad: 0,
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("relit"),
+            size: (texels * batch.len().max(1) * 16) as u64,
+            usage: storage,
+            mapped_at_creation: false,
+        });
+        let buffers = [
+            self.init_buffer(
+                "relight params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+            self.init_buffer("basis", bytemuck::cast_slice(&codes), storage),
+            self.init_buffer("coefficients", bytemuck::cast_slice(&coefficients), storage),
+            self.init_buffer("jobs", bytemuck::cast_slice(&jobs), storage),
+        ];
+        let resources = [
+            buffers[0].as_entire_binding(),
+            buffers[1].as_entire_binding(),
+            buffers[2].as_entire_binding(),
+            gamma.as_entire_binding(),
+            relit.as_entire_binding(),
+            peaks.as_entire_binding(),
+            wgpu::BindingResource::TextureView(target),
+            buffers[3].as_entire_binding(),
+        ];
+        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("relight"),
+            layout: &self.relight.layout,
+            entries: &resources
+                .into_iter()
+                .enumerate()
+                .map(|(b, resource)| wgpu::BindGroupEntry {
+                    binding: b as u32,
+                    resource,
+                })
+                .collect::<Vec<_>>(),
+        });
+        let groups = (texels as u32).div_ceil(WORKGROUP);
+        for pipeline in [&self.relight.relight, &self.relight.encode] {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("relight"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(groups, batch.len() as u32, 1);
+        }
     }
 
     /// Reads back the pre-lit texels of every view (for tests and inspection; a view not

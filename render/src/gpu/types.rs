@@ -20,7 +20,11 @@ pub struct GpuView {
     /// Pre-lit layer; -1 for a view not held (transparent).
     pub prelit_layer: i32,
     /// Padding to 16 bytes.
-    pub pad: [i32; 3],
+    pub pad0: i32,
+    /// Padding.
+    pub pad1: i32,
+    /// Padding.
+    pub pad2: i32,
 }
 
 /// `Quad` of `shaders/common.wgsl`.
@@ -137,12 +141,34 @@ pub struct GpuProxy {
 pub struct GpuRelightParams {
     /// Texels per view.
     pub texels: u32,
-    /// Basis images per view.
-    pub tiles: u32,
     /// Row length.
     pub width: u32,
-    /// View index.
+    /// Views in the batch.
+    pub jobs: u32,
+    /// Padding to 16 bytes.
+    pub pad: u32,
+}
+
+/// `Job` of `shaders/relight.wgsl`: one view of a relighting batch.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuRelightJob {
+    /// Its first basis code in the batch's codes.
+    pub basis_offset: u32,
+    /// Its first coefficient in the batch's coefficients.
+    pub coefficient_offset: u32,
+    /// Its basis images.
+    pub tiles: u32,
+    /// Its view index (of its peak).
     pub view: u32,
+    /// Its layer of the pre-lit texture.
+    pub layer: u32,
+    /// Its first texel in the batch's relit scratch.
+    pub relit_offset: u32,
+    /// Padding.
+    pub pad0: u32,
+    /// Padding.
+    pub pad1: u32,
 }
 
 /// `ShadowParams` of `shaders/shadow.wgsl`.

@@ -30,6 +30,7 @@ use crate::error::{RenderError, Result};
 use crate::footprint::{PixelBox, subject_box};
 use crate::gpu::composite::DrawnFrame;
 use crate::motion::pose_motion;
+use crate::reduced_views::ReducedViews;
 use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
 use crate::resident::{Lighting, PoseSource};
 use crate::shadow::{ShadowMaps, traced_shadow};
@@ -179,6 +180,9 @@ pub struct Shot<'a, R: ReadAt> {
     backdrop: Option<(LightingKey, DeviceBackdrop)>,
     plate: Option<RgbImage>,
     cache: Vec<Cached>,
+    /// Views reduced to a level of detail, kept between residencies (the same share of
+    /// the budget as the decoded views).
+    reduced: ReducedViews,
     counters: ShotCounters,
     /// Frames drawn at a time and camera of the caller's ([`Shot::draw_at`]).
     live_frames: usize,
@@ -242,6 +246,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             backdrop: None,
             plate,
             cache: Vec::new(),
+            reduced: ReducedViews::with_budget(options.memory_budget / DECODED_SHARE),
             counters: ShotCounters::default(),
             live_frames: 0,
         })
@@ -677,7 +682,14 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                  are made at full detail (interpolate = \"nearest\", or detail 0)"
             )));
         }
-        let source = PoseSource::load_planned(self.field, pose, &lighting, plan)?.reduced(level);
+        let source = PoseSource::load_at(
+            self.field,
+            pose,
+            &lighting,
+            plan,
+            level,
+            Some(&self.reduced),
+        )?;
         let mut resident = self.device.make_resident(&source)?;
         if self.plan.interpolate == TimeInterpolation::Flow {
             let motion = PoseStep::ALL.map(|step| {
