@@ -21,6 +21,7 @@ pub mod grid;
 pub mod image;
 pub mod io;
 pub mod light;
+pub mod lru;
 pub mod manifest;
 pub mod preview;
 pub mod progress;

@@ -7,25 +7,17 @@
 //!
 //! [`FieldFile::keep_decoded`]: crate::FieldFile::keep_decoded
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
+
+use frf_core::lru::Lru;
 
 use crate::container::ChunkKey;
 use crate::imagecodec::BasisCodes;
 
-/// The kept views, most recently used last, and the budget.
+/// The kept views, within their budget ([`Lru`]).
 #[derive(Default)]
 pub struct DecodedBasis {
-    inner: Mutex<Kept>,
-}
-
-#[derive(Default)]
-struct Kept {
-    budget: u64,
-    bytes: u64,
-    views: Vec<(ChunkKey, Arc<BasisCodes>)>,
-    /// Reads served from the kept views, and decodes made.
-    hits: u64,
-    misses: u64,
+    kept: Lru<ChunkKey, Arc<BasisCodes>>,
 }
 
 /// Bytes a view's codes hold.
@@ -36,9 +28,7 @@ fn size(b: &BasisCodes) -> u64 {
 impl DecodedBasis {
     /// Keeps at most `bytes` of decoded views (0: none; the kept ones beyond it leave).
     pub fn set_budget(&self, bytes: u64) {
-        let mut k = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        k.budget = bytes;
-        k.shrink();
+        self.kept.set_budget(bytes);
     }
 
     /// The view of `key`, decoded by `decode` unless it is kept.
@@ -47,42 +37,13 @@ impl DecodedBasis {
         key: ChunkKey,
         decode: impl FnOnce() -> crate::Result<BasisCodes>,
     ) -> crate::Result<Arc<BasisCodes>> {
-        {
-            let mut k = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-            if let Some(i) = k.views.iter().position(|(c, _)| *c == key) {
-                let entry = k.views.remove(i);
-                let found = entry.1.clone();
-                k.views.push(entry);
-                k.hits += 1;
-                return Ok(found);
-            }
-        }
-        // Decoded outside the lock: other views decode in parallel.
-        let codes = Arc::new(decode()?);
-        let mut k = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        k.misses += 1;
-        let bytes = size(&codes);
-        if bytes <= k.budget && !k.views.iter().any(|(c, _)| *c == key) {
-            k.bytes += bytes;
-            k.views.push((key, codes.clone()));
-            k.shrink();
-        }
-        Ok(codes)
+        self.kept
+            .get_or(key, |c| size(c), || Ok(Arc::new(decode()?)))
     }
 
     /// Reads served from kept views, and decodes made, so far.
     pub fn counts(&self) -> (u64, u64) {
-        let k = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        (k.hits, k.misses)
-    }
-}
-
-impl Kept {
-    fn shrink(&mut self) {
-        while self.bytes > self.budget && !self.views.is_empty() {
-            let (_, gone) = self.views.remove(0);
-            self.bytes -= size(&gone);
-        }
+        self.kept.counts()
     }
 }
 

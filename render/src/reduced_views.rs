@@ -5,8 +5,9 @@
 //! alpha) and each of its reduced flows are read, decoded and reduced once; a walker's
 //! residency then costs its relighting coefficients and the relight itself.
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
+use frf_core::lru::Lru;
 use frf_reflectance::imagecodec::BasisCodes;
 
 use crate::error::Result;
@@ -59,65 +60,27 @@ impl Entry {
     }
 }
 
-#[derive(Default)]
-struct Kept {
-    budget: u64,
-    bytes: u64,
-    /// Most recently used last.
-    entries: Vec<(Key, Entry)>,
-    hits: u64,
-    misses: u64,
-}
-
 /// The kept reduced views (empty, and keeping nothing, until a budget is set).
 #[derive(Default)]
 pub struct ReducedViews {
-    inner: Mutex<Kept>,
+    kept: Lru<Key, Entry>,
 }
 
 impl ReducedViews {
     /// Keeps at most `bytes` (0: nothing).
     pub fn with_budget(bytes: u64) -> Self {
         let views = Self::default();
-        views.lock().budget = bytes;
+        views.kept.set_budget(bytes);
         views
-    }
-
-    fn lock(&self) -> std::sync::MutexGuard<'_, Kept> {
-        self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// Reads served from kept views, and views reduced.
     pub fn counts(&self) -> (u64, u64) {
-        let k = self.lock();
-        (k.hits, k.misses)
+        self.kept.counts()
     }
 
     fn get_or(&self, key: Key, make: impl FnOnce() -> Result<Entry>) -> Result<Entry> {
-        {
-            let mut k = self.lock();
-            if let Some(i) = k.entries.iter().position(|(c, _)| *c == key) {
-                let entry = k.entries.remove(i);
-                let found = entry.1.clone();
-                k.entries.push(entry);
-                k.hits += 1;
-                return Ok(found);
-            }
-        }
-        // Made outside the lock: other views reduce in parallel.
-        let made = make()?;
-        let mut k = self.lock();
-        k.misses += 1;
-        let bytes = made.bytes();
-        if bytes <= k.budget && !k.entries.iter().any(|(c, _)| *c == key) {
-            k.bytes += bytes;
-            k.entries.push((key, made.clone()));
-            while k.bytes > k.budget {
-                let (_, old) = k.entries.remove(0);
-                k.bytes -= old.bytes();
-            }
-        }
-        Ok(made)
+        self.kept.get_or(key, Entry::bytes, make)
     }
 
     /// View `view` of pose `pose` at `level`, made by `make` unless kept.

@@ -127,22 +127,21 @@ pub fn texture_2d(
 
 /// A write-only storage texture binding of a compute pass.
 pub fn storage_texture(binding: u32, format: wgpu::TextureFormat) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::StorageTexture {
-            access: wgpu::StorageTextureAccess::WriteOnly,
-            format,
-            view_dimension: wgpu::TextureViewDimension::D2,
-        },
-        count: None,
-    }
+    storage_texture_of(binding, format, wgpu::TextureViewDimension::D2)
 }
 
-/// A write-only storage texture array of `format` for compute shaders.
+/// A write-only storage texture array binding of a compute pass.
 pub fn storage_texture_array(
     binding: u32,
     format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
+    storage_texture_of(binding, format, wgpu::TextureViewDimension::D2Array)
+}
+
+fn storage_texture_of(
+    binding: u32,
+    format: wgpu::TextureFormat,
+    view_dimension: wgpu::TextureViewDimension,
 ) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -150,7 +149,7 @@ pub fn storage_texture_array(
         ty: wgpu::BindingType::StorageTexture {
             access: wgpu::StorageTextureAccess::WriteOnly,
             format,
-            view_dimension: wgpu::TextureViewDimension::D2Array,
+            view_dimension,
         },
         count: None,
     }
