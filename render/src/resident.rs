@@ -246,7 +246,8 @@ impl PoseSource {
                     if view_used(i) {
                         Ok(field.alpha(pose, i / rows, i % rows)?)
                     } else {
-                        Ok(GrayImage::new(size.0 as usize, size.1 as usize, 0.0))
+                        // Covers nothing: no pixels to allocate or scan.
+                        Ok(GrayImage::new(0, 0, 0.0))
                     }
                 })
                 .collect::<Result<_>>()?;
@@ -278,11 +279,7 @@ impl PoseSource {
                             .collect(),
                         scales: whole.scales.clone(),
                     };
-                    let a: Vec<u8> = alphas[i]
-                        .pixels()
-                        .iter()
-                        .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
-                        .collect();
+                    let a = alpha_codes(&alphas[i]);
                     let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
                     for n in Neighbour::ALL {
                         if !flow_used(i, n) {
@@ -321,12 +318,7 @@ impl PoseSource {
                         return Ok(None);
                     }
                     let image = kept.image((pose, i, level), || {
-                        let alpha: Vec<u8> = field
-                            .alpha(pose, u, v)?
-                            .pixels()
-                            .iter()
-                            .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
-                            .collect();
+                        let alpha = alpha_codes(&field.alpha(pose, u, v)?);
                         let basis = field.basis_codes_shared(pose, u, v)?;
                         Ok(ReducedImage {
                             basis: reduce_basis(&basis, full, to, level),
@@ -418,6 +410,15 @@ impl PoseSource {
             plan,
         })
     }
+}
+
+/// A matte's alpha codes, `round(255 α)`.
+fn alpha_codes(matte: &GrayImage) -> Vec<u8> {
+    matte
+        .pixels()
+        .iter()
+        .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect()
 }
 
 /// A pose ready to render: pre-lit views, alpha and flow codes (see the module docs).
