@@ -28,9 +28,10 @@ struct Composite {
     shadow_extent: f32,
     // Walkers drawn (layers of `subjects` and `shadows`, back to front).
     instances: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    // Tiles in a row of `tiles`, and their side in pixels.
+    tile_columns: u32,
+    tile_side: u32,
+    pad: u32,
 }
 
 // A walker's subject frame: `subject_from_world`, as columns and translation; the
@@ -47,6 +48,11 @@ struct Instance {
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<uniform> params: Composite;
 @group(0) @binding(2) var<storage, read> instances: array<Instance>;
+// Per tile of the frame (row after row): the index in this array of its first walker and
+// their count; then the lists, indices into `instances` back to front. A walker a tile
+// does not list is transparent and casts no shadow there (`TileLists` in
+// render/src/footprint.rs).
+@group(0) @binding(3) var<storage, read> tiles: array<u32>;
 
 // The rendered walkers, premultiplied linear RGBA, one texel per pixel, one layer each.
 @group(1) @binding(0) var subjects: texture_2d_array<f32>;
@@ -164,6 +170,9 @@ fn luminance(c: vec3<f32>) -> f32 {
 @fragment
 fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
     let pixel = vec2<i32>(floor(position.xy));
+    let tile = (u32(pixel.y) / params.tile_side) * params.tile_columns + u32(pixel.x) / params.tile_side;
+    let first = tiles[2u * tile];
+    let listed = tiles[2u * tile + 1u];
     let dir = pixel_ray(frame, position);
     let origin = frame.centre.xyz;
     // The ground y = 0, met from above.
@@ -173,8 +182,8 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
         let p = origin + dir * (-origin.y / dir.y);
         if (finite(p.x) && finite(p.z)) {
             hits_ground = true;
-            for (var i = 0u; i < params.instances; i++) {
-                s *= shadow_at(i, vec3<f32>(p.x, 0.0, p.z));
+            for (var j = 0u; j < listed; j++) {
+                s *= shadow_at(tiles[first + j], vec3<f32>(p.x, 0.0, p.z));
             }
         }
     }
@@ -194,7 +203,8 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
     }
     // The walkers, each over the ones behind it.
     var front = vec4<f32>(0.0);
-    for (var i = 0u; i < params.instances; i++) {
+    for (var j = 0u; j < listed; j++) {
+        let i = tiles[first + j];
         let b = instances[i].bounds;
         if (any(vec2<u32>(pixel) < b.xy) || any(vec2<u32>(pixel) >= b.zw)) {
             continue;

@@ -55,6 +55,12 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let job = jobs[id.y];
+    // A transparent texel holds no light (the colour is premultiplied): not relit.
+    let alpha = basis[job.basis_offset + i] >> 24u;
+    if (alpha == 0u) {
+        relit[job.relit_offset + i] = vec4<f32>(0.0);
+        return;
+    }
     var out = vec3<f32>(0.0);
     for (var k = 0u; k < job.tiles; k++) {
         let c = coefficients[job.coefficient_offset + k];
@@ -66,8 +72,7 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         out.y += c.y * gamma_value((code >> 8u) & 255u);
         out.z += c.z * gamma_value((code >> 16u) & 255u);
     }
-    let alpha = f32(basis[job.basis_offset + i] >> 24u);
-    relit[job.relit_offset + i] = vec4<f32>(out, alpha);
+    relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     atomicMax(&peaks[job.view], bitcast<u32>(max(out.x, max(out.y, out.z))));
 }
 

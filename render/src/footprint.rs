@@ -70,6 +70,14 @@ pub struct PixelBox {
 }
 
 impl PixelBox {
+    /// No pixels.
+    pub const EMPTY: Self = Self {
+        x0: 0,
+        y0: 0,
+        x1: 0,
+        y1: 0,
+    };
+
     /// The whole of a `width x height` frame.
     pub fn whole(width: u32, height: u32) -> Self {
         Self {
@@ -96,6 +104,20 @@ impl PixelBox {
         (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
     }
 
+    /// The smallest box holding both (an empty box holds nothing).
+    pub fn union(self, other: Self) -> Self {
+        match (self.pixels(), other.pixels()) {
+            (0, _) => other,
+            (_, 0) => self,
+            _ => Self {
+                x0: self.x0.min(other.x0),
+                y0: self.y0.min(other.y0),
+                x1: self.x1.max(other.x1),
+                y1: self.y1.max(other.y1),
+            },
+        }
+    }
+
     /// As the shaders read it: `[x0, y0, x1, y1]`.
     pub fn to_array(self) -> [u32; 4] {
         [self.x0, self.y0, self.x1, self.y1]
@@ -116,6 +138,22 @@ pub fn subject_box(camera: &Camera) -> Option<PixelBox> {
             corners.push(Vec3::new(r * a.cos(), y, r * a.sin()));
         }
     }
+    box_of(camera, &corners)
+}
+
+/// The pixel box where `camera` (in the subject's frame) sees the square of ground
+/// within `half` metres of the subject's axis along both of its axes (where its shadow
+/// map lies), as [`subject_box`].
+pub fn ground_box(camera: &Camera, half: f32) -> Option<PixelBox> {
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .map(|(x, z)| Vec3::new(x * half, 0.0, z * half));
+    box_of(camera, &corners)
+}
+
+/// The pixel box holding `corners` (of a convex body, subject frame) as `camera` sees
+/// them, with a pixel's bilinear footprint either side: the whole frame when one is
+/// behind the camera, `None` when the box misses the frame.
+fn box_of(camera: &Camera, corners: &[Vec3]) -> Option<PixelBox> {
     let projected: Vec<Vec2> = corners.iter().filter_map(|&p| camera.project(p)).collect();
     if projected.len() < corners.len() {
         return Some(PixelBox::whole(camera.width, camera.height));
@@ -137,4 +175,175 @@ pub fn subject_box(camera: &Camera) -> Option<PixelBox> {
         x1: clamp(x1.ceil() + 2.0, w),
         y1: clamp(y1.ceil() + 2.0, h),
     })
+}
+
+/// Side of the square tiles the composite pass finds its walkers by, pixels.
+pub const TILE: u32 = 16;
+
+/// Per tile of a frame ([`TILE`] pixels square, row after row), the walkers whose pixel
+/// boxes meet it, in their order: the composite pass reads only those at a pixel, where
+/// every other walker is transparent and casts no shadow.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TileLists {
+    /// Tiles in a row.
+    pub columns: u32,
+    /// Per tile, the index in `words` of its first walker and their count; then the
+    /// lists, walker indices in the order given.
+    pub words: Vec<u32>,
+}
+
+impl TileLists {
+    /// The lists of a `width x height` frame whose walker `i` may touch only the pixels
+    /// of `boxes[i]`.
+    pub fn new(width: u32, height: u32, boxes: &[PixelBox]) -> Self {
+        let (columns, rows) = (width.div_ceil(TILE), height.div_ceil(TILE));
+        let tiles = (columns * rows) as usize;
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); tiles];
+        for (i, b) in boxes.iter().enumerate() {
+            if b.pixels() == 0 {
+                continue;
+            }
+            for ty in b.y0 / TILE..b.y1.div_ceil(TILE).min(rows) {
+                for tx in b.x0 / TILE..b.x1.div_ceil(TILE).min(columns) {
+                    lists[(ty * columns + tx) as usize].push(i as u32);
+                }
+            }
+        }
+        let mut words = Vec::with_capacity(2 * tiles + lists.iter().map(Vec::len).sum::<usize>());
+        let mut next = 2 * tiles as u32;
+        for l in &lists {
+            words.extend([next, l.len() as u32]);
+            next += l.len() as u32;
+        }
+        words.extend(lists.into_iter().flatten());
+        Self { columns, words }
+    }
+
+    /// The most words the lists of a `width x height` frame of `walkers` can take.
+    pub fn capacity(width: u32, height: u32, walkers: u32) -> usize {
+        let tiles = (width.div_ceil(TILE) * height.div_ceil(TILE)) as usize;
+        tiles * (2 + walkers as usize)
+    }
+
+    /// The walkers listed for the tile of pixel `(x, y)`.
+    pub fn at(&self, x: u32, y: u32) -> &[u32] {
+        let t = ((y / TILE) * self.columns + x / TILE) as usize;
+        let (first, count) = (self.words[2 * t] as usize, self.words[2 * t + 1] as usize);
+        &self.words[first..first + count]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    /// A 64x48 camera 5 m from the axis, 1.5 m up, looking at the ground by the subject.
+    fn camera() -> Camera {
+        let eye = Vec3::new(0.0, 1.5, 5.0);
+        Camera::look_at(eye, Vec3::ZERO, Vec3::Y, 60f32.to_radians(), 64, 48).expect("a camera")
+    }
+
+    #[test]
+    fn the_ground_box_holds_every_ray_that_meets_the_patch() {
+        let cam = camera();
+        let half = 1.5;
+        let b = ground_box(&cam, half).expect("the patch is in view");
+        assert!(b.pixels() < 64 * 48, "{b:?} is the whole frame");
+        // Every pixel whose ray meets the ground inside the patch is in the box.
+        let mut met = 0;
+        for y in 0..cam.height {
+            for x in 0..cam.width {
+                let (o, d) = (
+                    cam.centre(),
+                    cam.ray_direction(Vec2::new(x as f32, y as f32)),
+                );
+                if d.y >= 0.0 {
+                    continue;
+                }
+                let p = o + d * (-o.y / d.y);
+                if p.x.abs() <= half && p.z.abs() <= half {
+                    met += 1;
+                    assert!(
+                        b.contains(x, y),
+                        "pixel ({x}, {y}) meets the patch outside {b:?}"
+                    );
+                }
+            }
+        }
+        assert!(met > 100);
+    }
+
+    #[test]
+    fn tile_lists_name_each_walker_where_its_box_is() {
+        let boxes = [
+            PixelBox {
+                x0: 0,
+                y0: 0,
+                x1: 20,
+                y1: 10,
+            },
+            PixelBox {
+                x0: 0,
+                y0: 0,
+                x1: 0,
+                y1: 0,
+            },
+            PixelBox {
+                x0: 15,
+                y0: 5,
+                x1: 40,
+                y1: 33,
+            },
+        ];
+        let lists = TileLists::new(40, 33, &boxes);
+        assert_eq!(lists.columns, 3);
+        assert!(lists.words.len() <= TileLists::capacity(40, 33, 3));
+        for y in 0..33 {
+            for x in 0..40 {
+                let listed = lists.at(x, y);
+                // In order, no empty box, and every walker whose box holds the pixel.
+                assert!(listed.windows(2).all(|w| w[0] < w[1]));
+                assert!(!listed.contains(&1));
+                for (i, b) in boxes.iter().enumerate() {
+                    if b.contains(x, y) {
+                        assert!(listed.contains(&(i as u32)), "({x}, {y}) lacks {i}");
+                    }
+                }
+            }
+        }
+        // A tile the first box misses does not list it.
+        assert_eq!(lists.at(39, 32), &[2]);
+    }
+
+    #[test]
+    fn a_union_holds_both_boxes_and_ignores_an_empty_one() {
+        let a = PixelBox {
+            x0: 1,
+            y0: 2,
+            x1: 5,
+            y1: 6,
+        };
+        let b = PixelBox {
+            x0: 4,
+            y0: 0,
+            x1: 9,
+            y1: 3,
+        };
+        let empty = PixelBox {
+            x0: 0,
+            y0: 0,
+            x1: 0,
+            y1: 0,
+        };
+        assert_eq!(
+            a.union(b),
+            PixelBox {
+                x0: 1,
+                y0: 0,
+                x1: 9,
+                y1: 6
+            }
+        );
+        assert_eq!(a.union(empty), a);
+        assert_eq!(empty.union(b), b);
+    }
 }

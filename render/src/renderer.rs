@@ -245,23 +245,30 @@ impl Device {
 
     /// Sets the shadow `resident` casts (maps without an environment give none).
     pub fn set_shadow(&self, resident: &mut Resident, shadow: SceneShadow) -> Result<()> {
+        // Maps are relit for the pose's own coefficients of the ground; without them
+        // (no environment) they give no shadow.
         let shadow = match shadow {
-            SceneShadow::Maps(m) => resident
-                .ground_coefficients
-                .as_deref()
-                .map(|c| (Some(m), m.relight(c), c.to_vec())),
-            SceneShadow::Relit(r) => Some((None, r, Vec::new())),
-            SceneShadow::None => None,
+            SceneShadow::Maps(m) => match resident.ground_coefficients.as_deref() {
+                Some(_) => SceneShadow::Maps(m),
+                None => SceneShadow::None,
+            },
+            other => other,
         };
+        let coefficients = resident.ground_coefficients.clone().unwrap_or_default();
+        let cast = !matches!(shadow, SceneShadow::None);
         match (&mut resident.kind, self) {
-            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => match &shadow {
+            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => match shadow {
                 // The GPU relights the maps itself (tested against the CPU's).
-                Some((Some(m), _, c)) => gpu.set_shadow(pose, m, c)?,
-                Some((None, r, _)) => gpu.upload_shadow(pose, r)?,
-                None => pose.clear_shadow(),
+                SceneShadow::Maps(m) => gpu.set_shadow(pose, m, &coefficients)?,
+                SceneShadow::Relit(r) => gpu.upload_shadow(pose, &r)?,
+                SceneShadow::None => pose.clear_shadow(),
             },
             (ResidentKind::Cpu { shadow: relit, .. }, _) => {
-                *relit = shadow.as_ref().map(|s| s.1.clone());
+                *relit = match shadow {
+                    SceneShadow::Maps(m) => Some(m.relight(&coefficients)),
+                    SceneShadow::Relit(r) => Some(r),
+                    SceneShadow::None => None,
+                };
             }
             (ResidentKind::Gpu(_), Device::Cpu) => {
                 return Err(crate::RenderError::BadParameter(
@@ -269,7 +276,7 @@ impl Device {
                 ));
             }
         }
-        resident.shadow = shadow.is_some();
+        resident.shadow = cast;
         Ok(())
     }
 

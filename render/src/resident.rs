@@ -551,8 +551,17 @@ impl ResidentPose {
                 }
                 let b = &source.basis[i];
                 let n = b.width * b.height;
+                // A transparent texel holds no light (the colour is premultiplied): it
+                // is not relit.
+                let alpha = &source.alpha[i];
                 let relit: Vec<Rgb> = (0..n)
-                    .map(|p| relit_pixel(b, &source.coefficients[i], &lut, p))
+                    .map(|p| {
+                        if alpha[p] == 0 {
+                            [0.0; 3]
+                        } else {
+                            relit_pixel(b, &source.coefficients[i], &lut, p)
+                        }
+                    })
                     .collect();
                 let peak = relit.iter().flatten().copied().fold(0.0f32, f32::max);
                 let scale = if peak > 0.0 { peak } else { 1.0 };

@@ -280,9 +280,9 @@ fn pod_structs_match_naga_layouts() {
             env_yaw,
             shadow_extent,
             instances,
-            pad0,
-            pad1,
-            pad2
+            tile_columns,
+            tile_side,
+            pad
         ]
     );
     check_layout!(

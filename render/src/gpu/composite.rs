@@ -12,7 +12,7 @@ use frf_core::camera::Rigid;
 use std::sync::Arc;
 
 use super::composite_targets::CompositeTargets;
-use super::rebin::Subjects;
+use super::rebin::{Outside, Subjects};
 use super::time_morph::BetweenDraw;
 use super::timing::Timestamps;
 
@@ -27,7 +27,7 @@ use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
 use crate::error::Result;
-use crate::footprint::PixelBox;
+use crate::footprint::{PixelBox, TILE, TileLists, ground_box};
 use crate::morph::Variant;
 
 /// The pass's layouts and pipeline.
@@ -48,6 +48,7 @@ impl CompositePass {
                 uniform::<GpuFrame>(0, f),
                 uniform::<GpuComposite>(1, f),
                 storage::<GpuInstance>(2, true, f),
+                storage::<u32>(3, true, f),
             ],
         });
         let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -177,9 +178,9 @@ impl Gpu {
                 env_yaw: 0.0,
                 shadow_extent: 1.0,
                 instances: 0,
-                pad0: 0,
-                pad1: 0,
-                pad2: 0,
+                tile_columns: 0,
+                tile_side: TILE,
+                pad: 0,
             };
             let (env, plate, plate_size) = match backdrop {
                 Backdrop::None => (one("no environment"), one("no plate"), None),
@@ -329,12 +330,18 @@ impl Gpu {
                     .collect::<Vec<_>>(),
             );
             let whole = PixelBox::whole(size.0, size.1);
-            let drawn: Vec<(&GpuPose, Camera, PixelBox)> = order
+            // The composite reads a layer only within its box; the morph in time reads
+            // a walker's whole layer.
+            let drawn: Vec<(&GpuPose, Camera, PixelBox, Outside)> = order
                 .iter()
                 .map(|&k| {
                     let i = &instances[k];
                     let seen = camera.transformed(&i.world_from_subject.inverse());
-                    (i.pose, seen, i.within.unwrap_or(whole))
+                    let outside = match i.between {
+                        Some(_) => Outside::Read,
+                        None => Outside::Unread,
+                    };
+                    (i.pose, seen, i.within.unwrap_or(whole), outside)
                 })
                 .collect();
             let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);
@@ -355,6 +362,9 @@ impl Gpu {
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let mut gpu_instances = Vec::with_capacity(order.len());
+            // Per walker, the pixels it may touch: its layer's box, and where it sees its
+            // shadow's patch of ground.
+            let mut touched = Vec::with_capacity(order.len());
             for (layer, &k) in order.iter().enumerate() {
                 let i = &instances[k];
                 let m = i.world_from_subject.inverse();
@@ -379,6 +389,11 @@ impl Gpu {
                         },
                     );
                 }
+                let shadow_box = match shadow_info {
+                    Some(info) if has => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
+                    _ => None,
+                };
+                touched.push(drawn[layer].2.union(shadow_box.unwrap_or(PixelBox::EMPTY)));
                 gpu_instances.push(GpuInstance {
                     col_x: m.rotation.x_axis.extend(0.0).to_array(),
                     col_y: m.rotation.y_axis.extend(0.0).to_array(),
@@ -394,6 +409,9 @@ impl Gpu {
                 params.shadow_extent = info.extent_m;
             }
             params.instances = order.len() as u32;
+            let tiles = TileLists::new(size.0, size.1, &touched);
+            params.tile_columns = tiles.columns;
+            params.tile_side = TILE;
             let write = |buffer: &wgpu::Buffer, bytes: &[u8]| {
                 self.queue.write_buffer(buffer, 0, bytes);
             };
@@ -403,6 +421,7 @@ impl Gpu {
             );
             write(&t.params, bytemuck::bytes_of(&params));
             write(&t.instances, bytemuck::cast_slice(&gpu_instances));
+            write(&t.tiles, bytemuck::cast_slice(&tiles.words));
             // Made once per drawn subjects and backdrop, and kept with the targets.
             let image_group = t.image_groups.get((subjects.id(), backdrop.id), || {
                 let array_view = |t: &wgpu::Texture| {

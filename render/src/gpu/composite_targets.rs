@@ -1,7 +1,7 @@
 //! What a composited frame of one size, number of walkers and shadow-map size needs
 //! besides its inputs, made once and kept ([`Gpu::composite_targets`]): the four RGBA32F
-//! targets, the walkers' shadow maps gathered into one array, the uniforms and walker
-//! buffer (written with `write_buffer` each frame), the frame's bind group, and the
+//! targets, the walkers' shadow maps gathered into one array, the uniforms, walker
+//! buffer and tile lists (written with `write_buffer` each frame), the frame's bind group, and the
 //! staging buffers its images are read back through.
 
 use std::sync::Arc;
@@ -12,6 +12,7 @@ use super::composite::CompositePass;
 use super::kept::Kept;
 use super::readback::Readback;
 use super::types::{GpuComposite, GpuFrame, GpuInstance};
+use crate::footprint::TileLists;
 
 /// Image bind groups kept per set of targets: a shot alternates between few backdrops.
 const IMAGE_GROUPS: usize = 2;
@@ -31,6 +32,8 @@ pub(super) struct CompositeTargets {
     pub(super) frame: wgpu::Buffer,
     pub(super) params: wgpu::Buffer,
     pub(super) instances: wgpu::Buffer,
+    /// The frame's tile lists ([`crate::footprint::TileLists`]).
+    pub(super) tiles: wgpu::Buffer,
     pub(super) frame_group: wgpu::BindGroup,
     /// One staging buffer per target, in the order of `targets`.
     pub(super) readback: [Readback; 4],
@@ -78,6 +81,12 @@ impl CompositeTargets {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let tiles = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tile lists"),
+            size: (4 * TileLists::capacity(size.0, size.1, walkers)) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("composite frame"),
             layout: &pass.frame_layout,
@@ -94,6 +103,10 @@ impl CompositeTargets {
                     binding: 2,
                     resource: instances.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: tiles.as_entire_binding(),
+                },
             ],
         });
         let readback = labels.map(|label| Readback::new(device, label, size));
@@ -105,6 +118,7 @@ impl CompositeTargets {
             frame,
             params,
             instances,
+            tiles,
             frame_group,
             readback,
             image_groups: Kept::new(IMAGE_GROUPS),

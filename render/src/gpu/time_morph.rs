@@ -10,7 +10,7 @@ use glam::Mat2;
 use wgpu::util::DeviceExt;
 
 use super::composite::GpuBetween;
-use super::rebin::{SubjectTargets, Subjects, frame_uniform, workgroups};
+use super::rebin::{Outside, SubjectTargets, Subjects, frame_uniform, workgroups};
 use super::{Gpu, shaders};
 use crate::morph::Variant;
 
@@ -134,6 +134,7 @@ impl Gpu {
                     &pose.bind_group,
                     self.stage,
                     w.within,
+                    Outside::Read,
                     None,
                     false,
                 );

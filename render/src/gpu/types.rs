@@ -205,12 +205,12 @@ pub struct GpuComposite {
     pub shadow_extent: f32,
     /// Walkers drawn.
     pub instances: u32,
+    /// Tiles in a row of the frame's tile lists ([`crate::footprint::TileLists`]).
+    pub tile_columns: u32,
+    /// Their side, pixels ([`crate::footprint::TILE`]).
+    pub tile_side: u32,
     /// Padding to 16 bytes.
-    pub pad0: u32,
-    /// Padding.
-    pub pad1: u32,
-    /// Padding.
-    pub pad2: u32,
+    pub pad: u32,
 }
 
 /// `Instance` of `shaders/composite.wgsl`: `subject_from_world` of a walker.

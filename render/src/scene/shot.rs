@@ -542,14 +542,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .map(|(&(k, between), inst)| {
                 let world_from_subject = inst.world_from_subject();
                 let within = self.options.planned.then(|| {
-                    subject_box(&camera.transformed(&world_from_subject.inverse())).unwrap_or(
-                        PixelBox {
-                            x0: 0,
-                            y0: 0,
-                            x1: 0,
-                            y1: 0,
-                        },
-                    )
+                    subject_box(&camera.transformed(&world_from_subject.inverse()))
+                        .unwrap_or(PixelBox::EMPTY)
                 });
                 Walker {
                     resident: &self.cache[k].resident,
