@@ -78,12 +78,14 @@ fn reduced_crop(crop: Crop, level: u8) -> Crop {
 
 /// Box-filters `texels` (cropped by `from`) into the crop `to` of the image reduced by
 /// `level`: per reduced texel, the full texels of its block inside `from` are `add`ed
-/// into an accumulator (from its default) and `finish`ed with their count.
-fn reduce<T, A: Default, U>(
+/// into an accumulator (from its default) and `finish`ed with their count. A reduced
+/// texel whose `kept` entry is 0 is not filtered: it is `U`'s default.
+fn reduce<T, A: Default, U: Default>(
     texels: &[T],
     from: Crop,
     to: Crop,
     level: u8,
+    kept: Option<&[u8]>,
     add: impl Fn(&mut A, &T),
     finish: impl Fn(A, u32) -> U,
 ) -> Vec<U> {
@@ -93,6 +95,10 @@ fn reduce<T, A: Default, U>(
     for y in to.y0..to.y0 + to.height {
         let rows = (y * n).max(from.y0)..((y + 1) * n).min(fy1);
         for x in to.x0..to.x0 + to.width {
+            if kept.is_some_and(|k| k[out.len()] == 0) {
+                out.push(U::default());
+                continue;
+            }
             let cols = (x * n).max(from.x0)..((x + 1) * n).min(fx1);
             let mut acc = A::default();
             let mut count = 0;
@@ -158,8 +164,10 @@ fn flow_code(table: &[f32; 256], x: f32) -> i8 {
 }
 
 /// Basis codes `b` (cropped by `from`) reduced by `level` into the crop `to`: each
-/// block averaged in linear light and coded again.
-pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8) -> BasisCodes {
+/// block averaged in linear light and coded again. A texel transparent at this level (0
+/// in `alpha`, the alpha reduced alike) holds no light, the colour being premultiplied:
+/// its codes are 0, as relighting takes them (and it is not filtered).
+pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8, alpha: &[u8]) -> BasisCodes {
     let lut = gamma_lut();
     let codes = gamma_codes();
     let add = |sum: &mut [f32; 3], t: &[u8; 3]| {
@@ -174,7 +182,7 @@ pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8) -> BasisCod
         tiles: b
             .tiles
             .iter()
-            .map(|tile| reduce(tile, from, to, level, add, finish))
+            .map(|tile| reduce(tile, from, to, level, Some(alpha), add, finish))
             .collect(),
         scales: b.scales.clone(),
     }
@@ -184,7 +192,7 @@ pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8) -> BasisCod
 pub fn reduce_alpha(a: &[u8], from: Crop, to: Crop, level: u8) -> Vec<u8> {
     let add = |sum: &mut u32, &v: &u8| *sum += v as u32;
     let finish = |sum: u32, n: u32| ((sum + n / 2) / n.max(1)) as u8;
-    reduce(a, from, to, level, add, finish)
+    reduce(a, from, to, level, None, add, finish)
 }
 
 /// Flow codes (cropped by `from`, decoded and coded again through `table`,
@@ -212,7 +220,7 @@ pub fn reduce_flow(
         let f = scale / known as f32;
         [flow_code(table, u * f), flow_code(table, v * f)]
     };
-    reduce(flow, from, to, level, add, finish)
+    reduce(flow, from, to, level, None, add, finish)
 }
 
 /// The whole image of `size` reduced by `level`, as a crop (and its size).
@@ -240,6 +248,41 @@ mod tests {
         assert_eq!(detail_level(100.0, 1.0), MAX_LEVEL);
         assert_eq!(detail_level(100.0, 0.0), 0);
         assert_eq!(detail_level(f32::NAN, 10.0), 0);
+    }
+
+    #[test]
+    fn reduced_basis_codes_average_in_linear_light_and_hold_no_light_where_transparent() {
+        // A 4x2 image, two tiles, reduced by one level into two texels.
+        let tile = |a: u8, b: u8| {
+            vec![
+                [a; 3], [b; 3], [9; 3], [9; 3], [a; 3], [b; 3], [9; 3], [9; 3],
+            ]
+        };
+        let b = BasisCodes {
+            width: 4,
+            height: 2,
+            tiles: vec![tile(0, 255), tile(200, 200)],
+            scales: vec![1.0, 2.0],
+        };
+        let full = Crop {
+            x0: 0,
+            y0: 0,
+            width: 4,
+            height: 2,
+        };
+        let (_, to) = reduced_image((4, 2), 1);
+        // Both texels opaque: each block averaged in linear light.
+        let r = reduce_basis(&b, full, to, 1, &[255, 255]);
+        let lut = gamma_lut();
+        let mid = fast_gamma_code(gamma_codes(), (lut[0] + lut[255]) / 2.0);
+        assert!(mid > 128, "linear light, not codes, averaged: {mid}");
+        assert_eq!(r.tiles[0], vec![[mid; 3], [9; 3]]);
+        assert_eq!(r.tiles[1], vec![[200; 3], [9; 3]]);
+        assert_eq!(r.scales, b.scales);
+        // The second transparent: its codes are 0 in every tile.
+        let r = reduce_basis(&b, full, to, 1, &[255, 0]);
+        assert_eq!(r.tiles[0], vec![[mid; 3], [0; 3]]);
+        assert_eq!(r.tiles[1], vec![[200; 3], [0; 3]]);
     }
 
     #[test]

@@ -320,9 +320,10 @@ impl PoseSource {
                     let image = kept.image((pose, i, level), || {
                         let alpha = alpha_codes(&field.alpha(pose, u, v)?);
                         let basis = field.basis_codes_shared(pose, u, v)?;
+                        let alpha = reduce_alpha(&alpha, full, to, level);
                         Ok(ReducedImage {
-                            basis: reduce_basis(&basis, full, to, level),
-                            alpha: reduce_alpha(&alpha, full, to, level),
+                            basis: reduce_basis(&basis, full, to, level, &alpha),
+                            alpha,
                         })
                     })?;
                     let mut flows: [Option<Arc<Vec<[i8; 2]>>>; 4] = Default::default();
