@@ -16,7 +16,7 @@ struct Composite {
     ground_look: u32,
     // 1 when the pose has a relit shadow.
     has_shadow: u32,
-    // Texels per side of the relit shadow.
+    // Texels per side of the layers of `shadows` (the finest walker's).
     shadow_texels: u32,
     // Radiance of the Lambertian ground (rgb).
     ground_radiance: vec4<f32>,
@@ -35,7 +35,8 @@ struct Composite {
 }
 
 // A walker's subject frame: `subject_from_world`, as columns and translation; the
-// translation's w is 1 when the walker has a relit shadow. Its layer is transparent
+// translation's w is the texels a side of its relit shadow (its level of detail; 0
+// without one), which fill the corner of its layer of `shadows`. Its layer is transparent
 // outside `bounds` ([x0, y0, x1, y1], ends exclusive), and not read there.
 struct Instance {
     col_x: vec4<f32>,
@@ -99,9 +100,9 @@ fn bilinear(t: texture_2d<f32>, p: vec2<f32>) -> vec4<f32> {
     return out;
 }
 
-// The same for one layer of an array texture.
-fn bilinear_layer(t: texture_2d_array<f32>, layer: u32, p: vec2<f32>) -> vec4<f32> {
-    let size = vec2<i32>(textureDimensions(t));
+// The same for the `size` x `size` corner of one layer of an array texture.
+fn bilinear_layer(t: texture_2d_array<f32>, layer: u32, size1: i32, p: vec2<f32>) -> vec4<f32> {
+    let size = vec2<i32>(size1);
     let q = footprint(p);
     var out = vec4<f32>(0.0);
     for (var dy = 0; dy < 2; dy++) {
@@ -155,11 +156,12 @@ fn shadow_at(i: u32, p: vec3<f32>) -> vec3<f32> {
     let m = instances[i];
     let q = m.col_x.xyz * p.x + m.col_y.xyz * p.y + m.col_z.xyz * p.z + m.translation.xyz;
     let half = 0.5 * params.shadow_extent;
-    if (params.has_shadow == 0u || m.translation.w == 0.0 || abs(q.x) > half || abs(q.z) > half) {
+    let texels = m.translation.w;
+    if (params.has_shadow == 0u || texels == 0.0 || abs(q.x) > half || abs(q.z) > half) {
         return vec3<f32>(1.0);
     }
-    let s = params.shadow_extent / f32(params.shadow_texels);
-    let map = bilinear_layer(shadows, i, vec2<f32>((q.x + half) / s - 0.5, (q.z + half) / s - 0.5)).xyz;
+    let s = params.shadow_extent / texels;
+    let map = bilinear_layer(shadows, i, i32(texels), vec2<f32>((q.x + half) / s - 0.5, (q.z + half) / s - 0.5)).xyz;
     return mix(map, vec3<f32>(1.0), edge_fade(q, half));
 }
 

@@ -58,6 +58,44 @@ impl ShadowMaps {
         }))
     }
 
+    /// The maps box-filtered by `level` (blocks of `2^level` texels a side, averaged), or
+    /// by the coarsest level below it that divides their side: the same patch of ground
+    /// in fewer texels, for a walker too small in the frame to tell them apart.
+    pub fn reduced(&self, level: u8) -> Self {
+        let n = self.spec.ground.texels;
+        let level = (0..=level.min(15))
+            .rev()
+            .find(|&l| n.is_multiple_of(1 << l) && n >> l > 0)
+            .unwrap_or(0);
+        if level == 0 {
+            return self.clone();
+        }
+        let b = 1usize << level;
+        let m = (n >> level) as usize;
+        let mut spec = self.spec.clone();
+        spec.ground.texels = m as u32;
+        let maps = self
+            .maps
+            .iter()
+            .map(|map| {
+                Image::from_fn(m, m, |x, y| {
+                    let mut sum = 0.0;
+                    for dy in 0..b {
+                        for dx in 0..b {
+                            sum += map.get(x * b + dx, y * b + dy);
+                        }
+                    }
+                    sum / (b * b) as f32
+                })
+            })
+            .collect();
+        Self {
+            spec,
+            maps,
+            irradiance: self.irradiance.clone(),
+        }
+    }
+
     /// Per map: `c_k E_k` (RGB), the weights of [`ShadowMaps::relight`] from the
     /// coefficients of every condition of the field.
     pub fn weights(&self, coefficients: &[Rgb]) -> Vec<Rgb> {
@@ -240,6 +278,31 @@ mod tests {
         assert_eq!(relit.at(1.5, 0.0), [1.0; 3]);
         // At texel (1, 1)'s centre, (-0.25, -0.25).
         assert_eq!(relit.at(-0.25, -0.25), q);
+    }
+
+    #[test]
+    fn reduced_maps_average_blocks_over_the_same_patch() {
+        let m = maps();
+        let r = m.reduced(1);
+        assert_eq!(r.spec.ground.texels, 2);
+        assert_eq!(r.spec.ground.extent_m, m.spec.ground.extent_m);
+        // Block (0, 0) holds the one blocked texel of the first map: 3/4 lit.
+        assert_eq!(r.maps[0].get(0, 0), 0.75);
+        assert_eq!(r.maps[0].get(1, 1), 1.0);
+        assert_eq!(r.maps[1].get(1, 0), 0.5);
+        // Relit, the patch is the same: a reduced texel's centre relights as its block.
+        let c = [[1.0; 3], [50.0; 3], [1.0; 3]];
+        let (full, half) = (m.relight(&c), r.relight(&c));
+        assert_eq!(half.at(1.5, 0.0), [1.0; 3]);
+        let block = [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .iter()
+            .map(|&(x, y)| full.image.get(x, y)[0])
+            .sum::<f32>()
+            / 4.0;
+        assert!((half.at(-0.5, -0.5)[0] - block).abs() < 1e-6);
+        // A level past what divides the side stops at the coarsest that does; 0 is as is.
+        assert_eq!(m.reduced(5).spec.ground.texels, 1);
+        assert_eq!(m.reduced(0).maps, m.maps);
     }
 
     #[test]

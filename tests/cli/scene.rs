@@ -241,20 +241,34 @@ fn frame_ranges_split_a_shot_and_a_rerun_resumes() {
 }
 
 #[test]
-fn two_walkers_agree_between_the_gpu_and_the_cpu_reference() {
+fn walkers_agree_between_the_gpu_and_the_cpu_reference() {
     if gpu_flag().is_some() {
         eprintln!("FRF_SKIP_GPU=1: no GPU to compare with");
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let walkers = "[[instance]]\nposition = [-0.5, 0.0, 0.0]\n[[instance]]\nposition = [0.6, 0.0, -0.4]\nheading_deg = 90.0\n";
+    // Two walkers near the camera, and a third far enough away that the planner relights
+    // its shadow maps at a coarser level than theirs.
+    let walkers = "[[instance]]\nposition = [-0.5, 0.0, 0.0]\n[[instance]]\nposition = [0.6, 0.0, -0.4]\nheading_deg = 90.0\n[[instance]]\nposition = [-1.0, 0.0, -5.0]\nheading_deg = 30.0\n";
     let scene = write_scene(
         dir.path(),
-        "two.toml",
+        "three.toml",
         walkers,
-        "[0.5, 1.4, 3.2]",
-        "[-0.5, 1.4, 3.2]",
+        "[0.5, 4.0, 3.2]",
+        "[-0.5, 4.0, 3.2]",
     );
+    // Seen from above, large enough for the far walker's shadow to cover some hundreds
+    // of pixels.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(&scene, text.replace("size = [64, 48]", "size = [192, 144]")).unwrap();
+    let plan = plan_json(&scene, &[]);
+    let shadow_levels: Vec<u64> = plan["walker_counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["shadow_levels"][0].as_u64().unwrap())
+        .collect();
+    assert!(shadow_levels[0] < shadow_levels[2], "{shadow_levels:?}");
     let mut frames = Vec::new();
     for (out, flag) in [("gpu", None), ("cpu", Some("--cpu"))] {
         let out = dir.path().join(out);

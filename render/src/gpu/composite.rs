@@ -19,7 +19,7 @@ use super::timing::Timestamps;
 use super::bind::{
     FLOAT, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
 };
-use super::pose::GpuPose;
+use super::pose::{GpuPose, RelitShadowInfo};
 use super::rebin::frame_uniform;
 use super::types::{GpuComposite, GpuFrame, GpuInstance};
 use super::{Gpu, shaders};
@@ -305,19 +305,21 @@ impl Gpu {
         if instances.is_empty() {
             return Err(RenderError::BadParameter("a frame with no walker".into()));
         }
-        let shadow_info = instances
+        // The walkers' relit shadows: one patch of ground, each at its own level of
+        // detail (texels a side); the array holds the finest.
+        let infos: Vec<RelitShadowInfo> = instances
             .iter()
-            .find_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1));
+            .filter_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1))
+            .collect();
+        let shadow_info = infos.first().map(|first| RelitShadowInfo {
+            texels: infos.iter().map(|i| i.texels).max().unwrap_or(1),
+            extent_m: first.extent_m,
+        });
         if let Some(info) = shadow_info
-            && instances.iter().any(|i| {
-                i.shadow_pose()
-                    .shadow
-                    .as_ref()
-                    .is_some_and(|s| s.1.texels != info.texels)
-            })
+            && infos.iter().any(|i| i.extent_m != info.extent_m)
         {
             return Err(RenderError::BadParameter(
-                "walkers with shadow maps of different sizes".into(),
+                "walkers with shadow maps of different patches of ground".into(),
             ));
         }
         self.scoped("compositing a frame", || {
@@ -368,7 +370,7 @@ impl Gpu {
             for (layer, &k) in order.iter().enumerate() {
                 let i = &instances[k];
                 let m = i.world_from_subject.inverse();
-                let has = i.shadow_pose().shadow.is_some();
+                let texels = i.shadow_pose().shadow.as_ref().map_or(0, |s| s.1.texels);
                 if let Some((texture, _)) = &i.shadow_pose().shadow {
                     encoder.copy_texture_to_texture(
                         texture.as_image_copy(),
@@ -383,14 +385,14 @@ impl Gpu {
                             aspect: wgpu::TextureAspect::All,
                         },
                         wgpu::Extent3d {
-                            width: n_shadow,
-                            height: n_shadow,
+                            width: texels,
+                            height: texels,
                             depth_or_array_layers: 1,
                         },
                     );
                 }
                 let shadow_box = match shadow_info {
-                    Some(info) if has => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
+                    Some(info) if texels > 0 => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
                     _ => None,
                 };
                 touched.push(drawn[layer].2.union(shadow_box.unwrap_or(PixelBox::EMPTY)));
@@ -398,7 +400,7 @@ impl Gpu {
                     col_x: m.rotation.x_axis.extend(0.0).to_array(),
                     col_y: m.rotation.y_axis.extend(0.0).to_array(),
                     col_z: m.rotation.z_axis.extend(0.0).to_array(),
-                    translation: m.translation.extend(if has { 1.0 } else { 0.0 }).to_array(),
+                    translation: m.translation.extend(texels as f32).to_array(),
                     bounds: drawn[layer].2.to_array(),
                 });
             }

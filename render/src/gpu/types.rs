@@ -223,7 +223,8 @@ pub struct GpuInstance {
     pub col_y: [f32; 4],
     /// Rotation column z.
     pub col_z: [f32; 4],
-    /// Translation.
+    /// Translation; w: texels a side of its relit shadow (its level of detail; 0
+    /// without one).
     pub translation: [f32; 4],
     /// The pixels its frame pass shaded, `[x0, y0, x1, y1]` (ends exclusive): elsewhere
     /// its layer is transparent and not read.

@@ -68,6 +68,9 @@ pub struct PosePlan {
     /// The level of detail it is drawn at ([`crate::detail`]): the finest any frame
     /// needs (0, full detail, for a shot morphed between poses).
     pub level: u8,
+    /// The level its shadow maps are relit at: the coarsest whose texel spans at most
+    /// a frame's pixel at the walker, over every frame (0 without maps).
+    pub shadow_level: u8,
 }
 
 /// One frame: its time and the pose each walker shows.
@@ -156,6 +159,8 @@ pub struct WalkerCounts {
     pub flows: usize,
     /// Per pose: its level of detail ([`crate::detail`]).
     pub levels: Vec<u8>,
+    /// Per pose: the level its shadow maps are relit at.
+    pub shadow_levels: Vec<u8>,
 }
 
 impl WalkerCounts {
@@ -171,6 +176,7 @@ impl WalkerCounts {
                 .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
                 .sum(),
             levels: plans.iter().map(|p| p.level).collect(),
+            shadow_levels: plans.iter().map(|p| p.shadow_level).collect(),
         }
     }
 }
@@ -222,6 +228,7 @@ fn entry<'p>(
                 hull: false,
                 pose_flows: [false; 2],
                 level: u8::MAX,
+                shadow_level: u8::MAX,
             });
             plans.last_mut().expect("just pushed")
         }
@@ -713,8 +720,13 @@ impl Plan {
                 } else {
                     detail_level(captured_ppm(record)?, pixels_per_metre(&subject_camera))
                 };
+                let shadow_level = h.shadows.as_ref().map_or(0, |s| {
+                    let ground = s.ground.texels as f32 / s.ground.extent_m;
+                    detail_level(ground, pixels_per_metre(&subject_camera))
+                });
                 let plan = entry(&mut walkers[i], pose, views, &lit);
                 plan.level = plan.level.min(level);
+                plan.shadow_level = plan.shadow_level.min(shadow_level);
                 if let Some(step) = motion {
                     plan.pose_flows[step.index()] = true;
                 }
@@ -760,6 +772,7 @@ impl Plan {
                     union.pose_flows[k] |= p.pose_flows[k];
                 }
                 union.level = union.level.min(p.level);
+                union.shadow_level = union.shadow_level.min(p.shadow_level);
             }
         }
         let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;

@@ -701,6 +701,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         match self.scene.shadow {
             ShadowSpec::Maps if wants(plan.is_some_and(|p| p.shadow_maps)) => {
                 if let Some(maps) = ShadowMaps::load(self.field, pose)? {
+                    let level = self
+                        .options
+                        .detail
+                        .unwrap_or_else(|| plan.map_or(0, |p| p.shadow_level));
+                    let maps = maps.reduced(level);
                     self.device
                         .set_shadow(&mut resident, SceneShadow::Maps(&maps))?;
                 }
