@@ -612,6 +612,11 @@ heading_deg = 200.0
             read_exr(&out.join("frame_0000.exr")),
             read_exr(&out.join("frame_0000_subject.exr")),
         ));
+        // render.json says how many views were reduced: none at full detail.
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("render.json")).unwrap()).unwrap();
+        let made = report["residency"]["reduced_made"].as_u64().unwrap();
+        assert_eq!(made > 0, flag.is_none(), "{made} views reduced");
     }
     let (reduced, full) = (&frames[0], &frames[1]);
     // The walkers cover the same pixels...

@@ -130,6 +130,11 @@ pub struct ShotCounters {
     pub basis_views_reused: u64,
     /// (See `basis_views_reused`.)
     pub basis_views_decoded: u64,
+    /// Reduced views and flows (level of detail) taken from those kept between
+    /// residencies, and reduced, so far ([`crate::reduced_views`]).
+    pub reduced_reused: u64,
+    /// (See `reduced_reused`.)
+    pub reduced_made: u64,
 }
 
 /// One rendered frame of a shot.
@@ -590,6 +595,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         self.counters.basis_views_reused,
                         self.counters.basis_views_decoded,
                     ) = self.field.decoded_counts();
+                    (self.counters.reduced_reused, self.counters.reduced_made) =
+                        self.reduced.counts();
                     self.counters.poses_made_resident += 1;
                     made_resident.push(pose);
                     let entry = Cached {
