@@ -258,27 +258,12 @@ impl PoseSource {
                 .map(|i| {
                     let (u, v) = (i / rows, i % rows);
                     if !view_used(i) {
-                        let blank = BasisCodes {
-                            width: crop.width as usize,
-                            height: crop.height as usize,
-                            tiles: Vec::new(),
-                            scales: Vec::new(),
-                        };
-                        return Ok((blank, Vec::new(), Default::default()));
+                        return Ok(not_read(crop));
                     }
                     // Shared with every other read of the view (kept decoded, when the
                     // caller set a budget for it), cropped here.
                     let whole = field.basis_codes_shared(pose, u, v)?;
-                    let b = BasisCodes {
-                        width: crop.width as usize,
-                        height: crop.height as usize,
-                        tiles: whole
-                            .tiles
-                            .iter()
-                            .map(|t| crop.rows_of(t, full_w))
-                            .collect(),
-                        scales: whole.scales.clone(),
-                    };
+                    let b = cropped(&whole, crop, full_w);
                     let a = alpha_codes(&alphas[i]);
                     let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
                     for n in Neighbour::ALL {
@@ -286,10 +271,7 @@ impl PoseSource {
                             continue;
                         }
                         if let Some(codes) = field.flow_codes(pose, u, v, n)? {
-                            let plane = codes.len() / 2;
-                            let pairs: Vec<[i8; 2]> =
-                                (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
-                            let mut cropped = crop.rows_of(&pairs, full_w);
+                            let mut cropped = crop.rows_of(&flow_pairs(&codes), full_w);
                             extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
                             flows[n.index()] = Some(cropped);
                         }
@@ -336,10 +318,8 @@ impl PoseSource {
                             let Some(codes) = field.flow_codes(pose, u, v, n)? else {
                                 return Ok(Vec::new());
                             };
-                            let plane = codes.len() / 2;
-                            let pairs: Vec<[i8; 2]> =
-                                (0..plane).map(|k| [codes[k], codes[plane + k]]).collect();
-                            let mut reduced = reduce_flow(&pairs, &table, full, to, level);
+                            let mut reduced =
+                                reduce_flow(&flow_pairs(&codes), &table, full, to, level);
                             extend_flow(&mut reduced, to.width as usize, to.height as usize);
                             Ok(reduced)
                         })?;
@@ -359,21 +339,9 @@ impl PoseSource {
                 .iter()
                 .map(|r| {
                     let Some((image, flows)) = r else {
-                        let blank = BasisCodes {
-                            width: crop.width as usize,
-                            height: crop.height as usize,
-                            tiles: Vec::new(),
-                            scales: Vec::new(),
-                        };
-                        return (blank, Vec::new(), Default::default());
+                        return not_read(crop);
                     };
-                    let b = &image.basis;
-                    let basis = BasisCodes {
-                        width: crop.width as usize,
-                        height: crop.height as usize,
-                        tiles: b.tiles.iter().map(|t| crop.rows_of(t, w)).collect(),
-                        scales: b.scales.clone(),
-                    };
+                    let basis = cropped(&image.basis, crop, w);
                     let flows = flows
                         .each_ref()
                         .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
@@ -411,6 +379,33 @@ impl PoseSource {
             plan,
         })
     }
+}
+
+/// What a view not read holds: no basis images, alpha or flows.
+fn not_read(crop: Crop) -> ViewCodes {
+    let blank = BasisCodes {
+        width: crop.width as usize,
+        height: crop.height as usize,
+        tiles: Vec::new(),
+        scales: Vec::new(),
+    };
+    (blank, Vec::new(), Default::default())
+}
+
+/// Basis codes `b` (images `width` texels a row) cropped to `crop`.
+fn cropped(b: &BasisCodes, crop: Crop, width: usize) -> BasisCodes {
+    BasisCodes {
+        width: crop.width as usize,
+        height: crop.height as usize,
+        tiles: b.tiles.iter().map(|t| crop.rows_of(t, width)).collect(),
+        scales: b.scales.clone(),
+    }
+}
+
+/// A stored flow's codes (the x plane, then the y plane) as per-texel pairs.
+fn flow_pairs(codes: &[i8]) -> Vec<[i8; 2]> {
+    let plane = codes.len() / 2;
+    (0..plane).map(|k| [codes[k], codes[plane + k]]).collect()
 }
 
 /// A matte's alpha codes, `round(255 α)`.

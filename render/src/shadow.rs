@@ -61,14 +61,14 @@ impl ShadowMaps {
     /// The maps box-filtered by `level` (blocks of `2^level` texels a side, averaged), or
     /// by the coarsest level below it that divides their side: the same patch of ground
     /// in fewer texels, for a walker too small in the frame to tell them apart.
-    pub fn reduced(&self, level: u8) -> Self {
+    pub fn reduced(self, level: u8) -> Self {
         let n = self.spec.ground.texels;
         let level = (0..=level.min(15))
             .rev()
             .find(|&l| n.is_multiple_of(1 << l) && n >> l > 0)
             .unwrap_or(0);
         if level == 0 {
-            return self.clone();
+            return self;
         }
         let b = 1usize << level;
         let m = (n >> level) as usize;
@@ -92,7 +92,7 @@ impl ShadowMaps {
         Self {
             spec,
             maps,
-            irradiance: self.irradiance.clone(),
+            irradiance: self.irradiance,
         }
     }
 
@@ -283,7 +283,7 @@ mod tests {
     #[test]
     fn reduced_maps_average_blocks_over_the_same_patch() {
         let m = maps();
-        let r = m.reduced(1);
+        let r = m.clone().reduced(1);
         assert_eq!(r.spec.ground.texels, 2);
         assert_eq!(r.spec.ground.extent_m, m.spec.ground.extent_m);
         // Block (0, 0) holds the one blocked texel of the first map: 3/4 lit.
@@ -301,8 +301,8 @@ mod tests {
             / 4.0;
         assert!((half.at(-0.5, -0.5)[0] - block).abs() < 1e-6);
         // A level past what divides the side stops at the coarsest that does; 0 is as is.
-        assert_eq!(m.reduced(5).spec.ground.texels, 1);
-        assert_eq!(m.reduced(0).maps, m.maps);
+        assert_eq!(m.clone().reduced(5).spec.ground.texels, 1);
+        assert_eq!(m.clone().reduced(0).maps, m.maps);
     }
 
     #[test]

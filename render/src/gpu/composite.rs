@@ -17,7 +17,7 @@ use super::time_morph::BetweenDraw;
 use super::timing::Timestamps;
 
 use super::bind::{
-    FLOAT, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
+    FLOAT, bind_group, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
 };
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::rebin::frame_uniform;
@@ -440,18 +440,15 @@ impl Gpu {
                     view(&backdrop.plate),
                     array_view(&t.shadows),
                 ];
-                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("composite images"),
-                    layout: &self.composite.image_layout,
-                    entries: &views
+                bind_group(
+                    &self.device,
+                    "composite images",
+                    &self.composite.image_layout,
+                    views
                         .iter()
-                        .enumerate()
-                        .map(|(i, v)| wgpu::BindGroupEntry {
-                            binding: i as u32,
-                            resource: wgpu::BindingResource::TextureView(v),
-                        })
-                        .collect::<Vec<_>>(),
-                })
+                        .map(wgpu::BindingResource::TextureView)
+                        .collect(),
+                )
             });
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

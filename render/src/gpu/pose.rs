@@ -12,7 +12,8 @@ use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::bind::{
-    compute_pipeline, copy_to_buffer, storage, storage_texture_array, table_bytes, uniform,
+    bind_group, compute_pipeline, copy_to_buffer, storage, storage_texture_array, table_bytes,
+    uniform,
 };
 use super::formats::PoseFormats;
 use super::types::{GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuView};
@@ -566,28 +567,21 @@ impl Gpu {
             self.init_buffer("coefficients", bytemuck::cast_slice(&coefficients), storage),
             self.init_buffer("jobs", bytemuck::cast_slice(&jobs), storage),
         ];
-        let resources = [
-            buffers[0].as_entire_binding(),
-            buffers[1].as_entire_binding(),
-            buffers[2].as_entire_binding(),
-            gamma.as_entire_binding(),
-            relit.as_entire_binding(),
-            peaks.as_entire_binding(),
-            wgpu::BindingResource::TextureView(target),
-            buffers[3].as_entire_binding(),
-        ];
-        let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("relight"),
-            layout: &self.relight.layout,
-            entries: &resources
-                .into_iter()
-                .enumerate()
-                .map(|(b, resource)| wgpu::BindGroupEntry {
-                    binding: b as u32,
-                    resource,
-                })
-                .collect::<Vec<_>>(),
-        });
+        let bind = bind_group(
+            &self.device,
+            "relight",
+            &self.relight.layout,
+            vec![
+                buffers[0].as_entire_binding(),
+                buffers[1].as_entire_binding(),
+                buffers[2].as_entire_binding(),
+                gamma.as_entire_binding(),
+                relit.as_entire_binding(),
+                peaks.as_entire_binding(),
+                wgpu::BindingResource::TextureView(target),
+                buffers[3].as_entire_binding(),
+            ],
+        );
         let groups = (texels as u32).div_ceil(WORKGROUP);
         for pipeline in [&self.relight.relight, &self.relight.encode] {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
