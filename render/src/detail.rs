@@ -14,9 +14,12 @@
 //! detail: docs/results/render.md, "Level of detail").
 
 use frf_core::camera::Camera;
+use frf_reflectance::field::PoseRecord;
 use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use glam::Vec3;
+
+use crate::error::{RenderError, Result};
 
 use crate::geometry::Crop;
 
@@ -33,6 +36,23 @@ const AXIS_POINT_M: f32 = 1.0;
 pub fn pixels_per_metre(camera: &Camera) -> f32 {
     let d = (Vec3::new(0.0, AXIS_POINT_M, 0.0) - camera.centre()).length();
     camera.intrinsics.fx.abs().max(camera.intrinsics.fy.abs()) / d.max(1e-3)
+}
+
+/// Pixels per metre the pose's views captured the subject at: the median over its views
+/// ([`pixels_per_metre`]).
+pub fn captured_ppm(record: &PoseRecord) -> Result<f32> {
+    let mut ppm = record
+        .views
+        .iter()
+        .map(|v| {
+            v.camera
+                .to_camera()
+                .map(|c| pixels_per_metre(&c))
+                .map_err(RenderError::BadParameter)
+        })
+        .collect::<Result<Vec<f32>>>()?;
+    ppm.sort_by(f32::total_cmp);
+    Ok(ppm.get(ppm.len() / 2).copied().unwrap_or(0.0))
 }
 
 /// The level of detail for a walker seen at `seen` pixels per metre from views that

@@ -1,59 +1,159 @@
-//! Where a subject can show: the bounds a walker keeps to in its own frame (a cylinder
-//! round its axis), whether a ray may meet them, and the box of pixels where a camera
-//! sees them. The planner reads only the views such rays reach
-//! ([`crate::scene::plan`]), and each walker's frame pass shades only its box: outside
-//! it, the walker is transparent.
+//! Where a subject can show: the bounds a pose's subject keeps to in its own frame (a
+//! cylinder round its visual hull, grown by the reach of its flows), whether a ray may
+//! meet them, and the box of pixels where a camera sees them. The planner reads only the
+//! views such rays reach ([`crate::scene::plan`]), and each walker's frame pass shades
+//! only its box: outside it, the walker is transparent.
 
 use frf_core::camera::Camera;
+use frf_reflectance::field::PoseRecord;
 use glam::{Vec2, Vec3};
+use serde::Serialize;
 
-/// Where the subject can be, in its own frame: within this distance of its axis (metres;
-/// a walker's reach, 0.4 m, with its limbs' swing and a margin for the flows that carry
-/// its edges)...
+use crate::detail::captured_ppm;
+use crate::error::Result;
+
+/// Where a subject can be when nothing more is known of it (a field without a visual
+/// hull), in its own frame: within this distance of its axis (metres; a walker's reach,
+/// 0.4 m, with its limbs' swing and a margin for the flows that carry its edges)...
 pub const SUBJECT_RADIUS_M: f32 = 1.2;
 /// ... and between these heights (metres).
 pub const SUBJECT_HEIGHTS_M: (f32, f32) = (-0.2, 2.3);
 
-/// Whether the ray from `origin` along `dir` passes through the cylinder
-/// [`SUBJECT_RADIUS_M`] round the subject's axis between [`SUBJECT_HEIGHTS_M`]: only such
-/// rays can show the subject.
-pub fn may_see_subject(origin: Vec3, dir: Vec3) -> bool {
-    let (a, b) = (
-        dir.x * dir.x + dir.z * dir.z,
-        origin.x * dir.x + origin.z * dir.z,
-    );
-    let c = origin.x * origin.x + origin.z * origin.z - SUBJECT_RADIUS_M * SUBJECT_RADIUS_M;
-    let (t0, t1) = if a < 1e-12 {
-        // Along the axis: inside the cylinder or never.
-        if c > 0.0 {
-            return false;
-        }
-        (0.0, f32::INFINITY)
-    } else {
-        let disc = b * b - a * c;
-        if disc < 0.0 {
-            return false;
-        }
-        let r = disc.sqrt();
-        ((-b - r) / a, (-b + r) / a)
+/// Where a pose's subject can show, in its own frame: a vertical cylinder of `radius`
+/// round the axis through `axis` (its x and z), between `heights`. Only a ray through it
+/// can show the subject: the planner reads only the views such rays reach, and a
+/// walker's frame pass shades only the pixels where its camera sees it.
+///
+/// Of a pose with a visual hull ([`SubjectBounds::of_pose`]): the cylinder round the
+/// hull's box, grown by the farthest its flows can carry an edge. A rendered pixel is
+/// made of the views' samples where the morph's solve puts them: from the ray's
+/// projection at the proxy's depth (the hull, or the point nearest its axis) a sample
+/// moves by at most a flow's largest displacement (the pose's quantizer range `M`, each
+/// component), so a ray that passes farther than that from every silhouette, at the
+/// views' scale, samples only transparent texels. The hull holds every view's matte.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SubjectBounds {
+    /// `(x, z)` of the vertical axis, metres.
+    pub axis: Vec2,
+    /// Metres from the axis.
+    pub radius: f32,
+    /// Lowest and highest, metres.
+    pub heights: (f32, f32),
+}
+
+impl SubjectBounds {
+    /// Of a subject known only to be a person walking in place on the stage.
+    pub const DESIGN: Self = Self {
+        axis: Vec2::ZERO,
+        radius: SUBJECT_RADIUS_M,
+        heights: SUBJECT_HEIGHTS_M,
     };
-    let t0 = t0.max(0.0);
-    if t1 < t0 {
-        return false;
+
+    /// Of a pose of `record` whose visual hull spans `hull` (its box's corners, subject
+    /// frame; none: [`SubjectBounds::DESIGN`]): [`SubjectBounds::round_box`] grown by
+    /// [`flow_reach_m`].
+    pub fn of_pose(record: &PoseRecord, hull: Option<(Vec3, Vec3)>) -> Result<Self> {
+        let Some((lo, hi)) = hull else {
+            return Ok(Self::DESIGN);
+        };
+        let margin = flow_reach_m(record)?;
+        Ok(if margin.is_finite() {
+            Self::round_box(lo, hi, margin)
+        } else {
+            Self::DESIGN
+        })
     }
-    // Heights over the span inside the cylinder.
-    let (lo, hi) = SUBJECT_HEIGHTS_M;
-    let y0 = origin.y + dir.y * t0;
-    let y1 = if t1.is_finite() {
-        origin.y + dir.y * t1
-    } else if dir.y > 0.0 {
-        f32::INFINITY
-    } else if dir.y < 0.0 {
-        f32::NEG_INFINITY
-    } else {
-        y0
-    };
-    y0.min(y1) <= hi && y0.max(y1) >= lo
+
+    /// The vertical cylinder round the box `lo..hi` (subject frame), grown by `margin`
+    /// metres on every side.
+    pub fn round_box(lo: Vec3, hi: Vec3, margin: f32) -> Self {
+        let half = 0.5 * Vec2::new(hi.x - lo.x, hi.z - lo.z);
+        Self {
+            axis: 0.5 * Vec2::new(lo.x + hi.x, lo.z + hi.z),
+            radius: half.length() + margin,
+            heights: (lo.y - margin, hi.y + margin),
+        }
+    }
+
+    /// A cylinder holding both (a walker between two poses).
+    pub fn union(self, other: Self) -> Self {
+        Self {
+            axis: self.axis,
+            radius: self
+                .radius
+                .max(self.axis.distance(other.axis) + other.radius),
+            heights: (
+                self.heights.0.min(other.heights.0),
+                self.heights.1.max(other.heights.1),
+            ),
+        }
+    }
+
+    /// Whether the ray from `origin` along `dir` passes through the bounds: only such
+    /// rays can show the subject.
+    pub fn may_see(&self, origin: Vec3, dir: Vec3) -> bool {
+        let o = Vec2::new(origin.x, origin.z) - self.axis;
+        let (a, b) = (dir.x * dir.x + dir.z * dir.z, o.x * dir.x + o.y * dir.z);
+        let c = o.length_squared() - self.radius * self.radius;
+        let (t0, t1) = if a < 1e-12 {
+            // Along the axis: inside the cylinder or never.
+            if c > 0.0 {
+                return false;
+            }
+            (0.0, f32::INFINITY)
+        } else {
+            let disc = b * b - a * c;
+            if disc < 0.0 {
+                return false;
+            }
+            let r = disc.sqrt();
+            ((-b - r) / a, (-b + r) / a)
+        };
+        let t0 = t0.max(0.0);
+        if t1 < t0 {
+            return false;
+        }
+        // Heights over the span inside the cylinder.
+        let (lo, hi) = self.heights;
+        let y0 = origin.y + dir.y * t0;
+        let y1 = if t1.is_finite() {
+            origin.y + dir.y * t1
+        } else if dir.y > 0.0 {
+            f32::INFINITY
+        } else if dir.y < 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            y0
+        };
+        y0.min(y1) <= hi && y0.max(y1) >= lo
+    }
+
+    /// The pixel box where `camera` (in the subject's frame) sees the bounds: outside it
+    /// no ray can show the subject. The whole frame when part of the bounds is behind the
+    /// camera; `None` when the camera sees none of them.
+    pub fn pixel_box(&self, camera: &Camera) -> Option<PixelBox> {
+        let (lo, hi) = self.heights;
+        // The polygon's circumradius, so that it holds the circle.
+        let r = self.radius / (std::f32::consts::PI / 16.0).cos();
+        let mut corners = Vec::with_capacity(32);
+        for k in 0..16 {
+            let a = k as f32 * std::f32::consts::TAU / 16.0;
+            let (x, z) = (self.axis.x + r * a.cos(), self.axis.y + r * a.sin());
+            for y in [lo, hi] {
+                corners.push(Vec3::new(x, y, z));
+            }
+        }
+        box_of(camera, &corners)
+    }
+}
+
+/// How far (metres, at the subject's axis) a pose's flows can carry a sample: the
+/// largest displacement its quantizer represents (`M` each component, so `M √2`) at the
+/// pixels per metre its views captured the subject at (their median), and one more
+/// pixel for the bilinear footprint.
+pub fn flow_reach_m(record: &PoseRecord) -> Result<f32> {
+    let reach_px = record.flow_quantizer.range * std::f32::consts::SQRT_2 + 1.0;
+    Ok(reach_px / captured_ppm(record)?)
 }
 
 /// A box of pixels: columns `x0..x1` and rows `y0..y1` (ends exclusive).
@@ -124,26 +224,9 @@ impl PixelBox {
     }
 }
 
-/// The pixel box where `camera` (in the subject's frame) sees the subject's bounds
-/// ([`may_see_subject`]): outside it no ray can show the subject. The whole frame when
-/// part of the bounds is behind the camera; `None` when the camera sees none of them.
-pub fn subject_box(camera: &Camera) -> Option<PixelBox> {
-    let (lo, hi) = SUBJECT_HEIGHTS_M;
-    let mut corners = Vec::new();
-    for k in 0..16 {
-        let a = k as f32 * std::f32::consts::TAU / 16.0;
-        // The polygon's circumradius, so that it holds the circle.
-        let r = SUBJECT_RADIUS_M / (std::f32::consts::PI / 16.0).cos();
-        for y in [lo, hi] {
-            corners.push(Vec3::new(r * a.cos(), y, r * a.sin()));
-        }
-    }
-    box_of(camera, &corners)
-}
-
 /// The pixel box where `camera` (in the subject's frame) sees the square of ground
 /// within `half` metres of the subject's axis along both of its axes (where its shadow
-/// map lies), as [`subject_box`].
+/// map lies), as [`SubjectBounds::pixel_box`].
 pub fn ground_box(camera: &Camera, half: f32) -> Option<PixelBox> {
     let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
         .map(|(x, z)| Vec3::new(x * half, 0.0, z * half));
@@ -270,6 +353,52 @@ mod tests {
             }
         }
         assert!(met > 100);
+    }
+
+    #[test]
+    fn bounds_round_a_box_hold_every_ray_through_it_in_their_pixel_box() {
+        let (lo, hi) = (Vec3::new(-0.4, 0.0, -0.1), Vec3::new(0.1, 1.8, 0.3));
+        let bounds = SubjectBounds::round_box(lo, hi, 0.05);
+        // Between poses: a cylinder holding both.
+        let other = SubjectBounds::round_box(lo + Vec3::X, hi + Vec3::X, 0.0);
+        let both = bounds.union(other);
+        for camera in [
+            camera(),
+            Camera::look_at(Vec3::new(2.0, 3.0, 1.0), Vec3::Y, Vec3::Y, 1.0, 64, 48).unwrap(),
+        ] {
+            let b = bounds.pixel_box(&camera).expect("in view");
+            assert!(b.pixels() < 64 * 48 / 2, "{b:?} is loose");
+            let (mut through, mut seen) = (0, 0);
+            for y in 0..camera.height {
+                for x in 0..camera.width {
+                    let (o, d) = (
+                        camera.centre(),
+                        camera.ray_direction(Vec2::new(x as f32, y as f32)),
+                    );
+                    // The ray's span inside the box (slabs).
+                    let (t0, t1) = (0..3).fold((0.0f32, f32::INFINITY), |(t0, t1), k| {
+                        let (a, b) = ((lo[k] - o[k]) / d[k], (hi[k] - o[k]) / d[k]);
+                        (t0.max(a.min(b)), t1.min(a.max(b)))
+                    });
+                    if t0 <= t1 {
+                        through += 1;
+                        assert!(bounds.may_see(o, d), "ray ({x}, {y}) through the box");
+                        assert!(both.may_see(o, d), "ray ({x}, {y}) between poses");
+                    }
+                    if bounds.may_see(o, d) {
+                        seen += 1;
+                        assert!(b.contains(x, y), "pixel ({x}, {y}) sees it outside {b:?}");
+                    }
+                    if other.may_see(o, d) {
+                        assert!(both.may_see(o, d), "ray ({x}, {y}) of the other pose");
+                    }
+                }
+            }
+            assert!(
+                through > 20 && seen > through,
+                "{through} through, {seen} seen"
+            );
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@ use frf_core::image::GrayImage;
 use glam::Vec3;
 
 use crate::cylinder::{Cylinder, CylinderHit};
+use crate::footprint::SubjectBounds;
 use crate::gpu::types::{GpuQuad, GpuView};
 use crate::proxy::Proxy;
 use crate::rectified::QuadFrame;
@@ -149,6 +150,8 @@ pub struct PoseGeometry {
     pub prelit_layer_count: usize,
     /// Where rays beyond the grid's rows meet the subject.
     pub proxy: Proxy,
+    /// Where the subject can show: a ray that misses these bounds shows nothing of it.
+    pub bounds: SubjectBounds,
 }
 
 impl PoseGeometry {
@@ -206,6 +209,7 @@ impl PoseGeometry {
             prelit_layers: (0..cameras_len as i32).collect(),
             prelit_layer_count: cameras_len,
             proxy: Proxy::default(),
+            bounds: SubjectBounds::DESIGN,
         }
     }
 
@@ -228,6 +232,12 @@ impl PoseGeometry {
     /// Whether view `i` is held (has a pre-lit layer).
     pub fn holds(&self, i: usize) -> bool {
         self.prelit_layers[i] >= 0
+    }
+
+    /// The same geometry with its subject within `bounds`.
+    pub fn with_bounds(mut self, bounds: SubjectBounds) -> Self {
+        self.bounds = bounds;
+        self
     }
 
     /// The same geometry with `proxy` as its geometric proxy.

@@ -73,6 +73,14 @@ impl Resident {
         bytes(&self.kind) + self.motion.iter().flatten().map(bytes).sum::<u64>()
     }
 
+    /// Where its subject can show ([`crate::geometry::PoseGeometry::bounds`]).
+    pub fn bounds(&self) -> crate::footprint::SubjectBounds {
+        match &self.kind {
+            ResidentKind::Gpu(p) => p.geometry.bounds,
+            ResidentKind::Cpu { pose, .. } => pose.geometry.bounds,
+        }
+    }
+
     /// Whether its motion toward `step`'s pose is resident.
     pub fn has_motion(&self, step: PoseStep) -> bool {
         self.motion[step.index()].is_some()

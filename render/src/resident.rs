@@ -32,6 +32,7 @@ use rayon::prelude::*;
 use crate::detail::{reduce_alpha, reduce_basis, reduce_flow, reduced_camera, reduced_image};
 use crate::error::{RenderError, Result};
 use crate::extend::extend_flow;
+use crate::footprint::SubjectBounds;
 use crate::geometry::{Crop, PoseGeometry};
 use crate::proxy::Proxy;
 use crate::reduced_views::{ReducedImage, ReducedViews};
@@ -187,6 +188,7 @@ impl PoseSource {
         } else {
             None
         };
+        let bounds = SubjectBounds::of_pose(record, hull.as_ref().and_then(|h| h.bounds()))?;
         let (coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
             Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
             Lighting::Environment { env, floor } => {
@@ -363,6 +365,7 @@ impl PoseSource {
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
             })
+            .with_bounds(bounds)
             .with_proxy(Proxy::new(hull))
             .with_held(|i| read[i]);
         Ok(Self {

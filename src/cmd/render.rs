@@ -253,6 +253,9 @@ struct PlanReport<'a> {
     counts: &'a frf_render::scene::plan::PlanCounts,
     frames: usize,
     poses: Vec<u32>,
+    /// Per pose of `poses`: where its subject can show (the views read are those of the
+    /// rays through these bounds).
+    bounds: Vec<frf_render::footprint::SubjectBounds>,
     poses_substituted: &'a [(u32, u32)],
     conditions_left_out: &'a [String],
     floor_conditions_left_out: usize,
@@ -269,6 +272,7 @@ fn print_plan(plan: &Plan, json: bool) -> CliResult {
             counts: &plan.counts,
             frames: plan.frames.len(),
             poses: plan.poses.iter().map(|p| p.pose).collect(),
+            bounds: plan.poses.iter().map(|p| p.bounds).collect(),
             poses_substituted: &plan.poses_substituted,
             conditions_left_out: &plan.conditions_left_out,
             floor_conditions_left_out: plan.floor_conditions_left_out,

@@ -174,6 +174,19 @@ fn a_camera_on_one_side_reads_only_that_side() {
     // The camera sees the subject from the front only: well under half the grid.
     assert!(2 * n("views_used") < n("views_total"), "{plan}");
     assert!(plan["shadow_maps_read"].as_bool().unwrap(), "{plan}");
+    // Each pose's subject is bounded round its hull: tighter than a walking person's
+    // design bounds (1.2 m round the axis), and holding the whole body.
+    let bounds = plan["bounds"].as_array().unwrap();
+    assert_eq!(bounds.len(), plan["poses"].as_array().unwrap().len());
+    for b in bounds {
+        let radius = b["radius"].as_f64().unwrap();
+        let (lo, hi) = (
+            b["heights"][0].as_f64().unwrap(),
+            b["heights"][1].as_f64().unwrap(),
+        );
+        assert!(radius > 0.3 && radius < 1.0, "{b}");
+        assert!(lo < 0.0 && hi > 1.7 && hi < 2.3, "{b}");
+    }
 
     // Without a shadow the maps are not read.
     let text = std::fs::read_to_string(&one_side)

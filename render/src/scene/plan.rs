@@ -4,8 +4,8 @@
 //! - **Poses**: the poses the walkers show at the frames rendered (the nearest pose the
 //!   field holds stands in for one it lacks, and the plan says so).
 //! - **Views and flows**, per walker: the quads of the grid reached by the camera's rays
-//!   that may see the walker (that pass within [`SUBJECT_RADIUS_M`] of its axis, between
-//!   [`SUBJECT_HEIGHTS_M`]: a ray that misses those bounds shows nothing of it). Rays are
+//!   that may see the walker (that pass through its pose's bounds,
+//!   [`SubjectBounds::of_pose`]: a ray that misses them shows nothing of it). Rays are
 //!   traced through the cylinder of the pose's camera centres on a grid of pixels every
 //!   [`RAY_STEP_PX`] pixels over the box where the camera sees those bounds (finer for a
 //!   small box, and along its border), and every quad hit is grown by its neighbours, so
@@ -38,10 +38,10 @@ use serde::Serialize;
 
 use super::{Scene, ShadowSpec, TimeInterpolation};
 use crate::cylinder::{Clamp, Cylinder};
-use crate::detail::{detail_level, pixels_per_metre};
+use crate::detail::{captured_ppm, detail_level, pixels_per_metre};
 use crate::error::{RenderError, Result};
+use crate::footprint::SubjectBounds;
 pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
-use crate::footprint::{may_see_subject, subject_box};
 use crate::shadow::ground_hit;
 
 /// Spacing of the rays traced to find the quads a frame reaches, pixels.
@@ -71,6 +71,9 @@ pub struct PosePlan {
     /// The level its shadow maps are relit at: the coarsest whose texel spans at most
     /// a frame's pixel at the walker, over every frame (0 without maps).
     pub shadow_level: u8,
+    /// Where its subject can show ([`SubjectBounds::of_pose`]): the views read are those
+    /// of the rays through these bounds.
+    pub bounds: SubjectBounds,
 }
 
 /// One frame: its time and the pose each walker shows.
@@ -229,6 +232,7 @@ fn entry<'p>(
                 pose_flows: [false; 2],
                 level: u8::MAX,
                 shadow_level: u8::MAX,
+                bounds: SubjectBounds::DESIGN,
             });
             plans.last_mut().expect("just pushed")
         }
@@ -281,23 +285,6 @@ pub(crate) fn nearest_pose(wanted: u32, field_poses: &[u32], n: u32) -> u32 {
         .expect("a field holds at least one pose")
 }
 
-/// Pixels per metre the pose's views captured the subject at: the median over its views
-/// ([`pixels_per_metre`]).
-fn captured_ppm(record: &frf_reflectance::field::PoseRecord) -> Result<f32> {
-    let mut ppm = record
-        .views
-        .iter()
-        .map(|v| {
-            v.camera
-                .to_camera()
-                .map(|c| pixels_per_metre(&c))
-                .map_err(RenderError::BadParameter)
-        })
-        .collect::<Result<Vec<f32>>>()?;
-    ppm.sort_by(f32::total_cmp);
-    Ok(ppm.get(ppm.len() / 2).copied().unwrap_or(0.0))
-}
-
 /// Every `step`-th of `lo..=hi`, and `hi`.
 fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
     let mut v: Vec<u32> = (lo..=hi).step_by(step.max(1) as usize).collect();
@@ -308,7 +295,7 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
 }
 
 /// The quads `(u, v)` of `cylinder` the rays of `camera` that may see the subject reach
-/// ([`may_see_subject`]), sampled over the box where it sees the subject's bounds every
+/// (that pass through its `bounds`), sampled over the box where it sees the subject's bounds every
 /// [`RAY_STEP_PX`] pixels (finer for a box of few pixels, so that a distant walker is
 /// sampled at all) and along its border; and whether a ray of the whole frame (sampled
 /// every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of the subject's
@@ -316,17 +303,18 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
 fn reached(
     cylinder: &Cylinder,
     camera: &Camera,
+    bounds: &SubjectBounds,
     ground_half: f32,
 ) -> (BTreeSet<(usize, usize)>, bool) {
     let (w, h) = (camera.width, camera.height);
     let mut quads = BTreeSet::new();
-    if let Some(b) = subject_box(camera) {
+    if let Some(b) = bounds.pixel_box(camera) {
         let (x0, y0, x1, y1) = (b.x0, b.y0, b.x1 - 1, b.y1 - 1);
         let step = ((x1 - x0).min(y1 - y0) / 8).clamp(1, RAY_STEP_PX);
         for &y in &samples(y0, y1, step) {
             for &x in &samples(x0, x1, step) {
                 let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
-                if !may_see_subject(camera.centre(), dir) {
+                if !bounds.may_see(camera.centre(), dir) {
                     continue;
                 }
                 if let Some(hit) = cylinder.intersect(camera.centre(), dir) {
@@ -477,7 +465,8 @@ impl Plan {
         let size = scene.size.unwrap_or(image_size);
         let frames = scene.shot_frames(0..scene.frame_times().len(), size)?;
         let interpolate = scene.interpolate.unwrap_or(TimeInterpolation::Nearest);
-        let mut plan = Self::from_header(scene, header, &frames, interpolate)?;
+        // No hull yet: the design's bounds.
+        let mut plan = Self::from_header(scene, header, &frames, interpolate, &mut |_| Ok(None))?;
         if plan.ground_seen && scene.shadow != ShadowSpec::None {
             let (columns, rows) = (header.columns, header.rows);
             for p in &mut plan.poses {
@@ -562,7 +551,14 @@ impl Plan {
             None if holds_pose_flows => TimeInterpolation::Flow,
             None => TimeInterpolation::Nearest,
         };
-        let mut plan = Self::from_header(scene, field.header(), frames, interpolate)?;
+        let mut hull_box = |pose| {
+            Ok(match field.header().hulls {
+                Some(_) => field.hull(pose)?.and_then(|h| h.bounds()),
+                None => None,
+            })
+        };
+        let mut plan =
+            Self::from_header(scene, field.header(), frames, interpolate, &mut hull_box)?;
         let rows = field.header().rows;
         let counts = &mut plan.counts;
         (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
@@ -651,14 +647,16 @@ impl Plan {
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
-    /// poses, for `frames`, frames between poses drawn as `interpolate` says; the counts
-    /// of views and flows are those the plan asks for (no chunk is known, so no byte
-    /// either).
+    /// poses, for `frames`, frames between poses drawn as `interpolate` says, each pose's
+    /// subject within the bounds of the hull box `hull_box` gives
+    /// ([`SubjectBounds::of_pose`]); the counts of views and flows are those the plan asks
+    /// for (no chunk is known, so no byte either).
     pub fn from_header(
         scene: &Scene,
         h: &FieldHeader,
         frames: &[ShotFrame],
         interpolate: TimeInterpolation,
+        hull_box: &mut dyn FnMut(u32) -> Result<Option<(Vec3, Vec3)>>,
     ) -> Result<Self> {
         if frames.is_empty() {
             return Err(RenderError::BadParameter("a shot of no frame".into()));
@@ -687,6 +685,8 @@ impl Plan {
         let projector = Projector::new(&h.conditions)?;
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
         let mut ground_seen = false;
+        // Per pose drawn, where its subject can show.
+        let mut bounds = std::collections::BTreeMap::new();
         // Per walker, the poses it draws and what its own rays reach of them.
         let mut walkers: Vec<Vec<PosePlan>> = vec![Vec::new(); scene.instances.len()];
         for (fp, frame) in frame_plans.iter().zip(frames) {
@@ -712,7 +712,14 @@ impl Plan {
                     .collect::<Result<_>>()?;
                 let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
                 let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
-                let (quads, ground) = reached(&cylinder, &subject_camera, half);
+                let bounds = match bounds.get(&pose) {
+                    Some(b) => *b,
+                    None => {
+                        let b = SubjectBounds::of_pose(record, hull_box(pose)?)?;
+                        *bounds.entry(pose).or_insert(b)
+                    }
+                };
+                let (quads, ground) = reached(&cylinder, &subject_camera, &bounds, half);
                 ground_seen |= ground;
                 let level = if interpolate == TimeInterpolation::Flow {
                     // Motion views are made at the captured resolution.
@@ -725,6 +732,7 @@ impl Plan {
                     detail_level(ground, pixels_per_metre(&subject_camera))
                 });
                 let plan = entry(&mut walkers[i], pose, views, &lit);
+                plan.bounds = bounds;
                 plan.level = plan.level.min(level);
                 plan.shadow_level = plan.shadow_level.min(shadow_level);
                 if let Some(step) = motion {
@@ -771,6 +779,7 @@ impl Plan {
                 for k in 0..2 {
                     union.pose_flows[k] |= p.pose_flows[k];
                 }
+                union.bounds = p.bounds;
                 union.level = union.level.min(p.level);
                 union.shadow_level = union.shadow_level.min(p.shadow_level);
             }

@@ -27,7 +27,7 @@ use super::plan::{FramePlan, Plan, PosePlan, ShotFrame};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
 use crate::composite::Backdrop;
 use crate::error::{RenderError, Result};
-use crate::footprint::{PixelBox, subject_box};
+use crate::footprint::PixelBox;
 use crate::gpu::composite::DrawnFrame;
 use crate::motion::pose_motion;
 use crate::reduced_views::ReducedViews;
@@ -539,19 +539,26 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The walkers of a frame of `camera` whose poses are the cache's `slots`; a planned
-    /// shot shades each within the pixels where it may show ([`subject_box`]).
+    /// shot shades each within the pixels where its pose (both, between two) may show
+    /// ([`crate::footprint::SubjectBounds::pixel_box`]).
     fn walkers(&self, slots: &[Slot], camera: &Camera) -> Vec<Walker<'_>> {
         slots
             .iter()
             .zip(&self.scene.instances)
             .map(|(&(k, between), inst)| {
                 let world_from_subject = inst.world_from_subject();
+                let resident = &self.cache[k].resident;
                 let within = self.options.planned.then(|| {
-                    subject_box(&camera.transformed(&world_from_subject.inverse()))
+                    let mut bounds = resident.bounds();
+                    if let Some((after, _)) = between {
+                        bounds = bounds.union(self.cache[after].resident.bounds());
+                    }
+                    bounds
+                        .pixel_box(&camera.transformed(&world_from_subject.inverse()))
                         .unwrap_or(PixelBox::EMPTY)
                 });
                 Walker {
-                    resident: &self.cache[k].resident,
+                    resident,
                     world_from_subject,
                     between: between.map(|(after, s)| (&self.cache[after].resident, s)),
                     within,
