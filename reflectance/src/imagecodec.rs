@@ -184,14 +184,15 @@ pub fn decode_basis_codes(bytes: &[u8]) -> Result<BasisCodes> {
             rows * ch
         )));
     }
+    // Each tile's rows, copied out of the mosaic's rows (3 bytes a texel).
+    let (raw, stride) = (mosaic.as_raw(), columns * cw * 3);
     let tiles = (0..count)
         .map(|i| {
             let (x0, y0) = ((i % columns) * cw, (i / columns) * ch);
             let mut t = Vec::with_capacity(tw * th);
-            for y in 0..th {
-                for x in 0..tw {
-                    t.push(mosaic.get_pixel((x0 + x) as u32, (y0 + y) as u32).0);
-                }
+            for y in y0..y0 + th {
+                let row = &raw[y * stride + x0 * 3..y * stride + (x0 + tw) * 3];
+                t.extend(row.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
             }
             t
         })
