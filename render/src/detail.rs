@@ -20,7 +20,6 @@ use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use glam::Vec3;
 
 use crate::error::{RenderError, Result};
-
 use crate::geometry::Crop;
 
 /// The coarsest level used.

@@ -25,12 +25,12 @@ pub const SUBJECT_HEIGHTS_M: (f32, f32) = (-0.2, 2.3);
 /// walker's frame pass shades only the pixels where its camera sees it.
 ///
 /// Of a pose with a visual hull ([`SubjectBounds::of_pose`]): the cylinder round the
-/// hull's box, grown by the farthest its flows can carry an edge. A rendered pixel is
-/// made of the views' samples where the morph's solve puts them: from the ray's
-/// projection at the proxy's depth (the hull, or the point nearest its axis) a sample
-/// moves by at most a flow's largest displacement (the pose's quantizer range `M`, each
-/// component), so a ray that passes farther than that from every silhouette, at the
-/// views' scale, samples only transparent texels. The hull holds every view's matte.
+/// hull's box, grown by the reach of the pose's flows. The hull holds every view's
+/// matte, and a rendered pixel is made of the views' samples where the morph's solve
+/// puts them: from the ray's projection at the proxy's depth (the hull, or the point
+/// nearest its axis), moved by the flows' displacements, each at most the quantizer's
+/// range. Drawn with no margin at all, frames were identical on every camera tried
+/// (docs/design.md section 6.4): the margin is a safety factor.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SubjectBounds {
     /// `(x, z)` of the vertical axis, metres.

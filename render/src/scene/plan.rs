@@ -24,7 +24,8 @@
 //! The plan is conservative: no frame may need something it left out (a test renders
 //! scenes with and without the plan and compares the frames).
 
-use std::collections::BTreeSet;
+use std::collections::btree_map::Entry;
+use std::collections::{BTreeMap, BTreeSet};
 
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
@@ -295,7 +296,7 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
 }
 
 /// The quads `(u, v)` of `cylinder` the rays of `camera` that may see the subject reach
-/// (that pass through its `bounds`), sampled over the box where it sees the subject's bounds every
+/// (that pass through its `bounds`), sampled over the box where it sees the bounds every
 /// [`RAY_STEP_PX`] pixels (finer for a box of few pixels, so that a distant walker is
 /// sampled at all) and along its border; and whether a ray of the whole frame (sampled
 /// every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of the subject's
@@ -686,7 +687,7 @@ impl Plan {
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
         let mut ground_seen = false;
         // Per pose drawn, where its subject can show.
-        let mut bounds = std::collections::BTreeMap::new();
+        let mut bounds = BTreeMap::new();
         // Per walker, the poses it draws and what its own rays reach of them.
         let mut walkers: Vec<Vec<PosePlan>> = vec![Vec::new(); scene.instances.len()];
         for (fp, frame) in frame_plans.iter().zip(frames) {
@@ -712,12 +713,9 @@ impl Plan {
                     .collect::<Result<_>>()?;
                 let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
                 let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
-                let bounds = match bounds.get(&pose) {
-                    Some(b) => *b,
-                    None => {
-                        let b = SubjectBounds::of_pose(record, hull_box(pose)?)?;
-                        *bounds.entry(pose).or_insert(b)
-                    }
+                let bounds = match bounds.entry(pose) {
+                    Entry::Occupied(b) => *b.get(),
+                    Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
                 };
                 let (quads, ground) = reached(&cylinder, &subject_camera, &bounds, half);
                 ground_seen |= ground;
