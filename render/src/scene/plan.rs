@@ -5,13 +5,14 @@
 //!   field holds stands in for one it lacks, and the plan says so).
 //! - **Views and flows**, per walker: the quads of the grid reached by the camera's rays
 //!   that may see the walker (that pass through its pose's bounds,
-//!   [`SubjectBounds::of_pose`]: a ray that misses them shows nothing of it). Rays are
-//!   traced through the cylinder of the pose's camera centres on a grid of pixels every
-//!   [`RAY_STEP_PX`] pixels over the box where the camera sees those bounds (finer for a
-//!   small box, and along its border), and every quad hit is grown by its neighbours, so
-//!   that a ray between two samples, which meets the cylinder between their quads, is
-//!   covered. A quad needs its four views and the eight flows between them. Each walker is
-//!   made resident with its own needs; the field must provide every walker's together.
+//!   [`SubjectBounds::of_pose`]: a ray that misses them shows nothing of it), traced
+//!   through the cylinder of the pose's camera centres over the box where the camera
+//!   sees those bounds: at every pixel of a small box (the frame pass traces pixel
+//!   centres alone, so their quads are all it reads, with the quad across a side a hit
+//!   lies near), and every [`RAY_STEP_PX`] pixels of a larger one, each quad hit grown by
+//!   its neighbours so that a ray between two samples is covered ([`EXACT_PIXELS`]). A
+//!   quad needs its four views and the eight flows between them. Each walker is made
+//!   resident with its own needs; the field must provide every walker's together.
 //! - **Conditions**: a basis condition whose coefficient is zero at every frame is not
 //!   relit. Turned by any yaw, heading or turntable angle, a condition's region of the
 //!   sphere stays in its band of elevations; so it is left out when every environment of
@@ -38,15 +39,27 @@ use glam::{Vec2, Vec3};
 use serde::Serialize;
 
 use super::{Scene, ShadowSpec, TimeInterpolation};
-use crate::cylinder::{Clamp, Cylinder};
+use crate::cylinder::Cylinder;
 use crate::detail::{captured_ppm, detail_level, pixels_per_metre};
 use crate::error::{RenderError, Result};
 use crate::footprint::SubjectBounds;
 pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
 use crate::shadow::ground_hit;
 
-/// Spacing of the rays traced to find the quads a frame reaches, pixels.
+/// Spacing of the rays traced to find the quads a frame reaches, pixels, over a box of
+/// more than [`EXACT_PIXELS`].
 pub const RAY_STEP_PX: u32 = 4;
+
+/// A box of at most this many pixels is traced at every pixel: the frame pass traces
+/// pixel centres alone, so the quads those rays hit are all it reads (with the neighbour
+/// across a side a hit lies within [`EDGE`] of, where the GPU's arithmetic may round the
+/// other way); a larger box is sampled every [`RAY_STEP_PX`] and every hit grown by its
+/// eight neighbours.
+pub const EXACT_PIXELS: usize = 128 * 128;
+
+/// Fraction of a quad's side within which a hit also needs the quad across it
+/// ([`EXACT_PIXELS`]).
+pub const EDGE: f32 = 0.02;
 
 /// What one pose of the field must provide.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -295,36 +308,66 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
     v
 }
 
-/// The quads `(u, v)` of `cylinder` the rays of `camera` that may see the subject reach
-/// (that pass through its `bounds`), sampled over the box where it sees the bounds every
-/// [`RAY_STEP_PX`] pixels (finer for a box of few pixels, so that a distant walker is
-/// sampled at all) and along its border; and whether a ray of the whole frame (sampled
-/// every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of the subject's
-/// axis (in the same frame).
+/// The quads `(u, v)` of `cylinder` (`spans` columns of quads, wrapping when it is a
+/// ring) that the rays of `camera` that may see the subject (that pass through its
+/// `bounds`) reach, traced over the box where the camera sees the bounds: at every pixel
+/// of a box of at most [`EXACT_PIXELS`], each hit with the quad across a side it lies
+/// within [`EDGE`] of; else every [`RAY_STEP_PX`] pixels (finer for a thin box) and
+/// along its border, each hit grown by its eight neighbours, so that a ray between two
+/// samples, which meets the cylinder between their quads, is covered. Rays clamped above
+/// or below the grid keep the top or bottom row's quads. And whether a ray of the whole
+/// frame (sampled every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of
+/// the subject's axis (in the same frame).
 fn reached(
     cylinder: &Cylinder,
+    spans: usize,
     camera: &Camera,
     bounds: &SubjectBounds,
     ground_half: f32,
 ) -> (BTreeSet<(usize, usize)>, bool) {
     let (w, h) = (camera.width, camera.height);
+    let quad_rows = cylinder.rows().saturating_sub(1).max(1);
     let mut quads = BTreeSet::new();
     if let Some(b) = bounds.pixel_box(camera) {
         let (x0, y0, x1, y1) = (b.x0, b.y0, b.x1 - 1, b.y1 - 1);
-        let step = ((x1 - x0).min(y1 - y0) / 8).clamp(1, RAY_STEP_PX);
+        let exact = b.pixels() <= EXACT_PIXELS;
+        let step = if exact {
+            1
+        } else {
+            ((x1 - x0).min(y1 - y0) / 8).clamp(1, RAY_STEP_PX)
+        };
+        const ALL: &[isize] = &[-1, 0, 1];
+        // The offsets to the quads across the sides `f` (a fraction of the quad) is near.
+        let near = |f: f32| -> &'static [isize] {
+            if f < EDGE {
+                &[-1, 0]
+            } else if f > 1.0 - EDGE {
+                &[0, 1]
+            } else {
+                &[0]
+            }
+        };
         for &y in &samples(y0, y1, step) {
             for &x in &samples(x0, x1, step) {
                 let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
                 if !bounds.may_see(camera.centre(), dir) {
                     continue;
                 }
-                if let Some(hit) = cylinder.intersect(camera.centre(), dir) {
-                    let v = if hit.clamped == Clamp::None {
-                        hit.v
-                    } else {
-                        hit.v.min(cylinder.rows().saturating_sub(2))
-                    };
-                    quads.insert((hit.u, v));
+                let Some(hit) = cylinder.intersect(camera.centre(), dir) else {
+                    continue;
+                };
+                let v = hit.v.min(quad_rows - 1);
+                let (dus, dvs) = if exact {
+                    (near(hit.beta), near(hit.gamma))
+                } else {
+                    (ALL, ALL)
+                };
+                for &du in dus {
+                    let u = (hit.u as isize + du).rem_euclid(spans as isize) as usize;
+                    for &dv in dvs {
+                        let v = (v as isize + dv).clamp(0, quad_rows as isize - 1) as usize;
+                        quads.insert((u, v));
+                    }
                 }
             }
         }
@@ -717,7 +760,13 @@ impl Plan {
                     Entry::Occupied(b) => *b.get(),
                     Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
                 };
-                let (quads, ground) = reached(&cylinder, &subject_camera, &bounds, half);
+                let spans = if h.wraps {
+                    columns
+                } else {
+                    columns.saturating_sub(1)
+                }
+                .max(1);
+                let (quads, ground) = reached(&cylinder, spans, &subject_camera, &bounds, half);
                 ground_seen |= ground;
                 let level = if interpolate == TimeInterpolation::Flow {
                     // Motion views are made at the captured resolution.
@@ -736,25 +785,13 @@ impl Plan {
                 if let Some(step) = motion {
                     plan.pose_flows[step.index()] = true;
                 }
-                let spans = if h.wraps {
-                    columns
-                } else {
-                    columns.saturating_sub(1)
-                }
-                .max(1);
                 for &(u, v) in &quads {
-                    // The quad and its neighbours (see the module docs).
-                    for du in [spans - 1, 0, 1] {
-                        let uu = (u + du) % spans;
-                        for vv in [v.saturating_sub(1), v, (v + 1).min(rows.saturating_sub(2))] {
-                            let (u1, v1) = ((uu + 1) % columns, (vv + 1).min(rows - 1));
-                            for (a, b) in [(uu, vv), (u1, vv), (uu, v1), (u1, v1)] {
-                                plan.views[a * rows + b] = true;
-                            }
-                            for ((a, b), n) in quad_flows(uu, vv, columns, rows) {
-                                plan.flows[a * rows + b][n.index()] = true;
-                            }
-                        }
+                    let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
+                    for (a, b) in [(u, v), (u1, v), (u, v1), (u1, v1)] {
+                        plan.views[a * rows + b] = true;
+                    }
+                    for ((a, b), n) in quad_flows(u, v, columns, rows) {
+                        plan.flows[a * rows + b][n.index()] = true;
                     }
                 }
             }
