@@ -279,6 +279,8 @@ pub struct QuadData {
 pub struct Cylinder {
     columns: usize,
     rows: usize,
+    /// Column spans of quads: `columns` round a ring, one fewer on an open grid.
+    spans: usize,
     quads: Vec<Quad>,
     /// Which spans a ray's line can reach; `None` where the grid does not allow it.
     index: Option<ColumnIndex>,
@@ -324,9 +326,15 @@ impl Cylinder {
         Self {
             columns,
             rows,
+            spans,
             quads,
             index,
         }
+    }
+
+    /// Column spans of quads (`columns` round a ring, one fewer on an open grid).
+    pub fn spans(&self) -> usize {
+        self.spans
     }
 
     /// Columns.

@@ -308,11 +308,10 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
     v
 }
 
-/// The quads `(u, v)` of `cylinder` (`spans` columns of quads, wrapping when it is a
-/// ring) that the rays of `camera` that may see the subject (that pass through its
-/// `bounds`) reach, traced over the box where the camera sees the bounds: at every pixel
-/// of a box of at most [`EXACT_PIXELS`], each hit with the quad across a side it lies
-/// within [`EDGE`] of; else every [`RAY_STEP_PX`] pixels (finer for a thin box) and
+/// The quads `(u, v)` of `cylinder` (neighbours' columns taken round its spans) that
+/// the rays of `camera` that may see the subject (that pass through its `bounds`) reach,
+/// traced over the box where the camera sees the bounds: at every pixel of a box of at
+/// most [`EXACT_PIXELS`], each hit with the quad across a side it lies within [`EDGE`] of; else every [`RAY_STEP_PX`] pixels (finer for a thin box) and
 /// along its border, each hit grown by its eight neighbours, so that a ray between two
 /// samples, which meets the cylinder between their quads, is covered. Rays clamped above
 /// or below the grid keep the top or bottom row's quads. And whether a ray of the whole
@@ -320,12 +319,12 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
 /// the subject's axis (in the same frame).
 fn reached(
     cylinder: &Cylinder,
-    spans: usize,
     camera: &Camera,
     bounds: &SubjectBounds,
     ground_half: f32,
 ) -> (BTreeSet<(usize, usize)>, bool) {
     let (w, h) = (camera.width, camera.height);
+    let spans = cylinder.spans().max(1);
     let quad_rows = cylinder.rows().saturating_sub(1).max(1);
     let mut quads = BTreeSet::new();
     if let Some(b) = bounds.pixel_box(camera) {
@@ -760,13 +759,7 @@ impl Plan {
                     Entry::Occupied(b) => *b.get(),
                     Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
                 };
-                let spans = if h.wraps {
-                    columns
-                } else {
-                    columns.saturating_sub(1)
-                }
-                .max(1);
-                let (quads, ground) = reached(&cylinder, spans, &subject_camera, &bounds, half);
+                let (quads, ground) = reached(&cylinder, &subject_camera, &bounds, half);
                 ground_seen |= ground;
                 let level = if interpolate == TimeInterpolation::Flow {
                     // Motion views are made at the captured resolution.
