@@ -36,7 +36,11 @@ fn a_second_writer_of_a_field_is_refused_while_the_first_finishes() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    while !lock.exists() {
+    // The lock file appears before it is locked; its holder writes its process id into it
+    // once the lock is held. Waiting for the file alone let the second writer take the lock
+    // first in that gap (a CI run saw it), so wait for the first writer's id.
+    let held = first.id().to_string();
+    while std::fs::read_to_string(&lock).map_or(true, |s| s.trim() != held) {
         assert!(
             first.try_wait().unwrap().is_none(),
             "the first writer ended before it was seen writing"
