@@ -3,13 +3,18 @@
 // pose k''s render sampled on along k's motion, a fraction 1 - s, mixed (1 - s, s).
 // Motion renders hold (across, along) the subject's axis in metres as
 // ((r - b) / a, (g - b) / a); `to_image` takes metres to the frame's pixels.
+// Only the walker's pixel box is drawn and morphed: the renders hold nothing outside it
+// (transparent, and not cleared there), so the morph reads them only within it.
 
 struct TimeMorph {
     // Columns of the 2x2 map from metres to pixels.
     to_image: vec4<f32>,
-    size: vec2<u32>,
+    // The walker's pixel box: first column and row, one past the last.
+    bounds: vec4<u32>,
     s: f32,
-    _pad: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 @group(0) @binding(0) var<uniform> tm: TimeMorph;
@@ -28,12 +33,13 @@ fn motion_at(t: texture_2d<f32>, p: vec2<i32>) -> vec2<f32> {
     return tm.to_image.xy * metres.x + tm.to_image.zw * metres.y;
 }
 
-// Bilinear, pixel centres at integers, transparent beyond the edge (the CPU's
-// `Border::Zero`).
+// Bilinear, pixel centres at integers, transparent beyond the box (and so beyond the
+// frame's edge: the CPU's `Border::Zero`).
 fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
-    let size = vec2<i32>(tm.size);
-    let limit = f32(max(size.x, size.y) + 2);
-    let c = clamp(q, vec2<f32>(-limit), vec2<f32>(size) + limit);
+    let lo = vec2<i32>(tm.bounds.xy);
+    let hi = vec2<i32>(tm.bounds.zw);
+    let limit = f32(max(hi.x, hi.y) + 2);
+    let c = clamp(q, vec2<f32>(-limit), vec2<f32>(limit));
     let f0 = floor(c);
     let fr = c - f0;
     let i0 = vec2<i32>(f0);
@@ -42,7 +48,7 @@ fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
         for (var dx = 0; dx < 2; dx++) {
             let w = select(1.0 - fr.x, fr.x, dx == 1) * select(1.0 - fr.y, fr.y, dy == 1);
             let p = i0 + vec2<i32>(dx, dy);
-            if (w != 0.0 && all(p >= vec2<i32>(0)) && all(p < size)) {
+            if (w != 0.0 && all(p >= lo) && all(p < hi)) {
                 acc += w * textureLoad(t, p, 0);
             }
         }
@@ -52,11 +58,12 @@ fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
 
 @compute @workgroup_size(8, 8)
 fn morph_in_time(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= tm.size.x || id.y >= tm.size.y) {
+    let pixel = id.xy + tm.bounds.xy;
+    if (any(pixel >= tm.bounds.zw)) {
         return;
     }
-    let p = vec2<i32>(id.xy);
-    let at = vec2<f32>(id.xy);
+    let p = vec2<i32>(pixel);
+    let at = vec2<f32>(pixel);
     let a = bilinear_zero(before, at + tm.s * motion_at(after_motion, p));
     let b = bilinear_zero(after, at + (1.0 - tm.s) * motion_at(before_motion, p));
     textureStore(morphed, p, (1.0 - tm.s) * a + tm.s * b);

@@ -13,7 +13,7 @@ use super::Gpu;
 use super::bind::{compute_pipeline, full_screen_pipeline, texture_array};
 use super::formats::{FlowFormat, ImageFormat, PoseFormats};
 use super::pose::GpuPose;
-use super::rebin::{Outside, PassKind, RebinPass, SubjectTargets, frame_uniform, workgroups};
+use super::rebin::{PassKind, RebinPass, SubjectTargets, frame_uniform, workgroups};
 use super::timing::{Timestamps, median_min};
 use crate::cpu::render_cpu;
 use crate::error::Result;
@@ -314,17 +314,7 @@ pub fn run(
                         bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
                     );
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                        pass.record(
-                            e,
-                            &targets,
-                            0,
-                            &gpu_pose.bind_group,
-                            stage,
-                            whole,
-                            Outside::Read,
-                            t,
-                            false,
-                        )
+                        pass.record(e, &targets, 0, &gpu_pose.bind_group, stage, whole, t, false)
                     })?;
                     let timing = median_min(&times);
                     let error = match reference.iter().find(|(rv, _)| *rv == v) {
@@ -337,7 +327,6 @@ pub fn run(
                                 &gpu_pose.bind_group,
                                 stage,
                                 whole,
-                                Outside::Read,
                                 None,
                                 false,
                             );

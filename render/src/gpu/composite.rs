@@ -12,7 +12,7 @@ use frf_core::camera::Rigid;
 use std::sync::Arc;
 
 use super::composite_targets::CompositeTargets;
-use super::rebin::{Outside, Subjects};
+use super::rebin::Subjects;
 use super::time_morph::BetweenDraw;
 use super::timing::Timestamps;
 
@@ -332,18 +332,13 @@ impl Gpu {
                     .collect::<Vec<_>>(),
             );
             let whole = PixelBox::whole(size.0, size.1);
-            // The composite reads a layer only within its box; the morph in time reads
-            // a walker's whole layer.
-            let drawn: Vec<(&GpuPose, Camera, PixelBox, Outside)> = order
+            // The composite and the morph in time read a layer only within its box.
+            let drawn: Vec<(&GpuPose, Camera, PixelBox)> = order
                 .iter()
                 .map(|&k| {
                     let i = &instances[k];
                     let seen = camera.transformed(&i.world_from_subject.inverse());
-                    let outside = match i.between {
-                        Some(_) => Outside::Read,
-                        None => Outside::Unread,
-                    };
-                    (i.pose, seen, i.within.unwrap_or(whole), outside)
+                    (i.pose, seen, i.within.unwrap_or(whole))
                 })
                 .collect();
             let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);

@@ -358,22 +358,13 @@ impl SubjectTargets {
     }
 }
 
-/// Whether anything reads a walker's layer outside the pixels its frame pass shades.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Outside {
-    /// Read there (as transparent): the pass clears it.
-    Read,
-    /// Never read there (the composite reads a layer only within its box): left as it
-    /// was.
-    Unread,
-}
-
 impl RebinPass {
     /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer
     /// (whose bounds are `within`), into `layer` of `targets`, by `stage`, with the pass's
-    /// timestamps when given: the pixels `within` are shaded, the rest of the layer is
-    /// cleared unless `outside` says it is never read (a fragment pass clears it
-    /// always). Its pixel classes (of the pixels within) are counted into the targets'
+    /// timestamps when given: the pixels `within` are shaded; the rest of the layer is
+    /// left as it was by a compute pass (nothing reads a layer outside its walker's box:
+    /// the composite and the morph in time read within it) and cleared by a fragment
+    /// pass. Its pixel classes (of the pixels within) are counted into the targets'
     /// counters by the compute pass itself, and after a fragment pass by a pass of their
     /// own when `classes`.
     #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
@@ -385,16 +376,11 @@ impl RebinPass {
         pose_group: &wgpu::BindGroup,
         stage: PassKind,
         within: PixelBox,
-        outside: Outside,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
         let t = &targets.layers[layer];
         let size = within.size();
-        let whole = {
-            let s = targets.texture.size();
-            within == PixelBox::whole(s.width, s.height)
-        };
         match stage {
             PassKind::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -414,17 +400,6 @@ impl RebinPass {
                 }
             }
             PassKind::Compute => {
-                if !whole && outside == Outside::Read {
-                    // The pixels outside the bounds are not shaded: transparent.
-                    drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("rebin clear"),
-                        color_attachments: &[cleared(&t.view)],
-                        depth_stencil_attachment: None,
-                        timestamp_writes: None,
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    }));
-                }
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("rebin"),
                     timestamp_writes: super::timing::compute_pass_writes(timestamps),
@@ -470,7 +445,7 @@ impl Gpu {
     pub(super) fn draw_subjects(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        instances: &[(&GpuPose, Camera, PixelBox, Outside)],
+        instances: &[(&GpuPose, Camera, PixelBox)],
         size: (u32, u32),
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
@@ -478,7 +453,7 @@ impl Gpu {
         let targets = self.subject_targets(size, instances.len().max(1) as u32);
         encoder.clear_buffer(&targets.stats, 0, None);
         let mut outside = 0;
-        for (layer, &(pose, camera, within, read)) in instances.iter().enumerate() {
+        for (layer, &(pose, camera, within)) in instances.iter().enumerate() {
             let mut frame = frame_uniform(Some(pose), &camera, variant);
             frame.bounds = within.to_array();
             outside += size.0 as usize * size.1 as usize - within.pixels();
@@ -494,7 +469,6 @@ impl Gpu {
                 &pose.bind_group,
                 self.stage,
                 within,
-                read,
                 timestamps.filter(|_| layer == 0),
                 true,
             );
@@ -549,13 +523,8 @@ impl Gpu {
                     label: Some("frame"),
                 });
             let whole = PixelBox::whole(size.0, size.1);
-            let subject = self.draw_subjects(
-                &mut encoder,
-                &[(pose, *camera, whole, Outside::Read)],
-                size,
-                variant,
-                None,
-            );
+            let subject =
+                self.draw_subjects(&mut encoder, &[(pose, *camera, whole)], size, variant, None);
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
             self.copy_stats(&mut encoder, &subject);

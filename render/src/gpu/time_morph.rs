@@ -3,6 +3,9 @@
 //! walker's; pose `k'`'s render and both poses' motion renders into three layers of
 //! targets kept for frames between poses; `shaders/time_morph.wgsl` morphs them in time
 //! into a fourth, which is copied over the walker's layer before the composite reads it.
+//! All of it within the walker's pixel box alone: outside it the layers hold whatever an
+//! earlier frame left, and nothing reads them there (a far walker's morph costs its own
+//! pixels, not the frame's).
 
 use bytemuck::{Pod, Zeroable};
 use frf_core::camera::Camera;
@@ -10,7 +13,7 @@ use glam::Mat2;
 use wgpu::util::DeviceExt;
 
 use super::composite::GpuBetween;
-use super::rebin::{Outside, SubjectTargets, Subjects, frame_uniform, workgroups};
+use super::rebin::{SubjectTargets, Subjects, frame_uniform, workgroups};
 use super::{Gpu, shaders};
 use crate::morph::Variant;
 
@@ -19,9 +22,9 @@ use crate::morph::Variant;
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct TimeMorphUniform {
     to_image: [f32; 4],
-    size: [u32; 2],
+    bounds: [u32; 4],
     s: f32,
-    _pad: f32,
+    _pad: [f32; 3],
 }
 
 /// The pipeline of the morph in time.
@@ -134,7 +137,6 @@ impl Gpu {
                     &pose.bind_group,
                     self.stage,
                     w.within,
-                    Outside::Read,
                     None,
                     false,
                 );
@@ -142,9 +144,9 @@ impl Gpu {
             let m: Mat2 = crate::motion::motion_to_image(&w.camera);
             let uniform = TimeMorphUniform {
                 to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
-                size: [size.0, size.1],
+                bounds: w.within.to_array(),
                 s: b.s,
-                _pad: 0.0,
+                _pad: [0.0; 3],
             };
             let buffer = self
                 .device
@@ -181,27 +183,32 @@ impl Gpu {
                 });
                 pass.set_pipeline(&self.time_morph.pipeline);
                 pass.set_bind_group(0, &group, &[]);
-                let (x, y) = workgroups(size);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-            fn layer_copy(texture: &wgpu::Texture, z: usize) -> wgpu::TexelCopyTextureInfo<'_> {
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: z as u32,
-                    },
-                    aspect: wgpu::TextureAspect::All,
+                let (x, y) = workgroups(w.within.size());
+                if x * y > 0 {
+                    pass.dispatch_workgroups(x, y, 1);
                 }
             }
+            // The morphed walker, over its layer (only its box: nothing outside is read).
+            let (width, height) = w.within.size();
+            if width * height == 0 {
+                continue;
+            }
+            let layer_copy = |texture, z: usize| wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: w.within.x0,
+                    y: w.within.y0,
+                    z: z as u32,
+                },
+                aspect: wgpu::TextureAspect::All,
+            };
             encoder.copy_texture_to_texture(
                 layer_copy(scratch.texture(), 4 * j),
                 layer_copy(subjects.texture(), w.layer),
                 wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
+                    width,
+                    height,
                     depth_or_array_layers: 1,
                 },
             );
