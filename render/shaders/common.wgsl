@@ -74,6 +74,9 @@ struct Frame {
     // The pixels shaded, [x0, y0, x1, y1] (ends exclusive): the walker is transparent
     // outside them (`render/src/footprint.rs`).
     bounds: vec4<u32>,
+    // Where the frame pass writes: pixel p of the frame at texel p + place.xy of layer
+    // place.z of its target (`render/src/atlas.rs`; w unused).
+    place: vec4<i32>,
 }
 
 // The pose's geometric proxy: the visual hull's grid (its bits are bound beside it) and

@@ -36,14 +36,16 @@ struct Composite {
 
 // A walker's subject frame: `subject_from_world`, as columns and translation; the
 // translation's w is the texels a side of its relit shadow (its level of detail; 0
-// without one), which fill the corner of its layer of `shadows`. Its layer is transparent
-// outside `bounds` ([x0, y0, x1, y1], ends exclusive), and not read there.
+// without one), which fill the corner of its layer of `shadows`. It is transparent
+// outside `bounds` ([x0, y0, x1, y1], ends exclusive); within, pixel p of its render lies
+// at texel p + place.xy of layer place.z of `subjects` (`render/src/atlas.rs`).
 struct Instance {
     col_x: vec4<f32>,
     col_y: vec4<f32>,
     col_z: vec4<f32>,
     translation: vec4<f32>,
     bounds: vec4<u32>,
+    place: vec4<i32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -55,7 +57,8 @@ struct Instance {
 // render/src/footprint.rs).
 @group(0) @binding(3) var<storage, read> tiles: array<u32>;
 
-// The rendered walkers, premultiplied linear RGBA, one texel per pixel, one layer each.
+// The rendered walkers, premultiplied linear RGBA, one texel per pixel, packed into
+// pages (each walker's `place`).
 @group(1) @binding(0) var subjects: texture_2d_array<f32>;
 // The environment, latitude-longitude radiance (rgb).
 @group(1) @binding(1) var env: texture_2d<f32>;
@@ -211,7 +214,8 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
         if (any(vec2<u32>(pixel) < b.xy) || any(vec2<u32>(pixel) >= b.zw)) {
             continue;
         }
-        let layer = textureLoad(subjects, pixel, i32(i), 0);
+        let place = instances[i].place;
+        let layer = textureLoad(subjects, vec2<i32>(pixel) + place.xy, place.z, 0);
         front = layer + (1.0 - clamp(layer.w, 0.0, 1.0)) * front;
     }
     var out: Layers;

@@ -5,7 +5,7 @@
 // `common.wgsl`.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(2) var target_image: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(2) var target_image: texture_storage_2d_array<rgba32float, write>;
 @group(1) @binding(0) var prelit: texture_2d_array<u32>;
 
 fn fetch(pixel: vec2<u32>) -> vec4<f32> {
@@ -24,5 +24,5 @@ fn cs_floor(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= frame.size.x || id.y >= frame.size.y) {
         return;
     }
-    textureStore(target_image, id.xy, fetch(id.xy));
+    textureStore(target_image, id.xy, 0, fetch(id.xy));
 }

@@ -17,8 +17,9 @@
 @group(0) @binding(0) var<uniform> frame: Frame;
 // Pixels inside the grid, clamped above, clamped below, missed (compute entry points).
 @group(0) @binding(1) var<storage, read_write> stats: array<atomic<u32>, 4>;
-// The compute pass's target (`cs_main` only).
-@group(0) @binding(2) var target_image: texture_storage_2d<rgba32float, write>;
+// The compute pass's target (`cs_main` only): pixel p of the frame goes to texel
+// p + frame.place.xy of layer frame.place.z.
+@group(0) @binding(2) var target_image: texture_storage_2d_array<rgba32float, write>;
 
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
@@ -158,9 +159,10 @@ fn shade(position: vec2<f32>) -> vec4<f32> {
     return shade_classified(classify(position));
 }
 
+// Drawn into the layer `frame.place.z`, where frame pixel p lies at p + frame.place.xy.
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    return shade(position.xy);
+    return shade(position.xy - vec2<f32>(frame.place.xy));
 }
 
 // Per workgroup, how many of its pixels fell in each class; added to `stats` once.
@@ -190,7 +192,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocati
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         let c = classify(vec2<f32>(p) + 0.5);
-        textureStore(target_image, p, shade_classified(c));
+        textureStore(target_image, vec2<i32>(p) + frame.place.xy, frame.place.z, shade_classified(c));
         atomicAdd(&class_counts[c.kind], 1u);
     }
     flush_counts(local);

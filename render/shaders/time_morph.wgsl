@@ -3,14 +3,19 @@
 // pose k''s render sampled on along k's motion, a fraction 1 - s, mixed (1 - s, s).
 // Motion renders hold (across, along) the subject's axis in metres as
 // ((r - b) / a, (g - b) / a); `to_image` takes metres to the frame's pixels.
-// Only the walker's pixel box is drawn and morphed: the renders hold nothing outside it
-// (transparent, and not cleared there), so the morph reads them only within it.
+// Only the walker's pixel box is drawn and morphed, each render packed with others into
+// a page: the morph reads them only within the box (transparent beyond it).
 
 struct TimeMorph {
     // Columns of the 2x2 map from metres to pixels.
     to_image: vec4<f32>,
     // The walker's pixel box: first column and row, one past the last.
     bounds: vec4<u32>,
+    // Where each render holds frame pixel p: at p + its offset in its page
+    // (`render/src/atlas.rs`); xy, then zw: before and after, their motions, the morph.
+    at_poses: vec4<i32>,
+    at_motions: vec4<i32>,
+    at_morph: vec4<i32>,
     s: f32,
     _pad0: f32,
     _pad1: f32,
@@ -24,8 +29,8 @@ struct TimeMorph {
 @group(0) @binding(4) var after_motion: texture_2d<f32>;
 @group(0) @binding(5) var morphed: texture_storage_2d<rgba32float, write>;
 
-fn motion_at(t: texture_2d<f32>, p: vec2<i32>) -> vec2<f32> {
-    let m = textureLoad(t, p, 0);
+fn motion_at(t: texture_2d<f32>, p: vec2<i32>, at: vec2<i32>) -> vec2<f32> {
+    let m = textureLoad(t, p + at, 0);
     if (m.a < 1e-3) {
         return vec2<f32>(0.0);
     }
@@ -35,7 +40,7 @@ fn motion_at(t: texture_2d<f32>, p: vec2<i32>) -> vec2<f32> {
 
 // Bilinear, pixel centres at integers, transparent beyond the box (and so beyond the
 // frame's edge: the CPU's `Border::Zero`).
-fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
+fn bilinear_zero(t: texture_2d<f32>, at: vec2<i32>, q: vec2<f32>) -> vec4<f32> {
     let lo = vec2<i32>(tm.bounds.xy);
     let hi = vec2<i32>(tm.bounds.zw);
     let limit = f32(max(hi.x, hi.y) + 2);
@@ -49,7 +54,7 @@ fn bilinear_zero(t: texture_2d<f32>, q: vec2<f32>) -> vec4<f32> {
             let w = select(1.0 - fr.x, fr.x, dx == 1) * select(1.0 - fr.y, fr.y, dy == 1);
             let p = i0 + vec2<i32>(dx, dy);
             if (w != 0.0 && all(p >= lo) && all(p < hi)) {
-                acc += w * textureLoad(t, p, 0);
+                acc += w * textureLoad(t, p + at, 0);
             }
         }
     }
@@ -64,7 +69,7 @@ fn morph_in_time(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let p = vec2<i32>(pixel);
     let at = vec2<f32>(pixel);
-    let a = bilinear_zero(before, at + tm.s * motion_at(after_motion, p));
-    let b = bilinear_zero(after, at + (1.0 - tm.s) * motion_at(before_motion, p));
-    textureStore(morphed, p, (1.0 - tm.s) * a + tm.s * b);
+    let a = bilinear_zero(before, tm.at_poses.xy, at + tm.s * motion_at(after_motion, p, tm.at_motions.zw));
+    let b = bilinear_zero(after, tm.at_poses.zw, at + (1.0 - tm.s) * motion_at(before_motion, p, tm.at_motions.xy));
+    textureStore(morphed, p + tm.at_morph.xy, (1.0 - tm.s) * a + tm.s * b);
 }

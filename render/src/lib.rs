@@ -19,6 +19,7 @@
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod atlas;
 pub mod composite;
 pub mod cpu;
 pub mod cylinder;

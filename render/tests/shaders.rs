@@ -181,7 +181,8 @@ fn pod_structs_match_naga_layouts() {
             crop_size,
             flags,
             pad,
-            bounds
+            bounds,
+            place
         ]
     );
     check_layout!(
@@ -289,6 +290,6 @@ fn pod_structs_match_naga_layouts() {
         &composite,
         "Instance",
         GpuInstance,
-        [col_x, col_y, col_z, translation, bounds]
+        [col_x, col_y, col_z, translation, bounds, place]
     );
 }

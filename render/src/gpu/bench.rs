@@ -13,7 +13,7 @@ use super::Gpu;
 use super::bind::{compute_pipeline, full_screen_pipeline, texture_array};
 use super::formats::{FlowFormat, ImageFormat, PoseFormats};
 use super::pose::GpuPose;
-use super::rebin::{PassKind, RebinPass, SubjectTargets, frame_uniform, workgroups};
+use super::rebin::{PassKind, Place, RebinPass, SubjectTargets, frame_uniform, workgroups};
 use super::timing::{Timestamps, median_min};
 use crate::cpu::render_cpu;
 use crate::error::Result;
@@ -252,7 +252,7 @@ pub fn run(
     let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
     for &size in &options.sizes {
         let camera = bench_camera(size)?;
-        let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1);
+        let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1, 1);
         gpu.queue.write_buffer(
             targets.uniform(0),
             0,
@@ -288,7 +288,7 @@ pub fn run(
         let gpu_pose = gpu.upload_resident(pose, &pass.pose)?;
         for &size in &options.sizes {
             let camera = bench_camera(size)?;
-            let targets = SubjectTargets::new(&gpu.device, &pass, size, 1);
+            let targets = SubjectTargets::new(&gpu.device, &pass, size, 1, 1);
             let whole = crate::footprint::PixelBox::whole(size.0, size.1);
             for &stage in &options.stages {
                 let floor_ms = rows
@@ -314,7 +314,16 @@ pub fn run(
                         bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
                     );
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                        pass.record(e, &targets, 0, &gpu_pose.bind_group, stage, whole, t, false)
+                        pass.record(
+                            e,
+                            &targets,
+                            (0, Place::FRAME),
+                            &gpu_pose.bind_group,
+                            stage,
+                            whole,
+                            t,
+                            false,
+                        )
                     })?;
                     let timing = median_min(&times);
                     let error = match reference.iter().find(|(rv, _)| *rv == v) {
@@ -323,7 +332,7 @@ pub fn run(
                             pass.record(
                                 &mut e,
                                 &targets,
-                                0,
+                                (0, Place::FRAME),
                                 &gpu_pose.bind_group,
                                 stage,
                                 whole,
@@ -437,7 +446,7 @@ fn record_floor(
         PassKind::Fragment => {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("floor"),
-                color_attachments: &[super::bind::cleared(targets.layer_view(0))],
+                color_attachments: &[super::bind::cleared(targets.page_view(0))],
                 depth_stencil_attachment: None,
                 timestamp_writes: super::timing::render_pass_writes(timestamps),
                 occlusion_query_set: None,

@@ -397,6 +397,7 @@ impl Gpu {
                     col_z: m.rotation.z_axis.extend(0.0).to_array(),
                     translation: m.translation.extend(texels as f32).to_array(),
                     bounds: drawn[layer].2.to_array(),
+                    place: subjects.place(layer).0.to_array(),
                 });
             }
             let mut params = backdrop.params;

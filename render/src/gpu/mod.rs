@@ -127,11 +127,11 @@ pub struct Gpu {
     rebin: rebin::RebinPass,
     /// How the frame pass runs.
     stage: rebin::PassKind,
-    /// Frame targets kept per size and number of walkers.
-    targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
-    /// The renders of frames between poses kept per size and number of such walkers
-    /// (four layers each, [`time_morph`]).
-    between_targets: kept::Kept<((u32, u32), u32), rebin::SubjectTargets>,
+    /// Frame targets kept per size, number of walkers and of pages.
+    targets: kept::Kept<((u32, u32), u32, u32), rebin::SubjectTargets>,
+    /// The renders of frames between poses kept per size, number of renders (four for
+    /// each such walker, [`time_morph`]) and of pages.
+    between_targets: kept::Kept<((u32, u32), u32, u32), rebin::SubjectTargets>,
     /// The morph in time of walkers between poses.
     time_morph: time_morph::TimeMorphPass,
     /// Composite targets kept per size, number of walkers and shadow-map size.

@@ -11,8 +11,8 @@ use frf_core::image::{Image, Rgba};
 
 use super::Gpu;
 use super::bind::{
-    cleared, compute_pipeline, full_screen_pipeline, readback_buffer, sampler, storage,
-    storage_min, storage_texture, texture_array, uniform, uniform_buffer,
+    compute_pipeline, full_screen_pipeline, loaded, readback_buffer, sampler, storage, storage_min,
+    storage_texture_array, texture_array, uniform, uniform_buffer,
 };
 use super::formats::PoseFormats;
 use super::pose::{GpuPose, PoseBinding};
@@ -83,7 +83,7 @@ impl RebinPass {
             &[
                 uniform::<GpuFrame>(0, both),
                 storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
-                storage_texture(2, wgpu::TextureFormat::Rgba32Float),
+                storage_texture_array(2, wgpu::TextureFormat::Rgba32Float),
             ],
         );
         let classes_layout = layout(
@@ -160,6 +160,8 @@ pub(super) struct Subjects {
     targets: Arc<SubjectTargets>,
     /// Pixels outside the walkers' bounds, summed over the walkers: not shaded, missed.
     outside: usize,
+    /// Per walker (in drawing order), where its render lies.
+    places: Vec<Place>,
 }
 
 impl Subjects {
@@ -173,9 +175,10 @@ impl Subjects {
         self.targets.id
     }
 
-    /// The view of walker `layer`'s layer.
-    pub(super) fn layer_view(&self, layer: usize) -> &wgpu::TextureView {
-        self.targets.layer_view(layer)
+    /// Where walker `k` (in drawing order) lies, and the view of its page.
+    pub(super) fn place(&self, k: usize) -> (Place, &wgpu::TextureView) {
+        let place = self.places[k];
+        (place, self.targets.page_view(place.page))
     }
 }
 
@@ -200,6 +203,7 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         flags: variant.flags(),
         pad: 0,
         bounds: PixelBox::whole(camera.width, camera.height).to_array(),
+        place: [0; 4],
     };
     if let Some(pose) = pose {
         f.quad_count = pose.quad_count;
@@ -211,23 +215,70 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
     f
 }
 
-/// A frame's targets and per-frame buffers for one size and number of walkers, made once
-/// and kept ([`Gpu::subject_targets`]): the subjects' texture array, its layer views, the
-/// pixel-class counters, staging buffers to read them back through, and per layer a frame uniform (written with `write_buffer`)
-/// with the bind groups of the fragment, compute and class passes.
+/// Where a walker's render lies in its targets ([`crate::atlas`]): pixel `p` of the frame
+/// at texel `p + offset` of layer `page`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Place {
+    pub page: u32,
+    pub offset: [i32; 2],
+}
+
+impl Place {
+    /// The frame's own pixels, on layer 0.
+    pub const FRAME: Place = Place {
+        page: 0,
+        offset: [0, 0],
+    };
+
+    /// As the frame uniform's `place` holds it.
+    pub fn to_array(self) -> [i32; 4] {
+        [self.offset[0], self.offset[1], self.page as i32, 0]
+    }
+
+    /// Where frame pixel `(x, y)` lies in the page.
+    pub fn texel(self, x: u32, y: u32) -> (u32, u32) {
+        (
+            (x as i64 + self.offset[0] as i64) as u32,
+            (y as i64 + self.offset[1] as i64) as u32,
+        )
+    }
+}
+
+/// The places of renders within `boxes` packed into pages of `size` ([`crate::atlas`]),
+/// the first on page `first_page`; and the pages they take.
+pub(super) fn places(boxes: &[PixelBox], size: (u32, u32), first_page: u32) -> (Vec<Place>, u32) {
+    let sizes: Vec<(u32, u32)> = boxes.iter().map(PixelBox::size).collect();
+    let (placed, pages) = crate::atlas::pack(&sizes, size);
+    let places = placed
+        .iter()
+        .zip(boxes)
+        .map(|(at, b)| Place {
+            page: first_page + at.page,
+            offset: [at.x as i32 - b.x0 as i32, at.y as i32 - b.y0 as i32],
+        })
+        .collect();
+    (places, pages)
+}
+
+/// A frame's targets and per-frame buffers for one size, number of renders (slots) and
+/// of pages, made once and kept ([`Gpu::subject_targets`]): the pages (a texture array of
+/// the frame's size into which the renders are packed, each within its pixel box,
+/// [`Place`]), their views, the pixel-class counters, staging buffers to read them back
+/// through, and per slot a frame uniform (written with `write_buffer`) with the bind
+/// groups of the fragment, compute and class passes.
 pub(super) struct SubjectTargets {
     /// Names these targets in the keys of bind groups made of them ([`super::kept`]).
     pub(super) id: u64,
     texture: wgpu::Texture,
-    layers: Vec<LayerTargets>,
+    pages: Vec<wgpu::TextureView>,
+    slots: Vec<SlotTargets>,
     stats: wgpu::Buffer,
-    /// Staging buffers of the counters and of layer 0.
+    /// Staging buffers of the counters and of page 0.
     stats_readback: wgpu::Buffer,
     readback: Readback,
 }
 
-struct LayerTargets {
-    view: wgpu::TextureView,
+struct SlotTargets {
     uniform: wgpu::Buffer,
     fragment: wgpu::BindGroup,
     compute: wgpu::BindGroup,
@@ -239,14 +290,15 @@ impl SubjectTargets {
         device: &wgpu::Device,
         pass: &RebinPass,
         size: (u32, u32),
-        layers: u32,
+        slots: u32,
+        pages: u32,
     ) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("subjects"),
             size: wgpu::Extent3d {
                 width: size.0,
                 height: size.1,
-                depth_or_array_layers: layers,
+                depth_or_array_layers: pages,
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -258,6 +310,10 @@ impl SubjectTargets {
                 | wgpu::TextureUsages::COPY_DST
                 | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
+        });
+        let all = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
         });
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stats"),
@@ -274,48 +330,42 @@ impl SubjectTargets {
                 entries,
             })
         };
-        let layers = (0..layers)
-            .map(|layer| {
-                let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        let pages = (0..pages)
+            .map(|page| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
+                    base_array_layer: page,
                     array_layer_count: Some(1),
                     ..Default::default()
-                });
+                })
+            })
+            .collect();
+        let slots = (0..slots)
+            .map(|_| {
                 let uniform = uniform_buffer(device, "frame", std::mem::size_of::<GpuFrame>());
                 let frame = wgpu::BindGroupEntry {
                     binding: 0,
                     resource: uniform.as_entire_binding(),
                 };
-                LayerTargets {
+                let stats = wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: stats.as_entire_binding(),
+                };
+                SlotTargets {
                     fragment: group("frame", &pass.frame_layout, std::slice::from_ref(&frame)),
                     compute: group(
                         "frame (compute)",
                         &pass.compute_layout,
                         &[
                             frame.clone(),
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: stats.as_entire_binding(),
-                            },
+                            stats.clone(),
                             wgpu::BindGroupEntry {
                                 binding: 2,
-                                resource: wgpu::BindingResource::TextureView(&view),
+                                resource: wgpu::BindingResource::TextureView(&all),
                             },
                         ],
                     ),
-                    classes: group(
-                        "frame (classes)",
-                        &pass.classes_layout,
-                        &[
-                            frame.clone(),
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: stats.as_entire_binding(),
-                            },
-                        ],
-                    ),
-                    view,
+                    classes: group("frame (classes)", &pass.classes_layout, &[frame, stats]),
                     uniform,
                 }
             })
@@ -323,7 +373,8 @@ impl SubjectTargets {
         Self {
             id: super::kept::unique_id(),
             texture,
-            layers,
+            pages,
+            slots,
             stats,
             stats_readback: readback_buffer(device, "stats readback", 16),
             readback: Readback::new(device, "subject readback", size),
@@ -332,39 +383,39 @@ impl SubjectTargets {
 }
 
 impl SubjectTargets {
-    /// The texture array of the subjects.
+    /// The texture array of the pages.
     pub(super) fn texture(&self) -> &wgpu::Texture {
         &self.texture
     }
 
-    /// The frame uniform of `layer`.
-    pub(super) fn uniform(&self, layer: usize) -> &wgpu::Buffer {
-        &self.layers[layer].uniform
+    /// The frame uniform of `slot`.
+    pub(super) fn uniform(&self, slot: usize) -> &wgpu::Buffer {
+        &self.slots[slot].uniform
     }
 
-    /// The view of `layer`.
-    pub(super) fn layer_view(&self, layer: usize) -> &wgpu::TextureView {
-        &self.layers[layer].view
+    /// The view of `page`.
+    pub(super) fn page_view(&self, page: u32) -> &wgpu::TextureView {
+        &self.pages[page as usize]
     }
 
-    /// The fragment pass's frame bind group of `layer`.
-    pub(super) fn fragment_group(&self, layer: usize) -> &wgpu::BindGroup {
-        &self.layers[layer].fragment
+    /// The fragment pass's frame bind group of `slot`.
+    pub(super) fn fragment_group(&self, slot: usize) -> &wgpu::BindGroup {
+        &self.slots[slot].fragment
     }
 
-    /// The compute pass's frame bind group of `layer`.
-    pub(super) fn compute_group(&self, layer: usize) -> &wgpu::BindGroup {
-        &self.layers[layer].compute
+    /// The compute pass's frame bind group of `slot`.
+    pub(super) fn compute_group(&self, slot: usize) -> &wgpu::BindGroup {
+        &self.slots[slot].compute
     }
 }
 
 impl RebinPass {
-    /// Records pose `pose` drawn by the frame uniform already written to `layer`'s buffer
-    /// (whose bounds are `within`), into `layer` of `targets`, by `stage`, with the pass's
-    /// timestamps when given: the pixels `within` are shaded; the rest of the layer is
-    /// left as it was by a compute pass (nothing reads a layer outside its walker's box:
-    /// the composite and the morph in time read within it) and cleared by a fragment
-    /// pass. Its pixel classes (of the pixels within) are counted into the targets'
+    /// Records pose `pose` drawn by the frame uniform already written to `slot`'s buffer
+    /// (whose bounds are `within` and place `place`), into its place in `targets`, by
+    /// `stage`, with the pass's timestamps when given: the pixels `within` are shaded;
+    /// the rest of the page is left as it was (nothing reads a render outside its box:
+    /// the composite and the morph in time read within it; other renders share the
+    /// page). Its pixel classes (of the pixels within) are counted into the targets'
     /// counters by the compute pass itself, and after a fragment pass by a pass of their
     /// own when `classes`.
     #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
@@ -372,27 +423,28 @@ impl RebinPass {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
-        layer: usize,
+        (slot, place): (usize, Place),
         pose_group: &wgpu::BindGroup,
         stage: PassKind,
         within: PixelBox,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
-        let t = &targets.layers[layer];
+        let t = &targets.slots[slot];
         let size = within.size();
         match stage {
             PassKind::Fragment => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("rebin"),
-                    color_attachments: &[cleared(&t.view)],
+                    color_attachments: &[loaded(targets.page_view(place.page))],
                     depth_stencil_attachment: None,
                     timestamp_writes: super::timing::render_pass_writes(timestamps),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
                 if within.pixels() > 0 {
-                    pass.set_scissor_rect(within.x0, within.y0, size.0, size.1);
+                    let (x, y) = place.texel(within.x0, within.y0);
+                    pass.set_scissor_rect(x, y, size.0, size.1);
                     pass.set_pipeline(&self.fragment);
                     pass.set_bind_group(0, &t.fragment, &[]);
                     pass.set_bind_group(1, pose_group, &[]);
@@ -429,18 +481,23 @@ impl RebinPass {
 }
 
 impl Gpu {
-    /// The kept targets of frames of `size` with `layers` walkers (made on first use;
-    /// the few most recently used are kept).
-    pub(super) fn subject_targets(&self, size: (u32, u32), layers: u32) -> Arc<SubjectTargets> {
-        self.targets.get((size, layers), || {
-            SubjectTargets::new(&self.device, &self.rebin, size, layers)
+    /// The kept targets of frames of `size` with `slots` renders on `pages` pages (made
+    /// on first use; the few most recently used are kept).
+    pub(super) fn subject_targets(
+        &self,
+        size: (u32, u32),
+        slots: u32,
+        pages: u32,
+    ) -> Arc<SubjectTargets> {
+        self.targets.get((size, slots, pages), || {
+            SubjectTargets::new(&self.device, &self.rebin, size, slots, pages)
         })
     }
 
     /// Records the frame pass of every instance into `encoder`: each pose drawn by its
-    /// camera (in its subject frame) within its pixel box into its own layer of one
-    /// texture array of `size`, in the order given (back to front; the composite pass
-    /// puts each over the ones before it), and their pixel classes counted (the pixels
+    /// camera (in its subject frame) within its pixel box, the boxes packed into pages
+    /// of `size` ([`Place`]), in the order given (back to front; the composite pass puts
+    /// each over the ones before it), and their pixel classes counted (the pixels
     /// outside a box as missed).
     pub(super) fn draw_subjects(
         &self,
@@ -450,30 +507,34 @@ impl Gpu {
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> Subjects {
-        let targets = self.subject_targets(size, instances.len().max(1) as u32);
+        let boxes: Vec<PixelBox> = instances.iter().map(|i| i.2).collect();
+        let (places, pages) = places(&boxes, size, 0);
+        let targets = self.subject_targets(size, instances.len().max(1) as u32, pages);
         encoder.clear_buffer(&targets.stats, 0, None);
         let mut outside = 0;
-        for (layer, &(pose, camera, within)) in instances.iter().enumerate() {
+        for (slot, (&(pose, camera, within), &place)) in instances.iter().zip(&places).enumerate() {
             let mut frame = frame_uniform(Some(pose), &camera, variant);
             frame.bounds = within.to_array();
+            frame.place = place.to_array();
             outside += size.0 as usize * size.1 as usize - within.pixels();
-            self.queue.write_buffer(
-                &targets.layers[layer].uniform,
-                0,
-                bytemuck::bytes_of(&frame),
-            );
+            self.queue
+                .write_buffer(targets.uniform(slot), 0, bytemuck::bytes_of(&frame));
             self.rebin.record(
                 encoder,
                 &targets,
-                layer,
+                (slot, place),
                 &pose.bind_group,
                 self.stage,
                 within,
-                timestamps.filter(|_| layer == 0),
+                timestamps.filter(|_| slot == 0),
                 true,
             );
         }
-        Subjects { targets, outside }
+        Subjects {
+            targets,
+            outside,
+            places,
+        }
     }
 
     /// Copies the pixel-class counters of a drawn frame into its staging buffer.

@@ -13,8 +13,9 @@ use glam::Mat2;
 use wgpu::util::DeviceExt;
 
 use super::composite::GpuBetween;
-use super::rebin::{SubjectTargets, Subjects, frame_uniform, workgroups};
+use super::rebin::{Place, SubjectTargets, Subjects, frame_uniform, places, workgroups};
 use super::{Gpu, shaders};
+use crate::footprint::PixelBox;
 use crate::morph::Variant;
 
 /// The uniform of `shaders/time_morph.wgsl`.
@@ -23,6 +24,9 @@ use crate::morph::Variant;
 struct TimeMorphUniform {
     to_image: [f32; 4],
     bounds: [u32; 4],
+    at_poses: [i32; 4],
+    at_motions: [i32; 4],
+    at_morph: [i32; 4],
     s: f32,
     _pad: [f32; 3],
 }
@@ -117,23 +121,35 @@ impl Gpu {
         if walkers.is_empty() {
             return;
         }
-        let scratch = self
-            .between_targets
-            .get((size, 4 * walkers.len() as u32), || {
-                SubjectTargets::new(&self.device, &self.rebin, size, 4 * walkers.len() as u32)
-            });
+        // Three renders a walker (pose k', and both poses' motion) packed into pages,
+        // and each walker's morph into pages of its own after them: a pass never reads
+        // the page it writes.
+        let n = walkers.len();
+        let boxes: Vec<PixelBox> = walkers.iter().flat_map(|w| [w.within; 3]).collect();
+        let (renders, render_pages) = places(&boxes, size, 0);
+        let boxes: Vec<PixelBox> = walkers.iter().map(|w| w.within).collect();
+        let (morphs, morph_pages) = places(&boxes, size, render_pages);
+        let pages = render_pages + morph_pages;
+        let slots = 3 * n as u32;
+        let scratch = self.between_targets.get((size, slots, pages), || {
+            SubjectTargets::new(&self.device, &self.rebin, size, slots, pages)
+        });
         for (j, w) in walkers.iter().enumerate() {
             let b = w.between;
-            for (k, pose) in [(1, b.after), (2, b.before_motion), (3, b.after_motion)] {
-                let layer = 4 * j + k;
+            for (k, pose) in [b.after, b.before_motion, b.after_motion]
+                .into_iter()
+                .enumerate()
+            {
+                let slot = 3 * j + k;
                 let mut frame = frame_uniform(Some(pose), &w.camera, variant);
                 frame.bounds = w.within.to_array();
+                frame.place = renders[slot].to_array();
                 self.queue
-                    .write_buffer(scratch.uniform(layer), 0, bytemuck::bytes_of(&frame));
+                    .write_buffer(scratch.uniform(slot), 0, bytemuck::bytes_of(&frame));
                 self.rebin.record(
                     encoder,
                     &scratch,
-                    layer,
+                    (slot, renders[slot]),
                     &pose.bind_group,
                     self.stage,
                     w.within,
@@ -141,10 +157,17 @@ impl Gpu {
                     false,
                 );
             }
+            let (before, before_view) = subjects.place(w.layer);
+            let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
+            let morph = morphs[j];
+            let pair = |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
             let m: Mat2 = crate::motion::motion_to_image(&w.camera);
             let uniform = TimeMorphUniform {
                 to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
                 bounds: w.within.to_array(),
+                at_poses: pair(before, after),
+                at_motions: pair(before_motion, after_motion),
+                at_morph: pair(morph, morph),
                 s: b.s,
                 _pad: [0.0; 3],
             };
@@ -161,6 +184,7 @@ impl Gpu {
                     resource: wgpu::BindingResource::TextureView(v),
                 }
             }
+            let page = |p: Place| scratch.page_view(p.page);
             let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("time morph"),
                 layout: &self.time_morph.layout,
@@ -169,11 +193,11 @@ impl Gpu {
                         binding: 0,
                         resource: buffer.as_entire_binding(),
                     },
-                    view(subjects.layer_view(w.layer), 1),
-                    view(scratch.layer_view(4 * j + 1), 2),
-                    view(scratch.layer_view(4 * j + 2), 3),
-                    view(scratch.layer_view(4 * j + 3), 4),
-                    view(scratch.layer_view(4 * j), 5),
+                    view(before_view, 1),
+                    view(page(after), 2),
+                    view(page(before_motion), 3),
+                    view(page(after_motion), 4),
+                    view(page(morph), 5),
                 ],
             });
             {
@@ -188,24 +212,28 @@ impl Gpu {
                     pass.dispatch_workgroups(x, y, 1);
                 }
             }
-            // The morphed walker, over its layer (only its box: nothing outside is read).
+            // The morphed walker, over its render in the subjects (only its box: nothing
+            // outside is read).
             let (width, height) = w.within.size();
             if width * height == 0 {
                 continue;
             }
-            let layer_copy = |texture, z: usize| wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d {
-                    x: w.within.x0,
-                    y: w.within.y0,
-                    z: z as u32,
-                },
-                aspect: wgpu::TextureAspect::All,
+            let at = |texture, place: Place| {
+                let (x, y) = place.texel(w.within.x0, w.within.y0);
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x,
+                        y,
+                        z: place.page,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                }
             };
             encoder.copy_texture_to_texture(
-                layer_copy(scratch.texture(), 4 * j),
-                layer_copy(subjects.texture(), w.layer),
+                at(scratch.texture(), morph),
+                at(subjects.texture(), before),
                 wgpu::Extent3d {
                     width,
                     height,

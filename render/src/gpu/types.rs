@@ -115,6 +115,9 @@ pub struct GpuFrame {
     /// The pixels shaded, `[x0, y0, x1, y1]` (ends exclusive; [`crate::footprint`]):
     /// the walker is transparent outside them.
     pub bounds: [u32; 4],
+    /// Where the frame pass writes: pixel `p` of the frame at texel `p + place.xy` of
+    /// layer `place.z` of its target ([`crate::atlas`]; w unused).
+    pub place: [i32; 4],
 }
 
 /// `Proxy` of `shaders/common.wgsl`: the pose's geometric proxy ([`crate::proxy`]).
@@ -227,8 +230,11 @@ pub struct GpuInstance {
     /// without one).
     pub translation: [f32; 4],
     /// The pixels its frame pass shaded, `[x0, y0, x1, y1]` (ends exclusive): elsewhere
-    /// its layer is transparent and not read.
+    /// it is transparent and its render not read.
     pub bounds: [u32; 4],
+    /// Where its render lies: pixel `p` at texel `p + place.xy` of layer `place.z` of the
+    /// subjects ([`crate::atlas`]; w unused).
+    pub place: [i32; 4],
 }
 
 /// `ColumnIndex` of `shaders/common.wgsl`: the header of a cylinder's column index
