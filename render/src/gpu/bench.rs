@@ -446,7 +446,7 @@ fn record_floor(
         PassKind::Fragment => {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("floor"),
-                color_attachments: &[super::bind::cleared(targets.page_view(0))],
+                color_attachments: &[super::bind::loaded(targets.page_view(0))],
                 depth_stencil_attachment: None,
                 timestamp_writes: super::timing::render_pass_writes(timestamps),
                 occlusion_query_set: None,

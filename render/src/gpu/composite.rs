@@ -359,7 +359,7 @@ impl Gpu {
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let mut gpu_instances = Vec::with_capacity(order.len());
-            // Per walker, the pixels it may touch: its layer's box, and where it sees its
+            // Per walker, the pixels it may touch: its render's box, and where it sees its
             // shadow's patch of ground.
             let mut touched = Vec::with_capacity(order.len());
             for (layer, &k) in order.iter().enumerate() {

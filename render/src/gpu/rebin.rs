@@ -153,9 +153,10 @@ impl RebinPass {
     }
 }
 
-/// A frame's subjects, drawn and still on the GPU: one layer per instance of the
-/// targets' texture, in drawing order (back to front), premultiplied RGBA32F, and the
-/// pixel-class counters summed over the instances.
+/// A frame's subjects, drawn and still on the GPU: each instance's render within its
+/// pixel box, packed into the pages of the targets' texture ([`Place`]; instances in
+/// drawing order, back to front), premultiplied RGBA32F, and the pixel-class counters
+/// summed over the instances.
 pub(super) struct Subjects {
     targets: Arc<SubjectTargets>,
     /// Pixels outside the walkers' bounds, summed over the walkers: not shaded, missed.

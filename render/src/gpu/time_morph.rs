@@ -1,12 +1,12 @@
 //! The GPU twin of [`crate::motion::time_morph`]: walkers between two captured poses.
-//! Pose `k`'s render is drawn into the walker's own layer of the frame's subjects, as any
-//! walker's; pose `k'`'s render and both poses' motion renders into three layers of
-//! targets kept for frames between poses; `shaders/time_morph.wgsl` morphs them in time
-//! into a fourth, which is copied over the walker's layer before the composite reads it.
-//! All of it within the walker's pixel box alone: outside it the layers hold whatever an
-//! earlier frame left, and nothing reads them there (a far walker's morph costs its own
-//! pixels, not the frame's).
-
+//! Pose `k`'s render is drawn into the walker's place in the frame's subjects, as any
+//! walker's; pose `k'`'s render and both poses' motion renders into targets kept for
+//! frames between poses; `shaders/time_morph.wgsl` morphs them in time into a fourth
+//! render there, which is copied over the walker's before the composite reads it. All of
+//! it within the walker's pixel box alone, each render packed with others into pages
+//! ([`crate::atlas`]; the morphs on pages of their own, so that a pass never reads the
+//! page it writes): nothing reads a render outside its box, so a far walker's morph costs
+//! its own pixels, not the frame's.
 use bytemuck::{Pod, Zeroable};
 use frf_core::camera::Camera;
 use glam::Mat2;
@@ -97,7 +97,7 @@ impl TimeMorphPass {
     }
 }
 
-/// A walker between poses: its layer in the frame's subjects, its poses, and the camera
+/// A walker between poses: its index in the frame's subjects, its poses, and the camera
 /// that sees it (its subject frame).
 pub(super) struct BetweenDraw<'a> {
     pub layer: usize,
@@ -109,7 +109,7 @@ pub(super) struct BetweenDraw<'a> {
 
 impl Gpu {
     /// Records the morph in time of every walker of `walkers` into `encoder`, over its
-    /// layer of `subjects` (where pose `k` is already drawn; see the module docs).
+    /// render in `subjects` (where pose `k` is already drawn; see the module docs).
     pub(super) fn morph_in_time(
         &self,
         encoder: &mut wgpu::CommandEncoder,
