@@ -245,6 +245,16 @@ impl Place {
     }
 }
 
+/// One render of a frame: its slot of the targets (its frame uniform), where it lies,
+/// the camera that sees it (in its subject frame) and the pixels it may show in.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct DrawnRender {
+    pub slot: usize,
+    pub place: Place,
+    pub camera: Camera,
+    pub within: PixelBox,
+}
+
 /// The places of renders within `boxes` packed into pages of `size` ([`crate::atlas`]),
 /// the first on page `first_page`; and the pages they take.
 pub(super) fn places(boxes: &[PixelBox], size: (u32, u32), first_page: u32) -> (Vec<Place>, u32) {
@@ -514,19 +524,19 @@ impl Gpu {
         encoder.clear_buffer(&targets.stats, 0, None);
         let mut outside = 0;
         for (slot, (&(pose, camera, within), &place)) in instances.iter().zip(&places).enumerate() {
-            let mut frame = frame_uniform(Some(pose), &camera, variant);
-            frame.bounds = within.to_array();
-            frame.place = place.to_array();
             outside += size.0 as usize * size.1 as usize - within.pixels();
-            self.queue
-                .write_buffer(targets.uniform(slot), 0, bytemuck::bytes_of(&frame));
-            self.rebin.record(
+            let drawn = DrawnRender {
+                slot,
+                place,
+                camera,
+                within,
+            };
+            self.draw_render(
                 encoder,
                 &targets,
-                (slot, place),
-                &pose.bind_group,
-                self.stage,
-                within,
+                pose,
+                drawn,
+                variant,
                 timestamps.filter(|_| slot == 0),
                 true,
             );
@@ -536,6 +546,43 @@ impl Gpu {
             outside,
             places,
         }
+    }
+
+    /// Records `pose` drawn as `drawn` says into `targets`: its slot's frame uniform
+    /// (the camera, the box and the place) written, then the frame pass
+    /// ([`RebinPass::record`], which `timestamps` and `classes` go to).
+    #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
+    pub(super) fn draw_render(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &SubjectTargets,
+        pose: &GpuPose,
+        drawn: DrawnRender,
+        variant: Variant,
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+        classes: bool,
+    ) {
+        let DrawnRender {
+            slot,
+            place,
+            camera,
+            within,
+        } = drawn;
+        let mut frame = frame_uniform(Some(pose), &camera, variant);
+        frame.bounds = within.to_array();
+        frame.place = place.to_array();
+        self.queue
+            .write_buffer(targets.uniform(slot), 0, bytemuck::bytes_of(&frame));
+        self.rebin.record(
+            encoder,
+            targets,
+            (slot, place),
+            &pose.bind_group,
+            self.stage,
+            within,
+            timestamps,
+            classes,
+        );
     }
 
     /// Copies the pixel-class counters of a drawn frame into its staging buffer.

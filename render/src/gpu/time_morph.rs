@@ -13,7 +13,7 @@ use glam::Mat2;
 use wgpu::util::DeviceExt;
 
 use super::composite::GpuBetween;
-use super::rebin::{Place, SubjectTargets, Subjects, frame_uniform, places, workgroups};
+use super::rebin::{DrawnRender, Place, SubjectTargets, Subjects, places, workgroups};
 use super::{Gpu, shaders};
 use crate::footprint::PixelBox;
 use crate::morph::Variant;
@@ -141,21 +141,13 @@ impl Gpu {
                 .enumerate()
             {
                 let slot = 3 * j + k;
-                let mut frame = frame_uniform(Some(pose), &w.camera, variant);
-                frame.bounds = w.within.to_array();
-                frame.place = renders[slot].to_array();
-                self.queue
-                    .write_buffer(scratch.uniform(slot), 0, bytemuck::bytes_of(&frame));
-                self.rebin.record(
-                    encoder,
-                    &scratch,
-                    (slot, renders[slot]),
-                    &pose.bind_group,
-                    self.stage,
-                    w.within,
-                    None,
-                    false,
-                );
+                let drawn = DrawnRender {
+                    slot,
+                    place: renders[slot],
+                    camera: w.camera,
+                    within: w.within,
+                };
+                self.draw_render(encoder, &scratch, pose, drawn, variant, None, false);
             }
             let (before, before_view) = subjects.place(w.layer);
             let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);

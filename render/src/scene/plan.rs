@@ -311,8 +311,9 @@ fn samples(lo: u32, hi: u32, step: u32) -> Vec<u32> {
 /// The quads `(u, v)` of `cylinder` (neighbours' columns taken round its spans) that
 /// the rays of `camera` that may see the subject (that pass through its `bounds`) reach,
 /// traced over the box where the camera sees the bounds: at every pixel of a box of at
-/// most [`EXACT_PIXELS`], each hit with the quad across a side it lies within [`EDGE`] of; else every [`RAY_STEP_PX`] pixels (finer for a thin box) and
-/// along its border, each hit grown by its eight neighbours, so that a ray between two
+/// most [`EXACT_PIXELS`], each hit with the quad across a side it lies within [`EDGE`]
+/// of; else every [`RAY_STEP_PX`] pixels (finer for a thin box) and along its border,
+/// each hit grown by its eight neighbours, so that a ray between two
 /// samples, which meets the cylinder between their quads, is covered. Rays clamped above
 /// or below the grid keep the top or bottom row's quads. And whether a ray of the whole
 /// frame (sampled every [`RAY_STEP_PX`]) meets the ground within `ground_half` metres of
