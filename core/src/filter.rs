@@ -1,4 +1,7 @@
-//! Image filters shared by the pipeline: separable Gaussian blur.
+//! Image filters shared by the pipeline: separable Gaussian blur, and filling unknown
+//! values from the nearest known one.
+
+use std::collections::VecDeque;
 
 use crate::image::{Image, Pixel};
 
@@ -27,6 +30,43 @@ pub fn gaussian_blur<P: Pixel>(img: &Image<P>, sigma: f32) -> Image<P> {
         })
     };
     pass(&pass(img, 1, 0), 0, 1)
+}
+
+/// Gives every value of a `width x height` image for which `known` fails the value of
+/// the nearest one for which it holds (breadth first from every known value, 4-connected;
+/// ties to the first reached in row order). An image with nothing known is unchanged.
+pub fn extend_nearest<T: Copy>(
+    values: &mut [T],
+    width: usize,
+    height: usize,
+    known: impl Fn(&T) -> bool,
+) {
+    debug_assert_eq!(values.len(), width * height);
+    let mut done: Vec<bool> = values.iter().map(&known).collect();
+    let mut queue: VecDeque<usize> = (0..values.len()).filter(|&i| done[i]).collect();
+    while let Some(i) = queue.pop_front() {
+        let (x, y) = (i % width, i / width);
+        let value = values[i];
+        let mut visit = |j: usize| {
+            if !done[j] {
+                done[j] = true;
+                values[j] = value;
+                queue.push_back(j);
+            }
+        };
+        if x > 0 {
+            visit(i - 1);
+        }
+        if x + 1 < width {
+            visit(i + 1);
+        }
+        if y > 0 {
+            visit(i - width);
+        }
+        if y + 1 < height {
+            visit(i + width);
+        }
+    }
 }
 
 #[cfg(test)]

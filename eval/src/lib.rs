@@ -10,6 +10,8 @@
 //! - [`storage`]: the error of the lighting basis and of the image codec;
 //! - [`views`]: rendered frames between the grid's views against the true frames;
 //!   [`quads`]: `frf eval` at quad centres, with the scene's scores;
+//! - [`ingest_budget`]: the error budget of ingest: fields with one ingest component at
+//!   a time taken from the truth, scored at the captured views and at quad centres;
 //! - [`budget`]: the error budget of view interpolation: every variant at offsets along
 //!   rows, columns and toward quad centres, beside the captured views, the floor of any
 //!   flow-based morph and geometry baselines (unstructured lumigraph rendering);
@@ -27,6 +29,7 @@
 pub mod budget;
 pub mod error;
 pub mod ingest;
+pub mod ingest_budget;
 pub mod metrics;
 pub mod oracle;
 pub mod paths;

@@ -11,9 +11,7 @@ use frf_eval::ingest::StageEvaluator;
 use frf_flow::Preset;
 use frf_ingest::IngestError;
 use frf_ingest::edges::EdgeMethod;
-use frf_ingest::matte::MatteRule;
 use frf_ingest::pipeline::{IngestOptions, Progress, Silent, ingest, parts_dir};
-use frf_ingest::shadows::ShadowOptions;
 use frf_reflectance::FieldFile;
 use frf_stage::{Preset as StagePreset, SetFlowTruth, Stage, StageConfig, write_capture};
 
@@ -30,14 +28,7 @@ fn options(poses: Vec<u32>) -> IngestOptions {
     IngestOptions {
         poses,
         flow_preset: Preset::Fast,
-        flow_settings: Vec::new(),
-        jpeg_quality: 95,
-        predict_flow: true,
-        matte_rule: MatteRule::MatteBelowHalfCleanPlate,
-        shadows: Some(ShadowOptions::default()),
-        selection: None,
-        edge: EdgeMethod::Solve,
-        pose_flows: false,
+        ..IngestOptions::default()
     }
 }
 

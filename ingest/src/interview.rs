@@ -3,6 +3,10 @@
 //! so brightness constancy holds across views, and far less noisy than one track frame;
 //! measured on the small preset: 0.58 px instead of 0.73 px end-point error).
 //!
+//! With the pose's visual hull, each pair's flow is the hull's, refined on the images
+//! ([`crate::guided`]); without it (`--inter-view-flow images`, or no hull), the
+//! original's matching, through rectification:
+//!
 //! Both kinds of pair are first rectified ([`crate::rectify`]): the neighbour is warped
 //! onto the reference's fronto-parallel plane through the turntable axis, flow is measured
 //! there (it only has to explain the subject's relief around that plane and the actor's
@@ -28,7 +32,10 @@ use frf_core::image::{FlowImage, GrayImage, Image, RgbImage};
 use frf_flow::FlowParams;
 use rayon::prelude::*;
 
+use frf_reflectance::hull::VoxelHull;
+
 use crate::error::Result;
+use crate::guided::guided_flow;
 use crate::rectify::{rectify, rectifying_homography, unrectify_flow};
 
 /// Pixels beyond the matte where flow is kept.
@@ -124,13 +131,16 @@ pub struct GridViews<'a> {
     /// Per view and neighbour: the flow is wanted (`None`: all); a pair is measured when
     /// either of its two directions is wanted, and kept where it is.
     pub wanted: Option<&'a [[bool; 4]]>,
+    /// The pose's hull the flows are guided by ([`crate::guided`]); `None`: image
+    /// matching alone ([`rectified_flow`]).
+    pub hull: Option<&'a VoxelHull>,
 }
 
 /// The flows of a grid, and the thread time they took.
 pub struct GridFlows {
     /// Per view, toward each neighbour ([`Neighbour::ALL`] order; `None` at the grid's
-    /// edges): rectified flow averaged with the reverse one ([`symmetrize`]), kept near
-    /// the subject ([`keep_near_subject`]).
+    /// edges): the measured flow averaged with the reverse one ([`symmetrize`]), kept
+    /// near the subject ([`keep_near_subject`]).
     pub flows: Vec<[Option<FlowImage>; 4]>,
     /// Thread seconds spent on horizontal pairs.
     pub horizontal_seconds: f64,
@@ -139,8 +149,8 @@ pub struct GridFlows {
 }
 
 /// The flow from every view of a grid to each of its neighbours, in parallel over views:
-/// each pair measured both ways through rectification ([`rectified_flow`]), then averaged
-/// with its reverse. `each_view` is called once per view when its raw flows are done (to
+/// each pair measured both ways, guided by the hull ([`guided_flow`]) or through
+/// rectification ([`rectified_flow`]), then averaged with its reverse. `each_view` is called once per view when its raw flows are done (to
 /// show progress, and to stop: an error it returns ends the step).
 pub fn grid_flows(
     grid: &GridViews,
@@ -167,13 +177,11 @@ pub fn grid_flows(
                     continue;
                 }
                 let t = Instant::now();
-                flows[n.index()] = Some(rectified_flow(
-                    a,
-                    b,
-                    &grid.cameras[i],
-                    &grid.cameras[j],
-                    params,
-                )?);
+                let (ca, cb) = (&grid.cameras[i], &grid.cameras[j]);
+                flows[n.index()] = Some(match grid.hull {
+                    Some(hull) => guided_flow(a, b, ca, cb, hull, params)?,
+                    None => rectified_flow(a, b, ca, cb, params)?,
+                });
                 let dt = t.elapsed().as_secs_f64();
                 if matches!(n, Neighbour::Left | Neighbour::Right) {
                     horizontal += dt;

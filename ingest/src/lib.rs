@@ -7,7 +7,8 @@
 //! - [`pipeline`]: the ingest, pose by pose, parallel, resumable, with a report;
 //! - [`views`], [`matte`], [`registration`]: one view's mattes and registered basis images;
 //! - [`edges`]: keeping backdrop light out of the subject's edge pixels;
-//! - [`interview`], [`rectify`]: flow between grid neighbours, vertical pairs rectified;
+//! - [`interview`], [`guided`], [`rectify`]: flow between grid neighbours, guided by the
+//!   pose's visual hull or matched through rectification;
 //! - [`shadows`]: the pose's visual hull and its shadow attenuation maps;
 //! - [`evidence`]: what ingest hands to an evaluator, and the errors it records;
 //! - [`ring`]: a calibrated ring of real photographs (Middlebury multi-view) as a field.
@@ -17,6 +18,7 @@
 pub mod edges;
 pub mod error;
 pub mod evidence;
+pub mod guided;
 pub mod interview;
 pub mod matte;
 pub mod pipeline;

@@ -28,6 +28,7 @@ use serde::{Deserialize, Serialize};
 use crate::edges::EdgeMethod;
 use crate::error::{IngestError, Result};
 use crate::evidence::{Evaluator, PoseErrors, PoseEvidence, SampledView};
+use crate::guided::{InterViewFlow, flow_hull};
 use crate::interview::{GridViews, grid_flows};
 use crate::matte::MatteRule;
 use crate::shadows::{ShadowOptions, pose_shadows};
@@ -56,8 +57,44 @@ pub struct IngestOptions {
     /// What to do about backdrop light at the subject's edges.
     pub edge: EdgeMethod,
     /// Also measure and store each view's flows to the next and previous captured pose
-    /// ([`crate::poseflow`]; issue 24: no renderer reads them yet).
+    /// ([`crate::poseflow`]).
     pub pose_flows: bool,
+    /// How the flows between neighbouring views are measured.
+    pub inter_view_flow: InterViewFlow,
+}
+
+impl IngestOptions {
+    /// The flow parameters of registration and inter-view flow: the preset with its
+    /// overrides.
+    pub fn flow_params(&self) -> Result<FlowParams> {
+        let mut params = FlowParams::preset(self.flow_preset);
+        for (k, v) in &self.flow_settings {
+            params = params.with_setting(k, v)?;
+        }
+        Ok(params)
+    }
+}
+
+impl Default for IngestOptions {
+    /// The options `frf ingest` takes by default: every pose, the `balanced` flow preset,
+    /// JPEG quality 95, predicted flow codes, the half-clean-plate matte rule, edges
+    /// solved, hulls and shadow maps, no pose-to-pose flow, inter-view flow guided by
+    /// the hull.
+    fn default() -> Self {
+        Self {
+            poses: Vec::new(),
+            flow_preset: Preset::Balanced,
+            flow_settings: Vec::new(),
+            jpeg_quality: 95,
+            predict_flow: true,
+            matte_rule: MatteRule::MatteBelowHalfCleanPlate,
+            shadows: Some(ShadowOptions::default()),
+            selection: None,
+            edge: EdgeMethod::Solve,
+            pose_flows: false,
+            inter_view_flow: InterViewFlow::Hull,
+        }
+    }
 }
 
 /// The views and flows of each pose to ingest (a field made for one scene, `frf ingest
@@ -154,6 +191,14 @@ pub struct Settings {
     /// Pose-to-pose flows measured; parts written before they existed have none.
     #[serde(default)]
     pub pose_flows: bool,
+    /// How inter-view flow was measured ([`InterViewFlow::name`]); parts written before
+    /// the hull guided it were matched on images alone.
+    #[serde(default = "images_alone")]
+    pub inter_view_flow: String,
+}
+
+fn images_alone() -> String {
+    InterViewFlow::Images.name().into()
 }
 
 fn no_edge_method() -> String {
@@ -274,6 +319,7 @@ fn settings(options: &IngestOptions) -> Settings {
         ),
         edge: options.edge.name().into(),
         pose_flows: options.pose_flows,
+        inter_view_flow: options.inter_view_flow.name().into(),
         selection: options
             .selection
             .as_ref()
@@ -337,10 +383,7 @@ fn ingest_pose(
     progress: &dyn Progress,
 ) -> Result<PoseReport> {
     let (columns, rows) = (capture.cycles(), capture.cameras().len());
-    let mut params = FlowParams::preset(options.flow_preset);
-    for (k, v) in &options.flow_settings {
-        params = params.with_setting(k, v)?;
-    }
+    let params = options.flow_params()?;
     let mut steps = Vec::new();
 
     let start = Instant::now();
@@ -441,8 +484,6 @@ fn ingest_pose(
         ],
     ));
 
-    progress.begin(pose, "inter-view flow", columns * rows);
-    let start = Instant::now();
     let images: Vec<Option<&RgbImage>> = views
         .iter()
         .map(|v| v.as_ref().map(|v| &v.summed))
@@ -452,6 +493,21 @@ fn ingest_pose(
     let cameras: Vec<Camera> = (0..columns * rows)
         .map(|i| capture.subject_camera(i / rows, i % rows, pose))
         .collect();
+    let guide = if options.inter_view_flow == InterViewFlow::Hull {
+        progress.begin(pose, "hull of the flows", 1);
+        let start = Instant::now();
+        let hull = flow_guide(options, &cameras, &alphas)?;
+        steps.push(Step {
+            name: "hull of the flows".into(),
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        progress.advance();
+        hull
+    } else {
+        None
+    };
+    progress.begin(pose, "inter-view flow", columns * rows);
+    let start = Instant::now();
     let grid = grid_flows(
         &GridViews {
             columns,
@@ -463,6 +519,7 @@ fn ingest_pose(
             wanted: selected
                 .and_then(|s| s.flows.get(&pose))
                 .map(|f| f.as_slice()),
+            hull: guide.as_ref(),
         },
         &params,
         &|| {
@@ -487,12 +544,21 @@ fn ingest_pose(
             present.iter().filter(|&&p| p).count(),
         );
         let start = Instant::now();
-        let pose_flows =
-            crate::poseflow::pose_flows(capture, pose, header.wraps, &alphas, &params, &|| {
+        let pose_flows = crate::poseflow::pose_flows(
+            capture,
+            pose,
+            header.wraps,
+            &alphas,
+            guide.as_ref(),
+            &clean,
+            options.matte_rule,
+            &params,
+            &|| {
                 check_stop(progress)?;
                 progress.advance();
                 Ok(())
-            })?;
+            },
+        )?;
         steps.push(Step {
             name: "pose-to-pose flow".into(),
             seconds: start.elapsed().as_secs_f64(),
@@ -511,7 +577,6 @@ fn ingest_pose(
                 .zip(&alphas)
                 .filter_map(|(c, a)| a.map(|a| (*c, a)))
                 .unzip();
-            // Views allowed to disagree scale with the views there are.
             let mut s = *s;
             s.hull.misses = crate::shadows::misses_for(s.hull.misses, cams.len(), cameras.len());
             let r = pose_shadows(&cams, &mattes, &header.conditions, &s)?;
@@ -604,6 +669,30 @@ fn ingest_pose(
         .map_err(|e| IngestError::BadParameter(e.to_string()))?;
     frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
     Ok(report)
+}
+
+/// The hull a pose's inter-view flows are guided by (`None` when `options` do not ask
+/// for one, or nothing survives the carve): carved from the views ingested (`cameras`
+/// and `alphas` of the whole grid, `None` for a view not ingested), allowing the views
+/// of the shadow hull's tolerance to disagree, in proportion to the views there are.
+pub fn flow_guide(
+    options: &IngestOptions,
+    cameras: &[Camera],
+    alphas: &[Option<&GrayImage>],
+) -> Result<Option<frf_reflectance::hull::VoxelHull>> {
+    if options.inter_view_flow != InterViewFlow::Hull {
+        return Ok(None);
+    }
+    let (cams, mattes): (Vec<Camera>, Vec<&GrayImage>) = cameras
+        .iter()
+        .zip(alphas)
+        .filter_map(|(c, a)| a.map(|a| (*c, a)))
+        .unzip();
+    let asked = options
+        .shadows
+        .map_or(crate::shadows::DEFAULT_MISSES, |s| s.hull.misses);
+    let misses = crate::shadows::misses_for(asked, cams.len(), cameras.len());
+    flow_hull(&cams, &mattes, misses)
 }
 
 /// Ingests the capture in `capture_dir` into the field file `out`; each pose is judged by

@@ -9,7 +9,7 @@
 //! 1/60 s from T1). The frame is then warped onto T1 by reverse lookup,
 //! `I'(s) = I(s + f_t(s))`, bilinear.
 
-use frf_core::image::{Border, FlowImage, Image, RgbImage};
+use frf_core::image::{Border, FlowImage, Image, Pixel};
 
 use crate::error::{IngestError, Result};
 
@@ -81,7 +81,7 @@ impl TrackFlows {
 
 /// Warps `frame` onto the reference by reverse lookup, `I'(s) = I(s + F(s))`, bilinear,
 /// repeating the edge outside the image.
-pub fn warp_to_reference(frame: &RgbImage, flow: &FlowImage) -> Result<RgbImage> {
+pub fn warp_to_reference<P: Pixel>(frame: &Image<P>, flow: &FlowImage) -> Result<Image<P>> {
     if !frame.same_size(flow) {
         return Err(IngestError::BadParameter(
             "frame and flow sizes differ".into(),

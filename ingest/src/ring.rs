@@ -375,6 +375,8 @@ pub fn ingest_ring(
             alphas: &images.iter().map(|i| Some(&i.1)).collect::<Vec<_>>(),
             cameras: &cameras,
             wanted: None,
+            // The hull's search region is the stage's, not a ring's: matched on images.
+            hull: None,
         },
         params,
         &|| Ok(()),

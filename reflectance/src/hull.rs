@@ -149,6 +149,81 @@ impl VoxelHull {
         ))
     }
 
+    /// The hull of `views` at voxel side `voxel_m`, carved in a narrow band: first at
+    /// `coarse` times the side ([`VoxelHull::carve`]), then only the fine voxels of the
+    /// coarse voxels whose 26 neighbours are not all like them (the band around the
+    /// surface) are tested; the fine voxels of a coarse voxel deep inside are occupied,
+    /// of one far outside empty, as the coarse carve found them. The same hull as a
+    /// full carve at `voxel_m` wherever the surface's features are larger than a
+    /// coarse voxel (the walker's thinnest part, a hand, spans 2.5 coarse voxels of
+    /// 2 cm), at a small part of its cost: a full carve at 2.5 mm took 38 s for the
+    /// small preset's 108 views, the band 2 s (2 cores, loaded).
+    pub fn carve_banded(
+        views: &[Silhouette],
+        voxel_m: f32,
+        coarse: u32,
+        misses: usize,
+    ) -> Result<Self> {
+        let coarse = coarse.max(1);
+        let parent = Self::carve(views, voxel_m * coarse as f32, misses)?;
+        let pg = parent.grid;
+        let grid = VoxelGrid {
+            origin: pg.origin,
+            voxel_m,
+            dims: pg.dims.map(|d| d * coarse),
+        };
+        grid.validate().map_err(ReflectanceError::BadParameter)?;
+        // Per coarse voxel: 0 far outside, 1 deep inside, 2 in the band.
+        let class: Vec<u8> = (0..pg.len())
+            .into_par_iter()
+            .map(|index| {
+                let [i, j, k] = pg.cell(index).map(i64::from);
+                let here = parent.at(i, j, k);
+                let uniform = (-1..=1).all(|a| {
+                    (-1..=1).all(|b| (-1..=1).all(|c| parent.at(i + a, j + b, k + c) == here))
+                });
+                match (uniform, here) {
+                    (true, false) => 0,
+                    (true, true) => 1,
+                    (false, _) => 2,
+                }
+            })
+            .collect();
+        let n = grid.len();
+        let c = coarse;
+        let words: Vec<u64> = (0..n.div_ceil(64))
+            .into_par_iter()
+            .map(|w| {
+                let mut word = 0u64;
+                for b in 0..64 {
+                    let index = w * 64 + b;
+                    if index >= n {
+                        break;
+                    }
+                    let [i, j, k] = grid.cell(index);
+                    let inside = match class[pg.index(i / c, j / c, k / c)] {
+                        0 => false,
+                        1 => true,
+                        _ => {
+                            let p = grid.centre(i, j, k);
+                            views
+                                .iter()
+                                .filter(|s| outside(s, p))
+                                .take(misses + 1)
+                                .count()
+                                <= misses
+                        }
+                    };
+                    if inside {
+                        word |= 1 << b;
+                    }
+                }
+                word
+            })
+            .collect();
+        Ok(Self { grid, bits: words })
+    }
+
     /// The grid.
     pub fn grid(&self) -> &VoxelGrid {
         &self.grid

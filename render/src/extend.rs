@@ -11,8 +11,7 @@
 //! nothing to store (the field is unchanged) and one pass over each flow when a pose is
 //! loaded.
 
-use std::collections::VecDeque;
-
+use frf_core::filter::extend_nearest;
 use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
 
 /// Whether a texel's code pair is known.
@@ -21,46 +20,10 @@ fn known(c: [i8; 2]) -> bool {
 }
 
 /// Gives every unknown texel of a `width x height` flow the code of its nearest known
-/// texel ([`extend_nearest`]). A flow with no known texel stays unknown.
+/// texel ([`frf_core::filter::extend_nearest`]). A flow with no known texel stays
+/// unknown.
 pub fn extend_flow(codes: &mut [[i8; 2]], width: usize, height: usize) {
     extend_nearest(codes, width, height, |&c| known(c));
-}
-
-/// Gives every value of a `width x height` image for which `known` fails the value of
-/// the nearest one for which it holds (breadth first from every known value, 4-connected;
-/// ties to the first reached in row order). An image with nothing known is unchanged.
-pub fn extend_nearest<T: Copy>(
-    values: &mut [T],
-    width: usize,
-    height: usize,
-    known: impl Fn(&T) -> bool,
-) {
-    debug_assert_eq!(values.len(), width * height);
-    let mut done: Vec<bool> = values.iter().map(&known).collect();
-    let mut queue: VecDeque<usize> = (0..values.len()).filter(|&i| done[i]).collect();
-    while let Some(i) = queue.pop_front() {
-        let (x, y) = (i % width, i / width);
-        let value = values[i];
-        let mut visit = |j: usize| {
-            if !done[j] {
-                done[j] = true;
-                values[j] = value;
-                queue.push_back(j);
-            }
-        };
-        if x > 0 {
-            visit(i - 1);
-        }
-        if x + 1 < width {
-            visit(i + 1);
-        }
-        if y > 0 {
-            visit(i - width);
-        }
-        if y + 1 < height {
-            visit(i + width);
-        }
-    }
 }
 
 #[cfg(test)]

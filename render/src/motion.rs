@@ -37,8 +37,8 @@ use glam::{Mat2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{RenderError, Result};
-use crate::extend::extend_nearest;
 use crate::resident::{PoseSource, ResidentPose, srgb_lut};
+use frf_core::filter::extend_nearest;
 
 /// The code of the offset texel (blue): its decoded value times the view's scale is the
 /// offset exactly, so that `r − b` is the motion without a rounding bias.

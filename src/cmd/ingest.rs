@@ -8,6 +8,7 @@ use clap::{Args, ValueEnum};
 use frf_eval::ingest::StageEvaluator;
 use frf_ingest::edges::EdgeMethod;
 use frf_ingest::evidence::Evaluator;
+use frf_ingest::guided::InterViewFlow;
 use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
 use indicatif::ProgressBar;
 
@@ -26,30 +27,11 @@ pub struct IngestArgs {
     /// Poses to ingest, e.g. `0,1` or `0..4` (default: all captured).
     #[arg(long)]
     poses: Option<String>,
-    /// Optical-flow preset for registration and inter-view flow.
-    #[arg(long, value_enum, default_value = "balanced")]
-    flow_preset: FlowPresetArg,
-    /// Override a flow parameter, `key=value` (repeatable; keys as `frf flow --set`).
-    #[arg(long = "flow-set", value_name = "KEY=VALUE")]
-    flow_set: Vec<String>,
-    /// JPEG quality of the basis mosaics (95 keeps relit PSNR above 40 dB on stage data).
-    #[arg(long, default_value_t = 95)]
-    jpeg_quality: u8,
-    /// Do not predict flow codes from their neighbours.
-    #[arg(long)]
-    no_flow_prediction: bool,
+    #[command(flatten)]
+    method: IngestMethodArgs,
     /// Skip the evaluation against the virtual stage's truth.
     #[arg(long)]
     no_eval: bool,
-    /// Matte rule: `half-clean` (the matte frame darker than half its clean plate;
-    /// unbiased at silhouettes) or `paper` (the track frame brighter than the matte frame).
-    #[arg(long, value_enum, default_value = "half-clean")]
-    matte_rule: MatteArg,
-    /// Backdrop light at the subject's edges: `solve` (alpha of edge pixels solved from
-    /// the matte frame, then matted with it), `extend` (the interior's colour extended
-    /// under the edge) or `none` (the blurred binary matte, as the original).
-    #[arg(long, value_enum, default_value = "solve")]
-    edge: EdgeArg,
     /// Also measure and store each view's flow to the capture's next and previous pose,
     /// which shots between two poses morph by (docs/design.md §4.7). A field of every
     /// second pose is made from a capture filmed at those poses (`frf stage --poses
@@ -65,6 +47,74 @@ pub struct IngestArgs {
     report: Option<PathBuf>,
     #[command(flatten)]
     shadows: ShadowArgs,
+}
+
+/// How ingest processes a capture: flow, codecs, mattes and edges (`frf ingest`, and the
+/// fields of `frf eval --ingest-budget`).
+#[derive(Args)]
+pub struct IngestMethodArgs {
+    /// Optical-flow preset for registration and inter-view flow.
+    #[arg(long, value_enum, default_value = "balanced")]
+    flow_preset: FlowPresetArg,
+    /// Override a flow parameter, `key=value` (repeatable; keys as `frf flow --set`).
+    #[arg(long = "flow-set", value_name = "KEY=VALUE")]
+    flow_set: Vec<String>,
+    /// JPEG quality of the basis mosaics (95 keeps relit PSNR above 40 dB on stage data).
+    #[arg(long, default_value_t = 95)]
+    jpeg_quality: u8,
+    /// Do not predict flow codes from their neighbours.
+    #[arg(long)]
+    no_flow_prediction: bool,
+    /// Matte rule: `half-clean` (the matte frame darker than half its clean plate;
+    /// unbiased at silhouettes) or `paper` (the track frame brighter than the matte frame).
+    #[arg(long, value_enum, default_value = "half-clean")]
+    matte_rule: MatteArg,
+    /// Backdrop light at the subject's edges: `solve` (alpha of edge pixels solved from
+    /// the matte frame, then matted with it), `extend` (the interior's colour extended
+    /// under the edge) or `none` (the blurred binary matte, as the original).
+    #[arg(long, value_enum, default_value = "solve")]
+    edge: EdgeArg,
+    /// Flow between neighbouring views: `hull` (the reprojection of the pose's visual
+    /// hull, refined on the images) or `images` (image matching alone, through the plane
+    /// of the turntable's axis, as before).
+    #[arg(long, value_enum, default_value = "hull")]
+    inter_view_flow: InterViewArg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum InterViewArg {
+    Hull,
+    Images,
+}
+
+impl IngestMethodArgs {
+    /// These settings over `frf ingest`'s other defaults.
+    pub fn options(&self) -> CliResult<IngestOptions> {
+        Ok(IngestOptions {
+            flow_preset: self.flow_preset.into(),
+            flow_settings: self
+                .flow_set
+                .iter()
+                .map(|kv| {
+                    kv.split_once('=')
+                        .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
+                        .ok_or_else(|| format!("--flow-set {kv:?}: expected KEY=VALUE"))
+                })
+                .collect::<Result<_, _>>()?,
+            jpeg_quality: self.jpeg_quality,
+            predict_flow: !self.no_flow_prediction,
+            matte_rule: match self.matte_rule {
+                MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
+                MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
+            },
+            edge: self.edge.into(),
+            inter_view_flow: match self.inter_view_flow {
+                InterViewArg::Hull => InterViewFlow::Hull,
+                InterViewArg::Images => InterViewFlow::Images,
+            },
+            ..IngestOptions::default()
+        })
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -127,26 +177,9 @@ pub fn run(args: IngestArgs) -> CliResult {
             .map(parse_poses)
             .transpose()?
             .unwrap_or_default(),
-        flow_preset: args.flow_preset.into(),
-        flow_settings: args
-            .flow_set
-            .iter()
-            .map(|kv| {
-                kv.split_once('=')
-                    .map(|(k, v)| (k.trim().to_string(), v.trim().to_string()))
-                    .ok_or_else(|| format!("--flow-set {kv:?}: expected KEY=VALUE"))
-            })
-            .collect::<Result<_, _>>()?,
-        jpeg_quality: args.jpeg_quality,
-        predict_flow: !args.no_flow_prediction,
         shadows: args.shadows.options()?,
-        selection: None,
-        matte_rule: match args.matte_rule {
-            MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
-            MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
-        },
-        edge: args.edge.into(),
         pose_flows: args.pose_flow,
+        ..args.method.options()?
     };
     let bars = Bars {
         current: Mutex::new(None),

@@ -45,6 +45,23 @@ pub enum SetFlowTruth {
     None,
 }
 
+/// How bright each basis condition's lights are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Exposure {
+    /// Every condition delivers the same irradiance: the floor sectors, 7.7 times an
+    /// upper cell's solid angle, at a lower radiance (what a real stage's operator
+    /// would set, so that no condition clips; [`crate::rig`]). New captures.
+    Equal,
+    /// Every cell at the dome's radiance: the floor conditions clip the lower legs.
+    /// Captures whose `stage.toml` predates the choice were made so.
+    Dome,
+}
+
+fn exposure_of_older_captures() -> Exposure {
+    Exposure::Dome
+}
+
 /// Everything that determines a stage capture.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -73,6 +90,9 @@ pub struct StageConfig {
     pub noise: bool,
     /// Which reference-to-slot flows to write as ground truth.
     pub set_flow_truth: SetFlowTruth,
+    /// How bright each condition's lights are (a `stage.toml` without it: [`Exposure::Dome`]).
+    #[serde(default = "exposure_of_older_captures")]
+    pub exposure: Exposure,
     /// The views filmed per pose, when not every view (a capture made for one scene:
     /// `frf stage --for SCENE`); empty: all.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -100,6 +120,7 @@ impl StageConfig {
             perturbation: 1.0,
             noise: true,
             set_flow_truth: SetFlowTruth::Track,
+            exposure: Exposure::Equal,
             filmed: Vec::new(),
         }
     }

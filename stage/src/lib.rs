@@ -36,7 +36,7 @@ pub mod studio;
 pub mod truth;
 pub mod writer;
 
-pub use config::{Preset, SetFlowTruth, StageConfig};
+pub use config::{Exposure, Preset, SetFlowTruth, StageConfig};
 pub use error::{Result, StageError};
 pub use gait::Gait;
 pub use stage::{Stage, ViewSetup};

@@ -8,9 +8,19 @@
 //! elevation make them so), and three 120° sectors of the lower hemisphere (the floor
 //! conditions: light that a lit ground plane would send up). Each condition is an
 //! `n x n` grid of lights over its cell, equal-area in (azimuth, sin elevation); each light
-//! stands for its sub-cell and carries irradiance `Ω_light · L_dome`. A condition at
-//! coefficient 1 therefore approximates a uniform radiance `L_dome` over its cell, and an
-//! environment's coefficient for it is its mean radiance over the cell divided by `L_dome`.
+//! stands for its sub-cell and carries irradiance `Ω_light · L_c`, with `L_c` its
+//! condition's radiance ([`condition_radiance`]). A condition at coefficient 1 therefore
+//! approximates a uniform radiance `L_c` over its cell, and an environment's coefficient
+//! for it is its mean radiance over the cell divided by `L_c`.
+//!
+//! **Exposure.** Every condition delivers the same irradiance, as a real stage sets each
+//! condition's lights to use the sensor's range: the upper cells at radiance `L_dome`,
+//! the floor sectors (7.7 times the solid angle) at `L_dome · (2π/23) / (2π/3)`. At
+//! `L_dome` the floor sectors drove the lower legs and shoes to 3.1 times full scale and
+//! clipped 3 % of a view's pixels (small preset, measured with `frf eval
+//! --ingest-budget`'s `sensor` component: the floor conditions' frames, registered
+//! with the true motion and matted with the true alpha, reached 18 dB against the
+//! truth, the upper ones 31 to 43 dB).
 
 use std::f32::consts::{PI, TAU};
 
@@ -18,6 +28,7 @@ use frf_core::camera::Camera;
 use frf_core::light::{DirLight, direction_from_azimuth_elevation};
 use glam::Vec3;
 
+use crate::config::Exposure;
 use crate::studio::Illumination;
 
 /// Lighting sets per second (30 in the original).
@@ -36,9 +47,21 @@ pub const CAMERA_DISTANCE_M: f32 = 4.5;
 pub const LOOK_AT_HEIGHT_M: f32 = 0.9;
 /// Vertical field of view, degrees: frames 2.2 m at the turntable axis.
 pub const VERTICAL_FOV_DEG: f32 = 27.5;
-/// Radiance of the dome over a lit condition's cell: sets the exposure (a white diffuse
-/// surface facing one upper condition reads ≈ 0.7 of full scale).
+/// Radiance of the dome over a lit upper condition's cell: sets the exposure (a white
+/// diffuse surface facing one upper condition reads ≈ 0.7 of full scale).
 pub const DOME_RADIANCE: f32 = 8.0;
+/// Solid angle of every upper cell, steradians: the upper hemisphere in 23 equal parts.
+const UPPER_CELL_SR: f32 = TAU / 23.0;
+
+/// The radiance of a condition's lights over `cell`: with [`Exposure::Equal`] every
+/// condition delivers what an upper cell at [`DOME_RADIANCE`] delivers (see the module
+/// docs on exposure); with [`Exposure::Dome`] every cell is at [`DOME_RADIANCE`].
+pub fn condition_radiance(cell: &Cell, exposure: Exposure) -> f32 {
+    match exposure {
+        Exposure::Equal => DOME_RADIANCE * UPPER_CELL_SR / cell.solid_angle(),
+        Exposure::Dome => DOME_RADIANCE,
+    }
+}
 /// Track frames light every condition at this fraction of a basis frame's light,
 /// at its centre: evenly lit, exposed like a basis frame.
 const TRACK_FRACTION: f32 = 0.08;
@@ -99,6 +122,8 @@ pub struct BasisCondition {
     pub cell: Cell,
     /// Its lights, with the solid angle each stands for.
     pub lights: Vec<(DirLight, f32)>,
+    /// The radiance its lights stand for over its cell ([`condition_radiance`]).
+    pub radiance: f32,
 }
 
 /// The 26 cells: cap, rings of 6, 8, 8, and 3 floor sectors.
@@ -154,27 +179,31 @@ pub fn basis_cells() -> Vec<(String, bool, Cell)> {
     cells
 }
 
-/// The basis conditions with `n x n` lights each.
-pub fn basis(lights_per_axis: u32) -> Vec<BasisCondition> {
+/// The basis conditions with `n x n` lights each, exposed as `exposure` says.
+pub fn basis(lights_per_axis: u32, exposure: Exposure) -> Vec<BasisCondition> {
     basis_cells()
         .into_iter()
-        .map(|(name, floor, cell)| BasisCondition {
-            lights: cell
-                .grid(lights_per_axis)
-                .into_iter()
-                .map(|(direction, omega)| {
-                    (
-                        DirLight {
-                            direction,
-                            irradiance: [omega * DOME_RADIANCE; 3],
-                        },
-                        omega,
-                    )
-                })
-                .collect(),
-            name,
-            floor,
-            cell,
+        .map(|(name, floor, cell)| {
+            let radiance = condition_radiance(&cell, exposure);
+            BasisCondition {
+                lights: cell
+                    .grid(lights_per_axis)
+                    .into_iter()
+                    .map(|(direction, omega)| {
+                        (
+                            DirLight {
+                                direction,
+                                irradiance: [omega * radiance; 3],
+                            },
+                            omega,
+                        )
+                    })
+                    .collect(),
+                name,
+                floor,
+                cell,
+                radiance,
+            }
         })
         .collect()
 }
@@ -189,7 +218,7 @@ pub fn basis(lights_per_axis: u32) -> Vec<BasisCondition> {
 const TRACK_CAMERA_CLEARANCE_RAD: f32 = 35.0 * PI / 180.0;
 
 /// The lights of a track frame: one at the centre of every cell that is clear of the
-/// cameras' sightlines, each at a fraction of its cell's light.
+/// cameras' sightlines, each at a fraction of its condition's light.
 pub fn track_lights(basis: &[BasisCondition], cameras: &[Camera]) -> Vec<DirLight> {
     let centre = Vec3::new(0.0, LOOK_AT_HEIGHT_M, 0.0);
     let camera_dirs: Vec<Vec3> = cameras
@@ -200,7 +229,7 @@ pub fn track_lights(basis: &[BasisCondition], cameras: &[Camera]) -> Vec<DirLigh
         .iter()
         .map(|c| DirLight {
             direction: c.cell.centre(),
-            irradiance: [c.cell.solid_angle() * DOME_RADIANCE * TRACK_FRACTION; 3],
+            irradiance: [c.cell.solid_angle() * c.radiance * TRACK_FRACTION; 3],
         })
         .filter(|l| {
             camera_dirs
@@ -306,7 +335,7 @@ mod tests {
         let total: f32 = cells.iter().map(|c| c.2.solid_angle()).sum();
         assert!((total - 4.0 * PI).abs() < 1e-3);
         // Lights stay inside their cells and carry the cell's solid angle.
-        for cond in basis(3) {
+        for cond in basis(3, Exposure::Equal) {
             let sum: f32 = cond.lights.iter().map(|l| l.1).sum();
             assert!((sum - cond.cell.solid_angle()).abs() < 1e-4);
             for (l, _) in &cond.lights {
@@ -317,9 +346,35 @@ mod tests {
     }
 
     #[test]
+    fn every_condition_delivers_the_same_light_unless_the_dome_is_asked_for() {
+        let delivered =
+            |c: &BasisCondition| c.lights.iter().map(|l| l.0.irradiance[0]).sum::<f32>();
+        let equal = basis(3, Exposure::Equal);
+        let upper = delivered(&equal[0]);
+        assert!((upper - DOME_RADIANCE * TAU / 23.0).abs() < 1e-3, "{upper}");
+        for c in &equal {
+            assert!(
+                (delivered(c) / upper - 1.0).abs() < 1e-4,
+                "{}: {}",
+                c.name,
+                delivered(c)
+            );
+        }
+        // Captures made before: every cell at the dome's radiance, the floor sectors
+        // delivering their 7.7 times larger solid angle's worth.
+        let dome = basis(3, Exposure::Dome);
+        for (d, e) in dome.iter().zip(&equal) {
+            let ratio = delivered(d) / delivered(e);
+            let expected = if d.floor { 23.0 / 3.0 } else { 1.0 };
+            assert!((ratio - expected).abs() < 1e-3, "{}: {ratio}", d.name);
+            assert_eq!(d.radiance, DOME_RADIANCE);
+        }
+    }
+
+    #[test]
     fn basis_is_symmetric_about_the_vertical_axis() {
         // Turning ring 2 by one cell maps its conditions onto each other.
-        let b = basis(2);
+        let b = basis(2, Exposure::Equal);
         let ring: Vec<_> = b.iter().filter(|c| c.name.starts_with("ring2")).collect();
         let turn = glam::Mat3::from_rotation_y(TAU / 8.0);
         for (i, c) in ring.iter().enumerate() {
@@ -350,7 +405,7 @@ mod tests {
 
     #[test]
     fn track_lights_light_evenly_but_clear_the_cameras() {
-        let b = basis(2);
+        let b = basis(2, Exposure::Equal);
         let cams = cameras(64, 90);
         let track = track_lights(&b, &cams);
         assert!(

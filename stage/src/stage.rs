@@ -45,7 +45,7 @@ impl Stage {
     /// A stage for `config` (validated).
     pub fn new(config: StageConfig) -> Result<Self> {
         config.validate()?;
-        let basis = rig::basis(config.lights_per_axis);
+        let basis = rig::basis(config.lights_per_axis, config.exposure);
         let cameras = rig::cameras(config.width, config.height);
         let track = rig::track_lights(&basis, &cameras);
         Ok(Self {
@@ -210,6 +210,19 @@ impl Stage {
 
     /// The clean plate of camera `camera` for slot `slot`: the empty stage, lit alike.
     pub fn clean_plate(&self, camera: usize, slot: usize) -> Result<RgbImage> {
+        let color = self.render_clean_plate(camera, slot)?;
+        let key = hash(&[self.config.seed, 0xC1EA4, camera as u64, slot as u64]);
+        Ok(sensor::expose(
+            &color,
+            key,
+            self.config.noise,
+            CLEAN_PLATE_NOISE_SCALE,
+        ))
+    }
+
+    /// [`Stage::clean_plate`] as the lens forms it: without noise or quantization
+    /// (linear, unclipped).
+    pub fn render_clean_plate(&self, camera: usize, slot: usize) -> Result<RgbImage> {
         self.check_view(0, camera)?;
         let kind = self.slot(slot)?;
         let cam = &self.cameras[camera];
@@ -219,14 +232,7 @@ impl Stage {
             studio: true,
             illumination: &illumination,
         };
-        let color = render(cam, &scene, self.config.samples_per_axis).color;
-        let key = hash(&[self.config.seed, 0xC1EA4, camera as u64, slot as u64]);
-        Ok(sensor::expose(
-            &color,
-            key,
-            self.config.noise,
-            CLEAN_PLATE_NOISE_SCALE,
-        ))
+        Ok(render(cam, &scene, self.config.samples_per_axis).color)
     }
 
     /// The lights of basis condition `condition` (world frame).

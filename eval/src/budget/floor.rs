@@ -15,9 +15,9 @@
 //! blended, as a morph would have to.
 
 use frf_core::camera::Camera;
+use frf_core::filter::extend_nearest;
 use frf_core::flo::UNKNOWN_THRESHOLD;
 use frf_core::image::{Image, Rgba};
-use frf_render::extend::extend_nearest;
 use frf_render::resident::ResidentPose;
 use frf_stage::Stage;
 use frf_stage::geometry::Ray;

@@ -17,8 +17,8 @@
 //! is read from the views around it.
 
 use frf_core::camera::Camera;
+use frf_core::filter::extend_nearest;
 use frf_core::image::{Image, Rgba};
-use frf_render::extend::extend_nearest;
 use frf_render::resident::ResidentPose;
 use glam::Vec3;
 use rayon::prelude::*;

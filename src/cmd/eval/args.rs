@@ -35,9 +35,24 @@ pub struct EvalArgs {
     /// unstructured lumigraph rendering on the visual hull and on the true surface.
     #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows"])]
     pub budget: bool,
-    /// With `--budget`: also draw its plot here (`.svg` or `.png`) and its Markdown table
-    /// beside it (`.md`).
-    #[arg(long, requires = "budget")]
+    /// The error budget of ingest: the capture's pose ingested as `frf ingest` does (with
+    /// the settings below), and again with one component at a time taken from the stage's
+    /// truth (mattes, registration, sensor noise, the basis images, horizontal flows,
+    /// vertical flows, the codec; all of them: the oracle field), each field scored at the
+    /// captured views and at quad centres (`--cameras` each), beside FIELD itself.
+    #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows", "budget"])]
+    pub ingest_budget: bool,
+    /// With `--ingest-budget`: keep its fields in this directory, and reuse them when it
+    /// holds them for the same capture, pose and settings (another environment costs only
+    /// the renders); by default they are made in a temporary directory and removed.
+    #[arg(long, requires = "ingest_budget")]
+    pub fields: Option<PathBuf>,
+    /// With `--ingest-budget`: how its fields are ingested (as `frf ingest`).
+    #[command(flatten)]
+    pub method: crate::cmd::ingest::IngestMethodArgs,
+    /// With `--budget` or `--ingest-budget`: also draw its plot here (`.svg` or `.png`)
+    /// and its Markdown table beside it (`.md`).
+    #[arg(long)]
     pub plot: Option<PathBuf>,
     /// Along a path: frame size `WxH` (default: the field's image size).
     #[arg(long, value_parser = parse_size)]

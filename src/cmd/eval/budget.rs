@@ -18,16 +18,7 @@ use crate::cmd::progress::Bars;
 /// Runs the budget.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     let (source, stage, env, pose) = (&input.source, &input.stage, &input.env, input.pose);
-    let plot_png = match &args.plot {
-        None => None,
-        Some(p) => match p.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("svg") => Some(false),
-            Some(e) if e.eq_ignore_ascii_case("png") => Some(true),
-            _ => {
-                return Err(format!("--plot {}: expected a .svg or .png file", p.display()).into());
-            }
-        },
-    };
+    let plot_png = plot_format(args.plot.as_deref())?;
     let renderer = Renderer::open(source, args.compare.cpu)?;
     let resident = ResidentPose::relight_cpu(source);
     let lights = environment_lights(env, args.lights);
@@ -66,16 +57,12 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     );
     eprint!("{}", budget::table(&rows));
     if let (Some(path), Some(png)) = (&args.plot, plot_png) {
-        let bytes = if png {
-            budget::plot::png(&rows)?
-                .ok_or("no system font for the plot's text: draw it as .svg")?
-        } else {
-            budget::plot::svg(&rows)?.into_bytes()
-        };
-        write_bytes_atomic(path, &bytes)?;
-        write_bytes_atomic(
-            &path.with_extension("md"),
-            budget::markdown(&rows).as_bytes(),
+        write_plot(
+            path,
+            png,
+            &|| budget::plot::png(&rows),
+            &|| budget::plot::svg(&rows),
+            &budget::markdown(&rows),
         )?;
     }
     if args.compare.json {
@@ -91,5 +78,37 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         };
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
+    Ok(())
+}
+
+/// Whether `--plot PATH` asks for a PNG (`Some(true)`) or an SVG (`Some(false)`);
+/// `None` without `--plot`; any other extension is refused.
+pub(super) fn plot_format(plot: Option<&std::path::Path>) -> CliResult<Option<bool>> {
+    let Some(p) = plot else {
+        return Ok(None);
+    };
+    match p.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("svg") => Ok(Some(false)),
+        Some(e) if e.eq_ignore_ascii_case("png") => Ok(Some(true)),
+        _ => Err(format!("--plot {}: expected a .svg or .png file", p.display()).into()),
+    }
+}
+
+/// Writes a budget's plot to `path` (PNG or SVG, atomically) and its Markdown table
+/// beside it (`.md`).
+pub(super) fn write_plot(
+    path: &std::path::Path,
+    png: bool,
+    draw_png: &dyn Fn() -> frf_eval::Result<Option<Vec<u8>>>,
+    draw_svg: &dyn Fn() -> frf_eval::Result<String>,
+    markdown: &str,
+) -> CliResult {
+    let bytes = if png {
+        draw_png()?.ok_or("no system font for the plot's text: draw it as .svg")?
+    } else {
+        draw_svg()?.into_bytes()
+    };
+    write_bytes_atomic(path, &bytes)?;
+    write_bytes_atomic(&path.with_extension("md"), markdown.as_bytes())?;
     Ok(())
 }
