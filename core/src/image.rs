@@ -319,6 +319,43 @@ mod tests {
     }
 
     #[test]
+    fn bicubic_hits_pixel_centres_and_reproduces_quadratics() {
+        let q = |x: f32, y: f32| 0.3 * x * x - 0.2 * x * y + 0.7 * y + 2.0;
+        let img = Image::from_fn(9, 8, |x, y| q(x as f32, y as f32));
+        for y in 0..8 {
+            for x in 0..9 {
+                assert!(
+                    (img.sample_bicubic(x as f32, y as f32, Border::Zero) - img.get(x, y)).abs()
+                        < 1e-5
+                );
+            }
+        }
+        // Away from the borders, between the samples, the cubic convolution is exact for
+        // quadratics (Keys 1981), where bilinear is not.
+        for (x, y) in [(3.25, 4.5), (4.7, 3.1), (2.5, 2.5)] {
+            let (b, l) = (
+                img.sample_bicubic(x, y, Border::Clamp),
+                img.sample_bilinear(x, y, Border::Clamp),
+            );
+            assert!(
+                (b - q(x, y)).abs() < 1e-4,
+                "bicubic {b} vs {} at ({x}, {y})",
+                q(x, y)
+            );
+            assert!(
+                (l - q(x, y)).abs() > 1e-3,
+                "bilinear should miss the curvature at ({x}, {y})"
+            );
+        }
+        // Borders and hostile coordinates as bilinear.
+        let flat = Image::new(3, 3, 1.0f32);
+        assert!((flat.sample_bicubic(-0.5, 1.0, Border::Clamp) - 1.0).abs() < 1e-6);
+        assert_eq!(flat.sample_bicubic(-9.0, 1.0, Border::Zero), 0.0);
+        assert_eq!(flat.sample_bicubic(f32::NAN, 1.0, Border::Clamp), 0.0);
+        assert!((flat.sample_bicubic(1e30, 1.0, Border::Clamp) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
     fn from_vec_refuses_wrong_length() {
         let e = Image::from_vec(3, 3, vec![0.0f32; 8])
             .unwrap_err()

@@ -64,6 +64,19 @@ pub struct IngestOptions {
 }
 
 impl IngestOptions {
+    /// Checks the options that do not depend on the capture, naming the bad one: the
+    /// JPEG quality and the flow parameters.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=100).contains(&self.jpeg_quality) {
+            return Err(IngestError::BadParameter(format!(
+                "JPEG quality {} outside 1..=100",
+                self.jpeg_quality
+            )));
+        }
+        self.flow_params()?.validate()?;
+        Ok(())
+    }
+
     /// The flow parameters of registration and inter-view flow: the preset with its
     /// overrides.
     pub fn flow_params(&self) -> Result<FlowParams> {
@@ -717,12 +730,7 @@ pub fn ingest(
             capture.poses()
         )));
     }
-    if !(1..=100).contains(&options.jpeg_quality) {
-        return Err(IngestError::BadParameter(format!(
-            "JPEG quality {} outside 1..=100",
-            options.jpeg_quality
-        )));
-    }
+    options.validate()?;
     let wanted = settings(options);
     let mut reports = Vec::new();
     for &pose in &poses {

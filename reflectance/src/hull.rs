@@ -554,6 +554,33 @@ mod tests {
     }
 
     #[test]
+    fn the_band_carve_is_the_full_carve_at_a_small_part_of_the_tests() {
+        let views = sphere_views(12);
+        let s = silhouettes(&views);
+        let full = VoxelHull::carve(&s, 0.01, 1).unwrap();
+        let band = VoxelHull::carve_banded(&s, 0.01, 4, 1).unwrap();
+        // The band's grid is the coarse one's subdivided: it covers the full carve's box.
+        let (fb, bb) = (full.bounds().unwrap(), band.bounds().unwrap());
+        assert!((fb.0 - bb.0).abs().max_element() < 1e-4, "{fb:?} {bb:?}");
+        assert!((fb.1 - bb.1).abs().max_element() < 1e-4, "{fb:?} {bb:?}");
+        // Voxel by voxel, through their centres: the same occupancy.
+        let mut differ = 0;
+        for i in 0..band.grid().len() {
+            let [a, b, c] = band.grid().cell(i);
+            let p = band.grid().centre(a, b, c);
+            let g = full.grid();
+            let q = (p - Vec3::from(g.origin)) / g.voxel_m;
+            let inside_full = full.at(q.x.floor() as i64, q.y.floor() as i64, q.z.floor() as i64);
+            differ += usize::from(band.occupied(i) != inside_full);
+        }
+        assert_eq!(differ, 0, "{differ} of {} voxels differ", band.count());
+        assert!(band.count() > 100_000, "{}", band.count());
+        // A coarse factor of 1 is the plain carve.
+        let one = VoxelHull::carve_banded(&s, 0.02, 1, 1).unwrap();
+        assert_eq!(one.count(), VoxelHull::carve(&s, 0.02, 1).unwrap().count());
+    }
+
+    #[test]
     fn rays_through_the_hull_are_blocked_and_others_pass() {
         let views = sphere_views(8);
         let hull = VoxelHull::carve(&silhouettes(&views), 0.03, 0).unwrap();

@@ -152,6 +152,7 @@ pub fn write_fields(
     dir: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<(Component, PathBuf)>> {
+    options.validate()?;
     let settings = describe(options);
     let made_path = dir.join(MADE_FILE);
     let made = FieldsMade {
