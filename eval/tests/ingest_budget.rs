@@ -82,7 +82,14 @@ fn every_component_is_scored_and_all_of_them_true_is_the_oracle_field() {
     };
     write_oracle_field(&stage, &oracle, &oracle_options, &|_, _| {}).unwrap();
     let ingested = dir.path().join("ingested.frf");
-    ingest(&cap, &ingested, &options(), None, &frf_ingest::pipeline::Silent).unwrap();
+    ingest(
+        &cap,
+        &ingested,
+        &options(),
+        None,
+        &frf_ingest::pipeline::Silent,
+    )
+    .unwrap();
 
     let (rows, oracle_psnr) = scored(&stage, &fields, &oracle);
     let (_, ingested_psnr) = scored(&stage, &fields, &ingested);
@@ -98,7 +105,10 @@ fn every_component_is_scored_and_all_of_them_true_is_the_oracle_field() {
             100.0 * r.quad_centres.share_of_squared_error,
         );
         for p in [&r.captured, &r.quad_centres] {
-            assert!(p.psnr_subject.is_finite() && p.frames_psnr.len() == 2, "{r:?}");
+            assert!(
+                p.psnr_subject.is_finite() && p.frames_psnr.len() == 2,
+                "{r:?}"
+            );
             assert!(p.share_of_squared_error <= 1.0, "{r:?}");
         }
     }

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Result, StageError};
 use crate::gait::Gait;
+use crate::rig::Exposure;
 
 /// The named presets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -43,19 +44,6 @@ pub enum SetFlowTruth {
     Track,
     /// None (they can still be computed with the library).
     None,
-}
-
-/// How bright each basis condition's lights are.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Exposure {
-    /// Every condition delivers the same irradiance: the floor sectors, 7.7 times an
-    /// upper cell's solid angle, at a lower radiance (what a real stage's operator
-    /// would set, so that no condition clips; [`crate::rig`]). New captures.
-    Equal,
-    /// Every cell at the dome's radiance: the floor conditions clip the lower legs.
-    /// Captures whose `stage.toml` predates the choice were made so.
-    Dome,
 }
 
 fn exposure_of_older_captures() -> Exposure {

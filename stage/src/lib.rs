@@ -36,9 +36,10 @@ pub mod studio;
 pub mod truth;
 pub mod writer;
 
-pub use config::{Exposure, Preset, SetFlowTruth, StageConfig};
+pub use config::{Preset, SetFlowTruth, StageConfig};
 pub use error::{Result, StageError};
 pub use gait::Gait;
+pub use rig::Exposure;
 pub use stage::{Stage, ViewSetup};
 pub use truth::{Neighbour, TrueFlow, TruthImage};
 pub use writer::{WriteReport, open_stage, write_capture};

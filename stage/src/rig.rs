@@ -28,8 +28,8 @@ use frf_core::camera::Camera;
 use frf_core::light::{DirLight, direction_from_azimuth_elevation};
 use glam::Vec3;
 
-use crate::config::Exposure;
 use crate::studio::Illumination;
+use serde::{Deserialize, Serialize};
 
 /// Lighting sets per second (30 in the original).
 pub const SET_RATE_HZ: f64 = 30.0;
@@ -68,6 +68,19 @@ const TRACK_FRACTION: f32 = 0.08;
 /// Irradiance of a camera's ring light on the subject in matte frames: weak, so the
 /// subject stays dark while the retro-reflective floor returns it brightly.
 const RING_IRRADIANCE: f32 = 0.1;
+
+/// How bright each basis condition's lights are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Exposure {
+    /// Every condition delivers the same irradiance: the floor sectors, 7.7 times an
+    /// upper cell's solid angle, at a lower radiance (what a real stage's operator
+    /// would set, so that no condition clips; the module docs). New captures.
+    Equal,
+    /// Every cell at the dome's radiance: the floor conditions clip the lower legs.
+    /// Captures whose `stage.toml` predates the choice were made so.
+    Dome,
+}
 
 /// A cell of the sphere: azimuth range and elevation range (radians).
 #[derive(Debug, Clone, Copy, PartialEq)]

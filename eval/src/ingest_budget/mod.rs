@@ -27,6 +27,7 @@
 
 pub mod fields;
 pub mod plot;
+pub mod variants;
 
 use std::path::{Path, PathBuf};
 
