@@ -412,15 +412,7 @@ fn ingest_pose(
         seconds: start.elapsed().as_secs_f64(),
     });
 
-    let mut header = FieldHeader::from_capture(
-        capture,
-        &[pose],
-        LogQuantizer::new(1.0, 1.0)?,
-        options.jpeg_quality,
-    )?;
-    header.flow_predicted = options.predict_flow;
-    header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
-    header.hulls = options.shadows.map(|s| s.hull);
+    let mut header = pose_header(capture, pose, options)?;
     header.description = format!(
         "ingested from {} with flow {}",
         capture.dir().display(),
@@ -682,6 +674,22 @@ fn ingest_pose(
         .map_err(|e| IngestError::BadParameter(e.to_string()))?;
     frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
     Ok(report)
+}
+
+/// The header of the field of pose `pose` ingested with `options`: the capture's, with
+/// the options' codecs, hulls and shadow maps (the pose's flow quantizer is fitted once
+/// its flows are known).
+pub fn pose_header(capture: &Capture, pose: u32, options: &IngestOptions) -> Result<FieldHeader> {
+    let mut header = FieldHeader::from_capture(
+        capture,
+        &[pose],
+        LogQuantizer::new(1.0, 1.0)?,
+        options.jpeg_quality,
+    )?;
+    header.flow_predicted = options.predict_flow;
+    header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
+    header.hulls = options.shadows.map(|s| s.hull);
+    Ok(header)
 }
 
 /// The hull a pose's inter-view flows are guided by (`None` when `options` do not ask

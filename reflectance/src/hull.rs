@@ -60,6 +60,16 @@ pub struct VoxelHull {
 /// Whether view `s` puts the point `p` outside the subject: behind the camera, outside
 /// the image (every capture camera frames the whole subject), or where the matte is
 /// below [`INSIDE_ALPHA`].
+/// Whether point `p` lies inside the silhouettes of all `views` but at most `misses`.
+fn inside(views: &[Silhouette], p: Vec3, misses: usize) -> bool {
+    views
+        .iter()
+        .filter(|s| outside(s, p))
+        .take(misses + 1)
+        .count()
+        <= misses
+}
+
 fn outside(s: &Silhouette, p: Vec3) -> bool {
     let Some(pixel) = s.camera.project(p) else {
         return true;
@@ -95,6 +105,14 @@ impl VoxelHull {
     /// Carves `grid` from `views` (see the module docs): a voxel survives when at most
     /// `misses` of the views that see it put it outside their silhouette.
     pub fn carve_grid(grid: VoxelGrid, views: &[Silhouette], misses: usize) -> Self {
+        Self::from_test(grid, |[i, j, k]| {
+            !views.is_empty() && inside(views, grid.centre(i, j, k), misses)
+        })
+    }
+
+    /// The hull of `grid` whose voxel `(i, j, k)` is occupied where `occupied` says, the
+    /// voxels tested in parallel.
+    fn from_test(grid: VoxelGrid, occupied: impl Fn([u32; 3]) -> bool + Sync) -> Self {
         let n = grid.len();
         let words: Vec<u64> = (0..n.div_ceil(64))
             .into_par_iter()
@@ -105,18 +123,7 @@ impl VoxelHull {
                     if index >= n {
                         break;
                     }
-                    let [i, j, k] = grid.cell(index);
-                    let p = grid.centre(i, j, k);
-                    let mut out = 0usize;
-                    for s in views {
-                        if outside(s, p) {
-                            out += 1;
-                            if out > misses {
-                                break;
-                            }
-                        }
-                    }
-                    if !views.is_empty() && out <= misses {
+                    if occupied(grid.cell(index)) {
                         word |= 1 << b;
                     }
                 }
@@ -189,39 +196,14 @@ impl VoxelHull {
                 }
             })
             .collect();
-        let n = grid.len();
         let c = coarse;
-        let words: Vec<u64> = (0..n.div_ceil(64))
-            .into_par_iter()
-            .map(|w| {
-                let mut word = 0u64;
-                for b in 0..64 {
-                    let index = w * 64 + b;
-                    if index >= n {
-                        break;
-                    }
-                    let [i, j, k] = grid.cell(index);
-                    let inside = match class[pg.index(i / c, j / c, k / c)] {
-                        0 => false,
-                        1 => true,
-                        _ => {
-                            let p = grid.centre(i, j, k);
-                            views
-                                .iter()
-                                .filter(|s| outside(s, p))
-                                .take(misses + 1)
-                                .count()
-                                <= misses
-                        }
-                    };
-                    if inside {
-                        word |= 1 << b;
-                    }
-                }
-                word
-            })
-            .collect();
-        Ok(Self { grid, bits: words })
+        Ok(Self::from_test(grid, |[i, j, k]| {
+            match class[pg.index(i / c, j / c, k / c)] {
+                0 => false,
+                1 => true,
+                _ => inside(views, grid.centre(i, j, k), misses),
+            }
+        }))
     }
 
     /// The grid.

@@ -18,7 +18,7 @@ use frf_core::grid::Neighbour;
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 use frf_core::progress::Progress;
 use frf_ingest::interview::{GridViews, grid_flows};
-use frf_ingest::pipeline::{IngestOptions, flow_guide};
+use frf_ingest::pipeline::{IngestOptions, flow_guide, pose_header};
 use frf_ingest::shadows::{PoseShadows, pose_shadows};
 use frf_reflectance::flowcodec::quant::LogQuantizer;
 use frf_reflectance::store::encode_flows;
@@ -127,15 +127,7 @@ fn headers(
     pose: u32,
     options: &IngestOptions,
 ) -> Result<(FieldHeader, FieldHeader)> {
-    let mut header = FieldHeader::from_capture(
-        capture,
-        &[pose],
-        LogQuantizer::new(1.0, 1.0)?,
-        options.jpeg_quality,
-    )?;
-    header.flow_predicted = options.predict_flow;
-    header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
-    header.hulls = options.shadows.map(|s| s.hull);
+    let header = pose_header(capture, pose, options)?;
     let lossless = FieldHeader {
         jpeg_quality: LOSSLESS_JPEG_QUALITY,
         ..header.clone()

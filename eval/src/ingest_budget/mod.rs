@@ -371,6 +371,14 @@ pub fn evaluate_fields(
     Ok((rows, given, device))
 }
 
+/// A row's figures: PSNR, gain and share (percent) at the captured views, then at quad
+/// centres.
+fn figures(r: &ComponentScore) -> [f64; 6] {
+    let p = |s: &PlaceScore| [s.psnr_subject, s.gain_db, 100.0 * s.share_of_squared_error];
+    let (a, b) = (p(&r.captured), p(&r.quad_centres));
+    [a[0], a[1], a[2], b[0], b[1], b[2]]
+}
+
 /// The budget as a text table.
 pub fn table(report: &IngestBudgetReport) -> String {
     let mut out = format!(
@@ -387,15 +395,16 @@ pub fn table(report: &IngestBudgetReport) -> String {
         "share"
     );
     for r in &report.rows {
+        let f = figures(r);
         out += &format!(
             "{:<17} {:>8.2} {:>+8.2} {:>7.1}%   {:>8.2} {:>+8.2} {:>7.1}%\n",
             r.component.name(),
-            r.captured.psnr_subject,
-            r.captured.gain_db,
-            100.0 * r.captured.share_of_squared_error,
-            r.quad_centres.psnr_subject,
-            r.quad_centres.gain_db,
-            100.0 * r.quad_centres.share_of_squared_error,
+            f[0],
+            f[1],
+            f[2],
+            f[3],
+            f[4],
+            f[5]
         );
     }
     if let Some(g) = &report.given {
@@ -413,15 +422,16 @@ pub fn markdown(report: &IngestBudgetReport) -> String {
         "| taken from the truth | captured views: PSNR (dB) | gain (dB) | share of squared error | quad centres: PSNR (dB) | gain (dB) | share of squared error |\n|---|---|---|---|---|---|---|\n",
     );
     for r in &report.rows {
+        let f = figures(r);
         out += &format!(
             "| {} | {:.2} | {:+.2} | {:.1} % | {:.2} | {:+.2} | {:.1} % |\n",
             r.component.name(),
-            r.captured.psnr_subject,
-            r.captured.gain_db,
-            100.0 * r.captured.share_of_squared_error,
-            r.quad_centres.psnr_subject,
-            r.quad_centres.gain_db,
-            100.0 * r.quad_centres.share_of_squared_error,
+            f[0],
+            f[1],
+            f[2],
+            f[3],
+            f[4],
+            f[5]
         );
     }
     out
