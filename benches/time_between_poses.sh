@@ -8,6 +8,8 @@
 # Usage: benches/time_between_poses.sh WORKDIR SEED [FRF] [STAGE_FRF]
 #   FRF ingests and scores (default target/release/frf); STAGE_FRF films (default FRF),
 #   so that two builds can be compared on one capture. Extra ingest flags: INGEST_FLAGS.
+#   ORACLE=1 scores the oracle field with the true pose-to-pose flows instead (`frf stage
+#   field --pose-flow`): what the shot would gain with a perfect ingest.
 set -euo pipefail
 work=$1
 seed=$2
@@ -19,9 +21,14 @@ cap="$work/cap"
   --perturbation 0 --lights-per-axis 1 --out "$cap" > /dev/null
 field="$work/field.frf"
 rm -f "$field"
-# shellcheck disable=SC2086
-"$frf" ingest "$cap" --out "$field" --pose-flow --no-shadows ${INGEST_FLAGS:-} \
-  --report "$work/ingest.json" > /dev/null
+rm -f "$work/ingest.json"
+if [ -n "${ORACLE:-}" ]; then
+  "$frf" stage field --capture "$cap" --out "$field" --pose-flow --no-shadows > /dev/null
+else
+  # shellcheck disable=SC2086
+  "$frf" ingest "$cap" --out "$field" --pose-flow --no-shadows ${INGEST_FLAGS:-} \
+    --report "$work/ingest.json" > /dev/null
+fi
 for how in flow nearest; do
   cat > "$work/$how.toml" <<TOML
 field = "field.frf"
@@ -48,10 +55,13 @@ TOML
     > "$work/$how.json" 2> "$work/$how.log"
 done
 python3 - "$work" <<'PY'
-import json, sys
+import json, os, sys
 work = sys.argv[1]
-ingest = json.load(open(f"{work}/ingest.json"))
-print(f"pose-to-pose flow EPE {ingest['pose_flow_epe']:.3f} px of {ingest['pose_flow_motion']:.3f} px true motion")
+if os.path.exists(f"{work}/ingest.json"):
+    ingest = json.load(open(f"{work}/ingest.json"))
+    print(f"pose-to-pose flow EPE {ingest['pose_flow_epe']:.3f} px of {ingest['pose_flow_motion']:.3f} px true motion")
+else:
+    print("oracle field: the true pose-to-pose flows")
 def walker(how):
     r = json.load(open(f"{work}/{how}.json"))
     return [f["psnr_subject"] for f in r["frames"]]
