@@ -85,6 +85,11 @@ pub struct Capture {
 /// Tolerance on the orthonormality of manifest rotations (6 significant digits).
 const ROTATION_TOLERANCE: f32 = 1e-4;
 
+/// The most poses a walk cycle may be cut into (the original: 30; a pose every
+/// millisecond of a one-second cycle is 1000): bounds every pose list before it is
+/// allocated.
+pub const MAX_POSES_PER_CYCLE: u32 = 100_000;
+
 struct Check<'a> {
     path: &'a Path,
 }
@@ -431,8 +436,11 @@ fn check_timing(c: &Check, m: &Manifest) -> Result<()> {
     c.positive("timing.cycle_seconds", t.cycle_seconds)?;
     c.positive("timing.set_rate_hz", t.set_rate_hz)?;
     c.positive("timing.frame_rate_hz", t.frame_rate_hz)?;
-    if t.poses_per_cycle == 0 {
-        return Err(c.fail("timing.poses_per_cycle", "must be at least 1"));
+    if t.poses_per_cycle == 0 || t.poses_per_cycle > MAX_POSES_PER_CYCLE {
+        return Err(c.fail(
+            "timing.poses_per_cycle",
+            format!("must be 1 to {MAX_POSES_PER_CYCLE}"),
+        ));
     }
     if t.poses.is_empty() {
         return Err(c.fail("timing.poses", "no poses listed"));

@@ -85,14 +85,17 @@ fn same_file(file: &File, path: &Path) -> bool {
 /// earlier runs left. Errors name `path`.
 pub fn claim_output(path: &Path) -> Result<OutputClaim> {
     if path.is_dir() {
-        return Err(CoreError::bad_file(
-            path,
-            "a directory is there: give the path of the file to write",
-        ));
+        return Err(CoreError::BadOutput {
+            path: path.to_path_buf(),
+            problem: "a directory is there: give the path of the file to write".into(),
+        });
     }
     let name = file_name(path);
     if name.is_empty() {
-        return Err(CoreError::bad_file(path, "names no file"));
+        return Err(CoreError::BadOutput {
+            path: path.to_path_buf(),
+            problem: "names no file".into(),
+        });
     }
     let parent = path
         .parent()
@@ -111,14 +114,10 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
         match file.try_lock() {
             Ok(()) => {}
             Err(TryLockError::WouldBlock) => {
-                return Err(CoreError::bad_file(
-                    path,
-                    format!(
-                        "another process is writing it (it holds {}): wait for it to end, or \
-                         give another output",
-                        lock_path.display()
-                    ),
-                ));
+                return Err(CoreError::Busy {
+                    path: path.to_path_buf(),
+                    lock: lock_path,
+                });
             }
             Err(TryLockError::Error(e)) => return Err(CoreError::io(&lock_path, e)),
         }

@@ -19,18 +19,23 @@ pub enum Fault {
     Io,
     /// The user interrupted a long run; a rerun resumes it.
     Interrupted,
+    /// Another process is writing the same output: nothing is wrong with the request or
+    /// the data, and the same command succeeds once the other ends.
+    Busy,
 }
 
 impl Fault {
     /// The exit status of a run that failed with this fault: 2 usage (as for a command
-    /// line clap refuses), 3 damaged data, 4 GPU, 5 I/O, 130 interrupted (as a shell
-    /// reports an interrupt). 1 is left for anything else and 101 is a panic's.
+    /// line clap refuses), 3 damaged data, 4 GPU, 5 I/O, 75 busy (`EX_TEMPFAIL` of
+    /// sysexits.h: try again later), 130 interrupted (as a shell reports an interrupt). 1
+    /// is left for anything else and 101 is a panic's.
     pub fn exit_code(self) -> u8 {
         match self {
             Fault::Usage => 2,
             Fault::Damaged => 3,
             Fault::Gpu => 4,
             Fault::Io => 5,
+            Fault::Busy => 75,
             Fault::Interrupted => 130,
         }
     }
@@ -91,6 +96,23 @@ pub enum CoreError {
         /// The size found and the limit.
         problem: String,
     },
+    /// An output another process is writing (it holds the output's lock).
+    #[error("{}: another process is writing it (it holds {}): wait for it to end, or give another output", path.display(), lock.display())]
+    Busy {
+        /// The output.
+        path: PathBuf,
+        /// The lock file its writer holds.
+        lock: PathBuf,
+    },
+    /// A path given as an output that cannot be one (a directory, no file name): the
+    /// caller's to correct.
+    #[error("{}: {problem}", path.display())]
+    BadOutput {
+        /// The path.
+        path: PathBuf,
+        /// Why it cannot be written.
+        problem: String,
+    },
     /// A function was called with an argument it cannot accept.
     #[error("invalid argument {what}: {problem}")]
     InvalidArgument {
@@ -106,10 +128,12 @@ impl CoreError {
     pub fn fault(&self) -> Fault {
         match self {
             CoreError::Io { .. } => Fault::Io,
+            CoreError::Busy { .. } => Fault::Busy,
             CoreError::BadFile { .. } => Fault::Damaged,
             CoreError::SizeMismatch { .. }
             | CoreError::Manifest { .. }
             | CoreError::LimitExceeded { .. }
+            | CoreError::BadOutput { .. }
             | CoreError::InvalidArgument { .. } => Fault::Usage,
         }
     }

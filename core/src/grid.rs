@@ -115,6 +115,21 @@ impl PoseStep {
         }
     }
 
+    /// The pose this step leads to from `pose` among `poses` (sorted), whatever the
+    /// column: the next (previous) of them, past the last (first) the first (last);
+    /// `None` with fewer than two poses or when `pose` is not among them.
+    pub fn target(self, pose: u32, poses: &[u32]) -> Option<u32> {
+        let n = poses.len();
+        if n < 2 {
+            return None;
+        }
+        let i = poses.iter().position(|&p| p == pose)?;
+        Some(match self {
+            PoseStep::Next => poses[(i + 1) % n],
+            PoseStep::Prev => poses[(i + n - 1) % n],
+        })
+    }
+
     /// The pose and column this step leads to from `pose` in column `u`, among the
     /// captured `poses` (sorted) of a grid of `columns` (wrapping when `wraps`): `None`
     /// with fewer than two poses, or when the column it needs does not exist.
@@ -126,21 +141,13 @@ impl PoseStep {
         columns: usize,
         wraps: bool,
     ) -> Option<(u32, usize)> {
-        if poses.len() < 2 {
-            return None;
-        }
+        let to = self.target(pose, poses)?;
         let i = poses.iter().position(|&p| p == pose)?;
-        let (to, column) = match self {
-            PoseStep::Next if i + 1 < poses.len() => (poses[i + 1], Some(u)),
-            PoseStep::Next => (
-                poses[0],
-                Neighbour::Right.of(u, 0, columns, 1, wraps).map(|c| c.0),
-            ),
-            PoseStep::Prev if i > 0 => (poses[i - 1], Some(u)),
-            PoseStep::Prev => (
-                poses[poses.len() - 1],
-                Neighbour::Left.of(u, 0, columns, 1, wraps).map(|c| c.0),
-            ),
+        let column = match self {
+            PoseStep::Next if i + 1 < poses.len() => Some(u),
+            PoseStep::Next => Neighbour::Right.of(u, 0, columns, 1, wraps).map(|c| c.0),
+            PoseStep::Prev if i > 0 => Some(u),
+            PoseStep::Prev => Neighbour::Left.of(u, 0, columns, 1, wraps).map(|c| c.0),
         };
         column.map(|c| (to, c))
     }

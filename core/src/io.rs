@@ -136,7 +136,15 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String> {
             format!("{size} bytes, more than the {limit} a file of this kind may have"),
         ));
     }
-    std::fs::read_to_string(path).map_err(|e| CoreError::io(path, e))
+    let bytes = std::fs::read(path).map_err(|e| CoreError::io(path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let line = 1 + e.as_bytes()[..at].iter().filter(|&&b| b == b'\n').count();
+        CoreError::bad_file(
+            path,
+            format!("line {line} is not UTF-8 text (byte {at} of the file)"),
+        )
+    })
 }
 
 /// Width and height of an image file, read from its header only.

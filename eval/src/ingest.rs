@@ -55,8 +55,7 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
     // Per view: (alpha IoU, alpha MAE) and (sum, count) of flow errors, horizontal and
     // vertical.
     type ViewErrors = ((Option<f64>, f64), [(f64, usize); 4]);
-    let mut poses = stage.config().poses.clone();
-    poses.sort_unstable();
+    let poses = evidence.pose_flows_among;
     let per_view: Vec<ViewErrors> = (0..evidence.alphas.len())
         .into_par_iter()
         .filter(|&i| evidence.alphas[i].is_some())
@@ -89,7 +88,7 @@ pub fn evaluate_pose(stage: &Stage, pose: u32, evidence: &PoseEvidence) -> Resul
                         .pose_flows
                         .get(i)
                         .and_then(|p| p[step.index()].as_ref()),
-                    step.of(pose, u, &poses, columns, true),
+                    step.of(pose, u, poses, columns, true),
                 ) else {
                     continue;
                 };

@@ -169,6 +169,11 @@ pub fn write_oracle_field(
     header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
     header.hulls = options.shadows.map(|s| s.hull);
     header.description = format!("oracle field (stage ground truth): {}", header.description);
+    if options.pose_flows {
+        for &p in &options.poses {
+            header.record_pose_flows(p, &sorted)?;
+        }
+    }
     // Pass 2: render and encode views in parallel, write them in order, keeping the true
     // mattes for the hulls.
     let mut writer = FieldWriter::create(path, header.clone())?;

@@ -48,7 +48,7 @@ pub struct ShotFrameScore {
     /// Index in the shot.
     pub index: usize,
     /// Seconds into the shot.
-    pub time: f32,
+    pub time: f64,
     /// The pose drawn (the earlier, between two).
     pub pose: u32,
     /// Between two poses: the later and the fraction of the way to it.

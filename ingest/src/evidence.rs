@@ -86,6 +86,8 @@ pub struct PoseEvidence<'a> {
     pub flows: &'a [[Option<FlowImage>; 4]],
     /// Estimated pose-to-pose flows per view, in [`frf_core::grid::PoseStep::ALL`] order.
     pub pose_flows: &'a [[Option<FlowImage>; 2]],
+    /// The poses among which they lead to the next and the previous (sorted).
+    pub pose_flows_among: &'a [u32],
     /// The views the evaluator asked for ([`Evaluator::wants_unregistered`]).
     pub registered: &'a [SampledView],
     /// The pose's visual hull, when ingest carved one.

@@ -204,6 +204,10 @@ pub struct Settings {
     /// Pose-to-pose flows measured; parts written before they existed have none.
     #[serde(default)]
     pub pose_flows: bool,
+    /// The poses among which each pose's flows lead to its neighbours
+    /// ([`pose_flow_poses`]); empty without pose flows.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pose_flows_among: Vec<u32>,
     /// How inter-view flow was measured ([`InterViewFlow::name`]); parts written before
     /// the hull guided it were matched on images alone.
     #[serde(default = "images_alone")]
@@ -303,7 +307,7 @@ fn part_paths(out: &Path, pose: u32) -> (PathBuf, PathBuf) {
     )
 }
 
-fn settings(options: &IngestOptions) -> Settings {
+fn settings(capture: &Capture, options: &IngestOptions) -> Settings {
     Settings {
         flow_preset: std::iter::once(options.flow_preset.name().to_string())
             .chain(
@@ -332,12 +336,30 @@ fn settings(options: &IngestOptions) -> Settings {
         ),
         edge: options.edge.name().into(),
         pose_flows: options.pose_flows,
+        pose_flows_among: match options.pose_flows {
+            true => pose_flow_poses(capture, options),
+            false => Vec::new(),
+        },
         inter_view_flow: options.inter_view_flow.name().into(),
         selection: options
             .selection
             .as_ref()
             .map_or(String::new(), Selection::describe),
     }
+}
+
+/// The poses among which a pose's flows to the next and the previous pose are measured:
+/// those this run ingests when it ingests several (the field's consecutive poses, between
+/// which a shot morphs), the capture's when it ingests one (a part of a field to be
+/// merged from one-pose parts, whose poses are the capture's). Sorted.
+pub fn pose_flow_poses(capture: &Capture, options: &IngestOptions) -> Vec<u32> {
+    let mut poses = match options.poses.len() {
+        0 | 1 => capture.poses().to_vec(),
+        _ => options.poses.clone(),
+    };
+    poses.sort_unstable();
+    poses.dedup();
+    poses
 }
 
 /// A finished part of this pose made with these settings, if there is one.
@@ -416,7 +438,7 @@ fn ingest_pose(
     header.description = format!(
         "ingested from {} with flow {}",
         capture.dir().display(),
-        settings(options).flow_preset
+        settings(capture, options).flow_preset
     );
 
     // The views ingested: filmed, and selected.
@@ -551,7 +573,7 @@ fn ingest_pose(
         let start = Instant::now();
         let pose_flows = crate::poseflow::pose_flows(
             capture,
-            pose,
+            (pose, &pose_flow_poses(capture, options)),
             header.wraps,
             &alphas,
             guide.as_ref(),
@@ -600,6 +622,9 @@ fn ingest_pose(
     };
 
     let start = Instant::now();
+    if options.pose_flows {
+        header.record_pose_flows(pose, &pose_flow_poses(capture, options))?;
+    }
     header.pose_mut(pose)?.flow_quantizer = LogQuantizer::fit(
         flows
             .iter()
@@ -653,6 +678,7 @@ fn ingest_pose(
                         alphas: &alphas,
                         flows: &flows,
                         pose_flows: &pose_flows,
+                        pose_flows_among: &pose_flow_poses(capture, options),
                         registered: &registered,
                         hull: shadows.as_ref().map(|s| &s.hull),
                     },
@@ -665,7 +691,7 @@ fn ingest_pose(
     };
     let report = PoseReport {
         pose,
-        settings: settings(options),
+        settings: settings(capture, options),
         resumed: false,
         steps,
         errors,
@@ -739,7 +765,7 @@ pub fn ingest(
         )));
     }
     options.validate()?;
-    let wanted = settings(options);
+    let wanted = settings(&capture, options);
     let mut reports = Vec::new();
     for &pose in &poses {
         let report = match finished_part(out, pose, &wanted)? {

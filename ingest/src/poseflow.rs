@@ -70,15 +70,15 @@ fn matted_reference(
 }
 
 /// The pose-to-pose flows of every view of `pose` that `alphas` holds (`u`-major; the
-/// columns close into a ring when `wraps`), in
-/// [`PoseStep::ALL`] order (`None` where the step's view was not filmed, or the capture
-/// holds one pose); `clean` holds each camera's clean plates by slot, `rule` the matte
+/// columns close into a ring when `wraps`) to its neighbours among `poses` (sorted), in
+/// [`PoseStep::ALL`] order (`None` where the step's view was not filmed, or there is one
+/// pose); `clean` holds each camera's clean plates by slot, `rule` the matte
 /// rule. `each_view` is called once per view (progress, and stopping: an error it
 /// returns ends the step).
 #[allow(clippy::too_many_arguments)]
 pub fn pose_flows(
     capture: &Capture,
-    pose: u32,
+    (pose, poses): (u32, &[u32]),
     wraps: bool,
     alphas: &[Option<&GrayImage>],
     guide: Option<&VoxelHull>,
@@ -88,8 +88,6 @@ pub fn pose_flows(
     each_view: &(dyn Fn() -> Result<()> + Sync),
 ) -> Result<Vec<[Option<FlowImage>; 2]>> {
     let (columns, rows) = (capture.cycles(), capture.cameras().len());
-    let mut poses = capture.poses().to_vec();
-    poses.sort_unstable();
     (0..columns * rows)
         .into_par_iter()
         .map(|i| {
@@ -100,7 +98,7 @@ pub fn pose_flows(
             let (u, v) = (i / rows, i % rows);
             let mut from = None;
             for step in PoseStep::ALL {
-                let Some((to_pose, to_u)) = step.of(pose, u, &poses, columns, wraps) else {
+                let Some((to_pose, to_u)) = step.of(pose, u, poses, columns, wraps) else {
                     continue;
                 };
                 if !capture.is_filmed(to_pose, to_u, v) {

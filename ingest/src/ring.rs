@@ -418,6 +418,7 @@ pub fn ingest_ring(
                     .flatten()
                     .flat_map(|f| f.pixels().iter().flatten().copied()),
             ),
+            pose_flows_to: None,
         }],
         flow_predicted: true,
         jpeg_quality,

@@ -362,6 +362,13 @@ impl<R: ReadAt> FieldFile<R> {
                 "footer missing: the file is truncated or was not finished".into(),
             ));
         }
+        let footer_version = u32::from_le_bytes([footer[20], footer[21], footer[22], footer[23]]);
+        if footer_version != version {
+            return Err(bad(format!(
+                "the footer says format version {footer_version}, the preamble {version} \
+                 (damaged file)"
+            )));
+        }
         let u64_at = |i: usize| u64::from_le_bytes(footer[i..i + 8].try_into().unwrap_or([0; 8]));
         let (index_offset, index_length) = (u64_at(0), u64_at(8));
         let index_crc = u32::from_le_bytes([footer[16], footer[17], footer[18], footer[19]]);
@@ -567,6 +574,31 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
         }
     }
     header.poses.sort_by_key(|p| p.pose);
+    // Every part with pose-to-pose flows or none: a field with them for some poses only
+    // fails three frames into a render between poses.
+    let holds = |f: &FieldFile| {
+        f.header().poses.iter().any(|p| p.pose_flows_to.is_some())
+            || f.chunks()
+                .any(|c| matches!(c.key.kind, ChunkKind::PoseFlow(_)))
+    };
+    if let (Some(with), Some(without)) = (
+        files.iter().find(|f| holds(f)),
+        files.iter().find(|f| !holds(f)),
+    ) {
+        return Err(ReflectanceError::BadParameter(format!(
+            "{} holds pose-to-pose flows (ingested with --pose-flow), {} does not: ingest every \
+             part with --pose-flow, or none",
+            with.path().display(),
+            without.path().display()
+        )));
+    }
+    if let Err((pose, problem)) = header.check_pose_flows() {
+        let part = files
+            .iter()
+            .find(|f| f.header().poses.iter().any(|p| p.pose == pose))
+            .map_or(String::new(), |f| format!("{}: ", f.path().display()));
+        return Err(ReflectanceError::BadParameter(format!("{part}{problem}")));
+    }
     let mut writer = FieldWriter::create(out, header)?;
     for f in &files {
         let keys: Vec<ChunkKey> = f.chunks().map(|c| c.key).collect();

@@ -11,7 +11,7 @@
 
 use frf_core::camera::{Camera, Intrinsics, Rigid};
 use frf_core::capture::Capture;
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 use frf_core::light::DirLight;
 use frf_core::volume::GroundGrid;
@@ -136,6 +136,12 @@ pub struct PoseRecord {
     pub views: Vec<ViewRecord>,
     /// The quantizer of this pose's flows.
     pub flow_quantizer: LogQuantizer,
+    /// The poses its pose-to-pose flows lead to, in [`PoseStep::ALL`] order: `None` when
+    /// it holds none (or was written before they were recorded). A field draws the walk
+    /// between *its* consecutive poses, so these must be those
+    /// ([`FieldHeader::check_pose_flows`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pose_flows_to: Option<[Option<u32>; 2]>,
 }
 
 /// The shadow maps of a field (docs/design.md section 2.4): their ground grid and the
@@ -249,6 +255,7 @@ impl FieldHeader {
                     time_s: capture.pose_time_s(pose),
                     views,
                     flow_quantizer,
+                    pose_flows_to: None,
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -309,6 +316,61 @@ impl FieldHeader {
     /// The neighbour of view `(u, v)` in direction `n`, if any.
     pub fn neighbour(&self, u: usize, v: usize, n: Neighbour) -> Option<(usize, usize)> {
         n.of(u, v, self.columns, self.rows, self.wraps)
+    }
+
+    /// The poses held, sorted.
+    pub fn pose_list(&self) -> Vec<u32> {
+        let mut poses: Vec<u32> = self.poses.iter().map(|p| p.pose).collect();
+        poses.sort_unstable();
+        poses
+    }
+
+    /// Records on pose `pose` that its pose-to-pose flows were measured toward its
+    /// neighbours among `poses` (sorted).
+    pub fn record_pose_flows(&mut self, pose: u32, poses: &[u32]) -> Result<()> {
+        self.pose_mut(pose)?.pose_flows_to = Some(PoseStep::ALL.map(|s| s.target(pose, poses)));
+        Ok(())
+    }
+
+    /// Checks that every pose's recorded pose-to-pose flows lead to its neighbours among
+    /// the poses this field holds (when it holds several), the motion a frame between two
+    /// of them needs; says
+    /// which pose's do not (the pose, and the problem in words), and where they lead.
+    pub fn check_pose_flows(&self) -> std::result::Result<(), (u32, String)> {
+        let poses = self.pose_list();
+        for p in &self.poses {
+            let Some(to) = p.pose_flows_to else { continue };
+            for step in PoseStep::ALL {
+                let (held, needed) = (to[step.index()], step.target(p.pose, &poses));
+                // A one-pose field (a part to merge) has no neighbour to check against.
+                if held.is_some() && needed.is_some() && held != needed {
+                    let said = |t: Option<u32>| t.map_or("none".into(), |t| format!("pose {t}"));
+                    return Err((
+                        p.pose,
+                        format!(
+                            "pose {}'s flow {} leads to {}, but the pose {} it here is {} (it was \
+                         measured among other poses than this field's {poses:?}): ingest these \
+                         poses with --pose-flow in one run (frf ingest --poses {}), or parts of \
+                         one pose each from a capture of exactly them",
+                            p.pose,
+                            step.name(),
+                            said(held),
+                            match step {
+                                PoseStep::Next => "after",
+                                PoseStep::Prev => "before",
+                            },
+                            said(needed),
+                            poses
+                                .iter()
+                                .map(u32::to_string)
+                                .collect::<Vec<_>>()
+                                .join(",")
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Checks the header's consistency, saying what is wrong.

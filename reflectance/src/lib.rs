@@ -31,6 +31,7 @@ pub mod shadow;
 pub mod stats;
 pub mod store;
 pub mod unzstd;
+pub mod verify;
 
 pub use container::{FieldFile, FieldWriter};
 pub use field::{FieldHeader, ViewData};

@@ -420,6 +420,7 @@ fn poses_written_apart_merge_into_one_field() {
 fn the_fuzz_seeds_are_valid_inputs() {
     let seeds = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz/seeds");
     let container = seeds.join("container/tiny.frf");
+    let with_pose_flows = seeds.join("container/pose_flows.frf");
     let flow = seeds.join("huffman/flow_map.bin");
     let (basis, planes) = (
         seeds.join("images/basis.bin"),
@@ -433,6 +434,7 @@ fn the_fuzz_seeds_are_valid_inputs() {
             std::fs::create_dir_all(p.parent().unwrap()).unwrap();
         }
         write_views(&container, h.clone());
+        write_pose_flow_seed(&with_pose_flows, &capture, q);
         let v = view(&h, 0, 0, 1);
         let f = v.flows.iter().flatten().next().unwrap();
         std::fs::write(&flow, flowcodec::encode(f, &q, true).unwrap()).unwrap();
@@ -449,7 +451,71 @@ fn the_fuzz_seeds_are_valid_inputs() {
         }
     }
     assert!(field.size() < 64 << 10, "seed of {} bytes", field.size());
+    // The pose-flow seed: two poses whose flows lead to each other, every chunk whole.
+    let field = FieldFile::open(&with_pose_flows).unwrap();
+    assert!(field.header().check_pose_flows().is_ok());
+    assert!(
+        field
+            .chunks()
+            .any(|c| matches!(c.key.kind, ChunkKind::PoseFlow(_)))
+    );
+    assert!(field.verify(&|| {}).unwrap().damaged.is_empty());
+    assert!(field.size() < 64 << 10, "seed of {} bytes", field.size());
     flowcodec::decode(&std::fs::read(&flow).unwrap(), &q).unwrap();
     frf_reflectance::imagecodec::decode_basis(&std::fs::read(&basis).unwrap()).unwrap();
     frf_reflectance::imagecodec::decode_planes(&std::fs::read(&planes).unwrap()).unwrap();
+}
+
+/// A field of poses 0 and 1 of `capture`, with pose-to-pose flows between them (the
+/// views' own flows stand in for them): the fuzz target's seed for those chunks.
+fn write_pose_flow_seed(
+    path: &std::path::Path,
+    capture: &frf_core::capture::Capture,
+    q: LogQuantizer,
+) {
+    let mut h = FieldHeader::from_capture(capture, &[0, 1], q, 90).unwrap();
+    for pose in [0, 1] {
+        h.record_pose_flows(pose, &[0, 1]).unwrap();
+    }
+    let mut w = FieldWriter::create(path, h.clone()).unwrap();
+    for pose in [0, 1] {
+        for u in 0..h.columns {
+            for v in 0..h.rows {
+                let data = view(&h, pose, u, v);
+                let between = [data.flows[0].clone(), data.flows[1].clone()];
+                w.add_view(pose, u, v, &encode_view(&h, pose, &data).unwrap())
+                    .unwrap();
+                let flows = frf_reflectance::store::encode_pose_flows(&h, pose, &between).unwrap();
+                w.add_view(pose, u, v, &flows).unwrap();
+            }
+        }
+    }
+    w.finish().unwrap();
+}
+
+/// `FieldFile::verify` (`frf info --check`) decodes every chunk of a whole field without a
+/// complaint, and finds each damaged chunk of one with bytes changed in five places (its
+/// error naming the first and counting the rest), where opening the field reads only the
+/// index and succeeds.
+#[test]
+fn verify_reads_every_chunk_and_finds_each_damaged_one() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let whole = FieldFile::open(&root.join("fuzz/seeds/container/tiny.frf")).unwrap();
+    let calls = std::cell::Cell::new(0);
+    let v = whole.verify(&|| calls.set(calls.get() + 1)).unwrap();
+    assert_eq!(v.chunks, whole.chunks().count());
+    assert_eq!(calls.get(), v.chunks);
+    assert!(v.damaged.is_empty(), "{:?}", v.damaged);
+    assert!(v.error(whole.path()).is_none());
+
+    let path = root.join("tests/bad/damaged_chunks.frf");
+    let damaged = FieldFile::open(&path).unwrap();
+    let v = damaged.verify(&|| {}).unwrap();
+    assert!(v.damaged.len() >= 2, "{:?}", v.damaged);
+    let said = v.error(&path).unwrap().to_string();
+    assert!(said.contains(&v.damaged[0].0), "{said}");
+    assert!(
+        said.contains(&format!("{} more of the", v.damaged.len() - 1)),
+        "{said}"
+    );
 }

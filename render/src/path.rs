@@ -28,12 +28,17 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{RenderError, Result};
 
+/// The narrowest vertical field of view a camera may have, degrees (exclusive).
+pub const MIN_FOV_DEG: f32 = 0.1;
+/// The widest, degrees (exclusive): a pinhole's image diverges toward 180.
+pub const MAX_FOV_DEG: f32 = 170.0;
+
 /// One keyframe.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Key {
-    /// Time, seconds.
-    pub time: f32,
+    /// Time, seconds (64-bit, as every time of a scene).
+    pub time: f64,
     /// Camera centre, subject frame, metres.
     pub position: [f32; 3],
     /// Point the camera looks at.
@@ -96,9 +101,9 @@ impl Key {
         if !finite {
             return Err(bad(format!("key {i}: a value is not finite")));
         }
-        if !(self.fov_deg > 0.1 && self.fov_deg < 170.0) {
+        if !(self.fov_deg > MIN_FOV_DEG && self.fov_deg < MAX_FOV_DEG) {
             return Err(bad(format!(
-                "key {i}: fov_deg {} is outside (0.1, 170)",
+                "key {i}: fov_deg {} is outside ({MIN_FOV_DEG}, {MAX_FOV_DEG})",
                 self.fov_deg
             )));
         }
@@ -142,12 +147,12 @@ impl CameraPath {
     }
 
     /// Time span `(first, last)`.
-    pub fn span(&self) -> (f32, f32) {
+    pub fn span(&self) -> (f64, f64) {
         (self.keys[0].time, self.keys[self.keys.len() - 1].time)
     }
 
     /// The interpolated key at time `t` (clamped to the span).
-    pub fn at(&self, t: f32) -> Key {
+    pub fn at(&self, t: f64) -> Key {
         let k = &self.keys;
         let (t0, t1) = self.span();
         let t = t.clamp(t0, t1);
@@ -157,14 +162,15 @@ impl CameraPath {
         let i = k.partition_point(|key| key.time <= t).clamp(1, k.len() - 1) - 1;
         let (a, b) = (&k[i], &k[i + 1]);
         let h = b.time - a.time;
-        let s = (t - a.time) / h;
+        // The fraction of the segment in 64 bits, then 32 for the positions.
+        let s = ((t - a.time) / h) as f32;
         // Tangents from the neighbouring keys (one-sided at the ends), scaled to this
         // segment: the change over the neighbours times `h` over their time span. The
         // ratio of spans first, so that keys a subnormal time apart do not divide by it
         // (an infinite tangent times a tiny `h`).
         let tangent = |j: usize, f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
             let (l, r) = (j.saturating_sub(1), (j + 1).min(k.len() - 1));
-            (f(&k[r]) - f(&k[l])) * (h / (k[r].time - k[l].time))
+            (f(&k[r]) - f(&k[l])) * (h / (k[r].time - k[l].time)) as f32
         };
         let hermite = |f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
             let (p0, p1) = (f(a), f(b));
@@ -182,7 +188,7 @@ impl CameraPath {
             time: t,
             position: position.to_array(),
             look_at: look_at.to_array(),
-            fov_deg: fov.clamp(0.1, 170.0),
+            fov_deg: fov.clamp(MIN_FOV_DEG, MAX_FOV_DEG),
         }
     }
 
@@ -198,7 +204,7 @@ impl CameraPath {
                 let s = if frames == 1 {
                     0.0
                 } else {
-                    f as f32 / (frames - 1) as f32
+                    f as f64 / (frames - 1) as f64
                 };
                 self.at(t0 + s * (t1 - t0)).camera(width, height)
             })
@@ -228,7 +234,7 @@ impl Orbit {
     pub fn key(&self, f: f32) -> Key {
         let a = (self.start_deg + f * self.sweep_deg).to_radians();
         Key {
-            time: f,
+            time: f as f64,
             position: [
                 self.look_at.x + self.radius * a.sin(),
                 self.height,
@@ -278,7 +284,7 @@ impl Trajectory {
 mod tests {
     use super::*;
 
-    fn key(time: f32, x: f32) -> Key {
+    fn key(time: f64, x: f32) -> Key {
         Key {
             time,
             position: [x, 1.0, 3.0],
@@ -296,10 +302,10 @@ mod tests {
             assert!((at.fov_deg - k.fov_deg).abs() < 1e-4);
         }
         // Velocity is continuous across the middle key.
-        let x = |t: f32| p.at(t).position[0];
+        let x = |t: f64| p.at(t).position[0];
         let (e, t) = (1e-3, 1.0);
-        let before = (x(t) - x(t - e)) / e;
-        let after = (x(t + e) - x(t)) / e;
+        let before = (x(t) - x(t - e)) / e as f32;
+        let after = (x(t + e) - x(t)) / e as f32;
         assert!((before - after).abs() < 0.02, "{before} vs {after}");
     }
 

@@ -642,7 +642,7 @@ fn a_field_of_view_of_179_9_degrees_classifies_its_extreme_rays() {
 // ---------------------------------------------------------------------------------------
 // Camera paths and scenes.
 
-fn key(time: f32, position: [f32; 3], look_at: [f32; 3]) -> Key {
+fn key(time: f64, position: [f32; 3], look_at: [f32; 3]) -> Key {
     Key {
         time,
         position,
@@ -673,7 +673,7 @@ fn keys_a_float_step_apart_in_time_give_finite_cameras_through_both_keys() {
     // the subnormal span gave an infinite tangent, times a zero Hermite weight: NaN).
     let (p0, p1, p2) = ([1.0, 1.2, 3.0], [-1.0, 1.4, 3.0], [0.0, 1.3, -3.0]);
     let target = [0.0, 0.9, 0.0];
-    for (t0, t1) in [(1.0f32, 1.0f32.next_up()), (0.0, f32::from_bits(1))] {
+    for (t0, t1) in [(1.0f64, 1.0f64.next_up()), (0.0, f64::from_bits(1))] {
         let path = CameraPath::new(vec![
             key(t0, p0, target),
             key(t1, p1, target),
@@ -767,7 +767,7 @@ fn a_scene_of_zero_length_or_of_one_frame_renders_one_finite_camera() {
     let path = std::path::Path::new("/shots/stiff/scene.toml");
     let still = Scene::parse(path, SCENE).unwrap();
     assert_eq!(still.frame_times(), vec![2.0]);
-    for t in [2.0, 2.0f32.next_up(), 1e6] {
+    for t in [2.0, 2.0f64.next_up(), 1e6] {
         let c = still.camera_at(t, (32, 18)).unwrap();
         assert!(
             (c.centre() - Vec3::new(0.0, 1.4, 3.0)).length() < 1e-5,

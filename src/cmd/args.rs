@@ -134,6 +134,18 @@ pub fn parse_degrees(s: &str) -> Result<f32, String> {
     Ok(v)
 }
 
+/// Parses a vertical field of view in degrees, within the range a camera path allows.
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    use frf_render::path::{MAX_FOV_DEG, MIN_FOV_DEG};
+    let v = parse_degrees(s)?;
+    if !(v > MIN_FOV_DEG && v < MAX_FOV_DEG) {
+        return Err(format!(
+            "`{s}` degrees: a vertical field of view is within ({MIN_FOV_DEG}, {MAX_FOV_DEG})"
+        ));
+    }
+    Ok(v)
+}
+
 /// Writes a path into JSON as text, any invalid UTF-8 replaced: settings and reports
 /// name paths, and a path is not always a string.
 pub fn path_text<S: serde::Serializer>(p: &std::path::Path, s: S) -> Result<S::Ok, S::Error> {
@@ -178,11 +190,25 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
         if a >= b {
             return Err(bad());
         }
+        let most = frf_core::capture::MAX_POSES_PER_CYCLE;
+        if b > most {
+            return Err(format!(
+                "--poses {s:?}: a cycle holds at most {most} poses (0..{most})"
+            ));
+        }
         return Ok((a..b).collect());
     }
-    s.split(',')
+    let poses: Vec<u32> = s
+        .split(',')
         .map(|p| p.trim().parse().map_err(|_| bad()))
-        .collect()
+        .collect::<Result<_, _>>()?;
+    let most = frf_core::capture::MAX_POSES_PER_CYCLE;
+    match poses.iter().find(|&&p| p >= most) {
+        Some(p) => Err(format!(
+            "--poses {s:?}: pose {p} is beyond any cycle (at most {most} poses)"
+        )),
+        None => Ok(poses),
+    }
 }
 
 /// Parses an environment: a `.hdr` / `.exr` file, `sky`, `uniform` or `none`.
@@ -282,10 +308,10 @@ pub struct CameraArgs {
     #[arg(long, value_parser = parse_point, default_value = "0,0.9,0", allow_hyphen_values = true)]
     pub look_at: [f32; 3],
     /// Orbit: vertical field of view, degrees.
-    #[arg(long, default_value_t = 35.0)]
+    #[arg(long, default_value_t = 35.0, value_parser = parse_fov)]
     pub fov: f32,
     /// Orbit: azimuth of the first frame, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
     pub start: f32,
 }
 
@@ -500,6 +526,13 @@ mod tests {
         assert_eq!(parse_poses("0..3"), Ok(vec![0, 1, 2]));
         assert_eq!(parse_poses("4,1"), Ok(vec![4, 1]));
         assert!(parse_poses("3..3").unwrap_err().contains("--poses"));
+        // Bounded before anything is allocated (issue 35: 0..4294967295 took 23 GB).
+        assert!(
+            parse_poses("0..4294967295")
+                .unwrap_err()
+                .contains("at most")
+        );
+        assert!(parse_poses("1,4294967295").unwrap_err().contains("beyond"));
         let o = parse_orbit("3,1.2").unwrap();
         assert_eq!((o.radius, o.height, o.sweep_deg), (3.0, 1.2, 360.0));
         assert_eq!(parse_env("none"), Ok(EnvSource::None));

@@ -42,8 +42,8 @@ fn expected(spec: &str) -> CliResult<(Vec<u32>, String)> {
 
 /// Runs `frf merge`.
 pub fn run(args: MergeArgs) -> CliResult {
-    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
     let expect = args.expect.as_deref().map(expected).transpose()?;
+    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
     let mut parts = Vec::with_capacity(args.parts.len());
     let mut held: Vec<u32> = Vec::new();
     for p in &args.parts {

@@ -15,6 +15,8 @@ pub fn bar(message: &str) -> ProgressBar {
             .progress_chars("=> "),
     );
     bar.set_message(message.to_string());
+    // The elapsed time moves while a long step (a large frame) runs.
+    bar.enable_steady_tick(std::time::Duration::from_secs(1));
     bar
 }
 

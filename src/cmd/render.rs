@@ -118,7 +118,7 @@ pub struct RenderArgs {
     pub detail: Option<u8>,
     /// Most memory the resident poses may hold together, MB (the least recently used
     /// leave first).
-    #[arg(long, default_value_t = DEFAULT_BUDGET_MB)]
+    #[arg(long, default_value_t = DEFAULT_BUDGET_MB, value_parser = clap::value_parser!(u64).range(1..))]
     pub memory_budget: u64,
 }
 
@@ -147,7 +147,6 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
     {
         return Err("--backdrop plate: the plate's camera is a --camera path of one key".into());
     }
-    let cycle = h.cycle_seconds as f32;
     Ok(Scene {
         path: args.input.clone(),
         field: Some(args.input.clone()),
@@ -162,7 +161,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
         preview: Preview::Apng,
         variant: Variant::FourWay,
         lighting: vec![LightKey {
-            time: f32::NEG_INFINITY,
+            time: f64::NEG_INFINITY,
             env: source,
             yaw: args.lighting.yaw.to_radians(),
             intensity: 1.0,
@@ -178,7 +177,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
         instances: vec![Instance {
             position: Vec3::ZERO,
             heading: 0.0,
-            time_offset: pose as f32 / h.poses_per_cycle.max(1) as f32 * cycle,
+            time_offset: f64::from(pose) / f64::from(h.poses_per_cycle.max(1)) * h.cycle_seconds,
         }],
     })
 }
@@ -404,22 +403,28 @@ fn shadow_words<R: frf_reflectance::container::ReadAt>(
     traced_lights: usize,
 ) -> String {
     let plan = shot.plan();
-    let has_maps = shot.field().header().shadows.is_some();
+    let header = shot.field().header();
+    let (has_maps, has_hull) = (header.shadows.is_some(), header.hulls.is_some());
+    // What a shadow of the other kind would need, said only where the field holds it.
+    let other = if has_hull {
+        "--shadow traced traces the hull"
+    } else {
+        "nor has it a visual hull to trace: ingest without --no-shadows to cast a shadow"
+    };
     match scene.shadow {
         ShadowSpec::None => "none (--shadow none)".into(),
-        // Without maps there is no ground patch to see: say why first.
+        // Without maps or a hull there is no shadow to draw: say why first.
         ShadowSpec::Maps if !has_maps => {
-            "none (the field has no shadow maps, e.g. ingested with --no-shadows: --shadow \
-             traced traces the hull)"
-                .into()
+            format!("none (the field has no shadow maps, e.g. ingested with --no-shadows; {other})")
         }
+        ShadowSpec::Traced if !has_hull => "none (the field has no visual hull to trace, e.g. \
+             ingested with --no-shadows: ingest without it to cast a shadow)"
+            .into(),
         _ if !plan.ground_seen => "none drawn (no frame sees the ground patch)".into(),
         ShadowSpec::Maps if plan.poses.iter().any(|p| p.shadow_maps) => {
             "relit from the pose's maps".into()
         }
-        ShadowSpec::Maps => {
-            "none (the field has no shadow maps: --shadow traced traces the hull)".into()
-        }
+        ShadowSpec::Maps => format!("none (the field has no shadow maps; {other})"),
         ShadowSpec::Traced => {
             format!("traced from the hull under {traced_lights} median-cut lights")
         }

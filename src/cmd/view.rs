@@ -22,7 +22,7 @@ use crate::cmd::args::{FloorArg, VariantArg, parse_degrees, parse_env, parse_siz
 /// Memory the resident poses may hold by default, MB.
 const DEFAULT_BUDGET_MB: u64 = 2048;
 /// Frames per second of a recorded move of a field.
-const RECORD_FPS: f32 = 24.0;
+const RECORD_FPS: f64 = 24.0;
 
 /// Arguments of `frf view`.
 #[derive(Args)]
@@ -48,15 +48,15 @@ pub struct ViewArgs {
     /// Interpolation to start with (default: the scene's, else four-way).
     #[arg(long, value_enum)]
     pub variant: Option<VariantArg>,
-    /// Run the commands of FILE without a person (see `frf_view::script`), then close.
-    #[arg(long)]
+    /// Run the commands of FILE without a person, then close (`--help` lists them).
+    #[arg(long, value_name = "FILE", long_help = frf_view::script::help())]
     pub script: Option<PathBuf>,
     /// When the viewer closes, write the camera keys set (K) as a scene file that `frf
     /// render FILE --out DIR` renders.
     #[arg(long)]
     pub record: Option<PathBuf>,
     /// Most memory the resident poses may hold together, MB.
-    #[arg(long, default_value_t = DEFAULT_BUDGET_MB)]
+    #[arg(long, default_value_t = DEFAULT_BUDGET_MB, value_parser = clap::value_parser!(u64).range(1..))]
     pub memory_budget: u64,
     /// Draw frames as fast as possible, not at the display's rate (to measure).
     #[arg(long)]
@@ -75,7 +75,7 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
         path: args.input.clone(),
         field: Some(args.input.clone()),
         start: 0.0,
-        end: h.cycle_seconds as f32,
+        end: h.cycle_seconds,
         fps: RECORD_FPS,
         interpolate: None,
         size: Some(args.size),
@@ -84,7 +84,7 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
         preview: Preview::Apng,
         variant: args.variant.map_or(Variant::FourWay, Into::into),
         lighting: vec![LightKey {
-            time: f32::NEG_INFINITY,
+            time: f64::NEG_INFINITY,
             env,
             yaw: args.yaw.to_radians(),
             intensity: 1.0,

@@ -95,3 +95,21 @@ fn on_the_gl_backend_a_render_runs_or_is_refused_suggesting_the_cpu() {
         assert!(cpu.status.success(), "{}", stderr(&cpu));
     }
 }
+
+/// Outside a desktop session (no `XDG_RUNTIME_DIR`, as under a batch scheduler) a command
+/// that opens no window prints nothing about a display server: Mesa's device-selection
+/// layer probed Wayland and libwayland printed "error: XDG_RUNTIME_DIR is invalid or not
+/// set" once per adapter enumeration, in the same words as the program's own errors
+/// (issue 35).
+#[test]
+fn a_command_without_a_window_does_not_probe_for_a_display() {
+    let mut c = frf_command(&["info", "--gpu"]);
+    c.env_remove("XDG_RUNTIME_DIR")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT");
+    let o = c.output().unwrap();
+    let said = stderr(&o);
+    assert!(!said.contains("XDG_RUNTIME_DIR"), "{said}");
+    assert!(!said.contains("error:") || !o.status.success(), "{said}");
+}

@@ -82,6 +82,78 @@ const CASES: &[Case] = &[
         file: "cap_missing",
         problem: &["a directory is there"],
     },
+    // A footer whose version disagrees with the preamble's (it used to be read).
+    Case {
+        args: &["info", "{bad}/footer_version.frf"],
+        file: "footer_version.frf",
+        problem: &["footer says format version 99", "preamble 1"],
+    },
+    // A viewer script in Latin-1 (it exited 5 naming no line).
+    Case {
+        args: &["view", "{field}", "--script", "{bad}/script_not_utf8.txt"],
+        file: "script_not_utf8.txt",
+        problem: &["line 2 is not UTF-8 text"],
+    },
+    // Orbit flags named as the user wrote them (they were named as a camera path's TOML
+    // keys: "key 0: fov_deg 0 is outside (0.1, 170)", "key 0: a value is not finite").
+    Case {
+        args: &[
+            "render", "{field}", "--orbit", "3,1.2", "--fov", "0", "--out", "{out}/o",
+        ],
+        file: "--fov",
+        problem: &["a vertical field of view is within (0.1, 170)"],
+    },
+    Case {
+        args: &[
+            "render", "{field}", "--orbit", "3,1.2", "--fov", "nan", "--out", "{out}/o",
+        ],
+        file: "--fov",
+        problem: &["an angle is a finite number"],
+    },
+    Case {
+        args: &[
+            "render", "{field}", "--orbit", "3,1.2", "--start", "inf", "--out", "{out}/o",
+        ],
+        file: "--start",
+        problem: &["an angle is a finite number"],
+    },
+    // A memory budget of nothing: refused by the flag with nothing written (it was refused
+    // at the first frame, after settings.json was written into a new --out).
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2",
+            "--memory-budget",
+            "0",
+            "--out",
+            "{out}/o",
+        ],
+        file: "--memory-budget",
+        problem: &["0"],
+    },
+    // Chunks damaged in five places: `frf info` read only the index and said nothing;
+    // `--check` reads every chunk, names the first damaged one and counts the rest.
+    Case {
+        args: &["info", "{bad}/damaged_chunks.frf", "--check"],
+        file: "damaged_chunks.frf",
+        problem: &["checksum mismatch", "more of the"],
+    },
+    // A pose range bounded before it is allocated (it used to take 23 GB, then be killed
+    // with its lock left behind).
+    Case {
+        args: &[
+            "merge",
+            "{field}",
+            "--expect",
+            "0..4294967295",
+            "--out",
+            "{out}/m.frf",
+        ],
+        file: "--expect",
+        problem: &["at most 100000 poses"],
+    },
     Case {
         args: &[
             "render",

@@ -523,7 +523,8 @@ fn a_pose_the_field_lacks_is_refused_or_said() {
 }
 
 /// A field made without shadow maps, rendered with `--shadow maps`, says that it has no
-/// maps, not that no frame sees the ground (issue 23).
+/// maps, not that no frame sees the ground (issue 23); with `--shadow traced`, that it has
+/// no hull (issue 35).
 #[test]
 fn a_field_without_shadow_maps_says_so() {
     let dir = tempfile::tempdir().unwrap();
@@ -563,5 +564,22 @@ fn a_field_without_shadow_maps_says_so() {
     assert!(o.status.success(), "{}", stderr(&o));
     let said = stderr(&o);
     assert!(said.contains("the field has no shadow maps"), "{said}");
+    assert!(!said.contains("no frame sees the ground patch"), "{said}");
+    // Nor a hull (issue 35): `--shadow maps` does not send the user to `--shadow traced`,
+    // and `--shadow traced` says the hull is missing, not that the ground is unseen.
+    assert!(!said.contains("--shadow traced traces the hull"), "{said}");
+    assert!(said.contains("nor has it a visual hull"), "{said}");
+    let i = args.iter().position(|&a| a == "maps").unwrap();
+    args[i] = "traced";
+    let traced_out = dir.path().join("traced");
+    let i = args.iter().position(|&a| a == "--out").unwrap();
+    args[i + 1] = traced_out.to_str().unwrap();
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stderr(&o);
+    assert!(
+        said.contains("the field has no visual hull to trace"),
+        "{said}"
+    );
     assert!(!said.contains("no frame sees the ground patch"), "{said}");
 }

@@ -86,6 +86,26 @@ fn a_rerun_resumes_only_frames_made_from_the_same_field_and_keeps_their_statisti
     assert_eq!(repaired["pixels_inside"], first["pixels_inside"]);
     assert_eq!(std::fs::metadata(&exr).unwrap().len(), bytes);
 
+    // A frame overwritten in place, same size, four bytes changed (issue 35: resume
+    // compared sizes only and kept it).
+    let png = out.join("frame_0001.png");
+    let mut b = std::fs::read(&png).unwrap();
+    let middle = b.len() / 2;
+    for x in &mut b[middle..middle + 4] {
+        *x ^= 0xff;
+    }
+    std::fs::write(&png, &b).unwrap();
+    let o = render(&field, &out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("frame 1:"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("differ from those its record lists"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(report(&out)["frames_rendered"], 1);
+    assert_ne!(std::fs::read(&png).unwrap(), b);
+
     // Another field under the same path (one without shadow maps): not a resume (it used
     // to keep the old frames, as only the arguments were compared).
     let other = frf(&[

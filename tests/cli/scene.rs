@@ -517,8 +517,8 @@ fn eval_judges_a_scene_against_the_walker_at_each_frames_instant() {
     assert_eq!(instant.frames.len(), 4);
     for (a, b) in instant.frames.iter().zip(&pose.frames) {
         assert_eq!(a.pose, 0);
-        assert!((a.time_from_pose_s - a.time as f64).abs() < 1e-6, "{a:?}");
-        assert!((a.truth_time_s - a.time as f64).abs() < 1e-6, "{a:?}");
+        assert!((a.time_from_pose_s - a.time).abs() < 1e-6, "{a:?}");
+        assert!((a.truth_time_s - a.time).abs() < 1e-6, "{a:?}");
         assert_eq!(b.time_from_pose_s, 0.0);
         if a.index == 0 {
             assert!(

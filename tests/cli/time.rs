@@ -101,6 +101,80 @@ fn pose_flows_are_stored_judged_and_merge_like_the_rest() {
     let o = frf(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(std::fs::read(&whole).unwrap() == std::fs::read(&merged).unwrap());
+    pose_flows_lead_to_the_field_s_own_poses(d, &cap, &parts);
+}
+
+/// Issue 35: pose flows between the *field's* consecutive poses. Parts 0 and 2 of a
+/// capture of poses 0-2 hold flows to pose 1, which their merge lacks (it used to store
+/// them and draw 21 % worse frames between poses without a word); one ingest of 0 and 2
+/// measures between them; parts with and without pose flows do not merge; and a one-pose
+/// field drawn between poses says which pose stands in.
+fn pose_flows_lead_to_the_field_s_own_poses(
+    d: &std::path::Path,
+    cap: &std::path::Path,
+    parts: &[std::path::PathBuf],
+) {
+    let merge = |inputs: &[&std::path::Path], out: &std::path::Path| {
+        let mut args = vec!["merge"];
+        args.extend(inputs.iter().map(|p| p.to_str().unwrap()));
+        args.extend(["--out", out.to_str().unwrap()]);
+        frf(&args)
+    };
+    let out = d.join("skip.frf");
+    let o = merge(&[&parts[0], &parts[2]], &out);
+    let said = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert!(said.contains("leads to pose 1"), "{said}");
+    assert!(said.contains("--pose-flow in one run"), "{said}");
+    assert!(!out.exists());
+
+    let skip = d.join("skip_one_run.frf");
+    ingest(cap, &skip, &["--poses", "0,2"]);
+    let field = frf_reflectance::FieldFile::open(&skip).unwrap();
+    let h = field.header();
+    assert_eq!(h.pose(0).unwrap().pose_flows_to, Some([Some(2), Some(2)]));
+    assert_eq!(h.pose(2).unwrap().pose_flows_to, Some([Some(0), Some(0)]));
+    assert!(h.check_pose_flows().is_ok());
+
+    let plain = d.join("p1_plain.frf");
+    let o = frf(&[
+        "ingest",
+        cap.to_str().unwrap(),
+        "--flow-preset",
+        "fast",
+        "--no-shadows",
+        "--poses",
+        "1",
+        "--out",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = merge(&[&parts[0], &plain, &parts[2]], &out);
+    let said = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{said}");
+    assert!(said.contains("p1_plain.frf does not"), "{said}");
+    assert!(said.contains("with --pose-flow, or none"), "{said}");
+
+    // One pose holding pose flows, drawn between poses: pose 0 stands in for 1 and 2, and
+    // the plan says so (it said nothing with interpolate = "flow").
+    let scene = d.join("one_pose.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "field = {:?}\n[time]\nend = 0.1\nfps = 30\ninterpolate = \"flow\"\n\
+             [lighting]\nenv = \"uniform\"\n[camera]\norbit = {{ radius = 3.0, height = 1.4 }}\n",
+            parts[0].to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let o = frf(&["render", scene.to_str().unwrap(), "--plan", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plan: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        plan["poses_substituted"],
+        serde_json::json!([[1, 0], [2, 0]]),
+        "{plan}"
+    );
 }
 
 /// The motion criterion of issue 24: at 60 fps, twice the capture's pose rate, the frame

@@ -87,7 +87,7 @@ impl ViewCamera {
     }
 
     /// The camera path key of this camera at `time`.
-    pub fn key(&self, time: f32) -> Key {
+    pub fn key(&self, time: f64) -> Key {
         Key {
             time,
             position: self.position().to_array(),

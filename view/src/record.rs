@@ -52,9 +52,9 @@ struct SceneOut {
 
 #[derive(Serialize)]
 struct TimeOut {
-    start: f32,
-    end: f32,
-    fps: f32,
+    start: f64,
+    end: f64,
+    fps: f64,
 }
 
 #[derive(Serialize)]
@@ -76,7 +76,7 @@ struct LightingOut {
 
 #[derive(Serialize)]
 struct LightKeyOut {
-    time: f32,
+    time: f64,
     env: String,
     yaw_deg: f32,
     intensity: f32,
@@ -101,7 +101,7 @@ struct CompositeOut {
 struct InstanceOut {
     position: [f32; 3],
     heading_deg: f32,
-    time_offset: f32,
+    time_offset: f64,
 }
 
 /// `path` made absolute (resolved where it exists), as text.
@@ -282,7 +282,7 @@ heading_deg = 90.0
 time_offset = 0.25
 "#;
 
-    fn key(time: f32, x: f32) -> Key {
+    fn key(time: f64, x: f32) -> Key {
         Key {
             time,
             position: [x, 1.4, 3.0],

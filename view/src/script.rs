@@ -2,25 +2,12 @@
 //! command per line, `#` starting a comment. A script is read and checked whole before
 //! the window opens; an error names the file, the line and the command.
 //!
+//! The commands, their arguments and units are listed once, in [`COMMANDS`]; `frf view
+//! --help` prints them ([`help`]). For example:
+//!
 //! ```text
 //! camera 2.5 1.4 3.0  0 0.9 0  30   # position, point looked at, vertical fov (degrees)
-//! view 4 1                          # the captured view of column 4, row 1
-//! snap                              # the captured view nearest the camera
-//! orbit 15 -5                       # degrees about the point looked at (azimuth, elevation)
-//! dolly 0.8                         # distance times 0.8
-//! time 0.25                         # seconds of the scene's clock
-//! step 1                            # poses forward (negative: back)
-//! play / pause
-//! env sky                           # an environment offered: a file given (its path or
-//!                                   # name), sky, uniform
-//! yaw 90                            # degrees
-//! intensity 1.5
-//! variant fourway                   # nearest, linear, twoway, fourway, fourway-e06, ...
-//! backdrop env                      # none, env or plate
-//! shadow off                        # on or off
-//! layer alpha                       # composite, subject, backdrop, alpha or shadow
-//! exposure 1                        # stops
-//! key                               # record the camera at the current time (--record)
+//! env sky
 //! wait 3                            # let 3 frames be drawn
 //! screenshot shot.png               # the frame shown: .png as frf render writes, or .exr
 //! quit
@@ -37,6 +24,89 @@ use glam::Vec3;
 
 use crate::ViewError;
 
+/// Every command: its name, its arguments and what it does (the help of `frf view
+/// --script`, and the usage an error repeats).
+pub const COMMANDS: &[(&str, &str, &str)] = &[
+    (
+        "camera",
+        "X Y Z  TX TY TZ  FOV",
+        "camera at X Y Z looking at TX TY TZ (metres), vertical field of view FOV (degrees)",
+    ),
+    ("view", "U V", "the captured view of column U, row V"),
+    ("snap", "", "the captured view nearest the camera"),
+    (
+        "orbit",
+        "AZ EL",
+        "turn about the point looked at by AZ, EL degrees",
+    ),
+    (
+        "dolly",
+        "F",
+        "distance to the point looked at times F (> 0)",
+    ),
+    ("time", "T", "seconds of the scene's clock"),
+    ("step", "N", "N poses forward (negative: back)"),
+    ("play", "", "play the walk at its rate"),
+    ("pause", "", "stop it"),
+    (
+        "env",
+        "NAME",
+        "an environment offered: a file given (path or name), sky, uniform",
+    ),
+    (
+        "yaw",
+        "DEG",
+        "turn the environment about the vertical, degrees",
+    ),
+    ("intensity", "K", "environment times K (0 to 1e6)"),
+    (
+        "variant",
+        "NAME",
+        "interpolation: nearest, linear, twoway, fourway, fourway-e06, ...",
+    ),
+    ("backdrop", "NAME", "none, env or plate"),
+    ("shadow", "on|off", "the ground shadow"),
+    (
+        "layer",
+        "NAME",
+        "what is shown: composite, subject, backdrop, alpha or shadow",
+    ),
+    (
+        "exposure",
+        "STOPS",
+        "exposure of the frame shown, -30 to 30 stops",
+    ),
+    (
+        "key",
+        "",
+        "record the camera at the current time (with --record)",
+    ),
+    ("wait", "N", "let N frames be drawn"),
+    (
+        "screenshot",
+        "FILE",
+        "write the frame shown: .png (as frf render writes it) or .exr",
+    ),
+    ("quit", "", "close the viewer"),
+];
+
+/// The script language in words, for `frf view --help`.
+pub fn help() -> String {
+    let mut text = String::from(
+        "Run the commands of FILE without a person, then close. One command per line, `#` \
+         starts a comment; the commands up to a `wait`, `screenshot` or `quit` take effect \
+         together before the next frame is drawn. Commands:\n",
+    );
+    for (name, args, what) in COMMANDS {
+        let call = format!("{name} {args}");
+        text.push_str(&format!("  {call:<28} {what}\n"));
+    }
+    text.push_str(
+        "Example: camera 2.5 1.4 3.0  0 0.9 0  30, then wait 2, screenshot shot.png, quit",
+    );
+    text
+}
+
 /// One command of a script.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
@@ -51,7 +121,7 @@ pub enum Command {
     /// Distance times this.
     Dolly(f32),
     /// Seconds of the scene's clock.
-    Time(f32),
+    Time(f64),
     /// Poses forward (negative: back).
     Step(i32),
     /// Play the walk at its rate.
@@ -123,13 +193,25 @@ pub fn parse(path: &Path, text: &str) -> Result<Vec<Line>, ViewError> {
             line: i + 1,
             problem: format!("`{content}`: {why}"),
         };
-        let command = command(content).map_err(bad)?;
+        let command = command(content)
+            .map_err(|why| match usage(content) {
+                Some(u) => format!("{why} (usage: {u})"),
+                None => why,
+            })
+            .map_err(bad)?;
         out.push(Line {
             line: i + 1,
             command,
         });
     }
     Ok(out)
+}
+
+/// How the command `content` starts with is called, if it is one.
+fn usage(content: &str) -> Option<String> {
+    let name = content.split_whitespace().next()?;
+    let (name, args, _) = COMMANDS.iter().find(|(n, _, _)| *n == name)?;
+    Some(format!("{name} {args}").trim_end().to_string())
 }
 
 /// `n` finite numbers.
@@ -171,6 +253,16 @@ fn command(content: &str) -> Result<Command, String> {
             if !(v[6] > 0.0 && v[6] < 180.0) {
                 return Err(format!("field of view {} is outside (0, 180)", v[6]));
             }
+            let most = frf_render::scene::MAX_DISTANCE_M;
+            if let Some(c) = v[..6].iter().find(|c| c.abs() > most) {
+                return Err(format!(
+                    "coordinate {c} is beyond {most} m of the origin (position and point \
+                     looked at, metres)"
+                ));
+            }
+            if Vec3::new(v[0], v[1], v[2]).distance(Vec3::new(v[3], v[4], v[5])) < 1e-4 {
+                return Err("the camera and the point it looks at coincide".into());
+            }
             Command::Camera(
                 Vec3::new(v[0], v[1], v[2]),
                 Vec3::new(v[3], v[4], v[5]),
@@ -199,7 +291,14 @@ fn command(content: &str) -> Result<Command, String> {
             }
             Command::Dolly(v[0])
         }
-        "time" => Command::Time(numbers(&args, 1)?[0]),
+        "time" => {
+            // Read in 64 bits, as every time of a scene.
+            let w = one_word(&args)?;
+            match w.parse::<f64>() {
+                Ok(t) if t.is_finite() => Command::Time(t),
+                _ => return Err(format!("{w:?} is not a finite number of seconds")),
+            }
+        }
         "step" => Command::Step(
             one_word(&args)?
                 .parse()
@@ -211,8 +310,9 @@ fn command(content: &str) -> Result<Command, String> {
         "yaw" => Command::Yaw(numbers(&args, 1)?[0]),
         "intensity" => {
             let v = numbers(&args, 1)?[0];
-            if v < 0.0 {
-                return Err("the intensity must not be negative".into());
+            let most = frf_render::scene::MAX_INTENSITY;
+            if !(0.0..=most).contains(&v) {
+                return Err(format!("intensity {v}: expected 0 to {most:e}"));
             }
             Command::Intensity(v)
         }
@@ -277,7 +377,13 @@ fn command(content: &str) -> Result<Command, String> {
             Command::Screenshot(p)
         }
         "quit" => none(Command::Quit)?,
-        other => return Err(format!("no command {other:?}")),
+        other => {
+            let names: Vec<&str> = COMMANDS.iter().map(|c| c.0).collect();
+            return Err(format!(
+                "no command {other:?} (the commands: {}; `frf view --help` says what each takes)",
+                names.join(", ")
+            ));
+        }
     })
 }
 
@@ -330,6 +436,21 @@ quit
     }
 
     #[test]
+    fn the_help_lists_every_command_the_parser_knows() {
+        let help = help();
+        for (name, args, _) in COMMANDS {
+            assert!(help.contains(&format!("{name} {args}")), "{name}");
+            // The parser knows it: whatever it says of the arguments, not "no command".
+            let e = command(&format!("{name} ?? ?? ??"))
+                .err()
+                .unwrap_or_default();
+            assert!(!e.starts_with("no command"), "{name}: {e}");
+        }
+        let e = command("fly 3").expect_err("no such command");
+        assert!(e.contains("camera, view, snap"), "{e}");
+    }
+
+    #[test]
     fn a_bad_line_is_named() {
         for (text, line, words) in [
             ("time 1\ncamera 0 0 0 0 0\n", 2, "takes 7 number(s)"),
@@ -338,7 +459,18 @@ quit
             ("variant fiveway\n", 1, "no variant \"fiveway\""),
             ("screenshot shot.jpg\n", 1, ".png or an .exr"),
             ("camera 1 1 1 0 0 0 180\n", 1, "outside (0, 180)"),
+            // Issue 35: a far camera was said to coincide with its target, and an
+            // intensity of 1e38 drew a white frame.
+            ("camera 1e30 0 0 0 0.9 0 40\n", 1, "beyond 10000 m"),
+            ("camera 1 1 1 1 1 1 40\n", 1, "coincide"),
+            ("intensity 1e38\n", 1, "expected 0 to 1e6"),
             ("shadow maybe\n", 1, "on or off"),
+            // Issue 35: a first script missed the field of view, which nothing had said.
+            (
+                "camera 2.2 1.4 2.8 0 0.9 0\n",
+                1,
+                "usage: camera X Y Z  TX TY TZ  FOV",
+            ),
             ("quit now\n", 1, "takes nothing"),
         ] {
             let e = parse(Path::new("tour.txt"), text)

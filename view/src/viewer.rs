@@ -52,7 +52,7 @@ pub struct Viewer<'a> {
     /// The camera.
     pub camera: ViewCamera,
     /// Seconds of the scene's clock.
-    pub time: f32,
+    pub time: f64,
     /// Whether the walk plays.
     pub playing: bool,
     /// What is shown of a frame.
@@ -76,7 +76,7 @@ pub struct Viewer<'a> {
     /// The keys recorded.
     pub recording: Recording,
     /// Where the clock loops: `[start, end)`.
-    pub span: (f32, f32),
+    pub span: (f64, f64),
 }
 
 impl<'a> Viewer<'a> {
@@ -88,7 +88,7 @@ impl<'a> Viewer<'a> {
         let (start, end) = if scene.end > scene.start {
             (scene.start, scene.end)
         } else {
-            (scene.start, scene.start + h.cycle_seconds as f32)
+            (scene.start, scene.start + h.cycle_seconds)
         };
         let key = match &scene.camera {
             Trajectory::Path(p) => p.at(start),
@@ -143,13 +143,13 @@ impl<'a> Viewer<'a> {
     }
 
     /// Seconds between two poses of the walk.
-    pub fn pose_seconds(&self) -> f32 {
+    pub fn pose_seconds(&self) -> f64 {
         let h = self.shot.field().header();
-        (h.cycle_seconds / f64::from(h.poses_per_cycle.max(1))) as f32
+        h.cycle_seconds / f64::from(h.poses_per_cycle.max(1))
     }
 
     /// Sets the clock to `t`, looped into the span.
-    pub fn set_time(&mut self, t: f32) {
+    pub fn set_time(&mut self, t: f64) {
         let (a, b) = self.span;
         self.time = if t.is_finite() && b > a {
             a + (t - a).rem_euclid(b - a)
@@ -161,13 +161,13 @@ impl<'a> Viewer<'a> {
     /// Advances the clock by `seconds` of real time while playing.
     pub fn advance(&mut self, seconds: f32) {
         if self.playing {
-            self.set_time(self.time + seconds);
+            self.set_time(self.time + f64::from(seconds));
         }
     }
 
     /// Steps the walk `poses` poses forward (negative: back).
     pub fn step(&mut self, poses: i32) {
-        self.set_time(self.time + poses as f32 * self.pose_seconds());
+        self.set_time(self.time + f64::from(poses) * self.pose_seconds());
     }
 
     /// The poses the walkers show now.
@@ -248,7 +248,7 @@ impl<'a> Viewer<'a> {
         let (yaw, intensity) = (self.yaw_deg.to_radians(), self.intensity);
         self.shot.edit(|s| {
             s.lighting = vec![LightKey {
-                time: f32::NEG_INFINITY,
+                time: f64::NEG_INFINITY,
                 env,
                 yaw,
                 intensity,

@@ -8,8 +8,8 @@ use glam::Vec3;
 
 use super::file::{At, CameraToml, CompositeToml, LightingToml, OutputToml, Reporter, SceneToml};
 use super::{
-    BackdropSpec, Instance, LightKey, MAX_FRAMES, MAX_SIDE_PX, Preview, ShadowSpec,
-    TimeInterpolation,
+    BackdropSpec, Instance, LightKey, MAX_DISTANCE_M, MAX_FRAMES, MAX_INTENSITY, MAX_SIDE_PX,
+    MAX_TIME_S, Preview, ShadowSpec, TimeInterpolation,
 };
 use crate::composite::GroundLook;
 use crate::error::Result;
@@ -32,9 +32,13 @@ fn word<'w>(r: &Reporter, field: &str, v: &'w At<String>, allowed: &[&str]) -> R
     }
 }
 
-fn finite(r: &Reporter, field: &str, v: &At<f32>) -> Result<f32> {
+fn finite<T: Copy + std::fmt::Display + Into<f64>>(
+    r: &Reporter,
+    field: &str,
+    v: &At<T>,
+) -> Result<T> {
     let x = *v.get_ref();
-    if x.is_finite() {
+    if x.into().is_finite() {
         Ok(x)
     } else {
         Err(r.error(field, v.span(), format!("{x} is not a finite number")))
@@ -73,13 +77,22 @@ fn ground(r: &Reporter, v: &At<toml::Value>) -> Result<GroundLook> {
 }
 
 /// `time`: start, end and frame rate.
-pub fn time(r: &Reporter, raw: &SceneToml) -> Result<(f32, f32, f32)> {
+pub fn time(r: &Reporter, raw: &SceneToml) -> Result<(f64, f64, f64)> {
     let t = raw.time.get_ref();
     let (start, end, fps) = (
         finite(r, "time.start", &t.start)?,
         finite(r, "time.end", &t.end)?,
         finite(r, "time.fps", &t.fps)?,
     );
+    for (key, at, v) in [("time.start", &t.start, start), ("time.end", &t.end, end)] {
+        if v.abs() > MAX_TIME_S {
+            return Err(r.error(
+                key,
+                at.span(),
+                format!("{v} s: expected within ±{MAX_TIME_S:e} s"),
+            ));
+        }
+    }
     if end < start {
         return Err(r.error(
             "time.end",
@@ -94,7 +107,7 @@ pub fn time(r: &Reporter, raw: &SceneToml) -> Result<(f32, f32, f32)> {
             format!("{fps}: expected (0, 1000]"),
         ));
     }
-    if ((end - start) * fps) as f64 > MAX_FRAMES as f64 {
+    if (end - start) * fps > MAX_FRAMES as f64 {
         return Err(r.error(
             "time",
             raw.time.span(),
@@ -189,7 +202,7 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
         }
     };
     let mut lighting = vec![LightKey {
-        time: f32::NEG_INFINITY,
+        time: f64::NEG_INFINITY,
         env: base_env,
         yaw: finite(r, "lighting.yaw_deg", &l.yaw_deg)?.to_radians(),
         intensity: finite(r, "lighting.intensity", &l.intensity)?,
@@ -223,7 +236,7 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
         });
     }
     for (i, k) in lighting.iter().enumerate() {
-        if !(k.intensity >= 0.0 && k.intensity <= 1e6) {
+        if !(k.intensity >= 0.0 && k.intensity <= MAX_INTENSITY) {
             let span = if i == 0 {
                 l.intensity.span()
             } else {
@@ -351,7 +364,11 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
         let bad = |name: &str, value: String, range: &str| {
             Err(r.error(&key(name), inst.span(), format!("{value}: {range}")))
         };
-        if !v.position.iter().all(|c| c.is_finite() && c.abs() <= 1e4) {
+        if !v
+            .position
+            .iter()
+            .all(|c| c.is_finite() && c.abs() <= MAX_DISTANCE_M)
+        {
             return bad(
                 "position",
                 format!("{:?}", v.position),

@@ -86,13 +86,13 @@ pub struct SceneToml {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeToml {
-    /// Seconds.
-    #[serde(default = "zero")]
-    pub start: At<f32>,
+    /// Seconds (64-bit: a frame's instant is `start + i / fps` at any time of day).
+    #[serde(default = "zero_seconds")]
+    pub start: At<f64>,
     /// Seconds, exclusive.
-    pub end: At<f32>,
+    pub end: At<f64>,
     /// Frames per second.
-    pub fps: At<f32>,
+    pub fps: At<f64>,
     /// What a frame between captured poses shows.
     pub interpolate: Option<At<String>>,
 }
@@ -162,6 +162,10 @@ fn zero() -> At<f32> {
     At::new(0..0, 0.0)
 }
 
+fn zero_seconds() -> At<f64> {
+    At::new(0..0, 0.0)
+}
+
 fn one() -> At<f32> {
     At::new(0..0, 1.0)
 }
@@ -175,7 +179,7 @@ fn env_word() -> At<String> {
 #[serde(deny_unknown_fields)]
 pub struct LightKeyToml {
     /// Seconds.
-    pub time: At<f32>,
+    pub time: At<f64>,
     /// Another map from this key on.
     pub env: Option<At<String>>,
     /// Degrees.
@@ -277,7 +281,7 @@ pub struct InstanceToml {
     pub heading_deg: f32,
     /// Seconds.
     #[serde(default)]
-    pub time_offset: f32,
+    pub time_offset: f64,
 }
 
 /// Errors about one scene file, pointing at lines.

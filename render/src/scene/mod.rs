@@ -42,6 +42,15 @@ pub const MAX_FRAMES: usize = 200_000;
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
 /// Largest frame side, pixels (8K).
 pub const MAX_SIDE_PX: u32 = 8192;
+/// The latest instant a scene may name, seconds from its clock's zero (either way): f64
+/// resolves a microsecond there, so frames `1 / fps` apart stay apart.
+pub const MAX_TIME_S: f64 = 1e9;
+/// The brightest an environment may be scaled (`lighting.intensity`, the viewer's
+/// `intensity`): far above any exposure a frame can show, far below f32's overflow.
+pub const MAX_INTENSITY: f32 = 1e6;
+/// How far from the origin a position may lie, metres (walkers, the viewer's camera):
+/// f32 still resolves a millimetre there.
+pub const MAX_DISTANCE_M: f32 = 1e4;
 
 /// The animated preview of a render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,7 +89,7 @@ pub enum ShadowSpec {
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightKey {
     /// Seconds.
-    pub time: f32,
+    pub time: f64,
     /// The environment from this key on.
     pub env: EnvSource,
     /// Radians.
@@ -109,7 +118,7 @@ pub struct Instance {
     /// Its heading about `+y`, radians.
     pub heading: f32,
     /// Seconds its walk is ahead of the scene's clock.
-    pub time_offset: f32,
+    pub time_offset: f64,
 }
 
 impl Instance {
@@ -155,12 +164,12 @@ pub struct Scene {
     pub path: PathBuf,
     /// The field, if the file names one.
     pub field: Option<PathBuf>,
-    /// Seconds.
-    pub start: f32,
+    /// Seconds (every time of the scene is 64-bit: 32 bits resolve 1/16 s at 10^6 s).
+    pub start: f64,
     /// Seconds, exclusive (equal to `start` for a still).
-    pub end: f32,
+    pub end: f64,
     /// Frames per second.
-    pub fps: f32,
+    pub fps: f64,
     /// What a frame between captured poses shows; `None`: the morph in time when the
     /// field holds pose-to-pose flows, else the nearest pose.
     pub interpolate: Option<TimeInterpolation>,
@@ -243,18 +252,26 @@ impl Scene {
         })
     }
 
-    /// The frame times: `start + i / fps` before `end`; one frame (a still) when
-    /// `end == start`.
-    pub fn frame_times(&self) -> Vec<f32> {
-        let n = ((self.end - self.start) as f64 * self.fps as f64 - 1e-6)
-            .ceil()
-            .max(1.0) as usize;
-        (0..n).map(|i| self.start + i as f32 / self.fps).collect()
+    /// The frame times: `start + i / fps` for every `i` whose instant is before `end`
+    /// (each computed from `i`, never accumulated); one frame (a still) when `end ==
+    /// start`.
+    pub fn frame_times(&self) -> Vec<f64> {
+        let at = |i: usize| self.start + i as f64 / self.fps;
+        // The count from the half-open interval, corrected where rounding put the last
+        // instant on `end` or short of it.
+        let mut n = ((self.end - self.start) * self.fps).ceil().max(0.0) as usize;
+        while n > 0 && at(n - 1) >= self.end {
+            n -= 1;
+        }
+        while at(n) < self.end {
+            n += 1;
+        }
+        (0..n.max(1)).map(at).collect()
     }
 
     /// The camera at time `t`, frames of `size`: an orbit sweeps the time range (a full
     /// turn loops without repeating its first frame); keys are in scene seconds.
-    pub fn camera_at(&self, t: f32, size: (u32, u32)) -> Result<Camera> {
+    pub fn camera_at(&self, t: f64, size: (u32, u32)) -> Result<Camera> {
         match &self.camera {
             Trajectory::Path(p) => p.at(t).camera(size.0, size.1),
             Trajectory::Orbit(o) => {
@@ -264,14 +281,14 @@ impl Scene {
                 } else {
                     0.0
                 };
-                o.key(f).camera(size.0, size.1)
+                o.key(f as f32).camera(size.0, size.1)
             }
         }
     }
 
     /// The lighting at time `t`: piecewise linear between keys, the map cross-faded from
     /// one key's to the next's when they differ.
-    pub fn lighting_at(&self, t: f32) -> LightingAt {
+    pub fn lighting_at(&self, t: f64) -> LightingAt {
         let k = &self.lighting;
         let i = k.partition_point(|key| key.time <= t).max(1) - 1;
         let a = &k[i];
@@ -283,7 +300,7 @@ impl Scene {
             };
         };
         let s = if a.time.is_finite() {
-            ((t - a.time) / (b.time - a.time)).clamp(0.0, 1.0)
+            ((t - a.time) / (b.time - a.time)).clamp(0.0, 1.0) as f32
         } else {
             0.0
         };
@@ -301,7 +318,7 @@ impl Scene {
 
     /// The pose of the walk cycle (`poses_per_cycle` poses over `cycle_seconds`) that
     /// instance `i` shows at time `t`: the nearest pose to its phase, looping.
-    pub fn pose_at(&self, i: usize, t: f32, cycle_seconds: f64, poses_per_cycle: u32) -> u32 {
+    pub fn pose_at(&self, i: usize, t: f64, cycle_seconds: f64, poses_per_cycle: u32) -> u32 {
         let n = poses_per_cycle.max(1) as f64;
         let phase = self.phase_at(i, t, cycle_seconds);
         ((phase * n).round() as u32) % poses_per_cycle.max(1)
@@ -309,8 +326,8 @@ impl Scene {
 
     /// Where in its walk cycle (of `cycle_seconds`) instance `i` is at time `t`, in cycles,
     /// `[0, 1)`: pose `k` of `n` per cycle is at phase `k / n`.
-    pub fn phase_at(&self, i: usize, t: f32, cycle_seconds: f64) -> f64 {
-        ((t + self.instances[i].time_offset) as f64 / cycle_seconds).rem_euclid(1.0)
+    pub fn phase_at(&self, i: usize, t: f64, cycle_seconds: f64) -> f64 {
+        ((t + self.instances[i].time_offset) / cycle_seconds).rem_euclid(1.0)
     }
 
     /// Every environment the scene names.

@@ -44,7 +44,7 @@ const PREVIEW_WIDTH: usize = 480;
 #[derive(Serialize, Deserialize, Clone)]
 struct FrameRecord {
     index: usize,
-    time: f32,
+    time: f64,
     poses: Vec<u32>,
     made_resident: Vec<u32>,
     /// Kept from an earlier run (its timings are that run's).
@@ -57,9 +57,20 @@ struct FrameRecord {
     pixels_clamped_above: usize,
     pixels_clamped_below: usize,
     pixels_missed: usize,
-    /// The frame's files and their sizes in bytes (in the record only).
+    /// The frame's files, their sizes and checksums (in the record only).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    files: Vec<(String, u64)>,
+    files: Vec<FileRecord>,
+}
+
+/// One file of a frame as written: what a resume compares it with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct FileRecord {
+    /// Its name in the output directory.
+    name: String,
+    /// Its size, bytes.
+    bytes: u64,
+    /// The CRC-32 of its bytes: a frame overwritten in place at the same size is seen.
+    crc32: u32,
 }
 
 impl FrameRecord {
@@ -106,11 +117,13 @@ impl FrameFiles {
         written.extend([frame_path(dir, i, "exr"), frame_path(dir, i, "png")]);
         let mut record = self.record.clone();
         for path in written {
-            let bytes = std::fs::metadata(&path)
-                .map_err(|e| frf_core::CoreError::io(&path, e))?
-                .len();
+            let (bytes, crc32) = frf_core::io::content_identity(&path)?;
             let name = path.file_name().unwrap_or_default().to_string_lossy();
-            record.files.push((name.into_owned(), bytes));
+            record.files.push(FileRecord {
+                name: name.into_owned(),
+                bytes,
+                crc32,
+            });
         }
         record.seconds_writing = Some(t.elapsed().as_secs_f64());
         let text = serde_json::to_string_pretty(&record).map_err(json_error)?;
@@ -135,6 +148,8 @@ pub struct FrameRecordRef(FrameRecord);
 /// An output directory being filled.
 pub struct Output {
     dir: PathBuf,
+    /// Whether this run made the directory (it did not exist).
+    made_dir: bool,
     resume: bool,
     total: usize,
     records: Vec<FrameRecord>,
@@ -223,6 +238,7 @@ impl Output {
                 dir.display()
             )));
         }
+        let made_dir = !dir.exists();
         std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
         let mut settings = settings.clone();
         // A frame range may change between runs into one directory (array jobs); the
@@ -250,6 +266,7 @@ impl Output {
         write_bytes_atomic(&path, text.as_bytes())?;
         Ok(Self {
             dir: dir.to_path_buf(),
+            made_dir,
             resume: same && !overwrite,
             total,
             records: Vec::new(),
@@ -258,7 +275,7 @@ impl Output {
     }
 
     /// Whether frame `i` is there already and may be kept: its record is there and its
-    /// files have the sizes the record lists.
+    /// files have the sizes and checksums the record lists.
     pub fn kept(&self, i: usize) -> Kept {
         if !self.resume {
             return Kept::No;
@@ -274,21 +291,41 @@ impl Output {
                 false => Kept::No,
             };
         };
-        for (name, bytes) in &record.files {
-            let file = self.dir.join(name);
-            match std::fs::metadata(&file) {
-                Ok(m) if m.len() == *bytes => {}
-                Ok(m) => {
+        for f in &record.files {
+            let file = self.dir.join(&f.name);
+            match frf_core::io::content_identity(&file) {
+                Ok((bytes, _)) if bytes != f.bytes => {
                     return Kept::Damaged(format!(
-                        "{} holds {} bytes, its record says {bytes} (cut short?)",
+                        "{} holds {bytes} bytes, its record says {} (cut short?)",
                         file.display(),
-                        m.len()
+                        f.bytes
                     ));
                 }
+                Ok((_, crc)) if crc != f.crc32 => {
+                    return Kept::Damaged(format!(
+                        "{}: its bytes differ from those its record lists (changed since)",
+                        file.display()
+                    ));
+                }
+                Ok(_) => {}
                 Err(_) => return Kept::Damaged(format!("{} is missing", file.display())),
             }
         }
         Kept::Yes(Box::new(FrameRecordRef(record)))
+    }
+
+    /// Removes what [`Output::open`] wrote when no frame is in the directory: a run that
+    /// failed before its first frame leaves no directory it made (nor a settings file in
+    /// a directory it found empty).
+    pub fn abandon_if_empty(&self) {
+        if holds_frames(&self.dir) {
+            return;
+        }
+        let _ = std::fs::remove_file(self.dir.join("settings.json"));
+        if self.made_dir {
+            // Only when empty: anything else in it is not ours to remove.
+            let _ = std::fs::remove_dir(&self.dir);
+        }
     }
 
     /// Notes that frame `i` was kept from an earlier run, with its record.
@@ -364,11 +401,21 @@ impl Output {
                 let small = fit_width(&frames, PREVIEW_WIDTH);
                 match scene.preview {
                     Preview::Apng => {
-                        write_apng(&self.dir.join("preview.png"), &small, scene.fps, scale)?;
+                        write_apng(
+                            &self.dir.join("preview.png"),
+                            &small,
+                            scene.fps as f32,
+                            scale,
+                        )?;
                         extras.push("preview.png (animated)".into());
                     }
                     Preview::Gif => {
-                        write_gif(&self.dir.join("preview.gif"), &small, scene.fps, scale)?;
+                        write_gif(
+                            &self.dir.join("preview.gif"),
+                            &small,
+                            scene.fps as f32,
+                            scale,
+                        )?;
                         extras.push("preview.gif".into());
                     }
                     Preview::None => {}
@@ -509,5 +556,36 @@ impl Output {
                 format!(", {}", extras.join(", "))
             }
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run that fails before its first frame leaves nothing: the directory it made is
+    /// removed; in a directory it found, only the settings it wrote (issue 35:
+    /// `--memory-budget` refused at the first frame left a new `--out` with its settings).
+    #[test]
+    fn a_run_without_a_frame_leaves_no_directory_or_settings() -> Result<()> {
+        let root = tempfile::tempdir().map_err(|e| frf_core::CoreError::io(Path::new("."), e))?;
+        let settings = serde_json::json!({ "args": {} });
+        let made = root.path().join("new");
+        Output::open(&made, &settings, false, 3)?.abandon_if_empty();
+        assert!(!made.exists());
+
+        let found = root.path().join("found");
+        std::fs::create_dir(&found).map_err(|e| frf_core::CoreError::io(&found, e))?;
+        std::fs::write(found.join("notes.txt"), "mine")
+            .map_err(|e| frf_core::CoreError::io(&found, e))?;
+        Output::open(&found, &settings, false, 3)?.abandon_if_empty();
+        assert!(found.join("notes.txt").exists() && !found.join("settings.json").exists());
+
+        // With a frame in it, nothing is removed.
+        std::fs::write(frame_path(&found, 0, "png"), "x")
+            .map_err(|e| frf_core::CoreError::io(&found, e))?;
+        Output::open(&found, &settings, true, 3)?.abandon_if_empty();
+        assert!(found.join("settings.json").exists());
+        Ok(())
     }
 }

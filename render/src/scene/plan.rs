@@ -96,7 +96,7 @@ pub struct FramePlan {
     /// Index in the scene's frames.
     pub index: usize,
     /// Seconds.
-    pub time: f32,
+    pub time: f64,
     /// Per instance: the pose drawn (the earlier of two between poses).
     pub poses: Vec<u32>,
     /// Per instance, between two poses: the later pose and the fraction of the way to it
@@ -113,7 +113,7 @@ impl FramePlan {
         h: &FieldHeader,
         field_poses: &[u32],
         interpolate: TimeInterpolation,
-        (index, time): (usize, f32),
+        (index, time): (usize, f64),
     ) -> Self {
         let (poses, between) = (0..scene.instances.len())
             .map(|i| match interpolate {
@@ -455,7 +455,7 @@ pub struct ShotFrame {
     /// Index in the shot.
     pub index: usize,
     /// Seconds.
-    pub time: f32,
+    pub time: f64,
     /// The camera.
     pub camera: Camera,
 }
@@ -601,6 +601,14 @@ impl Plan {
                 None => None,
             })
         };
+        if interpolate == TimeInterpolation::Flow {
+            field.header().check_pose_flows().map_err(|(_, problem)| {
+                RenderError::BadParameter(format!(
+                    "{}: {problem}; or draw the nearest pose (time.interpolate = \"nearest\")",
+                    field.path().display()
+                ))
+            })?;
+        }
         let mut plan =
             Self::from_header(scene, field.header(), frames, interpolate, &mut hull_box)?;
         let rows = field.header().rows;
@@ -645,7 +653,34 @@ impl Plan {
             }
         }
         plan.check_views_held(field.path(), rows, &held)?;
+        plan.check_pose_flows_held(field)?;
         Ok(plan)
+    }
+
+    /// An error naming the first pose whose motion toward the next or previous pose the
+    /// frames between poses need and the field lacks altogether (its part merged without
+    /// `--pose-flow`, before merge refused that), before anything is rendered.
+    fn check_pose_flows_held<R: ReadAt>(&self, field: &FieldFile<R>) -> Result<()> {
+        for p in &self.poses {
+            for step in PoseStep::ALL {
+                let holds = field
+                    .chunks()
+                    .any(|c| c.key.pose == p.pose && c.key.kind == ChunkKind::PoseFlow(step));
+                if p.pose_flows[step.index()] && !holds {
+                    return Err(RenderError::BadParameter(format!(
+                        "{}: frames between poses need pose {}'s motion {}, and the field holds \
+                         none for it (was its part ingested without --pose-flow?): ingest pose {} \
+                         with --pose-flow and merge again, or draw the nearest pose \
+                         (time.interpolate = \"nearest\")",
+                        field.path().display(),
+                        p.pose,
+                        step.name(),
+                        p.pose
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// An error naming the views the frames need that the field lacks (a field made for
@@ -715,7 +750,10 @@ impl Plan {
                 let fp = FramePlan::at(scene, h, &field_poses, interpolate, (index, time));
                 for (i, &held) in fp.poses.iter().enumerate() {
                     let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                    if interpolate == TimeInterpolation::Nearest && held != wanted {
+                    // Morphing in time, a frame stands a pose in only where it has no
+                    // other to morph toward (a one-pose field): said as nearest's are.
+                    let morphed = interpolate == TimeInterpolation::Flow && fp.between[i].is_some();
+                    if !morphed && held != wanted {
                         substituted.insert((wanted, held));
                     }
                 }

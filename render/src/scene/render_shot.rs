@@ -3,8 +3,8 @@
 //! renders (at most two waiting), so that a sequence runs at the slower of rendering and
 //! encoding; frames already in the output are kept ([`Output::kept`]).
 
-use std::sync::mpsc::{channel, sync_channel};
-use std::time::Instant;
+use std::sync::mpsc::{RecvTimeoutError, channel, sync_channel};
+use std::time::{Duration, Instant};
 
 use frf_core::progress::Progress;
 use frf_reflectance::container::ReadAt;
@@ -16,7 +16,8 @@ use crate::error::{RenderError, Result};
 
 /// Renders `frames` of `shot` into `output` (with their layers when `layers`, the PNGs
 /// exposed by `exposure_stops`), one progress phase of a step per frame. Stops at the
-/// first error, of rendering or of writing; what was written stays (a rerun resumes).
+/// first error, of rendering or of writing; what was written stays (a rerun resumes), and
+/// a directory this run made that holds no frame is removed.
 pub fn render_shot<R: ReadAt>(
     shot: &mut Shot<'_, R>,
     frames: &[ShotFrame],
@@ -50,7 +51,9 @@ pub fn render_shot<R: ReadAt>(
                 Kept::No => {}
             }
             let t = Instant::now();
-            let r = match shot.render(f, layers) {
+            let r = match while_saying(progress, f.index, STILL_RENDERING_EVERY, || {
+                shot.render(f, layers)
+            }) {
                 Ok(r) => r,
                 Err(e) => {
                     result = Err(e);
@@ -75,7 +78,81 @@ pub fn render_shot<R: ReadAt>(
     for (i, seconds) in written.try_iter() {
         output.written(i, seconds);
     }
+    if rendered.is_err() {
+        // Failed before its first frame: a new output directory is not left behind with
+        // only the settings in it.
+        output.abandon_if_empty();
+    }
     rendered?;
     progress.finish();
     Ok(())
+}
+
+/// How long a frame renders before the user is told it still does, and how often again.
+pub const STILL_RENDERING_EVERY: Duration = Duration::from_secs(20);
+
+/// Runs `render` (frame `index`), saying `every` ([`STILL_RENDERING_EVERY`]) that the
+/// frame is still rendering: a large frame on a software GPU takes minutes, and a bar that
+/// counts frames would stand still meanwhile (and is hidden in a log).
+fn while_saying<T>(
+    progress: &dyn Progress,
+    index: usize,
+    every: Duration,
+    render: impl FnOnce() -> Result<T>,
+) -> Result<T> {
+    let (done, wait) = channel::<()>();
+    std::thread::scope(|scope| {
+        scope.spawn(move || {
+            let start = Instant::now();
+            while let Err(RecvTimeoutError::Timeout) = wait.recv_timeout(every) {
+                progress.note(&format!(
+                    "frame {index}: still rendering, {:.0} s so far",
+                    start.elapsed().as_secs_f64()
+                ));
+            }
+        });
+        let r = render();
+        let _ = done.send(());
+        r
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Mutex;
+
+    use super::*;
+
+    /// Keeps the notes.
+    #[derive(Default)]
+    struct Notes(Mutex<Vec<String>>);
+
+    impl Progress for Notes {
+        fn phase(&self, _what: &str, _total: usize) {}
+        fn step(&self) {}
+        fn note(&self, what: &str) {
+            self.0
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(what.into());
+        }
+    }
+
+    #[test]
+    fn a_long_frame_is_said_to_be_still_rendering_and_a_short_one_is_not() {
+        let notes = Notes::default();
+        let every = Duration::from_millis(20);
+        let r = while_saying(&notes, 7, every, || {
+            std::thread::sleep(Duration::from_millis(150));
+            Ok(3)
+        });
+        assert_eq!(r.ok(), Some(3));
+        let said = notes.0.lock().unwrap_or_else(|e| e.into_inner()).clone();
+        assert!(said.len() >= 2, "{said:?}");
+        assert!(said[0].starts_with("frame 7: still rendering"), "{said:?}");
+        let quiet = Notes::default();
+        let r = while_saying(&quiet, 0, Duration::from_secs(60), || Ok(()));
+        assert!(r.is_ok());
+        assert!(quiet.0.lock().unwrap_or_else(|e| e.into_inner()).is_empty());
+    }
 }

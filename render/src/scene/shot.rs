@@ -409,13 +409,13 @@ impl<'a, R: ReadAt> Shot<'a, R> {
 
     /// The pose each walker shows at `time`: the walk's pose at that time, or the nearest
     /// one the field holds; between two poses when the shot morphs in time, the earlier.
-    pub fn poses_at(&self, time: f32) -> Vec<u32> {
+    pub fn poses_at(&self, time: f64) -> Vec<u32> {
         self.frame_at(0, time).poses
     }
 
     /// The plan of a frame at `time` drawn as frame `index`: per walker, its pose (or the
     /// two it is between) as the shot's plan would give it.
-    fn frame_at(&self, index: usize, time: f32) -> FramePlan {
+    fn frame_at(&self, index: usize, time: f64) -> FramePlan {
         let h = self.field.header();
         let mut held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
         held.sort_unstable();
@@ -428,7 +428,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     pub fn draw_at(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
-        time: f32,
+        time: f64,
         camera: &frf_core::camera::Camera,
         timestamps: crate::gpu::timing::Timestamps,
     ) -> Result<DrawnFrame> {
@@ -467,7 +467,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// draws it (a viewer's screenshot; on the CPU too).
     pub fn render_at(
         &mut self,
-        time: f32,
+        time: f64,
         camera: &frf_core::camera::Camera,
         layers: bool,
     ) -> Result<ShotResult> {
@@ -478,7 +478,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
 
     /// The environment lighting the scene (scene frame) at `t` seconds: `None` when the
     /// scene shows the field unlit.
-    pub fn lighting_at(&mut self, t: f32) -> Result<Option<EnvMap>> {
+    pub fn lighting_at(&mut self, t: f64) -> Result<Option<EnvMap>> {
         let l = self.scene.lighting_at(t);
         self.world_lighting(&l)
     }
@@ -759,7 +759,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .map(|(k, _)| k);
             let Some(k) = victim else {
                 return Err(RenderError::BadParameter(format!(
-                    "frame {frame} needs {:.1} MB of resident poses, more than the memory budget of {:.1} MB",
+                    "frame {frame} needs {:.1} MB of resident poses, more than the memory budget of {:.1} MB (--memory-budget)",
                     total(&self.cache) as f64 / 1e6,
                     self.options.memory_budget as f64 / 1e6
                 )));

@@ -47,6 +47,42 @@ fn a_minimal_scene_gets_its_defaults() {
     assert!((c0 - c_end).length() < 1e-4);
 }
 
+/// Times near 10^6 s (issue 35): held in 32 bits they resolved 1/16 s, so that `start =
+/// 1e6, end = 1e6 + 0.1` at 30 fps gave 4 frames, two at one instant and the last at the
+/// exclusive end, and a walker 10^6 s ahead froze every other frame. In 64 bits: 3
+/// distinct frames `start + i / fps`, every one before `end`, and a walk that moves.
+#[test]
+fn times_far_from_zero_keep_their_frames_apart_and_the_walk_moving() {
+    let late = MINIMAL.replace(
+        "end = 1.0\nfps = 10",
+        "start = 1e6\nend = 1000000.1\nfps = 30",
+    );
+    let s = scene(&late).unwrap();
+    let t = s.frame_times();
+    assert_eq!(t.len(), 3, "{t:?}");
+    for (i, &ti) in t.iter().enumerate() {
+        assert_eq!(ti, 1e6 + i as f64 / 30.0);
+        assert!(ti < s.end);
+    }
+    // Beyond 10^9 s f64 no longer keeps microseconds: refused, naming the key.
+    let e = error(&MINIMAL.replace("end = 1.0", "start = 1e12\nend = 1e12"));
+    assert!(e.contains("time.start") && e.contains("within"), "{e}");
+    // Whole frame counts stay whole: 0 to 1 s at 10 fps is 10 frames, the last at 0.9 s.
+    let ten = scene(MINIMAL).unwrap().frame_times();
+    assert_eq!((ten.len(), ten[9]), (10, 0.9));
+
+    let ahead = format!("{MINIMAL}\n[[instance]]\ntime_offset = 1e6\n")
+        .replace("end = 1.0\nfps = 10", "end = 0.2\nfps = 60");
+    let s = scene(&ahead).unwrap();
+    let poses: Vec<u32> = s
+        .frame_times()
+        .iter()
+        .map(|&t| s.pose_at(0, t, 1.0, 300))
+        .collect();
+    // 300 poses a second at 60 fps: five poses a frame, every frame another.
+    assert!(poses.windows(2).all(|w| w[0] != w[1]), "{poses:?}");
+}
+
 #[test]
 fn a_zero_length_range_is_a_still_and_a_reversed_one_is_refused() {
     let still = MINIMAL.replace("end = 1.0", "start = 2.0\nend = 2.0");
