@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
-use crate::common::{frf, staged_capture, stderr};
+use crate::common::{frf_command, staged_capture, stderr};
 use frf_eval::report::STAGES;
 
 #[test]
@@ -25,18 +25,21 @@ fn a_quick_report_measures_every_stage_and_resumes() {
     )
     .unwrap();
     let out = dir.path().join("report");
+    // `--out` relative to the working directory, as a person types it: the shots' scene
+    // files named their field relative to it, and a scene reads paths relative to itself
+    // (the field was looked for at report/runs/report/runs/...).
     let mut args = vec![
         "report",
         "--capture",
         cap.to_str().unwrap(),
         "--out",
-        out.to_str().unwrap(),
+        "report",
         "--quick",
         "--peers",
         peers.to_str().unwrap(),
     ];
     args.extend(frf_testkit::cpu_flag());
-    let o = frf(&args);
+    let o = frf_command(&args).current_dir(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     let report: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
@@ -94,7 +97,7 @@ fn a_quick_report_measures_every_stage_and_resumes() {
     );
 
     // A rerun keeps every run: the same rows, measured before.
-    let o = frf(&args);
+    let o = frf_command(&args).current_dir(dir.path()).output().unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     let again: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
@@ -111,7 +114,7 @@ fn a_quick_report_measures_every_stage_and_resumes() {
 
     // Peers that are not the peer script's output are refused naming the file.
     std::fs::write(&peers, "{\"results\": {}}").unwrap();
-    let o = frf(&args);
+    let o = frf_command(&args).current_dir(dir.path()).output().unwrap();
     let e = stderr(&o);
     assert!(
         !o.status.success() && e.contains("peers.json") && e.contains("summary"),

@@ -93,7 +93,17 @@ impl Sweep<'_> {
                 &format!("{}; {}", staged.command, ingested.command),
             );
             for interpolate in ["flow", "nearest"] {
-                let mut text = scene(&f, p, config, &self.env, size);
+                // A scene file's paths are read relative to its own folder: the field
+                // beside it by name, an environment file by its absolute path (relative
+                // ones named the field twice over with a relative --out).
+                let beside = Path::new(f.file_name().unwrap_or_default());
+                let env = match Path::new(&self.env) {
+                    e if e.is_file() => s(
+                        &std::path::absolute(e).map_err(|err| frf_core::CoreError::io(e, err))?
+                    ),
+                    _ => self.env.clone(),
+                };
+                let mut text = scene(beside, p, config, &env, size);
                 text = text.replace(
                     "fps = 60.0\n",
                     &format!("fps = 60.0\ninterpolate = \"{interpolate}\"\n"),
