@@ -15,10 +15,11 @@ use std::time::Instant;
 
 use frf_core::camera::Camera;
 use frf_core::capture::Capture;
-use frf_core::image::{GrayImage, RgbImage};
+use frf_core::image::{FlowImage, GrayImage, RgbImage};
 use frf_flow::{FlowParams, Preset};
 use frf_reflectance::container::merge_fields;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
+use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::stats::FieldStats;
 use frf_reflectance::store::{EncodedView, encode_flows, encode_images, encode_pose_flows};
 use frf_reflectance::{FieldFile, FieldHeader, FieldWriter};
@@ -31,7 +32,7 @@ use crate::evidence::{Evaluator, PoseErrors, PoseEvidence, SampledView};
 use crate::guided::{InterViewFlow, flow_hull};
 use crate::interview::{GridViews, grid_flows};
 use crate::matte::MatteRule;
-use crate::shadows::{ShadowOptions, pose_shadows};
+use crate::shadows::{PoseShadows, ShadowOptions, pose_shadows};
 use crate::views::{ViewSeconds, ViewSettings, process_view};
 
 /// What to ingest and how.
@@ -400,6 +401,11 @@ fn share(phase_wall: f64, steps: &[(&str, f64)]) -> Vec<Step> {
         .collect()
 }
 
+/// A view's flows to its grid neighbours ([`frf_core::grid::Neighbour::ALL`] order).
+type ViewFlows = [Option<FlowImage>; 4];
+/// A view's flows to the next and previous pose ([`frf_core::grid::PoseStep::ALL`] order).
+type ViewPoseFlows = [Option<FlowImage>; 2];
+
 struct ViewOut {
     images: EncodedView,
     alpha: GrayImage,
@@ -422,13 +428,7 @@ fn ingest_pose(
     let mut steps = Vec::new();
 
     let start = Instant::now();
-    let clean: Vec<Vec<RgbImage>> = (0..rows)
-        .map(|v| {
-            (0..capture.slots().len())
-                .map(|s| capture.load_clean_plate(v, s))
-                .collect()
-        })
-        .collect::<frf_core::Result<_>>()?;
+    let clean = clean_plates(capture)?;
     steps.push(Step {
         name: "load clean plates".into(),
         seconds: start.elapsed().as_secs_f64(),
@@ -441,9 +441,144 @@ fn ingest_pose(
         settings(capture, options).flow_preset
     );
 
-    // The views ingested: filmed, and selected.
     let selected = options.selection.as_ref();
-    let present: Vec<bool> = (0..columns * rows)
+    let present = views_present(capture, pose, selected)?;
+    let views = views_step(
+        capture,
+        pose,
+        (&header, &present, &clean),
+        (options, &params, evaluator),
+        progress,
+        &mut steps,
+    )?;
+
+    let images: Vec<Option<&RgbImage>> = views
+        .iter()
+        .map(|v| v.as_ref().map(|v| &v.summed))
+        .collect();
+    let alphas: Vec<Option<&GrayImage>> =
+        views.iter().map(|v| v.as_ref().map(|v| &v.alpha)).collect();
+    let cameras: Vec<Camera> = (0..columns * rows)
+        .map(|i| capture.subject_camera(i / rows, i % rows, pose))
+        .collect();
+    let guide = match options.inter_view_flow {
+        InterViewFlow::Hull => {
+            guide_step(pose, options, (&cameras, &alphas), progress, &mut steps)?
+        }
+        InterViewFlow::Images => None,
+    };
+    progress.begin(pose, "inter-view flow", columns * rows);
+    let start = Instant::now();
+    let grid = grid_flows(
+        &GridViews {
+            columns,
+            rows,
+            wraps: header.wraps,
+            images: &images,
+            alphas: &alphas,
+            cameras: &cameras,
+            wanted: selected
+                .and_then(|s| s.flows.get(&pose))
+                .map(|f| f.as_slice()),
+            hull: guide.as_ref(),
+        },
+        &params,
+        &|| {
+            check_stop(progress)?;
+            progress.advance();
+            Ok(())
+        },
+    )?;
+    steps.extend(share(
+        start.elapsed().as_secs_f64(),
+        &[
+            ("inter-view flow, horizontal pairs", grid.horizontal_seconds),
+            ("inter-view flow, vertical pairs", grid.vertical_seconds),
+        ],
+    ));
+    let flows = grid.flows;
+
+    let among = pose_flow_poses(capture, options);
+    let pose_flows = match options.pose_flows {
+        true => pose_flow_step(
+            capture,
+            (pose, &among),
+            (&header, &alphas, guide.as_ref()),
+            (&clean, options.matte_rule, &params),
+            progress,
+            &mut steps,
+        )?,
+        false => vec![Default::default(); columns * rows],
+    };
+
+    let shadows = match &options.shadows {
+        Some(s) => Some(shadow_step(
+            pose,
+            (&cameras, &alphas),
+            (&header, s),
+            progress,
+            &mut steps,
+        )?),
+        None => None,
+    };
+
+    let start = Instant::now();
+    if options.pose_flows {
+        header.record_pose_flows(pose, &among)?;
+    }
+    let (part, json) = part_paths(out, pose);
+    write_part(
+        &part,
+        (header, pose),
+        &views,
+        &flows,
+        &pose_flows,
+        shadows.as_ref(),
+    )?;
+    steps.push(Step {
+        name: "compress flows and write".into(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+
+    let errors = match evaluator {
+        Some(evaluator) => Some(evaluate_step(
+            evaluator,
+            (pose, views),
+            (&flows, &pose_flows, &among),
+            shadows.as_ref(),
+            progress,
+        )?),
+        None => None,
+    };
+    let report = PoseReport {
+        pose,
+        settings: settings(capture, options),
+        resumed: false,
+        steps,
+        errors,
+    };
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| IngestError::BadParameter(e.to_string()))?;
+    frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
+    Ok(report)
+}
+
+/// Every camera's clean plates, by slot.
+fn clean_plates(capture: &Capture) -> Result<Vec<Vec<RgbImage>>> {
+    Ok((0..capture.cameras().len())
+        .map(|v| {
+            (0..capture.slots().len())
+                .map(|s| capture.load_clean_plate(v, s))
+                .collect()
+        })
+        .collect::<frf_core::Result<_>>()?)
+}
+
+/// Per view of `pose` (`u`-major), whether it is ingested: filmed, and selected; refused
+/// when none is.
+fn views_present(capture: &Capture, pose: u32, selected: Option<&Selection>) -> Result<Vec<bool>> {
+    let rows = capture.cameras().len();
+    let present: Vec<bool> = (0..capture.cycles() * rows)
         .map(|i| {
             capture.is_filmed(pose, i / rows, i % rows)
                 && selected.is_none_or(|s| s.views.get(&pose).is_some_and(|v| v[i]))
@@ -454,13 +589,27 @@ fn ingest_pose(
             "pose {pose}: no view of it is both filmed and selected"
         )));
     }
+    Ok(present)
+}
+
+/// Every view of `pose` that `present` marks matted, registered and its basis images
+/// encoded with `header`'s codecs (in parallel), timed into `steps`.
+fn views_step(
+    capture: &Capture,
+    pose: u32,
+    (header, present, clean): (&FieldHeader, &[bool], &[Vec<RgbImage>]),
+    (options, params, evaluator): (&IngestOptions, &FlowParams, Option<&dyn Evaluator>),
+    progress: &dyn Progress,
+    steps: &mut Vec<Step>,
+) -> Result<Vec<Option<ViewOut>>> {
+    let rows = capture.cameras().len();
     progress.begin(
         pose,
         "mattes and registration",
         present.iter().filter(|&&p| p).count(),
     );
     let start = Instant::now();
-    let views: Vec<Option<ViewOut>> = (0..columns * rows)
+    let views: Vec<Option<ViewOut>> = (0..present.len())
         .into_par_iter()
         .map(|i| {
             if !present[i] {
@@ -469,14 +618,14 @@ fn ingest_pose(
             check_stop(progress)?;
             let (u, v) = (i / rows, i % rows);
             let settings = ViewSettings {
-                flow: params,
+                flow: *params,
                 matte_rule: options.matte_rule,
                 keep_unregistered: evaluator.is_some_and(|e| e.wants_unregistered(u, v)),
                 edge: options.edge,
             };
             let r = process_view(capture, pose, u, v, &clean[v], &settings)?;
             let t = Instant::now();
-            let images = encode_images(&header, &r.basis, &r.alpha)?;
+            let images = encode_images(header, &r.basis, &r.alpha)?;
             progress.advance();
             Ok(Some(ViewOut {
                 images,
@@ -511,120 +660,150 @@ fn ingest_pose(
         ],
     ));
 
-    let images: Vec<Option<&RgbImage>> = views
+    Ok(views)
+}
+
+/// The errors of pose `pose` against the ground truth, from what ingest computed.
+fn evaluate_step(
+    evaluator: &dyn Evaluator,
+    (pose, views): (u32, Vec<Option<ViewOut>>),
+    (flows, pose_flows, among): (&[ViewFlows], &[ViewPoseFlows], &[u32]),
+    shadows: Option<&PoseShadows>,
+    progress: &dyn Progress,
+) -> Result<PoseErrors> {
+    progress.begin(pose, "evaluation against the ground truth", 1);
+    let alphas: Vec<Option<GrayImage>> = views
         .iter()
-        .map(|v| v.as_ref().map(|v| &v.summed))
+        .map(|v| v.as_ref().map(|v| v.alpha.clone()))
         .collect();
-    let alphas: Vec<Option<&GrayImage>> =
-        views.iter().map(|v| v.as_ref().map(|v| &v.alpha)).collect();
-    let cameras: Vec<Camera> = (0..columns * rows)
-        .map(|i| capture.subject_camera(i / rows, i % rows, pose))
+    let registered: Vec<SampledView> = views
+        .into_iter()
+        .flatten()
+        .filter_map(|v| v.registered)
         .collect();
-    let guide = if options.inter_view_flow == InterViewFlow::Hull {
-        progress.begin(pose, "hull of the flows", 1);
-        let start = Instant::now();
-        let hull = flow_guide(options, &cameras, &alphas)?;
-        steps.push(Step {
-            name: "hull of the flows".into(),
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        progress.advance();
-        hull
-    } else {
-        None
-    };
-    progress.begin(pose, "inter-view flow", columns * rows);
+    let e = evaluator
+        .evaluate(
+            pose,
+            &PoseEvidence {
+                alphas: &alphas,
+                flows,
+                pose_flows,
+                pose_flows_among: among,
+                registered: &registered,
+                hull: shadows.map(|s| &s.hull),
+            },
+        )
+        .map_err(IngestError::Evaluation)?;
+    progress.advance();
+    Ok(e)
+}
+
+/// The hull that guides `pose`'s inter-view flows ([`flow_guide`]), timed into `steps`.
+fn guide_step(
+    pose: u32,
+    options: &IngestOptions,
+    (cameras, alphas): (&[Camera], &[Option<&GrayImage>]),
+    progress: &dyn Progress,
+    steps: &mut Vec<Step>,
+) -> Result<Option<VoxelHull>> {
+    progress.begin(pose, "hull of the flows", 1);
     let start = Instant::now();
-    let grid = grid_flows(
-        &GridViews {
-            columns,
-            rows,
-            wraps: header.wraps,
-            images: &images,
-            alphas: &alphas,
-            cameras: &cameras,
-            wanted: selected
-                .and_then(|s| s.flows.get(&pose))
-                .map(|f| f.as_slice()),
-            hull: guide.as_ref(),
-        },
-        &params,
+    let hull = flow_guide(options, cameras, alphas)?;
+    steps.push(Step {
+        name: "hull of the flows".into(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+    progress.advance();
+    Ok(hull)
+}
+
+/// The pose-to-pose flows of every view of `pose` to its neighbours among `among`
+/// ([`crate::poseflow::pose_flows`]), timed into `steps`.
+fn pose_flow_step(
+    capture: &Capture,
+    (pose, among): (u32, &[u32]),
+    (header, alphas, guide): (&FieldHeader, &[Option<&GrayImage>], Option<&VoxelHull>),
+    (clean, rule, params): (&[Vec<RgbImage>], MatteRule, &FlowParams),
+    progress: &dyn Progress,
+    steps: &mut Vec<Step>,
+) -> Result<Vec<ViewPoseFlows>> {
+    progress.begin(
+        pose,
+        "pose-to-pose flow",
+        alphas.iter().filter(|a| a.is_some()).count(),
+    );
+    let start = Instant::now();
+    let pose_flows = crate::poseflow::pose_flows(
+        capture,
+        (pose, among),
+        header.wraps,
+        alphas,
+        guide,
+        clean,
+        rule,
+        params,
         &|| {
             check_stop(progress)?;
             progress.advance();
             Ok(())
         },
     )?;
-    steps.extend(share(
-        start.elapsed().as_secs_f64(),
-        &[
-            ("inter-view flow, horizontal pairs", grid.horizontal_seconds),
-            ("inter-view flow, vertical pairs", grid.vertical_seconds),
-        ],
-    ));
-    let flows = grid.flows;
+    steps.push(Step {
+        name: "pose-to-pose flow".into(),
+        seconds: start.elapsed().as_secs_f64(),
+    });
+    Ok(pose_flows)
+}
 
-    let pose_flows = if options.pose_flows {
-        progress.begin(
-            pose,
-            "pose-to-pose flow",
-            present.iter().filter(|&&p| p).count(),
-        );
-        let start = Instant::now();
-        let pose_flows = crate::poseflow::pose_flows(
-            capture,
-            (pose, &pose_flow_poses(capture, options)),
-            header.wraps,
-            &alphas,
-            guide.as_ref(),
-            &clean,
-            options.matte_rule,
-            &params,
-            &|| {
-                check_stop(progress)?;
-                progress.advance();
-                Ok(())
-            },
-        )?;
-        steps.push(Step {
-            name: "pose-to-pose flow".into(),
-            seconds: start.elapsed().as_secs_f64(),
-        });
-        pose_flows
-    } else {
-        vec![Default::default(); columns * rows]
-    };
+/// The cameras and mattes of the views ingested (those `alphas` holds).
+fn ingested_views<'a>(
+    cameras: &[Camera],
+    alphas: &[Option<&'a GrayImage>],
+) -> (Vec<Camera>, Vec<&'a GrayImage>) {
+    cameras
+        .iter()
+        .zip(alphas)
+        .filter_map(|(c, a)| a.map(|a| (*c, a)))
+        .unzip()
+}
 
-    let shadows = match &options.shadows {
-        Some(s) => {
-            progress.begin(pose, "visual hull and shadow maps", 1);
-            // Carved from the views ingested.
-            let (cams, mattes): (Vec<Camera>, Vec<&GrayImage>) = cameras
-                .iter()
-                .zip(&alphas)
-                .filter_map(|(c, a)| a.map(|a| (*c, a)))
-                .unzip();
-            let mut s = *s;
-            s.hull.misses = crate::shadows::misses_for(s.hull.misses, cams.len(), cameras.len());
-            let r = pose_shadows(&cams, &mattes, &header.conditions, &s)?;
-            steps.push(Step {
-                name: "visual hull".into(),
-                seconds: r.hull_seconds,
-            });
-            steps.push(Step {
-                name: "shadow maps".into(),
-                seconds: r.map_seconds,
-            });
-            progress.advance();
-            Some(r)
-        }
-        None => None,
-    };
+/// The visual hull and shadow maps of `pose`, carved from the views ingested, timed into
+/// `steps`.
+fn shadow_step(
+    pose: u32,
+    (cameras, alphas): (&[Camera], &[Option<&GrayImage>]),
+    (header, options): (&FieldHeader, &ShadowOptions),
+    progress: &dyn Progress,
+    steps: &mut Vec<Step>,
+) -> Result<PoseShadows> {
+    progress.begin(pose, "visual hull and shadow maps", 1);
+    let (cams, mattes) = ingested_views(cameras, alphas);
+    let mut s = *options;
+    s.hull.misses = crate::shadows::misses_for(s.hull.misses, cams.len(), cameras.len());
+    let r = pose_shadows(&cams, &mattes, &header.conditions, &s)?;
+    steps.push(Step {
+        name: "visual hull".into(),
+        seconds: r.hull_seconds,
+    });
+    steps.push(Step {
+        name: "shadow maps".into(),
+        seconds: r.map_seconds,
+    });
+    progress.advance();
+    Ok(r)
+}
 
-    let start = Instant::now();
-    if options.pose_flows {
-        header.record_pose_flows(pose, &pose_flow_poses(capture, options))?;
-    }
+/// Writes pose `pose`'s part to `part`: its views' images, their flows and pose-to-pose
+/// flows under a quantizer fitted to both, its hull and shadow maps.
+fn write_part(
+    part: &Path,
+    (mut header, pose): (FieldHeader, u32),
+    views: &[Option<ViewOut>],
+    flows: &[ViewFlows],
+    pose_flows: &[ViewPoseFlows],
+    shadows: Option<&PoseShadows>,
+) -> Result<()> {
+    let rows = header.rows;
     header.pose_mut(pose)?.flow_quantizer = LogQuantizer::fit(
         flows
             .iter()
@@ -634,72 +813,26 @@ fn ingest_pose(
     );
     let encoded: Vec<EncodedView> = flows
         .par_iter()
-        .zip(&pose_flows)
+        .zip(pose_flows)
         .map(|(f, p)| {
             let mut e = encode_flows(&header, pose, f)?;
             e.extend(encode_pose_flows(&header, pose, p)?);
             Ok(e)
         })
         .collect::<Result<_>>()?;
-    let (part, json) = part_paths(out, pose);
-    let mut writer = FieldWriter::create(&part, header)?;
+    let mut writer = FieldWriter::create(part, header)?;
     for (i, (view, flow)) in views.iter().zip(&encoded).enumerate() {
         if let Some(view) = view {
             writer.add_view(pose, i / rows, i % rows, &view.images)?;
             writer.add_view(pose, i / rows, i % rows, flow)?;
         }
     }
-    if let Some(s) = &shadows {
+    if let Some(s) = shadows {
         writer.add_hull(pose, &s.hull)?;
         writer.add_shadows(pose, &s.maps)?;
     }
     writer.finish()?;
-    steps.push(Step {
-        name: "compress flows and write".into(),
-        seconds: start.elapsed().as_secs_f64(),
-    });
-
-    let errors = match evaluator {
-        Some(evaluator) => {
-            progress.begin(pose, "evaluation against the ground truth", 1);
-            let alphas: Vec<Option<GrayImage>> = views
-                .iter()
-                .map(|v| v.as_ref().map(|v| v.alpha.clone()))
-                .collect();
-            let registered: Vec<SampledView> = views
-                .into_iter()
-                .flatten()
-                .filter_map(|v| v.registered)
-                .collect();
-            let e = evaluator
-                .evaluate(
-                    pose,
-                    &PoseEvidence {
-                        alphas: &alphas,
-                        flows: &flows,
-                        pose_flows: &pose_flows,
-                        pose_flows_among: &pose_flow_poses(capture, options),
-                        registered: &registered,
-                        hull: shadows.as_ref().map(|s| &s.hull),
-                    },
-                )
-                .map_err(IngestError::Evaluation)?;
-            progress.advance();
-            Some(e)
-        }
-        None => None,
-    };
-    let report = PoseReport {
-        pose,
-        settings: settings(capture, options),
-        resumed: false,
-        steps,
-        errors,
-    };
-    let text = serde_json::to_string_pretty(&report)
-        .map_err(|e| IngestError::BadParameter(e.to_string()))?;
-    frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
-    Ok(report)
+    Ok(())
 }
 
 /// The header of the field of pose `pose` ingested with `options`: the capture's, with
@@ -730,11 +863,7 @@ pub fn flow_guide(
     if options.inter_view_flow != InterViewFlow::Hull {
         return Ok(None);
     }
-    let (cams, mattes): (Vec<Camera>, Vec<&GrayImage>) = cameras
-        .iter()
-        .zip(alphas)
-        .filter_map(|(c, a)| a.map(|a| (*c, a)))
-        .unzip();
+    let (cams, mattes) = ingested_views(cameras, alphas);
     let asked = options
         .shadows
         .map_or(crate::shadows::DEFAULT_MISSES, |s| s.hull.misses);

@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use frf_core::lru::Lru;
 
-use crate::container::ChunkKey;
+use crate::chunk::ChunkKey;
 use crate::imagecodec::BasisCodes;
 
 /// The kept views, within their budget ([`Lru`]).

@@ -18,6 +18,7 @@
 //!
 //! Conventions: [`frf_core::conventions`].
 
+pub mod chunk;
 pub mod container;
 pub mod decoded;
 pub mod error;

@@ -14,12 +14,9 @@
 //! detail: docs/results/render.md, "Level of detail").
 
 use frf_core::camera::Camera;
-use frf_reflectance::field::PoseRecord;
 use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
-use glam::Vec3;
 
-use crate::error::{RenderError, Result};
 use crate::geometry::Crop;
 
 /// The coarsest level used.
@@ -27,32 +24,6 @@ pub const MAX_LEVEL: u8 = 3;
 
 /// A level's texel may cover up to this many of the frame's pixels, along each axis.
 pub const DETAIL_MARGIN: f32 = 1.0;
-
-/// Where on the subject's axis pixels per metre are measured (metres up: mid-body).
-const AXIS_POINT_M: f32 = 1.0;
-
-/// Pixels per metre `camera` (in the subject's frame) sees at the subject's axis.
-pub fn pixels_per_metre(camera: &Camera) -> f32 {
-    let d = (Vec3::new(0.0, AXIS_POINT_M, 0.0) - camera.centre()).length();
-    camera.intrinsics.fx.abs().max(camera.intrinsics.fy.abs()) / d.max(1e-3)
-}
-
-/// Pixels per metre the pose's views captured the subject at: the median over its views
-/// ([`pixels_per_metre`]).
-pub fn captured_ppm(record: &PoseRecord) -> Result<f32> {
-    let mut ppm = record
-        .views
-        .iter()
-        .map(|v| {
-            v.camera
-                .to_camera()
-                .map(|c| pixels_per_metre(&c))
-                .map_err(RenderError::BadParameter)
-        })
-        .collect::<Result<Vec<f32>>>()?;
-    ppm.sort_by(f32::total_cmp);
-    Ok(ppm.get(ppm.len() / 2).copied().unwrap_or(0.0))
-}
 
 /// The level of detail for a walker seen at `seen` pixels per metre from views that
 /// captured it at `captured` (see the module docs).
@@ -256,6 +227,8 @@ pub fn reduced_image(size: (u32, u32), level: u8) -> ((u32, u32), Crop) {
 
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+
     use super::*;
 
     #[test]

@@ -9,8 +9,33 @@ use frf_reflectance::field::PoseRecord;
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
-use crate::detail::captured_ppm;
-use crate::error::Result;
+use crate::error::{RenderError, Result};
+
+/// Where on the subject's axis pixels per metre are measured (metres up: mid-body).
+const AXIS_POINT_M: f32 = 1.0;
+
+/// Pixels per metre `camera` (in the subject's frame) sees at the subject's axis.
+pub fn pixels_per_metre(camera: &Camera) -> f32 {
+    let d = (Vec3::new(0.0, AXIS_POINT_M, 0.0) - camera.centre()).length();
+    camera.intrinsics.fx.abs().max(camera.intrinsics.fy.abs()) / d.max(1e-3)
+}
+
+/// Pixels per metre the pose's views captured the subject at: the median over its views
+/// ([`pixels_per_metre`]).
+pub fn captured_ppm(record: &PoseRecord) -> Result<f32> {
+    let mut ppm = record
+        .views
+        .iter()
+        .map(|v| {
+            v.camera
+                .to_camera()
+                .map(|c| pixels_per_metre(&c))
+                .map_err(RenderError::BadParameter)
+        })
+        .collect::<Result<Vec<f32>>>()?;
+    ppm.sort_by(f32::total_cmp);
+    Ok(ppm.get(ppm.len() / 2).copied().unwrap_or(0.0))
+}
 
 /// Where a subject can be when nothing more is known of it (a field without a visual
 /// hull), in its own frame: within this distance of its axis (metres; a walker's reach,

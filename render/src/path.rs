@@ -28,6 +28,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{RenderError, Result};
 
+/// Largest camera path (or scene) file, bytes: hand-written text.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
 /// The narrowest vertical field of view a camera may have, degrees (exclusive).
 pub const MIN_FOV_DEG: f32 = 0.1;
 /// The widest, degrees (exclusive): a pinhole's image diverges toward 180.
@@ -139,7 +142,7 @@ impl CameraPath {
 
     /// Reads and validates a TOML path file; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = frf_core::io::read_text(path, crate::scene::MAX_FILE_BYTES)
+        let text = frf_core::io::read_text(path, MAX_FILE_BYTES)
             .map_err(|e| bad(format!("camera path: {e}")))?;
         let raw: Self = toml::from_str(&text)
             .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;

@@ -37,7 +37,7 @@ use crate::cmd::args::{
     parse_size,
 };
 use crate::cmd::progress::Bars;
-use crate::cmd::render_settings::render_settings;
+use crate::cmd::render_settings::{FlagFiles, render_settings};
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;
@@ -470,7 +470,16 @@ pub fn run(args: RenderArgs) -> CliResult {
         return print_plan(&plan, args.json);
     }
     let out_dir = args.out.clone().ok_or("give --out DIR (or --plan)")?;
-    let settings = render_settings(&args, &scene, &field, !field_render, size)?;
+    let flagged = FlagFiles {
+        input: &args.input,
+        camera: args.camera.camera.as_deref(),
+        plate: args.scene.plate.as_deref(),
+        env: match &args.lighting.env {
+            Some(EnvSource::File(p)) => Some(p),
+            _ => None,
+        },
+    };
+    let settings = render_settings((&args, flagged), &scene, &field, !field_render, size)?;
 
     let start = Instant::now();
     let device = Device::open(args.cpu)?;

@@ -17,8 +17,20 @@ use frf_reflectance::FieldFile;
 use frf_render::scene::{BackdropSpec, Scene};
 use serde_json::{Value, json};
 
-use super::render::RenderArgs;
 use crate::CliResult;
+
+/// The files a render's flags name: their paths are made canonical in the settings, and
+/// their content identified.
+pub struct FlagFiles<'a> {
+    /// The scene file or field given.
+    pub input: &'a Path,
+    /// `--camera`.
+    pub camera: Option<&'a Path>,
+    /// `--plate`.
+    pub plate: Option<&'a Path>,
+    /// `--env`, when a file.
+    pub env: Option<&'a Path>,
+}
 
 /// `path` made absolute with its links resolved, as text (as given when that fails).
 fn canonical(path: &Path) -> String {
@@ -34,10 +46,10 @@ fn file_entry(path: &Path) -> CliResult<Value> {
     Ok(json!({ "path": canonical(path), "bytes": bytes, "crc32": crc32 }))
 }
 
-/// The settings of a render of `scene` from `field` at `size` with `args` (see the module
-/// text).
+/// The settings of a render of `scene` from `field` at `size` with `args` (the command's
+/// arguments; `flagged`, the files they name; see the module text).
 pub fn render_settings(
-    args: &RenderArgs,
+    (args, flagged): (&impl serde::Serialize, FlagFiles),
     scene: &Scene,
     field: &FieldFile,
     is_scene_file: bool,
@@ -55,11 +67,9 @@ pub fn render_settings(
             *v = canonical(p).into();
         }
     };
-    set("camera", "camera", args.camera.camera.as_deref());
-    set("scene", "plate", args.scene.plate.as_deref());
-    if let Some(EnvSource::File(p)) = &args.lighting.env {
-        set("lighting", "env", Some(p));
-    }
+    set("camera", "camera", flagged.camera);
+    set("scene", "plate", flagged.plate);
+    set("lighting", "env", flagged.env);
 
     let (bytes, index_crc32) = field.identity();
     let mut files = serde_json::Map::new();
@@ -81,12 +91,12 @@ pub fn render_settings(
     if let BackdropSpec::Plate(p) = &scene.backdrop {
         files.insert("plate".into(), file_entry(p)?);
     }
-    if let Some(p) = &args.camera.camera {
+    if let Some(p) = flagged.camera {
         files.insert("camera path".into(), file_entry(p)?);
     }
     let scene_text = match is_scene_file {
         true => Some(frf_core::io::read_text(
-            &args.input,
+            flagged.input,
             frf_render::scene::MAX_FILE_BYTES,
         )?),
         false => None,

@@ -13,68 +13,20 @@ use std::sync::Arc;
 
 use super::composite_targets::CompositeTargets;
 use super::rebin::Subjects;
-use super::time_morph::BetweenDraw;
+use super::time_morph::{BetweenDraw, GpuBetween};
 use super::timing::Timestamps;
 
-use super::bind::{
-    FLOAT, bind_group, cleared, full_screen_pipeline, storage, texture_2d, texture_array, uniform,
-};
+use super::Gpu;
+use super::bind::{bind_group, cleared};
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::rebin::frame_uniform;
-use super::types::{GpuComposite, GpuFrame, GpuInstance};
-use super::{Gpu, shaders};
+use super::types::{GpuComposite, GpuInstance};
 use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::footprint::{PixelBox, TILE, TileLists, ground_box};
 use crate::morph::Variant;
-
-/// The pass's layouts and pipeline.
-pub struct CompositePass {
-    pub(super) frame_layout: wgpu::BindGroupLayout,
-    image_layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
-}
-
-impl CompositePass {
-    /// Builds the pass on `device`.
-    pub fn new(device: &wgpu::Device) -> Self {
-        let module = shaders::module(device, "composite", shaders::COMPOSITE);
-        let f = wgpu::ShaderStages::FRAGMENT;
-        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("composite frame"),
-            entries: &[
-                uniform::<GpuFrame>(0, f),
-                uniform::<GpuComposite>(1, f),
-                storage::<GpuInstance>(2, true, f),
-                storage::<u32>(3, true, f),
-            ],
-        });
-        let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("composite images"),
-            entries: &[
-                texture_array(0, FLOAT),
-                texture_2d(1, FLOAT),
-                texture_2d(2, FLOAT),
-                texture_array(3, FLOAT),
-            ],
-        });
-        let pipeline = full_screen_pipeline(
-            device,
-            "composite",
-            &[&frame_layout, &image_layout],
-            &module,
-            "fs_composite",
-            4,
-        );
-        Self {
-            frame_layout,
-            image_layout,
-            pipeline,
-        }
-    }
-}
 
 /// A walker to draw: its resident pose and where it stands.
 pub struct GpuInstanceRef<'a> {
@@ -86,19 +38,6 @@ pub struct GpuInstanceRef<'a> {
     pub between: Option<GpuBetween<'a>>,
     /// The pixels where it may show: only these are shaded; `None`, the whole frame.
     pub within: Option<PixelBox>,
-}
-
-/// A walker between two captured poses: the later pose, both poses' motion toward the
-/// other, and the fraction of the way.
-pub struct GpuBetween<'a> {
-    /// Pose `k'`, relit alike.
-    pub after: &'a GpuPose,
-    /// Pose `k`'s motion toward `k'`.
-    pub before_motion: &'a GpuPose,
-    /// Pose `k'`'s motion toward `k`.
-    pub after_motion: &'a GpuPose,
-    /// The fraction of the way from `k` to `k'`.
-    pub s: f32,
 }
 
 impl GpuInstanceRef<'_> {

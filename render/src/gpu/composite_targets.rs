@@ -6,13 +6,59 @@
 
 use std::sync::Arc;
 
-use super::Gpu;
+use super::bind::{FLOAT, full_screen_pipeline, storage, texture_2d, texture_array, uniform};
 use super::bind::{rgba32f, uniform_buffer};
-use super::composite::CompositePass;
 use super::kept::Kept;
 use super::readback::Readback;
 use super::types::{GpuComposite, GpuFrame, GpuInstance};
+use super::{Gpu, shaders};
 use crate::footprint::TileLists;
+
+/// The pass's layouts and pipeline.
+pub struct CompositePass {
+    pub(super) frame_layout: wgpu::BindGroupLayout,
+    pub(super) image_layout: wgpu::BindGroupLayout,
+    pub(super) pipeline: wgpu::RenderPipeline,
+}
+
+impl CompositePass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "composite", shaders::COMPOSITE);
+        let f = wgpu::ShaderStages::FRAGMENT;
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite frame"),
+            entries: &[
+                uniform::<GpuFrame>(0, f),
+                uniform::<GpuComposite>(1, f),
+                storage::<GpuInstance>(2, true, f),
+                storage::<u32>(3, true, f),
+            ],
+        });
+        let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite images"),
+            entries: &[
+                texture_array(0, FLOAT),
+                texture_2d(1, FLOAT),
+                texture_2d(2, FLOAT),
+                texture_array(3, FLOAT),
+            ],
+        });
+        let pipeline = full_screen_pipeline(
+            device,
+            "composite",
+            &[&frame_layout, &image_layout],
+            &module,
+            "fs_composite",
+            4,
+        );
+        Self {
+            frame_layout,
+            image_layout,
+            pipeline,
+        }
+    }
+}
 
 /// Image bind groups kept per set of targets: a shot alternates between few backdrops.
 const IMAGE_GROUPS: usize = 2;

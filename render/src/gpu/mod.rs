@@ -140,7 +140,7 @@ pub struct Gpu {
     /// Whether passes can be timed on the GPU (`Features::TIMESTAMP_QUERY`).
     timestamps: bool,
     shadow: shadow::ShadowPass,
-    composite: composite::CompositePass,
+    composite: composite_targets::CompositePass,
 }
 
 impl Gpu {
@@ -198,7 +198,7 @@ impl Gpu {
             composite_targets: kept::Kept::new(KEPT_TARGETS),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
             shadow: shadow::ShadowPass::new(&device),
-            composite: composite::CompositePass::new(&device),
+            composite: composite_targets::CompositePass::new(&device),
             device,
             queue,
             adapter,

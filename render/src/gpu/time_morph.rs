@@ -12,11 +12,24 @@ use frf_core::camera::Camera;
 use glam::Mat2;
 use wgpu::util::DeviceExt;
 
-use super::composite::GpuBetween;
+use super::pose::GpuPose;
 use super::rebin::{DrawnRender, Place, SubjectTargets, Subjects, places, workgroups};
 use super::{Gpu, shaders};
 use crate::footprint::PixelBox;
 use crate::morph::Variant;
+
+/// A walker between two captured poses: the later pose, both poses' motion toward the
+/// other, and the fraction of the way.
+pub struct GpuBetween<'a> {
+    /// Pose `k'`, relit alike.
+    pub after: &'a GpuPose,
+    /// Pose `k`'s motion toward `k'`.
+    pub before_motion: &'a GpuPose,
+    /// Pose `k'`'s motion toward `k`.
+    pub after_motion: &'a GpuPose,
+    /// The fraction of the way from `k` to `k'`.
+    pub s: f32,
+}
 
 /// The uniform of `shaders/time_morph.wgsl`.
 #[repr(C)]

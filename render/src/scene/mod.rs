@@ -38,8 +38,8 @@ use file::{Reporter, SceneToml};
 
 /// Most frames a scene may have (an hour at 30 fps and more).
 pub const MAX_FRAMES: usize = 200_000;
-/// Largest scene (or camera path) file, bytes: hand-written text.
-pub const MAX_FILE_BYTES: u64 = 16 << 20;
+/// Largest scene (or camera path) file, bytes ([`crate::path::MAX_FILE_BYTES`]).
+pub use crate::path::MAX_FILE_BYTES;
 /// Largest frame side, pixels (8K).
 pub const MAX_SIDE_PX: u32 = 8192;
 /// The latest instant a scene may name, seconds from its clock's zero (either way): f64

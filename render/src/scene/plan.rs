@@ -40,10 +40,10 @@ use serde::Serialize;
 
 use super::{Scene, ShadowSpec, TimeInterpolation};
 use crate::cylinder::Cylinder;
-use crate::detail::{captured_ppm, detail_level, pixels_per_metre};
+use crate::detail::detail_level;
 use crate::error::{RenderError, Result};
-use crate::footprint::SubjectBounds;
 pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
+use crate::footprint::{SubjectBounds, captured_ppm, pixels_per_metre};
 use crate::shadow::ground_hit;
 
 /// Spacing of the rays traced to find the quads a frame reaches, pixels, over a box of
