@@ -113,6 +113,9 @@ pub enum CoreError {
         /// Why it cannot be written.
         problem: String,
     },
+    /// An argument outside what is allowed, named as the user gave it.
+    #[error(transparent)]
+    Argument(#[from] crate::argument::BadArgument),
     /// A function was called with an argument it cannot accept.
     #[error("invalid argument {what}: {problem}")]
     InvalidArgument {
@@ -134,6 +137,7 @@ impl CoreError {
             | CoreError::Manifest { .. }
             | CoreError::LimitExceeded { .. }
             | CoreError::BadOutput { .. }
+            | CoreError::Argument(_)
             | CoreError::InvalidArgument { .. } => Fault::Usage,
         }
     }

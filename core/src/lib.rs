@@ -7,6 +7,7 @@
 //! axes, units and coordinate conventions they all share are written once, in
 //! [`conventions`].
 
+pub mod argument;
 pub mod atomic;
 pub mod camera;
 pub mod capture;
@@ -28,4 +29,5 @@ pub mod progress;
 pub mod shared_data;
 pub mod volume;
 
+pub use argument::BadArgument;
 pub use error::{CoreError, Fault, Result};
