@@ -266,7 +266,7 @@ impl VoxelHull {
     }
 
     /// The parameter `t ≥ 0` at which the ray `origin + t dir` enters its first occupied
-    /// voxel, or `None` when it passes through none (3D DDA; `render/shaders/rebin/proxy.wgsl` is its
+    /// voxel, or `None` when it passes through none (3D DDA; `shaders/rebin/proxy.wgsl` is its
     /// twin).
     pub fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<f32> {
         if !(dir.is_finite() && origin.is_finite()) || dir == Vec3::ZERO {

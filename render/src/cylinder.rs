@@ -32,8 +32,8 @@ use std::cmp::Ordering;
 use frf_core::camera::{Camera, Intrinsics, Rigid};
 use glam::{Mat3, Quat, Vec2, Vec3};
 
-use crate::gpu::types::GpuColumnIndex;
 use column_index::ColumnIndex;
+use frf_shaders::types::GpuColumnIndex;
 
 /// Height of the walls above and below the grid, metres: far beyond any scene.
 const WALL_HEIGHT_M: f32 = 1.0e3;

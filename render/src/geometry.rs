@@ -14,9 +14,9 @@ use glam::Vec3;
 
 use crate::cylinder::{Cylinder, CylinderHit};
 use crate::footprint::SubjectBounds;
-use crate::gpu::types::{GpuQuad, GpuView};
 use crate::proxy::Proxy;
 use crate::rectified::QuadFrame;
+use frf_shaders::types::{GpuQuad, GpuView};
 
 /// Pixels kept around the union of the mattes (the flows reach 3 beyond them).
 pub const CROP_MARGIN_PX: u32 = 4;

@@ -31,7 +31,7 @@ use bytemuck::Zeroable;
 use frf_reflectance::hull::VoxelHull;
 use glam::{Vec2, Vec3};
 
-use crate::gpu::types::GpuProxy;
+use frf_shaders::types::GpuProxy;
 
 /// Below this squared horizontal length a ray is treated as vertical: it has no nearest
 /// point to a vertical axis.

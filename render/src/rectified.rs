@@ -24,7 +24,7 @@ use bytemuck::Zeroable;
 use frf_core::camera::{Camera, Intrinsics};
 use glam::{Mat3, Vec2, Vec3};
 
-use crate::gpu::types::GpuQuadFrame;
+use frf_shaders::types::GpuQuadFrame;
 
 /// The rectified frame of one quad (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -35,7 +35,7 @@ use bytemuck::Zeroable;
 use glam::{Vec2, Vec3};
 
 use super::{EDGE_SLACK, Quad};
-use crate::gpu::types::GpuColumnIndex;
+use frf_shaders::types::GpuColumnIndex;
 
 /// Angle every span's range is widened by, radians (rounding of the query's angles).
 const ANGLE_MARGIN: f32 = 1e-3;

@@ -20,13 +20,13 @@ use super::Gpu;
 use super::bind::{bind_group, cleared};
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::rebin::frame_uniform;
-use super::types::{GpuComposite, GpuInstance};
 use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::footprint::{PixelBox, TILE, TileLists, ground_box};
 use crate::morph::Variant;
+use frf_shaders::types::{GpuComposite, GpuInstance};
 
 /// A walker to draw: its resident pose and where it stands.
 pub struct GpuInstanceRef<'a> {

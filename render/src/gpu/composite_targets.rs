@@ -10,9 +10,9 @@ use super::bind::{FLOAT, full_screen_pipeline, storage, texture_2d, texture_arra
 use super::bind::{rgba32f, uniform_buffer};
 use super::kept::Kept;
 use super::readback::Readback;
-use super::types::{GpuComposite, GpuFrame, GpuInstance};
 use super::{Gpu, shaders};
 use crate::footprint::TileLists;
+use frf_shaders::types::{GpuComposite, GpuFrame, GpuInstance};
 
 /// The pass's layouts and pipeline.
 pub struct CompositePass {

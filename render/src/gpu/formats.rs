@@ -158,16 +158,6 @@ impl PoseFormats {
 
     /// The frame pass's source with these formats' sampling.
     pub fn rebin_source(self) -> String {
-        [
-            shaders::COMMON,
-            self.image.snippet(),
-            self.flow.snippet(),
-            shaders::REBIN,
-            shaders::CYLINDER,
-            shaders::PROXY,
-            shaders::E06,
-            shaders::SOLVED,
-        ]
-        .join("\n")
+        shaders::frame_pass(self.image.snippet(), self.flow.snippet())
     }
 }

@@ -32,60 +32,14 @@ pub mod scope;
 pub mod shadow;
 pub mod time_morph;
 pub mod timing;
-pub mod types;
 
 use crate::error::{RenderError, Result};
 
 pub use pose::GpuPose;
 
-/// The WGSL sources as compiled: each pass after the shared definitions.
+/// The WGSL sources as compiled ([`frf_shaders`]), and a pass made a module on a device.
 pub mod shaders {
-    /// `shaders/common.wgsl`.
-    pub const COMMON: &str = include_str!("../../shaders/common.wgsl");
-    /// `shaders/relight.wgsl`, standalone.
-    pub const RELIGHT: &str = include_str!("../../shaders/relight.wgsl");
-    /// `shaders/rebin.wgsl`, standalone.
-    pub const REBIN: &str = include_str!("../../shaders/rebin.wgsl");
-    /// `shaders/shadow.wgsl`, standalone.
-    pub const SHADOW: &str = include_str!("../../shaders/shadow.wgsl");
-    /// `shaders/composite.wgsl`, standalone.
-    pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
-    /// `shaders/present.wgsl`: a frame shown in a window.
-    pub const PRESENT: &str = include_str!("../../shaders/present.wgsl");
-    /// The morph in time of a frame between two poses.
-    pub const TIME_MORPH: &str = include_str!("../../shaders/time_morph.wgsl");
-    /// `shaders/floor.wgsl`, standalone.
-    pub const FLOOR: &str = include_str!("../../shaders/floor.wgsl");
-    /// `shaders/rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera
-    /// centres, composed after the frame pass.
-    pub const CYLINDER: &str = include_str!("../../shaders/rebin/cylinder.wgsl");
-    /// `shaders/rebin/proxy.wgsl`: the geometric proxy, composed after the frame pass.
-    pub const PROXY: &str = include_str!("../../shaders/rebin/proxy.wgsl");
-    /// `shaders/morph/e06.wgsl`: E06's morphs, composed after the frame pass.
-    pub const E06: &str = include_str!("../../shaders/morph/e06.wgsl");
-    /// `shaders/morph/solved.wgsl`: the solved four-way morph, composed after the frame
-    /// pass.
-    pub const SOLVED: &str = include_str!("../../shaders/morph/solved.wgsl");
-    /// `shaders/sample/prelit_codes.wgsl`: pre-lit views as integer codes.
-    pub const PRELIT_CODES: &str = include_str!("../../shaders/sample/prelit_codes.wgsl");
-    /// `shaders/sample/prelit_srgb.wgsl`: pre-lit views as sRGB8, filtered in hardware.
-    pub const PRELIT_SRGB: &str = include_str!("../../shaders/sample/prelit_srgb.wgsl");
-    /// `shaders/sample/flow_codes.wgsl`: flows as 8-bit log codes.
-    pub const FLOW_CODES: &str = include_str!("../../shaders/sample/flow_codes.wgsl");
-    /// `shaders/sample/flow_f16.wgsl`: flows as half floats, filtered in hardware.
-    pub const FLOW_F16: &str = include_str!("../../shaders/sample/flow_f16.wgsl");
-    /// `shaders/sample/flow_f32.wgsl`: flows as floats.
-    pub const FLOW_F32: &str = include_str!("../../shaders/sample/flow_f32.wgsl");
-
-    /// Every pass but the frame pass (composed by [`super::formats::PoseFormats`]), named.
-    pub const PASSES: [(&str, &str); 6] = [
-        ("relight", RELIGHT),
-        ("shadow", SHADOW),
-        ("composite", COMPOSITE),
-        ("floor", FLOOR),
-        ("present", PRESENT),
-        ("time_morph", TIME_MORPH),
-    ];
+    pub use frf_shaders::*;
 
     /// A pass's shader module on `device`.
     pub fn module(device: &wgpu::Device, name: &str, pass: &str) -> wgpu::ShaderModule {
@@ -93,11 +47,6 @@ pub mod shaders {
             label: Some(name),
             source: wgpu::ShaderSource::Wgsl(composed(pass).into()),
         })
-    }
-
-    /// A pass's full source: the shared definitions, then the pass.
-    pub fn composed(pass: &str) -> String {
-        format!("{COMMON}\n{pass}")
     }
 }
 

@@ -16,12 +16,12 @@ use super::bind::{
     uniform,
 };
 use super::formats::PoseFormats;
-use super::types::{GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuView};
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
 use crate::rectified::gpu_frame;
 use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
+use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuView};
 
 /// Workgroup size of the relighting pass (`@workgroup_size(64)`).
 const WORKGROUP: u32 = 64;

@@ -8,8 +8,8 @@ use super::bind::{FLOAT, full_screen_pipeline_into, texture_2d, uniform, uniform
 use super::composite::DrawnFrame;
 use super::kept::Kept;
 use super::timing::Timestamps;
-use super::types::GpuPresent;
 use super::{Gpu, shaders};
+use frf_shaders::types::GpuPresent;
 
 /// What a window shows of a frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -17,11 +17,11 @@ use super::bind::{
 use super::formats::PoseFormats;
 use super::pose::{GpuPose, PoseBinding};
 use super::readback::Readback;
-use super::types::{GpuColumnIndex, GpuFrame, GpuProxy, GpuQuad, GpuQuadFrame, GpuView};
 use crate::cpu::FrameStats;
 use crate::error::Result;
 use crate::footprint::PixelBox;
 use crate::morph::Variant;
+use frf_shaders::types::{GpuColumnIndex, GpuFrame, GpuProxy, GpuQuad, GpuQuadFrame, GpuView};
 
 /// Whether a pass runs as a full-screen triangle or as a compute dispatch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -8,10 +8,10 @@ use wgpu::util::DeviceExt;
 
 use super::bind::{compute_pipeline, rgba32f, storage, storage_texture, uniform};
 use super::pose::{GpuPose, RelitShadowInfo};
-use super::types::GpuShadowParams;
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::shadow::{RelitShadow, ShadowMaps};
+use frf_shaders::types::GpuShadowParams;
 
 /// Workgroup side of the pass (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;

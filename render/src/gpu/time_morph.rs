@@ -7,8 +7,8 @@
 //! ([`crate::atlas`]; the morphs on pages of their own, so that a pass never reads the
 //! page it writes): nothing reads a render outside its box, so a far walker's morph costs
 //! its own pixels, not the frame's.
-use bytemuck::{Pod, Zeroable};
 use frf_core::camera::Camera;
+use frf_shaders::types::GpuTimeMorph;
 use glam::Mat2;
 use wgpu::util::DeviceExt;
 
@@ -29,19 +29,6 @@ pub struct GpuBetween<'a> {
     pub after_motion: &'a GpuPose,
     /// The fraction of the way from `k` to `k'`.
     pub s: f32,
-}
-
-/// The uniform of `shaders/time_morph.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct TimeMorphUniform {
-    to_image: [f32; 4],
-    bounds: [u32; 4],
-    at_poses: [i32; 4],
-    at_motions: [i32; 4],
-    at_morph: [i32; 4],
-    s: f32,
-    _pad: [f32; 3],
 }
 
 /// The pipeline of the morph in time.
@@ -167,14 +154,16 @@ impl Gpu {
             let morph = morphs[j];
             let pair = |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
             let m: Mat2 = crate::motion::motion_to_image(&w.camera);
-            let uniform = TimeMorphUniform {
+            let uniform = GpuTimeMorph {
                 to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
                 bounds: w.within.to_array(),
                 at_poses: pair(before, after),
                 at_motions: pair(before_motion, after_motion),
                 at_morph: pair(morph, morph),
                 s: b.s,
-                _pad: [0.0; 3],
+                pad0: 0.0,
+                pad1: 0.0,
+                pad2: 0.0,
             };
             let buffer = self
                 .device

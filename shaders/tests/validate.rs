@@ -1,17 +1,16 @@
-//! The WGSL of `shaders/`: every file parses and validates with naga as compiled (the
-//! shared definitions of `common.wgsl`, then the pass), and every Pod struct of
-//! `frf_render::gpu::types` has the size and field offsets naga lays out for its WGSL
-//! twin. Needs no GPU.
+//! The WGSL of this crate: every file parses and validates with naga as compiled (the
+//! shared definitions of `common.wgsl`, then the pass; the frame pass with every choice of
+//! its sampling snippets), and every Pod mirror of [`frf_shaders::types`] has the size and
+//! member offsets naga lays out for its WGSL twin. Needs no GPU.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
 use std::mem::{offset_of, size_of};
 
-use frf_render::gpu::formats::{FlowFormat, ImageFormat, PoseFormats};
-use frf_render::gpu::shaders;
-use frf_render::gpu::types::{
+use frf_shaders as shaders;
+use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuPresent, GpuProxy, GpuQuad,
-    GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuView,
+    GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuTimeMorph, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -26,7 +25,7 @@ fn module(source: &str, name: &str) -> naga::Module {
 
 #[test]
 fn every_wgsl_file_parses_and_validates_as_compiled() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf();
     let mut passes = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
@@ -41,12 +40,12 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         } else if name == "rebin.wgsl" {
             // The frame pass, composed with every choice of its sampling snippets.
             assert_eq!(text, shaders::REBIN, "{name} as compiled");
-            for image in ImageFormat::ALL {
-                for flow in FlowFormat::ALL {
-                    let formats = PoseFormats { image, flow };
-                    let m = module(&formats.rebin_source(), &formats.name());
+            for (image, prelit) in shaders::PRELIT {
+                for (flow, flows) in shaders::FLOW {
+                    let name = format!("{image}/{flow}");
+                    let m = module(&shaders::frame_pass(prelit, flows), &name);
                     // vs_main, fs_main, cs_main, cs_classes.
-                    assert_eq!(m.entry_points.len(), 4, "{}", formats.name());
+                    assert_eq!(m.entry_points.len(), 4, "{name}");
                 }
             }
         } else {
@@ -66,10 +65,10 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
 fn every_piece_of_the_frame_pass_is_compiled_into_it() {
     // The pieces in the folders (sampling snippets, re-binning, morphs) are validated as
     // part of the frame pass: each must be in it for some choice of storage.
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let sources: Vec<String> = ImageFormat::ALL
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf();
+    let sources: Vec<String> = shaders::PRELIT
         .into_iter()
-        .flat_map(|image| FlowFormat::ALL.map(|flow| PoseFormats { image, flow }.rebin_source()))
+        .flat_map(|(_, prelit)| shaders::FLOW.map(|(_, flow)| shaders::frame_pass(prelit, flow)))
         .collect();
     let mut pieces = 0;
     for folder in ["sample", "rebin", "morph"] {
@@ -91,8 +90,7 @@ fn every_piece_of_the_frame_pass_is_compiled_into_it() {
 fn a_broken_shader_is_refused() {
     // The validation above can fail: a type error in an otherwise valid pass.
     let broken = shaders::REBIN.replacen("fn ", "fn broken() -> f32 { return 1u; }\nfn ", 1);
-    let source = PoseFormats::DEFAULT
-        .rebin_source()
+    let source = shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES)
         .replace(shaders::REBIN, &broken);
     let parsed = naga::front::wgsl::parse_str(&source);
     let problem = match parsed {
@@ -139,7 +137,10 @@ macro_rules! check_layout {
 
 #[test]
 fn pod_structs_match_naga_layouts() {
-    let rebin = module(&PoseFormats::DEFAULT.rebin_source(), "rebin");
+    let rebin = module(
+        &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES),
+        "rebin",
+    );
     check_layout!(
         &rebin,
         "View",
@@ -291,5 +292,14 @@ fn pod_structs_match_naga_layouts() {
         "Instance",
         GpuInstance,
         [col_x, col_y, col_z, translation, bounds, place]
+    );
+    let time_morph = module(&shaders::composed(shaders::TIME_MORPH), "time_morph");
+    check_layout!(
+        &time_morph,
+        "TimeMorph",
+        GpuTimeMorph,
+        [
+            to_image, bounds, at_poses, at_motions, at_morph, s, pad0, pad1, pad2
+        ]
     );
 }

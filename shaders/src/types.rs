@@ -1,9 +1,10 @@
-//! `#[repr(C)]` Pod structs mirroring the WGSL structs of `shaders/`, padded explicitly;
-//! a test checks each size and field offset against naga's layout of the shader.
+//! `#[repr(C)]` Pod structs mirroring the WGSL structs of the passes, padded explicitly;
+//! a test (`tests/validate.rs`) checks each size and member offset against naga's layout
+//! of the shader.
 
 use bytemuck::{Pod, Zeroable};
 
-/// `View` of `shaders/common.wgsl`.
+/// `View` of `common.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuView {
@@ -27,7 +28,7 @@ pub struct GpuView {
     pub pad2: i32,
 }
 
-/// `Quad` of `shaders/common.wgsl`.
+/// `Quad` of `common.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuQuad {
@@ -53,8 +54,8 @@ pub struct GpuQuad {
     pub pad: f32,
 }
 
-/// `QuadFrame` of `shaders/morph/solved.wgsl`: a quad's rectified frame
-/// ([`crate::rectified::QuadFrame`]).
+/// `QuadFrame` of `morph/solved.wgsl`: a quad's rectified frame
+/// (`frf_render::rectified::QuadFrame`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuQuadFrame {
@@ -80,7 +81,7 @@ pub struct GpuQuadFrame {
     pub pad: [f32; 2],
 }
 
-/// `Frame` of `shaders/common.wgsl`.
+/// `Frame` of `common.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuFrame {
@@ -96,7 +97,7 @@ pub struct GpuFrame {
     pub intrinsics: [f32; 4],
     /// Output size.
     pub size: [u32; 2],
-    /// [`crate::morph::Variant::index`].
+    /// `frf_render::morph::Variant::index`.
     pub variant: u32,
     /// Number of quads.
     pub quad_count: u32,
@@ -108,19 +109,19 @@ pub struct GpuFrame {
     pub crop_origin: [u32; 2],
     /// Crop size.
     pub crop_size: [u32; 2],
-    /// [`crate::morph::Variant::flags`].
+    /// `frf_render::morph::Variant::flags`.
     pub flags: u32,
     /// Padding to 16 bytes.
     pub pad: u32,
-    /// The pixels shaded, `[x0, y0, x1, y1]` (ends exclusive; [`crate::footprint`]):
+    /// The pixels shaded, `[x0, y0, x1, y1]` (ends exclusive; `frf_render::footprint`):
     /// the walker is transparent outside them.
     pub bounds: [u32; 4],
     /// Where the frame pass writes: pixel `p` of the frame at texel `p + place.xy` of
-    /// layer `place.z` of its target ([`crate::atlas`]; w unused).
+    /// layer `place.z` of its target (`frf_render::atlas`; w unused).
     pub place: [i32; 4],
 }
 
-/// `Proxy` of `shaders/common.wgsl`: the pose's geometric proxy ([`crate::proxy`]).
+/// `Proxy` of `common.wgsl`: the pose's geometric proxy (`frf_render::proxy`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuProxy {
@@ -138,7 +139,7 @@ pub struct GpuProxy {
     pub pad: [f32; 2],
 }
 
-/// `RelightParams` of `shaders/relight.wgsl`.
+/// `RelightParams` of `relight.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuRelightParams {
@@ -152,7 +153,7 @@ pub struct GpuRelightParams {
     pub pad: u32,
 }
 
-/// `Job` of `shaders/relight.wgsl`: one view of a relighting batch.
+/// `Job` of `relight.wgsl`: one view of a relighting batch.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuRelightJob {
@@ -174,7 +175,7 @@ pub struct GpuRelightJob {
     pub pad1: u32,
 }
 
-/// `ShadowParams` of `shaders/shadow.wgsl`.
+/// `ShadowParams` of `shadow.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuShadowParams {
@@ -186,7 +187,7 @@ pub struct GpuShadowParams {
     pub pad: [u32; 2],
 }
 
-/// `Composite` of `shaders/composite.wgsl`.
+/// `Composite` of `composite.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuComposite {
@@ -208,15 +209,15 @@ pub struct GpuComposite {
     pub shadow_extent: f32,
     /// Walkers drawn.
     pub instances: u32,
-    /// Tiles in a row of the frame's tile lists ([`crate::footprint::TileLists`]).
+    /// Tiles in a row of the frame's tile lists (`frf_render::footprint::TileLists`).
     pub tile_columns: u32,
-    /// Their side, pixels ([`crate::footprint::TILE`]).
+    /// Their side, pixels (`frf_render::footprint::TILE`).
     pub tile_side: u32,
     /// Padding to 16 bytes.
     pub pad: u32,
 }
 
-/// `Instance` of `shaders/composite.wgsl`: `subject_from_world` of a walker.
+/// `Instance` of `composite.wgsl`: `subject_from_world` of a walker.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuInstance {
@@ -233,12 +234,12 @@ pub struct GpuInstance {
     /// it is transparent and its render not read.
     pub bounds: [u32; 4],
     /// Where its render lies: pixel `p` at texel `p + place.xy` of layer `place.z` of the
-    /// subjects ([`crate::atlas`]; w unused).
+    /// subjects (`frf_render::atlas`; w unused).
     pub place: [i32; 4],
 }
 
-/// `ColumnIndex` of `shaders/common.wgsl`: the header of a cylinder's column index
-/// ([`crate::cylinder::column_index`]); per span its range of azimuths follows it in the
+/// `ColumnIndex` of `common.wgsl`: the header of a cylinder's column index
+/// (`frf_render::cylinder::column_index`); per span its range of azimuths follows it in the
 /// same buffer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
@@ -261,7 +262,7 @@ pub struct GpuColumnIndex {
     pub enabled: u32,
 }
 
-/// `Present` of `shaders/present.wgsl`.
+/// `Present` of `present.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuPresent {
@@ -269,7 +270,7 @@ pub struct GpuPresent {
     pub origin: [f32; 2],
     /// Size of the frame in the window, pixels.
     pub extent: [f32; 2],
-    /// The layer shown ([`super::present::ShownLayer`]).
+    /// The layer shown (`frf_render::gpu::present::ShownLayer`).
     pub layer: u32,
     /// 1 when the shader encodes sRGB (the target format does not).
     pub encode: u32,
@@ -277,4 +278,28 @@ pub struct GpuPresent {
     pub exposure: f32,
     /// Padding.
     pub pad: u32,
+}
+
+/// `TimeMorph` of `time_morph.wgsl`: a walker's morph in time between two poses.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuTimeMorph {
+    /// Columns of the 2x2 map from metres to pixels.
+    pub to_image: [f32; 4],
+    /// The walker's pixel box: first column and row, one past the last.
+    pub bounds: [u32; 4],
+    /// Offsets in their pages of the renders of pose `k` (xy) and `k'` (zw).
+    pub at_poses: [i32; 4],
+    /// Offsets of the two poses' motion renders.
+    pub at_motions: [i32; 4],
+    /// Offset of the morph (xy; zw the same).
+    pub at_morph: [i32; 4],
+    /// The fraction of the way from `k` to `k'`.
+    pub s: f32,
+    /// Padding.
+    pub pad0: f32,
+    /// Padding.
+    pub pad1: f32,
+    /// Padding.
+    pub pad2: f32,
 }

@@ -17,9 +17,9 @@ struct TimeMorph {
     at_motions: vec4<i32>,
     at_morph: vec4<i32>,
     s: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 @group(0) @binding(0) var<uniform> tm: TimeMorph;

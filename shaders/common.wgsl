@@ -1,5 +1,5 @@
 // Shared by the renderer's passes (prepended to them when they are compiled): the
-// structures mirrored by `render/src/gpu/types.rs` (a test checks their sizes against
+// structures mirrored by `src/types.rs` (a test checks their sizes against
 // this file), and the pure functions of light-field re-binning, twins of
 // `render/src/cylinder.rs` and `render/src/morph/` operation for operation.
 

@@ -1,0 +1,76 @@
+//! Shaders: the WGSL of the renderer's GPU passes (the `.wgsl` files beside this crate's
+//! `src/`, see their README), included at compile time, and the `#[repr(C)]` Pod mirrors
+//! of the structs they share with the CPU ([`types`]). The renderer (`frf-render`)
+//! compiles them on its device; this crate's tests validate every pass with naga as
+//! compiled and check every mirror's size and member offsets against naga's layout, with
+//! no GPU.
+//!
+//! A pass is compiled as [`COMMON`] followed by the pass ([`composed`]); the frame pass is
+//! [`REBIN`] with its pieces: one sampling snippet of each kind ([`PRELIT`], [`FLOW`]),
+//! the ray's entry into the cylinder, the proxy and the morphs ([`frame_pass`]).
+
+pub mod types;
+
+/// `common.wgsl`: the structures and pure functions every pass shares.
+pub const COMMON: &str = include_str!("../common.wgsl");
+/// `relight.wgsl`, standalone.
+pub const RELIGHT: &str = include_str!("../relight.wgsl");
+/// `rebin.wgsl`, standalone: the frame pass, before its pieces.
+pub const REBIN: &str = include_str!("../rebin.wgsl");
+/// `shadow.wgsl`, standalone.
+pub const SHADOW: &str = include_str!("../shadow.wgsl");
+/// `composite.wgsl`, standalone.
+pub const COMPOSITE: &str = include_str!("../composite.wgsl");
+/// `present.wgsl`: a frame shown in a window.
+pub const PRESENT: &str = include_str!("../present.wgsl");
+/// `time_morph.wgsl`: the morph in time of a frame between two poses.
+pub const TIME_MORPH: &str = include_str!("../time_morph.wgsl");
+/// `floor.wgsl`, standalone.
+pub const FLOOR: &str = include_str!("../floor.wgsl");
+/// `rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera centres, composed
+/// after the frame pass.
+pub const CYLINDER: &str = include_str!("../rebin/cylinder.wgsl");
+/// `rebin/proxy.wgsl`: the geometric proxy, composed after the frame pass.
+pub const PROXY: &str = include_str!("../rebin/proxy.wgsl");
+/// `morph/e06.wgsl`: E06's morphs, composed after the frame pass.
+pub const E06: &str = include_str!("../morph/e06.wgsl");
+/// `morph/solved.wgsl`: the solved four-way morph, composed after the frame pass.
+pub const SOLVED: &str = include_str!("../morph/solved.wgsl");
+/// `sample/prelit_codes.wgsl`: pre-lit views as integer codes.
+pub const PRELIT_CODES: &str = include_str!("../sample/prelit_codes.wgsl");
+/// `sample/prelit_srgb.wgsl`: pre-lit views as sRGB8, filtered in hardware.
+pub const PRELIT_SRGB: &str = include_str!("../sample/prelit_srgb.wgsl");
+/// `sample/flow_codes.wgsl`: flows as 8-bit log codes.
+pub const FLOW_CODES: &str = include_str!("../sample/flow_codes.wgsl");
+/// `sample/flow_f16.wgsl`: flows as half floats, filtered in hardware.
+pub const FLOW_F16: &str = include_str!("../sample/flow_f16.wgsl");
+/// `sample/flow_f32.wgsl`: flows as floats.
+pub const FLOW_F32: &str = include_str!("../sample/flow_f32.wgsl");
+
+/// Every pass but the frame pass ([`frame_pass`]), named.
+pub const PASSES: [(&str, &str); 6] = [
+    ("relight", RELIGHT),
+    ("shadow", SHADOW),
+    ("composite", COMPOSITE),
+    ("floor", FLOOR),
+    ("present", PRESENT),
+    ("time_morph", TIME_MORPH),
+];
+
+/// The snippets that read the pre-lit views (one is compiled into a frame pass), named as
+/// the renderer's image formats.
+pub const PRELIT: [(&str, &str); 2] = [("codes", PRELIT_CODES), ("srgb8", PRELIT_SRGB)];
+
+/// The snippets that read the flows, named as the renderer's flow formats.
+pub const FLOW: [(&str, &str); 3] = [("codes8", FLOW_CODES), ("f16", FLOW_F16), ("f32", FLOW_F32)];
+
+/// A pass's full source: the shared definitions, then the pass.
+pub fn composed(pass: &str) -> String {
+    format!("{COMMON}\n{pass}")
+}
+
+/// The frame pass's full source with one snippet reading the pre-lit views (of
+/// [`PRELIT`]) and one reading the flows (of [`FLOW`]).
+pub fn frame_pass(prelit: &str, flow: &str) -> String {
+    [COMMON, prelit, flow, REBIN, CYLINDER, PROXY, E06, SOLVED].join("\n")
+}
