@@ -148,6 +148,7 @@ fn fault_of(e: &(dyn std::error::Error + 'static)) -> Fault {
         frf_reflectance::ReflectanceError,
         frf_ingest::IngestError,
         frf_render::RenderError,
+        frf_scene::SceneError,
         frf_stage::StageError,
         frf_eval::EvalError,
         frf_view::ViewError

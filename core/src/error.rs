@@ -22,12 +22,15 @@ pub enum Fault {
     /// Another process is writing the same output: nothing is wrong with the request or
     /// the data, and the same command succeeds once the other ends.
     Busy,
+    /// The program itself failed (a worker thread panicked, a report that does not
+    /// serialize): nothing the caller can correct; a bug to report.
+    Internal,
 }
 
 impl Fault {
     /// The exit status of a run that failed with this fault: 2 usage (as for a command
     /// line clap refuses), 3 damaged data, 4 GPU, 5 I/O, 75 busy (`EX_TEMPFAIL` of
-    /// sysexits.h: try again later), 130 interrupted (as a shell reports an interrupt). 1
+    /// sysexits.h: try again later), 70 internal (`EX_SOFTWARE`), 130 interrupted (as a shell reports an interrupt). 1
     /// is left for anything else and 101 is a panic's.
     pub fn exit_code(self) -> u8 {
         match self {
@@ -36,6 +39,7 @@ impl Fault {
             Fault::Gpu => 4,
             Fault::Io => 5,
             Fault::Busy => 75,
+            Fault::Internal => 70,
             Fault::Interrupted => 130,
         }
     }

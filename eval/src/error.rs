@@ -24,6 +24,9 @@ pub enum EvalError {
     /// Rendering.
     #[error(transparent)]
     Render(#[from] frf_render::RenderError),
+    /// The scene: its file, plan, shot and output.
+    #[error(transparent)]
+    Scene(#[from] frf_scene::SceneError),
 }
 
 impl EvalError {
@@ -36,6 +39,7 @@ impl EvalError {
             EvalError::Reflectance(e) => e.fault(),
             EvalError::Ingest(e) => e.fault(),
             EvalError::Render(e) => e.fault(),
+            EvalError::Scene(e) => e.fault(),
         }
     }
 }

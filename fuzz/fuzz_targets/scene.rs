@@ -8,7 +8,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    if let Ok(scene) = frf_render::scene::Scene::parse(std::path::Path::new("fuzz.toml"), text) {
+    if let Ok(scene) = frf_scene::Scene::parse(std::path::Path::new("fuzz.toml"), text) {
         let _ = scene.frame_times();
     }
 });

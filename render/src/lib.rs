@@ -12,8 +12,8 @@
 //!   [`renderer`]: one front for both.
 //! - [`shadow`]: the subject's relit shadow on the ground; [`composite`]: backdrops and
 //!   Porter–Duff compositing of the subject over them.
-//! - [`path`]: virtual camera paths (keyframes, orbit); [`scene`]: scene files (walkers
-//!   in time, lighting, camera, backdrop) and the plan of what a scene needs.
+//! - [`pose_plan`]: what a pose must provide to the frames drawn (views, flows,
+//!   conditions, maps), as the scene's planner (crate `frf-scene`) decides it.
 //! - [`synthetic`]: a procedural pose of the original's shape, for benchmarks without a
 //!   field.
 //!
@@ -31,13 +31,12 @@ pub mod geometry;
 pub mod gpu;
 pub mod morph;
 pub mod motion;
-pub mod path;
+pub mod pose_plan;
 pub mod proxy;
 pub mod rectified;
 pub mod reduced_views;
 pub mod renderer;
 pub mod resident;
-pub mod scene;
 pub mod shadow;
 pub mod shadow_reach;
 pub mod synthetic;

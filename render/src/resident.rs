@@ -34,9 +34,9 @@ use crate::error::{RenderError, Result};
 use crate::extend::extend_flow;
 use crate::footprint::SubjectBounds;
 use crate::geometry::{Crop, PoseGeometry};
+use crate::pose_plan::PosePlan;
 use crate::proxy::Proxy;
 use crate::reduced_views::{ReducedImage, ReducedViews};
-use crate::scene::plan::PosePlan;
 
 /// How the field is lit.
 #[derive(Debug, Clone)]

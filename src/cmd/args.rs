@@ -13,8 +13,8 @@ use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, DEFAULT_VOXEL_M
 use frf_reflectance::field::HullSpec;
 use frf_reflectance::project::FloorModel;
 use frf_render::morph::Variant;
-use frf_render::path::{CameraPath, Orbit, Trajectory};
 use frf_render::resident::Lighting;
+use frf_scene::path::{CameraPath, Orbit, Trajectory};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -136,7 +136,7 @@ pub fn parse_degrees(s: &str) -> Result<f32, String> {
 
 /// Parses a vertical field of view in degrees, within the range a camera path allows.
 pub fn parse_fov(s: &str) -> Result<f32, String> {
-    use frf_render::path::{MAX_FOV_DEG, MIN_FOV_DEG};
+    use frf_scene::path::{MAX_FOV_DEG, MIN_FOV_DEG};
     let v = parse_degrees(s)?;
     if !(v > MIN_FOV_DEG && v < MAX_FOV_DEG) {
         return Err(format!(
@@ -296,7 +296,7 @@ pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
 /// Where the camera goes: shared by `frf render` and `frf eval`.
 #[derive(Args, Clone, Serialize, PartialEq)]
 pub struct CameraArgs {
-    /// Keyframed camera path (TOML; see `frf_render::path`).
+    /// Keyframed camera path (TOML; see `frf_scene::path`).
     #[arg(long, conflicts_with = "orbit")]
     #[serde(serialize_with = "opt_path_text")]
     pub camera: Option<PathBuf>,

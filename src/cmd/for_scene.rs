@@ -10,8 +10,8 @@ use frf_ingest::pipeline::Selection;
 use frf_ingest::shadows::ShadowOptions;
 use frf_reflectance::FieldHeader;
 use frf_reflectance::flowcodec::quant::LogQuantizer;
-use frf_render::scene::Scene;
-use frf_render::scene::plan::Plan;
+use frf_scene::Scene;
+use frf_scene::plan::Plan;
 
 use crate::CliResult;
 

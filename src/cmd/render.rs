@@ -1,15 +1,15 @@
 //! `frf render INPUT`: frames of walkers relit by an environment, along a camera path,
 //! shadowed and composited, on the GPU (or the CPU reference with `--cpu`).
 //!
-//! INPUT is a scene file (`SCENE.toml`, [`frf_render::scene`]; flags override it, e.g.
+//! INPUT is a scene file (`SCENE.toml`, [`frf_scene`]; flags override it, e.g.
 //! `--field F` renders the same scene from another field) or a field file with the scene
 //! given by flags (one walker frozen in `--pose`, `--env`, `--orbit` or `--camera`).
-//! Either way a plan of what the frames need is made first ([`frf_render::scene::plan`];
+//! Either way a plan of what the frames need is made first ([`frf_scene::plan`];
 //! `--plan [--json]` prints it and stops, `--explain` measures what it saves), and only
 //! that is read, relit and drawn (`--no-plan`: everything). Frames are written as 8-bit
 //! sRGB PNG (straight alpha) and linear premultiplied EXR, with EXR layers on request, a
 //! contact sheet, an animated preview and `render.json`; `--frames A..B` renders part of
-//! a shot (for a farm), and a rerun resumes (`frf_render::scene::output`).
+//! a shot (for a farm), and a rerun resumes (`frf_scene::output`).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -19,14 +19,14 @@ use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
-use frf_render::path::Trajectory;
 use frf_render::renderer::Device;
 use frf_render::resident::{Lighting, PoseSource};
-use frf_render::scene::output::Output;
-use frf_render::scene::plan::{Plan, ShotFrame};
-use frf_render::scene::render_shot::render_shot;
-use frf_render::scene::shot::{Shot, ShotOptions};
-use frf_render::scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+use frf_scene::output::Output;
+use frf_scene::path::Trajectory;
+use frf_scene::plan::{Plan, ShotFrame};
+use frf_scene::render_shot::render_shot;
+use frf_scene::shot::{Shot, ShotOptions};
+use frf_scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -249,7 +249,7 @@ fn frames_of(
 #[derive(Serialize)]
 struct PlanReport<'a> {
     #[serde(flatten)]
-    counts: &'a frf_render::scene::plan::PlanCounts,
+    counts: &'a frf_scene::plan::PlanCounts,
     frames: usize,
     poses: Vec<u32>,
     /// Per pose of `poses`: where its subject can show (the views read are those of the
@@ -262,7 +262,7 @@ struct PlanReport<'a> {
     shadow_maps_read: bool,
     /// Per walker: the poses it draws and the views and flows its own rays reach (what
     /// it is made resident with).
-    walker_counts: &'a [frf_render::scene::plan::WalkerCounts],
+    walker_counts: &'a [frf_scene::plan::WalkerCounts],
 }
 
 fn print_plan(plan: &Plan, json: bool) -> CliResult {

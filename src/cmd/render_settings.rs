@@ -14,7 +14,7 @@ use std::path::Path;
 
 use frf_core::env::EnvSource;
 use frf_reflectance::FieldFile;
-use frf_render::scene::{BackdropSpec, Scene};
+use frf_scene::{BackdropSpec, Scene};
 use serde_json::{Value, json};
 
 use crate::CliResult;
@@ -97,7 +97,7 @@ pub fn render_settings(
     let scene_text = match is_scene_file {
         true => Some(frf_core::io::read_text(
             flagged.input,
-            frf_render::scene::MAX_FILE_BYTES,
+            frf_scene::MAX_FILE_BYTES,
         )?),
         false => None,
     };

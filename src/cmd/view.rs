@@ -11,8 +11,8 @@ use frf_core::env::EnvSource;
 use frf_reflectance::FieldFile;
 use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
-use frf_render::path::{Orbit, Trajectory};
-use frf_render::scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+use frf_scene::path::{Orbit, Trajectory};
+use frf_scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
 use frf_view::{Ended, ViewOptions};
 use glam::Vec3;
 

@@ -13,7 +13,7 @@ use frf_render::gpu::Gpu;
 use frf_render::gpu::present::{PresentPass, ShownLayer};
 use frf_render::morph::Variant;
 use frf_render::renderer::Device;
-use frf_render::scene::shot::{Shot, ShotOptions};
+use frf_scene::shot::{Shot, ShotOptions};
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -799,7 +799,10 @@ impl App<'_> {
             let fatal = self.script.is_some()
                 || matches!(
                     e,
-                    ViewError::Render(_) | ViewError::Window(_) | ViewError::ScriptFailed { .. }
+                    ViewError::Render(_)
+                        | ViewError::Scene(_)
+                        | ViewError::Window(_)
+                        | ViewError::ScriptFailed { .. }
                 );
             if fatal {
                 self.fail(event_loop, e);

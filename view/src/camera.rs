@@ -6,7 +6,7 @@
 //! viewer shows is what `frf render` draws of the same key.
 
 use frf_core::camera::Camera;
-use frf_render::path::Key;
+use frf_scene::path::Key;
 use glam::Vec3;
 
 /// Steepest elevation, radians: the camera never looks straight down or up (where `+y`
@@ -97,7 +97,7 @@ impl ViewCamera {
     }
 
     /// The camera of `width x height` frames, as `frf render` makes it of [`Self::key`].
-    pub fn camera(&self, width: u32, height: u32) -> frf_render::Result<Camera> {
+    pub fn camera(&self, width: u32, height: u32) -> frf_scene::Result<Camera> {
         self.key(0.0).camera(width, height)
     }
 

@@ -11,7 +11,7 @@
 //!
 //! A frame is drawn into the renderer's kept targets and shown by a present pass
 //! ([`frf_render::gpu::present`]): nothing is made or read back per frame; poses are
-//! relit only when the light changes ([`frf_render::scene::shot::Shot::edit`]).
+//! relit only when the light changes ([`frf_scene::shot::Shot::edit`]).
 
 mod app;
 pub mod camera;
@@ -24,7 +24,7 @@ pub mod viewer;
 use std::path::PathBuf;
 
 use frf_core::env::EnvSource;
-use frf_render::scene::Scene;
+use frf_scene::Scene;
 
 /// Errors of the viewer.
 #[derive(Debug, thiserror::Error)]
@@ -73,6 +73,9 @@ pub enum ViewError {
     /// Rendering failed.
     #[error(transparent)]
     Render(#[from] frf_render::RenderError),
+    /// The scene: its file, plan, shot and output.
+    #[error(transparent)]
+    Scene(#[from] frf_scene::SceneError),
     /// Reading the field failed.
     #[error(transparent)]
     Field(#[from] frf_reflectance::ReflectanceError),
@@ -94,6 +97,7 @@ impl ViewError {
             | ViewError::Record(_) => Fault::Usage,
             ViewError::ScriptFailed { source, .. } => source.fault(),
             ViewError::Render(e) => e.fault(),
+            ViewError::Scene(e) => e.fault(),
             ViewError::Field(e) => e.fault(),
             ViewError::Core(e) => e.fault(),
         }

@@ -13,8 +13,8 @@ use std::path::Path;
 use frf_core::env::EnvSource;
 use frf_reflectance::project::FloorModel;
 use frf_render::composite::GroundLook;
-use frf_render::path::Key;
-use frf_render::scene::{BackdropSpec, Scene, ShadowSpec};
+use frf_scene::path::Key;
+use frf_scene::{BackdropSpec, Scene, ShadowSpec};
 use serde::Serialize;
 
 use crate::ViewError;
@@ -322,7 +322,7 @@ time_offset = 0.25
             assert!((a.heading - b.heading).abs() < 1e-6);
             assert_eq!(a.time_offset, b.time_offset);
         }
-        let frf_render::path::Trajectory::Path(p) = &back.camera else {
+        let frf_scene::path::Trajectory::Path(p) = &back.camera else {
             panic!("keys become a path");
         };
         assert_eq!(p.keys, vec![key(0.0, 2.0), key(0.5, 3.0)]);

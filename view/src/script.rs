@@ -176,7 +176,7 @@ pub struct Line {
 /// Reads and checks the script at `path`; relative screenshot paths are relative to the
 /// working directory, as a command line's.
 pub fn load(path: &Path) -> Result<Vec<Line>, ViewError> {
-    let text = frf_core::io::read_text(path, frf_render::scene::MAX_FILE_BYTES)?;
+    let text = frf_core::io::read_text(path, frf_scene::MAX_FILE_BYTES)?;
     parse(path, &text)
 }
 
@@ -253,7 +253,7 @@ fn command(content: &str) -> Result<Command, String> {
             if !(v[6] > 0.0 && v[6] < 180.0) {
                 return Err(format!("field of view {} is outside (0, 180)", v[6]));
             }
-            let most = frf_render::scene::MAX_DISTANCE_M;
+            let most = frf_scene::MAX_DISTANCE_M;
             if let Some(c) = v[..6].iter().find(|c| c.abs() > most) {
                 return Err(format!(
                     "coordinate {c} is beyond {most} m of the origin (position and point \
@@ -310,7 +310,7 @@ fn command(content: &str) -> Result<Command, String> {
         "yaw" => Command::Yaw(numbers(&args, 1)?[0]),
         "intensity" => {
             let v = numbers(&args, 1)?[0];
-            let most = frf_render::scene::MAX_INTENSITY;
+            let most = frf_scene::MAX_INTENSITY;
             if !(0.0..=most).contains(&v) {
                 return Err(format!("intensity {v}: expected 0 to {most:e}"));
             }

@@ -11,9 +11,9 @@ use frf_reflectance::container::FileSource;
 use frf_render::composite::GroundLook;
 use frf_render::gpu::present::ShownLayer;
 use frf_render::morph::Variant;
-use frf_render::path::Trajectory;
-use frf_render::scene::shot::Shot;
-use frf_render::scene::{BackdropSpec, LightKey, ShadowSpec};
+use frf_scene::path::Trajectory;
+use frf_scene::shot::Shot;
+use frf_scene::{BackdropSpec, LightKey, ShadowSpec};
 use glam::Vec3;
 
 use crate::ViewError;

@@ -5,7 +5,7 @@
 use frf_eval::shot::evaluate_shot;
 use frf_reflectance::FieldFile;
 use frf_render::renderer::Device;
-use frf_render::scene::Scene;
+use frf_scene::Scene;
 
 use super::args::EvalArgs;
 use crate::CliResult;

@@ -22,11 +22,12 @@
 
 use std::path::Path;
 
+use frf_core::BadArgument;
 use frf_core::camera::Camera;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::error::{RenderError, Result};
+use crate::error::{Result, SceneError};
 
 /// Largest camera path (or scene) file, bytes: hand-written text.
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
@@ -76,8 +77,9 @@ pub struct Orbit {
     pub fov_deg: f32,
 }
 
-fn bad(what: impl Into<String>) -> RenderError {
-    RenderError::BadParameter(what.into())
+/// Key `key` of a path refused for `problem`.
+fn key_error(key: usize, problem: String) -> SceneError {
+    SceneError::CameraKey { key, problem }
 }
 
 impl Key {
@@ -102,19 +104,23 @@ impl Key {
                 .all(|c| c.is_finite())
             && self.fov_deg.is_finite();
         if !finite {
-            return Err(bad(format!("key {i}: a value is not finite")));
+            return Err(key_error(i, "a value is not finite".into()));
         }
         if !(self.fov_deg > MIN_FOV_DEG && self.fov_deg < MAX_FOV_DEG) {
-            return Err(bad(format!(
-                "key {i}: fov_deg {} is outside ({MIN_FOV_DEG}, {MAX_FOV_DEG})",
-                self.fov_deg
-            )));
+            return Err(key_error(
+                i,
+                format!(
+                    "fov_deg {} is outside ({MIN_FOV_DEG}, {MAX_FOV_DEG})",
+                    self.fov_deg
+                ),
+            ));
         }
         let forward = Vec3::from(self.look_at) - Vec3::from(self.position);
         if forward.length() < 1e-4 || forward.normalize().cross(Vec3::Y).length() < 1e-4 {
-            return Err(bad(format!(
-                "key {i}: look_at equals position or lies straight above or below it"
-            )));
+            return Err(key_error(
+                i,
+                "look_at equals position or lies straight above or below it".into(),
+            ));
         }
         Ok(())
     }
@@ -125,16 +131,15 @@ impl CameraPath {
     /// absurd fields of view and degenerate views.
     pub fn new(keys: Vec<Key>) -> Result<Self> {
         if keys.is_empty() {
-            return Err(bad("a camera path needs at least one key"));
+            return Err(BadArgument::new("a camera path", "of no key", "at least one key").into());
         }
         for (i, k) in keys.iter().enumerate() {
             k.check(i)?;
             if i > 0 && k.time <= keys[i - 1].time {
-                return Err(bad(format!(
-                    "key {i}: time {} does not follow {}",
-                    k.time,
-                    keys[i - 1].time
-                )));
+                return Err(key_error(
+                    i,
+                    format!("time {} does not follow {}", k.time, keys[i - 1].time),
+                ));
             }
         }
         Ok(Self { keys })
@@ -142,11 +147,19 @@ impl CameraPath {
 
     /// Reads and validates a TOML path file; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = frf_core::io::read_text(path, MAX_FILE_BYTES)
-            .map_err(|e| bad(format!("camera path: {e}")))?;
-        let raw: Self = toml::from_str(&text)
-            .map_err(|e| bad(format!("camera path {}: {e}", path.display())))?;
-        Self::new(raw.keys).map_err(|e| bad(format!("camera path {}: {e}", path.display())))
+        let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;
+        let in_file = |source: SceneError| SceneError::CameraPath {
+            path: path.to_path_buf(),
+            source: Box::new(source),
+        };
+        let raw: Self = toml::from_str(&text).map_err(|e| {
+            in_file(SceneError::Syntax {
+                path: path.to_path_buf(),
+                line: String::new(),
+                problem: e.to_string(),
+            })
+        })?;
+        Self::new(raw.keys).map_err(in_file)
     }
 
     /// Time span `(first, last)`.
@@ -199,7 +212,7 @@ impl CameraPath {
     /// first and last frames on the first and last keys).
     pub fn cameras(&self, frames: usize, width: u32, height: u32) -> Result<Vec<Camera>> {
         if frames == 0 || frames > 100_000 {
-            return Err(bad(format!("{frames} frames (1 to 100000)")));
+            return Err(BadArgument::new("frames", frames, "1 to 100000").into());
         }
         let (t0, t1) = self.span();
         (0..frames)
@@ -216,21 +229,45 @@ impl CameraPath {
 }
 
 impl Orbit {
-    /// Refuses non-finite or absurd parameters and a view straight down the axis.
-    pub fn validate(&self) -> Result<()> {
+    /// Refuses non-finite or absurd parameters, each named as a field of the orbit
+    /// (`radius`, `height`, `start_deg`, `sweep_deg`, `look_at`, `fov_deg`; the command
+    /// line renames them as its flags).
+    pub fn validate(&self) -> Result<(), BadArgument> {
         if !(self.radius.is_finite() && self.radius > 1e-3 && self.radius < 1e4) {
-            return Err(bad(format!(
-                "orbit radius {} m is outside (0.001, 10000)",
-                self.radius
-            )));
+            let allowed = "more than 0.001 and less than 10000 metres";
+            return Err(BadArgument::new("radius", self.radius, allowed));
         }
         if !(self.sweep_deg.is_finite() && self.sweep_deg.abs() <= 3600.0) {
-            return Err(bad(format!(
-                "orbit sweep {} degrees is outside [-3600, 3600]",
-                self.sweep_deg
-            )));
+            let allowed = "-3600 to 3600 degrees";
+            return Err(BadArgument::new("sweep_deg", self.sweep_deg, allowed));
         }
-        self.key(0.0).check(0)
+        if !(self.fov_deg > MIN_FOV_DEG && self.fov_deg < MAX_FOV_DEG) {
+            let allowed = format!("more than {MIN_FOV_DEG} and less than {MAX_FOV_DEG} degrees");
+            return Err(BadArgument::new("fov_deg", self.fov_deg, allowed));
+        }
+        let finite = [
+            (
+                "height",
+                self.height.is_finite(),
+                format!("{}", self.height),
+            ),
+            (
+                "start_deg",
+                self.start_deg.is_finite(),
+                format!("{}", self.start_deg),
+            ),
+            (
+                "look_at",
+                self.look_at.is_finite(),
+                format!("{:?}", self.look_at.to_array()),
+            ),
+        ];
+        match finite.into_iter().find(|(_, ok, _)| !ok) {
+            Some((name, _, value)) => Err(BadArgument::new(name, value, "finite values")),
+            // The camera is `radius` from the vertical through `look_at`: never straight
+            // above or below it.
+            None => Ok(()),
+        }
     }
 
     /// The key at fraction `f` of the sweep: exactly on the circle.
@@ -267,7 +304,7 @@ impl Trajectory {
             Self::Orbit(o) => {
                 o.validate()?;
                 if frames == 0 || frames > 100_000 {
-                    return Err(bad(format!("{frames} frames (1 to 100000)")));
+                    return Err(BadArgument::new("frames", frames, "1 to 100000").into());
                 }
                 let closed = (o.sweep_deg.abs() % 360.0).abs() < 1e-3;
                 let steps = if closed || frames == 1 {
@@ -341,7 +378,10 @@ mod tests {
             .cameras(4, 8, 8)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("orbit radius inf m is outside"), "{e}");
+        assert_eq!(
+            e,
+            "radius inf: expected more than 0.001 and less than 10000 metres"
+        );
     }
 
     #[test]
@@ -364,7 +404,7 @@ mod tests {
         assert!(e.contains("key 0: look_at equals position"), "{e}");
         let p = CameraPath::new(vec![key(0.0, 0.0)]).unwrap();
         let e = p.cameras(0, 8, 8).unwrap_err().to_string();
-        assert!(e.contains("0 frames (1 to 100000)"), "{e}");
+        assert_eq!(e, "frames 0: expected 1 to 100000");
         let text = "[[key]]\ntime = 0.0\nposition = [1.0, 1.0, 3.0]\nlook_at = [0.0, 0.9, 0.0]\nfov_deg = 30.0\nzoom = 2\n";
         let dir = tempfile::tempdir().unwrap();
         let f = dir.path().join("path.toml");

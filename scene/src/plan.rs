@@ -28,23 +28,26 @@
 use std::collections::btree_map::Entry;
 use std::collections::{BTreeMap, BTreeSet};
 
+use frf_core::BadArgument;
 use frf_core::camera::Camera;
 use frf_core::env::EnvMap;
 use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::manifest::FilmedSpec;
 use frf_reflectance::container::{ChunkKind, ReadAt};
 use frf_reflectance::project::{FloorModel, Projector};
-use frf_reflectance::{FieldFile, FieldHeader};
+use frf_reflectance::{FieldFile, FieldHeader, ReflectanceError};
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
+pub use frf_render::pose_plan::PosePlan;
+
 use super::{Scene, ShadowSpec, TimeInterpolation};
-use crate::cylinder::Cylinder;
-use crate::detail::detail_level;
-use crate::error::{RenderError, Result};
-pub use crate::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
-use crate::footprint::{SubjectBounds, captured_ppm, pixels_per_metre};
-use crate::shadow::ground_hit;
+use crate::error::{Result, SceneError};
+use frf_render::cylinder::Cylinder;
+use frf_render::detail::detail_level;
+pub use frf_render::footprint::{SUBJECT_HEIGHTS_M, SUBJECT_RADIUS_M};
+use frf_render::footprint::{SubjectBounds, captured_ppm, pixels_per_metre};
+use frf_render::shadow::ground_hit;
 
 /// Spacing of the rays traced to find the quads a frame reaches, pixels, over a box of
 /// more than [`EXACT_PIXELS`].
@@ -61,35 +64,6 @@ pub const EXACT_PIXELS: usize = 128 * 128;
 /// ([`EXACT_PIXELS`]).
 pub const EDGE: f32 = 0.02;
 
-/// What one pose of the field must provide.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PosePlan {
-    /// The pose.
-    pub pose: u32,
-    /// Per view (`u`-major): needed.
-    pub views: Vec<bool>,
-    /// Per view and neighbour ([`Neighbour::ALL`] order): the flow is needed.
-    pub flows: Vec<[bool; 4]>,
-    /// Per basis condition: relit.
-    pub conditions: Vec<bool>,
-    /// The shadow maps are read.
-    pub shadow_maps: bool,
-    /// The visual hull is read.
-    pub hull: bool,
-    /// The pose's motion toward the next and the previous pose
-    /// ([`frf_core::grid::PoseStep`] order) is read, for the views read.
-    pub pose_flows: [bool; 2],
-    /// The level of detail it is drawn at ([`crate::detail`]): the finest any frame
-    /// needs (0, full detail, for a shot morphed between poses).
-    pub level: u8,
-    /// The level its shadow maps are relit at: the coarsest whose texel spans at most
-    /// a frame's pixel at the walker, over every frame (0 without maps).
-    pub shadow_level: u8,
-    /// Where its subject can show ([`SubjectBounds::of_pose`]): the views read are those
-    /// of the rays through these bounds.
-    pub bounds: SubjectBounds,
-}
-
 /// One frame: its time and the pose each walker shows.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FramePlan {
@@ -100,7 +74,7 @@ pub struct FramePlan {
     /// Per instance: the pose drawn (the earlier of two between poses).
     pub poses: Vec<u32>,
     /// Per instance, between two poses: the later pose and the fraction of the way to it
-    /// ([`crate::motion`]).
+    /// ([`frf_render::motion`]).
     pub between: Vec<Option<(u32, f32)>>,
 }
 
@@ -174,7 +148,7 @@ pub struct WalkerCounts {
     pub views: usize,
     /// Flow maps made resident for it, over its poses.
     pub flows: usize,
-    /// Per pose: its level of detail ([`crate::detail`]).
+    /// Per pose: its level of detail ([`frf_render::detail`]).
     pub levels: Vec<u8>,
     /// Per pose: the level its shadow maps are relit at.
     pub shadow_levels: Vec<u8>,
@@ -469,12 +443,12 @@ impl Scene {
     ) -> Result<Vec<ShotFrame>> {
         let times = self.frame_times();
         if range.start >= range.end || range.end > times.len() {
-            return Err(RenderError::BadParameter(format!(
-                "frames {}..{} of a scene of {} frames",
-                range.start,
-                range.end,
-                times.len()
-            )));
+            return Err(BadArgument::new(
+                "--frames",
+                format!("{}..{}", range.start, range.end),
+                format!("frames within 0..{} of this scene", times.len()),
+            )
+            .into());
         }
         range
             .map(|index| {
@@ -584,12 +558,13 @@ impl Plan {
             .any(|c| matches!(c.key.kind, ChunkKind::PoseFlow(_)));
         let interpolate = match scene.interpolate {
             Some(TimeInterpolation::Flow) if !holds_pose_flows => {
-                return Err(RenderError::BadParameter(format!(
-                    "{}: the scene morphs between poses (time.interpolate = \"flow\") and the \
-                     field holds no pose-to-pose flow: ingest with --pose-flow, or set \
-                     interpolate = \"nearest\"",
-                    field.path().display()
-                )));
+                return Err(SceneError::FieldLacks {
+                    field: field.path().to_path_buf(),
+                    problem: "the scene morphs between poses (time.interpolate = \"flow\") and \
+                              the field holds no pose-to-pose flow: ingest with --pose-flow, or \
+                              set interpolate = \"nearest\""
+                        .into(),
+                });
             }
             Some(i) => i,
             None if holds_pose_flows => TimeInterpolation::Flow,
@@ -602,12 +577,15 @@ impl Plan {
             })
         };
         if interpolate == TimeInterpolation::Flow {
-            field.header().check_pose_flows().map_err(|(_, problem)| {
-                RenderError::BadParameter(format!(
-                    "{}: {problem}; or draw the nearest pose (time.interpolate = \"nearest\")",
-                    field.path().display()
-                ))
-            })?;
+            field
+                .header()
+                .check_pose_flows()
+                .map_err(|(_, problem)| SceneError::FieldLacks {
+                    field: field.path().to_path_buf(),
+                    problem: format!(
+                        "{problem}; or draw the nearest pose (time.interpolate = \"nearest\")"
+                    ),
+                })?;
         }
         let mut plan =
             Self::from_header(scene, field.header(), frames, interpolate, &mut hull_box)?;
@@ -667,16 +645,18 @@ impl Plan {
                     .chunks()
                     .any(|c| c.key.pose == p.pose && c.key.kind == ChunkKind::PoseFlow(step));
                 if p.pose_flows[step.index()] && !holds {
-                    return Err(RenderError::BadParameter(format!(
-                        "{}: frames between poses need pose {}'s motion {}, and the field holds \
+                    return Err(SceneError::FieldLacks {
+                        field: field.path().to_path_buf(),
+                        problem: format!(
+                            "frames between poses need pose {}'s motion {}, and the field holds \
                          none for it (was its part ingested without --pose-flow?): ingest pose {} \
                          with --pose-flow and merge again, or draw the nearest pose \
                          (time.interpolate = \"nearest\")",
-                        field.path().display(),
-                        p.pose,
-                        step.name(),
-                        p.pose
-                    )));
+                            p.pose,
+                            step.name(),
+                            p.pose
+                        ),
+                    });
                 }
             }
         }
@@ -709,20 +689,22 @@ impl Plan {
             .take(8)
             .map(|(p, u, v)| format!("pose {p} view ({u}, {v})"))
             .collect();
-        Err(RenderError::BadParameter(format!(
-            "{}: lacks {} of the {} views the frames need ({}{}): it was made for another \
+        Err(SceneError::FieldLacks {
+            field: field.to_path_buf(),
+            problem: format!(
+                "lacks {} of the {} views the frames need ({}{}): it was made for another \
              scene or camera (frf ingest --for); film and ingest these views (frf stage --for, \
              frf ingest --for this scene) or render from a field that holds them",
-            field.display(),
-            missing.len(),
-            needed,
-            listed.join(", "),
-            if missing.len() > listed.len() {
-                ", ..."
-            } else {
-                ""
-            }
-        )))
+                missing.len(),
+                needed,
+                listed.join(", "),
+                if missing.len() > listed.len() {
+                    ", ..."
+                } else {
+                    ""
+                }
+            ),
+        })
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
@@ -738,7 +720,7 @@ impl Plan {
         hull_box: &mut dyn FnMut(u32) -> Result<Option<(Vec3, Vec3)>>,
     ) -> Result<Self> {
         if frames.is_empty() {
-            return Err(RenderError::BadParameter("a shot of no frame".into()));
+            return Err(SceneError::Misuse("a shot of no frame"));
         }
         let mut field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
         field_poses.sort_unstable();
@@ -789,7 +771,7 @@ impl Plan {
                         v.camera
                             .to_camera()
                             .map(|c| c.centre())
-                            .map_err(RenderError::BadParameter)
+                            .map_err(|e| ReflectanceError::Corrupt(format!("a camera: {e}")).into())
                     })
                     .collect::<Result<_>>()?;
                 let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);

@@ -1,7 +1,11 @@
 //! Scenes: a shot of one or more walking subjects, relit by an environment that may
 //! change over time, seen along a camera path, shadowed and composited over a backdrop.
+//! This crate sits above the renderer (`frf-render`), which knows nothing of scenes: what
+//! the planner decides reaches it as plain data (`frf_render::pose_plan::PosePlan`).
 //!
-//! - [`file`]: the TOML a person writes, and its errors (naming the field and line);
+//! - [`file`]: the TOML a person writes (read, and written by the viewer's recorder), and
+//!   its errors (naming the field and line); [`path`]: virtual camera paths (keyframes,
+//!   orbit); [`error`]: what can go wrong, each fault in its class;
 //! - [`Scene`]: the checked scene, and what it asks for at each frame time (camera,
 //!   lighting, and the pose of each walker: the walk cycle at that time, looping);
 //! - [`plan`]: what a scene needs from a field, computed before any work, so that only
@@ -17,8 +21,10 @@
 //! origin the scene frame is the subject frame of the field.
 
 mod check;
+pub mod error;
 pub mod file;
 pub mod output;
+pub mod path;
 pub mod plan;
 pub mod render_shot;
 pub mod shot;
@@ -30,16 +36,16 @@ use frf_core::env::EnvSource;
 use frf_reflectance::project::FloorModel;
 use glam::Vec3;
 
-use crate::composite::GroundLook;
-use crate::error::{RenderError, Result};
-use crate::morph::Variant;
+pub use crate::error::{Result, SceneError};
 use crate::path::Trajectory;
 use file::{Reporter, SceneToml};
+use frf_render::composite::GroundLook;
+use frf_render::morph::Variant;
 
 /// Most frames a scene may have (an hour at 30 fps and more).
 pub const MAX_FRAMES: usize = 200_000;
 /// Largest scene (or camera path) file, bytes ([`crate::path::MAX_FILE_BYTES`]).
-pub use crate::path::MAX_FILE_BYTES;
+pub use path::MAX_FILE_BYTES;
 /// Largest frame side, pixels (8K).
 pub const MAX_SIDE_PX: u32 = 8192;
 /// The latest instant a scene may name, seconds from its clock's zero (either way): f64
@@ -143,7 +149,7 @@ pub enum TimeInterpolation {
     /// The captured pose nearest its instant.
     Nearest,
     /// Both poses' renders morphed in time by the motion between them
-    /// ([`crate::motion`]).
+    /// ([`frf_render::motion`]).
     Flow,
 }
 
@@ -204,11 +210,8 @@ impl Scene {
         given
             .map(Path::to_path_buf)
             .or_else(|| self.field.clone())
-            .ok_or_else(|| {
-                RenderError::BadParameter(format!(
-                    "{}: no field (give field = \"...\" or --field)",
-                    self.path.display()
-                ))
+            .ok_or_else(|| SceneError::NoField {
+                scene: self.path.clone(),
             })
     }
 

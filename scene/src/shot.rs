@@ -25,17 +25,18 @@ use frf_reflectance::container::ReadAt;
 
 use super::plan::{FramePlan, Plan, PosePlan, ShotFrame};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
-use crate::composite::Backdrop;
-use crate::error::{RenderError, Result};
-use crate::footprint::PixelBox;
-use crate::gpu::composite::DrawnFrame;
-use crate::motion::pose_motion;
-use crate::reduced_views::ReducedViews;
-use crate::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
-use crate::resident::{Lighting, PoseSource};
-use crate::shadow::{ShadowMaps, traced_shadow};
+use crate::error::{Result, SceneError};
+use frf_core::BadArgument;
 use frf_core::camera::Camera;
 use frf_core::grid::PoseStep;
+use frf_render::composite::Backdrop;
+use frf_render::footprint::PixelBox;
+use frf_render::gpu::composite::DrawnFrame;
+use frf_render::motion::pose_motion;
+use frf_render::reduced_views::ReducedViews;
+use frf_render::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
+use frf_render::resident::{Lighting, PoseSource};
+use frf_render::shadow::{ShadowMaps, traced_shadow};
 
 /// The share of the memory budget, `1 / DECODED_SHARE`, that keeps views' basis images
 /// decoded between reads ([`FieldFile::keep_decoded`]), besides the resident poses'.
@@ -52,7 +53,7 @@ pub struct ShotOptions {
     pub planned: bool,
     /// Median-cut lights of a traced shadow.
     pub traced_lights: usize,
-    /// Every walker at this level of detail ([`crate::detail`]); `None`: the plan's
+    /// Every walker at this level of detail ([`frf_render::detail`]); `None`: the plan's
     /// choice per walker (full detail without a plan).
     pub detail: Option<u8>,
 }
@@ -131,7 +132,7 @@ pub struct ShotCounters {
     /// (See `basis_views_reused`.)
     pub basis_views_decoded: u64,
     /// Reduced views and flows (level of detail) taken from those kept between
-    /// residencies, and reduced, so far ([`crate::reduced_views`]).
+    /// residencies, and reduced, so far ([`frf_render::reduced_views`]).
     pub reduced_reused: u64,
     /// (See `reduced_reused`.)
     pub reduced_made: u64,
@@ -164,12 +165,12 @@ pub struct ShadowReach {
 impl ShadowReach {
     /// Whether the shadow reaches past where the maps begin to fade.
     pub fn cut(&self) -> bool {
-        self.reach_m > 0.5 * self.patch_side_m * crate::shadow::EDGE_FADE_FROM
+        self.reach_m > 0.5 * self.patch_side_m * frf_render::shadow::EDGE_FADE_FROM
     }
 
     /// The patch side that would hold the shadow whole, metres.
     pub fn side_needed_m(&self) -> f32 {
-        crate::shadow_reach::patch_side_holding(self.reach_m)
+        frf_render::shadow_reach::patch_side_holding(self.reach_m)
     }
 }
 
@@ -263,11 +264,13 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// How far the shot's shadow reaches against the field's patch of maps
-    /// ([`crate::shadow_reach`]), under the lowest of its lighting keys' shadow-making
+    /// ([`frf_render::shadow_reach`]), under the lowest of its lighting keys' shadow-making
     /// lights, for the hull of the first pose drawn (a nominal person without one);
     /// `None` when no map is drawn or nothing lights the ground from above.
     pub fn shadow_reach(&mut self) -> Result<Option<ShadowReach>> {
-        use crate::shadow_reach::{NOMINAL_SUBJECT, lowest_shadow_light_elevation, shadow_reach};
+        use frf_render::shadow_reach::{
+            NOMINAL_SUBJECT, lowest_shadow_light_elevation, shadow_reach,
+        };
         let Some(spec) = &self.field.header().shadows else {
             return Ok(None);
         };
@@ -319,7 +322,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The GPU adapter and why it was taken; `None` on the CPU.
-    pub fn adapter(&self) -> Option<&crate::gpu::adapter::AdapterReport> {
+    pub fn adapter(&self) -> Option<&frf_render::gpu::adapter::AdapterReport> {
         self.device.adapter_report()
     }
 
@@ -430,11 +433,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         encoder: &mut wgpu::CommandEncoder,
         time: f64,
         camera: &frf_core::camera::Camera,
-        timestamps: crate::gpu::timing::Timestamps,
+        timestamps: frf_render::gpu::timing::Timestamps,
     ) -> Result<DrawnFrame> {
         let Device::Gpu(_) = &self.device else {
-            return Err(RenderError::BadParameter(
-                "a frame drawn without a readback needs the GPU".into(),
+            return Err(SceneError::Misuse(
+                "a frame drawn without a readback needs the GPU",
             ));
         };
         self.live_frames += 1;
@@ -448,19 +451,19 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let instances = walkers
             .iter()
             .map(Walker::gpu_instance)
-            .collect::<Result<Vec<_>>>()?;
-        let b = backdrop.gpu().ok_or_else(|| {
-            RenderError::BadParameter("a backdrop made resident on the CPU".into())
-        })?;
+            .collect::<frf_render::Result<Vec<_>>>()?;
+        let b = backdrop
+            .gpu()
+            .ok_or_else(|| SceneError::Misuse("a backdrop made resident on the CPU"))?;
         backdrop.check(camera)?;
-        gpu.encode_composite(
+        Ok(gpu.encode_composite(
             encoder,
             &instances,
             b,
             camera,
             self.scene.variant,
             timestamps,
-        )
+        )?)
     }
 
     /// Renders the frame of `camera` at `time` and reads it back, as [`Shot::draw_at`]
@@ -491,14 +494,14 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 Backdrop::environment(env.clone(), *ground)
             }
             (BackdropSpec::Environment(_), None) => {
-                return Err(RenderError::BadParameter(
-                    "an environment backdrop without an environment".into(),
+                return Err(SceneError::Misuse(
+                    "an environment backdrop without an environment",
                 ));
             }
             (BackdropSpec::Plate(_), _) => Backdrop::Plate(
                 self.plate
                     .clone()
-                    .ok_or_else(|| RenderError::BadParameter("no plate loaded".into()))?,
+                    .ok_or(SceneError::Misuse("no plate loaded"))?,
             ),
         })
     }
@@ -512,7 +515,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .find(|f| f.index == frame.index)
             .cloned()
             .ok_or_else(|| {
-                RenderError::BadParameter(format!("frame {} was not planned", frame.index))
+                SceneError::Internal(format!("frame {} was not planned", frame.index))
             })?;
         self.render_plan(&fp, &frame.camera, layers)
     }
@@ -540,7 +543,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
 
     /// The walkers of a frame of `camera` whose poses are the cache's `slots`; a planned
     /// shot shades each within the pixels where its pose (both, between two) may show
-    /// ([`crate::footprint::SubjectBounds::pixel_box`]).
+    /// ([`frf_render::footprint::SubjectBounds::pixel_box`]).
     fn walkers(&self, slots: &[Slot], camera: &Camera) -> Vec<Walker<'_>> {
         slots
             .iter()
@@ -685,10 +688,13 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .detail
             .unwrap_or_else(|| plan.map_or(0, |p| p.level));
         if level > 0 && self.plan.interpolate == TimeInterpolation::Flow {
-            return Err(RenderError::BadParameter(format!(
-                "level of detail {level} in a shot morphed between poses: its motion views \
-                 are made at full detail (interpolate = \"nearest\", or detail 0)"
-            )));
+            return Err(BadArgument::new(
+                "--detail",
+                level,
+                "0 in a shot morphed between poses, whose motion views are made at full \
+                 detail (or time.interpolate = \"nearest\")",
+            )
+            .into());
         }
         let source = PoseSource::load_at(
             self.field,
@@ -758,11 +764,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .min_by_key(|(_, c)| c.last_frame)
                 .map(|(k, _)| k);
             let Some(k) = victim else {
-                return Err(RenderError::BadParameter(format!(
-                    "frame {frame} needs {:.1} MB of resident poses, more than the memory budget of {:.1} MB (--memory-budget)",
-                    total(&self.cache) as f64 / 1e6,
-                    self.options.memory_budget as f64 / 1e6
-                )));
+                return Err(SceneError::MemoryBudget {
+                    frame,
+                    needed_mb: total(&self.cache) as f64 / 1e6,
+                    budget_mb: self.options.memory_budget as f64 / 1e6,
+                });
             };
             self.cache.remove(k);
             self.counters.evictions += 1;

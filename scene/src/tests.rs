@@ -238,7 +238,7 @@ fn a_time_between_poses_finds_both_and_the_fraction() {
 
 #[test]
 fn only_rays_near_the_subject_may_see_it() {
-    use crate::footprint::SubjectBounds;
+    use frf_render::footprint::SubjectBounds;
     let may_see_subject = |o, d| SubjectBounds::DESIGN.may_see(o, d);
     let eye = Vec3::new(0.0, 1.5, 12.0);
     // Straight at the body, over its head, beside it, and down onto its feet.

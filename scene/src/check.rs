@@ -11,10 +11,10 @@ use super::{
     BackdropSpec, Instance, LightKey, MAX_DISTANCE_M, MAX_FRAMES, MAX_INTENSITY, MAX_SIDE_PX,
     MAX_TIME_S, Preview, ShadowSpec, TimeInterpolation,
 };
-use crate::composite::GroundLook;
 use crate::error::Result;
-use crate::morph::Variant;
 use crate::path::{CameraPath, Orbit, Trajectory};
+use frf_render::composite::GroundLook;
+use frf_render::morph::Variant;
 
 /// Albedo of `floor = "ground"`: a mid-grey ground.
 const GROUND_FLOOR_ALBEDO: f32 = 0.3;

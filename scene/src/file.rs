@@ -30,7 +30,7 @@
 //! [camera]                            # an orbit over the time range, or keys
 //! orbit = { radius = 3.2, height = 1.4, start_deg = -30.0, sweep_deg = 120.0,
 //!           look_at = [0.0, 0.9, 0.0], fov_deg = 35.0 }
-//! # [[camera.key]]                    # as camera path files (frf_render::path)
+//! # [[camera.key]]                    # as camera path files (frf_scene::path)
 //! # time = 0.0
 //! # position = [2.5, 1.4, 3.0]
 //! # look_at = [0.0, 0.9, 0.0]
@@ -54,7 +54,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::error::{RenderError, Result};
+use crate::error::{Result, SceneError};
 
 /// A value and where it was written.
 pub type At<T> = Spanned<T>;
@@ -310,16 +310,18 @@ impl<'a> Reporter<'a> {
         field: &str,
         span: Range<usize>,
         problem: impl std::fmt::Display,
-    ) -> RenderError {
+    ) -> SceneError {
         let place = if span.is_empty() && span.start == 0 {
             "(not given)".to_string()
         } else {
             format!("line {}", self.line(span.start))
         };
-        RenderError::BadParameter(format!(
-            "scene {}: {field} ({place}): {problem}",
-            self.path.display()
-        ))
+        SceneError::File {
+            path: self.path.to_path_buf(),
+            field: field.to_string(),
+            place,
+            problem: problem.to_string(),
+        }
     }
 
     /// A path written in the file, relative to the file's directory.
@@ -339,6 +341,10 @@ pub fn parse(path: &Path, text: &str) -> Result<SceneToml> {
         let line = e.span().map_or(String::new(), |s| {
             format!(" (line {})", Reporter::new(path, text).line(s.start))
         });
-        RenderError::BadParameter(format!("scene {}{line}: {}", path.display(), e.message()))
+        SceneError::Syntax {
+            path: path.to_path_buf(),
+            line,
+            problem: e.message().to_string(),
+        }
     })
 }

@@ -12,7 +12,7 @@ use frf_reflectance::container::ReadAt;
 use super::output::{FrameFiles, Kept, Output};
 use super::plan::ShotFrame;
 use super::shot::Shot;
-use crate::error::{RenderError, Result};
+use crate::error::{Result, SceneError};
 
 /// Renders `frames` of `shot` into `output` (with their layers when `layers`, the PNGs
 /// exposed by `exposure_stops`), one progress phase of a step per frame. Stops at the
@@ -68,11 +68,9 @@ pub fn render_shot<R: ReadAt>(
             progress.step();
         }
         drop(to_writer);
-        let wrote = writer.join().unwrap_or_else(|_| {
-            Err(RenderError::BadParameter(
-                "the frame writer panicked".into(),
-            ))
-        });
+        let wrote = writer
+            .join()
+            .unwrap_or_else(|_| Err(SceneError::Internal("the frame writer panicked".into())));
         result.and(wrote)
     });
     for (i, seconds) in written.try_iter() {

@@ -28,11 +28,11 @@ use serde::{Deserialize, Serialize};
 use super::plan::ShotFrame;
 use super::shot::{Shot, ShotCounters, ShotResult};
 use super::{Preview, Scene};
-use crate::cpu::FrameStats;
-use crate::error::{RenderError, Result};
+use crate::error::{Result, SceneError};
+use frf_render::cpu::FrameStats;
 
-fn json_error(e: serde_json::Error) -> RenderError {
-    RenderError::BadParameter(format!("a render's report does not serialize: {e}"))
+fn json_error(e: serde_json::Error) -> SceneError {
+    SceneError::Internal(format!("a render's report does not serialize: {e}"))
 }
 
 /// Frames on the contact sheet (evenly spaced).
@@ -87,7 +87,7 @@ impl FrameRecord {
 /// The files of one rendered frame, not yet written.
 pub struct FrameFiles {
     dir: PathBuf,
-    frame: crate::renderer::Frame,
+    frame: frf_render::renderer::Frame,
     record: FrameRecord,
 }
 
@@ -233,10 +233,10 @@ impl Output {
         total: usize,
     ) -> Result<Self> {
         if dir.exists() && !dir.is_dir() {
-            return Err(RenderError::BadParameter(format!(
-                "--out {}: a file is there, not a directory",
-                dir.display()
-            )));
+            return Err(SceneError::Output {
+                dir: dir.to_path_buf(),
+                problem: "a file is there, not a directory (--out)".into(),
+            });
         }
         let made_dir = !dir.exists();
         std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
@@ -258,10 +258,12 @@ impl Output {
                 Some(old) => format!("they differ in {}", differences(old, &settings).join(", ")),
                 None => "its settings.json is missing or unreadable".into(),
             };
-            return Err(RenderError::BadParameter(format!(
-                "{} holds frames of a render with other settings ({what}); use --overwrite or another --out",
-                dir.display()
-            )));
+            return Err(SceneError::Output {
+                dir: dir.to_path_buf(),
+                problem: format!(
+                    "holds frames of a render with other settings ({what}); use --overwrite or another --out"
+                ),
+            });
         }
         write_bytes_atomic(&path, text.as_bytes())?;
         Ok(Self {
@@ -444,7 +446,7 @@ impl Output {
             (false, false) => "the resumed frames, when earlier runs rendered them",
             (false, true) => "no frame (nothing timed)",
         };
-        let median = (!seconds.is_empty()).then(|| crate::gpu::timing::median_min(&seconds).0);
+        let median = (!seconds.is_empty()).then(|| frf_render::gpu::timing::median_min(&seconds).0);
         let mean_of = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
         let (mean, writing_mean) = (mean_of(&seconds), mean_of(&writing));
         let (first, last) = (
@@ -461,7 +463,7 @@ impl Output {
             device: String,
             /// The GPU adapter, why it was taken, and every one considered.
             #[serde(skip_serializing_if = "Option::is_none")]
-            adapter: Option<&'a crate::gpu::adapter::AdapterReport>,
+            adapter: Option<&'a frf_render::gpu::adapter::AdapterReport>,
             frames_total: usize,
             frames_rendered: usize,
             frames_resumed: usize,
