@@ -1,5 +1,7 @@
 //! The scene file: TOML a person writes by hand, read and checked field by field.
-//! Errors name the file, the field and its line. Paths are relative to the file.
+//! Errors name the file, the field and its line. Paths are relative to the file. The
+//! same structs are written: the viewer records a camera move as a scene file through
+//! them ([`written`] values).
 //!
 //! ```toml
 //! field = "../demo-out/walker.frf"    # the flowed reflectance field
@@ -51,7 +53,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 use crate::error::{Result, SceneError};
@@ -59,11 +61,17 @@ use crate::error::{Result, SceneError};
 /// A value and where it was written.
 pub type At<T> = Spanned<T>;
 
+/// A value written by a program (no place in a text): what a recorded scene holds.
+pub fn written<T>(value: T) -> At<T> {
+    At::new(0..0, value)
+}
+
 /// The file as written (see the module docs).
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneToml {
     /// The field.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub field: Option<At<String>>,
     /// Time range and rate.
     pub time: At<TimeToml>,
@@ -83,7 +91,7 @@ pub struct SceneToml {
 }
 
 /// `[time]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeToml {
     /// Seconds (64-bit: a frame's instant is `start + i / fps` at any time of day).
@@ -94,15 +102,17 @@ pub struct TimeToml {
     /// Frames per second.
     pub fps: At<f64>,
     /// What a frame between captured poses shows.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub interpolate: Option<At<String>>,
 }
 
 /// `[output]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputToml {
     /// Frame width and height (read as a list: a fixed-size array would take the first
     /// two of a longer one).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub size: Option<At<Vec<u32>>>,
     /// Stops, PNG only.
     #[serde(default = "zero")]
@@ -139,10 +149,11 @@ fn default_variant() -> At<String> {
 }
 
 /// `[lighting]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightingToml {
     /// Environment (with keys, the first key's when omitted).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub env: Option<At<String>>,
     /// Degrees.
     #[serde(default = "zero")]
@@ -154,7 +165,7 @@ pub struct LightingToml {
     #[serde(default = "env_word")]
     pub floor: At<String>,
     /// Keyframes.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub key: Vec<At<LightKeyToml>>,
 }
 
@@ -175,24 +186,28 @@ fn env_word() -> At<String> {
 }
 
 /// `[[lighting.key]]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightKeyToml {
     /// Seconds.
     pub time: At<f64>,
     /// Another map from this key on.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub env: Option<At<String>>,
     /// Degrees.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub yaw_deg: Option<At<f32>>,
     /// Multiplier.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub intensity: Option<At<f32>>,
 }
 
 /// `[camera]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraToml {
     /// An orbit over the time range.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub orbit: Option<At<OrbitToml>>,
     /// Keys.
     #[serde(default)]
@@ -200,7 +215,7 @@ pub struct CameraToml {
 }
 
 /// `camera.orbit`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct OrbitToml {
     /// Metres from the vertical axis through `look_at`.
@@ -234,7 +249,7 @@ fn default_fov() -> f32 {
 }
 
 /// `[composite]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct CompositeToml {
     /// "env", "plate" or "none".
@@ -242,11 +257,13 @@ pub struct CompositeToml {
     pub backdrop: At<String>,
     /// "env", an albedo or `[r, g, b]`.
     #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ground: Option<At<toml::Value>>,
     /// "maps", "traced" or "none".
     #[serde(default = "maps_word")]
     pub shadow: At<String>,
     /// The plate.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub plate: Option<At<String>>,
 }
 
@@ -270,7 +287,7 @@ fn maps_word() -> At<String> {
 }
 
 /// `[[instance]]`.
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct InstanceToml {
     /// Metres.

@@ -23,10 +23,12 @@
 mod check;
 pub mod error;
 pub mod file;
+mod of_field;
 pub mod output;
 pub mod path;
 pub mod plan;
 pub mod render_shot;
+pub mod settings;
 pub mod shot;
 
 use std::path::{Path, PathBuf};
@@ -41,6 +43,7 @@ use crate::path::Trajectory;
 use file::{Reporter, SceneToml};
 use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
+pub use of_field::{FIELD_PREVIEW_FPS, FieldLook};
 
 /// Most frames a scene may have (an hour at 30 fps and more).
 pub const MAX_FRAMES: usize = 200_000;
@@ -67,6 +70,17 @@ pub enum Preview {
     Gif,
     /// None.
     None,
+}
+
+impl Preview {
+    /// Its name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preview::Apng => "apng",
+            Preview::Gif => "gif",
+            Preview::None => "none",
+        }
+    }
 }
 
 /// What the subject is put over.

@@ -26,6 +26,7 @@ use frf_reflectance::container::ReadAt;
 use serde::{Deserialize, Serialize};
 
 use super::plan::ShotFrame;
+use super::settings::RenderSettings;
 use super::shot::{Shot, ShotCounters, ShotResult};
 use super::{Preview, Scene};
 use crate::error::{Result, SceneError};
@@ -228,7 +229,7 @@ impl Output {
     /// the same settings resumes; `overwrite` renders every frame again).
     pub fn open(
         dir: &Path,
-        settings: &serde_json::Value,
+        settings: &RenderSettings,
         overwrite: bool,
         total: usize,
     ) -> Result<Self> {
@@ -240,7 +241,7 @@ impl Output {
         }
         let made_dir = !dir.exists();
         std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
-        let mut settings = settings.clone();
+        let mut settings = serde_json::to_value(settings).map_err(json_error)?;
         // A frame range may change between runs into one directory (array jobs); the
         // shot's frame count may not.
         if let Some(args) = settings.get_mut("args").and_then(|a| a.as_object_mut()) {
@@ -571,7 +572,12 @@ mod tests {
     #[test]
     fn a_run_without_a_frame_leaves_no_directory_or_settings() -> Result<()> {
         let root = tempfile::tempdir().map_err(|e| frf_core::CoreError::io(Path::new("."), e))?;
-        let settings = serde_json::json!({ "args": {} });
+        let settings = RenderSettings {
+            args: serde_json::json!({}),
+            files: Default::default(),
+            scene: None,
+            size: (4, 3),
+        };
         let made = root.path().join("new");
         Output::open(&made, &settings, false, 3)?.abandon_if_empty();
         assert!(!made.exists());

@@ -12,7 +12,6 @@ pub mod ingest;
 pub mod merge;
 pub mod progress;
 pub mod render;
-pub mod render_settings;
 pub mod report;
 pub mod stage;
 pub mod stage_field;

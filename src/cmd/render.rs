@@ -18,16 +18,15 @@ use clap::Args;
 use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
-use frf_render::morph::Variant;
 use frf_render::renderer::Device;
 use frf_render::resident::{Lighting, PoseSource};
 use frf_scene::output::Output;
 use frf_scene::path::Trajectory;
 use frf_scene::plan::{Plan, ShotFrame};
 use frf_scene::render_shot::render_shot;
+use frf_scene::settings::{FlagFiles, RenderSettings};
 use frf_scene::shot::{Shot, ShotOptions};
-use frf_scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
-use glam::Vec3;
+use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use serde::Serialize;
 
 use crate::CliResult;
@@ -37,7 +36,6 @@ use crate::cmd::args::{
     parse_size,
 };
 use crate::cmd::progress::Bars;
-use crate::cmd::render_settings::{FlagFiles, render_settings};
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;
@@ -147,25 +145,9 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
     {
         return Err("--backdrop plate: the plate's camera is a --camera path of one key".into());
     }
-    Ok(Scene {
-        path: args.input.clone(),
-        field: Some(args.input.clone()),
-        start: 0.0,
-        end: 0.0,
-        // The preview of a field render plays at a typical video rate.
-        fps: 12.0,
-        interpolate: None,
-        size: None,
-        exposure: 0.0,
-        layers: false,
-        preview: Preview::Apng,
-        variant: Variant::FourWay,
-        lighting: vec![LightKey {
-            time: f64::NEG_INFINITY,
-            env: source,
-            yaw: args.lighting.yaw.to_radians(),
-            intensity: 1.0,
-        }],
+    let look = FieldLook {
+        env: source,
+        yaw: args.lighting.yaw.to_radians(),
         floor: args.lighting.floor.into(),
         camera: trajectory,
         backdrop,
@@ -174,12 +156,8 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
             ShadowArg::Traced => ShadowSpec::Traced,
             ShadowArg::None => ShadowSpec::None,
         },
-        instances: vec![Instance {
-            position: Vec3::ZERO,
-            heading: 0.0,
-            time_offset: f64::from(pose) / f64::from(h.poses_per_cycle.max(1)) * h.cycle_seconds,
-        }],
-    })
+    };
+    Ok(Scene::of_field(&args.input, h, pose, look))
 }
 
 /// The scene of the arguments: the file with its overrides, or the flags.
@@ -479,7 +457,8 @@ pub fn run(args: RenderArgs) -> CliResult {
             _ => None,
         },
     };
-    let settings = render_settings((&args, flagged), &scene, &field, !field_render, size)?;
+    let args_json = serde_json::to_value(&args)?;
+    let settings = RenderSettings::new((args_json, flagged), &scene, &field, !field_render, size)?;
 
     let start = Instant::now();
     let device = Device::open(args.cpu)?;

@@ -12,7 +12,7 @@ use frf_reflectance::FieldFile;
 use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
 use frf_scene::path::{Orbit, Trajectory};
-use frf_scene::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use frf_view::{Ended, ViewOptions};
 use glam::Vec3;
 
@@ -71,24 +71,9 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
     let h = field.header();
     let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
     let lit = env != EnvSource::None;
-    Ok(Scene {
-        path: args.input.clone(),
-        field: Some(args.input.clone()),
-        start: 0.0,
-        end: h.cycle_seconds,
-        fps: RECORD_FPS,
-        interpolate: None,
-        size: Some(args.size),
-        exposure: 0.0,
-        layers: false,
-        preview: Preview::Apng,
-        variant: args.variant.map_or(Variant::FourWay, Into::into),
-        lighting: vec![LightKey {
-            time: f64::NEG_INFINITY,
-            env,
-            yaw: args.yaw.to_radians(),
-            intensity: 1.0,
-        }],
+    let look = FieldLook {
+        env,
+        yaw: args.yaw.to_radians(),
         floor: args.floor.into(),
         // Where the plan of the live shot looks from; the viewer starts at a captured view.
         camera: Trajectory::Orbit(Orbit {
@@ -105,11 +90,14 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
             BackdropSpec::None
         },
         shadow: ShadowSpec::Maps,
-        instances: vec![Instance {
-            position: Vec3::ZERO,
-            heading: 0.0,
-            time_offset: 0.0,
-        }],
+    };
+    // The walk plays from pose 0.
+    Ok(Scene {
+        end: h.cycle_seconds,
+        fps: RECORD_FPS,
+        size: Some(args.size),
+        variant: args.variant.map_or(Variant::FourWay, Into::into),
+        ..Scene::of_field(&args.input, h, 0, look)
     })
 }
 

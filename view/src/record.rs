@@ -13,9 +13,12 @@ use std::path::Path;
 use frf_core::env::EnvSource;
 use frf_reflectance::project::FloorModel;
 use frf_render::composite::GroundLook;
+use frf_scene::file::{
+    CameraToml, CompositeToml, InstanceToml, LightKeyToml, LightingToml, OutputToml, SceneToml,
+    TimeToml, written,
+};
 use frf_scene::path::Key;
 use frf_scene::{BackdropSpec, Scene, ShadowSpec};
-use serde::Serialize;
 
 use crate::ViewError;
 
@@ -37,71 +40,6 @@ impl Recording {
     pub fn keys(&self) -> &[Key] {
         &self.keys
     }
-}
-
-#[derive(Serialize)]
-struct SceneOut {
-    field: String,
-    time: TimeOut,
-    output: OutputOut,
-    lighting: LightingOut,
-    camera: CameraOut,
-    composite: CompositeOut,
-    instance: Vec<InstanceOut>,
-}
-
-#[derive(Serialize)]
-struct TimeOut {
-    start: f64,
-    end: f64,
-    fps: f64,
-}
-
-#[derive(Serialize)]
-struct OutputOut {
-    size: [u32; 2],
-    exposure: f32,
-    variant: &'static str,
-}
-
-#[derive(Serialize)]
-struct LightingOut {
-    env: String,
-    yaw_deg: f32,
-    intensity: f32,
-    floor: &'static str,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    key: Vec<LightKeyOut>,
-}
-
-#[derive(Serialize)]
-struct LightKeyOut {
-    time: f64,
-    env: String,
-    yaw_deg: f32,
-    intensity: f32,
-}
-
-#[derive(Serialize)]
-struct CameraOut {
-    key: Vec<Key>,
-}
-
-#[derive(Serialize)]
-struct CompositeOut {
-    backdrop: &'static str,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    ground: Option<toml::Value>,
-    shadow: &'static str,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    plate: Option<String>,
-}
-
-#[derive(Serialize)]
-struct InstanceOut {
-    position: [f32; 3],
-    heading_deg: f32,
-    time_offset: f64,
 }
 
 /// `path` made absolute (resolved where it exists), as text.
@@ -159,60 +97,76 @@ pub fn scene_toml(
             ("none", None, None)
         }
     };
-    let out = SceneOut {
-        field: absolute(field),
-        time: TimeOut {
-            start: first.time,
+    let out = SceneToml {
+        field: Some(written(absolute(field))),
+        time: written(TimeToml {
+            start: written(first.time),
             // One frame past the last key, so that it is a frame too; a single key is a
             // still.
-            end: if keys.len() > 1 {
+            end: written(if keys.len() > 1 {
                 last.time + 1.0 / fps
             } else {
                 first.time
-            },
-            fps,
+            }),
+            fps: written(fps),
+            interpolate: scene.interpolate.map(|i| written(i.name().to_string())),
+        }),
+        output: OutputToml {
+            size: Some(written(vec![size.0, size.1])),
+            exposure: written(exposure),
+            layers: scene.layers,
+            preview: written(scene.preview.name().to_string()),
+            variant: written(scene.variant.name().to_string()),
         },
-        output: OutputOut {
-            size: [size.0, size.1],
-            exposure,
-            variant: scene.variant.name(),
-        },
-        lighting: LightingOut {
-            env: env_text(&base.env),
-            yaw_deg: base.yaw.to_degrees(),
-            intensity: base.intensity,
-            floor: match scene.floor {
-                FloorModel::Environment => "env",
-                FloorModel::LambertianGround { .. } => "ground",
-            },
+        lighting: written(LightingToml {
+            env: Some(written(env_text(&base.env))),
+            yaw_deg: written(base.yaw.to_degrees()),
+            intensity: written(base.intensity),
+            floor: written(
+                match scene.floor {
+                    FloorModel::Environment => "env",
+                    FloorModel::LambertianGround { .. } => "ground",
+                }
+                .to_string(),
+            ),
             key: scene.lighting[1..]
                 .iter()
-                .map(|k| LightKeyOut {
-                    time: k.time,
-                    env: env_text(&k.env),
-                    yaw_deg: k.yaw.to_degrees(),
-                    intensity: k.intensity,
+                .map(|k| {
+                    written(LightKeyToml {
+                        time: written(k.time),
+                        env: Some(written(env_text(&k.env))),
+                        yaw_deg: Some(written(k.yaw.to_degrees())),
+                        intensity: Some(written(k.intensity)),
+                    })
                 })
                 .collect(),
-        },
-        camera: CameraOut { key: keys.to_vec() },
-        composite: CompositeOut {
-            backdrop,
-            ground,
-            shadow: match scene.shadow {
-                ShadowSpec::Maps => "maps",
-                ShadowSpec::Traced => "traced",
-                ShadowSpec::None => "none",
-            },
-            plate,
+        }),
+        camera: written(CameraToml {
+            orbit: None,
+            key: keys.iter().map(|k| written(*k)).collect(),
+        }),
+        composite: CompositeToml {
+            backdrop: written(backdrop.to_string()),
+            ground: ground.map(written),
+            shadow: written(
+                match scene.shadow {
+                    ShadowSpec::Maps => "maps",
+                    ShadowSpec::Traced => "traced",
+                    ShadowSpec::None => "none",
+                }
+                .to_string(),
+            ),
+            plate: plate.map(written),
         },
         instance: scene
             .instances
             .iter()
-            .map(|i| InstanceOut {
-                position: i.position.to_array(),
-                heading_deg: i.heading.to_degrees(),
-                time_offset: i.time_offset,
+            .map(|i| {
+                written(InstanceToml {
+                    position: i.position.to_array(),
+                    heading_deg: i.heading.to_degrees(),
+                    time_offset: i.time_offset,
+                })
             })
             .collect(),
     };
@@ -252,9 +206,12 @@ mod tests {
 [time]
 end = 2.0
 fps = 12.0
+interpolate = "nearest"
 
 [output]
 variant = "linear"
+preview = "gif"
+layers = true
 
 [lighting]
 env = "sky"
@@ -312,6 +269,10 @@ time_offset = 0.25
         assert_eq!(back.size, Some((64, 48)));
         assert_eq!(back.exposure, 1.0);
         assert_eq!(back.variant, scene.variant);
+        assert_eq!(
+            (back.preview, back.layers, back.interpolate),
+            (scene.preview, scene.layers, scene.interpolate)
+        );
         assert_eq!(back.lighting, scene.lighting);
         assert_eq!(back.floor, scene.floor);
         assert_eq!(back.backdrop, scene.backdrop);

@@ -1,0 +1,74 @@
+//! The scene of a field given without a scene file (`frf render FIELD --orbit ...`,
+//! `frf view FIELD`): one walker at the origin of the field's subject frame, its walk at
+//! a pose, lit by one environment ([`FieldLook`]), seen along a camera path, over a
+//! backdrop with a shadow. A still at time 0 by default; the viewer plays it.
+
+use std::path::Path;
+
+use frf_core::env::EnvSource;
+use frf_reflectance::FieldHeader;
+use frf_reflectance::project::FloorModel;
+use frf_render::morph::Variant;
+use glam::Vec3;
+
+use crate::path::Trajectory;
+use crate::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
+
+/// The rate of a field's preview (a typical video rate).
+pub const FIELD_PREVIEW_FPS: f64 = 12.0;
+
+/// How a field is shown: what a scene file would say of its lighting, camera, backdrop
+/// and shadow.
+#[derive(Debug, Clone)]
+pub struct FieldLook {
+    /// The environment.
+    pub env: EnvSource,
+    /// Its yaw, radians.
+    pub yaw: f32,
+    /// What lights the subject from below.
+    pub floor: FloorModel,
+    /// The camera.
+    pub camera: Trajectory,
+    /// What the walker is put over.
+    pub backdrop: BackdropSpec,
+    /// Where its shadow comes from.
+    pub shadow: ShadowSpec,
+}
+
+impl Scene {
+    /// The scene of the field at `field` (whose header is `header`) seen as `look`: one
+    /// walker at the origin, heading 0, its walk `pose` poses into the cycle; a still at
+    /// time 0 in four-way interpolation, with an animated PNG preview at
+    /// [`FIELD_PREVIEW_FPS`]. Callers that play it set `end`, `fps` and `size`.
+    pub fn of_field(field: &Path, header: &FieldHeader, pose: u32, look: FieldLook) -> Scene {
+        let cycle = f64::from(header.poses_per_cycle.max(1));
+        Scene {
+            path: field.to_path_buf(),
+            field: Some(field.to_path_buf()),
+            start: 0.0,
+            end: 0.0,
+            fps: FIELD_PREVIEW_FPS,
+            interpolate: None,
+            size: None,
+            exposure: 0.0,
+            layers: false,
+            preview: Preview::Apng,
+            variant: Variant::FourWay,
+            lighting: vec![LightKey {
+                time: f64::NEG_INFINITY,
+                env: look.env,
+                yaw: look.yaw,
+                intensity: 1.0,
+            }],
+            floor: look.floor,
+            camera: look.camera,
+            backdrop: look.backdrop,
+            shadow: look.shadow,
+            instances: vec![Instance {
+                position: Vec3::ZERO,
+                heading: 0.0,
+                time_offset: f64::from(pose) / cycle * header.cycle_seconds,
+            }],
+        }
+    }
+}
