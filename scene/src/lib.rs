@@ -22,11 +22,13 @@
 
 mod check;
 pub mod error;
+pub mod explain;
 pub mod file;
 mod of_field;
 pub mod output;
 pub mod path;
 pub mod plan;
+pub mod plan_report;
 pub mod render_shot;
 pub mod settings;
 pub mod shot;

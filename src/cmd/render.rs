@@ -19,10 +19,11 @@ use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
 use frf_render::renderer::Device;
-use frf_render::resident::{Lighting, PoseSource};
+use frf_scene::explain::explain;
 use frf_scene::output::Output;
 use frf_scene::path::Trajectory;
 use frf_scene::plan::{Plan, ShotFrame};
+use frf_scene::plan_report::shadow_words;
 use frf_scene::render_shot::render_shot;
 use frf_scene::settings::{FlagFiles, RenderSettings};
 use frf_scene::shot::{Shot, ShotOptions};
@@ -223,190 +224,13 @@ fn frames_of(
     Ok((scene.shot_frames(range.start..range.end, size)?, total))
 }
 
-/// The report of `--plan --json`.
-#[derive(Serialize)]
-struct PlanReport<'a> {
-    #[serde(flatten)]
-    counts: &'a frf_scene::plan::PlanCounts,
-    frames: usize,
-    poses: Vec<u32>,
-    /// Per pose of `poses`: where its subject can show (the views read are those of the
-    /// rays through these bounds).
-    bounds: Vec<frf_render::footprint::SubjectBounds>,
-    poses_substituted: &'a [(u32, u32)],
-    conditions_left_out: &'a [String],
-    floor_conditions_left_out: usize,
-    ground_seen: bool,
-    shadow_maps_read: bool,
-    /// Per walker: the poses it draws and the views and flows its own rays reach (what
-    /// it is made resident with).
-    walker_counts: &'a [frf_scene::plan::WalkerCounts],
-}
-
+/// `--plan [--json]`: the plan printed.
 fn print_plan(plan: &Plan, json: bool) -> CliResult {
-    if json {
-        let report = PlanReport {
-            counts: &plan.counts,
-            frames: plan.frames.len(),
-            poses: plan.poses.iter().map(|p| p.pose).collect(),
-            bounds: plan.poses.iter().map(|p| p.bounds).collect(),
-            poses_substituted: &plan.poses_substituted,
-            conditions_left_out: &plan.conditions_left_out,
-            floor_conditions_left_out: plan.floor_conditions_left_out,
-            ground_seen: plan.ground_seen,
-            shadow_maps_read: plan.poses.iter().any(|p| p.shadow_maps),
-            walker_counts: &plan.walker_counts,
-        };
-        println!("{}", serde_json::to_string_pretty(&report)?);
-        return Ok(());
-    }
-    let c = &plan.counts;
-    let mb = |b: u64| b as f64 / 1e6;
-    println!("plan of {} frames:", plan.frames.len());
-    println!("  poses      {:>6} of {:>6}", c.poses_used, c.poses_total);
-    println!(
-        "  views      {:>6} of {:>6}  (over the poses used)",
-        c.views_used, c.views_total
-    );
-    println!("  flows      {:>6} of {:>6}", c.flows_used, c.flows_total);
-    println!(
-        "  conditions {:>6} of {:>6}  (left out: {})",
-        c.conditions_used,
-        c.conditions_total,
-        if plan.conditions_left_out.is_empty() {
-            "none".to_string()
-        } else {
-            plan.conditions_left_out.join(", ")
-        }
-    );
-    println!(
-        "  bytes read {:>9.2} of {:>9.2} MB",
-        mb(c.bytes_read),
-        mb(c.bytes_total)
-    );
-    println!(
-        "  shadow maps {}",
-        if plan.poses.iter().any(|p| p.shadow_maps) {
-            "read"
-        } else if plan.ground_seen {
-            "not read (no maps asked for)"
-        } else {
-            "not read (no frame sees the ground patch)"
-        }
-    );
-    if plan.walker_counts.len() > 1 {
-        // Each walker is made resident with what its own rays reach.
-        let views: Vec<usize> = plan.walker_counts.iter().map(|w| w.views).collect();
-        println!(
-            "  per walker  {} walkers, views made resident {} to {} (mean {:.1}) over their poses",
-            views.len(),
-            views.iter().min().copied().unwrap_or(0),
-            views.iter().max().copied().unwrap_or(0),
-            views.iter().sum::<usize>() as f64 / views.len() as f64
-        );
-    }
-    for (wanted, held) in &plan.poses_substituted {
-        println!("  pose {wanted} is not in the field: pose {held} stands in for it");
+    match json {
+        true => println!("{}", serde_json::to_string_pretty(&plan.report())?),
+        false => println!("{}", plan.describe()),
     }
     Ok(())
-}
-
-/// `--explain`: the plan, and what each saving is worth, measured on the first pose.
-fn explain<R: frf_reflectance::container::ReadAt>(
-    scene: &Scene,
-    field: &FieldFile<R>,
-    plan: &Plan,
-    cpu: bool,
-) -> CliResult {
-    print_plan(plan, false)?;
-    let Some(first) = plan.poses.first() else {
-        return Ok(());
-    };
-    let lighting = match &scene.lighting[0].env.load()? {
-        Some(env) => Lighting::Environment {
-            env: env
-                .rotated(scene.lighting[0].yaw)
-                .scaled(scene.lighting[0].intensity),
-            floor: scene.floor,
-        },
-        None => Lighting::Unlit,
-    };
-    let device = Device::open(cpu)?;
-    let measure = |planned: bool| -> CliResult<(f64, u64)> {
-        let before = field.bytes_read();
-        let t = Instant::now();
-        let source =
-            PoseSource::load_planned(field, first.pose, &lighting, planned.then_some(first))?;
-        let resident = device.make_resident(&source)?;
-        drop(resident);
-        Ok((t.elapsed().as_secs_f64(), field.bytes_read() - before))
-    };
-    // Once untimed (caches, pipelines), then each way.
-    measure(false)?;
-    let (full_s, full_b) = measure(false)?;
-    let (planned_s, planned_b) = measure(true)?;
-    let c = &plan.counts;
-    println!(
-        "measured on pose {} ({}), reading and relighting one pose:",
-        first.pose,
-        device.name()
-    );
-    println!(
-        "  every view, flow and condition: {full_s:.3} s, {:.2} MB read",
-        full_b as f64 / 1e6
-    );
-    println!(
-        "  as planned:                     {planned_s:.3} s, {:.2} MB read",
-        planned_b as f64 / 1e6
-    );
-    println!(
-        "  views, flows and conditions left out save {:.3} s and {:.2} MB per pose, {:.2} s over the {} poses drawn",
-        full_s - planned_s,
-        (full_b.saturating_sub(planned_b)) as f64 / 1e6,
-        (full_s - planned_s) * c.poses_used as f64,
-        c.poses_used
-    );
-    println!(
-        "  the {} poses never drawn save {:.2} s (each as a full pose)",
-        c.poses_total - c.poses_used,
-        full_s * (c.poses_total - c.poses_used) as f64
-    );
-    Ok(())
-}
-
-/// Where the ground's shadow comes from, in words for the summary.
-fn shadow_words<R: frf_reflectance::container::ReadAt>(
-    scene: &Scene,
-    shot: &Shot<'_, R>,
-    traced_lights: usize,
-) -> String {
-    let plan = shot.plan();
-    let header = shot.field().header();
-    let (has_maps, has_hull) = (header.shadows.is_some(), header.hulls.is_some());
-    // What a shadow of the other kind would need, said only where the field holds it.
-    let other = if has_hull {
-        "--shadow traced traces the hull"
-    } else {
-        "nor has it a visual hull to trace: ingest without --no-shadows to cast a shadow"
-    };
-    match scene.shadow {
-        ShadowSpec::None => "none (--shadow none)".into(),
-        // Without maps or a hull there is no shadow to draw: say why first.
-        ShadowSpec::Maps if !has_maps => {
-            format!("none (the field has no shadow maps, e.g. ingested with --no-shadows; {other})")
-        }
-        ShadowSpec::Traced if !has_hull => "none (the field has no visual hull to trace, e.g. \
-             ingested with --no-shadows: ingest without it to cast a shadow)"
-            .into(),
-        _ if !plan.ground_seen => "none drawn (no frame sees the ground patch)".into(),
-        ShadowSpec::Maps if plan.poses.iter().any(|p| p.shadow_maps) => {
-            "relit from the pose's maps".into()
-        }
-        ShadowSpec::Maps => format!("none (the field has no shadow maps; {other})"),
-        ShadowSpec::Traced => {
-            format!("traced from the hull under {traced_lights} median-cut lights")
-        }
-    }
 }
 
 /// Runs `frf render`.
@@ -443,7 +267,11 @@ pub fn run(args: RenderArgs) -> CliResult {
     if args.plan || args.explain {
         let plan = Plan::new(&scene, &field, &frames)?;
         if args.explain {
-            return explain(&scene, &field, &plan, args.cpu);
+            print_plan(&plan, false)?;
+            if let Some(e) = explain(&scene, &field, &plan, args.cpu)? {
+                println!("{}", e.describe(&plan));
+            }
+            return Ok(());
         }
         return print_plan(&plan, args.json);
     }
@@ -500,7 +328,12 @@ pub fn run(args: RenderArgs) -> CliResult {
     );
     eprintln!(
         "shadow: {}",
-        shadow_words(&scene, &shot, options.traced_lights)
+        shadow_words(
+            &scene,
+            shot.plan(),
+            shot.field().header(),
+            options.traced_lights
+        )
     );
     if let Some(r) = shot.shadow_reach()?.filter(|r| r.cut()) {
         eprintln!(
