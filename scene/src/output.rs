@@ -384,121 +384,21 @@ impl Output {
         wall_seconds: f64,
         bytes_read: u64,
     ) -> Result<String> {
-        let scale = 2f32.powf(scene.exposure);
-        let all_there = (0..self.total).all(|i| frame_path(&self.dir, i, "exr").exists());
-        let mut extras = Vec::new();
-        if all_there {
-            let frames: Vec<Image<Rgba>> = (0..self.total)
-                .map(|i| read_rgba(&frame_path(&self.dir, i, "exr")))
-                .collect::<frf_core::Result<_>>()?;
-            let every = self.total.div_ceil(SHEET_FRAMES).max(1);
-            let sheet: Vec<RgbImage> = frames.iter().step_by(every).map(over_gray).collect();
-            let columns = sheet.len().min(SHEET_FRAMES / 2);
-            write_png8_srgb(
-                &self.dir.join("contact.png"),
-                &contact::sheet(&sheet, columns),
-                scale,
-            )?;
-            extras.push("contact.png".to_string());
-            if self.total > 1 {
-                let small = fit_width(&frames, PREVIEW_WIDTH);
-                match scene.preview {
-                    Preview::Apng => {
-                        write_apng(
-                            &self.dir.join("preview.png"),
-                            &small,
-                            scene.fps as f32,
-                            scale,
-                        )?;
-                        extras.push("preview.png (animated)".into());
-                    }
-                    Preview::Gif => {
-                        write_gif(
-                            &self.dir.join("preview.gif"),
-                            &small,
-                            scene.fps as f32,
-                            scale,
-                        )?;
-                        extras.push("preview.gif".into());
-                    }
-                    Preview::None => {}
-                }
-            }
-        }
-        let rendered = self.records.iter().filter(|r| !r.resumed).count();
-        // Timings of the frames this run rendered; when it rendered none, those its
-        // records kept from the runs that did.
-        let timed_now = rendered > 0;
-        let timed = |r: &&FrameRecord| r.resumed != timed_now;
-        let seconds: Vec<f64> = self
-            .records
-            .iter()
-            .filter(timed)
-            .filter_map(|r| r.seconds)
-            .collect();
-        let writing: Vec<f64> = self
-            .records
-            .iter()
-            .filter(timed)
-            .filter_map(|r| r.seconds_writing)
-            .collect();
-        let timings_of = match (timed_now, seconds.is_empty()) {
-            (true, _) => "the frames this run rendered",
-            (false, false) => "the resumed frames, when earlier runs rendered them",
-            (false, true) => "no frame (nothing timed)",
-        };
-        let median = (!seconds.is_empty()).then(|| frf_render::gpu::timing::median_min(&seconds).0);
-        let mean_of = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
-        let (mean, writing_mean) = (mean_of(&seconds), mean_of(&writing));
-        let (first, last) = (
-            self.records.iter().map(|r| r.index).min().unwrap_or(0),
-            self.records.iter().map(|r| r.index).max().unwrap_or(0),
-        );
-        let name = if first == 0 && last + 1 == self.total {
-            "render.json".to_string()
-        } else {
-            format!("render_frames_{first}-{}.json", last + 1)
-        };
-        #[derive(Serialize)]
-        struct Report<'a> {
-            device: String,
-            /// The GPU adapter, why it was taken, and every one considered.
-            #[serde(skip_serializing_if = "Option::is_none")]
-            adapter: Option<&'a frf_render::gpu::adapter::AdapterReport>,
-            frames_total: usize,
-            frames_rendered: usize,
-            frames_resumed: usize,
-            seconds_setup: f64,
-            /// Which frames the timings below are of.
-            timings_of: &'a str,
-            seconds_per_frame_median: Option<f64>,
-            seconds_per_frame_mean: Option<f64>,
-            seconds_writing_per_frame_mean: Option<f64>,
-            seconds_wall: f64,
-            plan: &'a super::plan::PlanCounts,
-            planned: bool,
-            /// Poses the scene asks for that the field lacks, and the pose drawn instead.
-            poses_substituted: &'a [(u32, u32)],
-            bytes_read_measured: u64,
-            residency: &'a ShotCounters,
-            pixels_inside: usize,
-            pixels_clamped_above: usize,
-            pixels_clamped_below: usize,
-            pixels_missed: usize,
-            frames: &'a [FrameRecord],
-        }
+        let extras = self.write_sheet_and_preview(scene)?;
+        let timings = self.timings();
+        let name = self.report_name();
         let t = self.totals;
-        let report = Report {
+        let report = RenderReport {
             device: shot.device(),
             adapter: shot.adapter(),
             frames_total: self.total,
-            frames_rendered: rendered,
-            frames_resumed: self.records.len() - rendered,
+            frames_rendered: timings.rendered,
+            frames_resumed: self.records.len() - timings.rendered,
             seconds_setup: setup_seconds,
-            timings_of,
-            seconds_per_frame_median: median,
-            seconds_per_frame_mean: mean,
-            seconds_writing_per_frame_mean: writing_mean,
+            timings_of: timings.of,
+            seconds_per_frame_median: timings.median,
+            seconds_per_frame_mean: timings.mean,
+            seconds_writing_per_frame_mean: timings.writing_mean,
             seconds_wall: wall_seconds,
             plan: &shot.plan().counts,
             planned: shot.planned(),
@@ -517,15 +417,124 @@ impl Output {
                 .map_err(json_error)?
                 .as_bytes(),
         )?;
+        Ok(self.summary(&report, &timings, &name, &extras))
+    }
+
+    /// The contact sheet and the animated preview, when every frame of the shot is in
+    /// the directory; the names of what was written.
+    fn write_sheet_and_preview(&self, scene: &Scene) -> Result<Vec<String>> {
+        let scale = 2f32.powf(scene.exposure);
+        let all_there = (0..self.total).all(|i| frame_path(&self.dir, i, "exr").exists());
+        let mut extras = Vec::new();
+        if !all_there {
+            return Ok(extras);
+        }
+        let frames: Vec<Image<Rgba>> = (0..self.total)
+            .map(|i| read_rgba(&frame_path(&self.dir, i, "exr")))
+            .collect::<frf_core::Result<_>>()?;
+        let every = self.total.div_ceil(SHEET_FRAMES).max(1);
+        let sheet: Vec<RgbImage> = frames.iter().step_by(every).map(over_gray).collect();
+        let columns = sheet.len().min(SHEET_FRAMES / 2);
+        write_png8_srgb(
+            &self.dir.join("contact.png"),
+            &contact::sheet(&sheet, columns),
+            scale,
+        )?;
+        extras.push("contact.png".to_string());
+        if self.total > 1 {
+            let small = fit_width(&frames, PREVIEW_WIDTH);
+            match scene.preview {
+                Preview::Apng => {
+                    write_apng(
+                        &self.dir.join("preview.png"),
+                        &small,
+                        scene.fps as f32,
+                        scale,
+                    )?;
+                    extras.push("preview.png (animated)".into());
+                }
+                Preview::Gif => {
+                    write_gif(
+                        &self.dir.join("preview.gif"),
+                        &small,
+                        scene.fps as f32,
+                        scale,
+                    )?;
+                    extras.push("preview.gif".into());
+                }
+                Preview::None => {}
+            }
+        }
+        Ok(extras)
+    }
+
+    /// The timings of the frames this run rendered; when it rendered none, those its
+    /// records kept from the runs that did.
+    fn timings(&self) -> Timings {
+        let rendered = self.records.iter().filter(|r| !r.resumed).count();
+        let timed_now = rendered > 0;
+        let timed = |r: &&FrameRecord| r.resumed != timed_now;
+        let seconds: Vec<f64> = self
+            .records
+            .iter()
+            .filter(timed)
+            .filter_map(|r| r.seconds)
+            .collect();
+        let writing: Vec<f64> = self
+            .records
+            .iter()
+            .filter(timed)
+            .filter_map(|r| r.seconds_writing)
+            .collect();
+        let of = match (timed_now, seconds.is_empty()) {
+            (true, _) => "the frames this run rendered",
+            (false, false) => "the resumed frames, when earlier runs rendered them",
+            (false, true) => "no frame (nothing timed)",
+        };
+        let median = (!seconds.is_empty()).then(|| frf_render::gpu::timing::median_min(&seconds).0);
+        let mean_of = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+        Timings {
+            rendered,
+            timed_now,
+            of,
+            median,
+            mean: mean_of(&seconds),
+            writing_mean: mean_of(&writing),
+        }
+    }
+
+    /// `render.json` for a whole shot, `render_frames_A-B.json` for part of one.
+    fn report_name(&self) -> String {
+        let (first, last) = (
+            self.records.iter().map(|r| r.index).min().unwrap_or(0),
+            self.records.iter().map(|r| r.index).max().unwrap_or(0),
+        );
+        if first == 0 && last + 1 == self.total {
+            "render.json".to_string()
+        } else {
+            format!("render_frames_{first}-{}.json", last + 1)
+        }
+    }
+
+    /// The summary for people of a run that wrote `report` as `name` and `extras`.
+    fn summary(
+        &self,
+        report: &RenderReport,
+        timings: &Timings,
+        name: &str,
+        extras: &[String],
+    ) -> String {
+        let t = self.totals;
         let all = (t.inside + t.clamped_above + t.clamped_below + t.missed).max(1);
         let pct = |n: usize| 100.0 * n as f64 / all as f64;
-        let c = shot.counters();
-        let timings = match (median, mean, writing_mean) {
+        let c = report.residency;
+        let (wall_seconds, setup_seconds) = (report.seconds_wall, report.seconds_setup);
+        let timings = match (timings.median, timings.mean, timings.writing_mean) {
             (Some(median), Some(mean), writing) => format!(
                 "{median:.3} s/frame median to render ({mean:.3} mean), {} s mean to write \
                  (on its own thread){}",
                 writing.map_or("?".into(), |w| format!("{w:.3}")),
-                if timed_now {
+                if timings.timed_now {
                     ""
                 } else {
                     ", as the resumed frames' earlier runs measured"
@@ -533,13 +542,13 @@ impl Output {
             ),
             _ => "no frame timed".into(),
         };
-        Ok(format!(
+        format!(
             "{} frames in {}: {timings}, {wall_seconds:.2} s wall; setup {setup_seconds:.2} s; \
              {} resumed; poses made resident {} ({} relit for a new lighting, {} dropped for the memory budget, \
              peak {:.1} MB, {:.2} s); {:.2} MB read from the field\n\
              pixels: {:.1} % re-binned inside the grid, {:.1} % clamped to the top row, {:.1} % to the bottom row, \
              {:.1} % missed; {} written{}",
-            rendered,
+            report.frames_rendered,
             self.dir.display(),
             report.frames_resumed,
             c.poses_made_resident,
@@ -547,7 +556,7 @@ impl Output {
             c.evictions,
             c.peak_resident_bytes as f64 / 1e6,
             c.residency_seconds,
-            bytes_read as f64 / 1e6,
+            report.bytes_read_measured as f64 / 1e6,
             pct(t.inside),
             pct(t.clamped_above),
             pct(t.clamped_below),
@@ -558,8 +567,51 @@ impl Output {
             } else {
                 format!(", {}", extras.join(", "))
             }
-        ))
+        )
     }
+}
+
+/// The timings a run's report gives.
+struct Timings {
+    /// Frames this run rendered.
+    rendered: usize,
+    /// The timings are this run's (else the resumed frames').
+    timed_now: bool,
+    /// Which frames the timings are of, in words.
+    of: &'static str,
+    median: Option<f64>,
+    mean: Option<f64>,
+    writing_mean: Option<f64>,
+}
+
+/// `render.json`: what a run rendered, how long it took, what it read.
+#[derive(Serialize)]
+struct RenderReport<'a> {
+    device: String,
+    /// The GPU adapter, why it was taken, and every one considered.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    adapter: Option<&'a frf_render::gpu::adapter::AdapterReport>,
+    frames_total: usize,
+    frames_rendered: usize,
+    frames_resumed: usize,
+    seconds_setup: f64,
+    /// Which frames the timings below are of.
+    timings_of: &'a str,
+    seconds_per_frame_median: Option<f64>,
+    seconds_per_frame_mean: Option<f64>,
+    seconds_writing_per_frame_mean: Option<f64>,
+    seconds_wall: f64,
+    plan: &'a super::plan::PlanCounts,
+    planned: bool,
+    /// Poses the scene asks for that the field lacks, and the pose drawn instead.
+    poses_substituted: &'a [(u32, u32)],
+    bytes_read_measured: u64,
+    residency: &'a ShotCounters,
+    pixels_inside: usize,
+    pixels_clamped_above: usize,
+    pixels_clamped_below: usize,
+    pixels_missed: usize,
+    frames: &'a [FrameRecord],
 }
 
 #[cfg(test)]

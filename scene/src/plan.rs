@@ -722,117 +722,19 @@ impl Plan {
         if frames.is_empty() {
             return Err(SceneError::Misuse("a shot of no frame"));
         }
-        let mut field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
-        field_poses.sort_unstable();
-        let mut substituted = BTreeSet::new();
-        let frame_plans: Vec<FramePlan> = frames
-            .iter()
-            .map(|f| {
-                let (index, time) = (f.index, f.time);
-                let fp = FramePlan::at(scene, h, &field_poses, interpolate, (index, time));
-                for (i, &held) in fp.poses.iter().enumerate() {
-                    let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
-                    // Morphing in time, a frame stands a pose in only where it has no
-                    // other to morph toward (a one-pose field): said as nearest's are.
-                    let morphed = interpolate == TimeInterpolation::Flow && fp.between[i].is_some();
-                    if !morphed && held != wanted {
-                        substituted.insert((wanted, held));
-                    }
-                }
-                fp
-            })
-            .collect();
-
-        let (columns, rows) = (h.columns, h.rows);
-        let views = columns * rows;
-        let half = h.shadows.as_ref().map_or(0.0, |s| 0.5 * s.ground.extent_m);
+        let (frame_plans, substituted) = frame_plans(scene, h, frames, interpolate);
+        let views = h.columns * h.rows;
         let projector = Projector::new(&h.conditions)?;
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
-        let mut ground_seen = false;
-        // Per pose drawn, where its subject can show.
-        let mut bounds = BTreeMap::new();
-        // Per walker, the poses it draws and what its own rays reach of them.
-        let mut walkers: Vec<Vec<PosePlan>> = vec![Vec::new(); scene.instances.len()];
-        for (fp, frame) in frame_plans.iter().zip(frames) {
-            let camera = frame.camera;
-            let drawn = fp.poses.iter().enumerate().flat_map(|(i, &pose)| {
-                let between = fp.between[i];
-                // Pose k, with its motion on to k'; and k', with its motion back to k.
-                [(i, pose, between.map(|_| PoseStep::Next))]
-                    .into_iter()
-                    .chain(between.map(|(after, _)| (i, after, Some(PoseStep::Prev))))
-            });
-            for (i, pose, motion) in drawn {
-                let record = h.pose(pose)?;
-                let centres: Vec<Vec3> = record
-                    .views
-                    .iter()
-                    .map(|v| {
-                        v.camera
-                            .to_camera()
-                            .map(|c| c.centre())
-                            .map_err(|e| ReflectanceError::Corrupt(format!("a camera: {e}")).into())
-                    })
-                    .collect::<Result<_>>()?;
-                let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
-                let subject_camera = scene.instances[i].camera_in_subject_frame(&camera);
-                let bounds = match bounds.entry(pose) {
-                    Entry::Occupied(b) => *b.get(),
-                    Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
-                };
-                let (quads, ground) = reached(&cylinder, &subject_camera, &bounds, half);
-                ground_seen |= ground;
-                let level = if interpolate == TimeInterpolation::Flow {
-                    // Motion views are made at the captured resolution.
-                    0
-                } else {
-                    detail_level(captured_ppm(record)?, pixels_per_metre(&subject_camera))
-                };
-                let shadow_level = h.shadows.as_ref().map_or(0, |s| {
-                    let ground = s.ground.texels as f32 / s.ground.extent_m;
-                    detail_level(ground, pixels_per_metre(&subject_camera))
-                });
-                let plan = entry(&mut walkers[i], pose, views, &lit);
-                plan.bounds = bounds;
-                plan.level = plan.level.min(level);
-                plan.shadow_level = plan.shadow_level.min(shadow_level);
-                if let Some(step) = motion {
-                    plan.pose_flows[step.index()] = true;
-                }
-                for &(u, v) in &quads {
-                    let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
-                    for (a, b) in [(u, v), (u1, v), (u, v1), (u1, v1)] {
-                        plan.views[a * rows + b] = true;
-                    }
-                    for ((a, b), n) in quad_flows(u, v, columns, rows) {
-                        plan.flows[a * rows + b][n.index()] = true;
-                    }
-                }
-            }
-        }
+        let traced = Traced {
+            scene,
+            h,
+            interpolate,
+            lit: &lit,
+        };
+        let (mut walkers, ground_seen) = traced.walkers(&frame_plans, frames, hull_box)?;
         // Every walker's plans together: what the field must provide for the shot.
-        let mut poses: Vec<PosePlan> = Vec::new();
-        for w in &walkers {
-            for p in w {
-                let union = entry(&mut poses, p.pose, views, &lit);
-                union
-                    .views
-                    .iter_mut()
-                    .zip(&p.views)
-                    .for_each(|(u, &v)| *u |= v);
-                for (u, f) in union.flows.iter_mut().zip(&p.flows) {
-                    for k in 0..4 {
-                        u[k] |= f[k];
-                    }
-                }
-                for k in 0..2 {
-                    union.pose_flows[k] |= p.pose_flows[k];
-                }
-                union.bounds = p.bounds;
-                union.level = union.level.min(p.level);
-                union.shadow_level = union.shadow_level.min(p.shadow_level);
-            }
-        }
+        let mut poses = union_of(&walkers, views, &lit);
         let wants_shadow = ground_seen && scene.shadow != ShadowSpec::None;
         for p in poses.iter_mut().chain(walkers.iter_mut().flatten()) {
             p.shadow_maps = wants_shadow && scene.shadow == ShadowSpec::Maps && h.shadows.is_some();
@@ -843,32 +745,7 @@ impl Plan {
         for w in &mut walkers {
             w.sort_by_key(|p| p.pose);
         }
-
-        let counts = PlanCounts {
-            poses_used: poses.len(),
-            poses_total: h.poses.len(),
-            views_used: poses
-                .iter()
-                .map(|p| p.views.iter().filter(|&&v| v).count())
-                .sum(),
-            views_total: poses.len() * views,
-            flows_used: poses
-                .iter()
-                .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
-                .sum(),
-            flows_total: 0,
-            pose_flows_used: poses
-                .iter()
-                .map(|p| {
-                    let views = p.views.iter().filter(|&&v| v).count();
-                    p.pose_flows.iter().filter(|&&f| f).count() * views
-                })
-                .sum(),
-            conditions_used: lit.iter().filter(|&&l| l).count(),
-            conditions_total: h.conditions.len(),
-            bytes_read: 0,
-            bytes_total: 0,
-        };
+        let counts = PlanCounts::of(&poses, h, &lit);
         let left_out: Vec<usize> = (0..lit.len()).filter(|&k| !lit[k]).collect();
         Ok(Self {
             counts,
@@ -895,5 +772,201 @@ impl Plan {
     /// The plan of pose `pose` as walker `walker` draws it (its own rays' needs).
     pub fn walker_pose(&self, walker: usize, pose: u32) -> Option<&PosePlan> {
         self.walkers.get(walker)?.iter().find(|p| p.pose == pose)
+    }
+}
+
+/// Per frame, the pose each walker shows; and the poses substituted (`(wanted, held)`)
+/// for ones the field lacks.
+fn frame_plans(
+    scene: &Scene,
+    h: &FieldHeader,
+    frames: &[ShotFrame],
+    interpolate: TimeInterpolation,
+) -> (Vec<FramePlan>, BTreeSet<(u32, u32)>) {
+    let mut field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
+    field_poses.sort_unstable();
+    let mut substituted = BTreeSet::new();
+    let frame_plans: Vec<FramePlan> = frames
+        .iter()
+        .map(|f| {
+            let (index, time) = (f.index, f.time);
+            let fp = FramePlan::at(scene, h, &field_poses, interpolate, (index, time));
+            for (i, &held) in fp.poses.iter().enumerate() {
+                let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                // Morphing in time, a frame stands a pose in only where it has no
+                // other to morph toward (a one-pose field): said as nearest's are.
+                let morphed = interpolate == TimeInterpolation::Flow && fp.between[i].is_some();
+                if !morphed && held != wanted {
+                    substituted.insert((wanted, held));
+                }
+            }
+            fp
+        })
+        .collect();
+    (frame_plans, substituted)
+}
+
+/// What the walkers' rays are traced against: the scene, the field's header, how frames
+/// between poses are drawn and which conditions are lit.
+struct Traced<'a> {
+    scene: &'a Scene,
+    h: &'a FieldHeader,
+    interpolate: TimeInterpolation,
+    lit: &'a [bool],
+}
+
+impl Traced<'_> {
+    /// Per walker, the poses it draws and what its own rays reach of them over
+    /// `frames` (planned as `frame_plans`); and whether any ray meets the ground patch.
+    fn walkers(
+        &self,
+        frame_plans: &[FramePlan],
+        frames: &[ShotFrame],
+        hull_box: &mut dyn FnMut(u32) -> Result<Option<(Vec3, Vec3)>>,
+    ) -> Result<(Vec<Vec<PosePlan>>, bool)> {
+        let mut ground_seen = false;
+        // Per pose drawn, where its subject can show.
+        let mut bounds = BTreeMap::new();
+        let mut walkers: Vec<Vec<PosePlan>> = vec![Vec::new(); self.scene.instances.len()];
+        for (fp, frame) in frame_plans.iter().zip(frames) {
+            let drawn = fp.poses.iter().enumerate().flat_map(|(i, &pose)| {
+                let between = fp.between[i];
+                // Pose k, with its motion on to k'; and k', with its motion back to k.
+                [(i, pose, between.map(|_| PoseStep::Next))]
+                    .into_iter()
+                    .chain(between.map(|(after, _)| (i, after, Some(PoseStep::Prev))))
+            });
+            for (i, pose, motion) in drawn {
+                let record = self.h.pose(pose)?;
+                let b = match bounds.entry(pose) {
+                    Entry::Occupied(b) => *b.get(),
+                    Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
+                };
+                let subject_camera = self.scene.instances[i].camera_in_subject_frame(&frame.camera);
+                let plan = entry(
+                    &mut walkers[i],
+                    pose,
+                    self.h.columns * self.h.rows,
+                    self.lit,
+                );
+                ground_seen |= self.trace(record, &subject_camera, b, motion, plan)?;
+            }
+        }
+        Ok((walkers, ground_seen))
+    }
+
+    /// Marks in `plan` what `camera` (in the subject's frame) reaches of the pose of
+    /// `record` whose subject shows within `bounds`, drawn with its motion toward
+    /// `motion`; whether a ray meets the ground patch.
+    fn trace(
+        &self,
+        record: &frf_reflectance::field::PoseRecord,
+        camera: &Camera,
+        bounds: SubjectBounds,
+        motion: Option<PoseStep>,
+        plan: &mut PosePlan,
+    ) -> Result<bool> {
+        let h = self.h;
+        let (columns, rows) = (h.columns, h.rows);
+        let half = h.shadows.as_ref().map_or(0.0, |s| 0.5 * s.ground.extent_m);
+        let centres: Vec<Vec3> = record
+            .views
+            .iter()
+            .map(|v| {
+                v.camera
+                    .to_camera()
+                    .map(|c| c.centre())
+                    .map_err(|e| ReflectanceError::Corrupt(format!("a camera: {e}")).into())
+            })
+            .collect::<Result<_>>()?;
+        let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
+        let (quads, ground) = reached(&cylinder, camera, &bounds, half);
+        let level = if self.interpolate == TimeInterpolation::Flow {
+            // Motion views are made at the captured resolution.
+            0
+        } else {
+            detail_level(captured_ppm(record)?, pixels_per_metre(camera))
+        };
+        let shadow_level = h.shadows.as_ref().map_or(0, |s| {
+            let ground = s.ground.texels as f32 / s.ground.extent_m;
+            detail_level(ground, pixels_per_metre(camera))
+        });
+        plan.bounds = bounds;
+        plan.level = plan.level.min(level);
+        plan.shadow_level = plan.shadow_level.min(shadow_level);
+        if let Some(step) = motion {
+            plan.pose_flows[step.index()] = true;
+        }
+        for &(u, v) in &quads {
+            let (u1, v1) = ((u + 1) % columns, (v + 1).min(rows - 1));
+            for (a, b) in [(u, v), (u1, v), (u, v1), (u1, v1)] {
+                plan.views[a * rows + b] = true;
+            }
+            for ((a, b), n) in quad_flows(u, v, columns, rows) {
+                plan.flows[a * rows + b][n.index()] = true;
+            }
+        }
+        Ok(ground)
+    }
+}
+
+/// Every walker's plans of a pose together, per pose (poses of `views` views, `lit`
+/// conditions).
+fn union_of(walkers: &[Vec<PosePlan>], views: usize, lit: &[bool]) -> Vec<PosePlan> {
+    let mut poses: Vec<PosePlan> = Vec::new();
+    for w in walkers {
+        for p in w {
+            let union = entry(&mut poses, p.pose, views, lit);
+            union
+                .views
+                .iter_mut()
+                .zip(&p.views)
+                .for_each(|(u, &v)| *u |= v);
+            for (u, f) in union.flows.iter_mut().zip(&p.flows) {
+                for k in 0..4 {
+                    u[k] |= f[k];
+                }
+            }
+            for k in 0..2 {
+                union.pose_flows[k] |= p.pose_flows[k];
+            }
+            union.bounds = p.bounds;
+            union.level = union.level.min(p.level);
+            union.shadow_level = union.shadow_level.min(p.shadow_level);
+        }
+    }
+    poses
+}
+
+impl PlanCounts {
+    /// The counts of `poses` planned on the field of `h` with `lit` conditions (the
+    /// bytes are counted once the field's index is at hand, [`Plan::new`]).
+    fn of(poses: &[PosePlan], h: &FieldHeader, lit: &[bool]) -> Self {
+        let views = h.columns * h.rows;
+        PlanCounts {
+            poses_used: poses.len(),
+            poses_total: h.poses.len(),
+            views_used: poses
+                .iter()
+                .map(|p| p.views.iter().filter(|&&v| v).count())
+                .sum(),
+            views_total: poses.len() * views,
+            flows_used: poses
+                .iter()
+                .map(|p| p.flows.iter().flatten().filter(|&&f| f).count())
+                .sum(),
+            flows_total: 0,
+            pose_flows_used: poses
+                .iter()
+                .map(|p| {
+                    let views = p.views.iter().filter(|&&v| v).count();
+                    p.pose_flows.iter().filter(|&&f| f).count() * views
+                })
+                .sum(),
+            conditions_used: lit.iter().filter(|&&l| l).count(),
+            conditions_total: h.conditions.len(),
+            bytes_read: 0,
+            bytes_total: 0,
+        }
     }
 }
