@@ -332,7 +332,18 @@ impl CameraArgs {
             look_at: Vec3::from(self.look_at),
             fov_deg: self.fov,
         };
-        orbit.validate()?;
+        // The orbit names its fields; the user gave them as flags.
+        orbit.validate().map_err(|e| {
+            let flag = match e.name.as_str() {
+                "radius" => "--orbit RADIUS",
+                "height" => "--orbit HEIGHT",
+                "sweep_deg" => "--orbit SWEEP_DEG",
+                "start_deg" => "--start",
+                "look_at" => "--look-at",
+                _ => "--fov",
+            };
+            e.renamed(flag)
+        })?;
         Ok(Trajectory::Orbit(orbit))
     }
 }

@@ -120,10 +120,11 @@ fn interp(args: InterpArgs) -> CliResult {
         .iter()
         .find(|(w, h)| *w == 0 || *h == 0 || *w > 16384 || *h > 16384)
     {
-        return Err(format!("--size {w}x{h}: frames are 1 to 16384 pixels a side").into());
+        let size = format!("{w}x{h}");
+        return Err(frf_core::BadArgument::new("--size", size, "1 to 16384 pixels a side").into());
     }
     if args.repeats == 0 {
-        return Err("--repeats must be at least 1".into());
+        return Err(frf_core::BadArgument::new("--repeats", 0, "at least 1").into());
     }
     let options = BenchOptions {
         sizes,

@@ -246,9 +246,7 @@ pub fn run(args: RenderArgs) -> CliResult {
     if let Some(e) = args.exposure {
         scene.exposure = e;
     }
-    if !scene.exposure.is_finite() || scene.exposure.abs() > 30.0 {
-        return Err(format!("--exposure {} stops is outside [-30, 30]", scene.exposure).into());
-    }
+    frf_core::argument::within("--exposure", scene.exposure, -30.0, 30.0, "stops")?;
     scene.layers |= args.layers;
     let field = FieldFile::open(&field_path)?;
     let h = field.header();

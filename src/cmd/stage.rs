@@ -287,9 +287,7 @@ fn truth(args: TruthArgs) -> CliResult {
             .load()?
             .ok_or("--env none: a truth image needs lighting (an environment or --basis)")?
             .rotated(args.yaw.to_radians());
-        if args.lights == 0 || args.lights > 65536 {
-            return Err(format!("--lights {}: expected 1..=65536", args.lights).into());
-        }
+        frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
         (
             environment_lights(&env, args.lights),
             format!("environment {source}"),

@@ -117,6 +117,46 @@ const CASES: &[Case] = &[
         file: "--start",
         problem: &["an angle is a finite number"],
     },
+    // Orbit values the flags' parsers pass and the orbit refuses: named as the flags, with
+    // the value and what is allowed (they were "orbit radius 0.0001 m is outside ...").
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "0.0001,1.2",
+            "--out",
+            "{out}/o",
+        ],
+        file: "--orbit RADIUS 0.0001",
+        problem: &["expected more than 0.001 and less than 10000 metres"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2,4000",
+            "--out",
+            "{out}/o",
+        ],
+        file: "--orbit SWEEP_DEG 4000",
+        problem: &["expected -3600 to 3600 degrees"],
+    },
+    Case {
+        args: &[
+            "render",
+            "{field}",
+            "--orbit",
+            "3,1.2",
+            "--exposure",
+            "40",
+            "--out",
+            "{out}/o",
+        ],
+        file: "--exposure 40",
+        problem: &["expected -30 to 30 stops"],
+    },
     // A memory budget of nothing: refused by the flag with nothing written (it was refused
     // at the first frame, after settings.json was written into a new --out).
     Case {

@@ -30,9 +30,7 @@ pub fn load(args: &EvalArgs) -> CliResult<EvalInput> {
     let pose = field.pose_or_first(args.pose)?;
     let (lighting, env) = args.lighting.lighting(h.conditions.len())?;
     let env = env.ok_or("frf eval needs an environment (the truth is relit by it)")?;
-    if !(1..=65536).contains(&args.lights) {
-        return Err(format!("--lights {} (1 to 65536)", args.lights).into());
-    }
+    frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
     let stage = frf_stage::open_stage(&args.capture)?;
     if !stage.config().poses.contains(&pose) {
         return Err(format!(

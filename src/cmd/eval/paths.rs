@@ -21,9 +21,7 @@ const DEFAULT_FRAMES: usize = 8;
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     let geometry = &input.source.geometry;
     let frames = args.frames.unwrap_or(DEFAULT_FRAMES);
-    if !(1..=10_000).contains(&frames) {
-        return Err(format!("--frames {frames} (1 to 10000)").into());
-    }
+    frf_core::argument::within("--frames", frames, 1, 10_000, "")?;
     let (w, h) = args.size.unwrap_or(geometry.image_size);
     let paths: Vec<NamedPath> = if args.suite {
         suite(geometry)?
