@@ -123,6 +123,8 @@ const CASES: &[Case] = &[
         args: &[
             "render",
             "{field}",
+            "--env",
+            "sky",
             "--orbit",
             "0.0001,1.2",
             "--out",
@@ -135,6 +137,8 @@ const CASES: &[Case] = &[
         args: &[
             "render",
             "{field}",
+            "--env",
+            "sky",
             "--orbit",
             "3,1.2,4000",
             "--out",
@@ -147,6 +151,8 @@ const CASES: &[Case] = &[
         args: &[
             "render",
             "{field}",
+            "--env",
+            "sky",
             "--orbit",
             "3,1.2",
             "--exposure",
