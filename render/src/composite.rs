@@ -73,13 +73,11 @@ impl Backdrop {
         if let Backdrop::Plate(p) = self
             && (p.width() as u32, p.height() as u32) != (camera.width, camera.height)
         {
-            return Err(RenderError::BadParameter(format!(
-                "the plate is {}x{}, the camera {}x{}: a plate is seen by its own camera",
-                p.width(),
-                p.height(),
-                camera.width,
-                camera.height
-            )));
+            return Err(RenderError::Mismatch {
+                what: "the plate (a plate is seen by its own camera)".into(),
+                expected: format!("the camera's {}x{}", camera.width, camera.height),
+                got: format!("{}x{}", p.width(), p.height()),
+            });
         }
         Ok(())
     }
@@ -155,11 +153,11 @@ pub fn back_to_front(camera: &Camera, positions: &[Vec3]) -> Vec<usize> {
 pub fn stack(layers: Vec<Image<Rgba>>) -> Result<Image<Rgba>> {
     let mut layers = layers.into_iter();
     let Some(mut out) = layers.next() else {
-        return Err(RenderError::BadParameter("no walker to stack".into()));
+        return Err(RenderError::Misuse("no walker to stack".into()));
     };
     for layer in layers {
         if layer.size() != out.size() {
-            return Err(RenderError::BadParameter(
+            return Err(RenderError::Misuse(
                 "walker layers of different sizes".into(),
             ));
         }
@@ -181,7 +179,7 @@ pub fn compose(
     backdrop.check(camera)?;
     let (w, h) = subject.size();
     if (w as u32, h as u32) != (camera.width, camera.height) {
-        return Err(RenderError::BadParameter(format!(
+        return Err(RenderError::Misuse(format!(
             "a {w}x{h} subject for a {}x{} camera",
             camera.width, camera.height
         )));

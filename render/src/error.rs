@@ -6,9 +6,42 @@ pub type Result<T, E = RenderError> = std::result::Result<T, E>;
 /// Everything that can go wrong while rendering.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    /// A parameter is out of range (camera path, size, frames, pose).
+    /// An argument outside what is allowed, named as the user gave it.
+    #[error(transparent)]
+    Argument(#[from] frf_core::BadArgument),
+    /// Two things that must agree in size do not (a plate and its camera).
+    #[error("{what}: expected {expected}, got {got}")]
+    Mismatch {
+        /// What does not match.
+        what: String,
+        /// What was expected.
+        expected: String,
+        /// What was found.
+        got: String,
+    },
+    /// The shot needs a view the field does not hold (a field made for another scene).
+    #[error(
+        "{}: the shot needs view ({u}, {v}) of pose {pose}, which this field does not hold \
+         (a field made for another scene: ingest the capture with --for this scene)",
+        field.display()
+    )]
+    ViewNotHeld {
+        /// The field file.
+        field: std::path::PathBuf,
+        /// The pose.
+        pose: u32,
+        /// The view's column.
+        u: usize,
+        /// The view's row.
+        v: usize,
+    },
+    /// A camera stored in the field that is not a camera.
+    #[error("a camera of the field: {0}")]
+    BadCamera(String),
+    /// A call the renderer's state does not allow (a pose resident on one device given
+    /// to the other, a frame with no walker): the program's own mistake.
     #[error("{0}")]
-    BadParameter(String),
+    Misuse(String),
     /// No GPU adapter that can run the passes (what each lacks), or the GPU misbehaved.
     #[error("GPU: {0}")]
     Gpu(String),
@@ -50,7 +83,11 @@ impl RenderError {
     pub fn fault(&self) -> frf_core::Fault {
         use frf_core::Fault;
         match self {
-            RenderError::BadParameter(_) => Fault::Usage,
+            RenderError::Argument(_)
+            | RenderError::Mismatch { .. }
+            | RenderError::ViewNotHeld { .. } => Fault::Usage,
+            RenderError::BadCamera(_) => Fault::Damaged,
+            RenderError::Misuse(_) => Fault::Internal,
             RenderError::Gpu(_)
             | RenderError::Wgpu { .. }
             | RenderError::GpuValidation { .. }

@@ -30,7 +30,7 @@ pub fn captured_ppm(record: &PoseRecord) -> Result<f32> {
             v.camera
                 .to_camera()
                 .map(|c| pixels_per_metre(&c))
-                .map_err(RenderError::BadParameter)
+                .map_err(RenderError::BadCamera)
         })
         .collect::<Result<Vec<f32>>>()?;
     ppm.sort_by(f32::total_cmp);

@@ -128,7 +128,7 @@ pub fn pose_motion<R: ReadAt>(
             let later = h.pose(to_pose)?.views[to_u * rows + v]
                 .camera
                 .to_camera()
-                .map_err(RenderError::BadParameter)?;
+                .map_err(RenderError::BadCamera)?;
             let to_metres = motion_to_image(camera).inverse();
             if !to_metres.is_finite() {
                 return Ok(None);
@@ -222,7 +222,7 @@ pub fn time_morph(pair: &TimePair, s: f32, to_image: Mat2) -> Result<Image<Rgba>
         .iter()
         .any(|i| i.size() != (w, h))
     {
-        return Err(RenderError::BadParameter(
+        return Err(RenderError::Misuse(
             "the renders of a frame between poses differ in size".into(),
         ));
     }

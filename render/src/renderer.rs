@@ -101,7 +101,7 @@ impl Resident {
                 between: None,
                 within: None,
             }),
-            ResidentKind::Cpu { .. } => Err(crate::RenderError::BadParameter(
+            ResidentKind::Cpu { .. } => Err(crate::RenderError::Misuse(
                 "a CPU-resident pose given to the GPU renderer".into(),
             )),
         }
@@ -150,7 +150,7 @@ impl<'a> Walker<'a> {
         if let Some((after, s)) = self.between {
             let gpu = |k: Option<&'a ResidentKind>, step| match k {
                 Some(ResidentKind::Gpu(p)) => Ok(&**p),
-                Some(ResidentKind::Cpu { .. }) => Err(crate::RenderError::BadParameter(
+                Some(ResidentKind::Cpu { .. }) => Err(crate::RenderError::Misuse(
                     "a CPU-resident pose given to the GPU renderer".into(),
                 )),
                 None => Err(no_motion(step)),
@@ -280,7 +280,7 @@ impl Device {
                 };
             }
             (ResidentKind::Gpu(_), Device::Cpu) => {
-                return Err(crate::RenderError::BadParameter(
+                return Err(crate::RenderError::Misuse(
                     "a GPU-resident pose given to the CPU renderer".into(),
                 ));
             }
@@ -325,7 +325,7 @@ impl Device {
         match (&resident.kind, self) {
             (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => gpu.render(pose, camera, variant),
             (ResidentKind::Cpu { pose, .. }, _) => Ok(render_cpu(pose, camera, variant)),
-            (ResidentKind::Gpu(_), Device::Cpu) => Err(crate::RenderError::BadParameter(
+            (ResidentKind::Gpu(_), Device::Cpu) => Err(crate::RenderError::Misuse(
                 "a GPU-resident pose given to the CPU renderer".into(),
             )),
         }
@@ -424,7 +424,7 @@ impl Device {
 fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
     match kind {
         ResidentKind::Cpu { pose, .. } => Ok(pose),
-        ResidentKind::Gpu(_) => Err(crate::RenderError::BadParameter(
+        ResidentKind::Gpu(_) => Err(crate::RenderError::Misuse(
             "a GPU-resident pose given to the CPU renderer".into(),
         )),
     }
@@ -432,7 +432,7 @@ fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
 
 /// The error of a frame between poses whose motion toward `step` was not made.
 fn no_motion(step: PoseStep) -> crate::RenderError {
-    crate::RenderError::BadParameter(format!(
+    crate::RenderError::Misuse(format!(
         "a frame between poses lacks a pose's motion {}",
         step.name()
     ))

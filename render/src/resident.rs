@@ -140,47 +140,11 @@ impl PoseSource {
         let h = field.header();
         let record = h.pose(pose)?;
         let (columns, rows) = (h.columns, h.rows);
-        let views = columns * rows;
-        if let Some(p) = plan
-            && (p.pose != pose
-                || p.views.len() != views
-                || p.conditions.len() != h.conditions.len())
-        {
-            return Err(RenderError::BadParameter(format!(
-                "the plan of pose {} does not fit pose {pose} of this field",
-                p.pose
-            )));
-        }
-        // A view is read when the plan wants it (or there is no plan) and the field holds
-        // it: a field ingested for one scene holds only that scene's views.
-        let held = |i: usize| {
-            field.has(&ChunkKey {
-                pose,
-                u: (i / rows) as u32,
-                v: (i % rows) as u32,
-                kind: ChunkKind::Alpha,
-            })
-        };
-        if let Some(p) = plan
-            && let Some(i) = (0..views).find(|&i| p.views[i] && !held(i))
-        {
-            return Err(RenderError::BadParameter(format!(
-                "{}: the shot needs view ({}, {}) of pose {pose}, which this field does not hold \
-                 (a field made for another scene: ingest the capture with --for this scene)",
-                field.path().display(),
-                i / rows,
-                i % rows
-            )));
-        }
-        let read: Vec<bool> = (0..views)
-            .map(|i| plan.is_none_or(|p| p.views[i]) && held(i))
-            .collect();
-        let view_used = |i: usize| read[i];
-        let flow_used = |i: usize, n: Neighbour| plan.is_none_or(|p| p.flows[i][n.index()]);
+        let read = views_read(field, pose, plan)?;
         let cameras = record
             .views
             .iter()
-            .map(|v| v.camera.to_camera().map_err(RenderError::BadParameter))
+            .map(|v| v.camera.to_camera().map_err(RenderError::BadCamera))
             .collect::<Result<Vec<_>>>()?;
         // The hull is the renderer's proxy for rays beyond the grid's rows.
         let hull = if plan.is_none_or(|p| p.hull) {
@@ -189,173 +153,29 @@ impl PoseSource {
             None
         };
         let bounds = SubjectBounds::of_pose(record, hull.as_ref().and_then(|h| h.bounds()))?;
-        let (coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
-            Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
-            Lighting::Environment { env, floor } => {
-                let projector = field.projector()?;
-                // One pass over the map for every view's turntable angle and the
-                // subject's own frame (angle 0), the last.
-                // Views not read keep angle 0 (their coefficients are never used).
-                let mut angles: Vec<f32> = record
-                    .views
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| {
-                        if view_used(i) {
-                            v.turntable_deg.to_radians()
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect();
-                angles.push(0.0);
-                let mut all = projector.project_many(env, &angles, *floor);
-                let own = all.pop();
-                (all, own)
-            }
-        };
-        let mut coefficients = coefficients;
-        if let Some(p) = plan {
-            // Conditions the plan leaves out have zero weight at every frame.
-            for c in &mut coefficients {
-                for (k, used) in p.conditions.iter().enumerate() {
-                    if !used {
-                        c[k] = [0.0; 3];
-                    }
-                }
-            }
-        }
-        let used: Vec<bool> = (0..h.conditions.len())
-            .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
-            .collect();
-        let plan = LightingPlan {
-            skipped_conditions: h
-                .conditions
-                .iter()
-                .zip(&used)
-                .filter(|(_, u)| !**u)
-                .map(|(c, _)| c.name.clone())
-                .collect(),
-            images_combined: views * used.iter().filter(|&&u| u).count(),
-            images_total: views * h.conditions.len(),
-        };
+        let (coefficients, ground_coefficients, lighting_plan) =
+            relighting(field, pose, lighting, plan, &read)?;
         let table = flow_lut(&record.flow_quantizer);
+        let reading = Reading {
+            field,
+            pose,
+            rows,
+            read: &read,
+            plan,
+        };
         let (size, crop, cameras, per_view) = if level == 0 {
             let size = (h.width, h.height);
-            let alphas: Vec<GrayImage> = (0..views)
-                .into_par_iter()
-                .map(|i| {
-                    if view_used(i) {
-                        Ok(field.alpha(pose, i / rows, i % rows)?)
-                    } else {
-                        // Covers nothing: no pixels to allocate or scan.
-                        Ok(GrayImage::new(0, 0, 0.0))
-                    }
-                })
-                .collect::<Result<_>>()?;
-            let crop = Crop::of_mattes(&alphas, size);
-            let full_w = h.width as usize;
-            let per_view: Vec<ViewCodes> = (0..views)
-                .into_par_iter()
-                .map(|i| {
-                    let (u, v) = (i / rows, i % rows);
-                    if !view_used(i) {
-                        return Ok(not_read(crop));
-                    }
-                    // Shared with every other read of the view (kept decoded, when the
-                    // caller set a budget for it), cropped here.
-                    let whole = field.basis_codes_shared(pose, u, v)?;
-                    let b = cropped(&whole, crop, full_w);
-                    let a = alpha_codes(&alphas[i]);
-                    let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
-                    for n in Neighbour::ALL {
-                        if !flow_used(i, n) {
-                            continue;
-                        }
-                        if let Some(codes) = field.flow_codes(pose, u, v, n)? {
-                            let mut cropped = crop.rows_of(&flow_pairs(&codes), full_w);
-                            extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
-                            flows[n.index()] = Some(cropped);
-                        }
-                    }
-                    Ok((b, crop.rows_of(&a, full_w), flows))
-                })
-                .collect::<Result<_>>()?;
+            let (crop, per_view) = reading.full_detail(size)?;
             (size, crop, cameras, per_view)
         } else {
             let none = ReducedViews::default();
-            let kept = kept.unwrap_or(&none);
-            let (size, to) = reduced_image((h.width, h.height), level);
-            let full = Crop {
-                x0: 0,
-                y0: 0,
-                width: h.width,
-                height: h.height,
-            };
-            // Per view read: its reduced image and flows (of the whole reduced image).
-            type Reduced = (Arc<ReducedImage>, [Option<Arc<Vec<[i8; 2]>>>; 4]);
-            let reduced: Vec<Option<Reduced>> = (0..views)
-                .into_par_iter()
-                .map(|i| {
-                    let (u, v) = (i / rows, i % rows);
-                    if !view_used(i) {
-                        return Ok(None);
-                    }
-                    let image = kept.image((pose, i, level), || {
-                        let alpha = alpha_codes(&field.alpha(pose, u, v)?);
-                        let basis = field.basis_codes_shared(pose, u, v)?;
-                        let alpha = reduce_alpha(&alpha, full, to, level);
-                        Ok(ReducedImage {
-                            basis: reduce_basis(&basis, full, to, level, &alpha),
-                            alpha,
-                        })
-                    })?;
-                    let mut flows: [Option<Arc<Vec<[i8; 2]>>>; 4] = Default::default();
-                    for n in Neighbour::ALL {
-                        if !flow_used(i, n) {
-                            continue;
-                        }
-                        // An absent flow (at the grid's edge) is kept as no codes.
-                        let flow = kept.flow((pose, i, n.index(), level), || {
-                            let Some(codes) = field.flow_codes(pose, u, v, n)? else {
-                                return Ok(Vec::new());
-                            };
-                            let mut reduced =
-                                reduce_flow(&flow_pairs(&codes), &table, full, to, level);
-                            extend_flow(&mut reduced, to.width as usize, to.height as usize);
-                            Ok(reduced)
-                        })?;
-                        flows[n.index()] = (!flow.is_empty()).then_some(flow);
-                    }
-                    Ok(Some((image, flows)))
-                })
-                .collect::<Result<_>>()?;
-            // Cropped to the views' mattes, as at full detail.
-            let alphas: Vec<&[u8]> = reduced
-                .iter()
-                .map(|r| r.as_ref().map_or(&[][..], |(i, _)| &i.alpha[..]))
-                .collect();
-            let crop = Crop::of_alpha_codes(&alphas, size);
-            let w = size.0 as usize;
-            let per_view: Vec<ViewCodes> = reduced
-                .iter()
-                .map(|r| {
-                    let Some((image, flows)) = r else {
-                        return not_read(crop);
-                    };
-                    let basis = cropped(&image.basis, crop, w);
-                    let flows = flows
-                        .each_ref()
-                        .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
-                    (basis, crop.rows_of(&image.alpha, w), flows)
-                })
-                .collect();
+            let (size, crop, per_view) = reading.reduced(level, kept.unwrap_or(&none), &table)?;
             let cameras = cameras.iter().map(|c| reduced_camera(c, level)).collect();
             (size, crop, cameras, per_view)
         };
-        let mut basis = Vec::with_capacity(views);
-        let mut alpha = Vec::with_capacity(views);
-        let mut flows = Vec::with_capacity(views);
+        let mut basis = Vec::with_capacity(per_view.len());
+        let mut alpha = Vec::with_capacity(per_view.len());
+        let mut flows = Vec::with_capacity(per_view.len());
         for (b, a, f) in per_view {
             basis.push(b);
             alpha.push(a);
@@ -379,8 +199,258 @@ impl PoseSource {
             alpha,
             coefficients,
             ground_coefficients,
-            plan,
+            plan: lighting_plan,
         })
+    }
+}
+
+/// Per view of pose `pose`, whether it is read: the plan wants it (or there is no plan)
+/// and the field holds it (a field ingested for one scene holds only that scene's views).
+/// A plan that does not fit the pose, or wants a view the field lacks, is refused.
+fn views_read<R: ReadAt>(
+    field: &FieldFile<R>,
+    pose: u32,
+    plan: Option<&PosePlan>,
+) -> Result<Vec<bool>> {
+    let h = field.header();
+    let rows = h.rows;
+    let views = h.columns * rows;
+    if let Some(p) = plan
+        && (p.pose != pose || p.views.len() != views || p.conditions.len() != h.conditions.len())
+    {
+        return Err(RenderError::Misuse(format!(
+            "the plan of pose {} does not fit pose {pose} of this field",
+            p.pose
+        )));
+    }
+    let held = |i: usize| {
+        field.has(&ChunkKey {
+            pose,
+            u: (i / rows) as u32,
+            v: (i % rows) as u32,
+            kind: ChunkKind::Alpha,
+        })
+    };
+    if let Some(p) = plan
+        && let Some(i) = (0..views).find(|&i| p.views[i] && !held(i))
+    {
+        return Err(RenderError::ViewNotHeld {
+            field: field.path().to_path_buf(),
+            pose,
+            u: i / rows,
+            v: i % rows,
+        });
+    }
+    Ok((0..views)
+        .map(|i| plan.is_none_or(|p| p.views[i]) && held(i))
+        .collect())
+}
+
+/// Per view, the coefficients of every condition; the subject frame's own; what
+/// relighting leaves out.
+type Relighting = (Vec<Vec<Rgb>>, Option<Vec<Rgb>>, LightingPlan);
+
+/// Per view of pose `pose` (those `read`), the relighting coefficients of `lighting`,
+/// with the conditions `plan` leaves out at zero; the subject frame's own (for the
+/// ground), and what relighting leaves out.
+fn relighting<R: ReadAt>(
+    field: &FieldFile<R>,
+    pose: u32,
+    lighting: &Lighting,
+    plan: Option<&PosePlan>,
+    read: &[bool],
+) -> Result<Relighting> {
+    let h = field.header();
+    let record = h.pose(pose)?;
+    let views = read.len();
+    let (mut coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
+        Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
+        Lighting::Environment { env, floor } => {
+            let projector = field.projector()?;
+            // One pass over the map for every view's turntable angle and the
+            // subject's own frame (angle 0), the last.
+            // Views not read keep angle 0 (their coefficients are never used).
+            let mut angles: Vec<f32> = record
+                .views
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    if read[i] {
+                        v.turntable_deg.to_radians()
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            angles.push(0.0);
+            let mut all = projector.project_many(env, &angles, *floor);
+            let own = all.pop();
+            (all, own)
+        }
+    };
+    if let Some(p) = plan {
+        // Conditions the plan leaves out have zero weight at every frame.
+        for c in &mut coefficients {
+            for (k, used) in p.conditions.iter().enumerate() {
+                if !used {
+                    c[k] = [0.0; 3];
+                }
+            }
+        }
+    }
+    let used: Vec<bool> = (0..h.conditions.len())
+        .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
+        .collect();
+    let lighting_plan = LightingPlan {
+        skipped_conditions: h
+            .conditions
+            .iter()
+            .zip(&used)
+            .filter(|(_, u)| !**u)
+            .map(|(c, _)| c.name.clone())
+            .collect(),
+        images_combined: views * used.iter().filter(|&&u| u).count(),
+        images_total: views * h.conditions.len(),
+    };
+    Ok((coefficients, ground_coefficients, lighting_plan))
+}
+
+/// What a load reads of a pose: the views `read`, and the flows `plan` wants.
+struct Reading<'a, R: ReadAt> {
+    field: &'a FieldFile<R>,
+    pose: u32,
+    rows: usize,
+    read: &'a [bool],
+    plan: Option<&'a PosePlan>,
+}
+
+impl<R: ReadAt> Reading<'_, R> {
+    /// Whether the flow of view `i` toward `n` is read.
+    fn flow_used(&self, i: usize, n: Neighbour) -> bool {
+        self.plan.is_none_or(|p| p.flows[i][n.index()])
+    }
+
+    /// The views read at full detail (images of `size`), cropped to their mattes.
+    fn full_detail(&self, size: (u32, u32)) -> Result<(Crop, Vec<ViewCodes>)> {
+        let (field, pose, rows) = (self.field, self.pose, self.rows);
+        let views = self.read.len();
+        let alphas: Vec<GrayImage> = (0..views)
+            .into_par_iter()
+            .map(|i| {
+                if self.read[i] {
+                    Ok(field.alpha(pose, i / rows, i % rows)?)
+                } else {
+                    // Covers nothing: no pixels to allocate or scan.
+                    Ok(GrayImage::new(0, 0, 0.0))
+                }
+            })
+            .collect::<Result<_>>()?;
+        let crop = Crop::of_mattes(&alphas, size);
+        let full_w = size.0 as usize;
+        let per_view: Vec<ViewCodes> = (0..views)
+            .into_par_iter()
+            .map(|i| {
+                let (u, v) = (i / rows, i % rows);
+                if !self.read[i] {
+                    return Ok(not_read(crop));
+                }
+                // Shared with every other read of the view (kept decoded, when the
+                // caller set a budget for it), cropped here.
+                let whole = field.basis_codes_shared(pose, u, v)?;
+                let b = cropped(&whole, crop, full_w);
+                let a = alpha_codes(&alphas[i]);
+                let mut flows: [Option<Vec<[i8; 2]>>; 4] = Default::default();
+                for n in Neighbour::ALL {
+                    if !self.flow_used(i, n) {
+                        continue;
+                    }
+                    if let Some(codes) = field.flow_codes(pose, u, v, n)? {
+                        let mut cropped = crop.rows_of(&flow_pairs(&codes), full_w);
+                        extend_flow(&mut cropped, crop.width as usize, crop.height as usize);
+                        flows[n.index()] = Some(cropped);
+                    }
+                }
+                Ok((b, crop.rows_of(&a, full_w), flows))
+            })
+            .collect::<Result<_>>()?;
+        Ok((crop, per_view))
+    }
+
+    /// The views read at level of detail `level` (taken from `kept` when it holds them,
+    /// and kept there), cropped to their reduced mattes; the reduced image size.
+    fn reduced(
+        &self,
+        level: u8,
+        kept: &ReducedViews,
+        table: &[f32; 256],
+    ) -> Result<((u32, u32), Crop, Vec<ViewCodes>)> {
+        let (field, pose, rows) = (self.field, self.pose, self.rows);
+        let h = field.header();
+        let (size, to) = reduced_image((h.width, h.height), level);
+        let full = Crop {
+            x0: 0,
+            y0: 0,
+            width: h.width,
+            height: h.height,
+        };
+        // Per view read: its reduced image and flows (of the whole reduced image).
+        type Reduced = (Arc<ReducedImage>, [Option<Arc<Vec<[i8; 2]>>>; 4]);
+        let reduced: Vec<Option<Reduced>> = (0..self.read.len())
+            .into_par_iter()
+            .map(|i| {
+                let (u, v) = (i / rows, i % rows);
+                if !self.read[i] {
+                    return Ok(None);
+                }
+                let image = kept.image((pose, i, level), || {
+                    let alpha = alpha_codes(&field.alpha(pose, u, v)?);
+                    let basis = field.basis_codes_shared(pose, u, v)?;
+                    let alpha = reduce_alpha(&alpha, full, to, level);
+                    Ok(ReducedImage {
+                        basis: reduce_basis(&basis, full, to, level, &alpha),
+                        alpha,
+                    })
+                })?;
+                let mut flows: [Option<Arc<Vec<[i8; 2]>>>; 4] = Default::default();
+                for n in Neighbour::ALL {
+                    if !self.flow_used(i, n) {
+                        continue;
+                    }
+                    // An absent flow (at the grid's edge) is kept as no codes.
+                    let flow = kept.flow((pose, i, n.index(), level), || {
+                        let Some(codes) = field.flow_codes(pose, u, v, n)? else {
+                            return Ok(Vec::new());
+                        };
+                        let mut reduced = reduce_flow(&flow_pairs(&codes), table, full, to, level);
+                        extend_flow(&mut reduced, to.width as usize, to.height as usize);
+                        Ok(reduced)
+                    })?;
+                    flows[n.index()] = (!flow.is_empty()).then_some(flow);
+                }
+                Ok(Some((image, flows)))
+            })
+            .collect::<Result<_>>()?;
+        // Cropped to the views' mattes, as at full detail.
+        let alphas: Vec<&[u8]> = reduced
+            .iter()
+            .map(|r| r.as_ref().map_or(&[][..], |(i, _)| &i.alpha[..]))
+            .collect();
+        let crop = Crop::of_alpha_codes(&alphas, size);
+        let w = size.0 as usize;
+        let per_view: Vec<ViewCodes> = reduced
+            .iter()
+            .map(|r| {
+                let Some((image, flows)) = r else {
+                    return not_read(crop);
+                };
+                let basis = cropped(&image.basis, crop, w);
+                let flows = flows
+                    .each_ref()
+                    .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
+                (basis, crop.rows_of(&image.alpha, w), flows)
+            })
+            .collect();
+        Ok((size, crop, per_view))
     }
 }
 

@@ -45,7 +45,7 @@ fn camera(u: usize, v: usize) -> Result<Camera> {
     let azimuth = -(u as f32 * 10.0).to_radians();
     let eye = TARGET + direction_from_azimuth_elevation(azimuth, elevation) * RADIUS_M;
     Camera::look_at(eye, TARGET, Vec3::Y, FOV, IMAGE.0, IMAGE.1)
-        .map_err(|e| RenderError::BadParameter(e.to_string()))
+        .map_err(|e| RenderError::Misuse(e.to_string()))
 }
 
 /// The synthetic pose (see the module docs), lit by one white condition.
@@ -76,8 +76,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
     let alpha: Vec<u8> = (0..w * h)
         .map(|i| (alpha_at(i % w, i / w) * 255.0).round() as u8)
         .collect();
-    let quantizer =
-        LogQuantizer::new(0.5, 64.0).map_err(|e| RenderError::BadParameter(e.to_string()))?;
+    let quantizer = LogQuantizer::new(0.5, 64.0).map_err(|e| RenderError::Misuse(e.to_string()))?;
     let mut basis = Vec::with_capacity(views);
     let mut codes = Vec::with_capacity(views);
     for i in 0..views {
@@ -142,7 +141,7 @@ pub fn bench_camera(size: (u32, u32)) -> Result<Camera> {
     let azimuth = -(2.5f32 * 10.0).to_radians();
     let eye = TARGET + direction_from_azimuth_elevation(azimuth, elevation) * RADIUS_M;
     Camera::look_at(eye, TARGET, Vec3::Y, FOV, size.0, size.1)
-        .map_err(|e| RenderError::BadParameter(e.to_string()))
+        .map_err(|e| RenderError::Misuse(e.to_string()))
 }
 
 #[cfg(test)]

@@ -218,10 +218,11 @@ pub fn choose_for(
                         .to_lowercase()
                         .contains(&needle)
             }) else {
-                return Err(RenderError::BadParameter(format!(
-                    "no GPU adapter matches `{n}` (--adapter or {ADAPTER_ENV}); found: {}",
+                let allowed = format!(
+                    "a GPU adapter's name (or {ADAPTER_ENV}); found: {}",
                     summary()
-                )));
+                );
+                return Err(frf_core::BadArgument::new("--adapter", n, allowed).into());
             };
             if !c.lacks.is_empty() {
                 return Err(RenderError::Gpu(format!(

@@ -7,6 +7,7 @@
 //! compared with the CPU reference's at the first size: a combination is correct when it
 //! stays within [`CORRECT_MAX_ABS`] of it.
 
+use frf_core::image::{Image, Rgba};
 use serde::Serialize;
 
 use super::Gpu;
@@ -202,94 +203,28 @@ pub fn run(
     progress: &mut dyn FnMut(&str),
 ) -> Result<BenchReport> {
     let info = gpu.adapter_report();
-    let mut rows = Vec::new();
-    let mut floor_bandwidth = Vec::new();
-    let first_size = options.sizes.first().copied();
     // The CPU reference first: its frames at the first size are the yardstick.
-    let mut cpu_rows = Vec::new();
-    let mut reference = Vec::new();
-    for &size in &options.sizes {
-        if u64::from(size.0) * u64::from(size.1) > options.cpu_max_pixels {
-            continue;
-        }
-        let camera = bench_camera(size)?;
-        for v in VARIANTS {
-            progress(&format!("CPU reference {} {}x{}", v.name(), size.0, size.1));
-            let mut times = Vec::new();
-            let mut frame = None;
-            for _ in 0..options.cpu_repeats.max(1) {
-                let start = std::time::Instant::now();
-                let (img, _) = render_cpu(pose, &camera, v);
-                times.push(start.elapsed().as_secs_f64() * 1e3);
-                frame = Some(img);
-            }
-            let (ms_median, ms_min) = median_min(&times);
-            cpu_rows.push(CpuRow {
-                variant: v.name().to_string(),
-                width: size.0,
-                height: size.1,
-                ms_median,
-                ms_min,
-                threads: rayon::current_num_threads(),
-            });
-            if Some(size) == first_size
-                && let Some(f) = frame
-            {
-                reference.push((v, f));
-            }
-        }
-    }
-    let mut fastest: Option<(f64, String)> = None;
+    let (cpu_rows, reference) = cpu_reference(pose, options, progress)?;
+    let (mut rows, floor_bandwidth) = floor_rows(gpu, pose, options, progress)?;
     let largest = options
         .sizes
         .iter()
         .copied()
         .max_by_key(|s| u64::from(s.0) * u64::from(s.1));
-    // The floor, once per size and stage, on the codes' texture.
-    let codes_pass = RebinPass::new(&gpu.device, PoseFormats::DEFAULT);
-    let codes_pose = gpu.upload_resident(pose, &codes_pass.pose)?;
-    let floor = FloorPass::new(&gpu.device, &codes_pass);
-    let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
-    for &size in &options.sizes {
-        let camera = bench_camera(size)?;
-        let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1, 1);
-        gpu.queue.write_buffer(
-            targets.uniform(0),
-            0,
-            bytemuck::bytes_of(&frame_uniform(Some(&codes_pose), &camera, Variant::Nearest)),
-        );
-        for &stage in &options.stages {
-            progress(&format!("floor {} {}x{}", stage.name(), size.0, size.1));
-            let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                record_floor(&floor, &targets, &floor_group, stage, size, e, t)
-            })?;
-            let (median, min) = median_min(&times);
-            let pixels = f64::from(size.0) * f64::from(size.1);
-            floor_bandwidth.push(FloorBandwidth {
-                stage: stage.name().to_string(),
-                width: size.0,
-                height: size.1,
-                gb_per_s: pixels * 20.0 / (median * 1e-3) / 1e9,
-            });
-            rows.push(row(
-                "floor",
-                PoseFormats::DEFAULT,
-                stage,
-                size,
-                (median, min),
-                median,
-                None,
-            ));
-        }
-    }
-    drop(codes_pose);
+    let mut fastest: Option<(f64, String)> = None;
     for &formats in &options.formats {
         let pass = RebinPass::new(&gpu.device, formats);
         let gpu_pose = gpu.upload_resident(pose, &pass.pose)?;
         for &size in &options.sizes {
             let camera = bench_camera(size)?;
             let targets = SubjectTargets::new(&gpu.device, &pass, size, 1, 1);
-            let whole = crate::footprint::PixelBox::whole(size.0, size.1);
+            let drawn = Drawn {
+                gpu,
+                pass: &pass,
+                targets: &targets,
+                pose: &gpu_pose,
+                size,
+            };
             for &stage in &options.stages {
                 let floor_ms = rows
                     .iter()
@@ -314,43 +249,12 @@ pub fn run(
                         bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
                     );
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                        pass.record(
-                            e,
-                            &targets,
-                            (0, Place::FRAME),
-                            &gpu_pose.bind_group,
-                            stage,
-                            whole,
-                            t,
-                            false,
-                        )
+                        drawn.record(e, stage, t)
                     })?;
                     let timing = median_min(&times);
                     let error = match reference.iter().find(|(rv, _)| *rv == v) {
-                        Some((_, cpu)) if Some(size) == first_size => {
-                            let mut e = gpu.device.create_command_encoder(&Default::default());
-                            pass.record(
-                                &mut e,
-                                &targets,
-                                (0, Place::FRAME),
-                                &gpu_pose.bind_group,
-                                stage,
-                                whole,
-                                None,
-                                false,
-                            );
-                            let copied = gpu.copy_rgba(&mut e, targets.texture(), size);
-                            gpu.queue.submit([e.finish()]);
-                            let img = gpu.read_rgba(&copied)?;
-                            Some(
-                                img.pixels()
-                                    .iter()
-                                    .zip(cpu.pixels())
-                                    .flat_map(|(a, b)| {
-                                        (0..4).map(move |k| f64::from((a[k] - b[k]).abs()))
-                                    })
-                                    .fold(0.0, f64::max),
-                            )
+                        Some((_, cpu)) if Some(size) == options.sizes.first().copied() => {
+                            Some(drawn.max_abs_error(stage, cpu)?)
                         }
                         _ => None,
                     };
@@ -395,6 +299,144 @@ pub fn run(
         floor_bandwidth,
         fastest_correct_fourway: fastest.map(|f| f.1),
     })
+}
+
+/// A variant's frame drawn by the CPU reference.
+type ReferenceFrame = (Variant, Image<Rgba>);
+
+/// The CPU reference's rows at every size of at most `options.cpu_max_pixels`, and its
+/// frames at the first size (the yardstick of the GPU's error), per variant.
+fn cpu_reference(
+    pose: &ResidentPose,
+    options: &BenchOptions,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<CpuRow>, Vec<ReferenceFrame>)> {
+    let first_size = options.sizes.first().copied();
+    let mut cpu_rows = Vec::new();
+    let mut reference = Vec::new();
+    for &size in &options.sizes {
+        if u64::from(size.0) * u64::from(size.1) > options.cpu_max_pixels {
+            continue;
+        }
+        let camera = bench_camera(size)?;
+        for v in VARIANTS {
+            progress(&format!("CPU reference {} {}x{}", v.name(), size.0, size.1));
+            let mut times = Vec::new();
+            let mut frame = None;
+            for _ in 0..options.cpu_repeats.max(1) {
+                let start = std::time::Instant::now();
+                let (img, _) = render_cpu(pose, &camera, v);
+                times.push(start.elapsed().as_secs_f64() * 1e3);
+                frame = Some(img);
+            }
+            let (ms_median, ms_min) = median_min(&times);
+            cpu_rows.push(CpuRow {
+                variant: v.name().to_string(),
+                width: size.0,
+                height: size.1,
+                ms_median,
+                ms_min,
+                threads: rayon::current_num_threads(),
+            });
+            if Some(size) == first_size
+                && let Some(f) = frame
+            {
+                reference.push((v, f));
+            }
+        }
+    }
+    Ok((cpu_rows, reference))
+}
+
+/// The floor's rows (once per size and stage, on the codes' texture) and its bandwidth.
+fn floor_rows(
+    gpu: &Gpu,
+    pose: &ResidentPose,
+    options: &BenchOptions,
+    progress: &mut dyn FnMut(&str),
+) -> Result<(Vec<BenchRow>, Vec<FloorBandwidth>)> {
+    let mut rows = Vec::new();
+    let mut floor_bandwidth = Vec::new();
+    let codes_pass = RebinPass::new(&gpu.device, PoseFormats::DEFAULT);
+    let codes_pose = gpu.upload_resident(pose, &codes_pass.pose)?;
+    let floor = FloorPass::new(&gpu.device, &codes_pass);
+    let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
+    for &size in &options.sizes {
+        let camera = bench_camera(size)?;
+        let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1, 1);
+        gpu.queue.write_buffer(
+            targets.uniform(0),
+            0,
+            bytemuck::bytes_of(&frame_uniform(Some(&codes_pose), &camera, Variant::Nearest)),
+        );
+        for &stage in &options.stages {
+            progress(&format!("floor {} {}x{}", stage.name(), size.0, size.1));
+            let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
+                record_floor(&floor, &targets, &floor_group, stage, size, e, t)
+            })?;
+            let (median, min) = median_min(&times);
+            let pixels = f64::from(size.0) * f64::from(size.1);
+            floor_bandwidth.push(FloorBandwidth {
+                stage: stage.name().to_string(),
+                width: size.0,
+                height: size.1,
+                gb_per_s: pixels * 20.0 / (median * 1e-3) / 1e9,
+            });
+            rows.push(row(
+                "floor",
+                PoseFormats::DEFAULT,
+                stage,
+                size,
+                (median, min),
+                median,
+                None,
+            ));
+        }
+    }
+    Ok((rows, floor_bandwidth))
+}
+
+/// One frame pass drawn whole into its targets: a resident pose at a size.
+struct Drawn<'a> {
+    gpu: &'a Gpu,
+    pass: &'a RebinPass,
+    targets: &'a SubjectTargets,
+    pose: &'a GpuPose,
+    size: (u32, u32),
+}
+
+impl Drawn<'_> {
+    /// Records the frame pass as `stage` into `encoder`, timed by `timestamps`.
+    fn record(&self, encoder: &mut wgpu::CommandEncoder, stage: PassKind, timestamps: Timestamps) {
+        let whole = crate::footprint::PixelBox::whole(self.size.0, self.size.1);
+        self.pass.record(
+            encoder,
+            self.targets,
+            (0, Place::FRAME),
+            &self.pose.bind_group,
+            stage,
+            whole,
+            timestamps,
+            false,
+        )
+    }
+
+    /// The largest absolute difference of any channel of the frame drawn as `stage` from
+    /// the CPU reference's `cpu`.
+    fn max_abs_error(&self, stage: PassKind, cpu: &Image<Rgba>) -> Result<f64> {
+        let gpu = self.gpu;
+        let mut e = gpu.device.create_command_encoder(&Default::default());
+        self.record(&mut e, stage, None);
+        let copied = gpu.copy_rgba(&mut e, self.targets.texture(), self.size);
+        gpu.queue.submit([e.finish()]);
+        let img = gpu.read_rgba(&copied)?;
+        Ok(img
+            .pixels()
+            .iter()
+            .zip(cpu.pixels())
+            .flat_map(|(a, b)| (0..4).map(move |k| f64::from((a[k] - b[k]).abs())))
+            .fold(0.0, f64::max))
+    }
 }
 
 fn row(

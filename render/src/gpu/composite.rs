@@ -236,31 +236,16 @@ impl Gpu {
         if let Some((w, h)) = backdrop.plate_size
             && (w, h) != (camera.width, camera.height)
         {
-            return Err(RenderError::BadParameter(format!(
-                "the plate is {w}x{h}, the camera {}x{}: a plate is seen by its own camera",
-                camera.width, camera.height
-            )));
+            return Err(RenderError::Mismatch {
+                what: "the plate (a plate is seen by its own camera)".into(),
+                expected: format!("the camera's {}x{}", camera.width, camera.height),
+                got: format!("{w}x{h}"),
+            });
         }
         if instances.is_empty() {
-            return Err(RenderError::BadParameter("a frame with no walker".into()));
+            return Err(RenderError::Misuse("a frame with no walker".into()));
         }
-        // The walkers' relit shadows: one patch of ground, each at its own level of
-        // detail (texels a side); the array holds the finest.
-        let infos: Vec<RelitShadowInfo> = instances
-            .iter()
-            .filter_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1))
-            .collect();
-        let shadow_info = infos.first().map(|first| RelitShadowInfo {
-            texels: infos.iter().map(|i| i.texels).max().unwrap_or(1),
-            extent_m: first.extent_m,
-        });
-        if let Some(info) = shadow_info
-            && infos.iter().any(|i| i.extent_m != info.extent_m)
-        {
-            return Err(RenderError::BadParameter(
-                "walkers with shadow maps of different patches of ground".into(),
-            ));
-        }
+        let shadow_info = shared_shadow(instances)?;
         self.scoped("compositing a frame", || {
             let size = (camera.width, camera.height);
             let order = back_to_front(
@@ -297,48 +282,15 @@ impl Gpu {
             self.morph_in_time(encoder, &subjects, &between, size, variant);
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
-            let mut gpu_instances = Vec::with_capacity(order.len());
-            // Per walker, the pixels it may touch: its render's box, and where it sees its
-            // shadow's patch of ground.
-            let mut touched = Vec::with_capacity(order.len());
-            for (layer, &k) in order.iter().enumerate() {
-                let i = &instances[k];
-                let m = i.world_from_subject.inverse();
-                let texels = i.shadow_pose().shadow.as_ref().map_or(0, |s| s.1.texels);
-                if let Some((texture, _)) = &i.shadow_pose().shadow {
-                    encoder.copy_texture_to_texture(
-                        texture.as_image_copy(),
-                        wgpu::TexelCopyTextureInfo {
-                            texture: &t.shadows,
-                            mip_level: 0,
-                            origin: wgpu::Origin3d {
-                                x: 0,
-                                y: 0,
-                                z: layer as u32,
-                            },
-                            aspect: wgpu::TextureAspect::All,
-                        },
-                        wgpu::Extent3d {
-                            width: texels,
-                            height: texels,
-                            depth_or_array_layers: 1,
-                        },
-                    );
-                }
-                let shadow_box = match shadow_info {
-                    Some(info) if texels > 0 => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
-                    _ => None,
-                };
-                touched.push(drawn[layer].2.union(shadow_box.unwrap_or(PixelBox::EMPTY)));
-                gpu_instances.push(GpuInstance {
-                    col_x: m.rotation.x_axis.extend(0.0).to_array(),
-                    col_y: m.rotation.y_axis.extend(0.0).to_array(),
-                    col_z: m.rotation.z_axis.extend(0.0).to_array(),
-                    translation: m.translation.extend(texels as f32).to_array(),
-                    bounds: drawn[layer].2.to_array(),
-                    place: subjects.place(layer).0.to_array(),
-                });
-            }
+            let (gpu_instances, touched) = place_walkers(
+                encoder,
+                instances,
+                &order,
+                &drawn,
+                &subjects,
+                &t,
+                shadow_info,
+            );
             let mut params = backdrop.params;
             if let Some(info) = shadow_info {
                 params.has_shadow = 1;
@@ -359,50 +311,140 @@ impl Gpu {
             write(&t.params, bytemuck::bytes_of(&params));
             write(&t.instances, bytemuck::cast_slice(&gpu_instances));
             write(&t.tiles, bytemuck::cast_slice(&tiles.words));
-            // Made once per drawn subjects and backdrop, and kept with the targets.
-            let image_group = t.image_groups.get((subjects.id(), backdrop.id), || {
-                let array_view = |t: &wgpu::Texture| {
-                    t.create_view(&wgpu::TextureViewDescriptor {
-                        dimension: Some(wgpu::TextureViewDimension::D2Array),
-                        ..Default::default()
-                    })
-                };
-                let view =
-                    |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-                let views = [
-                    array_view(subjects.texture()),
-                    view(&backdrop.env),
-                    view(&backdrop.plate),
-                    array_view(&t.shadows),
-                ];
-                bind_group(
-                    &self.device,
-                    "composite images",
-                    &self.composite.image_layout,
-                    views
-                        .iter()
-                        .map(wgpu::BindingResource::TextureView)
-                        .collect(),
-                )
-            });
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("composite"),
-                    color_attachments: &t.target_views.iter().map(cleared).collect::<Vec<_>>(),
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.composite.pipeline);
-                pass.set_bind_group(0, &t.frame_group, &[]);
-                pass.set_bind_group(1, &*image_group, &[]);
-                pass.draw(0..3, 0..1);
-            }
+            self.record_composite(encoder, &t, &subjects, backdrop);
             Ok(DrawnFrame {
                 targets: t,
                 subjects,
             })
         })
     }
+}
+
+impl Gpu {
+    /// Records the composite pass over targets `t`: `subjects` over `backdrop`, with the
+    /// walkers' shadows (the uniforms already written).
+    fn record_composite(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        t: &CompositeTargets,
+        subjects: &Subjects,
+        backdrop: &GpuBackdrop,
+    ) {
+        // Made once per drawn subjects and backdrop, and kept with the targets.
+        let image_group = t.image_groups.get((subjects.id(), backdrop.id), || {
+            let array_view = |t: &wgpu::Texture| {
+                t.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                })
+            };
+            let view = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+            let views = [
+                array_view(subjects.texture()),
+                view(&backdrop.env),
+                view(&backdrop.plate),
+                array_view(&t.shadows),
+            ];
+            bind_group(
+                &self.device,
+                "composite images",
+                &self.composite.image_layout,
+                views
+                    .iter()
+                    .map(wgpu::BindingResource::TextureView)
+                    .collect(),
+            )
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("composite"),
+            color_attachments: &t.target_views.iter().map(cleared).collect::<Vec<_>>(),
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.composite.pipeline);
+        pass.set_bind_group(0, &t.frame_group, &[]);
+        pass.set_bind_group(1, &*image_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
+/// The walkers' relit shadows: one patch of ground, each at its own level of detail
+/// (texels a side); the array holds the finest. `None` when no walker has maps.
+fn shared_shadow(instances: &[GpuInstanceRef]) -> Result<Option<RelitShadowInfo>> {
+    let infos: Vec<RelitShadowInfo> = instances
+        .iter()
+        .filter_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1))
+        .collect();
+    let shadow_info = infos.first().map(|first| RelitShadowInfo {
+        texels: infos.iter().map(|i| i.texels).max().unwrap_or(1),
+        extent_m: first.extent_m,
+    });
+    if let Some(info) = shadow_info
+        && infos.iter().any(|i| i.extent_m != info.extent_m)
+    {
+        return Err(RenderError::Misuse(
+            "walkers with shadow maps of different patches of ground".into(),
+        ));
+    }
+    Ok(shadow_info)
+}
+
+/// Each walker, back to front (`order`; `drawn`: its render's pose, camera and box),
+/// placed for the composite: its instance, and the pixels it may touch (its render's
+/// box, and where it sees its shadow's patch of ground); its relit shadow is copied into
+/// its layer of the targets' shadows.
+fn place_walkers(
+    encoder: &mut wgpu::CommandEncoder,
+    instances: &[GpuInstanceRef],
+    order: &[usize],
+    drawn: &[(&GpuPose, Camera, PixelBox)],
+    subjects: &Subjects,
+    t: &CompositeTargets,
+    shadow_info: Option<RelitShadowInfo>,
+) -> (Vec<GpuInstance>, Vec<PixelBox>) {
+    let mut gpu_instances = Vec::with_capacity(order.len());
+    // Per walker, the pixels it may touch: its render's box, and where it sees its
+    // shadow's patch of ground.
+    let mut touched = Vec::with_capacity(order.len());
+    for (layer, &k) in order.iter().enumerate() {
+        let i = &instances[k];
+        let m = i.world_from_subject.inverse();
+        let texels = i.shadow_pose().shadow.as_ref().map_or(0, |s| s.1.texels);
+        if let Some((texture, _)) = &i.shadow_pose().shadow {
+            encoder.copy_texture_to_texture(
+                texture.as_image_copy(),
+                wgpu::TexelCopyTextureInfo {
+                    texture: &t.shadows,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: layer as u32,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d {
+                    width: texels,
+                    height: texels,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        let shadow_box = match shadow_info {
+            Some(info) if texels > 0 => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
+            _ => None,
+        };
+        touched.push(drawn[layer].2.union(shadow_box.unwrap_or(PixelBox::EMPTY)));
+        gpu_instances.push(GpuInstance {
+            col_x: m.rotation.x_axis.extend(0.0).to_array(),
+            col_y: m.rotation.y_axis.extend(0.0).to_array(),
+            col_z: m.rotation.z_axis.extend(0.0).to_array(),
+            translation: m.translation.extend(texels as f32).to_array(),
+            bounds: drawn[layer].2.to_array(),
+            place: subjects.place(layer).0.to_array(),
+        });
+    }
+    (gpu_instances, touched)
 }

@@ -57,7 +57,7 @@ impl Gpu {
                 .iter()
                 .any(|m| m.size() != (n as usize, n as usize))
             {
-                return Err(RenderError::BadParameter(format!(
+                return Err(RenderError::Misuse(format!(
                     "shadow maps are not all {n}x{n}"
                 )));
             }
