@@ -65,6 +65,86 @@ impl Live<'_> {
             Device::Cpu => unreachable!("the viewer opens a GPU"),
         }
     }
+
+    /// The device and queue the shot draws with (the viewer opens a GPU).
+    fn device_and_queue(&self) -> (wgpu::Device, wgpu::Queue) {
+        match self.viewer.shot.render_device() {
+            Device::Gpu(g) => (g.device().clone(), g.queue().clone()),
+            Device::Cpu => unreachable!("the viewer opens a GPU"),
+        }
+    }
+
+    /// Records the panel (when `figures` are given: the panel is shown) over the frame in
+    /// `view`, a window of `window_size`; what the person asked for, the command buffers
+    /// egui needs submitted first, and whether egui wants another frame at once.
+    fn draw_panel(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        window_size: (u32, u32),
+        figures: Option<&Figures>,
+        message: &mut Option<String>,
+    ) -> (panel::Actions, Vec<wgpu::CommandBuffer>, bool) {
+        let input = self.egui.take_egui_input(&self.window);
+        let mut actions = panel::Actions::default();
+        let viewer = &mut self.viewer;
+        let mut output = self.egui.egui_ctx().clone().run_ui(input, |ui| {
+            if let Some(figures) = figures {
+                actions = panel::show(ui, viewer, figures, message);
+            }
+        });
+        self.egui
+            .handle_platform_output(&self.window, output.platform_output);
+        let pixels_per_point = output.pixels_per_point;
+        let jobs = self
+            .egui
+            .egui_ctx()
+            .tessellate(output.shapes, pixels_per_point);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [window_size.0, window_size.1],
+            pixels_per_point,
+        };
+        let (device, queue) = self.device_and_queue();
+        // Every texture change is applied (egui checks that none is dropped unapplied).
+        let mut textures = std::mem::take(&mut output.textures_delta);
+        for (id, deltas) in textures.set.drain() {
+            for delta in &deltas {
+                self.egui_renderer
+                    .update_texture(&device, &queue, id, delta);
+            }
+        }
+        let extra = self
+            .egui_renderer
+            .update_buffers(&device, &queue, encoder, &jobs, &screen);
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("panel"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.egui_renderer
+                .render(&mut pass.forget_lifetime(), &jobs, &screen);
+        }
+        for id in textures.free.drain() {
+            self.egui_renderer.free_texture(&id);
+        }
+        let repaint_now = output
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .is_some_and(|v| v.repaint_delay.is_zero());
+        (actions, extra, repaint_now)
+    }
 }
 
 /// The application: options until the window opens, then the live viewer.
@@ -389,64 +469,15 @@ impl<'a> App<'a> {
             size,
             adapter: live.adapter.clone(),
         };
-        let input = live.egui.take_egui_input(&live.window);
-        let mut actions = panel::Actions::default();
         let message = &mut self.message;
-        let viewer = &mut live.viewer;
-        let mut output = live.egui.egui_ctx().clone().run_ui(input, |ui| {
-            if show_panel {
-                actions = panel::show(ui, viewer, &figures, message);
-            }
-        });
-        live.egui
-            .handle_platform_output(&live.window, output.platform_output);
-        let pixels_per_point = output.pixels_per_point;
-        let jobs = live
-            .egui
-            .egui_ctx()
-            .tessellate(output.shapes, pixels_per_point);
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [window_size.0, window_size.1],
-            pixels_per_point,
-        };
-        let (device, queue) = match live.viewer.shot.render_device() {
-            Device::Gpu(g) => (g.device().clone(), g.queue().clone()),
-            Device::Cpu => unreachable!("the viewer opens a GPU"),
-        };
-        // Every texture change is applied (egui checks that none is dropped unapplied).
-        let mut textures = std::mem::take(&mut output.textures_delta);
-        for (id, deltas) in textures.set.drain() {
-            for delta in &deltas {
-                live.egui_renderer
-                    .update_texture(&device, &queue, id, delta);
-            }
-        }
-        let extra =
-            live.egui_renderer
-                .update_buffers(&device, &queue, &mut encoder, &jobs, &screen);
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("panel"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            live.egui_renderer
-                .render(&mut pass.forget_lifetime(), &jobs, &screen);
-        }
-        for id in textures.free.drain() {
-            live.egui_renderer.free_texture(&id);
-        }
+        let (actions, extra, repaint_now) = live.draw_panel(
+            &mut encoder,
+            &view,
+            window_size,
+            show_panel.then_some(&figures),
+            message,
+        );
+        let (device, queue) = live.device_and_queue();
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         queue.present(texture);
         if let Some(t) = &mut live.timer {
@@ -478,10 +509,7 @@ impl<'a> App<'a> {
             live.window.request_redraw();
         }
         if let Some(live) = &self.live
-            && output
-                .viewport_output
-                .get(&egui::ViewportId::ROOT)
-                .is_some_and(|v| v.repaint_delay.is_zero())
+            && repaint_now
         {
             live.window.request_redraw();
         }
