@@ -120,7 +120,7 @@ pub struct FieldWriter {
 impl FieldWriter {
     /// Starts writing `path` (through a temporary file beside it).
     pub fn create(path: &Path, header: FieldHeader) -> Result<Self> {
-        header.validate().map_err(ReflectanceError::BadParameter)?;
+        header.validate().map_err(ReflectanceError::Misuse)?;
         if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(parent).map_err(|e| io(parent, e))?;
         }
@@ -159,7 +159,7 @@ impl FieldWriter {
     /// Appends a chunk; a key may be written once.
     pub fn add_chunk(&mut self, key: ChunkKey, bytes: &[u8]) -> Result<()> {
         if self.chunks.contains_key(&key) {
-            return Err(ReflectanceError::BadParameter(format!(
+            return Err(ReflectanceError::Misuse(format!(
                 "{}: {key} written twice",
                 self.path.display()
             )));
@@ -167,7 +167,7 @@ impl FieldWriter {
         let out = self
             .out
             .as_mut()
-            .ok_or_else(|| ReflectanceError::BadParameter("writer finished".into()))?;
+            .ok_or_else(|| ReflectanceError::Misuse("writer finished".into()))?;
         out.write_all(bytes).map_err(|e| io(&self.tmp, e))?;
         self.chunks.insert(
             key,
@@ -188,8 +188,10 @@ impl FieldWriter {
             header: self.header.clone(),
             chunks: self.chunks.values().copied().collect(),
         };
-        let json = serde_json::to_vec(&index)
-            .map_err(|e| ReflectanceError::BadParameter(e.to_string()))?;
+        let json = serde_json::to_vec(&index).map_err(|e| ReflectanceError::Codec {
+            what: "the field's index as JSON",
+            problem: e.to_string(),
+        })?;
         let packed = zstd::bulk::compress(&json, ZSTD_LEVEL).map_err(|e| io(&self.tmp, e))?;
         let mut footer = Vec::with_capacity(FOOTER_BYTES as usize);
         footer.extend_from_slice(&self.offset.to_le_bytes());
@@ -198,7 +200,7 @@ impl FieldWriter {
         footer.extend_from_slice(&VERSION.to_le_bytes());
         footer.extend_from_slice(END_MAGIC);
         let Some(mut out) = self.out.take() else {
-            return Err(ReflectanceError::BadParameter("writer finished".into()));
+            return Err(ReflectanceError::Misuse("writer finished".into()));
         };
         out.write_all(&packed).map_err(|e| io(&self.tmp, e))?;
         out.write_all(&footer).map_err(|e| io(&self.tmp, e))?;
@@ -385,24 +387,19 @@ impl<R: ReadAt> FieldFile<R> {
         let held: Vec<u32> = self.header.poses.iter().map(|p| p.pose).collect();
         match requested {
             Some(p) if held.contains(&p) => Ok(p),
-            Some(p) => Err(ReflectanceError::BadParameter(format!(
-                "{}: pose {p} is not in the field (it holds {})",
-                self.path.display(),
-                if held.is_empty() {
-                    "none".to_string()
-                } else {
-                    held.iter()
-                        .map(u32::to_string)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                }
-            ))),
-            None => held.first().copied().ok_or_else(|| {
-                ReflectanceError::BadParameter(format!(
-                    "{}: the field holds no pose",
-                    self.path.display()
-                ))
+            Some(p) => Err(ReflectanceError::NoSuchPose {
+                file: Some(self.path.clone()),
+                within: "field",
+                pose: p,
+                held: crate::field::listed(&held),
             }),
+            None => held
+                .first()
+                .copied()
+                .ok_or_else(|| ReflectanceError::Missing {
+                    file: self.path.clone(),
+                    what: "the field holds no pose".into(),
+                }),
         }
     }
 
@@ -423,12 +420,13 @@ impl<R: ReadAt> FieldFile<R> {
 
     /// The checked bytes of a chunk.
     pub fn read_chunk(&self, key: &ChunkKey) -> Result<Vec<u8>> {
-        let entry = self.chunks.get(key).ok_or_else(|| {
-            ReflectanceError::BadParameter(format!(
-                "{}: no {key} in this field",
-                self.path.display()
-            ))
-        })?;
+        let entry = self
+            .chunks
+            .get(key)
+            .ok_or_else(|| ReflectanceError::Missing {
+                file: self.path.clone(),
+                what: format!("no {key} in this field"),
+            })?;
         let mut bytes = vec![0u8; entry.length as usize];
         self.source
             .read_exact_at(entry.offset, &mut bytes)
@@ -478,7 +476,7 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
         .map(|p| FieldFile::open(p))
         .collect::<Result<Vec<_>>>()?;
     let Some(first) = files.first() else {
-        return Err(ReflectanceError::BadParameter("nothing to merge".into()));
+        return Err(ReflectanceError::Misuse("nothing to merge".into()));
     };
     let shape = |h: &FieldHeader| FieldHeader {
         poses: Vec::new(),
@@ -489,19 +487,20 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
     header.poses.clear();
     for f in &files {
         if shape(f.header()) != shape(first.header()) {
-            return Err(ReflectanceError::BadParameter(format!(
-                "{}: grid, basis or codec settings differ from {}",
-                f.path().display(),
-                first.path().display()
-            )));
+            return Err(ReflectanceError::Incompatible {
+                part: f.path().to_path_buf(),
+                problem: format!(
+                    "grid, basis or codec settings differ from {}",
+                    first.path().display()
+                ),
+            });
         }
         for p in &f.header().poses {
             if header.poses.iter().any(|q| q.pose == p.pose) {
-                return Err(ReflectanceError::BadParameter(format!(
-                    "{}: pose {} is in two parts",
-                    f.path().display(),
-                    p.pose
-                )));
+                return Err(ReflectanceError::Incompatible {
+                    part: f.path().to_path_buf(),
+                    problem: format!("pose {} is in two parts", p.pose),
+                });
             }
             header.poses.push(p.clone());
         }
@@ -518,19 +517,21 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
         files.iter().find(|f| holds(f)),
         files.iter().find(|f| !holds(f)),
     ) {
-        return Err(ReflectanceError::BadParameter(format!(
-            "{} holds pose-to-pose flows (ingested with --pose-flow), {} does not: ingest every \
-             part with --pose-flow, or none",
-            with.path().display(),
-            without.path().display()
-        )));
+        return Err(ReflectanceError::Incompatible {
+            part: without.path().to_path_buf(),
+            problem: format!(
+                "holds no pose-to-pose flow, {} does (ingested with --pose-flow): ingest every \
+                 part with --pose-flow, or none",
+                with.path().display()
+            ),
+        });
     }
     if let Err((pose, problem)) = header.check_pose_flows() {
         let part = files
             .iter()
             .find(|f| f.header().poses.iter().any(|p| p.pose == pose))
-            .map_or(String::new(), |f| format!("{}: ", f.path().display()));
-        return Err(ReflectanceError::BadParameter(format!("{part}{problem}")));
+            .map_or(out.to_path_buf(), |f| f.path().to_path_buf());
+        return Err(ReflectanceError::Incompatible { part, problem });
     }
     let mut writer = FieldWriter::create(out, header)?;
     for f in &files {

@@ -32,9 +32,59 @@ pub enum ReflectanceError {
         /// What is wrong.
         problem: String,
     },
-    /// The caller asked for something absent or impossible.
+    /// An argument outside what is allowed, named as the user gave it.
+    #[error(transparent)]
+    Argument(#[from] frf_core::BadArgument),
+    /// A pose the field (or the capture) does not hold.
+    #[error(
+        "{}pose {pose} is not in the {within} (it holds {held})",
+        file.as_ref().map_or(String::new(), |p| format!("{}: ", p.display()))
+    )]
+    NoSuchPose {
+        /// The field file, where known.
+        file: Option<PathBuf>,
+        /// `field` or `capture`.
+        within: &'static str,
+        /// The pose asked for.
+        pose: u32,
+        /// The poses it holds, listed (`none` when it holds none).
+        held: String,
+    },
+    /// Something asked of a field that it does not hold (a chunk, a view, any pose).
+    #[error("{}: {what}", file.display())]
+    Missing {
+        /// The field file.
+        file: PathBuf,
+        /// What it lacks.
+        what: String,
+    },
+    /// Parts of a field that cannot be merged.
+    #[error("{}: {problem}", part.display())]
+    Incompatible {
+        /// The part that does not fit the others.
+        part: PathBuf,
+        /// Why, and what to do.
+        problem: String,
+    },
+    /// Values that are not finite, or overflow.
+    #[error("{what} is not finite")]
+    NonFinite {
+        /// The value and where, e.g. `coefficient [inf, 0, 0]`.
+        what: String,
+    },
+    /// A codec failed where its input was valid (compression, JPEG encoding, JSON): the
+    /// program's own failure.
+    #[error("{what}: {problem}")]
+    Codec {
+        /// The codec.
+        what: &'static str,
+        /// Its message.
+        problem: String,
+    },
+    /// A call this crate's state does not allow (a writer finished, a chunk written
+    /// twice, nothing to encode): the program's own mistake.
     #[error("{0}")]
-    BadParameter(String),
+    Misuse(String),
     /// Images of the wrong size or count.
     #[error("{what}: expected {expected}, got {got}")]
     Mismatch {
@@ -67,7 +117,13 @@ impl ReflectanceError {
             ReflectanceError::Corrupt(_)
             | ReflectanceError::BadChunk { .. }
             | ReflectanceError::BadFile { .. } => Fault::Damaged,
-            ReflectanceError::BadParameter(_) | ReflectanceError::Mismatch { .. } => Fault::Usage,
+            ReflectanceError::Argument(_)
+            | ReflectanceError::NoSuchPose { .. }
+            | ReflectanceError::Missing { .. }
+            | ReflectanceError::Incompatible { .. }
+            | ReflectanceError::NonFinite { .. }
+            | ReflectanceError::Mismatch { .. } => Fault::Usage,
+            ReflectanceError::Codec { .. } | ReflectanceError::Misuse(_) => Fault::Internal,
             ReflectanceError::Core(e) => e.fault(),
             ReflectanceError::Io { .. } => Fault::Io,
         }

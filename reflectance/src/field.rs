@@ -238,10 +238,12 @@ impl FieldHeader {
             .iter()
             .map(|&pose| {
                 if !capture.poses().contains(&pose) {
-                    return Err(ReflectanceError::BadParameter(format!(
-                        "pose {pose} is not in the capture (it has {:?})",
-                        capture.poses()
-                    )));
+                    return Err(ReflectanceError::NoSuchPose {
+                        file: None,
+                        within: "capture",
+                        pose,
+                        held: listed(capture.poses()),
+                    });
                 }
                 let views = (0..capture.cycles())
                     .flat_map(|u| (0..rows).map(move |v| (u, v)))
@@ -296,21 +298,25 @@ impl FieldHeader {
         self.poses
             .iter_mut()
             .find(|p| p.pose == pose)
-            .ok_or_else(|| {
-                ReflectanceError::BadParameter(format!(
-                    "pose {pose} is not in the field (it has poses {available:?})"
-                ))
+            .ok_or_else(|| ReflectanceError::NoSuchPose {
+                file: None,
+                within: "field",
+                pose,
+                held: listed(&available),
             })
     }
 
     /// The record of pose `pose`.
     pub fn pose(&self, pose: u32) -> Result<&PoseRecord> {
-        self.poses.iter().find(|p| p.pose == pose).ok_or_else(|| {
-            ReflectanceError::BadParameter(format!(
-                "pose {pose} is not in the field (it has poses {:?})",
-                self.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
-            ))
-        })
+        self.poses
+            .iter()
+            .find(|p| p.pose == pose)
+            .ok_or_else(|| ReflectanceError::NoSuchPose {
+                file: None,
+                within: "field",
+                pose,
+                held: listed(&self.poses.iter().map(|p| p.pose).collect::<Vec<_>>()),
+            })
     }
 
     /// The neighbour of view `(u, v)` in direction `n`, if any.
@@ -446,4 +452,15 @@ pub struct ViewData {
     pub alpha: GrayImage,
     /// Flow to each neighbour, in [`Neighbour::ALL`] order (`None` where there is none).
     pub flows: [Option<FlowImage>; 4],
+}
+/// Poses listed for a message: `0, 1, 2`, or `none`.
+pub fn listed(poses: &[u32]) -> String {
+    if poses.is_empty() {
+        return "none".into();
+    }
+    poses
+        .iter()
+        .map(u32::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
 }

@@ -179,7 +179,7 @@ impl VoxelHull {
             voxel_m,
             dims: pg.dims.map(|d| d * coarse),
         };
-        grid.validate().map_err(ReflectanceError::BadParameter)?;
+        grid.validate().map_err(ReflectanceError::Misuse)?;
         // Per coarse voxel: 0 far outside, 1 deep inside, 2 in the band.
         let class: Vec<u8> = (0..pg.len())
             .into_par_iter()
@@ -352,8 +352,10 @@ impl VoxelHull {
         for w in &self.bits {
             raw.extend(w.to_le_bytes());
         }
-        zstd::bulk::compress(&raw, ZSTD_LEVEL)
-            .map_err(|e| ReflectanceError::BadParameter(format!("hull compression: {e}")))
+        zstd::bulk::compress(&raw, ZSTD_LEVEL).map_err(|e| ReflectanceError::Codec {
+            what: "hull compression",
+            problem: e.to_string(),
+        })
     }
 
     /// Decodes [`VoxelHull::encode`]'s bytes, trusting nothing in them.

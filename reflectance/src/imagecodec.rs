@@ -48,14 +48,10 @@ fn le_u32(bytes: &[u8], at: usize) -> u32 {
 /// Layout: `[count u32][tile width u32][tile height u32][count x scale f32][JPEG]`.
 pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
     let Some(first) = images.first() else {
-        return Err(ReflectanceError::BadParameter(
-            "no basis images to encode".into(),
-        ));
+        return Err(ReflectanceError::Misuse("no basis images to encode".into()));
     };
     if !(1..=100).contains(&quality) {
-        return Err(ReflectanceError::BadParameter(format!(
-            "JPEG quality {quality} outside 1..=100"
-        )));
+        return Err(frf_core::BadArgument::new("--jpeg-quality", quality, "1 to 100").into());
     }
     let (tw, th) = first.size();
     if let Some(bad) = images.iter().find(|i| i.size() != (tw, th)) {
@@ -70,9 +66,9 @@ pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
     let (cw, ch) = (cell(tw), cell(th));
     let (mw, mh) = (columns * cw, rows * ch);
     if mw > 65_535 || mh > 65_535 {
-        return Err(ReflectanceError::BadParameter(format!(
-            "mosaic {mw}x{mh} exceeds JPEG's 65535 pixels per side"
-        )));
+        let mosaic = format!("{mw}x{mh}");
+        let allowed = "at most JPEG's 65535 pixels a side (fewer conditions or smaller images)";
+        return Err(frf_core::BadArgument::new("the basis mosaic", mosaic, allowed).into());
     }
     let mut mosaic = Rgb8Image::new(mw as u32, mh as u32);
     let mut scales = Vec::with_capacity(images.len());
@@ -104,7 +100,10 @@ pub fn encode_basis(images: &[RgbImage], quality: u8) -> Result<Vec<u8>> {
     let mut jpeg = Vec::new();
     image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, quality)
         .encode_image(&DynamicImage::ImageRgb8(mosaic))
-        .map_err(|e| ReflectanceError::BadParameter(format!("JPEG encoding failed: {e}")))?;
+        .map_err(|e| ReflectanceError::Codec {
+            what: "JPEG encoding",
+            problem: e.to_string(),
+        })?;
     let mut out = Vec::with_capacity(12 + 4 * scales.len() + jpeg.len());
     for v in [images.len() as u32, tw as u32, th as u32] {
         out.extend_from_slice(&v.to_le_bytes());
@@ -228,7 +227,7 @@ pub fn decode_basis(bytes: &[u8]) -> Result<Vec<RgbImage>> {
 /// Layout: `[count u32][width u32][height u32][zstd(u16 little-endian samples)]`.
 pub fn encode_planes(planes: &[GrayImage]) -> Result<Vec<u8>> {
     let Some(first) = planes.first() else {
-        return Err(ReflectanceError::BadParameter("no planes to encode".into()));
+        return Err(ReflectanceError::Misuse("no planes to encode".into()));
     };
     let (w, h) = first.size();
     let mut raw = Vec::with_capacity(planes.len() * w * h * 2);
@@ -249,8 +248,10 @@ pub fn encode_planes(planes: &[GrayImage]) -> Result<Vec<u8>> {
             raw.extend_from_slice(&q.to_le_bytes());
         }
     }
-    let packed = zstd::bulk::compress(&raw, ZSTD_LEVEL)
-        .map_err(|e| ReflectanceError::BadParameter(format!("zstd: {e}")))?;
+    let packed = zstd::bulk::compress(&raw, ZSTD_LEVEL).map_err(|e| ReflectanceError::Codec {
+        what: "zstd",
+        problem: e.to_string(),
+    })?;
     let mut out = Vec::with_capacity(12 + packed.len());
     for v in [planes.len() as u32, w as u32, h as u32] {
         out.extend_from_slice(&v.to_le_bytes());
@@ -346,7 +347,7 @@ mod tests {
         let e = encode_basis(&[gradient(4, 4, 1.0)], 0)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("JPEG quality 0"), "{e}");
+        assert_eq!(e, "--jpeg-quality 0: expected 1 to 100");
         let e = encode_basis(&[gradient(4, 4, 1.0), gradient(5, 4, 1.0)], 90)
             .unwrap_err()
             .to_string();

@@ -82,7 +82,7 @@ impl Projector {
             })
             .collect();
         if lights.is_empty() || conditions.len() > u16::MAX as usize {
-            return Err(ReflectanceError::BadParameter(
+            return Err(ReflectanceError::Misuse(
                 "a basis needs 1..65535 conditions with lights".into(),
             ));
         }

@@ -19,7 +19,7 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
         });
     }
     let Some(first) = basis.first() else {
-        return Err(ReflectanceError::BadParameter(
+        return Err(ReflectanceError::Misuse(
             "no basis images to relight".into(),
         ));
     };
@@ -35,9 +35,9 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
         .iter()
         .find(|c| c.iter().any(|v| !v.is_finite()))
     {
-        return Err(ReflectanceError::BadParameter(format!(
-            "coefficient {c:?} is not finite"
-        )));
+        return Err(ReflectanceError::NonFinite {
+            what: format!("coefficient {c:?}"),
+        });
     }
     let active: Vec<(&RgbImage, Rgb)> = basis
         .iter()
@@ -61,11 +61,13 @@ pub fn relight(basis: &[RgbImage], coefficients: &[Rgb]) -> Result<RgbImage> {
     // Finite inputs can still overflow f32 (huge coefficients on bright texels): refuse
     // rather than return infinities.
     if let Some(i) = pixels.iter().position(|p| p.iter().any(|v| !v.is_finite())) {
-        return Err(ReflectanceError::BadParameter(format!(
-            "relit pixel ({}, {}) overflows f32: coefficients too large for the basis",
-            i % w,
-            i / w
-        )));
+        return Err(ReflectanceError::NonFinite {
+            what: format!(
+                "relit pixel ({}, {}) (it overflows f32: coefficients too large for the basis)",
+                i % w,
+                i / w
+            ),
+        });
     }
     Ok(Image::from_vec(w, h, pixels)?)
 }

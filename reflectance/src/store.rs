@@ -146,9 +146,10 @@ impl FieldWriter {
     /// Writes the shadow attenuation maps of a pose (one per condition of the header's
     /// shadow spec).
     pub fn add_shadows(&mut self, pose: u32, maps: &[GrayImage]) -> Result<()> {
-        let spec = self.header().shadows.clone().ok_or_else(|| {
-            ReflectanceError::BadParameter("the header declares no shadow maps".into())
-        })?;
+        let spec =
+            self.header().shadows.clone().ok_or_else(|| {
+                ReflectanceError::Misuse("the header declares no shadow maps".into())
+            })?;
         if maps.len() != spec.conditions.len() {
             return Err(ReflectanceError::Mismatch {
                 what: "shadow maps".into(),
@@ -171,7 +172,7 @@ impl FieldWriter {
     pub fn add_hull(&mut self, pose: u32, hull: &VoxelHull) -> Result<()> {
         self.header().pose(pose)?;
         if self.header().hulls.is_none() {
-            return Err(ReflectanceError::BadParameter(
+            return Err(ReflectanceError::Misuse(
                 "the header declares no visual hulls".into(),
             ));
         }
@@ -183,9 +184,17 @@ impl FieldWriter {
 /// fault (other errors name their file already).
 fn naming(path: &std::path::Path, e: ReflectanceError) -> ReflectanceError {
     match e {
-        ReflectanceError::BadParameter(p) => {
-            ReflectanceError::BadParameter(format!("{}: {p}", path.display()))
-        }
+        ReflectanceError::NoSuchPose {
+            file: None,
+            within,
+            pose,
+            held,
+        } => ReflectanceError::NoSuchPose {
+            file: Some(path.to_path_buf()),
+            within,
+            pose,
+            held,
+        },
         other => other,
     }
 }
@@ -328,11 +337,13 @@ impl<R: ReadAt> FieldFile<R> {
             .map_err(|e| naming(self.path(), e))?;
         let (columns, rows) = (self.header().columns, self.header().rows);
         if u >= columns || v >= rows {
-            return Err(ReflectanceError::BadParameter(format!(
-                "{}: view ({u}, {v}) is outside the field's {columns}x{rows} grid \
-                 (u < {columns}, v < {rows})",
-                self.path().display()
-            )));
+            return Err(ReflectanceError::Missing {
+                file: self.path().to_path_buf(),
+                what: format!(
+                    "view ({u}, {v}) is outside the field's {columns}x{rows} grid \
+                     (u < {columns}, v < {rows})"
+                ),
+            });
         }
         let mut flows: [Option<FlowImage>; 4] = Default::default();
         for n in Neighbour::ALL {

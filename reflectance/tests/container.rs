@@ -246,7 +246,7 @@ fn truncated_and_corrupted_files_are_refused_naming_the_chunk() {
     assert!(
         e.contains(&path.display().to_string())
             && e.contains("pose 5 is not in the field")
-            && e.contains("poses [0, 1]"),
+            && e.contains("it holds 0, 1"),
         "{e}"
     );
     let e = field.view(0, 9, 0).unwrap_err().to_string();

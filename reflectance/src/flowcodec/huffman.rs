@@ -151,7 +151,7 @@ impl HuffmanTable {
         for &s in symbols {
             let (code, len) = codes[s as usize];
             if len == 0 {
-                return Err(ReflectanceError::BadParameter(format!(
+                return Err(ReflectanceError::Misuse(format!(
                     "symbol {s} has no code in this table"
                 )));
             }

@@ -109,8 +109,12 @@ pub fn encode(flow: &FlowImage, q: &LogQuantizer, predicted: bool) -> Result<Vec
             }
         }
     }
-    let mask = zstd::bulk::compress(&known, crate::imagecodec::ZSTD_LEVEL)
-        .map_err(|e| ReflectanceError::BadParameter(format!("zstd: {e}")))?;
+    let mask = zstd::bulk::compress(&known, crate::imagecodec::ZSTD_LEVEL).map_err(|e| {
+        ReflectanceError::Codec {
+            what: "zstd",
+            problem: e.to_string(),
+        }
+    })?;
     let mut counts = [0u64; 256];
     for &s in &symbols {
         counts[s as usize] += 1;

@@ -14,7 +14,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{ReflectanceError, Result};
+use crate::error::Result;
 
 /// The code for unknown flow.
 pub const UNKNOWN_CODE: i8 = i8::MIN;
@@ -36,17 +36,22 @@ impl LogQuantizer {
     /// decodes to infinity, or every value, 0 included, encodes to the extreme code).
     pub fn new(scale: f32, range: f32) -> Result<Self> {
         if !(scale.is_finite() && range.is_finite() && scale > 0.0 && range > 0.0) {
-            return Err(ReflectanceError::BadParameter(format!(
-                "log quantizer needs finite positive scale and range, got s = {scale}, M = {range}"
-            )));
+            return Err(frf_core::BadArgument::new(
+                "flow quantizer (scale s, range M)",
+                format!("s = {scale}, M = {range}"),
+                "finite and positive",
+            )
+            .into());
         }
         let q = Self { scale, range };
         let k = q.k();
         if !(k.is_finite() && k > 0.0) {
-            return Err(ReflectanceError::BadParameter(format!(
-                "log quantizer's range and scale are too far apart for f32: M / s = {}",
-                range / scale
-            )));
+            return Err(frf_core::BadArgument::new(
+                "flow quantizer M / s",
+                range / scale,
+                "a ratio f32 can hold (range and scale closer together)",
+            )
+            .into());
         }
         Ok(q)
     }
@@ -168,11 +173,14 @@ mod tests {
         assert_eq!(q.decode(UNKNOWN_CODE), frf_core::flo::UNKNOWN);
         assert_eq!(q.encode(0.0), 0);
         let e = LogQuantizer::new(0.0, 1.0).unwrap_err().to_string();
-        assert!(e.contains("got s = 0, M = 1"), "{e}");
+        assert!(
+            e.contains("s = 0, M = 1: expected finite and positive"),
+            "{e}"
+        );
         let e = LogQuantizer::new(1.0, f32::INFINITY)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("got s = 1, M = inf"), "{e}");
+        assert!(e.contains("s = 1, M = inf"), "{e}");
     }
 
     #[test]
