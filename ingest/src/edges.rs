@@ -73,9 +73,10 @@ fn refuse_non_finite<P: frf_core::image::Pixel>(what: &str, img: &Image<P>) -> R
         .position(|p| !p.channels().iter().all(|c| c.is_finite()))
     {
         let (x, y) = (i % img.width(), i / img.width());
-        return Err(IngestError::BadParameter(format!(
-            "{what} holds a non-finite value at pixel ({x}, {y})"
-        )));
+        return Err(IngestError::NonFinite {
+            what: what.to_string(),
+            at: (x, y),
+        });
     }
     Ok(())
 }
@@ -91,15 +92,16 @@ pub fn soft_alpha(
     matte_clean: &RgbImage,
 ) -> Result<GrayImage> {
     if !(alpha.same_size(matte) && alpha.same_size(matte_clean)) {
-        return Err(IngestError::BadParameter(format!(
-            "alpha ({}x{}), matte frame ({}x{}) and its clean plate ({}x{}) differ in size",
-            alpha.width(),
-            alpha.height(),
-            matte.width(),
-            matte.height(),
-            matte_clean.width(),
-            matte_clean.height()
-        )));
+        let other = if alpha.same_size(matte) {
+            matte_clean.size()
+        } else {
+            matte.size()
+        };
+        return Err(IngestError::sizes(
+            "the matte frame and its clean plate, as the alpha",
+            alpha.size(),
+            other,
+        ));
     }
     refuse_non_finite("the matte frame", matte)?;
     refuse_non_finite("the matte frame's clean plate", matte_clean)?;
@@ -181,13 +183,11 @@ fn push_pull(straight: &RgbImage, weight: &GrayImage) -> RgbImage {
 /// input.
 pub fn extend_interior(premultiplied: &RgbImage, alpha: &GrayImage) -> Result<RgbImage> {
     if !premultiplied.same_size(alpha) {
-        return Err(IngestError::BadParameter(format!(
-            "image ({}x{}) and alpha ({}x{}) differ in size",
-            premultiplied.width(),
-            premultiplied.height(),
-            alpha.width(),
-            alpha.height()
-        )));
+        return Err(IngestError::sizes(
+            "the alpha",
+            premultiplied.size(),
+            alpha.size(),
+        ));
     }
     refuse_non_finite("the premultiplied image", premultiplied)?;
     refuse_non_finite("alpha", alpha)?;
@@ -402,14 +402,11 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("matte frame (10x10)") && e.contains("differ in size"),
+            e.contains("the matte frame and its clean plate") && e.contains("got 10x10"),
             "{e}"
         );
         let e = extend_interior(&small, &blurred).unwrap_err().to_string();
-        assert!(
-            e.contains("image (10x10)") && e.contains("differ in size"),
-            "{e}"
-        );
+        assert!(e.contains("the alpha: expected 10x10"), "{e}");
         // A zero clean plate (no contrast anywhere) gives the blurred matte back, finite.
         let black = Image::new(40, 50, [0.0f32; 3]);
         assert_eq!(soft_alpha(&blurred, &s.matte, &black).unwrap(), blurred);

@@ -143,18 +143,12 @@ pub fn guided_flow(
     params: &FlowParams,
 ) -> Result<FlowImage> {
     if !a.same_size(b) {
-        return Err(IngestError::BadParameter(format!(
-            "views of {}x{} and {}x{} cannot be matched",
-            a.width(),
-            a.height(),
-            b.width(),
-            b.height()
-        )));
+        return Err(IngestError::sizes("the view matched", a.size(), b.size()));
     }
     let (w, h) = a.size();
     let prior = hull_flow(hull, camera_a, camera_b, w, h);
     if prior.pixels().first().is_none_or(|f| !is_known(*f)) {
-        return Err(IngestError::BadParameter(
+        return Err(IngestError::Degenerate(
             "no ray of the view meets the pose's hull: it cannot guide the flow".into(),
         ));
     }
@@ -173,16 +167,11 @@ pub fn refine_flow(
     params: &FlowParams,
     search_px: f32,
 ) -> Result<FlowImage> {
-    if !(a.same_size(b) && a.same_size(prior)) {
-        return Err(IngestError::BadParameter(format!(
-            "views of {}x{} and {}x{} and a prior of {}x{} cannot be matched",
-            a.width(),
-            a.height(),
-            b.width(),
-            b.height(),
-            prior.width(),
-            prior.height()
-        )));
+    if !a.same_size(b) {
+        return Err(IngestError::sizes("the view matched", a.size(), b.size()));
+    }
+    if !a.same_size(prior) {
+        return Err(IngestError::sizes("the prior flow", a.size(), prior.size()));
     }
     let (w, h) = a.size();
     let warped = Image::from_fn(w, h, |x, y| {
@@ -325,6 +314,6 @@ mod tests {
         let e = refine_flow(&a, &b, &Image::new(3, 3, [0.0; 2]), &params, 4.0)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("a prior of 3x3"), "{e}");
+        assert!(e.contains("the prior flow") && e.contains("got 3x3"), "{e}");
     }
 }

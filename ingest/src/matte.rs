@@ -31,13 +31,7 @@ const CENTRE_Y: (f32, f32) = (1.0 / 6.0, 5.0 / 6.0);
 
 fn check_same(what: &str, a: &RgbImage, b: &RgbImage) -> Result<()> {
     if a.size() != b.size() {
-        return Err(IngestError::BadParameter(format!(
-            "{what}: {}x{} and {}x{} differ",
-            a.width(),
-            a.height(),
-            b.width(),
-            b.height()
-        )));
+        return Err(IngestError::sizes(what, a.size(), b.size()));
     }
     Ok(())
 }
@@ -154,9 +148,7 @@ pub fn alpha(input: &MatteInput, rule: MatteRule) -> Result<GrayImage> {
 pub fn premultiply(frame: &RgbImage, alpha: &GrayImage, clean: &RgbImage) -> Result<RgbImage> {
     check_same("frame and clean plate", frame, clean)?;
     if !frame.same_size(alpha) {
-        return Err(IngestError::BadParameter(
-            "frame and alpha sizes differ".into(),
-        ));
+        return Err(IngestError::sizes("the alpha", frame.size(), alpha.size()));
     }
     let pixels = frame
         .pixels()
@@ -297,7 +289,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("track and matte frames") && e.contains("20x20 and 21x20"),
+            e.contains("track and matte frames: expected 20x20, got 21x20"),
             "{e}"
         );
     }

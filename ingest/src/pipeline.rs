@@ -68,12 +68,7 @@ impl IngestOptions {
     /// Checks the options that do not depend on the capture, naming the bad one: the
     /// JPEG quality and the flow parameters.
     pub fn validate(&self) -> Result<()> {
-        if !(1..=100).contains(&self.jpeg_quality) {
-            return Err(IngestError::BadParameter(format!(
-                "JPEG quality {} outside 1..=100",
-                self.jpeg_quality
-            )));
-        }
+        frf_core::argument::within("--jpeg-quality", self.jpeg_quality, 1, 100, "")?;
         self.flow_params()?.validate()?;
         Ok(())
     }
@@ -373,12 +368,13 @@ fn finished_part(out: &Path, pose: u32, wanted: &Settings) -> Result<Option<Pose
     let mut report: PoseReport = serde_json::from_str(&text)
         .map_err(|e| frf_core::CoreError::bad_file(&json, format!("not a pose report: {e}")))?;
     if &report.settings != wanted {
-        return Err(IngestError::BadParameter(format!(
-            "{}: pose {pose} was ingested with {:?}, this run asks for {wanted:?}; use the same settings or remove {}",
-            part.display(),
-            report.settings,
-            parts_dir(out).display()
-        )));
+        return Err(IngestError::SettingsChanged {
+            part,
+            pose,
+            was: format!("{:?}", report.settings),
+            wanted: format!("{wanted:?}"),
+            parts: parts_dir(out),
+        });
     }
     FieldFile::open(&part)?;
     report.resumed = true;
@@ -558,7 +554,7 @@ fn ingest_pose(
         errors,
     };
     let text = serde_json::to_string_pretty(&report)
-        .map_err(|e| IngestError::BadParameter(e.to_string()))?;
+        .map_err(|e| IngestError::Internal(format!("a pose report as JSON: {e}")))?;
     frf_core::atomic::write_bytes_atomic(&json, text.as_bytes())?;
     Ok(report)
 }
@@ -585,7 +581,7 @@ fn views_present(capture: &Capture, pose: u32, selected: Option<&Selection>) -> 
         })
         .collect();
     if !present.iter().any(|&p| p) {
-        return Err(IngestError::BadParameter(format!(
+        return Err(IngestError::Degenerate(format!(
             "pose {pose}: no view of it is both filmed and selected"
         )));
     }
@@ -888,10 +884,13 @@ pub fn ingest(
         options.poses.clone()
     };
     if let Some(p) = poses.iter().find(|p| !capture.poses().contains(p)) {
-        return Err(IngestError::BadParameter(format!(
-            "pose {p} is not in the capture (it has {:?})",
-            capture.poses()
-        )));
+        return Err(frf_reflectance::ReflectanceError::NoSuchPose {
+            file: Some(capture.dir().to_path_buf()),
+            within: "capture",
+            pose: *p,
+            held: frf_reflectance::field::listed(capture.poses()),
+        }
+        .into());
     }
     options.validate()?;
     let wanted = settings(&capture, options);

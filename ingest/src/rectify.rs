@@ -51,7 +51,7 @@ pub fn plane_homography(
     let n = normal.normalize_or_zero();
     let c = n.dot(point - reference.centre());
     if n == Vec3::ZERO || c.abs() < 1e-6 {
-        return Err(IngestError::BadParameter(
+        return Err(IngestError::Degenerate(
             "rectification plane passes through the reference camera".into(),
         ));
     }
@@ -66,7 +66,7 @@ pub fn plane_homography(
         * (Mat3::IDENTITY + outer)
         * m;
     if !h.is_finite() {
-        return Err(IngestError::BadParameter("degenerate rectification".into()));
+        return Err(IngestError::Degenerate("degenerate rectification".into()));
     }
     Ok(Homography(h))
 }

@@ -26,30 +26,33 @@ impl TrackFlows {
     /// is added. Times must be distinct, finite and non-zero, flows of one size.
     pub fn new(mut to_tracks: Vec<(f64, FlowImage)>) -> Result<Self> {
         let Some((_, first)) = to_tracks.first() else {
-            return Err(IngestError::BadParameter(
+            return Err(IngestError::Degenerate(
                 "registration needs at least one other track frame".into(),
             ));
         };
         let (w, h) = first.size();
         for (i, (t, f)) in to_tracks.iter().enumerate() {
             if !t.is_finite() || *t == 0.0 {
-                return Err(IngestError::BadParameter(format!(
-                    "track flow {i} has time {t} s; times must be finite and non-zero \
-                     (0 is the reference frame)"
-                )));
+                let allowed = "a finite, non-zero time in seconds (0 is the reference frame)";
+                return Err(frf_core::BadArgument::new(
+                    format!("track flow {i}'s time"),
+                    t,
+                    allowed,
+                )
+                .into());
             }
             if f.size() != (w, h) {
-                return Err(IngestError::BadParameter(format!(
-                    "track flow {i} is {}x{}, the first is {w}x{h}",
-                    f.width(),
-                    f.height()
-                )));
+                return Err(IngestError::sizes(
+                    &format!("track flow {i}"),
+                    (w, h),
+                    f.size(),
+                ));
             }
         }
         to_tracks.push((0.0, Image::new(w, h, [0.0; 2])));
         to_tracks.sort_by(|a, b| a.0.total_cmp(&b.0));
         if to_tracks.windows(2).any(|k| k[0].0 == k[1].0) {
-            return Err(IngestError::BadParameter(
+            return Err(IngestError::Degenerate(
                 "two track frames share a time".into(),
             ));
         }
@@ -83,9 +86,7 @@ impl TrackFlows {
 /// repeating the edge outside the image.
 pub fn warp_to_reference<P: Pixel>(frame: &Image<P>, flow: &FlowImage) -> Result<Image<P>> {
     if !frame.same_size(flow) {
-        return Err(IngestError::BadParameter(
-            "frame and flow sizes differ".into(),
-        ));
+        return Err(IngestError::sizes("the flow", frame.size(), flow.size()));
     }
     let w = frame.width();
     let pixels = flow
@@ -127,7 +128,10 @@ mod tests {
         let e = TrackFlows::new(vec![(0.0, constant([0.0; 2]))])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("track flow 0 has time 0 s"), "{e}");
+        assert!(
+            e.contains("track flow 0's time 0: expected a finite, non-zero time"),
+            "{e}"
+        );
         let e = TrackFlows::new(vec![(1.0, constant([0.0; 2])), (1.0, constant([1.0; 2]))])
             .unwrap_err()
             .to_string();

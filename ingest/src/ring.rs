@@ -193,7 +193,7 @@ pub fn ring_frame(views: &[RingView]) -> Result<(Rigid, Vec<usize>, bool)> {
     }
     let mut axis = normal.normalize_or_zero();
     if axis == Vec3::ZERO {
-        return Err(IngestError::BadParameter(
+        return Err(IngestError::Degenerate(
             "the cameras do not form a ring".into(),
         ));
     }
@@ -244,7 +244,7 @@ pub fn ring_frame(views: &[RingView]) -> Result<(Rigid, Vec<usize>, bool)> {
         .iter()
         .enumerate()
         .max_by(|a, b| a.1.total_cmp(b.1))
-        .ok_or_else(|| IngestError::BadParameter("a ring without views".into()))?;
+        .ok_or_else(|| IngestError::Degenerate("a ring without views".into()))?;
     let wraps = gap < 2.5 * median;
     let start = if wraps { 0 } else { (widest + 1) % n };
     let order: Vec<usize> = (0..n).map(|k| azimuths[(start + k) % n].1).collect();

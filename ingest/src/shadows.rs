@@ -12,7 +12,7 @@ use frf_reflectance::field::{ConditionRecord, HullSpec, ShadowSpec};
 use frf_reflectance::hull::{Silhouette, VoxelHull};
 use frf_reflectance::shadow::{attenuation_maps, shadow_spec};
 
-use crate::error::{IngestError, Result};
+use crate::error::Result;
 
 /// Voxel side of the visual hull by default, metres: finer than the ground texels of the
 /// original's shadow maps (3 m / 128 = 2.3 cm).
@@ -68,22 +68,18 @@ impl ShadowOptions {
         let v = self.hull.voxel_m;
         // Below 2 mm a hull of the search region exceeds the grid limit; above 50 cm it
         // no longer resembles a person.
-        if !(0.002..=0.5).contains(&v) {
-            return Err(IngestError::BadParameter(format!(
-                "hull voxel side {v} m: expected 0.002 to 0.5"
-            )));
-        }
+        frf_core::argument::within("--hull-voxel", v, 0.002, 0.5, "metres")?;
         // Beyond 256 directions per light the maps no longer change visibly and the
         // tracing takes minutes.
-        if !(1..=256).contains(&self.light_samples) {
-            return Err(IngestError::BadParameter(format!(
-                "{} shadow samples per light: expected 1 to 256",
-                self.light_samples
-            )));
+        frf_core::argument::within("--shadow-samples", self.light_samples, 1, 256, "")?;
+        let g = self.ground;
+        if !(g.extent_m.is_finite() && g.extent_m > 0.0) {
+            let allowed = "a positive side of the ground patch, metres";
+            return Err(frf_core::BadArgument::new("--shadow-extent", g.extent_m, allowed).into());
         }
-        self.ground
-            .validate()
-            .map_err(|e| IngestError::BadParameter(format!("shadow maps: {e}")))
+        let most = frf_core::volume::MAX_GROUND_TEXELS;
+        frf_core::argument::within("--shadow-texels", g.texels, 1, most, "")?;
+        Ok(())
     }
 
     /// The shadow spec of a field with these `conditions`.

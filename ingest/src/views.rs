@@ -112,11 +112,11 @@ impl SetFrames<'_> {
     fn check(&self) -> Result<()> {
         let slots = self.capture.slots().len();
         if self.frames.len() != slots || self.clean.len() != slots {
-            return Err(IngestError::BadParameter(format!(
-                "a lighting set has {slots} slots; given {} frames and {} clean plates",
-                self.frames.len(),
-                self.clean.len()
-            )));
+            return Err(IngestError::Mismatch {
+                what: "the frames and clean plates of a lighting set".into(),
+                expected: format!("{slots} of each (one per slot)"),
+                got: format!("{} and {}", self.frames.len(), self.clean.len()),
+            });
         }
         Ok(())
     }
