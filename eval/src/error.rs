@@ -6,9 +6,20 @@ pub type Result<T, E = EvalError> = std::result::Result<T, E>;
 /// Everything that can go wrong while judging results against the truth.
 #[derive(Debug, thiserror::Error)]
 pub enum EvalError {
-    /// A parameter is out of range or inconsistent with the capture or field.
+    /// An argument outside what is allowed, named as the user gave it.
+    #[error(transparent)]
+    Argument(#[from] frf_core::BadArgument),
+    /// What was asked has no truth to compare with (a scene of several walkers, an
+    /// unlit scene, a pose the capture did not film, a grid with no quad).
     #[error("{0}")]
-    BadParameter(String),
+    NoTruth(String),
+    /// A plot could not be drawn or written.
+    #[error("plot: {0}")]
+    Plot(String),
+    /// A call the evaluation's state does not allow (nothing to score, no layers
+    /// returned): the program's own mistake.
+    #[error("{0}")]
+    Misuse(String),
     /// Images, cameras, environments, files.
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
@@ -33,7 +44,9 @@ impl EvalError {
     /// Who is at fault ([`frf_core::Fault`]).
     pub fn fault(&self) -> frf_core::Fault {
         match self {
-            EvalError::BadParameter(_) => frf_core::Fault::Usage,
+            EvalError::Argument(_) | EvalError::NoTruth(_) => frf_core::Fault::Usage,
+            EvalError::Plot(_) => frf_core::Fault::Io,
+            EvalError::Misuse(_) => frf_core::Fault::Internal,
             EvalError::Core(e) => e.fault(),
             EvalError::Stage(e) => e.fault(),
             EvalError::Reflectance(e) => e.fault(),

@@ -19,7 +19,7 @@ use frf_stage::render::{Scene, render};
 use frf_stage::studio::Illumination;
 use rayon::prelude::*;
 
-use crate::error::{EvalError, Result};
+use crate::error::Result;
 
 /// The true flows of view `(u, v)` of `pose` to each neighbour ([`Neighbour::ALL`] order).
 pub fn true_flows(stage: &Stage, pose: u32, u: usize, v: usize) -> Result<[Option<FlowImage>; 4]> {
@@ -118,10 +118,13 @@ pub fn write_oracle_field(
         .iter()
         .find(|p| !stage.config().poses.contains(p))
     {
-        return Err(EvalError::BadParameter(format!(
-            "pose {p} is not rendered by this stage (it has {:?})",
-            stage.config().poses
-        )));
+        return Err(frf_reflectance::ReflectanceError::NoSuchPose {
+            file: Some(path.to_path_buf()),
+            within: "capture",
+            pose: *p,
+            held: frf_reflectance::field::listed(&stage.config().poses),
+        }
+        .into());
     }
     let capture = Capture::from_manifest(path.parent().unwrap_or(path), stage.manifest())?;
     let (columns, rows) = (stage.cycles(), stage.cameras().len());

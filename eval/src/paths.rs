@@ -58,7 +58,7 @@ fn rig(geometry: &PoseGeometry) -> Result<(f32, f32, f32)> {
             .collect()
     };
     if geometry.columns == 0 || geometry.rows == 0 || geometry.cameras.is_empty() {
-        return Err(EvalError::BadParameter("a pose without cameras".into()));
+        return Err(EvalError::NoTruth("a pose without cameras".into()));
     }
     let (bottom, top) = (row(0), row(geometry.rows - 1));
     let n = bottom.len() as f32;
@@ -70,7 +70,7 @@ fn rig(geometry: &PoseGeometry) -> Result<(f32, f32, f32)> {
     let y0 = bottom.iter().map(|c| c.y).sum::<f32>() / n;
     let y1 = top.iter().map(|c| c.y).sum::<f32>() / top.len() as f32;
     if !(radius.is_finite() && radius > 1e-3 && y0.is_finite() && y1.is_finite()) {
-        return Err(EvalError::BadParameter(format!(
+        return Err(EvalError::NoTruth(format!(
             "a grid of radius {radius} m, rows at {y0} and {y1} m"
         )));
     }

@@ -41,9 +41,8 @@ pub struct RingScore {
 /// from 2: an uneven last gap gets its own halfway view.
 pub fn held_out_views(views: usize, stride: usize, wraps: bool) -> Result<Vec<usize>> {
     if stride < 2 || views.div_ceil(stride.max(1)) < 2 {
-        return Err(EvalError::BadParameter(format!(
-            "stride {stride} over {views} views holds no view out between two kept ones"
-        )));
+        let allowed = format!("2 or more, leaving a view out between two kept ones of {views}");
+        return Err(frf_core::BadArgument::new("--stride", stride, allowed).into());
     }
     let kept: Vec<usize> = (0..views).step_by(stride).collect();
     let mut held = Vec::new();
@@ -70,7 +69,7 @@ pub fn score_held_out(
     variants: &[Variant],
 ) -> Result<Vec<RingScore>> {
     let Some(&first) = held.first() else {
-        return Err(EvalError::BadParameter("no view is held out".into()));
+        return Err(EvalError::NoTruth("no view is held out".into()));
     };
     let photos = held
         .par_iter()

@@ -182,9 +182,9 @@ pub fn score_scene<R: ReadAt>(
     let mut bright = Vec::new();
     for c in at_views {
         // The walker of that view's cycle as filmed, lit as the renderer relit it.
-        let (u, v) = c.view.ok_or_else(|| {
-            EvalError::BadParameter("a captured-view camera without its view".into())
-        })?;
+        let (u, v) = c
+            .view
+            .ok_or_else(|| EvalError::Misuse("a captured-view camera without its view".into()))?;
         let t = stage.true_view_image(pose, u, v, &env_lights_for_view(stage, lights, pose, u))?;
         let truth = &rgba_from(&t.color, &t.alpha)?;
         let (img, _) = renderer.render(&c.camera, Variant::FourWay)?;

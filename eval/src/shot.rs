@@ -95,7 +95,7 @@ fn score_frame_walkers<R: ReadAt>(
 ) -> Result<(ShotFrameScore, Walkers)> {
     let scene = shot.scene();
     if scene.instances.len() != 1 {
-        return Err(EvalError::BadParameter(format!(
+        return Err(EvalError::NoTruth(format!(
             "a scene of {} walkers: the stage's truth has one",
             scene.instances.len()
         )));
@@ -104,7 +104,7 @@ fn score_frame_walkers<R: ReadAt>(
     let cycle = stage.config().gait.cycle_seconds();
     let instant = scene.phase_at(0, frame.time, cycle) * cycle;
     let world = shot.lighting_at(frame.time)?.ok_or_else(|| {
-        EvalError::BadParameter("an unlit scene has no true lighting to compare with".into())
+        EvalError::NoTruth("an unlit scene has no true lighting to compare with".into())
     })?;
     let backdrop = shot.backdrop_of(Some(&world))?;
 
@@ -115,7 +115,7 @@ fn score_frame_walkers<R: ReadAt>(
     let layers = rendered
         .frame
         .layers
-        .ok_or_else(|| EvalError::BadParameter("the renderer returned no layers".into()))?;
+        .ok_or_else(|| EvalError::Misuse("the renderer returned no layers".into()))?;
 
     // The truth, in the walker's frame: its camera and its lighting.
     let t = Instant::now();
@@ -282,7 +282,7 @@ pub fn evaluate_shot<R: ReadAt>(
     let mut shot = Shot::new(scene, field, device, &frames, options)?;
     for f in &shot.plan().frames {
         if let Some(p) = f.poses.iter().find(|p| !stage.config().poses.contains(p)) {
-            return Err(EvalError::BadParameter(format!(
+            return Err(EvalError::NoTruth(format!(
                 "{}: frame {} draws pose {p}, which the capture did not film",
                 paths.2.display(),
                 f.index

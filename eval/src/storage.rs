@@ -132,7 +132,7 @@ pub fn codec_curve(
     qualities: &[u8],
 ) -> Result<Vec<CodecPoint>> {
     if views.is_empty() || qualities.is_empty() {
-        return Err(EvalError::BadParameter(
+        return Err(EvalError::Misuse(
             "codec curve needs views and qualities".into(),
         ));
     }
@@ -208,7 +208,7 @@ pub fn flow_quantization(
     use frf_core::flo::is_known;
     use frf_reflectance::flowcodec::{self, quant::LogQuantizer};
     if flows.is_empty() {
-        return Err(EvalError::BadParameter("no flows to quantize".into()));
+        return Err(EvalError::Misuse("no flows to quantize".into()));
     }
     let values = || {
         flows.iter().flat_map(|f| {
@@ -239,9 +239,7 @@ pub fn flow_quantization(
     }
     let seconds = start.elapsed().as_secs_f64();
     if known == 0 {
-        return Err(EvalError::BadParameter(
-            "the flows hold no known vector".into(),
-        ));
+        return Err(EvalError::NoTruth("the flows hold no known vector".into()));
     }
     Ok(QuantizationScore {
         scale: q.scale,

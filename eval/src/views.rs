@@ -118,15 +118,13 @@ pub(crate) fn quad_corners(geometry: &PoseGeometry, count: usize) -> Result<Vec<
         columns.saturating_sub(1)
     };
     if quads_u == 0 || geometry.cameras.len() != columns * rows {
-        return Err(EvalError::BadParameter(format!(
+        return Err(EvalError::NoTruth(format!(
             "a {columns}x{rows} grid has no quad between views"
         )));
     }
     if count == 0 || count > quads_u * rows.max(2) {
-        return Err(EvalError::BadParameter(format!(
-            "{count} cameras between views (1 to {})",
-            quads_u * rows.max(2)
-        )));
+        let allowed = format!("1 to {} cameras between views", quads_u * rows.max(2));
+        return Err(frf_core::BadArgument::new("--cameras", count, allowed).into());
     }
     let gaps = rows.saturating_sub(1).max(1);
     Ok((0..count)

@@ -57,9 +57,7 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, rows: &[BudgetRow]) -
         .filter(|v| v.is_finite())
         .collect();
     if all.is_empty() {
-        return Err(EvalError::BadParameter(
-            "plot: the budget has no finite score".into(),
-        ));
+        return Err(EvalError::Plot("the budget has no finite score".into()));
     }
     let lo = all.iter().copied().fold(f64::INFINITY, f64::min).floor() - 1.0;
     let hi = all.iter().copied().fold(f64::NEG_INFINITY, f64::max).ceil() + 1.0;

@@ -102,15 +102,17 @@ fn reused(dir: &Path, made: &FieldsMade) -> Option<FieldsMade> {
 fn filmed(capture_dir: &Path, pose: u32) -> Result<Capture> {
     let capture = Capture::open(capture_dir)?;
     if !capture.poses().contains(&pose) {
-        return Err(EvalError::BadParameter(format!(
-            "{}: pose {pose} was not filmed (the capture has {:?})",
-            capture_dir.display(),
-            capture.poses()
-        )));
+        return Err(frf_reflectance::ReflectanceError::NoSuchPose {
+            file: Some(capture_dir.to_path_buf()),
+            within: "capture",
+            pose,
+            held: frf_reflectance::field::listed(capture.poses()),
+        }
+        .into());
     }
     let (columns, rows) = (capture.cycles(), capture.cameras().len());
     if let Some(i) = (0..columns * rows).find(|&i| !capture.is_filmed(pose, i / rows, i % rows)) {
-        return Err(EvalError::BadParameter(format!(
+        return Err(EvalError::NoTruth(format!(
             "{}: view ({}, {}) of pose {pose} was not filmed; the ingest budget needs every view",
             capture_dir.display(),
             i / rows,
@@ -312,7 +314,7 @@ pub fn write_fields(
         ..made
     };
     let text = serde_json::to_string_pretty(&made)
-        .map_err(|e| EvalError::BadParameter(format!("the budget's record: {e}")))?;
+        .map_err(|e| EvalError::Misuse(format!("the budget's record as JSON: {e}")))?;
     frf_core::atomic::write_bytes_atomic(&dir.join(MADE_FILE), text.as_bytes())?;
     Ok(paths(&made))
 }

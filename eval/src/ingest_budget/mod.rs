@@ -284,7 +284,7 @@ pub fn evaluate_fields(
     progress: &dyn Progress,
 ) -> Result<(Vec<ComponentScore>, Option<GivenField>, String)> {
     let Some((_, first)) = fields.first() else {
-        return Err(EvalError::BadParameter(
+        return Err(EvalError::Misuse(
             "the ingest budget has no fields to score".into(),
         ));
     };
@@ -341,9 +341,7 @@ pub fn evaluate_fields(
     let base = scored
         .iter()
         .find(|s| s.0 == Component::Ingested)
-        .ok_or_else(|| {
-            EvalError::BadParameter("the ingest budget lacks its ingested field".into())
-        })?
+        .ok_or_else(|| EvalError::Misuse("the ingest budget lacks its ingested field".into()))?
         .clone();
     let place = |s: &VariantScore, ingested: &VariantScore| {
         let error = |v: &VariantScore| -> f64 {

@@ -40,9 +40,7 @@ fn draw<DB: DrawingBackend>(
         .filter(|r| r.component != Component::Ingested)
         .collect();
     if rows.is_empty() {
-        return Err(EvalError::BadParameter(
-            "plot: the budget has no component".into(),
-        ));
+        return Err(EvalError::Plot("the budget has no component".into()));
     }
     let names: Vec<&str> = rows.iter().map(|r| r.component.name()).collect();
     let panels = root.split_evenly((1, 2));

@@ -38,7 +38,7 @@ pub fn fonts_available() -> bool {
 }
 
 pub(crate) fn plot_error(e: impl std::fmt::Display) -> EvalError {
-    EvalError::BadParameter(format!("plot: {e}"))
+    EvalError::Plot(e.to_string())
 }
 
 /// Panels laid out side by side, at most three per row.
