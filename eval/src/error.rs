@@ -13,6 +13,17 @@ pub enum EvalError {
     /// unlit scene, a pose the capture did not film, a grid with no quad).
     #[error("{0}")]
     NoTruth(String),
+    /// A run of `frf report` failed, or its output lacks what the report reads.
+    #[error("{run}: {problem}")]
+    Run {
+        /// The run, as its command.
+        run: String,
+        /// What went wrong.
+        problem: String,
+    },
+    /// A report missing rows of some stage.
+    #[error("the report is incomplete:\n{}", .0.join("\n"))]
+    Incomplete(Vec<String>),
     /// A plot could not be drawn or written.
     #[error("plot: {0}")]
     Plot(String),
@@ -41,10 +52,21 @@ pub enum EvalError {
 }
 
 impl EvalError {
+    /// A [`EvalError::Run`] of the run `run`.
+    pub fn run(run: impl Into<String>, problem: impl std::fmt::Display) -> Self {
+        EvalError::Run {
+            run: run.into(),
+            problem: problem.to_string(),
+        }
+    }
+
     /// Who is at fault ([`frf_core::Fault`]).
     pub fn fault(&self) -> frf_core::Fault {
         match self {
-            EvalError::Argument(_) | EvalError::NoTruth(_) => frf_core::Fault::Usage,
+            EvalError::Argument(_) | EvalError::NoTruth(_) | EvalError::Run { .. } => {
+                frf_core::Fault::Usage
+            }
+            EvalError::Incomplete(_) => frf_core::Fault::Internal,
             EvalError::Plot(_) => frf_core::Fault::Io,
             EvalError::Misuse(_) => frf_core::Fault::Internal,
             EvalError::Core(e) => e.fault(),

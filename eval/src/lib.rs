@@ -39,6 +39,7 @@ pub mod ring;
 pub mod scene;
 pub mod shot;
 pub mod storage;
+pub mod sweep;
 pub mod views;
 
 pub use error::{EvalError, Result};

@@ -7,12 +7,15 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::CliResult;
+use crate::error::{EvalError, Result};
 
 /// Runs of this binary, each kept under `runs/` with its wall time.
 pub struct Runner {
+    /// The `frf` binary.
     pub exe: PathBuf,
+    /// Where each run's record and output are kept.
     pub runs: PathBuf,
+    /// Counts the runs.
     pub bar: indicatif::ProgressBar,
     /// Wall seconds of every run, whether made now or kept from an earlier invocation.
     pub measured: std::cell::Cell<f64>,
@@ -31,14 +34,16 @@ struct RunRecord {
 
 /// What a run printed and how long it took.
 pub struct Ran {
+    /// What it printed on stdout.
     pub stdout: String,
+    /// The command, as `frf ARGS`.
     pub command: String,
 }
 
 impl Runner {
     /// Runs `frf args` unless `runs/ID.run.json` holds a finished run of the same arguments
     /// (and `outputs` exist).
-    pub fn run(&self, id: &str, args: &[String], outputs: &[&Path]) -> CliResult<Ran> {
+    pub fn run(&self, id: &str, args: &[String], outputs: &[&Path]) -> Result<Ran> {
         let record = self.runs.join(format!("{id}.run.json"));
         let command = format!("frf {}", args.join(" "));
         self.bar
@@ -62,16 +67,20 @@ impl Runner {
         if let Some(name) = frf_render::gpu::adapter::preferred() {
             child.env(frf_render::gpu::adapter::ADAPTER_ENV, name);
         }
-        let out = child.output()?;
+        let exe = &self.exe;
+        let out = child
+            .output()
+            .map_err(|e| frf_core::CoreError::io(exe, e))?;
         let seconds = start.elapsed().as_secs_f64();
         if !out.status.success() {
-            return Err(format!(
-                "{command} failed:\n{}",
-                String::from_utf8_lossy(&out.stderr).trim_end()
-            )
-            .into());
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            return Err(EvalError::run(
+                command,
+                format!("failed:\n{}", stderr.trim_end()),
+            ));
         }
-        let stdout = String::from_utf8(out.stdout)?;
+        let stdout = String::from_utf8(out.stdout)
+            .map_err(|e| EvalError::run(&command, format!("printed other than UTF-8: {e}")))?;
         let kept = RunRecord {
             command: command.clone(),
             seconds,
@@ -79,7 +88,9 @@ impl Runner {
         };
         frf_core::atomic::write_bytes_atomic(
             &record,
-            serde_json::to_string_pretty(&kept)?.as_bytes(),
+            serde_json::to_string_pretty(&kept)
+                .map_err(|e| EvalError::Misuse(format!("a run's record as JSON: {e}")))?
+                .as_bytes(),
         )?;
         self.bar.inc(1);
         self.measured.set(self.measured.get() + seconds);

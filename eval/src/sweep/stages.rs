@@ -5,20 +5,20 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::paths::PathsReport;
+use crate::quads::QuadsReport;
+use crate::report::Row;
+use crate::storage::CodecPoint;
+use crate::views::VariantScore;
 use frf_core::capture::Capture;
 use frf_core::grid::Neighbour;
-use frf_eval::paths::PathsReport;
-use frf_eval::quads::QuadsReport;
-use frf_eval::report::Row;
-use frf_eval::storage::CodecPoint;
-use frf_eval::views::VariantScore;
 use frf_ingest::pipeline::IngestReport;
 use frf_stage::config::StageConfig;
 use serde::de::DeserializeOwned;
 
 use super::capture_size;
 use super::runner::{Ran, Runner};
-use crate::CliResult;
+use crate::error::{EvalError, Result};
 
 /// The morph variants the sweep compares.
 const VARIANTS: &str =
@@ -45,18 +45,19 @@ pub struct Sweep<'a> {
 }
 
 /// A run's report, read as `T`.
-pub(super) fn parse<T: DeserializeOwned>(text: &str, ran: &str) -> CliResult<T> {
-    serde_json::from_str(text).map_err(|e| format!("{ran}: its report does not read: {e}").into())
+pub(super) fn parse<T: DeserializeOwned>(text: &str, ran: &str) -> Result<T> {
+    serde_json::from_str(text)
+        .map_err(|e| EvalError::run(ran, format!("its report does not read: {e}")))
 }
 
 /// A run's report file.
-pub(super) fn read(path: &Path) -> CliResult<String> {
+pub(super) fn read(path: &Path) -> Result<String> {
     Ok(std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?)
 }
 
 /// A figure a report may lack (no truth to judge by).
-fn need(value: Option<f64>, what: &str, ran: &str) -> CliResult<f64> {
-    value.ok_or_else(|| format!("{ran}: no {what} in its report").into())
+fn need(value: Option<f64>, what: &str, ran: &str) -> Result<f64> {
+    value.ok_or_else(|| EvalError::run(ran, format!("no {what} in its report")))
 }
 
 pub(super) fn s(p: &Path) -> String {
@@ -82,11 +83,11 @@ pub(super) fn ingest_args(
 }
 
 /// The one variant of an evaluation of one variant.
-fn only(variants: &[VariantScore], ran: &str) -> CliResult<VariantScore> {
+fn only(variants: &[VariantScore], ran: &str) -> Result<VariantScore> {
     variants
         .first()
         .cloned()
-        .ok_or_else(|| format!("{ran}: no variant in its report").into())
+        .ok_or_else(|| EvalError::run(ran, "no variant in its report"))
 }
 
 impl Sweep<'_> {
@@ -133,7 +134,7 @@ impl Sweep<'_> {
         id: &str,
         field: &Path,
         extra: &[&str],
-    ) -> CliResult<(T, Ran)> {
+    ) -> Result<(T, Ran)> {
         let mut a: Vec<String> = [
             "eval",
             &s(field),
@@ -152,7 +153,7 @@ impl Sweep<'_> {
     }
 
     /// `frf eval` of `field` along the orbit inside the cylinder at `size`, four-way.
-    fn orbit_eval(&self, id: &str, field: &Path, size: &str) -> CliResult<(VariantScore, Ran)> {
+    fn orbit_eval(&self, id: &str, field: &Path, size: &str) -> Result<(VariantScore, Ran)> {
         let a = [
             "--orbit",
             "3,1.2",
@@ -166,13 +167,13 @@ impl Sweep<'_> {
         let path = o
             .paths
             .first()
-            .ok_or_else(|| format!("{}: no path in its report", ran.command))?;
+            .ok_or_else(|| EvalError::run(&ran.command, "no path in its report"))?;
         Ok((only(&path.variants, &ran.command)?, ran))
     }
 
     /// Ingest: registration, mattes and inter-view flow, per flow preset (and λ). Returns
     /// the default ingest's field, seconds and command.
-    pub fn ingest(&mut self, runs: &Path) -> CliResult<(PathBuf, f64, String)> {
+    pub fn ingest(&mut self, runs: &Path) -> Result<(PathBuf, f64, String)> {
         let presets: &[&str] =
             self.quick_or(&["fast", "balanced"], &["fast", "balanced", "accurate"]);
         let lambdas: &[&str] = self.quick_or(&[], &["6", "48"]);
@@ -252,11 +253,11 @@ impl Sweep<'_> {
                 default_field = Some((field, r.seconds, ran.command.clone()));
             }
         }
-        Ok(default_field.ok_or("no default ingest")?)
+        default_field.ok_or(EvalError::Misuse("no default ingest".into()))
     }
 
     /// Flow storage: the log quantizer's scale on the true inter-view flows (in process).
-    pub fn flow_storage(&mut self, capture: &Capture, capture_dir: &Path) -> CliResult {
+    pub fn flow_storage(&mut self, capture: &Capture, capture_dir: &Path) -> Result<()> {
         let flows: Vec<_> = (0..capture.cycles())
             .step_by((capture.cycles() / 6).max(1))
             .map(|cycle| {
@@ -278,7 +279,7 @@ impl Sweep<'_> {
             Some(1.0),
             Some(5.0),
         ] {
-            let q = frf_eval::storage::flow_quantization(&flows, scale)?;
+            let q = crate::storage::flow_quantization(&flows, scale)?;
             let value = match scale {
                 None => format!("{:.3} (fitted)", q.scale),
                 Some(v) => format!("{v}"),
@@ -291,14 +292,14 @@ impl Sweep<'_> {
                 q.seconds_per_map,
                 "encode and decode one map",
                 scale.is_none(),
-                "(in process: frf_eval::storage::flow_quantization on true flows)",
+                "(in process: crate::storage::flow_quantization on true flows)",
             );
         }
         Ok(())
     }
 
     /// Basis compression: JPEG quality against relit PSNR.
-    pub fn basis_compression(&mut self) -> CliResult {
+    pub fn basis_compression(&mut self) -> Result<()> {
         let qualities = self.quick_or("50,80,95", "50,60,70,80,85,90,95,98");
         let a: Vec<String> = [
             "stage",
@@ -331,7 +332,7 @@ impl Sweep<'_> {
     }
 
     /// Novel views at quad centres, every variant.
-    pub fn novel_views(&mut self, field: &Path) -> CliResult {
+    pub fn novel_views(&mut self, field: &Path) -> Result<()> {
         let (views, ran) = self.eval::<QuadsReport>(
             "eval_views",
             field,
@@ -359,7 +360,7 @@ impl Sweep<'_> {
     }
 
     /// The path suite (inside, near, outside, above, below the grid), every variant.
-    pub fn camera_paths(&mut self, field: &Path) -> CliResult {
+    pub fn camera_paths(&mut self, field: &Path) -> Result<()> {
         let (suite, ran) = self.eval::<PathsReport>(
             "eval_suite",
             field,
@@ -397,7 +398,7 @@ impl Sweep<'_> {
         stage_config: &StageConfig,
         (w, h): (u32, u32),
         default_ingest: (f64, &str),
-    ) -> CliResult {
+    ) -> Result<()> {
         let sizes: Vec<(u32, u32)> = self.quick_or(
             vec![(w, h), (2 * w, 2 * h)],
             vec![(w / 2, h / 2), (w, h), (2 * w, 2 * h), (4 * w, 4 * h)],
@@ -474,7 +475,7 @@ impl Sweep<'_> {
     }
 
     /// The GPU renderer against the CPU reference, same cameras.
-    pub fn renderers(&mut self, field: &Path, cpu_only: bool) -> CliResult {
+    pub fn renderers(&mut self, field: &Path, cpu_only: bool) -> Result<()> {
         let renderers: &[(&str, bool)] = if cpu_only {
             &[("cpu", true)]
         } else {
@@ -519,7 +520,7 @@ impl Sweep<'_> {
 
     /// Shadows: hull voxel and shadow-map texels, on oracle fields (perfect mattes),
     /// timed as `stage field` times its hulls and maps.
-    pub fn shadows(&mut self, runs: &Path) -> CliResult {
+    pub fn shadows(&mut self, runs: &Path) -> Result<()> {
         let (cap, pose) = (self.cap.clone(), self.pose.to_string());
         let field_args = |extra: &[&str], out: &Path| -> Vec<String> {
             ["stage", "field", "--capture", &cap, "--poses", &pose]
@@ -549,15 +550,15 @@ impl Sweep<'_> {
             let build = built
                 .stdout
                 .lines()
-                .find_map(|l| l.strip_prefix(frf_eval::oracle::SHADOW_TIME_LINE))
+                .find_map(|l| l.strip_prefix(crate::oracle::SHADOW_TIME_LINE))
                 .and_then(|t| t.trim_end_matches(" s").parse::<f64>().ok())
                 .ok_or_else(|| {
-                    format!("{}: no time of the hulls and shadow maps", built.command)
+                    EvalError::run(&built.command, "no time of the hulls and shadow maps")
                 })?;
             let command = format!("{}; {}", built.command, scored.command);
             let scene = o
                 .scene
-                .ok_or_else(|| format!("{}: no scene scores in its report", scored.command))?;
+                .ok_or_else(|| EvalError::run(&scored.command, "no scene scores in its report"))?;
             let c = &scored.command;
             let sh = ("shadows", "hull voxel, shadow texels");
             self.push(

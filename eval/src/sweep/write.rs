@@ -5,10 +5,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
 
-use frf_eval::report::{PeerPoint, Report, Row, html, plot};
+use crate::report::{PeerPoint, Report, Row, html, plot};
 use serde::Deserialize;
 
-use crate::CliResult;
+use crate::error::{EvalError, Result};
 
 /// The peer script's JSON (`benches/flow_peers/run_peers.py`), as far as a report reads
 /// it.
@@ -32,13 +32,15 @@ struct PeerMeans {
 }
 
 /// The Middlebury means of the peer script: our presets as rows, the rest as peers.
-pub fn peer_rows(path: &Path, rows: &mut Vec<Row>, peers: &mut Vec<PeerPoint>) -> CliResult {
+pub fn peer_rows(path: &Path, rows: &mut Vec<Row>, peers: &mut Vec<PeerPoint>) -> Result<()> {
     let text = std::fs::read_to_string(path).map_err(|e| frf_core::CoreError::io(path, e))?;
     let file: PeersFile = serde_json::from_str(&text).map_err(|e| {
-        format!(
-            "{}: not the peer script's output (a `summary` of methods, each with epe and \
-             seconds): {e}",
-            path.display()
+        frf_core::CoreError::bad_file(
+            path,
+            format!(
+                "not the peer script's output (a `summary` of methods, each with epe and \
+                 seconds): {e}"
+            ),
         )
     })?;
     let command = file
@@ -86,11 +88,13 @@ pub fn commit() -> String {
 }
 
 /// Writes `report.json`, every stage's plot and `index.html` (each atomically).
-pub fn write_report(report: &Report, out: &Path) -> CliResult {
+pub fn write_report(report: &Report, out: &Path) -> Result<()> {
     use frf_core::atomic::write_bytes_atomic;
     write_bytes_atomic(
         &out.join("report.json"),
-        serde_json::to_string_pretty(report)?.as_bytes(),
+        serde_json::to_string_pretty(report)
+            .map_err(|e| EvalError::Misuse(format!("the report as JSON: {e}")))?
+            .as_bytes(),
     )?;
     let mut png = true;
     for stage in report.stages() {
@@ -118,7 +122,7 @@ pub fn write_report(report: &Report, out: &Path) -> CliResult {
     for stage in report.stages() {
         for metric in report.metrics(stage) {
             let series = report.series(stage, metric);
-            let front: Vec<String> = frf_eval::report::pareto_front(&series)
+            let front: Vec<String> = crate::report::pareto_front(&series)
                 .into_iter()
                 .map(|i| {
                     let r = series[i];

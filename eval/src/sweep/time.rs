@@ -7,12 +7,12 @@
 
 use std::path::Path;
 
-use frf_eval::shot::ShotReport;
+use crate::shot::ShotReport;
 use frf_ingest::pipeline::IngestReport;
 use frf_stage::config::StageConfig;
 
-use super::sweep::{Sweep, ingest_args, parse, read, s};
-use crate::CliResult;
+use super::stages::{Sweep, ingest_args, parse, read, s};
+use crate::error::Result;
 
 /// The stage's name in the report.
 const STAGE: &str = "time between poses";
@@ -54,7 +54,7 @@ impl Sweep<'_> {
         runs: &Path,
         config: &StageConfig,
         size: (u32, u32),
-    ) -> CliResult {
+    ) -> Result<()> {
         let p = self.pose;
         let n = config.poses_per_cycle();
         for (name, every) in [("every pose", 1), ("every second pose", 2)] {
