@@ -26,6 +26,7 @@
 pub mod bench;
 pub mod error;
 pub mod estimate;
+pub mod files;
 mod gradient;
 mod interp;
 mod median;
