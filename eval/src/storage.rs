@@ -249,3 +249,128 @@ pub fn flow_quantization(
         seconds_per_map: seconds / flows.len() as f64,
     })
 }
+/// Views used by the stage's storage measures: every ninth column, all cameras.
+pub fn sample_views(stage: &Stage) -> Vec<(usize, usize)> {
+    (0..stage.cycles())
+        .step_by(9)
+        .flat_map(|u| (0..stage.cameras().len()).map(move |v| (u, v)))
+        .collect()
+}
+
+/// The basis-projection error under each of several environments (`frf stage
+/// projection-error`): a row per environment over [`sample_views`] of the first pose.
+pub struct ProjectionTable {
+    /// The pose measured.
+    pub pose: u32,
+    /// Views per environment.
+    pub views: usize,
+    /// Per environment.
+    pub rows: Vec<ProjectionRow>,
+}
+
+/// One environment's projection error.
+#[derive(Debug, Clone, Serialize)]
+pub struct ProjectionRow {
+    /// Its name.
+    pub env: String,
+    /// Views measured.
+    pub views: usize,
+    /// Mean PSNR over the subject, dB.
+    pub mean_psnr_subject_db: f64,
+    /// Least PSNR of a view, dB.
+    pub min_psnr_subject_db: f64,
+    /// Mean relative absolute error.
+    pub relative_mae: f64,
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+impl ProjectionTable {
+    /// Measures the projection error of `stage`'s first pose under each named
+    /// environment, its truth from `lights` median-cut lights, the floor as `floor`.
+    pub fn measure(
+        stage: &Stage,
+        envs: &[(String, EnvMap)],
+        lights: usize,
+        floor: FloorModel,
+    ) -> Result<Self> {
+        let projector = stage_projector(stage)?;
+        let views = sample_views(stage);
+        let pose = stage.config().poses[0];
+        let mut rows = Vec::new();
+        for (name, env) in envs {
+            let start = std::time::Instant::now();
+            let errors = projection_error(stage, &projector, env, lights, floor, pose, &views)?;
+            let n = errors.len() as f64;
+            rows.push(ProjectionRow {
+                env: name.clone(),
+                views: errors.len(),
+                mean_psnr_subject_db: errors.iter().map(|e| e.psnr_subject_db).sum::<f64>() / n,
+                min_psnr_subject_db: errors
+                    .iter()
+                    .map(|e| e.psnr_subject_db)
+                    .fold(f64::INFINITY, f64::min),
+                relative_mae: errors.iter().map(|e| e.relative_mae).sum::<f64>() / n,
+                seconds: start.elapsed().as_secs_f64(),
+            });
+        }
+        Ok(Self {
+            pose,
+            views: views.len(),
+            rows,
+        })
+    }
+
+    /// The rows as JSON (pretty, keys in order).
+    pub fn json(&self) -> String {
+        serde_json::to_value(&self.rows)
+            .and_then(|v| serde_json::to_string_pretty(&v))
+            .unwrap_or_default()
+    }
+
+    /// The table for a person.
+    pub fn text(&self) -> String {
+        let mut out = format!(
+            "basis-projection error: relit true basis images vs true image under the environment ({} views of pose {}, subject pixels, peak = brightest true value)\n",
+            self.views, self.pose
+        );
+        out += &format!(
+            "{:<24} {:>12} {:>12} {:>10} {:>9}\n",
+            "environment", "mean PSNR dB", "min PSNR dB", "rel. MAE", "seconds"
+        );
+        for r in &self.rows {
+            out += &format!(
+                "{:<24} {:>12.2} {:>12.2} {:>9.2}% {:>9.1}\n",
+                r.env,
+                r.mean_psnr_subject_db,
+                r.min_psnr_subject_db,
+                100.0 * r.relative_mae,
+                r.seconds
+            );
+        }
+        out
+    }
+}
+
+/// The codec curve (`frf stage codec-curve`) as a table for a person: relit under the
+/// environment named `env`, over `views` views.
+pub fn codec_table(curve: &[CodecPoint], env: &str, views: usize) -> String {
+    let mut out = format!(
+        "basis mosaic (gamma 2.2 JPEG) over quality: ratio against 16-bit linear RGB, and PSNR of the view relit under {env} against the uncompressed basis ({views} views, subject pixels)\n"
+    );
+    out += &format!(
+        "{:>8} {:>14} {:>16} {:>16} {:>14}\n",
+        "quality", "ratio (x:1)", "min PSNR (dB)", "mean PSNR (dB)", "ms per view"
+    );
+    for p in curve {
+        out += &format!(
+            "{:>8} {:>14.1} {:>16.2} {:>16.2} {:>14.1}\n",
+            p.quality,
+            p.ratio_vs_16bit,
+            p.min_relit_psnr_db,
+            p.mean_relit_psnr_db,
+            1e3 * p.seconds_per_view
+        );
+    }
+    out
+}

@@ -25,6 +25,7 @@ pub mod pipeline;
 pub mod poseflow;
 pub mod rectify;
 pub mod registration;
+pub mod report_text;
 pub mod ring;
 pub mod shadows;
 pub mod views;

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand, ValueEnum};
 use frf_reflectance::FieldFile;
 use frf_render::gpu::Gpu;
-use frf_render::gpu::bench::{BenchOptions, BenchReport, all_formats, run};
+use frf_render::gpu::bench::{BenchOptions, all_formats, run};
 use frf_render::gpu::formats::PoseFormats;
 use frf_render::gpu::rebin::PassKind;
 use frf_render::resident::{Lighting, PoseSource, ResidentPose};
@@ -148,69 +148,9 @@ fn interp(args: InterpArgs) -> CliResult {
         progress.set_message(m.to_string())
     })?;
     progress.finish_and_clear();
-    print_table(&report, args.field.is_some());
+    eprintln!("{}", report.table(args.field.is_some()));
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
     Ok(())
-}
-
-fn print_table(r: &BenchReport, field: bool) {
-    eprintln!(
-        "{} ({}, {}; timed by {}); pose: {}, {:.1} MB resident as codes/codes8",
-        r.adapter,
-        r.backend,
-        r.driver,
-        r.clock,
-        if field {
-            "the field's"
-        } else {
-            "synthetic, 36 x 3 views of 320 x 448"
-        },
-        r.bytes_per_pose as f64 / 1e6
-    );
-    eprintln!(
-        "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10} {:>10} {:>9} {:>8} {:>11}",
-        "variant",
-        "image",
-        "flow",
-        "stage",
-        "size",
-        "median ms",
-        "min ms",
-        "x floor",
-        "ns/px",
-        "max |Δ| cpu"
-    );
-    for x in &r.rows {
-        eprintln!(
-            "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10.4} {:>10.4} {:>9.2} {:>8.2} {:>11}",
-            x.variant,
-            x.image_format,
-            x.flow_format,
-            x.stage,
-            format!("{}x{}", x.width, x.height),
-            x.ms_median,
-            x.ms_min,
-            x.vs_floor,
-            x.ns_per_pixel,
-            x.max_abs_vs_cpu
-                .map_or("".to_string(), |e| format!("{e:.2e}"))
-        );
-    }
-    for x in &r.cpu_rows {
-        eprintln!(
-            "CPU reference ({} threads) {:<8} {}x{}: {:.2} ms median, {:.2} ms min",
-            x.threads, x.variant, x.width, x.height, x.ms_median, x.ms_min
-        );
-    }
-    for b in &r.floor_bandwidth {
-        eprintln!(
-            "floor {} {}x{}: {:.1} GB/s achieved (4 B read + 16 B written a pixel)",
-            b.stage, b.width, b.height, b.gb_per_s
-        );
-    }
-    if let Some(f) = &r.fastest_correct_fourway {
-        eprintln!("fastest correct four-way at the largest size: {f}");
-    }
 }

@@ -9,7 +9,7 @@ use frf_eval::ingest::StageEvaluator;
 use frf_ingest::edges::EdgeMethod;
 use frf_ingest::evidence::Evaluator;
 use frf_ingest::guided::InterViewFlow;
-use frf_ingest::pipeline::{IngestOptions, IngestReport, Progress, ingest};
+use frf_ingest::pipeline::{IngestOptions, Progress, ingest};
 use indicatif::ProgressBar;
 
 use crate::CliResult;
@@ -232,105 +232,13 @@ pub fn run(args: IngestArgs) -> CliResult {
     {
         b.finish_and_clear();
     }
-    print_report(&report, &args.out);
+    println!("{}", report.describe(&args.out));
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
         frf_core::atomic::write_bytes_atomic(path, text.as_bytes())?;
         println!("report written to {}", path.display());
     }
     Ok(())
-}
-
-fn print_report(r: &IngestReport, out: &std::path::Path) {
-    println!(
-        "field written to {}: {} poses of {} views, {}x{} pixels, flow {}, edges {}",
-        out.display(),
-        r.poses.len(),
-        r.views,
-        r.width,
-        r.height,
-        r.settings.flow_preset,
-        r.settings.edge
-    );
-    let resumed = r.poses.iter().filter(|p| p.resumed).count();
-    if resumed > 0 {
-        println!(
-            "  {resumed} poses were already finished and resumed; their time is not counted below"
-        );
-    }
-    println!("  time per step (wall seconds, all poses of this run):");
-    for s in &r.steps {
-        println!("    {:<36} {:>8.1}", s.name, s.seconds);
-    }
-    println!("  whole run: {:.1} s wall", r.seconds);
-    let f = |v: Option<f64>, unit: &str, digits: usize| match v {
-        Some(v) => format!("{v:.digits$}{unit}"),
-        None => {
-            "not measured (no stage truth, --no-eval, or nothing to measure at this size)".into()
-        }
-    };
-    println!("  against the virtual stage's truth:");
-    println!(
-        "    alpha IoU                           {}",
-        f(r.alpha_iou, "", 4)
-    );
-    println!(
-        "    alpha mean absolute error           {}",
-        f(r.alpha_mae, "", 4)
-    );
-    println!(
-        "    registered basis PSNR (subject)     {}",
-        f(r.registration_psnr, " dB", 2)
-    );
-    println!(
-        "    same frames unregistered            {}",
-        f(r.unregistered_psnr, " dB", 2)
-    );
-    let pair = |after: Option<f64>, before: Option<f64>| match (after, before) {
-        (Some(a), Some(b)) => format!("{a:.4} ({b:.4} before edge decontamination)"),
-        _ => f(after, "", 4),
-    };
-    println!(
-        "    edge band error over black          {}",
-        pair(r.edge_band_error_dark, r.edge_band_error_dark_raw)
-    );
-    println!(
-        "    edge band error over bright         {}",
-        pair(r.edge_band_error_bright, r.edge_band_error_bright_raw)
-    );
-    println!(
-        "    flow EPE inside matte, horizontal   {}",
-        f(r.flow_epe_horizontal, " px", 3)
-    );
-    println!(
-        "    flow EPE inside matte, vertical     {}",
-        f(r.flow_epe_vertical, " px", 3)
-    );
-    if r.settings.pose_flows {
-        println!(
-            "    flow EPE inside matte, pose to pose {}",
-            match (r.pose_flow_epe, r.pose_flow_motion) {
-                (Some(e), Some(m)) => format!("{e:.3} px (the true motion: {m:.3} px)"),
-                (e, _) => f(e, " px", 3),
-            }
-        );
-    }
-    println!(
-        "    visual hull IoU (voxels)            {}",
-        f(r.hull_iou, "", 4)
-    );
-    println!(
-        "  field: flow {:.1} % of 8-bit codes, basis images {:.1}:1 vs 16-bit linear, {:.2} MB",
-        100.0 * r.field.flow_ratio_vs_8bit,
-        r.field.image_ratio_vs_16bit,
-        (r.field.bytes.flow
-            + r.field.bytes.images
-            + r.field.bytes.alpha
-            + r.field.bytes.shadows
-            + r.field.bytes.hulls
-            + r.field.bytes.other) as f64
-            / 1e6
-    );
 }
 
 /// Arguments of `frf ingest-ring`.

@@ -8,7 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use frf_core::env::{EnvMap, EnvSource};
 use frf_eval::oracle::{OracleOptions, SHADOW_TIME_LINE, write_oracle_field};
-use frf_eval::storage::{codec_curve, projection_error, stage_projector};
+use frf_eval::storage::{ProjectionTable, codec_curve, codec_table, sample_views};
 use frf_reflectance::project::FloorModel;
 
 use crate::CliResult;
@@ -112,61 +112,18 @@ fn environment(source: &EnvSource) -> CliResult<EnvMap> {
         .ok_or("--env none: these measures need an environment to relight with")?)
 }
 
-/// Views used by the evaluations: every ninth column, all cameras.
-fn sample_views(stage: &frf_stage::Stage) -> Vec<(usize, usize)> {
-    (0..stage.cycles())
-        .step_by(9)
-        .flat_map(|u| (0..stage.cameras().len()).map(move |v| (u, v)))
-        .collect()
-}
-
 /// Runs `frf stage projection-error`.
 pub fn projection(args: ProjectionArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
-    let projector = stage_projector(&stage)?;
-    let floor = FloorModel::from(args.floor);
-    let views = sample_views(&stage);
-    let pose = stage.config().poses[0];
-    let mut rows = Vec::new();
+    let mut envs = Vec::new();
     for source in &args.env {
-        let env = environment(source)?;
-        let start = Instant::now();
-        let errors = projection_error(&stage, &projector, &env, args.lights, floor, pose, &views)?;
-        let n = errors.len() as f64;
-        let mean_psnr = errors.iter().map(|e| e.psnr_subject_db).sum::<f64>() / n;
-        let min_psnr = errors
-            .iter()
-            .map(|e| e.psnr_subject_db)
-            .fold(f64::INFINITY, f64::min);
-        let mae = errors.iter().map(|e| e.relative_mae).sum::<f64>() / n;
-        let name = source.name();
-        rows.push(serde_json::json!({
-            "env": name, "views": errors.len(), "mean_psnr_subject_db": mean_psnr,
-            "min_psnr_subject_db": min_psnr, "relative_mae": mae,
-            "seconds": start.elapsed().as_secs_f64(),
-        }));
+        envs.push((source.name(), environment(source)?));
     }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
-        return Ok(());
-    }
-    println!(
-        "basis-projection error: relit true basis images vs true image under the environment ({} views of pose {pose}, subject pixels, peak = brightest true value)",
-        views.len()
-    );
-    println!(
-        "{:<24} {:>12} {:>12} {:>10} {:>9}",
-        "environment", "mean PSNR dB", "min PSNR dB", "rel. MAE", "seconds"
-    );
-    for r in rows {
-        println!(
-            "{:<24} {:>12.2} {:>12.2} {:>9.2}% {:>9.1}",
-            r["env"].as_str().unwrap_or(""),
-            r["mean_psnr_subject_db"].as_f64().unwrap_or(0.0),
-            r["min_psnr_subject_db"].as_f64().unwrap_or(0.0),
-            100.0 * r["relative_mae"].as_f64().unwrap_or(0.0),
-            r["seconds"].as_f64().unwrap_or(0.0)
-        );
+    let floor = FloorModel::from(args.floor);
+    let table = ProjectionTable::measure(&stage, &envs, args.lights, floor)?;
+    match args.json {
+        true => println!("{}", table.json()),
+        false => print!("{}", table.text()),
     }
     Ok(())
 }
@@ -195,28 +152,12 @@ pub fn codec(args: CodecArgs) -> CliResult {
     let views = sample_views(&stage);
     let pose = stage.config().poses[0];
     let curve = codec_curve(&stage, &env, pose, &views, &args.qualities)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&curve)?);
-        return Ok(());
-    }
-    println!(
-        "basis mosaic (gamma 2.2 JPEG) over quality: ratio against 16-bit linear RGB, and PSNR of the view relit under {} against the uncompressed basis ({} views, subject pixels)",
-        args.env,
-        views.len()
-    );
-    println!(
-        "{:>8} {:>14} {:>16} {:>16} {:>14}",
-        "quality", "ratio (x:1)", "min PSNR (dB)", "mean PSNR (dB)", "ms per view"
-    );
-    for p in curve {
-        println!(
-            "{:>8} {:>14.1} {:>16.2} {:>16.2} {:>14.1}",
-            p.quality,
-            p.ratio_vs_16bit,
-            p.min_relit_psnr_db,
-            p.mean_relit_psnr_db,
-            1e3 * p.seconds_per_view
-        );
+    match args.json {
+        true => println!("{}", serde_json::to_string_pretty(&curve)?),
+        false => print!(
+            "{}",
+            codec_table(&curve, &args.env.to_string(), views.len())
+        ),
     }
     Ok(())
 }

@@ -439,6 +439,74 @@ impl Drawn<'_> {
     }
 }
 
+impl BenchReport {
+    /// The report as a table for a person (`field`: the pose came from a field, else it
+    /// is the synthetic one).
+    pub fn table(&self, field: bool) -> String {
+        let r = self;
+        let mut lines = Vec::new();
+
+        lines.push(format!(
+            "{} ({}, {}; timed by {}); pose: {}, {:.1} MB resident as codes/codes8",
+            r.adapter,
+            r.backend,
+            r.driver,
+            r.clock,
+            if field {
+                "the field's"
+            } else {
+                "synthetic, 36 x 3 views of 320 x 448"
+            },
+            r.bytes_per_pose as f64 / 1e6
+        ));
+        lines.push(format!(
+            "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10} {:>10} {:>9} {:>8} {:>11}",
+            "variant",
+            "image",
+            "flow",
+            "stage",
+            "size",
+            "median ms",
+            "min ms",
+            "x floor",
+            "ns/px",
+            "max |Δ| cpu"
+        ));
+        for x in &r.rows {
+            lines.push(format!(
+                "{:<8} {:<7} {:<7} {:<8} {:>10} {:>10.4} {:>10.4} {:>9.2} {:>8.2} {:>11}",
+                x.variant,
+                x.image_format,
+                x.flow_format,
+                x.stage,
+                format!("{}x{}", x.width, x.height),
+                x.ms_median,
+                x.ms_min,
+                x.vs_floor,
+                x.ns_per_pixel,
+                x.max_abs_vs_cpu
+                    .map_or("".to_string(), |e| format!("{e:.2e}"))
+            ));
+        }
+        for x in &r.cpu_rows {
+            lines.push(format!(
+                "CPU reference ({} threads) {:<8} {}x{}: {:.2} ms median, {:.2} ms min",
+                x.threads, x.variant, x.width, x.height, x.ms_median, x.ms_min
+            ));
+        }
+        for b in &r.floor_bandwidth {
+            lines.push(format!(
+                "floor {} {}x{}: {:.1} GB/s achieved (4 B read + 16 B written a pixel)",
+                b.stage, b.width, b.height, b.gb_per_s
+            ));
+        }
+        if let Some(f) = &r.fastest_correct_fourway {
+            lines.push(format!("fastest correct four-way at the largest size: {f}"));
+        }
+        lines.join("\n")
+    }
+}
+
 fn row(
     variant: &str,
     formats: PoseFormats,
