@@ -32,6 +32,7 @@ pub mod plan_report;
 pub mod render_shot;
 pub mod settings;
 pub mod shot;
+pub mod shot_report;
 
 use std::path::{Path, PathBuf};
 

@@ -12,6 +12,7 @@ use frf_render::morph::Variant;
 use glam::Vec3;
 
 use crate::path::Trajectory;
+use crate::plan::ShotFrame;
 use crate::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
 
 /// The rate of a field's preview (a typical video rate).
@@ -70,5 +71,22 @@ impl Scene {
                 time_offset: f64::from(pose) / cycle * header.cycle_seconds,
             }],
         }
+    }
+
+    /// `n` frames of `size` along the camera path, the walk frozen at time 0 (a field
+    /// render: the walker's time offset picks its pose).
+    pub fn frozen_frames(&self, n: usize, size: (u32, u32)) -> crate::Result<Vec<ShotFrame>> {
+        let frames = self
+            .camera
+            .cameras(n, size.0, size.1)?
+            .into_iter()
+            .enumerate()
+            .map(|(index, camera)| ShotFrame {
+                index,
+                time: 0.0,
+                camera,
+            })
+            .collect();
+        Ok(frames)
     }
 }

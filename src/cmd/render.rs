@@ -23,10 +23,10 @@ use frf_scene::explain::explain;
 use frf_scene::output::Output;
 use frf_scene::path::Trajectory;
 use frf_scene::plan::{Plan, ShotFrame};
-use frf_scene::plan_report::shadow_words;
 use frf_scene::render_shot::render_shot;
 use frf_scene::settings::{FlagFiles, RenderSettings};
 use frf_scene::shot::{Shot, ShotOptions};
+use frf_scene::shot_report::shot_preamble;
 use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use serde::Serialize;
 
@@ -204,19 +204,7 @@ fn frames_of(
                 .map_err(|_| format!("--frames {s:?}: a field render takes a count of frames"))?,
             None => DEFAULT_FRAMES,
         };
-        // A field render freezes the walk: the walker's time offset picks the pose.
-        let time = 0.0;
-        let frames = scene
-            .camera
-            .cameras(n, size.0, size.1)?
-            .into_iter()
-            .enumerate()
-            .map(|(index, camera)| ShotFrame {
-                index,
-                time,
-                camera,
-            })
-            .collect();
+        let frames = scene.frozen_frames(n, size)?;
         return Ok((frames, n));
     }
     let total = scene.frame_times().len();
@@ -299,56 +287,10 @@ pub fn run(args: RenderArgs) -> CliResult {
     // Opened once every input has been read and checked: a bad environment, plate or
     // field leaves no output directory behind.
     let mut output = Output::open(&out_dir, &settings, args.overwrite, total)?;
-    let c = &shot.plan().counts;
-    eprintln!(
-        "{}: {} of {} frames, {}x{}, {}; plan: {} of {} poses, {} of {} views, {} of {} flows, {} of {} conditions, {:.2} of {:.2} MB{}",
-        field_path.display(),
-        frames.len(),
-        total,
-        size.0,
-        size.1,
-        shot.device(),
-        c.poses_used,
-        c.poses_total,
-        c.views_used,
-        c.views_total,
-        c.flows_used,
-        c.flows_total,
-        c.conditions_used,
-        c.conditions_total,
-        c.bytes_read as f64 / 1e6,
-        c.bytes_total as f64 / 1e6,
-        if options.planned {
-            ""
-        } else {
-            " (--no-plan: everything is read)"
-        }
-    );
-    eprintln!(
-        "shadow: {}",
-        shadow_words(
-            &scene,
-            shot.plan(),
-            shot.field().header(),
-            options.traced_lights
-        )
-    );
-    if let Some(r) = shot.shadow_reach()?.filter(|r| r.cut()) {
-        eprintln!(
-            "warning: the lights that make the shadow are as low as {:.0}°: it reaches {:.1} m \
-             from the walker, past the field's {:.1} m patch of shadow maps (they fade out from \
-             {:.1} m): ingest with --shadow-extent {:.0} (or --for this scene) to hold it whole",
-            r.elevation_deg,
-            r.reach_m,
-            r.patch_side_m,
-            0.5 * r.patch_side_m * frf_render::shadow::EDGE_FADE_FROM,
-            r.side_needed_m().ceil()
-        );
-    }
-    for (wanted, held) in &shot.plan().poses_substituted {
-        eprintln!(
-            "pose {wanted} is not in the field: pose {held} stands in for it (render.json: poses_substituted)"
-        );
+    let shape = (frames.len(), total, size);
+    let said = shot_preamble(&scene, &mut shot, &field_path, shape, options.traced_lights)?;
+    for line in said {
+        eprintln!("{line}");
     }
     render_shot(
         &mut shot,
