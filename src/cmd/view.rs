@@ -13,7 +13,7 @@ use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
 use frf_scene::path::{Orbit, Trajectory};
 use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
-use frf_view::{Ended, ViewOptions};
+use frf_view::ViewOptions;
 use glam::Vec3;
 
 use crate::CliResult;
@@ -141,60 +141,11 @@ pub fn run(args: ViewArgs) -> CliResult {
         start_at_captured_view: !is_scene,
         no_vsync: args.no_vsync,
     })?;
-    let median = |v: &[f64]| {
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        s.get(s.len() / 2).copied()
-    };
-    let gpu = median(&outcome.gpu_ms);
-    let frame = median(&outcome.frame_ms);
-    eprintln!(
-        "frf view: {}. {} frames drawn on {}; GPU time per frame {} (timestamps); time between frames {} ({})",
-        match outcome.ended {
-            Ended::Quit => "closed",
-            Ended::WindowClosed => "the window was closed",
-        },
-        outcome.frames,
-        outcome.adapter,
-        gpu.map_or("n/a".into(), |ms| format!("{ms:.2} ms median")),
-        frame.map_or("n/a".into(), |ms| format!("{ms:.1} ms median")),
-        frame.map_or("n/a".into(), |ms| format!("{:.1} fps", 1e3 / ms)),
-    );
-    let (made, seconds) = outcome.residency;
-    if made > 0 {
-        eprintln!(
-            "  poses made resident (read and relit for a light): {made}, {:.2} s each",
-            seconds / made as f64
-        );
-    }
-    for s in &outcome.screenshots {
-        eprintln!("  wrote {}", s.display());
-    }
-    if let Some((path, keys, note)) = &outcome.recorded {
-        eprintln!(
-            "  recorded {keys} camera keys to {}: `frf render {} --out DIR` renders the move",
-            path.display(),
-            path.display()
-        );
-        if let Some(n) = note {
-            eprintln!("  note: {n}");
-        }
+    for line in outcome.summary() {
+        eprintln!("{line}");
     }
     if args.json {
-        let report = serde_json::json!({
-            "ended": format!("{:?}", outcome.ended),
-            "adapter": outcome.adapter,
-            "frames": outcome.frames,
-            "gpu_ms_median": gpu,
-            "gpu_ms": outcome.gpu_ms,
-            "frame_ms_median": frame,
-            "fps_median": frame.map(|ms| 1e3 / ms),
-            "screenshots": outcome.screenshots.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
-            "recorded": outcome.recorded.as_ref().map(|r| r.0.display().to_string()),
-            "poses_made_resident": made,
-            "residency_seconds": seconds,
-        });
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        println!("{}", outcome.json());
     }
     Ok(())
 }

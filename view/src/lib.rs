@@ -15,6 +15,7 @@
 
 mod app;
 pub mod camera;
+mod outcome;
 mod panel;
 pub mod record;
 pub mod script;
