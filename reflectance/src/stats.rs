@@ -113,4 +113,87 @@ impl<R: ReadAt> FieldFile<R> {
             pose_flow_maps,
         }
     }
+
+    /// The field for a person, a line each (`frf info`): grid, poses, codecs, bytes by
+    /// kind and what each holds.
+    pub fn describe(&self) -> String {
+        let mut lines = Vec::new();
+        let h = self.header();
+        let s = self.stats();
+        let mb = |b: u64| b as f64 / 1e6;
+        lines.push(format!("{}", self.path().display()));
+        lines.push(format!("  source: {}", h.description));
+        lines.push(format!(
+            "  grid: {} x {} views ({}), {}x{} pixels, {} basis conditions ({} floor)",
+            h.columns,
+            h.rows,
+            if h.wraps { "closed ring" } else { "open" },
+            h.width,
+            h.height,
+            h.conditions.len(),
+            h.conditions.iter().filter(|c| c.floor).count()
+        ));
+        lines.push(format!(
+            "  poses: {:?}",
+            h.poses.iter().map(|p| p.pose).collect::<Vec<_>>()
+        ));
+        for p in &h.poses {
+            lines.push(format!(
+                "  pose {}: flow log quantizer s = {:.4} px, M = {:.2} px",
+                p.pose, p.flow_quantizer.scale, p.flow_quantizer.range
+            ));
+        }
+        let predicted = if h.flow_predicted {
+            "predicted from neighbours"
+        } else {
+            "not predicted"
+        };
+        lines.push(format!("  flow codes: {predicted}"));
+        lines.push(format!("  JPEG quality: {}", h.jpeg_quality));
+        lines.push("  bytes by kind (MB):".to_string());
+        for (kind, b) in [
+            ("basis images", s.bytes.images),
+            ("flow maps", s.bytes.flow),
+            ("pose flow maps", s.bytes.pose_flow),
+            ("alpha", s.bytes.alpha),
+            ("shadow maps", s.bytes.shadows),
+            ("visual hulls", s.bytes.hulls),
+            ("index and framing", s.bytes.other),
+        ] {
+            lines.push(format!("    {kind:<18} {:>10.3}", mb(b)));
+        }
+        lines.push(format!(
+            "  flow: {} maps, {:.1} % of their 8-bit quantized size",
+            s.flow_maps,
+            100.0 * s.flow_ratio_vs_8bit
+        ));
+        lines.push(format!(
+            "  pose-to-pose flow: {} maps (to the next and the previous captured pose of each view)",
+            s.pose_flow_maps
+        ));
+        lines.push(format!(
+            "  basis images: {} images, {:.1}:1 against 16-bit linear RGB",
+            s.basis_images, s.image_ratio_vs_16bit
+        ));
+        match &h.shadows {
+            Some(spec) => lines.push(format!(
+                "  shadows: {} maps ({} conditions per pose), {} x {} texels over {} m x {} m",
+                s.shadow_maps,
+                spec.conditions.len(),
+                spec.ground.texels,
+                spec.ground.texels,
+                spec.ground.extent_m,
+                spec.ground.extent_m
+            )),
+            None => lines.push("  shadows: none".to_string()),
+        }
+        match &h.hulls {
+            Some(spec) => lines.push(format!(
+                "  visual hulls: {} ({} m voxels, {} views may disagree)",
+                s.hulls, spec.voxel_m, spec.misses
+            )),
+            None => lines.push("  visual hulls: none".to_string()),
+        }
+        lines.join("\n")
+    }
 }
