@@ -2,19 +2,17 @@
 //! of time per step and, for virtual-stage captures, each step's error against the truth.
 
 use std::path::PathBuf;
-use std::sync::Mutex;
 
 use clap::{Args, ValueEnum};
 use frf_eval::ingest::StageEvaluator;
 use frf_ingest::edges::EdgeMethod;
 use frf_ingest::evidence::Evaluator;
 use frf_ingest::guided::InterViewFlow;
-use frf_ingest::pipeline::{IngestOptions, Progress, ingest};
-use indicatif::ProgressBar;
+use frf_ingest::pipeline::{IngestOptions, ingest};
 
 use crate::CliResult;
 use crate::cmd::args::{FlowPresetArg, ShadowArgs, parse_poses};
-use crate::cmd::progress::bar;
+use crate::cmd::progress::Bars;
 
 /// Arguments of `frf ingest`.
 #[derive(Args)]
@@ -140,32 +138,6 @@ impl From<EdgeArg> for EdgeMethod {
     }
 }
 
-struct Bars {
-    current: Mutex<Option<ProgressBar>>,
-}
-
-impl Progress for Bars {
-    fn begin(&self, pose: u32, step: &str, total: usize) {
-        let mut current = self.current.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(b) = current.take() {
-            b.finish_and_clear();
-        }
-        let b = bar(&format!("pose {pose}: {step}"));
-        b.set_length(total as u64);
-        *current = Some(b);
-    }
-    fn advance(&self) {
-        if let Some(b) = self
-            .current
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .as_ref()
-        {
-            b.inc(1);
-        }
-    }
-}
-
 /// Runs `frf ingest`.
 pub fn run(args: IngestArgs) -> CliResult {
     let _claim =
@@ -181,9 +153,7 @@ pub fn run(args: IngestArgs) -> CliResult {
         pose_flows: args.pose_flow,
         ..args.method.options()?
     };
-    let bars = Bars {
-        current: Mutex::new(None),
-    };
+    let bars = Bars::default();
     let judge = if args.no_eval {
         None
     } else {
@@ -224,14 +194,7 @@ pub fn run(args: IngestArgs) -> CliResult {
         options.selection = Some(crate::cmd::for_scene::selection(&plan));
     }
     let report = ingest(&args.capture, &args.out, &options, evaluator, &bars)?;
-    if let Some(b) = bars
-        .current
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .take()
-    {
-        b.finish_and_clear();
-    }
+    drop(bars);
     println!("{}", report.describe(&args.out));
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;

@@ -68,6 +68,17 @@ impl Progress for Bars {
     }
 }
 
+/// An ingest's progress: a bar per pose and step.
+impl frf_ingest::pipeline::Progress for Bars {
+    fn begin(&self, pose: u32, step: &str, total: usize) {
+        self.phase(&format!("pose {pose}: {step}"), total);
+    }
+
+    fn advance(&self) {
+        self.step();
+    }
+}
+
 impl Drop for Bars {
     fn drop(&mut self) {
         self.finish();
