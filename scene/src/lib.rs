@@ -232,6 +232,19 @@ impl Scene {
             })
     }
 
+    /// The frame size of a render: a plate's own (a plate is seen by its camera), else
+    /// `given` (the command line's), else the scene's, else the field's image size.
+    pub fn frame_size(&self, given: Option<(u32, u32)>, field: (u32, u32)) -> Result<(u32, u32)> {
+        let plate = match &self.backdrop {
+            BackdropSpec::Plate(p) => {
+                let (w, h) = frf_core::io::image_dimensions(p)?;
+                Some((w as u32, h as u32))
+            }
+            _ => None,
+        };
+        Ok(plate.or(given).or(self.size).unwrap_or(field))
+    }
+
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;

@@ -1,17 +1,25 @@
 //! The shot loop every front end runs: each frame of a shot rendered ([`Shot::render`])
 //! and its files encoded and written on a thread of their own while the next frame
 //! renders (at most two waiting), so that a sequence runs at the slower of rendering and
-//! encoding; frames already in the output are kept ([`Output::kept`]).
+//! encoding; frames already in the output are kept ([`Output::kept`]). [`render_to_dir`]
+//! runs a whole shot into a directory, as `frf render` does.
 
 use std::sync::mpsc::{RecvTimeoutError, channel, sync_channel};
 use std::time::{Duration, Instant};
 
+use std::path::Path;
+
 use frf_core::progress::Progress;
+use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
+use frf_render::renderer::Device;
 
 use super::output::{FrameFiles, Kept, Output};
 use super::plan::ShotFrame;
-use super::shot::Shot;
+use super::settings::RenderSettings;
+use super::shot::{Shot, ShotOptions};
+use super::shot_report::shot_preamble;
+use crate::Scene;
 use crate::error::{Result, SceneError};
 
 /// Renders `frames` of `shot` into `output` (with their layers when `layers`, the PNGs
@@ -113,6 +121,70 @@ fn while_saying<T>(
         let _ = done.send(());
         r
     })
+}
+
+/// A shot rendered into a directory: the scene on a field, the frames asked for (of
+/// the shot's `total`), their size, and the directory with the settings it keeps.
+pub struct ShotJob<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The field it is rendered from.
+    pub field: &'a FieldFile,
+    /// The field's path, as given.
+    pub field_path: &'a Path,
+    /// The frames to render.
+    pub frames: &'a [ShotFrame],
+    /// Frames of the whole shot.
+    pub total: usize,
+    /// Frame size.
+    pub size: (u32, u32),
+    /// The output directory.
+    pub out_dir: &'a Path,
+    /// What its frames are made from (`settings.json`).
+    pub settings: &'a RenderSettings,
+    /// Render every frame again even where the directory holds it.
+    pub overwrite: bool,
+}
+
+/// Renders `job` with `options` into its directory (resuming) on the GPU, or the CPU
+/// reference with `cpu`, saying what the plan reads before the first frame through
+/// `say`; the summary for people (its setup time counts opening the device).
+pub fn render_to_dir(
+    job: &ShotJob,
+    cpu: bool,
+    options: ShotOptions,
+    progress: &dyn Progress,
+    say: &mut dyn FnMut(&str),
+) -> Result<String> {
+    let start = Instant::now();
+    let device = Device::open(cpu)?;
+    let mut shot = Shot::new(job.scene, job.field, device, job.frames, options)?;
+    let setup_seconds = start.elapsed().as_secs_f64();
+    // Opened once every input has been read and checked: a bad environment, plate or
+    // field leaves no output directory behind.
+    let mut output = Output::open(job.out_dir, job.settings, job.overwrite, job.total)?;
+    let shape = (job.frames.len(), job.total, job.size);
+    let preamble = shot_preamble(
+        job.scene,
+        &mut shot,
+        job.field_path,
+        shape,
+        options.traced_lights,
+    )?;
+    for line in preamble {
+        say(&line);
+    }
+    let scene = job.scene;
+    render_shot(
+        &mut shot,
+        job.frames,
+        &mut output,
+        (scene.layers, scene.exposure),
+        progress,
+    )?;
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let bytes_read = job.field.bytes_read();
+    output.finish(scene, &shot, setup_seconds, wall_seconds, bytes_read)
 }
 
 #[cfg(test)]

@@ -12,21 +12,17 @@
 //! a shot (for a farm), and a rerun resumes (`frf_scene::output`).
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use clap::Args;
 use frf_core::env::EnvSource;
 use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
-use frf_render::renderer::Device;
 use frf_scene::explain::explain;
-use frf_scene::output::Output;
 use frf_scene::path::Trajectory;
 use frf_scene::plan::{Plan, ShotFrame};
-use frf_scene::render_shot::render_shot;
+use frf_scene::render_shot::{ShotJob, render_to_dir};
 use frf_scene::settings::{FlagFiles, RenderSettings};
-use frf_scene::shot::{Shot, ShotOptions};
-use frf_scene::shot_report::shot_preamble;
+use frf_scene::shot::ShotOptions;
 use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use serde::Serialize;
 
@@ -238,17 +234,7 @@ pub fn run(args: RenderArgs) -> CliResult {
     scene.layers |= args.layers;
     let field = FieldFile::open(&field_path)?;
     let h = field.header();
-    let plate_size = match &scene.backdrop {
-        BackdropSpec::Plate(p) => {
-            let (w, h) = frf_core::io::image_dimensions(p)?;
-            Some((w as u32, h as u32))
-        }
-        _ => None,
-    };
-    let size = plate_size
-        .or(args.size)
-        .or(scene.size)
-        .unwrap_or((h.width, h.height));
+    let size = scene.frame_size(args.size, (h.width, h.height))?;
     let (frames, total) = frames_of(&args, &scene, size, field_render)?;
     if args.plan || args.explain {
         let plan = Plan::new(&scene, &field, &frames)?;
@@ -274,39 +260,26 @@ pub fn run(args: RenderArgs) -> CliResult {
     let args_json = serde_json::to_value(&args)?;
     let settings = RenderSettings::new((args_json, flagged), &scene, &field, !field_render, size)?;
 
-    let start = Instant::now();
-    let device = Device::open(args.cpu)?;
+    let job = ShotJob {
+        scene: &scene,
+        field: &field,
+        field_path: &field_path,
+        frames: &frames,
+        total,
+        size,
+        out_dir: &out_dir,
+        settings: &settings,
+        overwrite: args.overwrite,
+    };
     let options = ShotOptions {
         memory_budget: args.memory_budget.saturating_mul(1_000_000),
         planned: !args.no_plan,
         traced_lights: args.scene.shadow_lights,
         detail: args.detail,
     };
-    let mut shot = Shot::new(&scene, &field, device, &frames, options)?;
-    let setup_seconds = start.elapsed().as_secs_f64();
-    // Opened once every input has been read and checked: a bad environment, plate or
-    // field leaves no output directory behind.
-    let mut output = Output::open(&out_dir, &settings, args.overwrite, total)?;
-    let shape = (frames.len(), total, size);
-    let said = shot_preamble(&scene, &mut shot, &field_path, shape, options.traced_lights)?;
-    for line in said {
-        eprintln!("{line}");
-    }
-    render_shot(
-        &mut shot,
-        &frames,
-        &mut output,
-        (scene.layers, scene.exposure),
-        &Bars::default(),
-    )?;
-    let wall_seconds = start.elapsed().as_secs_f64();
-    let summary = output.finish(
-        &scene,
-        &shot,
-        setup_seconds,
-        wall_seconds,
-        field.bytes_read(),
-    )?;
+    let summary = render_to_dir(&job, args.cpu, options, &Bars::default(), &mut |line| {
+        eprintln!("{line}")
+    })?;
     eprintln!("{summary}");
     Ok(())
 }
