@@ -34,6 +34,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{EvalError, Result};
 use crate::metrics::max_row_jump;
 use crate::views::{EvalCamera, ReportHeader, VariantScore, evaluate, truth_frames};
+use crate::views::{TABLE_HEADER, table_row};
 use frf_core::progress::Progress;
 
 /// A named trajectory of the suite.
@@ -267,6 +268,33 @@ pub fn evaluate_paths(
         paths: scores,
         mean_psnr_subject,
     })
+}
+
+impl PathsReport {
+    /// The scores for a person: per path a line per variant (with its largest row jump),
+    /// then the mean over the paths.
+    pub fn describe(&self) -> String {
+        let mut lines = Vec::new();
+        for p in &self.paths {
+            let jump = p.truth_max_row_jump.iter().cloned().fold(0.0, f64::max);
+            lines.push(format!(
+                "{} ({}; the truth's largest row jump {jump:.3}):",
+                p.name, p.about
+            ));
+            lines.push(format!("  {TABLE_HEADER}"));
+            for s in &p.variants {
+                let worst = s.frames.iter().map(|f| f.max_row_jump).fold(0.0, f64::max);
+                lines.push(format!("  {}  row jump {worst:.3}", table_row(s)));
+            }
+        }
+        if self.paths.len() > 1 {
+            lines.push("mean subject PSNR over the paths:".to_string());
+            for (name, m) in &self.mean_psnr_subject {
+                lines.push(format!("  {name:<21} {m:.2} dB"));
+            }
+        }
+        lines.join("\n")
+    }
 }
 
 #[cfg(test)]

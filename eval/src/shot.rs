@@ -334,6 +334,62 @@ pub fn spread_frames(total: usize, count: usize) -> Vec<usize> {
     out
 }
 
+impl ShotReport {
+    /// The report for a person: a line per frame and their means (`lights`: the truth's
+    /// median-cut lights).
+    pub fn describe(&self, lights: usize) -> String {
+        let mut lines = Vec::new();
+        lines.push(format!(
+            "{}: {} of {} frames against the stage's truth ({} median-cut lights, the walker at {}), {}",
+            self.scene.display(),
+            self.frames.len(),
+            self.frames_total,
+            lights,
+            match self.truth_at {
+                TruthAt::Instant => "each frame's instant",
+                TruthAt::Pose => "the instant of the pose drawn",
+            },
+            self.device
+        ));
+        lines.push("frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s".to_string());
+        for s in &self.frames {
+            // Between two poses: both, the earlier first.
+            let pose = match s.between {
+                Some((after, _)) => format!("{}-{after}", s.pose),
+                None => s.pose.to_string(),
+            };
+            lines.push(format!(
+                "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
+                s.index,
+                s.time,
+                pose,
+                1e3 * s.time_from_pose_s,
+                s.psnr_frame,
+                s.psnr_subject,
+                s.ssim_subject,
+                s.seconds_render,
+                s.seconds_truth
+            ));
+        }
+        lines.push(format!(
+            "mean: frame {:.2} dB, walker {:.2} dB (SSIM {:.4}); {:.3} s a frame rendered (first frames make their poses resident), {:.2} s a true frame",
+            self.psnr_frame_mean,
+            self.psnr_subject_mean,
+            self.ssim_subject_mean,
+            self.seconds_render_mean,
+            self.seconds_truth_mean
+        ));
+        if let Some(m) = &self.steadiness {
+            lines.push(format!(
+                "motion: the walker's largest change between consecutive frames {:.5} (mean |ΔRGBA| a pixel), \
+                 the truth's {:.5}: {:.2}x ({} pairs)",
+                m.largest_change, m.truth_largest_change, m.ratio, m.pairs
+            ));
+        }
+        lines.join("\n")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::spread_frames;

@@ -5,7 +5,6 @@
 //! row-to-row jump of the subject (a seam) beside the truth's, and seconds per frame.
 
 use frf_eval::paths::{NamedPath, PathOptions, evaluate_paths, suite};
-use frf_eval::views::{TABLE_HEADER, table_row};
 use frf_render::renderer::Renderer;
 use frf_stage::truth::environment_lights;
 
@@ -59,7 +58,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         &options,
         &Bars::default(),
     )?;
-    eprintln!(
+    let header = format!(
         "{} pose {} under {} (truth: {} median-cut lights, {:.2} s/frame on the CPU), {} \
          path(s) of {frames} frames at {w}x{h}, {}:",
         args.field.display(),
@@ -70,24 +69,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         paths.len(),
         report.header.device
     );
-    for p in &report.paths {
-        let jump = p.truth_max_row_jump.iter().cloned().fold(0.0, f64::max);
-        eprintln!(
-            "{} ({}; the truth's largest row jump {jump:.3}):",
-            p.name, p.about
-        );
-        eprintln!("  {TABLE_HEADER}");
-        for s in &p.variants {
-            let worst = s.frames.iter().map(|f| f.max_row_jump).fold(0.0, f64::max);
-            eprintln!("  {}  row jump {worst:.3}", table_row(s));
-        }
-    }
-    if report.paths.len() > 1 {
-        eprintln!("mean subject PSNR over the paths:");
-        for (name, m) in &report.mean_psnr_subject {
-            eprintln!("  {name:<21} {m:.2} dB");
-        }
-    }
+    eprintln!("{header}\n{}", report.describe());
     if args.compare.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }

@@ -23,9 +23,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
         }
     }
     let field_path = scene.field_or(args.scene_field.as_deref())?;
-    if !(1..=65536).contains(&args.lights) {
-        return Err(format!("--lights {} (1 to 65536)", args.lights).into());
-    }
+    frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
     let field = FieldFile::open(&field_path)?;
     let stage = frf_stage::open_stage(&args.capture)?;
     let report = evaluate_shot(
@@ -42,54 +40,6 @@ pub fn run(args: &EvalArgs) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    println!(
-        "{}: {} of {} frames against the stage's truth ({} median-cut lights, the walker at {}), {}",
-        report.scene.display(),
-        report.frames.len(),
-        report.frames_total,
-        args.lights,
-        match report.truth_at {
-            frf_eval::shot::TruthAt::Instant => "each frame's instant",
-            frf_eval::shot::TruthAt::Pose => "the instant of the pose drawn",
-        },
-        report.device
-    );
-    println!(
-        "frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s"
-    );
-    for s in &report.frames {
-        // Between two poses: both, the earlier first.
-        let pose = match s.between {
-            Some((after, _)) => format!("{}-{after}", s.pose),
-            None => s.pose.to_string(),
-        };
-        println!(
-            "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
-            s.index,
-            s.time,
-            pose,
-            1e3 * s.time_from_pose_s,
-            s.psnr_frame,
-            s.psnr_subject,
-            s.ssim_subject,
-            s.seconds_render,
-            s.seconds_truth
-        );
-    }
-    println!(
-        "mean: frame {:.2} dB, walker {:.2} dB (SSIM {:.4}); {:.3} s a frame rendered (first frames make their poses resident), {:.2} s a true frame",
-        report.psnr_frame_mean,
-        report.psnr_subject_mean,
-        report.ssim_subject_mean,
-        report.seconds_render_mean,
-        report.seconds_truth_mean
-    );
-    if let Some(m) = &report.steadiness {
-        println!(
-            "motion: the walker's largest change between consecutive frames {:.5} (mean |ΔRGBA| a pixel), \
-             the truth's {:.5}: {:.2}x ({} pairs)",
-            m.largest_change, m.truth_largest_change, m.ratio, m.pairs
-        );
-    }
+    println!("{}", report.describe(args.lights));
     Ok(())
 }
