@@ -9,6 +9,7 @@
 
 pub mod argument;
 pub mod atomic;
+pub mod bars;
 pub mod camera;
 pub mod capture;
 pub mod claim;

@@ -151,6 +151,18 @@ pub trait Progress: Sync {
     }
 }
 
+/// Every progress of phases ([`frf_core::progress::Progress`], e.g. bars) shows an
+/// ingest: a phase per pose and step.
+impl<T: frf_core::progress::Progress> Progress for T {
+    fn begin(&self, pose: u32, step: &str, total: usize) {
+        self.phase(&format!("pose {pose}: {step}"), total);
+    }
+
+    fn advance(&self) {
+        self.step();
+    }
+}
+
 fn check_stop(progress: &dyn Progress) -> Result<()> {
     if progress.should_stop() {
         return Err(IngestError::Interrupted);

@@ -14,8 +14,8 @@ use frf_render::resident::{Lighting, PoseSource, ResidentPose};
 use frf_render::synthetic::synthetic_pose;
 
 use super::args::{LightingArgs, parse_size};
-use super::progress::bar;
 use crate::CliResult;
+use frf_core::bars::bar;
 
 /// `frf bench ...`.
 #[derive(Args)]

@@ -33,7 +33,7 @@ pub struct InfoArgs {
 
 /// `frf info FIELD --check`.
 fn check(path: &std::path::Path, field: &FieldFile, json: bool) -> CliResult {
-    let bar = crate::cmd::progress::bar("chunks checked");
+    let bar = frf_core::bars::bar("chunks checked");
     bar.set_length(field.chunks().count() as u64);
     let v = field.verify(&|| bar.inc(1))?;
     bar.finish_and_clear();

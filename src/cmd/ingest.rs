@@ -12,7 +12,7 @@ use frf_ingest::pipeline::{IngestOptions, ingest};
 
 use crate::CliResult;
 use crate::cmd::args::{FlowPresetArg, ShadowArgs, parse_poses};
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Arguments of `frf ingest`.
 #[derive(Args)]

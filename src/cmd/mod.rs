@@ -1,4 +1,4 @@
-//! One module per subcommand, plus shared progress reporting and argument parsing.
+//! One module per subcommand, plus shared argument parsing.
 
 pub mod args;
 pub mod bench;
@@ -10,7 +10,6 @@ pub mod hull;
 pub mod info;
 pub mod ingest;
 pub mod merge;
-pub mod progress;
 pub mod render;
 pub mod report;
 pub mod stage;

@@ -32,7 +32,7 @@ use crate::cmd::args::{
     BackdropArg, BackdropArgs, CameraArgs, GroundArg, LightingArgs, ShadowArg, VariantArg,
     parse_size,
 };
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Frames along a path of a field render, by default.
 const DEFAULT_FRAMES: usize = 36;

@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use crate::CliResult;
 use crate::cmd::args::{parse_env, parse_point, parse_poses, parse_size};
-use crate::cmd::progress::bar;
+use frf_core::bars::bar;
 
 /// Arguments of `frf stage`.
 #[derive(Args)]

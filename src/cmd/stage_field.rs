@@ -13,7 +13,7 @@ use frf_reflectance::project::FloorModel;
 
 use crate::CliResult;
 use crate::cmd::args::{FloorArg, parse_env};
-use crate::cmd::progress::bar;
+use frf_core::bars::bar;
 
 /// Arguments of `frf stage field`.
 #[derive(Args)]

@@ -13,7 +13,7 @@ use frf_stage::truth::environment_lights;
 use super::args::EvalArgs;
 use super::input::EvalInput;
 use crate::CliResult;
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Runs the budget.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {

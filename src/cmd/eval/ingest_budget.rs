@@ -9,7 +9,7 @@ use super::args::EvalArgs;
 use super::budget::{plot_format, write_plot};
 use super::input::EvalInput;
 use crate::CliResult;
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Runs the ingest budget.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {

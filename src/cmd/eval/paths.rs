@@ -11,7 +11,7 @@ use frf_stage::truth::environment_lights;
 use super::args::EvalArgs;
 use super::input::EvalInput;
 use crate::CliResult;
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Frames along each path, by default.
 const DEFAULT_FRAMES: usize = 8;

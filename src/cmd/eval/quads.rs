@@ -12,7 +12,7 @@ use super::args::EvalArgs;
 use super::input::EvalInput;
 use crate::CliResult;
 use crate::cmd::args::GroundArg;
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Runs `frf eval` at quad centres.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {

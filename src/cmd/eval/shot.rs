@@ -9,7 +9,7 @@ use frf_scene::Scene;
 
 use super::args::EvalArgs;
 use crate::CliResult;
-use crate::cmd::progress::Bars;
+use frf_core::bars::Bars;
 
 /// Frames scored by default.
 const DEFAULT_FRAMES: usize = 4;

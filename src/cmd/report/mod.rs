@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use clap::Args;
 use frf_eval::sweep::{ReportOptions, run_report};
 
-use super::progress::bar;
 use crate::CliResult;
+use frf_core::bars::bar;
 
 /// Arguments of `frf report`.
 #[derive(Args)]

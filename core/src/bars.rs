@@ -1,9 +1,9 @@
-//! Progress bars for long commands (indicatif), drawn on stderr and hidden when stderr
-//! is not a terminal.
+//! Progress drawn as bars (indicatif) on standard error, hidden when it is not a
+//! terminal: [`bar`] for a count of steps, [`Bars`] for a [`Progress`] of phases.
 
 use std::sync::Mutex;
 
-use frf_core::progress::Progress;
+use crate::progress::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// A bar with a message, position/length, elapsed time and ETA.
@@ -65,17 +65,6 @@ impl Progress for Bars {
             Some(b) => b.suspend(|| eprintln!("{what}")),
             None => eprintln!("{what}"),
         });
-    }
-}
-
-/// An ingest's progress: a bar per pose and step.
-impl frf_ingest::pipeline::Progress for Bars {
-    fn begin(&self, pose: u32, step: &str, total: usize) {
-        self.phase(&format!("pose {pose}: {step}"), total);
-    }
-
-    fn advance(&self) {
-        self.step();
     }
 }
 
