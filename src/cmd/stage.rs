@@ -6,12 +6,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::{Args, Subcommand, ValueEnum};
-use frf_core::camera::Camera;
 use frf_core::env::EnvSource;
-use frf_core::io::{rgba_from, write_exr_rgba, write_png8_srgba};
-use frf_stage::truth::{DEFAULT_ENVIRONMENT_LIGHTS, environment_lights};
+use frf_core::io::{write_exr_rgba, write_png8_srgba};
+use frf_stage::truth::DEFAULT_ENVIRONMENT_LIGHTS;
+use frf_stage::truth_shot::{TruthCamera, TruthLight, parse_basis};
 use frf_stage::{Gait, Preset, SetFlowTruth, StageConfig};
-use glam::Vec3;
 
 use crate::CliResult;
 use crate::cmd::args::{parse_env, parse_point, parse_poses, parse_size};
@@ -234,101 +233,66 @@ fn capture(args: CaptureArgs) -> CliResult {
     Ok(())
 }
 
-fn parse_basis(s: &str, conditions: usize) -> CliResult<Vec<f32>> {
-    let mut weights = vec![0.0; conditions];
-    for item in s.split(',') {
-        let bad = || {
-            format!(
-                "--basis item {item:?}: expected condition=weight with condition < {conditions}"
-            )
-        };
-        let (c, w) = item.split_once('=').ok_or_else(bad)?;
-        let c: usize = c.trim().parse().map_err(|_| bad())?;
-        let w: f32 = w.trim().parse().map_err(|_| bad())?;
-        if c >= conditions || !w.is_finite() {
-            return Err(bad().into());
-        }
-        weights[c] = w;
-    }
-    Ok(weights)
-}
-
 fn truth(args: TruthArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
     let config = stage.config();
     let pose = args.pose.unwrap_or(config.poses[0]);
     if pose >= config.poses_per_cycle() {
-        return Err(format!(
-            "--pose {pose}: a cycle has {} poses",
-            config.poses_per_cycle()
-        )
-        .into());
+        let allowed = format!("a pose of the cycle's {}", config.poses_per_cycle());
+        return Err(frf_core::BadArgument::new("--pose", pose, allowed).into());
     }
-    let (w, h) = args.size.unwrap_or((config.width, config.height));
-    let camera = if let Some(view) = &args.view {
-        let (u, v) = view
-            .split_once(',')
-            .and_then(|(u, v)| {
-                Some((
-                    u.trim().parse::<usize>().ok()?,
-                    v.trim().parse::<usize>().ok()?,
-                ))
-            })
-            .ok_or_else(|| format!("--view {view:?}: expected U,V"))?;
-        stage.subject_camera(pose, u, v)?
-    } else {
-        let eye = Vec3::from(args.eye.ok_or("give --view U,V or --eye and --look-at")?);
-        let target = Vec3::from(args.look_at.unwrap_or([0.0, 0.9, 0.0]));
-        Camera::look_at(eye, target, Vec3::Y, args.fov.to_radians(), w, h)?
+    let camera = match (&args.view, args.eye) {
+        (Some(view), _) => {
+            let (u, v) = view
+                .split_once(',')
+                .and_then(|(u, v)| Some((u.trim().parse().ok()?, v.trim().parse().ok()?)))
+                .ok_or_else(|| format!("--view {view:?}: expected U,V"))?;
+            TruthCamera::View(u, v)
+        }
+        (None, Some(eye)) => TruthCamera::Eye {
+            eye,
+            look_at: args.look_at.unwrap_or([0.0, 0.9, 0.0]),
+            fov_deg: args.fov,
+            size: args.size.unwrap_or((config.width, config.height)),
+        },
+        (None, None) => return Err("give --view U,V or --eye and --look-at".into()),
+    };
+    let light = match (&args.env, &args.basis) {
+        (Some(source), _) => TruthLight::Environment {
+            env: source
+                .load()?
+                .ok_or("--env none: a truth image needs lighting (an environment or --basis)")?
+                .rotated(args.yaw.to_radians()),
+            name: source.to_string(),
+            lights: args.lights,
+        },
+        (None, Some(spec)) => TruthLight::Basis {
+            weights: parse_basis(spec, stage.basis().len())?,
+            turntable_deg: args.turntable,
+        },
+        (None, None) => return Err("give --env FILE or --basis c=w,...".into()),
     };
     let start = Instant::now();
-    let (lights, what) = if let Some(source) = &args.env {
-        let env = source
-            .load()?
-            .ok_or("--env none: a truth image needs lighting (an environment or --basis)")?
-            .rotated(args.yaw.to_radians());
-        frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
-        (
-            environment_lights(&env, args.lights),
-            format!("environment {source}"),
-        )
-    } else {
-        let weights = parse_basis(
-            args.basis
-                .as_deref()
-                .ok_or("give --env FILE or --basis c=w,...")?,
-            stage.basis().len(),
-        )?;
-        (
-            stage.basis_lights(&weights, args.turntable.to_radians())?,
-            "basis combination".to_string(),
-        )
-    };
-    let instant = match args.time {
-        Some(t) if !t.is_finite() => return Err(format!("--time {t}: not a finite number").into()),
-        Some(t) => t.rem_euclid(config.gait.cycle_seconds()),
-        None => stage.pose_time_s(pose),
-    };
-    let image = stage.truth_image_at(instant, &camera, &lights);
-    let rgba = rgba_from(&image.color, &image.alpha)?;
+    let shot = stage.truth_shot(pose, camera, &light, args.time)?;
     let is_exr = args
         .out
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if is_exr {
-        write_exr_rgba(&args.out, &rgba)?;
+        write_exr_rgba(&args.out, &shot.rgba)?;
     } else {
-        write_png8_srgba(&args.out, &rgba, args.exposure)?;
+        write_png8_srgba(&args.out, &shot.rgba, args.exposure)?;
     }
-    let coverage = image.alpha.pixels().iter().sum::<f32>() / image.alpha.pixels().len() as f32;
+    let c = &shot.camera;
     println!(
-        "truth image of pose {pose}, {}x{}, under {what} ({} lights): {}",
-        camera.width,
-        camera.height,
-        lights.len(),
+        "truth image of pose {pose}, {}x{}, under {} ({} lights): {}",
+        c.width,
+        c.height,
+        shot.what,
+        shot.lights,
         args.out.display()
     );
-    println!("subject coverage (mean alpha): {coverage:.3}");
+    println!("subject coverage (mean alpha): {:.3}", shot.coverage);
     println!("render time: {:.2} s", start.elapsed().as_secs_f64());
     Ok(())
 }

@@ -34,6 +34,7 @@ pub mod sensor;
 pub mod stage;
 pub mod studio;
 pub mod truth;
+pub mod truth_shot;
 pub mod writer;
 
 pub use config::{Preset, SetFlowTruth, StageConfig};
