@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use frf_reflectance::FieldFile;
-use frf_reflectance::container::merge_fields;
+use frf_reflectance::merge::merge_parts;
 
 use crate::CliResult;
 
@@ -44,47 +44,14 @@ fn expected(spec: &str) -> CliResult<(Vec<u32>, String)> {
 pub fn run(args: MergeArgs) -> CliResult {
     let expect = args.expect.as_deref().map(expected).transpose()?;
     let _claim = crate::cmd::claim::claim(&args.out, &[])?;
-    let mut parts = Vec::with_capacity(args.parts.len());
-    let mut held: Vec<u32> = Vec::new();
-    for p in &args.parts {
-        let f = FieldFile::open(p)?;
-        held.extend(f.header().poses.iter().map(|r| r.pose));
-        let first = f
-            .header()
-            .poses
-            .iter()
-            .map(|r| r.pose)
-            .min()
-            .ok_or_else(|| format!("{}: holds no pose", p.display()))?;
-        parts.push((first, p.clone()));
-    }
-    parts.sort();
-    held.sort_unstable();
-    if let Some((poses, from)) = &expect {
-        let missing: Vec<u32> = poses
-            .iter()
-            .copied()
-            .filter(|p| !held.contains(p))
-            .collect();
-        if !missing.is_empty() {
-            return Err(format!(
-                "the parts hold poses {held:?}, {from} expects {poses:?}: poses {missing:?} are \
-                 missing (ingest them, e.g. frf ingest CAPTURE --poses {}); nothing written",
-                missing
-                    .iter()
-                    .map(u32::to_string)
-                    .collect::<Vec<_>>()
-                    .join(",")
-            )
-            .into());
-        }
-    }
-    let paths: Vec<PathBuf> = parts.into_iter().map(|(_, p)| p).collect();
-    merge_fields(&paths, &args.out)?;
+    let expected = expect
+        .as_ref()
+        .map(|(p, from)| (p.as_slice(), from.as_str()));
+    let held = merge_parts(&args.parts, &args.out, expected)?;
     let s = FieldFile::open(&args.out)?.stats();
     println!(
         "{} parts merged into {}: {} poses {held:?}{}, {:.2} MB",
-        paths.len(),
+        args.parts.len(),
         args.out.display(),
         s.poses,
         match &expect {
