@@ -62,7 +62,31 @@ impl Default for ShadowOptions {
     }
 }
 
+/// Most texels per side of a patch sized for a scene without `--shadow-texels` (6 m at the
+/// original's density): tracing the maps costs as the square of it, and a long shadow's
+/// far end is soft.
+pub const MAX_AUTO_TEXELS: u32 = 256;
+
 impl ShadowOptions {
+    /// The ground patch of the maps: of side `extent_m` where given, else `needed` metres
+    /// (a scene's need) but at least the original's; of `texels` a side where given, else
+    /// following the side at the original's density (128 per 3 m), at most
+    /// [`MAX_AUTO_TEXELS`].
+    pub fn ground_for(
+        extent_m: Option<f32>,
+        texels: Option<u32>,
+        needed: Option<f32>,
+    ) -> GroundGrid {
+        let original = GroundGrid::ORIGINAL;
+        let extent_m = extent_m
+            .unwrap_or_else(|| needed.map_or(original.extent_m, |n| n.max(original.extent_m)));
+        let texels = texels.unwrap_or_else(|| {
+            let per_metre = original.texels as f32 / original.extent_m;
+            ((extent_m * per_metre).ceil() as u32).clamp(original.texels, MAX_AUTO_TEXELS)
+        });
+        GroundGrid { extent_m, texels }
+    }
+
     /// Checks the options, naming the bad one.
     pub fn validate(&self) -> Result<()> {
         let v = self.hull.voxel_m;

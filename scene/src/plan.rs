@@ -434,6 +434,30 @@ pub struct ShotFrame {
     pub camera: Camera,
 }
 
+/// The frames `spec` names of a shot of `total` (`--frames`): `N` (frames 0 to N − 1)
+/// or `A..B`; all of them when absent.
+pub fn frame_range(spec: Option<&str>, total: usize) -> Result<std::ops::Range<usize>> {
+    let Some(s) = spec else {
+        return Ok(0..total);
+    };
+    let bad = || {
+        let allowed = format!("N or A..B within the shot's {total} frames");
+        SceneError::from(BadArgument::new("--frames", format!("{s:?}"), allowed))
+    };
+    let range = match s.split_once("..") {
+        Some((a, b)) => {
+            let a: usize = a.trim().parse().map_err(|_| bad())?;
+            let b: usize = b.trim().parse().map_err(|_| bad())?;
+            a..b
+        }
+        None => 0..s.trim().parse::<usize>().map_err(|_| bad())?,
+    };
+    if range.start >= range.end || range.end > total {
+        return Err(bad());
+    }
+    Ok(range)
+}
+
 impl Scene {
     /// The frames `range` of the scene (indices into [`Scene::frame_times`]), of `size`.
     pub fn shot_frames(

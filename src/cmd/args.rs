@@ -7,7 +7,6 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use frf_core::env::{EnvMap, EnvSource};
-use frf_core::volume::GroundGrid;
 use frf_flow::Preset;
 use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, DEFAULT_VOXEL_M, ShadowOptions};
 use frf_reflectance::field::HullSpec;
@@ -348,11 +347,6 @@ impl CameraArgs {
     }
 }
 
-/// Most texels per side of a patch sized for a scene without `--shadow-texels` (6 m at the
-/// original's density): tracing the maps costs as the square of it, and a long shadow's
-/// far end is soft.
-pub const MAX_AUTO_TEXELS: u32 = 256;
-
 /// The visual hull and shadow maps made in ingest (`frf ingest`, `frf stage field`).
 #[derive(Args)]
 pub struct ShadowArgs {
@@ -385,28 +379,20 @@ impl ShadowArgs {
         self.options_for(None)
     }
 
-    /// [`ShadowArgs::options`] with a patch of side `needed` metres (a scene's need, at
-    /// least the original's) where `--shadow-extent` is not given; the texels follow the
-    /// side where `--shadow-texels` is not given (128 per 3 m, at most
-    /// [`MAX_AUTO_TEXELS`]).
+    /// [`ShadowArgs::options`] with a patch of side `needed` metres (a scene's need) where
+    /// `--shadow-extent` is not given ([`ShadowOptions::ground_for`]).
     pub fn options_for(&self, needed: Option<f32>) -> CliResult<Option<ShadowOptions>> {
         if self.no_shadows {
             return Ok(None);
         }
-        let original = GroundGrid::ORIGINAL;
-        let extent_m = self
-            .shadow_extent
-            .unwrap_or_else(|| needed.map_or(original.extent_m, |n| n.max(original.extent_m)));
-        let texels = self.shadow_texels.unwrap_or_else(|| {
-            let per_metre = original.texels as f32 / original.extent_m;
-            ((extent_m * per_metre).ceil() as u32).clamp(original.texels, MAX_AUTO_TEXELS)
-        });
+        let hull = HullSpec {
+            voxel_m: self.hull_voxel,
+            misses: self.hull_misses,
+        };
+        let ground = ShadowOptions::ground_for(self.shadow_extent, self.shadow_texels, needed);
         let o = ShadowOptions {
-            hull: HullSpec {
-                voxel_m: self.hull_voxel,
-                misses: self.hull_misses,
-            },
-            ground: GroundGrid { extent_m, texels },
+            hull,
+            ground,
             light_samples: self.shadow_samples,
         };
         o.validate()?;
@@ -490,32 +476,6 @@ pub enum ShadowArg {
     Traced,
     /// No shadow.
     None,
-}
-
-/// A half-open range of frame indices.
-pub struct FrameRange;
-
-impl FrameRange {
-    /// Parses `--frames`: `N` (frames 0 to N − 1) or `A..B`, within a shot of `total`
-    /// frames; all of them when absent.
-    pub fn parse(s: Option<&str>, total: usize) -> CliResult<std::ops::Range<usize>> {
-        let Some(s) = s else {
-            return Ok(0..total);
-        };
-        let bad = || format!("--frames {s:?}: expected N or A..B within the shot's {total} frames");
-        let range = match s.split_once("..") {
-            Some((a, b)) => {
-                let a: usize = a.trim().parse().map_err(|_| bad())?;
-                let b: usize = b.trim().parse().map_err(|_| bad())?;
-                a..b
-            }
-            None => 0..s.trim().parse::<usize>().map_err(|_| bad())?,
-        };
-        if range.start >= range.end || range.end > total {
-            return Err(bad().into());
-        }
-        Ok(range)
-    }
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@ use frf_reflectance::{FieldFile, FieldHeader};
 use frf_render::composite::GroundLook;
 use frf_scene::explain::explain;
 use frf_scene::path::Trajectory;
-use frf_scene::plan::{Plan, ShotFrame};
+use frf_scene::plan::{Plan, ShotFrame, frame_range};
 use frf_scene::render_shot::{ShotJob, render_to_dir};
 use frf_scene::settings::{FlagFiles, RenderSettings};
 use frf_scene::shot::ShotOptions;
@@ -27,7 +27,6 @@ use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use serde::Serialize;
 
 use crate::CliResult;
-use crate::cmd::args::FrameRange;
 use crate::cmd::args::{
     BackdropArg, BackdropArgs, CameraArgs, GroundArg, LightingArgs, ShadowArg, VariantArg,
     parse_size,
@@ -204,7 +203,7 @@ fn frames_of(
         return Ok((frames, n));
     }
     let total = scene.frame_times().len();
-    let range = FrameRange::parse(args.frames.as_deref(), total)?;
+    let range = frame_range(args.frames.as_deref(), total)?;
     Ok((scene.shot_frames(range.start..range.end, size)?, total))
 }
 
