@@ -8,10 +8,11 @@ use std::path::Path;
 use frf_core::env::EnvSource;
 use frf_reflectance::FieldHeader;
 use frf_reflectance::project::FloorModel;
+use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
 use glam::Vec3;
 
-use crate::path::Trajectory;
+use crate::path::{Orbit, Trajectory};
 use crate::plan::ShotFrame;
 use crate::{BackdropSpec, Instance, LightKey, Preview, Scene, ShadowSpec};
 
@@ -34,6 +35,34 @@ pub struct FieldLook {
     pub backdrop: BackdropSpec,
     /// Where its shadow comes from.
     pub shadow: ShadowSpec,
+}
+
+impl FieldLook {
+    /// How the viewer shows a field: lit by `env` (turned by `yaw` radians) over that
+    /// environment with the maps' shadow (nothing behind it unlit), the plan of its live
+    /// shot made from an orbit around the walker (the viewer starts at a captured view).
+    pub fn viewer(env: EnvSource, yaw: f32, floor: FloorModel) -> Self {
+        let lit = env != EnvSource::None;
+        FieldLook {
+            env,
+            yaw,
+            floor,
+            camera: Trajectory::Orbit(Orbit {
+                radius: 3.2,
+                height: 1.4,
+                start_deg: 0.0,
+                sweep_deg: 360.0,
+                look_at: Vec3::new(0.0, 0.9, 0.0),
+                fov_deg: 35.0,
+            }),
+            backdrop: if lit {
+                BackdropSpec::Environment(GroundLook::Environment)
+            } else {
+                BackdropSpec::None
+            },
+            shadow: ShadowSpec::Maps,
+        }
+    }
 }
 
 impl Scene {

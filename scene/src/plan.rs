@@ -458,7 +458,29 @@ pub fn frame_range(spec: Option<&str>, total: usize) -> Result<std::ops::Range<u
     Ok(range)
 }
 
+/// The largest patch of shadow maps sized for a scene's lighting, metres: a sun a few
+/// degrees high would ask for tens of metres.
+pub const MAX_SCENE_PATCH_M: f32 = 12.0;
+
 impl Scene {
+    /// The side of the patch of shadow maps (metres, at most [`MAX_SCENE_PATCH_M`])
+    /// that holds the shadow of a standing person under the lowest shadow-making light of
+    /// the scene's lighting keys, and that light's elevation (degrees); `None` when
+    /// nothing lights the ground from above.
+    pub fn shadow_patch(&self) -> Result<Option<(f32, f32)>> {
+        use frf_render::shadow_reach::{
+            NOMINAL_SUBJECT, lowest_shadow_light_elevation, patch_side_holding, shadow_reach,
+        };
+        let mut envs = Vec::new();
+        for env in self.environments() {
+            envs.extend(env.load()?);
+        }
+        Ok(lowest_shadow_light_elevation(&envs).map(|e| {
+            let side = patch_side_holding(shadow_reach(e, NOMINAL_SUBJECT));
+            (side.min(MAX_SCENE_PATCH_M), e.to_degrees())
+        }))
+    }
+
     /// The frames `range` of the scene (indices into [`Scene::frame_times`]), of `size`.
     pub fn shot_frames(
         &self,

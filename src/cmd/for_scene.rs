@@ -1,7 +1,6 @@
 //! `--for SCENE` of `frf stage` and `frf ingest`: the scene planned on a capture
 //! ([`Plan::for_capture`]), so that only the poses, views and flows it needs are filmed
-//! or ingested; and the patch of shadow maps the scene's lighting needs
-//! ([`frf_render::shadow_reach`]).
+//! or ingested (the patch of shadow maps its lighting needs: [`Scene::shadow_patch`]).
 
 use std::path::Path;
 
@@ -14,29 +13,6 @@ use frf_scene::Scene;
 use frf_scene::plan::Plan;
 
 use crate::CliResult;
-
-/// The largest patch of shadow maps sized for a scene's lighting, metres: a sun a few
-/// degrees high would ask for tens of metres.
-pub const MAX_SCENE_PATCH_M: f32 = 12.0;
-
-/// The side of the patch of shadow maps (metres, at most [`MAX_SCENE_PATCH_M`]) that holds
-/// the shadow of a standing person under the lowest shadow-making light of the scene at
-/// `scene`'s lighting keys, and that light's elevation (degrees); `None` when nothing
-/// lights the ground from above.
-pub fn shadow_patch(scene: &Path) -> CliResult<Option<(f32, f32)>> {
-    use frf_render::shadow_reach::{
-        NOMINAL_SUBJECT, lowest_shadow_light_elevation, patch_side_holding, shadow_reach,
-    };
-    let scene = Scene::load(scene)?;
-    let mut envs = Vec::new();
-    for env in scene.environments() {
-        envs.extend(env.load()?);
-    }
-    Ok(lowest_shadow_light_elevation(&envs).map(|e| {
-        let side = patch_side_holding(shadow_reach(e, NOMINAL_SUBJECT));
-        (side.min(MAX_SCENE_PATCH_M), e.to_degrees())
-    }))
-}
 
 /// The plan of the scene at `scene` on `capture`: the field the capture would make
 /// (the quantizer and JPEG quality do not matter to a plan) with shadow maps of `shadows`

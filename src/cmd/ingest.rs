@@ -162,7 +162,7 @@ pub fn run(args: IngestArgs) -> CliResult {
     let evaluator = judge.as_ref().map(|j| j as &dyn Evaluator);
     if let Some(scene) = &args.for_scene {
         let capture = frf_core::capture::Capture::open_manifest(&args.capture)?;
-        if let Some((side, elevation)) = crate::cmd::for_scene::shadow_patch(scene)? {
+        if let Some((side, elevation)) = frf_scene::Scene::load(scene)?.shadow_patch()? {
             options.shadows = args.shadows.options_for(Some(side))?;
             if let Some(s) = &options.shadows {
                 println!(
@@ -170,7 +170,7 @@ pub fn run(args: IngestArgs) -> CliResult {
                      reach down to {elevation:.0}°{})",
                     s.ground.extent_m,
                     s.ground.texels,
-                    if side >= crate::cmd::for_scene::MAX_SCENE_PATCH_M {
+                    if side >= frf_scene::plan::MAX_SCENE_PATCH_M {
                         ": their shadow is longer than the largest patch made unasked"
                     } else {
                         ""

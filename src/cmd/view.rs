@@ -9,12 +9,9 @@ use std::path::PathBuf;
 use clap::Args;
 use frf_core::env::EnvSource;
 use frf_reflectance::FieldFile;
-use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
-use frf_scene::path::{Orbit, Trajectory};
-use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
+use frf_scene::{FieldLook, Scene};
 use frf_view::ViewOptions;
-use glam::Vec3;
 
 use crate::CliResult;
 use crate::cmd::args::{FloorArg, VariantArg, parse_degrees, parse_env, parse_size};
@@ -70,27 +67,7 @@ pub struct ViewArgs {
 fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
     let h = field.header();
     let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
-    let lit = env != EnvSource::None;
-    let look = FieldLook {
-        env,
-        yaw: args.yaw.to_radians(),
-        floor: args.floor.into(),
-        // Where the plan of the live shot looks from; the viewer starts at a captured view.
-        camera: Trajectory::Orbit(Orbit {
-            radius: 3.2,
-            height: 1.4,
-            start_deg: 0.0,
-            sweep_deg: 360.0,
-            look_at: Vec3::new(0.0, 0.9, 0.0),
-            fov_deg: 35.0,
-        }),
-        backdrop: if lit {
-            BackdropSpec::Environment(GroundLook::Environment)
-        } else {
-            BackdropSpec::None
-        },
-        shadow: ShadowSpec::Maps,
-    };
+    let look = FieldLook::viewer(env, args.yaw.to_radians(), args.floor.into());
     // The walk plays from pose 0.
     Ok(Scene {
         end: h.cycle_seconds,
