@@ -104,6 +104,22 @@ pub fn score_held_out(
         .collect()
 }
 
+/// The held-out views' scores as a table for a person, a line per variant.
+pub fn ring_table(scores: &[RingScore]) -> String {
+    let mut lines = Vec::new();
+    lines.push(format!(
+        "{:<18} {:>17} {:>17} {:>9}",
+        "variant", "PSNR silhouette", "SSIM silhouette", "s/frame"
+    ));
+    for r in scores {
+        lines.push(format!(
+            "{:<18} {:>14.2} dB {:>17.4} {:>9.4}",
+            r.name, r.psnr_silhouette, r.ssim_silhouette, r.seconds_per_frame
+        ));
+    }
+    lines.join("\n")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -265,3 +265,40 @@ fn seconds_label(s: f64) -> String {
         format!("{s:.1e}")
     }
 }
+/// Whether `--plot PATH` asks for a PNG (`Some(true)`) or an SVG (`Some(false)`);
+/// `None` without `--plot`; any other extension is refused.
+pub fn plot_format(plot: Option<&std::path::Path>) -> Result<Option<bool>> {
+    let Some(p) = plot else {
+        return Ok(None);
+    };
+    match p.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("svg") => Ok(Some(false)),
+        Some(e) if e.eq_ignore_ascii_case("png") => Ok(Some(true)),
+        _ => {
+            let allowed = "a .svg or .png file";
+            Err(frf_core::BadArgument::new("--plot", p.display(), allowed).into())
+        }
+    }
+}
+
+/// Writes a budget's plot to `path` (PNG or SVG, atomically) and its Markdown table
+/// beside it (`.md`).
+pub fn write_plot(
+    path: &std::path::Path,
+    png: bool,
+    draw_png: &dyn Fn() -> Result<Option<Vec<u8>>>,
+    draw_svg: &dyn Fn() -> Result<String>,
+    markdown: &str,
+) -> Result<()> {
+    use frf_core::atomic::write_bytes_atomic;
+    let bytes = if png {
+        draw_png()?.ok_or_else(|| {
+            EvalError::Plot("no system font for the plot's text: draw it as .svg".into())
+        })?
+    } else {
+        draw_svg()?.into_bytes()
+    };
+    write_bytes_atomic(path, &bytes)?;
+    write_bytes_atomic(&path.with_extension("md"), markdown.as_bytes())?;
+    Ok(())
+}

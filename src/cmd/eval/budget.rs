@@ -2,10 +2,10 @@
 //! error budget of view interpolation ([`frf_eval::budget`]), printed as a table, and
 //! drawn with its Markdown table beside the plot.
 
-use frf_core::atomic::write_bytes_atomic;
 use frf_core::image::{Image, Rgba};
 use frf_core::io::write_png8_srgba;
 use frf_eval::budget::{self, BudgetInputs, BudgetReport};
+use frf_eval::report::plot::{plot_format, write_plot};
 use frf_render::renderer::Renderer;
 use frf_render::resident::ResidentPose;
 use frf_stage::truth::environment_lights;
@@ -78,37 +78,5 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         };
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
-    Ok(())
-}
-
-/// Whether `--plot PATH` asks for a PNG (`Some(true)`) or an SVG (`Some(false)`);
-/// `None` without `--plot`; any other extension is refused.
-pub(super) fn plot_format(plot: Option<&std::path::Path>) -> CliResult<Option<bool>> {
-    let Some(p) = plot else {
-        return Ok(None);
-    };
-    match p.extension().and_then(|e| e.to_str()) {
-        Some(e) if e.eq_ignore_ascii_case("svg") => Ok(Some(false)),
-        Some(e) if e.eq_ignore_ascii_case("png") => Ok(Some(true)),
-        _ => Err(format!("--plot {}: expected a .svg or .png file", p.display()).into()),
-    }
-}
-
-/// Writes a budget's plot to `path` (PNG or SVG, atomically) and its Markdown table
-/// beside it (`.md`).
-pub(super) fn write_plot(
-    path: &std::path::Path,
-    png: bool,
-    draw_png: &dyn Fn() -> frf_eval::Result<Option<Vec<u8>>>,
-    draw_svg: &dyn Fn() -> frf_eval::Result<String>,
-    markdown: &str,
-) -> CliResult {
-    let bytes = if png {
-        draw_png()?.ok_or("no system font for the plot's text: draw it as .svg")?
-    } else {
-        draw_svg()?.into_bytes()
-    };
-    write_bytes_atomic(path, &bytes)?;
-    write_bytes_atomic(&path.with_extension("md"), markdown.as_bytes())?;
     Ok(())
 }

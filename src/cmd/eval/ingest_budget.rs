@@ -6,10 +6,10 @@ use frf_eval::ingest_budget::{self, BudgetScoring, IngestBudgetReport, fields};
 use frf_stage::truth::environment_lights;
 
 use super::args::EvalArgs;
-use super::budget::{plot_format, write_plot};
 use super::input::EvalInput;
 use crate::CliResult;
 use frf_core::bars::Bars;
+use frf_eval::report::plot::{plot_format, write_plot};
 
 /// Runs the ingest budget.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {

@@ -2,7 +2,7 @@
 //! rendered from their neighbours and scored against the photographs
 //! ([`frf_eval::ring`]).
 
-use frf_eval::ring::{held_out_views, score_held_out};
+use frf_eval::ring::{held_out_views, ring_table, score_held_out};
 use frf_reflectance::FieldFile;
 use frf_render::renderer::Renderer;
 use frf_render::resident::{Lighting, PoseSource};
@@ -28,29 +28,20 @@ pub fn run(args: RingEvalArgs) -> CliResult {
     let source = PoseSource::load(&field, 0, &Lighting::Unlit)?;
     let renderer = Renderer::open(&source, args.compare.cpu)?;
     let scores = score_held_out(&renderer, &views, &cameras, &held, &args.compare.variants())?;
+    let gap = if wraps {
+        format!("{} apart", views.len() - (views.len() - 1) / s * s)
+    } else {
+        "open".into()
+    };
     eprintln!(
         "{}: {} held-out views, each rendered from the kept views either side ({} apart, \
-         the last gap {}), {}:",
+         the last gap {gap}), {}:",
         args.field.display(),
         held.len(),
         s,
-        if wraps {
-            format!("{} apart", views.len() - (views.len() - 1) / s * s)
-        } else {
-            "open".into()
-        },
         renderer.device()
     );
-    eprintln!(
-        "{:<18} {:>17} {:>17} {:>9}",
-        "variant", "PSNR silhouette", "SSIM silhouette", "s/frame"
-    );
-    for r in &scores {
-        eprintln!(
-            "{:<18} {:>14.2} dB {:>17.4} {:>9.4}",
-            r.name, r.psnr_silhouette, r.ssim_silhouette, r.seconds_per_frame
-        );
-    }
+    eprintln!("{}", ring_table(&scores));
     if args.compare.json {
         println!(
             "{}",
