@@ -75,29 +75,11 @@ fn die_quietly_on_a_closed_pipe() {
     }
 }
 
-/// Keeps Mesa's Vulkan device-selection layer from probing for a display server: loaded
-/// into every Vulkan process, it connects to Wayland to find the desktop's GPU, and
-/// outside a desktop session (a batch job, ssh) libwayland prints `error: XDG_RUNTIME_DIR
-/// is invalid or not set in the environment.` once per adapter enumeration. Its ordering
-/// of the GPUs is not used here (`frf_render::gpu::adapter` ranks them itself), so a
-/// command that opens no window turns it off, as its own variable does; a user who set
-/// either of its variables keeps the choice.
-#[allow(unsafe_code)]
-fn keep_the_display_probe_quiet() {
-    if std::env::var_os("NODEVICE_SELECT").is_none()
-        && std::env::var_os("MESA_VK_DEVICE_SELECT").is_none()
-    {
-        // SAFETY: at start-up, before any thread is spawned: no other thread reads the
-        // environment while it changes.
-        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
-    }
-}
-
 fn main() -> ExitCode {
     die_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
     if !matches!(cli.command, Command::View(_)) {
-        keep_the_display_probe_quiet();
+        frf_render::gpu::adapter::keep_the_display_probe_quiet();
     }
     if let Some(name) = &cli.adapter {
         frf_render::gpu::adapter::prefer(name);

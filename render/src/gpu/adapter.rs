@@ -279,3 +279,21 @@ pub fn survey() -> (Vec<Candidate>, Result<AdapterReport>) {
     let found = candidates(&instance).into_iter().map(|(_, c)| c).collect();
     (found, choose(&instance).map(|(_, report)| report))
 }
+
+/// Keeps Mesa's Vulkan device-selection layer from probing for a display server: loaded
+/// into every Vulkan process, it connects to Wayland to find the desktop's GPU, and
+/// outside a desktop session (a batch job, ssh) libwayland prints `error: XDG_RUNTIME_DIR
+/// is invalid or not set in the environment.` once per adapter enumeration. Its ordering
+/// of the GPUs is not used here (this module ranks them itself), so a program that opens
+/// no window turns it off at start-up, before any thread, as its own variable does; a
+/// user who set either of its variables keeps the choice.
+#[allow(unsafe_code)]
+pub fn keep_the_display_probe_quiet() {
+    if std::env::var_os("NODEVICE_SELECT").is_none()
+        && std::env::var_os("MESA_VK_DEVICE_SELECT").is_none()
+    {
+        // SAFETY: at start-up, before any thread is spawned: no other thread reads the
+        // environment while it changes.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
