@@ -102,6 +102,31 @@ pub struct OracleWritten {
     pub shadow_seconds: f64,
 }
 
+impl OracleWritten {
+    /// The field written to `out` for a person, `seconds` after it was started: the
+    /// time, the hulls' and shadow maps' (on a line `frf report` reads) and the sizes.
+    pub fn describe(&self, out: &std::path::Path, seconds: f64) -> Result<String> {
+        let stats = &self.stats;
+        let bytes = std::fs::metadata(out)
+            .map_err(|e| frf_core::CoreError::io(out, e))?
+            .len();
+        Ok([
+            format!(
+                "oracle field written to {} in {seconds:.1} s (wall)",
+                out.display()
+            ),
+            format!("{SHADOW_TIME_LINE}{:.3} s", self.shadow_seconds),
+            format!(
+                "flow: {:.1} % of 8-bit quantized size; basis images: {:.1}:1 against 16-bit linear; total {:.2} MB",
+                100.0 * stats.flow_ratio_vs_8bit,
+                stats.image_ratio_vs_16bit,
+                bytes as f64 / 1e6
+            ),
+        ]
+        .join("\n"))
+    }
+}
+
 /// How `frf stage field` starts the line giving the seconds of its hulls and shadow maps
 /// ([`OracleWritten::shadow_seconds`]), which `frf report` reads.
 pub const SHADOW_TIME_LINE: &str = "visual hulls and shadow maps: ";

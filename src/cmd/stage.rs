@@ -214,22 +214,7 @@ fn capture(args: CaptureArgs) -> CliResult {
         bar.set_position(done as u64);
     })?;
     bar.finish_and_clear();
-    let c = stage.config();
-    println!(
-        "capture written to {}: {}x{} pixels, {} cycles x {} cameras, {} poses, 33 frames per set",
-        out.display(),
-        c.width,
-        c.height,
-        c.cycles,
-        stage.cameras().len(),
-        c.poses.len()
-    );
-    println!(
-        "work units (one view of one pose, or one camera's clean plates): {} rendered, {} already done",
-        report.units_rendered, report.units_skipped
-    );
-    println!("wall time of this run: {:.1} s", report.seconds);
-    println!("capture size on disk: {:.1} MB", report.bytes as f64 / 1e6);
+    println!("{}", report.describe(&stage, &out));
     Ok(())
 }
 

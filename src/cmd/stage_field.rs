@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use clap::Args;
 use frf_core::env::{EnvMap, EnvSource};
-use frf_eval::oracle::{OracleOptions, SHADOW_TIME_LINE, write_oracle_field};
+use frf_eval::oracle::{OracleOptions, write_oracle_field};
 use frf_eval::storage::{ProjectionTable, codec_curve, codec_table, sample_views};
 use frf_reflectance::project::FloorModel;
 
@@ -69,19 +69,8 @@ pub fn field(args: FieldArgs) -> CliResult {
         },
     )?;
     bar.finish_and_clear();
-    println!(
-        "oracle field written to {} in {:.1} s (wall)",
-        args.out.display(),
-        start.elapsed().as_secs_f64()
-    );
-    let stats = written.stats;
-    println!("{SHADOW_TIME_LINE}{:.3} s", written.shadow_seconds);
-    println!(
-        "flow: {:.1} % of 8-bit quantized size; basis images: {:.1}:1 against 16-bit linear; total {:.2} MB",
-        100.0 * stats.flow_ratio_vs_8bit,
-        stats.image_ratio_vs_16bit,
-        std::fs::metadata(&args.out)?.len() as f64 / 1e6
-    );
+    let seconds = start.elapsed().as_secs_f64();
+    println!("{}", written.describe(&args.out, seconds)?);
     Ok(())
 }
 

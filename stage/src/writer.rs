@@ -94,6 +94,34 @@ pub struct WriteReport {
     pub bytes: u64,
 }
 
+impl WriteReport {
+    /// The run for a person: the capture written to `out` by `stage`, the work done and
+    /// its size.
+    pub fn describe(&self, stage: &Stage, out: &Path) -> String {
+        let mut lines = Vec::new();
+        let c = stage.config();
+        lines.push(format!(
+            "capture written to {}: {}x{} pixels, {} cycles x {} cameras, {} poses, 33 frames per set",
+            out.display(),
+            c.width,
+            c.height,
+            c.cycles,
+            stage.cameras().len(),
+            c.poses.len()
+        ));
+        lines.push(format!(
+            "work units (one view of one pose, or one camera's clean plates): {} rendered, {} already done",
+            self.units_rendered, self.units_skipped
+        ));
+        lines.push(format!("wall time of this run: {:.1} s", self.seconds));
+        lines.push(format!(
+            "capture size on disk: {:.1} MB",
+            self.bytes as f64 / 1e6
+        ));
+        lines.join("\n")
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
 enum Unit {
     Clean {
