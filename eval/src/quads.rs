@@ -147,3 +147,23 @@ pub fn evaluate_quads<R: ReadAt>(
         scene,
     })
 }
+impl QuadsReport {
+    /// The scene's scores in a line for a person (`None` without them); `extent_m`: the
+    /// side of the field's patch of shadow maps.
+    pub fn scene_line(&self, extent_m: f32) -> Option<String> {
+        let s = self.scene.as_ref()?;
+        let f = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+        Some(format!(
+            "scene: hull IoU {}, shadow MAE {} (relit maps against the true relative irradiance, {} m \
+             patch; traced against the hull instead: {}), composite PSNR {:.2} dB (four-way, over the environment), edge-band \
+             error {} over black / {} over bright (at the captured views)",
+            f(s.hull_iou),
+            f(s.shadow_mae),
+            extent_m,
+            f(s.shadow_mae_traced),
+            s.psnr_composite,
+            f(s.edge_band_mae_dark),
+            f(s.edge_band_mae_bright)
+        ))
+    }
+}

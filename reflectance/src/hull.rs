@@ -230,6 +230,21 @@ impl VoxelHull {
         self.bits.iter().map(|w| w.count_ones() as usize).sum()
     }
 
+    /// The hull in words: voxels, their side, its volume, its bounds and its grid.
+    pub fn describe(&self) -> String {
+        let g = self.grid();
+        let bounds = self.bounds().map_or("empty".to_string(), |(lo, hi)| {
+            format!("{lo:.3} to {hi:.3} m")
+        });
+        format!(
+            "{} voxels of {} m ({:.4} m³), {bounds}; grid {:?}",
+            self.count(),
+            g.voxel_m,
+            self.volume_m3(),
+            g.dims
+        )
+    }
+
     /// Occupied volume, cubic metres.
     pub fn volume_m3(&self) -> f32 {
         self.count() as f32 * self.grid.voxel_m.powi(3)

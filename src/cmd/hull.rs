@@ -33,16 +33,9 @@ pub fn run(args: HullArgs) -> CliResult {
         )
     })?;
     hull.write_ply(&args.out)?;
-    let g = hull.grid();
-    let bounds = hull.bounds().map_or("empty".to_string(), |(lo, hi)| {
-        format!("{lo:.3} to {hi:.3} m")
-    });
     println!(
-        "visual hull of pose {pose}: {} voxels of {} m ({:.4} m³), {bounds}; grid {:?}; mesh written to {}",
-        hull.count(),
-        g.voxel_m,
-        hull.volume_m3(),
-        g.dims,
+        "visual hull of pose {pose}: {}; mesh written to {}",
+        hull.describe(),
         args.out.display()
     );
     Ok(())

@@ -63,20 +63,10 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     for s in report.variants.iter().chain([&report.at_captured_views]) {
         eprintln!("{}", table_row(s));
     }
-    if let Some(s) = &report.scene {
-        let f = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.4}"));
-        eprintln!(
-            "scene: hull IoU {}, shadow MAE {} (relit maps against the true relative irradiance, {} m \
-             patch; traced against the hull instead: {}), composite PSNR {:.2} dB (four-way, over the environment), edge-band \
-             error {} over black / {} over bright (at the captured views)",
-            f(s.hull_iou),
-            f(s.shadow_mae),
-            ShadowMaps::load(&input.field, input.pose)?.map_or(0.0, |m| m.spec.ground.extent_m),
-            f(s.shadow_mae_traced),
-            s.psnr_composite,
-            f(s.edge_band_mae_dark),
-            f(s.edge_band_mae_bright)
-        );
+    let extent =
+        ShadowMaps::load(&input.field, input.pose)?.map_or(0.0, |m| m.spec.ground.extent_m);
+    if let Some(line) = report.scene_line(extent) {
+        eprintln!("{line}");
     }
     if args.compare.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
