@@ -33,10 +33,12 @@ pub fn load(args: &EvalArgs) -> CliResult<EvalInput> {
     frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
     let stage = frf_stage::open_stage(&args.capture)?;
     if !stage.config().poses.contains(&pose) {
-        return Err(format!(
-            "{}: pose {pose} is not in the capture",
-            args.capture.display()
-        )
+        return Err(frf_reflectance::ReflectanceError::NoSuchPose {
+            file: Some(args.capture.clone()),
+            within: "capture",
+            pose,
+            held: frf_reflectance::field::listed(&stage.config().poses),
+        }
         .into());
     }
     let source = PoseSource::load(&field, pose, &lighting)?;

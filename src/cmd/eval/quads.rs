@@ -63,10 +63,10 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     for s in report.variants.iter().chain([&report.at_captured_views]) {
         eprintln!("{}", table_row(s));
     }
-    let extent =
-        ShadowMaps::load(&input.field, input.pose)?.map_or(0.0, |m| m.spec.ground.extent_m);
-    if let Some(line) = report.scene_line(extent) {
-        eprintln!("{line}");
+    if report.scene.is_some() {
+        let maps = ShadowMaps::load(&input.field, input.pose)?;
+        let extent = maps.map_or(0.0, |m| m.spec.ground.extent_m);
+        eprintln!("{}", report.scene_line(extent).unwrap_or_default());
     }
     if args.compare.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
