@@ -25,6 +25,23 @@ pub struct OutputClaim {
 }
 
 impl OutputClaim {
+    /// What was removed, for a person: `None` when nothing was.
+    pub fn removed_note(&self) -> Option<String> {
+        if self.removed.is_empty() {
+            return None;
+        }
+        let names: Vec<String> = self
+            .removed
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        Some(format!(
+            "removed {} temporary file(s) an interrupted run left: {}",
+            names.len(),
+            names.join(", ")
+        ))
+    }
+
     /// Temporary files of earlier, interrupted runs that the claim removed.
     pub fn removed(&self) -> &[PathBuf] {
         &self.removed

@@ -245,6 +245,29 @@ impl Scene {
         Ok(plate.or(given).or(self.size).unwrap_or(field))
     }
 
+    /// Whether `path` names a scene file (`.toml`) rather than a field.
+    pub fn is_scene_file(path: &Path) -> bool {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    }
+
+    /// The scene file at `path` with the command line's overrides: every lighting key's
+    /// environment replaced by `env`, the field by `field`; the scene and its field.
+    pub fn load_overridden(
+        path: &Path,
+        env: Option<&EnvSource>,
+        field: Option<&Path>,
+    ) -> Result<(Self, PathBuf)> {
+        let mut scene = Self::load(path)?;
+        if let Some(env) = env {
+            for k in &mut scene.lighting {
+                k.env = env.clone();
+            }
+        }
+        let field = scene.field_or(field)?;
+        Ok((scene, field))
+    }
+
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
         let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;

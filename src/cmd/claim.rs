@@ -14,17 +14,8 @@ pub fn claim(out: &Path, private_dirs: &[&Path]) -> CliResult<OutputClaim> {
     for dir in private_dirs {
         claim.clear_temporaries_in(dir);
     }
-    if !claim.removed().is_empty() {
-        let names: Vec<String> = claim
-            .removed()
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect();
-        eprintln!(
-            "removed {} temporary file(s) an interrupted run left: {}",
-            names.len(),
-            names.join(", ")
-        );
+    if let Some(note) = claim.removed_note() {
+        eprintln!("{note}");
     }
     Ok(claim)
 }

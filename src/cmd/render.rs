@@ -158,11 +158,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
 
 /// The scene of the arguments: the file with its overrides, or the flags.
 fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
-    let is_scene = args
-        .input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    if !is_scene {
+    if !Scene::is_scene_file(&args.input) {
         let field = args.field.clone().unwrap_or_else(|| args.input.clone());
         let f = FieldFile::open(&field)?;
         let pose = f.pose_or_first(args.pose)?;
@@ -175,14 +171,12 @@ fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
         )
         .into());
     }
-    let mut scene = Scene::load(&args.input)?;
-    if let Some(env) = &args.lighting.env {
-        for k in &mut scene.lighting {
-            k.env = env.clone();
-        }
-    }
-    let field = scene.field_or(args.field.as_deref())?;
-    Ok((scene, field))
+    let env = args.lighting.env.as_ref();
+    Ok(Scene::load_overridden(
+        &args.input,
+        env,
+        args.field.as_deref(),
+    )?)
 }
 
 /// The frames of `scene` the arguments ask for, of `size`.
@@ -219,10 +213,7 @@ fn print_plan(plan: &Plan, json: bool) -> CliResult {
 /// Runs `frf render`.
 pub fn run(args: RenderArgs) -> CliResult {
     let (mut scene, field_path) = scene_of(&args)?;
-    let field_render = !args
-        .input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let field_render = !Scene::is_scene_file(&args.input);
     if let Some(v) = args.variant {
         scene.variant = v.into();
     }

@@ -80,20 +80,16 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
 
 /// Runs `frf view`.
 pub fn run(args: ViewArgs) -> CliResult {
-    let is_scene = args
-        .input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let is_scene = Scene::is_scene_file(&args.input);
     let script = match &args.script {
         Some(p) => Some((p.clone(), frf_view::script::load(p)?)),
         None => None,
     };
     let (scene, field_path) = if is_scene {
-        let mut scene = Scene::load(&args.input)?;
+        let (mut scene, field) = Scene::load_overridden(&args.input, None, args.field.as_deref())?;
         if let Some(v) = args.variant {
             scene.variant = v.into();
         }
-        let field = scene.field_or(args.field.as_deref())?;
         (scene, field)
     } else {
         let field_path = args.field.clone().unwrap_or_else(|| args.input.clone());

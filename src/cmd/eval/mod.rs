@@ -21,11 +21,7 @@ use crate::CliResult;
 
 /// Runs `frf eval`.
 pub fn run(args: EvalArgs) -> CliResult {
-    if args
-        .field
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-    {
+    if frf_scene::Scene::is_scene_file(&args.field) {
         return shot::run(&args);
     }
     if args.plot.is_some() && !(args.budget || args.ingest_budget) {

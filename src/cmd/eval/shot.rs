@@ -16,13 +16,9 @@ const DEFAULT_FRAMES: usize = 4;
 
 /// Runs `frf eval SCENE.toml`.
 pub fn run(args: &EvalArgs) -> CliResult {
-    let mut scene = Scene::load(&args.field)?;
-    if let Some(env) = &args.lighting.env {
-        for k in &mut scene.lighting {
-            k.env = env.clone();
-        }
-    }
-    let field_path = scene.field_or(args.scene_field.as_deref())?;
+    let env = args.lighting.env.as_ref();
+    let (scene, field_path) =
+        Scene::load_overridden(&args.field, env, args.scene_field.as_deref())?;
     frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
     let field = FieldFile::open(&field_path)?;
     let stage = frf_stage::open_stage(&args.capture)?;
