@@ -35,6 +35,16 @@ pub enum RenderError {
         /// The view's row.
         v: usize,
     },
+    /// A field of photographs (one lighting condition, no reflectance basis) asked to
+    /// be relit.
+    #[error(
+        "the field holds {conditions} lighting condition(s), photographs rather than a \
+         reflectance basis: it cannot be relit; use --env none"
+    )]
+    NotRelightable {
+        /// Its lighting conditions.
+        conditions: usize,
+    },
     /// A camera stored in the field that is not a camera.
     #[error("a camera of the field: {0}")]
     BadCamera(String),
@@ -85,7 +95,8 @@ impl RenderError {
         match self {
             RenderError::Argument(_)
             | RenderError::Mismatch { .. }
-            | RenderError::ViewNotHeld { .. } => Fault::Usage,
+            | RenderError::ViewNotHeld { .. }
+            | RenderError::NotRelightable { .. } => Fault::Usage,
             RenderError::BadCamera(_) => Fault::Damaged,
             RenderError::Misuse(_) => Fault::Internal,
             RenderError::Gpu(_)

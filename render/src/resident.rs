@@ -52,6 +52,31 @@ pub enum Lighting {
     Unlit,
 }
 
+impl Lighting {
+    /// The lighting of a field of `conditions` basis conditions by `env` (turned by `yaw`
+    /// radians; unlit without one), and that environment for truth renders. A field of
+    /// photographs (one condition) cannot be relit.
+    pub fn of(
+        env: Option<EnvMap>,
+        yaw: f32,
+        floor: FloorModel,
+        conditions: usize,
+    ) -> Result<(Self, Option<EnvMap>)> {
+        let Some(env) = env else {
+            return Ok((Lighting::Unlit, None));
+        };
+        if conditions <= 1 {
+            return Err(RenderError::NotRelightable { conditions });
+        }
+        let env = env.rotated(yaw);
+        let lighting = Lighting::Environment {
+            env: env.clone(),
+            floor,
+        };
+        Ok((lighting, Some(env)))
+    }
+}
+
 /// One view's codes as read from the field: basis tiles, 8-bit alpha, and the
 /// log-coded flow to each of its four neighbours (absent at the grid's edges).
 type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4]);

@@ -244,27 +244,11 @@ impl LightingArgs {
     /// for truth renders (`None` for `none`).
     pub fn lighting(&self, conditions: usize) -> CliResult<(Lighting, Option<EnvMap>)> {
         let source = self.source()?;
-        let Some(env) = source
+        let env = source
             .load()
-            .map_err(|e| format!("environment {source}: {e}"))?
-        else {
-            return Ok((Lighting::Unlit, None));
-        };
-        if conditions <= 1 {
-            return Err(format!(
-                "the field holds {conditions} lighting condition(s), photographs rather than \
-                 a reflectance basis: it cannot be relit; use --env none"
-            )
-            .into());
-        }
-        let env = env.rotated(self.yaw.to_radians());
-        Ok((
-            Lighting::Environment {
-                env: env.clone(),
-                floor: self.floor.into(),
-            },
-            Some(env),
-        ))
+            .map_err(|e| format!("environment {source}: {e}"))?;
+        let yaw = self.yaw.to_radians();
+        Ok(Lighting::of(env, yaw, self.floor.into(), conditions)?)
     }
 }
 
