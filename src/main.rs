@@ -93,7 +93,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => cmd::merge::run(args),
         Command::Render(args) => cmd::render::run(*args),
         Command::Eval(args) => cmd::eval::run(*args),
-        Command::EvalRing(args) => cmd::eval::run_ring(args),
+        Command::EvalRing(args) => cmd::eval::ring::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::View(args) => cmd::view::run(*args),
         Command::Bench(args) => cmd::bench::run_bench(args),

@@ -495,6 +495,14 @@ pub enum EnvSource {
 const UNIFORM_SIZE: usize = 64;
 
 impl EnvSource {
+    /// The environment, where `need` (what it is for) requires one: `none` is refused
+    /// as a `--env`.
+    pub fn load_required(&self, need: &str) -> Result<EnvMap> {
+        let allowed = format!("an environment ({need})");
+        self.load()?
+            .ok_or_else(|| crate::BadArgument::new("--env", "none", allowed).into())
+    }
+
     /// The environment: `None` for [`EnvSource::None`].
     pub fn load(&self) -> Result<Option<EnvMap>> {
         Ok(match self {

@@ -118,6 +118,20 @@ pub struct Selection {
 }
 
 impl Selection {
+    /// The selection of `poses`: per pose, the views and the flows (per view, toward
+    /// each neighbour) wanted.
+    pub fn of<'a>(poses: impl IntoIterator<Item = (u32, &'a [bool], &'a [[bool; 4]])>) -> Self {
+        let (mut views, mut flows) = (
+            std::collections::BTreeMap::new(),
+            std::collections::BTreeMap::new(),
+        );
+        for (pose, v, f) in poses {
+            views.insert(pose, v.to_vec());
+            flows.insert(pose, f.to_vec());
+        }
+        Self { views, flows }
+    }
+
     /// A short description for settings and reports: views and flows wanted per pose.
     pub fn describe(&self) -> String {
         self.views

@@ -308,6 +308,20 @@ pub struct RingReport {
     pub seconds: f64,
 }
 
+impl RingReport {
+    /// The ring written to `out`, for a person.
+    pub fn describe(&self, out: &Path) -> String {
+        format!(
+            "ring of {} photographs ({}) written to {} in {:.1} s (wall); mean matte coverage {:.1} % of the frame",
+            self.views,
+            if self.wraps { "closed" } else { "open" },
+            out.display(),
+            self.seconds,
+            100.0 * self.coverage
+        )
+    }
+}
+
 /// The ring described by `par` in its subject frame: the views sorted by azimuth, their
 /// cameras (subject frame) and whether the ring closes.
 pub fn ring_views(par: &Path) -> Result<(Vec<RingView>, Vec<Camera>, bool)> {

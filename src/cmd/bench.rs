@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::{Args, Subcommand, ValueEnum};
 use frf_reflectance::FieldFile;
 use frf_render::gpu::Gpu;
-use frf_render::gpu::bench::{BenchOptions, all_formats, run};
+use frf_render::gpu::bench::{BenchOptions, DEFAULT_SIZES, all_formats, run};
 use frf_render::gpu::formats::PoseFormats;
 use frf_render::gpu::rebin::PassKind;
 use frf_render::resident::{Lighting, PoseSource, ResidentPose};
@@ -112,20 +112,10 @@ fn interp(args: InterpArgs) -> CliResult {
     };
     let pose = ResidentPose::relight_cpu(&source);
     let sizes = if args.sizes.is_empty() {
-        vec![(640, 400), (1280, 800), (1920, 1080), (3840, 2160)]
+        DEFAULT_SIZES.to_vec()
     } else {
         args.sizes.clone()
     };
-    if let Some(&(w, h)) = sizes
-        .iter()
-        .find(|(w, h)| *w == 0 || *h == 0 || *w > 16384 || *h > 16384)
-    {
-        let size = format!("{w}x{h}");
-        return Err(frf_core::BadArgument::new("--size", size, "1 to 16384 pixels a side").into());
-    }
-    if args.repeats == 0 {
-        return Err(frf_core::BadArgument::new("--repeats", 0, "at least 1").into());
-    }
     let options = BenchOptions {
         sizes,
         formats: match args.formats {
@@ -142,6 +132,7 @@ fn interp(args: InterpArgs) -> CliResult {
         cpu_repeats: args.cpu_repeats,
         cpu_max_pixels: (args.cpu_max_mp.max(0.0) * 1e6) as u64,
     };
+    options.check()?;
     let gpu = Gpu::new()?;
     let progress = bar("benchmark");
     let report = run(&gpu, &pose, &options, &mut |m| {

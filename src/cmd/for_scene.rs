@@ -29,16 +29,9 @@ pub fn plan(scene: &Path, capture: &Capture, shadows: Option<&ShadowOptions>) ->
 
 /// The views and flows of `plan`, for ingest.
 pub fn selection(plan: &Plan) -> Selection {
-    Selection {
-        views: plan
-            .poses
+    Selection::of(
+        plan.poses
             .iter()
-            .map(|p| (p.pose, p.views.clone()))
-            .collect(),
-        flows: plan
-            .poses
-            .iter()
-            .map(|p| (p.pose, p.flows.clone()))
-            .collect(),
-    }
+            .map(|p| (p.pose, &p.views[..], &p.flows[..])),
+    )
 }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use frf_reflectance::FieldFile;
+use frf_reflectance::{FieldFile, ReflectanceError};
 
 use crate::CliResult;
 
@@ -26,11 +26,9 @@ pub struct HullArgs {
 pub fn run(args: HullArgs) -> CliResult {
     let field = FieldFile::open(&args.field)?;
     let pose = field.pose_or_first(args.pose)?;
-    let hull = field.hull(pose)?.ok_or_else(|| {
-        format!(
-            "{}: pose {pose} has no visual hull (ingest it without --no-shadows)",
-            args.field.display()
-        )
+    let hull = field.hull(pose)?.ok_or_else(|| ReflectanceError::Missing {
+        file: args.field.clone(),
+        what: format!("pose {pose} has no visual hull (ingest it without --no-shadows)"),
     })?;
     hull.write_ply(&args.out)?;
     println!(

@@ -234,13 +234,6 @@ pub fn run_ring(args: RingArgs) -> CliResult {
         args.jpeg_quality,
         args.stride,
     )?;
-    println!(
-        "ring of {} photographs ({}) written to {} in {:.1} s (wall); mean matte coverage {:.1} % of the frame",
-        r.views,
-        if r.wraps { "closed" } else { "open" },
-        args.out.display(),
-        r.seconds,
-        100.0 * r.coverage
-    );
+    println!("{}", r.describe(&args.out));
     Ok(())
 }

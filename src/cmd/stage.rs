@@ -245,8 +245,7 @@ fn truth(args: TruthArgs) -> CliResult {
     let light = match (&args.env, &args.basis) {
         (Some(source), _) => TruthLight::Environment {
             env: source
-                .load()?
-                .ok_or("--env none: a truth image needs lighting (an environment or --basis)")?
+                .load_required("a truth image needs lighting, or --basis")?
                 .rotated(args.yaw.to_radians()),
             name: source.to_string(),
             lights: args.lights,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use frf_core::env::{EnvMap, EnvSource};
+use frf_core::env::EnvSource;
 use frf_eval::oracle::{OracleOptions, write_oracle_field};
 use frf_eval::storage::{ProjectionTable, codec_curve, codec_table, sample_views};
 use frf_reflectance::project::FloorModel;
@@ -94,19 +94,15 @@ pub struct ProjectionArgs {
     json: bool,
 }
 
-/// The environment of `source`, which must be one (not `none`).
-fn environment(source: &EnvSource) -> CliResult<EnvMap> {
-    Ok(source
-        .load()?
-        .ok_or("--env none: these measures need an environment to relight with")?)
-}
-
 /// Runs `frf stage projection-error`.
 pub fn projection(args: ProjectionArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
     let mut envs = Vec::new();
     for source in &args.env {
-        envs.push((source.name(), environment(source)?));
+        envs.push((
+            source.name(),
+            source.load_required("these measures relight with it")?,
+        ));
     }
     let floor = FloorModel::from(args.floor);
     let table = ProjectionTable::measure(&stage, &envs, args.lights, floor)?;
@@ -137,7 +133,7 @@ pub struct CodecArgs {
 /// Runs `frf stage codec-curve`.
 pub fn codec(args: CodecArgs) -> CliResult {
     let stage = frf_stage::open_stage(&args.capture)?;
-    let env = environment(&args.env)?;
+    let env = args.env.load_required("these measures relight with it")?;
     let views = sample_views(&stage);
     let pose = stage.config().poses[0];
     let curve = codec_curve(&stage, &env, pose, &views, &args.qualities)?;

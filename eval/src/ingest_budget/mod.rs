@@ -434,3 +434,20 @@ pub fn markdown(report: &IngestBudgetReport) -> String {
     }
     out
 }
+impl IngestBudgetReport {
+    /// What the budget measured, in a line above its table.
+    pub fn header(&self) -> String {
+        format!(
+            "ingest budget of {} pose {} under {}: subject PSNR of the four-way morph at {} \
+             captured views and {} quad centres, each field with one component taken from the \
+             truth (renders on {}; truth: {} median-cut lights)",
+            self.capture,
+            self.pose,
+            self.env,
+            self.cameras,
+            self.cameras,
+            self.device,
+            self.truth_lights
+        )
+    }
+}

@@ -149,6 +149,27 @@ pub struct BenchReport {
     pub fastest_correct_fourway: Option<String>,
 }
 
+/// The frame sizes measured by default: 640x400 to 4K.
+pub const DEFAULT_SIZES: [(u32, u32); 4] = [(640, 400), (1280, 800), (1920, 1080), (3840, 2160)];
+
+impl BenchOptions {
+    /// Refuses sizes outside 1 to 16384 pixels a side (`--size`) and no repeat
+    /// (`--repeats`).
+    pub fn check(&self) -> Result<()> {
+        let bad = |&(w, h): &(u32, u32)| w == 0 || h == 0 || w > 16384 || h > 16384;
+        if let Some(&(w, h)) = self.sizes.iter().find(|s| bad(s)) {
+            let size = format!("{w}x{h}");
+            return Err(
+                frf_core::BadArgument::new("--size", size, "1 to 16384 pixels a side").into(),
+            );
+        }
+        if self.repeats == 0 {
+            return Err(frf_core::BadArgument::new("--repeats", 0, "at least 1").into());
+        }
+        Ok(())
+    }
+}
+
 /// The floor pass's pipelines (`shaders/floor.wgsl`).
 struct FloorPass {
     layout: wgpu::BindGroupLayout,

@@ -58,18 +58,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         given,
         rows,
     };
-    eprintln!(
-        "ingest budget of {} pose {} under {}: subject PSNR of the four-way morph at {} captured \
-         views and {} quad centres, each field with one component taken from the truth \
-         (renders on {}; truth: {} median-cut lights)",
-        report.capture,
-        report.pose,
-        report.env,
-        args.cameras,
-        args.cameras,
-        report.device,
-        args.lights
-    );
+    eprintln!("{}", report.header());
     eprint!("{}", ingest_budget::table(&report));
     if let (Some(path), Some(png)) = (&args.plot, plot_png) {
         write_plot(

@@ -12,7 +12,7 @@ mod ingest_budget;
 mod input;
 mod paths;
 mod quads;
-mod ring;
+pub mod ring;
 mod shot;
 
 pub use args::{EvalArgs, RingEvalArgs};
@@ -37,9 +37,4 @@ pub fn run(args: EvalArgs) -> CliResult {
     } else {
         quads::run(&args, &input)
     }
-}
-
-/// Runs `frf eval-ring`.
-pub fn run_ring(args: RingEvalArgs) -> CliResult {
-    ring::run(args)
 }
