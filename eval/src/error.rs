@@ -13,13 +13,24 @@ pub enum EvalError {
     /// unlit scene, a pose the capture did not film, a grid with no quad).
     #[error("{0}")]
     NoTruth(String),
-    /// A run of `frf report` failed, or its output lacks what the report reads.
-    #[error("{run}: {problem}")]
-    Run {
+    /// A run of `frf report` failed: its command, its exit status and the end of what it
+    /// said (its fault is the run's own, read from its status).
+    #[error("{command} failed (exit status {}):\n{stderr_tail}", status.map_or("none".into(), |s| s.to_string()))]
+    RunFailed {
         /// The run, as its command.
-        run: String,
-        /// What went wrong.
-        problem: String,
+        command: String,
+        /// Its exit status (`None`: ended by a signal).
+        status: Option<i32>,
+        /// The last lines of its standard error.
+        stderr_tail: String,
+    },
+    /// A run's output lacks what the report reads from it (the program's own mistake).
+    #[error("{command}: {lacks}")]
+    RunOutput {
+        /// The run, as its command.
+        command: String,
+        /// What is missing or unreadable.
+        lacks: String,
     },
     /// A report missing rows of some stage.
     #[error("the report is incomplete:\n{}", .0.join("\n"))]
@@ -52,21 +63,28 @@ pub enum EvalError {
 }
 
 impl EvalError {
-    /// A [`EvalError::Run`] of the run `run`.
-    pub fn run(run: impl Into<String>, problem: impl std::fmt::Display) -> Self {
-        EvalError::Run {
-            run: run.into(),
-            problem: problem.to_string(),
+    /// A [`EvalError::RunOutput`] of the run `command`.
+    pub fn run(command: impl Into<String>, lacks: impl std::fmt::Display) -> Self {
+        EvalError::RunOutput {
+            command: command.into(),
+            lacks: lacks.to_string(),
         }
     }
 
     /// Who is at fault ([`frf_core::Fault`]).
     pub fn fault(&self) -> frf_core::Fault {
         match self {
-            EvalError::Argument(_) | EvalError::NoTruth(_) | EvalError::Run { .. } => {
-                frf_core::Fault::Usage
-            }
-            EvalError::Incomplete(_) => frf_core::Fault::Internal,
+            EvalError::Argument(_) | EvalError::NoTruth(_) => frf_core::Fault::Usage,
+            EvalError::RunFailed { status, .. } => match status {
+                Some(2) => frf_core::Fault::Usage,
+                Some(3) => frf_core::Fault::Damaged,
+                Some(4) => frf_core::Fault::Gpu,
+                Some(5) => frf_core::Fault::Io,
+                Some(75) => frf_core::Fault::Busy,
+                Some(130) | None => frf_core::Fault::Interrupted,
+                _ => frf_core::Fault::Internal,
+            },
+            EvalError::RunOutput { .. } | EvalError::Incomplete(_) => frf_core::Fault::Internal,
             EvalError::Plot(_) => frf_core::Fault::Io,
             EvalError::Misuse(_) => frf_core::Fault::Internal,
             EvalError::Core(e) => e.fault(),

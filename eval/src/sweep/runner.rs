@@ -9,6 +9,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 
+/// Lines of a failed run's standard error kept in its error.
+const STDERR_TAIL_LINES: usize = 40;
+
 /// Runs of this binary, each kept under `runs/` with its wall time.
 pub struct Runner {
     /// The `frf` binary.
@@ -74,10 +77,12 @@ impl Runner {
         let seconds = start.elapsed().as_secs_f64();
         if !out.status.success() {
             let stderr = String::from_utf8_lossy(&out.stderr);
-            return Err(EvalError::run(
+            let lines: Vec<&str> = stderr.trim_end().lines().collect();
+            return Err(EvalError::RunFailed {
                 command,
-                format!("failed:\n{}", stderr.trim_end()),
-            ));
+                status: out.status.code(),
+                stderr_tail: lines[lines.len().saturating_sub(STDERR_TAIL_LINES)..].join("\n"),
+            });
         }
         let stdout = String::from_utf8(out.stdout)
             .map_err(|e| EvalError::run(&command, format!("printed other than UTF-8: {e}")))?;
