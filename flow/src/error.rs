@@ -63,6 +63,24 @@ pub enum FlowError {
         /// What was expected and not found.
         problem: String,
     },
+    /// A file of another size than the first image's (the second image, a starting
+    /// flow).
+    #[error(
+        "{} is {}x{} but {} is {}x{}: {what}",
+        path.display(), size.0, size.1, first.display(), first_size.0, first_size.1
+    )]
+    NotSameSize {
+        /// What must hold: `the two images must be the same size`.
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// Its size.
+        size: (usize, usize),
+        /// The first image.
+        first: PathBuf,
+        /// Its size.
+        first_size: (usize, usize),
+    },
     /// Reading or writing a file failed (see [`CoreError`]).
     #[error(transparent)]
     Core(#[from] CoreError),

@@ -9,7 +9,7 @@ use frf_core::io::read_rgb;
 use serde::Serialize;
 
 use crate::bench::{PairResult, find_pairs, run_pair, threads};
-use crate::error::Result;
+use crate::error::{FlowError, Result};
 use crate::params::FlowParams;
 use crate::viz::write_flow_png;
 use crate::{estimate_flow_from, read_flo, write_flo};
@@ -52,22 +52,25 @@ pub fn flow_files(
     let init = files.init.map(read_flo).transpose()?;
     // Sizes checked here, where the files' names are known.
     // The second image and the starting flow are of the first image's size.
-    let same = |path: &Path, got: (usize, usize)| -> Result<()> {
-        if got == a.size() {
+    let same = |what: &'static str, path: &Path, size: (usize, usize)| -> Result<()> {
+        if size == a.size() {
             return Ok(());
         }
-        Err(frf_core::CoreError::SizeMismatch {
+        Err(FlowError::NotSameSize {
+            what,
             path: path.to_path_buf(),
-            expected_width: a.width(),
-            expected_height: a.height(),
-            got_width: got.0,
-            got_height: got.1,
-        }
-        .into())
+            size,
+            first: files.a.to_path_buf(),
+            first_size: a.size(),
+        })
     };
-    same(files.b, b.size())?;
+    same("the two images must be the same size", files.b, b.size())?;
     if let (Some(f), Some(path)) = (&init, files.init) {
-        same(path, f.size())?;
+        same(
+            "the initial flow must be the first image's size",
+            path,
+            f.size(),
+        )?;
     }
     started(a.size());
     let start = Instant::now();
@@ -310,7 +313,7 @@ mod tests {
         };
         let err = flow_files(&files, &fast(), |_| {}).unwrap_err().to_string();
         assert!(
-            err.contains("b.png: expected 32x32 pixels, got 32x31"),
+            err.contains("b.png is 32x31") && err.contains("a.png is 32x32"),
             "{err}"
         );
         assert!(!dir.path().join("f.flo").exists());

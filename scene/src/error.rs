@@ -45,12 +45,12 @@ pub enum SceneError {
         problem: String,
     },
     /// A camera path file refused.
-    #[error("camera path {}: {source}", path.display())]
+    #[error("camera path {}: {problem}", path.display())]
     CameraPath {
         /// The file.
         path: PathBuf,
-        /// Why.
-        source: Box<SceneError>,
+        /// Why: its syntax, or a key refused.
+        problem: String,
     },
     /// A scene that names no field, given none on the command line.
     #[error("{}: no field (give field = \"...\" or --field)", scene.display())]
@@ -114,12 +114,12 @@ impl SceneError {
             SceneError::File { .. }
             | SceneError::Syntax { .. }
             | SceneError::CameraKey { .. }
+            | SceneError::CameraPath { .. }
             | SceneError::NoField { .. }
             | SceneError::FieldLacks { .. }
             | SceneError::Output { .. }
             | SceneError::MemoryBudget { .. }
             | SceneError::Argument(_) => Fault::Usage,
-            SceneError::CameraPath { source, .. } => source.fault(),
             SceneError::Misuse(_) | SceneError::Internal(_) => Fault::Internal,
             SceneError::Render(e) => e.fault(),
             SceneError::Field(e) => e.fault(),

@@ -148,18 +148,12 @@ impl CameraPath {
     /// Reads and validates a TOML path file; errors name the file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;
-        let in_file = |source: SceneError| SceneError::CameraPath {
+        let in_file = |problem: String| SceneError::CameraPath {
             path: path.to_path_buf(),
-            source: Box::new(source),
+            problem,
         };
-        let raw: Self = toml::from_str(&text).map_err(|e| {
-            in_file(SceneError::Syntax {
-                path: path.to_path_buf(),
-                line: String::new(),
-                problem: e.to_string(),
-            })
-        })?;
-        Self::new(raw.keys).map_err(in_file)
+        let raw: Self = toml::from_str(&text).map_err(|e| in_file(e.to_string()))?;
+        Self::new(raw.keys).map_err(|e| in_file(e.to_string()))
     }
 
     /// Time span `(first, last)`.

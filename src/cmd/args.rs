@@ -318,9 +318,9 @@ impl CameraArgs {
         // The orbit names its fields; the user gave them as flags.
         orbit.validate().map_err(|e| {
             let flag = match e.name.as_str() {
-                "radius" => "--orbit RADIUS",
-                "height" => "--orbit HEIGHT",
-                "sweep_deg" => "--orbit SWEEP_DEG",
+                "radius" => "--orbit radius",
+                "height" => "--orbit height",
+                "sweep_deg" => "--orbit sweep",
                 "start_deg" => "--start",
                 "look_at" => "--look-at",
                 _ => "--fov",

@@ -130,7 +130,7 @@ const CASES: &[Case] = &[
             "--out",
             "{out}/o",
         ],
-        file: "--orbit RADIUS 0.0001",
+        file: "--orbit radius 0.0001",
         problem: &["expected more than 0.001 and less than 10000 metres"],
     },
     Case {
@@ -144,7 +144,7 @@ const CASES: &[Case] = &[
             "--out",
             "{out}/o",
         ],
-        file: "--orbit SWEEP_DEG 4000",
+        file: "--orbit sweep 4000",
         problem: &["expected -3600 to 3600 degrees"],
     },
     Case {
