@@ -518,11 +518,11 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
         files.iter().find(|f| !holds(f)),
     ) {
         return Err(ReflectanceError::Incompatible {
-            part: without.path().to_path_buf(),
+            part: with.path().to_path_buf(),
             problem: format!(
-                "holds no pose-to-pose flow, {} does (ingested with --pose-flow): ingest every \
-                 part with --pose-flow, or none",
-                with.path().display()
+                "holds pose-to-pose flows (ingested with --pose-flow), {} does not: ingest \
+                 every part with --pose-flow, or none",
+                without.path().display()
             ),
         });
     }
