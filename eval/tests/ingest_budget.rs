@@ -173,7 +173,10 @@ fn the_budget_refuses_what_it_cannot_build() {
     let e = write_fields(&stage, &cap, 3, &options(), &dir.path().join("f"), &Silent)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("pose 3 was not filmed"), "{e}");
+    assert!(
+        e.contains("pose 3 is not in the capture (it holds 0)"),
+        "{e}"
+    );
     let e = write_fields(
         &stage,
         &dir.path().join("nowhere"),
