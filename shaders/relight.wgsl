@@ -2,8 +2,10 @@
 // workgroups per view): the weighted sum of each view's basis images (JPEG-decoded 8-bit
 // gamma-2.2 codes, linearized through the table the CPU uses), then its encoding into its
 // layer of the pre-lit texture as sRGB codes of colour / scale, the scale being the
-// view's brightest value. Twin of `ResidentPose::relight_cpu` in
-// `render/src/resident.rs`. Compiled after `common.wgsl`.
+// view's brightest value, which the encoding also writes into the pose's view table (the
+// frame pass reads it there: nothing goes back to the host). The codes stay resident
+// between relights; a new light rewrites only the coefficients. Twin of
+// `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
 
 struct RelightParams {
     // Texels per view (the pose's crop) and its row length.
@@ -43,6 +45,8 @@ struct Job {
 // The pre-lit texture, every layer.
 @group(0) @binding(6) var output: texture_storage_2d_array<rgba8uint, write>;
 @group(0) @binding(7) var<storage, read> jobs: array<Job>;
+// The pose's view table, whose `scale` the encoding sets.
+@group(0) @binding(8) var<storage, read_write> views: array<View>;
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
@@ -94,6 +98,9 @@ fn encode(@builtin(global_invocation_id) id: vec3<u32>) {
     var scale = bitcast<f32>(atomicLoad(&peaks[job.view]));
     if (scale <= 0.0) {
         scale = 1.0;
+    }
+    if (i == 0u) {
+        views[job.view].scale = scale;
     }
     let r = relit[job.relit_offset + i];
     let code = vec4<u32>(

@@ -50,7 +50,10 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     // The frames below find their quads through the cylinder's column index.
     assert!(pose.geometry.cylinder.has_column_index());
 
-    for (i, (a, b)) in cpu.scales.iter().zip(&pose.scales).enumerate() {
+    // The scales the relighting pass wrote into the pose's view table, never read back
+    // by the renderer itself.
+    let scales = gpu.read_scales(&pose).unwrap();
+    for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
         assert!(
             (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
             "view {i}: scale {a} vs {b}"
@@ -238,5 +241,94 @@ fn the_relit_shadow_and_the_composite_agree_with_the_cpu() {
             .fold(0.0f32, f32::max);
         assert!(ds <= 1e-3, "{what}: shadow layer differs by {ds}");
         assert!(worst(gl.subject.pixels(), cl.subject.pixels()) <= 2e-3);
+    }
+}
+
+/// Relit in place under a light that turns every frame, from the codes it keeps resident:
+/// each frame's pre-lit codes and scales equal the CPU twin's (as a fresh upload's do),
+/// and a frame rendered from the pose relit in place equals one rendered from the pose
+/// made resident afresh under that light, bit for bit.
+#[test]
+fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
+    use frf_reflectance::project::FloorModel;
+    use frf_render::renderer::Device;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let sky = EnvMap::sky();
+    let first = fixture.source(&sky);
+    let pose = gpu.upload_pose(&first).unwrap();
+    let shared = pose.basis().unwrap().clone();
+    let cam = Camera::look_at(
+        Vec3::new(2.2, 1.4, 3.0),
+        Vec3::new(0.0, 0.9, 0.0),
+        Vec3::Y,
+        0.55,
+        64,
+        90,
+    )
+    .unwrap();
+    for (frame, yaw) in [0.4f32, 1.3, 2.9, 4.4].into_iter().enumerate() {
+        let lighting = Lighting::Environment {
+            env: sky.rotated(yaw),
+            floor: FloorModel::Environment,
+        };
+        let source = first.relit(&field, &lighting, None).unwrap();
+        gpu.relight_pose(&pose, &source).unwrap();
+        let cpu = ResidentPose::relight_cpu(&source);
+        let scales = gpu.read_scales(&pose).unwrap();
+        for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
+                "frame {frame}, view {i}: scale {a} vs {b}"
+            );
+        }
+        let texels = gpu.read_prelit(&pose).unwrap();
+        for (i, (a, b)) in cpu.prelit.iter().zip(&texels).enumerate() {
+            for (x, y) in a.iter().zip(b) {
+                for k in 0..4 {
+                    let d = (x[k] as i32 - y[k] as i32).abs();
+                    assert!(d <= 1, "frame {frame}, view {i}: code {x:?} vs {y:?}");
+                }
+            }
+        }
+        // A copy made afresh, sharing the codes, draws the same frame.
+        let fresh = gpu.upload_pose_sharing(&source, Some(&shared)).unwrap();
+        assert!(std::sync::Arc::ptr_eq(fresh.basis().unwrap(), &shared));
+        let (a, _) = gpu.render(&pose, &cam, Variant::FourWay).unwrap();
+        let (b, _) = gpu.render(&fresh, &cam, Variant::FourWay).unwrap();
+        assert!(
+            a.pixels() == b.pixels(),
+            "frame {frame}: relit in place differs"
+        );
+    }
+    // Relit with another pose's views: refused, not drawn wrong.
+    let other = fixture.source(&sky);
+    match gpu.relight_pose(&pose, &other) {
+        Err(RenderError::Misuse(m)) => assert!(m.contains("another pose's views"), "{m}"),
+        r => panic!("expected a misuse, got {:?}", r.map(|_| ())),
+    }
+    // The same through the device front, on the CPU twin too.
+    for device in [Device::Gpu(Box::new(gpu)), Device::Cpu] {
+        let mut resident = device.make_resident(&first).unwrap();
+        let lighting = Lighting::Environment {
+            env: sky.rotated(2.0),
+            floor: FloorModel::Environment,
+        };
+        let source = resident.source().relit(&field, &lighting, None).unwrap();
+        device.relight(&mut resident, &source).unwrap();
+        let fresh = device.make_resident(&source).unwrap();
+        let (a, _) = device
+            .render_subject(&resident, &cam, Variant::FourWay)
+            .unwrap();
+        let (b, _) = device
+            .render_subject(&fresh, &cam, Variant::FourWay)
+            .unwrap();
+        assert!(
+            a.pixels() == b.pixels(),
+            "{}: relit in place differs",
+            device.name()
+        );
     }
 }

@@ -52,9 +52,16 @@ enum ResidentKind {
     },
 }
 
-/// A pose made resident on a [`Device`], relit.
+/// A pose made resident on a [`Device`], relit; relit again under a new light by
+/// [`Device::relight`] from the basis codes it keeps (on the GPU, shared with the other
+/// residents made from the same [`PoseSource`] views).
 pub struct Resident {
     kind: ResidentKind,
+    /// The views it was made from (their basis codes, shared; the coefficients of its
+    /// current light).
+    source: PoseSource,
+    /// The shadow maps it casts its shadow from, relit with it.
+    shadow_maps: Option<std::sync::Arc<ShadowMaps>>,
     /// Its motion toward the next and the previous pose ([`frf_core::grid::PoseStep`]
     /// order), when made ([`Device::set_motion`]).
     motion: [Option<ResidentKind>; 2],
@@ -65,13 +72,29 @@ pub struct Resident {
 }
 
 impl Resident {
-    /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy).
+    /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy), its
+    /// shared basis codes left out ([`Resident::basis`]).
     pub fn bytes(&self) -> u64 {
         let bytes = |k: &ResidentKind| match k {
             ResidentKind::Gpu(p) => p.geometry.resident_bytes(),
             ResidentKind::Cpu { pose, .. } => pose.resident_bytes(),
         };
         bytes(&self.kind) + self.motion.iter().flatten().map(bytes).sum::<u64>()
+    }
+
+    /// Its basis codes, which residents made from the same views share: an identity
+    /// (equal for those that share them) and the bytes they hold where it is rendered.
+    pub fn basis(&self) -> (usize, u64) {
+        let id = std::sync::Arc::as_ptr(&self.source.basis) as usize;
+        match &self.kind {
+            ResidentKind::Gpu(p) => (id, p.basis().map_or(0, |b| b.bytes())),
+            ResidentKind::Cpu { .. } => (id, self.source.basis_bytes()),
+        }
+    }
+
+    /// The views it was made from, with the coefficients of its current light.
+    pub fn source(&self) -> &PoseSource {
+        &self.source
     }
 
     /// Where its subject can show ([`crate::geometry::PoseGeometry::bounds`]).
@@ -214,8 +237,25 @@ impl Device {
 
     /// Makes `source` resident, relit (on the GPU, or on the CPU).
     pub fn make_resident(&self, source: &PoseSource) -> Result<Resident> {
+        self.make_resident_sharing(source, None)
+    }
+
+    /// [`Device::make_resident`], sharing the basis codes `like` holds when it was made
+    /// from the same views (e.g. [`PoseSource::relit`] of its source): on the GPU they
+    /// are not uploaded again.
+    pub fn make_resident_sharing(
+        &self,
+        source: &PoseSource,
+        like: Option<&Resident>,
+    ) -> Result<Resident> {
         let kind = match self {
-            Device::Gpu(gpu) => ResidentKind::Gpu(Box::new(gpu.upload_pose(source)?)),
+            Device::Gpu(gpu) => {
+                let basis = like.and_then(|r| match &r.kind {
+                    ResidentKind::Gpu(p) => p.basis(),
+                    ResidentKind::Cpu { .. } => None,
+                });
+                ResidentKind::Gpu(Box::new(gpu.upload_pose_sharing(source, basis)?))
+            }
             Device::Cpu => ResidentKind::Cpu {
                 pose: Box::new(ResidentPose::relight_cpu(source)),
                 shadow: None,
@@ -223,11 +263,40 @@ impl Device {
         };
         Ok(Resident {
             kind,
+            source: source.clone(),
+            shadow_maps: None,
             ground_coefficients: source.ground_coefficients.clone(),
             shadow: false,
             pose: source.geometry.pose,
             motion: [None, None],
         })
+    }
+
+    /// Relights `resident` with `source`'s coefficients, `source` being its own views
+    /// under a new light ([`PoseSource::relit`]), and its shadow maps with them. On the
+    /// GPU this records one relighting dispatch per batch of views and one for the shadow
+    /// (sent with the next frame), and uploads nothing but the coefficients.
+    pub fn relight(&self, resident: &mut Resident, source: &PoseSource) -> Result<()> {
+        if !std::sync::Arc::ptr_eq(&resident.source.basis, &source.basis) {
+            return Err(crate::RenderError::Misuse(
+                "a pose relit from views it was not made from".into(),
+            ));
+        }
+        match (&mut resident.kind, self) {
+            (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => gpu.relight_pose(pose, source)?,
+            (ResidentKind::Cpu { pose, .. }, _) => **pose = ResidentPose::relight_cpu(source),
+            (ResidentKind::Gpu(_), Device::Cpu) => {
+                return Err(crate::RenderError::Misuse(
+                    "a GPU-resident pose given to the CPU renderer".into(),
+                ));
+            }
+        }
+        resident.source = source.clone();
+        resident.ground_coefficients = source.ground_coefficients.clone();
+        if let Some(maps) = resident.shadow_maps.clone() {
+            self.set_shadow(resident, SceneShadow::Maps(&maps))?;
+        }
+        Ok(())
     }
 
     /// Sets the motion `resident` carries toward its next and previous poses
@@ -265,6 +334,13 @@ impl Device {
         };
         let coefficients = resident.ground_coefficients.clone().unwrap_or_default();
         let cast = !matches!(shadow, SceneShadow::None);
+        resident.shadow_maps = match &shadow {
+            SceneShadow::Maps(m) => match &resident.shadow_maps {
+                Some(kept) if std::ptr::eq(&**kept, *m) => Some(kept.clone()),
+                _ => Some(std::sync::Arc::new((*m).clone())),
+            },
+            _ => None,
+        };
         match (&mut resident.kind, self) {
             (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => match shadow {
                 // The GPU relights the maps itself (tested against the CPU's).

@@ -114,10 +114,10 @@ pub struct PoseSource {
     /// The flows.
     pub flows: Arc<PoseFlows>,
     /// Per view: the basis mosaic's codes and scales, cropped (no tiles for a view not
-    /// read).
-    pub basis: Vec<BasisCodes>,
+    /// read); shared by the pose relit under other lights ([`PoseSource::relit`]).
+    pub basis: Arc<Vec<BasisCodes>>,
     /// Per view: alpha codes (`round(255 α)`), cropped (none for a view not read).
-    pub alpha: Vec<Vec<u8>>,
+    pub alpha: Arc<Vec<Vec<u8>>>,
     /// Per view and condition: relighting coefficients (RGB).
     pub coefficients: Vec<Vec<Rgb>>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
@@ -132,6 +132,37 @@ impl PoseSource {
     /// codes, and no pre-lit layer once resident (it samples as transparent).
     pub fn is_blank(&self, i: usize) -> bool {
         self.alpha[i].is_empty()
+    }
+
+    /// The same views under `lighting`: new coefficients (the conditions `plan` leaves
+    /// out at zero), everything else shared with `self`. What a new light costs the host
+    /// before the GPU relights the views.
+    pub fn relit<R: ReadAt>(
+        &self,
+        field: &FieldFile<R>,
+        lighting: &Lighting,
+        plan: Option<&PosePlan>,
+    ) -> Result<Self> {
+        let read: Vec<bool> = (0..self.basis.len()).map(|i| !self.is_blank(i)).collect();
+        let (coefficients, ground_coefficients, plan) =
+            relighting(field, self.geometry.pose, lighting, plan, &read)?;
+        Ok(Self {
+            coefficients,
+            ground_coefficients,
+            plan,
+            ..self.clone()
+        })
+    }
+
+    /// Bytes its basis and alpha codes hold.
+    pub fn basis_bytes(&self) -> u64 {
+        let basis: usize = self
+            .basis
+            .iter()
+            .map(|b| b.tiles.iter().map(|t| t.len() * 3).sum::<usize>())
+            .sum();
+        let alpha: usize = self.alpha.iter().map(Vec::len).sum();
+        (basis + alpha) as u64
     }
 
     /// Loads pose `pose` of a field and the relighting coefficients of `lighting`.
@@ -220,8 +251,8 @@ impl PoseSource {
                 quantizer: record.flow_quantizer,
                 table,
             }),
-            basis,
-            alpha,
+            basis: Arc::new(basis),
+            alpha: Arc::new(alpha),
             coefficients,
             ground_coefficients,
             plan: lighting_plan,

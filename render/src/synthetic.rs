@@ -121,8 +121,8 @@ pub fn synthetic_pose() -> Result<PoseSource> {
             table: flow_lut(&quantizer),
             quantizer,
         }),
-        basis,
-        alpha: vec![alpha; views],
+        basis: Arc::new(basis),
+        alpha: Arc::new(vec![alpha; views]),
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
         ground_coefficients: None,
         plan: LightingPlan {

@@ -20,6 +20,7 @@
 //! frame is `world_from_subject = T(position) · R_y(heading)`. With one instance at the
 //! origin the scene frame is the subject frame of the field.
 
+pub mod bench_frame;
 mod check;
 pub mod error;
 pub mod explain;

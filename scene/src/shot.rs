@@ -77,6 +77,22 @@ fn covers(have: &Option<PosePlan>, want: &Option<PosePlan>) -> bool {
     }
 }
 
+/// Bytes the cache's residents hold: each its own, and their basis codes once for those
+/// that share them.
+fn cache_bytes(cache: &[Cached]) -> u64 {
+    let mut seen: Vec<usize> = Vec::new();
+    let mut total = 0;
+    for c in cache {
+        total += c.resident.bytes();
+        let (id, bytes) = c.resident.basis();
+        if !seen.contains(&id) {
+            seen.push(id);
+            total += bytes;
+        }
+    }
+    total
+}
+
 /// A walker's cache slot in a frame, and between two poses the later pose's slot and the
 /// fraction of the way to it.
 type Slot = (usize, Option<(usize, f32)>);
@@ -383,7 +399,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
 
     /// Bytes the resident poses hold now.
     pub fn resident_bytes(&self) -> u64 {
-        self.cache.iter().map(|c| c.resident.bytes()).sum()
+        cache_bytes(&self.cache)
     }
 
     /// Changes the scene by `f`; what the change makes stale is made again when a frame
@@ -443,6 +459,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         self.live_frames += 1;
         let fp = self.frame_at(self.live_frames, time);
         let slots = self.prepare(&fp)?.0;
+        if let Device::Gpu(gpu) = &self.device {
+            // Relights recorded for this frame go ahead of the caller's encoder.
+            gpu.flush();
+        }
         let walkers = self.walkers(&slots, camera);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
         let Device::Gpu(gpu) = &self.device else {
@@ -596,10 +616,27 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             });
             let slot = match found {
                 Some(k) if self.cache[k].lighting == key => k,
-                found => {
+                Some(k) => {
+                    // The same views under a new light: relit where they are.
                     let t = Instant::now();
+                    self.relight_cached(k, world.as_ref())?;
+                    self.counters.residency_seconds += t.elapsed().as_secs_f64();
+                    self.counters.poses_made_resident += 1;
+                    self.counters.relights += 1;
+                    made_resident.push(pose);
+                    self.cache[k].lighting = key.clone();
+                    k
+                }
+                None => {
+                    let t = Instant::now();
+                    // Another walker's copy of views that cover these lends them, basis
+                    // codes and all (the first made, so that copies share one).
+                    let like = self
+                        .cache
+                        .iter()
+                        .position(|c| c.pose == pose && covers(&c.plan, &wanted));
                     let resident =
-                        self.make_resident(pose, heading, world.as_ref(), wanted.as_ref())?;
+                        self.make_resident(pose, heading, world.as_ref(), wanted.as_ref(), like)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     (
                         self.counters.basis_views_reused,
@@ -609,25 +646,15 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         self.reduced.counts();
                     self.counters.poses_made_resident += 1;
                     made_resident.push(pose);
-                    let entry = Cached {
+                    self.cache.push(Cached {
                         pose,
                         heading: heading.to_bits(),
                         plan: wanted,
                         lighting: key.clone(),
                         resident,
                         last_frame: fp.index,
-                    };
-                    match found {
-                        Some(k) => {
-                            self.counters.relights += 1;
-                            self.cache[k] = entry;
-                            k
-                        }
-                        None => {
-                            self.cache.push(entry);
-                            self.cache.len() - 1
-                        }
-                    }
+                    });
+                    self.cache.len() - 1
                 }
             };
             self.cache[slot].last_frame = fp.index;
@@ -666,15 +693,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         }
     }
 
-    /// Reads pose `pose` as `plan` says (everything when `None`), relights it for a walker
-    /// of `heading` under the scene frame's lighting `world`, and sets its shadow.
-    fn make_resident(
-        &self,
-        pose: u32,
-        heading: f32,
-        world: Option<&EnvMap>,
-        plan: Option<&PosePlan>,
-    ) -> Result<Resident> {
+    /// The lighting of a walker of `heading` under the scene frame's lighting `world`.
+    fn walker_lighting(&self, heading: f32, world: Option<&EnvMap>) -> (Option<EnvMap>, Lighting) {
         let env = world.map(|e| e.rotated(-heading));
         let lighting = match &env {
             Some(e) => Lighting::Environment {
@@ -683,6 +703,67 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             },
             None => Lighting::Unlit,
         };
+        (env, lighting)
+    }
+
+    /// Relights cache entry `k` for its walker's heading under `world`: its views' new
+    /// coefficients, relit where they are resident, with its shadow.
+    fn relight_cached(&mut self, k: usize, world: Option<&EnvMap>) -> Result<()> {
+        let heading = f32::from_bits(self.cache[k].heading);
+        let (env, lighting) = self.walker_lighting(heading, world);
+        let entry = &self.cache[k];
+        let source = entry
+            .resident
+            .source()
+            .relit(self.field, &lighting, entry.plan.as_ref())?;
+        let traced = match self.scene.shadow {
+            ShadowSpec::Traced if entry.resident.has_shadow() => {
+                self.traced_shadow(entry.pose, env.as_ref())?
+            }
+            _ => None,
+        };
+        let resident = &mut self.cache[k].resident;
+        self.device.relight(resident, &source)?;
+        if let Some(shadow) = traced {
+            self.device
+                .set_shadow(resident, SceneShadow::Relit(shadow))?;
+        }
+        Ok(())
+    }
+
+    /// The shadow of pose `pose`'s hull under `env` (traced), when it has a hull and
+    /// there is an environment.
+    fn traced_shadow(
+        &self,
+        pose: u32,
+        env: Option<&EnvMap>,
+    ) -> Result<Option<frf_render::shadow::RelitShadow>> {
+        let (Some(hull), Some(env)) = (self.field.hull(pose)?, env) else {
+            return Ok(None);
+        };
+        let ground = self
+            .field
+            .header()
+            .shadows
+            .as_ref()
+            .map_or(frf_core::volume::GroundGrid::ORIGINAL, |s| s.ground);
+        let lights = env.median_cut(self.options.traced_lights);
+        Ok(Some(traced_shadow(&hull, &lights, ground)))
+    }
+
+    /// Reads pose `pose` as `plan` says (everything when `None`), relights it for a walker
+    /// of `heading` under the scene frame's lighting `world`, and sets its shadow. With
+    /// `like` (a cache entry of the same pose whose plan covers `plan`), its views are
+    /// taken from there, basis codes shared, instead of being read again.
+    fn make_resident(
+        &self,
+        pose: u32,
+        heading: f32,
+        world: Option<&EnvMap>,
+        plan: Option<&PosePlan>,
+        like: Option<usize>,
+    ) -> Result<Resident> {
+        let (env, lighting) = self.walker_lighting(heading, world);
         let level = self
             .options
             .detail
@@ -696,15 +777,19 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             )
             .into());
         }
-        let source = PoseSource::load_at(
-            self.field,
-            pose,
-            &lighting,
-            plan,
-            level,
-            Some(&self.reduced),
-        )?;
-        let mut resident = self.device.make_resident(&source)?;
+        let like = like.map(|k| &self.cache[k].resident);
+        let source = match like {
+            Some(r) => r.source().relit(self.field, &lighting, plan)?,
+            None => PoseSource::load_at(
+                self.field,
+                pose,
+                &lighting,
+                plan,
+                level,
+                Some(&self.reduced),
+            )?,
+        };
+        let mut resident = self.device.make_resident_sharing(&source, like)?;
         if self.plan.interpolate == TimeInterpolation::Flow {
             let motion = PoseStep::ALL.map(|step| {
                 let wanted = match plan {
@@ -731,18 +816,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 }
             }
             ShadowSpec::Traced if wants(plan.is_some_and(|p| p.hull)) => {
-                if let (Some(hull), Some(env)) = (self.field.hull(pose)?, &env) {
-                    let ground = self
-                        .field
-                        .header()
-                        .shadows
-                        .as_ref()
-                        .map_or(frf_core::volume::GroundGrid::ORIGINAL, |s| s.ground);
-                    let lights = env.median_cut(self.options.traced_lights);
-                    self.device.set_shadow(
-                        &mut resident,
-                        SceneShadow::Relit(traced_shadow(&hull, &lights, ground)),
-                    )?;
+                if let Some(shadow) = self.traced_shadow(pose, env.as_ref())? {
+                    self.device
+                        .set_shadow(&mut resident, SceneShadow::Relit(shadow))?;
                 }
             }
             _ => {}
@@ -754,7 +830,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// resident poses fit the budget; `slots` (indices into the cache of this frame's
     /// poses) are kept valid.
     fn keep_within_budget(&mut self, frame: usize, slots: &mut [usize]) -> Result<()> {
-        let total = |c: &[Cached]| c.iter().map(|c| c.resident.bytes()).sum::<u64>();
+        let total = cache_bytes;
         while total(&self.cache) > self.options.memory_budget {
             let victim = self
                 .cache

@@ -1,6 +1,7 @@
 //! `frf bench interp`: the GPU interpolation benchmark ([`frf_render::gpu::bench`]) on a
-//! field's pose or on the synthetic pose of the original's shape, printed as a table or
-//! as JSON.
+//! field's pose or on the synthetic pose of the original's shape; `frf bench frame`:
+//! what a crowd's frame costs by walkers and lighting ([`frf_scene::bench_frame`]). Each
+//! prints a table, or JSON.
 
 use std::path::PathBuf;
 
@@ -15,7 +16,10 @@ use frf_render::synthetic::synthetic_pose;
 
 use super::args::{LightingArgs, parse_size};
 use crate::CliResult;
-use frf_core::bars::bar;
+use frf_core::bars::{Bars, bar};
+use frf_scene::Scene;
+use frf_scene::bench_frame::{FrameBenchOptions, LightMode, run_frame_bench};
+use frf_scene::shot::ShotOptions;
 
 /// `frf bench ...`.
 #[derive(Args)]
@@ -29,6 +33,51 @@ enum BenchCommand {
     /// Time per frame of the floor pass and every interpolation, every storage format,
     /// fragment and compute, several sizes; the CPU reference in the same run.
     Interp(InterpArgs),
+    /// Host, GPU and wall time per frame of a scene's first walker copied 1, 10, 40, 100
+    /// times, under a constant and a turning light.
+    Frame(FrameArgs),
+}
+
+/// Which lightings `frf bench frame` times.
+#[derive(Clone, Copy, ValueEnum)]
+enum LightArg {
+    /// The scene's first lighting key, held.
+    Constant,
+    /// Turned 15 degrees a frame.
+    Turning,
+    /// Both.
+    Both,
+}
+
+/// Arguments of `frf bench frame`.
+#[derive(Args)]
+struct FrameArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// The field (default: the one the scene names).
+    #[arg(long)]
+    field: Option<PathBuf>,
+    /// Walker counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,10,40,100")]
+    walkers: Vec<usize>,
+    /// Lightings timed.
+    #[arg(long, value_enum, default_value = "both")]
+    light: LightArg,
+    /// Frames counted per row (one more is drawn first, not counted).
+    #[arg(long, default_value_t = 6)]
+    frames: usize,
+    /// Frame size, WxH (default: the scene's, else the field's).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Most memory the resident poses may hold together, MB.
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u64).range(1..))]
+    memory_budget: u64,
+    /// Render on the CPU reference.
+    #[arg(long)]
+    cpu: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
 }
 
 /// Which storage formats to time.
@@ -93,7 +142,38 @@ struct InterpArgs {
 pub fn run_bench(args: BenchArgs) -> CliResult {
     match args.what {
         BenchCommand::Interp(a) => interp(a),
+        BenchCommand::Frame(a) => frame(a),
     }
+}
+
+fn frame(args: FrameArgs) -> CliResult {
+    let (scene, field_path) = Scene::load_overridden(&args.scene, None, args.field.as_deref())?;
+    let field = FieldFile::open(&field_path)?;
+    let h = field.header();
+    let size = scene.frame_size(args.size, (h.width, h.height))?;
+    let options = FrameBenchOptions {
+        walkers: args.walkers,
+        lights: match args.light {
+            LightArg::Constant => vec![LightMode::Constant],
+            LightArg::Turning => vec![LightMode::Turning],
+            LightArg::Both => vec![LightMode::Constant, LightMode::Turning],
+        },
+        frames: args.frames,
+        size,
+        shot: ShotOptions {
+            memory_budget: args.memory_budget.saturating_mul(1_000_000),
+            planned: true,
+            traced_lights: 256,
+            detail: None,
+        },
+        cpu: args.cpu,
+    };
+    let report = run_frame_bench(&scene, &field, &options, &Bars::default())?;
+    eprint!("{}", report.table());
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
 }
 
 fn interp(args: InterpArgs) -> CliResult {

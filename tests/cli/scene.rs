@@ -647,3 +647,113 @@ heading_deg = 200.0
         "{pixel:.1} dB, {blocks:.1} dB over 4x4"
     );
 }
+
+/// A light that turns every frame (issue 37): the shot relights its resident poses in
+/// place, from the basis codes they keep, and every frame equals the same frame rendered
+/// alone, its poses made resident afresh under that light.
+#[test]
+fn a_turning_light_relit_in_place_draws_what_a_fresh_residency_draws() {
+    let dir = tempfile::tempdir().unwrap();
+    let walkers = "[[instance]]\n[[instance]]\nposition = [0.9, 0.0, -0.6]\nheading_deg = 60.0\n";
+    let scene = write_scene(
+        dir.path(),
+        "turning.toml",
+        walkers,
+        "[0.0, 1.4, 3.0]",
+        "[0.4, 1.4, 3.0]",
+    );
+    let text = std::fs::read_to_string(&scene).unwrap().replace(
+        "[lighting]\nenv = \"sky\"\n",
+        "[lighting]\nenv = \"sky\"\n[[lighting.key]]\ntime = 0.0\nyaw_deg = 0.0\n\
+         [[lighting.key]]\ntime = 0.4\nyaw_deg = 120.0\n",
+    );
+    std::fs::write(&scene, text).unwrap();
+    let render = |out: &Path, frames: &str| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--frames",
+            frames,
+        ];
+        args.extend(gpu_flag());
+        ok(&args);
+    };
+    let whole = dir.path().join("whole");
+    render(&whole, "0..3");
+    let report = whole.join("render_frames_0-3.json");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(report).unwrap()).unwrap();
+    let relights = report["residency"]["relights"].as_u64().unwrap();
+    assert!(
+        relights >= 4,
+        "two walkers relit on frames 1 and 2: {relights}"
+    );
+    for k in 0..3 {
+        let alone = dir.path().join(format!("alone{k}"));
+        render(&alone, &format!("{k}..{}", k + 1));
+        let name = format!("frame_{k:04}.exr");
+        let (a, b) = (read_exr(&whole.join(&name)), read_exr(&alone.join(&name)));
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max);
+        assert!(
+            worst <= 1e-6,
+            "frame {k}: relit in place differs by {worst}"
+        );
+    }
+}
+
+/// `frf bench frame` (issue 37): a row per walker count and lighting, the fields its JSON
+/// promises, turning rows relighting every walker every frame and constant ones none.
+#[test]
+fn the_frame_bench_reports_a_row_per_walkers_and_light() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "bench.toml",
+        "[[instance]]\n",
+        "[0.0, 1.4, 3.0]",
+        "[0.0, 1.4, 3.0]",
+    );
+    let mut args = vec![
+        "bench",
+        "frame",
+        scene.to_str().unwrap(),
+        "--walkers",
+        "1,3",
+        "--frames",
+        "2",
+        "--json",
+    ];
+    args.extend(gpu_flag());
+    let out = ok(&args);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = report["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "{report}");
+    for r in rows {
+        for key in [
+            "walkers",
+            "light",
+            "host_ms_per_frame",
+            "gpu_ms_per_frame",
+            "wall_ms_per_frame",
+        ] {
+            assert!(!r[key].is_null(), "{key} missing: {r}");
+        }
+        let walkers = r["walkers"].as_f64().unwrap();
+        let relit = r["relights_per_frame"].as_f64().unwrap();
+        match r["light"].as_str().unwrap() {
+            "turning" => assert_eq!(relit, walkers, "{r}"),
+            "constant" => assert_eq!(relit, 0.0, "{r}"),
+            other => panic!("light {other}"),
+        }
+        assert!(r["wall_ms_per_frame"].as_f64().unwrap() > 0.0);
+    }
+    let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
+}

@@ -153,9 +153,9 @@ fn controls(
     let mut yaw = v.yaw_deg;
     if ui
         .add(egui::Slider::new(&mut yaw, -180.0..=180.0).text("yaw ° ([ ])"))
-        .drag_stopped()
-        || (yaw != v.yaw_deg && !ui.ctx().egui_is_using_pointer())
+        .changed()
     {
+        // Applied while dragged: a new light is one relighting dispatch per pose.
         v.set_yaw(yaw)?;
     }
     let mut k = v.intensity;
@@ -165,8 +165,7 @@ fn controls(
                 .logarithmic(true)
                 .text("intensity"),
         )
-        .drag_stopped()
-        || (k != v.intensity && !ui.ctx().egui_is_using_pointer())
+        .changed()
     {
         v.set_intensity(k)?;
     }

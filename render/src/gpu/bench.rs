@@ -449,7 +449,7 @@ impl Drawn<'_> {
         let mut e = gpu.device.create_command_encoder(&Default::default());
         self.record(&mut e, stage, None);
         let copied = gpu.copy_rgba(&mut e, self.targets.texture(), self.size);
-        gpu.queue.submit([e.finish()]);
+        gpu.submit([e.finish()]);
         let img = gpu.read_rgba(&copied)?;
         Ok(img
             .pixels()

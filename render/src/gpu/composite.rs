@@ -205,7 +205,7 @@ impl Gpu {
                 t.readback[k].copy(&mut encoder, &t.targets[k]);
             }
             self.copy_stats(&mut encoder, &drawn.subjects);
-            self.queue.submit([encoder.finish()]);
+            self.submit([encoder.finish()]);
             let image = self.read_rgba(&t.readback[0])?;
             let layers = if layers {
                 Some(Layers {

@@ -1,8 +1,9 @@
 //! The wgpu renderer, one module per pass (its layout, pipeline and WGSL together), each
 //! the twin of a CPU reference it is tested against:
 //!
-//! - [`pose`]: a pose made resident and relit (`shaders/relight.wgsl`; twin of
-//!   [`crate::resident::ResidentPose::relight_cpu`]);
+//! - [`pose`]: a pose made resident;
+//! - [`relight`]: its views relit from basis codes kept resident (`shaders/relight.wgsl`;
+//!   twin of [`crate::resident::ResidentPose::relight_cpu`]);
 //! - [`rebin`]: the subject of a frame, re-binned and morphed (`shaders/rebin.wgsl`; twin
 //!   of [`crate::cpu::render_cpu`]);
 //! - [`shadow`]: the pose's shadow maps relit (`shaders/shadow.wgsl`; twin of
@@ -28,6 +29,7 @@ pub mod pose;
 pub mod present;
 mod readback;
 pub mod rebin;
+pub mod relight;
 pub mod scope;
 pub mod shadow;
 pub mod time_morph;
@@ -72,7 +74,11 @@ pub struct Gpu {
     wgpu_adapter: wgpu::Adapter,
     report: adapter::AdapterReport,
     uncaptured: scope::Uncaptured,
-    relight: pose::RelightPass,
+    relight: relight::RelightPass,
+    /// Work recorded between frames, sent ahead of the next ([`Gpu::submit`]).
+    pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
+    /// Nanoseconds the host has waited on the device ([`Gpu::waited`]).
+    waited_ns: std::sync::atomic::AtomicU64,
     rebin: rebin::RebinPass,
     /// How the frame pass runs.
     stage: rebin::PassKind,
@@ -138,7 +144,9 @@ impl Gpu {
             report.name, report.backend, report.device_type
         );
         Self {
-            relight: pose::RelightPass::new(&device),
+            relight: relight::RelightPass::new(&device),
+            pending: std::sync::Mutex::new(None),
+            waited_ns: std::sync::atomic::AtomicU64::new(0),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,
             targets: kept::Kept::new(KEPT_TARGETS),
@@ -203,10 +211,20 @@ impl Gpu {
     }
 
     pub(crate) fn wait(&self) -> Result<()> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(wgpu_err("waiting on the device"))?;
+        let start = std::time::Instant::now();
+        let polled = self.device.poll(wgpu::PollType::wait_indefinitely());
+        self.waited_ns.fetch_add(
+            start.elapsed().as_nanos() as u64,
+            std::sync::atomic::Ordering::Relaxed,
+        );
+        polled.map_err(wgpu_err("waiting on the device"))?;
         Ok(())
+    }
+
+    /// How long the host has waited on the device so far (for every readback and
+    /// fence): what a frame's wall time less this is the host's own work.
+    pub fn waited(&self) -> std::time::Duration {
+        std::time::Duration::from_nanos(self.waited_ns.load(std::sync::atomic::Ordering::Relaxed))
     }
 
     pub(crate) fn read_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {

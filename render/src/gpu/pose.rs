@@ -1,9 +1,8 @@
 //! Making a pose resident on the GPU: its flows as RG8 integer texture arrays (the 8-bit
 //! log codes, decoded in the shader), the view and quad tables and the cylinder's column
 //! index as storage buffers, and every view relit on the GPU into an RGBA8 texture array
-//! (`shaders/relight.wgsl`), one dispatch pair per batch of views: the weighted sum of
-//! each view's basis images, then its encoding with the view's peak. Twin of
-//! [`crate::resident::ResidentPose::relight_cpu`].
+//! ([`super::relight`], from basis codes kept resident and shared between the pose's
+//! relit copies).
 
 use std::sync::Arc;
 
@@ -11,61 +10,15 @@ use frf_core::volume::GroundGrid;
 use glam::Quat;
 use wgpu::util::DeviceExt;
 
-use super::bind::{
-    bind_group, compute_pipeline, copy_to_buffer, storage, storage_texture_array, table_bytes,
-    uniform,
-};
+use super::Gpu;
+use super::bind::{copy_to_buffer, table_bytes};
 use super::formats::PoseFormats;
-use super::{Gpu, shaders};
+use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
 use crate::rectified::gpu_frame;
 use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
-use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuView};
-
-/// Workgroup size of the relighting pass (`@workgroup_size(64)`).
-const WORKGROUP: u32 = 64;
-
-/// Most bytes of basis codes the relighting records into one batch.
-const RELIGHT_BATCH_BYTES: usize = 64 << 20;
-
-/// The relighting pipelines.
-pub struct RelightPass {
-    layout: wgpu::BindGroupLayout,
-    relight: wgpu::ComputePipeline,
-    encode: wgpu::ComputePipeline,
-}
-
-impl RelightPass {
-    /// Builds the pass on `device`.
-    pub fn new(device: &wgpu::Device) -> Self {
-        let relight_module = shaders::module(device, "relight", shaders::RELIGHT);
-        let c = wgpu::ShaderStages::COMPUTE;
-        let relight_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("relight"),
-            entries: &[
-                uniform::<GpuRelightParams>(0, c),
-                storage::<u32>(1, true, c),
-                storage::<[f32; 4]>(2, true, c),
-                storage::<[[f32; 4]; 64]>(3, true, c),
-                storage::<[f32; 4]>(4, false, c),
-                storage::<u32>(5, false, c),
-                storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
-                storage::<GpuRelightJob>(7, true, c),
-            ],
-        });
-        let compute = |entry: &str| {
-            compute_pipeline(device, entry, &[&relight_layout], &relight_module, entry)
-        };
-        let (relight, encode) = (compute("relight"), compute("encode"));
-
-        Self {
-            layout: relight_layout,
-            relight,
-            encode,
-        }
-    }
-}
+use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuView};
 
 /// How the frame pass binds a resident pose (made by [`super::rebin::RebinPass`]): the
 /// storage it reads ([`super::formats`]), the layout of bind group 1 and the sampler in it.
@@ -80,14 +33,18 @@ pub struct PoseBinding {
 pub struct GpuPose {
     pub(super) bind_group: wgpu::BindGroup,
     prelit: wgpu::Texture,
-    /// Per view: the pre-lit colour scale found by the relighting pass.
-    pub scales: Vec<f32>,
+    /// The view table (whose scales the relighting pass sets).
+    pub(super) views: wgpu::Buffer,
+    /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
+    pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
     /// holds on the GPU.
     pub geometry: Arc<PoseGeometry>,
     pub(super) quad_count: u32,
     /// The relit shadow of the ground, when the pose has shadow maps and a lighting.
     pub(super) shadow: Option<(wgpu::Texture, RelitShadowInfo)>,
+    /// The shadow maps and weights it was relit from, kept to relight it again.
+    pub(super) shadow_maps: Option<super::shadow::MapRelight>,
 }
 
 /// What the composite pass needs to know of a relit shadow texture.
@@ -108,6 +65,12 @@ impl GpuPose {
         })
     }
 
+    /// The basis codes it is relit from, shared with the other poses relit from them;
+    /// `None` for a pose uploaded already lit.
+    pub fn basis(&self) -> Option<&Arc<GpuBasis>> {
+        self.relight.as_ref().map(PoseRelight::basis)
+    }
+
     /// Whether a relit shadow is resident.
     pub fn has_shadow(&self) -> bool {
         self.shadow.is_some()
@@ -124,19 +87,34 @@ impl GpuPose {
     /// Drops the relit shadow.
     pub fn clear_shadow(&mut self) {
         self.shadow = None;
+        self.shadow_maps = None;
     }
 }
 
 impl Gpu {
-    /// Makes pose `source` resident: uploads its flows and tables and relights every view
-    /// on the GPU.
+    /// Makes pose `source` resident: uploads its basis codes, flows and tables and
+    /// relights every view on the GPU.
     pub fn upload_pose(&self, source: &PoseSource) -> Result<GpuPose> {
+        self.upload_pose_sharing(source, None)
+    }
+
+    /// [`Gpu::upload_pose`], relit from `basis` when it holds `source`'s codes (another
+    /// copy of the same views: a walker of another heading) instead of uploading them.
+    pub fn upload_pose_sharing(
+        &self,
+        source: &PoseSource,
+        basis: Option<&Arc<GpuBasis>>,
+    ) -> Result<GpuPose> {
+        let basis = match basis {
+            Some(b) if b.holds(&source.basis) => b.clone(),
+            _ => self.upload_basis(source)?,
+        };
         self.scoped("making a pose resident", || {
-            self.upload_pose_unscoped(source)
+            self.upload_pose_unscoped(source, basis)
         })
     }
 
-    fn upload_pose_unscoped(&self, source: &PoseSource) -> Result<GpuPose> {
+    fn upload_pose_unscoped(&self, source: &PoseSource, basis: Arc<GpuBasis>) -> Result<GpuPose> {
         let geometry = &source.geometry;
         let crop = geometry.crop;
         let texels = crop.texels();
@@ -182,15 +160,45 @@ impl Gpu {
                 | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        let scales = self.relight_views(source, &prelit)?;
-        Ok(self.bind_pose(
+        // Scales are set by the relighting pass; a view not relit keeps 1.
+        let mut pose = self.bind_pose(
             &self.rebin.pose,
             &source.geometry,
-            scales,
+            vec![1.0; geometry.views()],
             prelit,
             &flows,
             source.flows.table,
-        ))
+        );
+        let relight = self.pose_relight(basis, geometry.views());
+        self.record_relight(&relight, source, &pose);
+        pose.relight = Some(relight);
+        Ok(pose)
+    }
+
+    /// The views' pre-lit colour scales as the GPU holds them (for tests and inspection).
+    pub fn read_scales(&self, pose: &GpuPose) -> Result<Vec<f32>> {
+        self.scoped("reading a pose's scales back", || {
+            let size = pose.views.size();
+            let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("views readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("views readback"),
+                });
+            encoder.copy_buffer_to_buffer(&pose.views, 0, &readback, 0, size);
+            self.submit([encoder.finish()]);
+            let bytes = self.read_buffer(&readback)?;
+            let views: &[GpuView] = bytemuck::cast_slice(&bytes);
+            Ok(views[..pose.geometry.views()]
+                .iter()
+                .map(|v| v.scale)
+                .collect())
+        })
     }
 
     /// Makes a pose relit on the CPU resident with the storage `pass` reads
@@ -342,7 +350,13 @@ impl Gpu {
                     usage: wgpu::BufferUsages::STORAGE,
                 })
         };
-        let view_buffer = buffer("views", bytemuck::cast_slice(&gpu_views));
+        let view_buffer = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("views"),
+                contents: bytemuck::cast_slice(&gpu_views),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            });
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
         let tables = buffer("tables", &table_bytes(&[srgb_lut(), flow_table]));
         let (index, ranges) = geometry.cylinder.column_index_gpu();
@@ -413,184 +427,12 @@ impl Gpu {
         GpuPose {
             bind_group,
             prelit,
-            scales,
+            views: view_buffer,
+            relight: None,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,
             shadow: None,
-        }
-    }
-
-    /// Relights every view into its layer of `prelit`; returns the views' scales. Views
-    /// are relit in batches (one dispatch pair each) of up to [`RELIGHT_BATCH_BYTES`] of
-    /// basis codes.
-    fn relight_views(&self, source: &PoseSource, prelit: &wgpu::Texture) -> Result<Vec<f32>> {
-        let views = source.basis.len();
-        let storage = wgpu::BufferUsages::STORAGE;
-        let gamma = self.init_buffer(
-            "gamma",
-            &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
-            storage,
-        );
-        let peaks = self.init_buffer(
-            "peaks",
-            &vec![0u8; views.max(1) * 4],
-            storage | wgpu::BufferUsages::COPY_SRC,
-        );
-        let target = prelit.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("relight"),
-            });
-        // The views read (a view not read has no layer: it samples as transparent, as
-        // the CPU's does, and its peak stays zero, scale 1), in batches.
-        let texels = source.geometry.crop.texels();
-        let read: Vec<usize> = (0..views)
-            .filter(|&i| !source.is_blank(i) && source.geometry.prelit_layers[i] >= 0)
-            .collect();
-        let mut batch: Vec<usize> = Vec::new();
-        let mut bytes = 0;
-        for (k, &i) in read.iter().enumerate() {
-            batch.push(i);
-            bytes += source.basis[i].tiles.len() * texels * 4;
-            if bytes >= RELIGHT_BATCH_BYTES || k + 1 == read.len() {
-                self.record_relight(&mut encoder, source, &batch, [&gamma, &peaks], &target);
-                batch.clear();
-                bytes = 0;
-            }
-        }
-        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("peaks readback"),
-            size: (views.max(1) * 4) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.copy_buffer_to_buffer(&peaks, 0, &readback, 0, (views.max(1) * 4) as u64);
-        self.queue.submit([encoder.finish()]);
-        let bytes = self.read_buffer(&readback)?;
-        Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[..views]
-            .iter()
-            .map(|&b| {
-                let p = f32::from_bits(b);
-                if p > 0.0 { p } else { 1.0 }
-            })
-            .collect())
-    }
-
-    /// A buffer holding `contents`.
-    fn init_buffer(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
-        self.device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-    }
-
-    /// Records the relighting of views `batch` of `source` into `encoder`: their codes,
-    /// coefficients and jobs uploaded, then the two passes over every view at once,
-    /// writing the views' peaks into `gamma_peaks[1]` and their texels into `target`.
-    fn record_relight(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        source: &PoseSource,
-        batch: &[usize],
-        [gamma, peaks]: [&wgpu::Buffer; 2],
-        target: &wgpu::TextureView,
-    ) {
-        let crop = source.geometry.crop;
-        let texels = crop.texels();
-        let mut codes: Vec<u32> = Vec::new();
-        let mut coefficients: Vec<[f32; 4]> = Vec::new();
-        let mut jobs = Vec::with_capacity(batch.len());
-        for (j, &i) in batch.iter().enumerate() {
-            let basis = &source.basis[i];
-            jobs.push(GpuRelightJob {
-                basis_offset: codes.len() as u32,
-                coefficient_offset: coefficients.len() as u32,
-                tiles: basis.tiles.len() as u32,
-                view: i as u32,
-                layer: source.geometry.prelit_layers[i] as u32,
-                relit_offset: (j * texels) as u32,
-                pad0: 0,
-                pad1: 0,
-            });
-            for (k, tile) in basis.tiles.iter().enumerate() {
-                codes.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
-                    let alpha = if k == 0 { a as u32 } else { 0 };
-                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
-                }));
-            }
-            coefficients.extend(
-                source.coefficients[i]
-                    .iter()
-                    .zip(&basis.scales)
-                    .map(|(c, &s)| {
-                        let used = if c.iter().all(|&x| x == 0.0) {
-                            0.0
-                        } else {
-                            1.0
-                        };
-                        [c[0] * s, c[1] * s, c[2] * s, used]
-                    }),
-            );
-        }
-        if codes.is_empty() {
-            codes.push(0);
-        }
-        if coefficients.is_empty() {
-            coefficients.push([0.0; 4]);
-        }
-        let params = GpuRelightParams {
-            texels: texels as u32,
-            width: crop.width,
-            jobs: batch.len() as u32,
-            pad: 0,
-        };
-        let storage = wgpu::BufferUsages::STORAGE;
-        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("relit"),
-            size: (texels * batch.len().max(1) * 16) as u64,
-            usage: storage,
-            mapped_at_creation: false,
-        });
-        let buffers = [
-            self.init_buffer(
-                "relight params",
-                bytemuck::bytes_of(&params),
-                wgpu::BufferUsages::UNIFORM,
-            ),
-            self.init_buffer("basis", bytemuck::cast_slice(&codes), storage),
-            self.init_buffer("coefficients", bytemuck::cast_slice(&coefficients), storage),
-            self.init_buffer("jobs", bytemuck::cast_slice(&jobs), storage),
-        ];
-        let bind = bind_group(
-            &self.device,
-            "relight",
-            &self.relight.layout,
-            vec![
-                buffers[0].as_entire_binding(),
-                buffers[1].as_entire_binding(),
-                buffers[2].as_entire_binding(),
-                gamma.as_entire_binding(),
-                relit.as_entire_binding(),
-                peaks.as_entire_binding(),
-                wgpu::BindingResource::TextureView(target),
-                buffers[3].as_entire_binding(),
-            ],
-        );
-        let groups = (texels as u32).div_ceil(WORKGROUP);
-        for pipeline in [&self.relight.relight, &self.relight.encode] {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("relight"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.dispatch_workgroups(groups, batch.len() as u32, 1);
+            shadow_maps: None,
         }
     }
 
@@ -620,7 +462,7 @@ impl Gpu {
                 label: Some("prelit readback"),
             });
         copy_to_buffer(&mut encoder, &pose.prelit, &buffer, row, (w, h, layers));
-        self.queue.submit([encoder.finish()]);
+        self.submit([encoder.finish()]);
         let bytes = self.read_buffer(&buffer)?;
         Ok(g.prelit_layers
             .iter()

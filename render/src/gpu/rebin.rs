@@ -637,7 +637,7 @@ impl Gpu {
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
             self.copy_stats(&mut encoder, &subject);
-            self.queue.submit([encoder.finish()]);
+            self.submit([encoder.finish()]);
             Ok((self.read_rgba(&t.readback)?, self.read_stats(&subject)?))
         })
     }

@@ -6,7 +6,7 @@
 use frf_core::image::{Rgb, RgbImage};
 use wgpu::util::DeviceExt;
 
-use super::bind::{compute_pipeline, rgba32f, storage, storage_texture, uniform};
+use super::bind::{bind_group, compute_pipeline, rgba32f, storage, storage_texture, uniform};
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
@@ -41,9 +41,20 @@ impl ShadowPass {
     }
 }
 
+/// A pose's shadow maps resident with their weights and relit texture, bound: relit
+/// again by writing the weights.
+pub struct MapRelight {
+    texels: u32,
+    maps: usize,
+    weights: wgpu::Buffer,
+    bind: wgpu::BindGroup,
+}
+
 impl Gpu {
     /// Relights `maps` with the coefficients of every condition of the field (projected
-    /// for the ground's frame) and keeps the result resident with `pose`.
+    /// for the ground's frame) and keeps the result resident with `pose`. The maps are
+    /// uploaded once: relit again (a new light), only the weights are written. Recorded
+    /// with the pending work ([`Gpu::submit`]), not submitted.
     pub fn set_shadow(
         &self,
         pose: &mut GpuPose,
@@ -61,106 +72,118 @@ impl Gpu {
                     "shadow maps are not all {n}x{n}"
                 )));
             }
-            let texels: Vec<f32> = maps
-                .maps
-                .iter()
-                .flat_map(|m| m.pixels().iter().copied())
-                .collect();
-            let weights: Vec<[f32; 4]> = maps
+            let mut weights: Vec<[f32; 4]> = maps
                 .weights(coefficients)
                 .iter()
                 .map(|w| [w[0], w[1], w[2], 0.0])
                 .collect();
-            let buffer = |label: &str, contents: &[u8], usage| {
-                self.device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(label),
-                        contents,
-                        usage,
-                    })
-            };
-            let params = GpuShadowParams {
-                texels: n,
-                maps: maps.maps.len() as u32,
-                pad: [0; 2],
-            };
-            let params = buffer(
-                "shadow params",
-                bytemuck::bytes_of(&params),
-                wgpu::BufferUsages::UNIFORM,
-            );
             // Storage bindings may not be empty.
-            let texels = if texels.is_empty() { vec![0.0] } else { texels };
-            let weights = if weights.is_empty() {
-                vec![[0.0; 4]]
-            } else {
-                weights
+            if weights.is_empty() {
+                weights.push([0.0; 4]);
+            }
+            let kept = pose
+                .shadow_maps
+                .take()
+                .filter(|k| k.texels == n && k.maps == maps.maps.len() && pose.shadow.is_some());
+            let relight = match kept {
+                Some(k) => k,
+                None => self.map_relight(pose, maps, weights.len())?,
             };
-            let map_buffer = buffer(
-                "shadow maps",
-                bytemuck::cast_slice(&texels),
-                wgpu::BufferUsages::STORAGE,
-            );
-            let weight_buffer = buffer(
-                "shadow weights",
-                bytemuck::cast_slice(&weights),
-                wgpu::BufferUsages::STORAGE,
-            );
-            let relit = rgba32f(
-                &self.device,
-                "relit shadow",
-                (n, n),
-                wgpu::TextureUsages::STORAGE_BINDING
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-            );
-            let view = relit.create_view(&wgpu::TextureViewDescriptor::default());
-            let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadow"),
-                layout: &self.shadow.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: map_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: weight_buffer.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: wgpu::BindingResource::TextureView(&view),
-                    },
-                ],
-            });
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("shadow"),
-                });
-            {
+            self.queue
+                .write_buffer(&relight.weights, 0, bytemuck::cast_slice(&weights));
+            self.with_pending(|encoder| {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("shadow"),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&self.shadow.pipeline);
-                pass.set_bind_group(0, &bind, &[]);
+                pass.set_bind_group(0, &relight.bind, &[]);
                 let groups = n.div_ceil(WORKGROUP);
                 pass.dispatch_workgroups(groups, groups, 1);
-            }
-            self.queue.submit([encoder.finish()]);
-            pose.shadow = Some((
-                relit,
-                RelitShadowInfo {
-                    texels: n,
-                    extent_m: maps.spec.ground.extent_m,
-                },
-            ));
+            });
+            pose.shadow_maps = Some(relight);
             Ok(())
+        })
+    }
+
+    /// Uploads `maps` for `pose`: the maps, a weight buffer of `weights` entries and the
+    /// relit texture (set as the pose's shadow), bound together.
+    fn map_relight(
+        &self,
+        pose: &mut GpuPose,
+        maps: &ShadowMaps,
+        weights: usize,
+    ) -> Result<MapRelight> {
+        let n = maps.spec.ground.texels;
+        let mut texels: Vec<f32> = maps
+            .maps
+            .iter()
+            .flat_map(|m| m.pixels().iter().copied())
+            .collect();
+        if texels.is_empty() {
+            texels.push(0.0);
+        }
+        let buffer = |label: &str, contents: &[u8], usage| {
+            self.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+        };
+        let params = GpuShadowParams {
+            texels: n,
+            maps: maps.maps.len() as u32,
+            pad: [0; 2],
+        };
+        let params = buffer(
+            "shadow params",
+            bytemuck::bytes_of(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let map_buffer = buffer(
+            "shadow maps",
+            bytemuck::cast_slice(&texels),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let weight_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow weights"),
+            size: (weights * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let relit = rgba32f(
+            &self.device,
+            "relit shadow",
+            (n, n),
+            wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        );
+        let view = relit.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind = bind_group(
+            &self.device,
+            "shadow",
+            &self.shadow.layout,
+            vec![
+                params.as_entire_binding(),
+                map_buffer.as_entire_binding(),
+                weight_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&view),
+            ],
+        );
+        pose.shadow = Some((
+            relit,
+            RelitShadowInfo {
+                texels: n,
+                extent_m: maps.spec.ground.extent_m,
+            },
+        ));
+        Ok(MapRelight {
+            texels: n,
+            maps: maps.maps.len(),
+            weights: weight_buffer,
+            bind,
         })
     }
 
@@ -200,6 +223,7 @@ impl Gpu {
                     extent_m: relit.ground.extent_m,
                 },
             ));
+            pose.shadow_maps = None;
             Ok(())
         })
     }
@@ -217,7 +241,7 @@ impl Gpu {
                     label: Some("shadow readback"),
                 });
             let copied = self.copy_rgba(&mut encoder, texture, size);
-            self.queue.submit([encoder.finish()]);
+            self.submit([encoder.finish()]);
             let img = self.read_rgba(&copied)?;
             Ok(Some(img.map(|p| [p[0], p[1], p[2]])))
         })

@@ -83,7 +83,7 @@ impl Gpu {
             for _ in 0..warmup {
                 record(&mut warm, None);
             }
-            self.queue.submit([warm.finish()]);
+            self.submit([warm.finish()]);
             self.wait()?;
             if !self.timestamps {
                 let mut times = Vec::with_capacity(repeats as usize);
@@ -91,7 +91,7 @@ impl Gpu {
                     let mut e = encoder("timed");
                     record(&mut e, None);
                     let start = Instant::now();
-                    self.queue.submit([e.finish()]);
+                    self.submit([e.finish()]);
                     self.wait()?;
                     times.push(start.elapsed().as_secs_f64() * 1e3);
                 }
@@ -117,7 +117,7 @@ impl Gpu {
             }
             e.resolve_query_set(&queries, 0..count, &resolved, 0);
             e.copy_buffer_to_buffer(&resolved, 0, &readback, 0, bytes);
-            self.queue.submit([e.finish()]);
+            self.submit([e.finish()]);
             let ticks = self.read_buffer(&readback)?;
             let ticks: &[u64] = bytemuck::cast_slice(&ticks);
             let period = f64::from(self.queue.get_timestamp_period());

@@ -1,0 +1,371 @@
+//! Relighting a resident pose on the GPU (`shaders/relight.wgsl`), twin of
+//! [`crate::resident::ResidentPose::relight_cpu`].
+//!
+//! A pose's basis codes are uploaded once ([`GpuBasis`], shared by every relit copy of
+//! the same views: walkers of other headings, the same walker under a new light). A
+//! light is then one dispatch pair per batch of views: the new coefficients written into
+//! the pose's own buffer, the weighted sum of the basis images, and its encoding into the
+//! pose's pre-lit layers with each view's peak as its scale, written by the GPU into the
+//! pose's view table. Nothing is uploaded again, nothing is read back and nothing waits:
+//! the dispatches of every pose relit between two frames are recorded into the GPU's one
+//! pending encoder, which [`Gpu::submit`] sends just ahead of the next frame.
+
+use std::sync::Arc;
+
+use frf_reflectance::imagecodec::BasisCodes;
+use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
+use wgpu::util::DeviceExt;
+
+use super::bind::{
+    bind_group, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
+};
+use super::{Gpu, GpuPose, shaders};
+use crate::error::Result;
+use crate::resident::PoseSource;
+
+/// Workgroup size of the relighting pass (`@workgroup_size(64)`).
+const WORKGROUP: u32 = 64;
+
+/// Most bytes of basis codes one batch of views holds.
+const RELIGHT_BATCH_BYTES: usize = 64 << 20;
+
+/// The relighting pipelines and the gamma table they decode codes with.
+pub struct RelightPass {
+    layout: wgpu::BindGroupLayout,
+    relight: wgpu::ComputePipeline,
+    encode: wgpu::ComputePipeline,
+    gamma: wgpu::Buffer,
+}
+
+impl RelightPass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "relight", shaders::RELIGHT);
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("relight"),
+            entries: &[
+                uniform::<GpuRelightParams>(0, c),
+                storage::<u32>(1, true, c),
+                storage::<[f32; 4]>(2, true, c),
+                storage::<[[f32; 4]; 64]>(3, true, c),
+                storage::<[f32; 4]>(4, false, c),
+                storage::<u32>(5, false, c),
+                storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
+                storage::<GpuRelightJob>(7, true, c),
+                storage::<frf_shaders::types::GpuView>(8, false, c),
+            ],
+        });
+        let compute = |entry: &str| compute_pipeline(device, entry, &[&layout], &module, entry);
+        let gamma = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("gamma"),
+            contents: &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        Self {
+            relight: compute("relight"),
+            encode: compute("encode"),
+            layout,
+            gamma,
+        }
+    }
+}
+
+/// One batch of views' codes and jobs.
+struct BasisBatch {
+    /// The views (indices into the pose's views), in job order.
+    views: Vec<usize>,
+    params: wgpu::Buffer,
+    codes: wgpu::Buffer,
+    jobs: wgpu::Buffer,
+    /// Coefficients (`vec4`) the batch's jobs read.
+    coefficients: usize,
+}
+
+/// The basis codes of a pose's views resident on the GPU (see the module docs).
+pub struct GpuBasis {
+    batches: Vec<BasisBatch>,
+    /// The host codes it was made from, kept so that their address names it.
+    made_from: Arc<Vec<BasisCodes>>,
+    texels: usize,
+    bytes: u64,
+}
+
+impl GpuBasis {
+    /// Bytes it holds on the GPU.
+    pub fn bytes(&self) -> u64 {
+        self.bytes
+    }
+
+    /// Whether it holds `codes` (the same host copy).
+    pub fn holds(&self, codes: &Arc<Vec<BasisCodes>>) -> bool {
+        Arc::ptr_eq(&self.made_from, codes)
+    }
+}
+
+/// What a relit pose keeps to be relit again: the shared codes, its own coefficients
+/// (one buffer per batch) and the views' peaks.
+pub struct PoseRelight {
+    basis: Arc<GpuBasis>,
+    coefficients: Vec<wgpu::Buffer>,
+    peaks: wgpu::Buffer,
+}
+
+impl PoseRelight {
+    /// The shared codes.
+    pub fn basis(&self) -> &Arc<GpuBasis> {
+        &self.basis
+    }
+}
+
+/// The coefficients of `batch`'s jobs for `source`: per view and basis image, RGB times
+/// the image's scale, and whether the condition is used at all.
+fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]> {
+    let mut out = Vec::with_capacity(batch.coefficients.max(1));
+    for &i in &batch.views {
+        let scales = &source.basis[i].scales;
+        for (k, &s) in scales.iter().enumerate() {
+            let c = source.coefficients[i].get(k).copied().unwrap_or([0.0; 3]);
+            let used = if c.iter().all(|&x| x == 0.0) {
+                0.0
+            } else {
+                1.0
+            };
+            out.push([c[0] * s, c[1] * s, c[2] * s, used]);
+        }
+    }
+    if out.is_empty() {
+        out.push([0.0; 4]);
+    }
+    out
+}
+
+impl Gpu {
+    /// Uploads the basis codes of `source`'s views read (with their alpha codes), in
+    /// batches of up to [`RELIGHT_BATCH_BYTES`].
+    pub fn upload_basis(&self, source: &PoseSource) -> Result<Arc<GpuBasis>> {
+        self.scoped("uploading basis codes", || {
+            let crop = source.geometry.crop;
+            let texels = crop.texels();
+            let read: Vec<usize> = (0..source.basis.len())
+                .filter(|&i| !source.is_blank(i) && source.geometry.prelit_layers[i] >= 0)
+                .collect();
+            let mut groups: Vec<Vec<usize>> = Vec::new();
+            let mut bytes = 0;
+            for &i in &read {
+                if groups.is_empty() || bytes >= RELIGHT_BATCH_BYTES {
+                    groups.push(Vec::new());
+                    bytes = 0;
+                }
+                groups.last_mut().expect("pushed").push(i);
+                bytes += source.basis[i].tiles.len() * texels * 4;
+            }
+            let batches: Vec<BasisBatch> = groups
+                .into_iter()
+                .map(|views| self.basis_batch(source, views))
+                .collect();
+            let bytes = batches
+                .iter()
+                .map(|b| b.codes.size() + b.jobs.size() + b.params.size())
+                .sum();
+            Ok(Arc::new(GpuBasis {
+                batches,
+                made_from: source.basis.clone(),
+                texels,
+                bytes,
+            }))
+        })
+    }
+
+    /// One batch of `views` of `source`: codes packed RGBA8 (tile 0's alpha byte holding
+    /// the view's alpha code), jobs and parameters.
+    fn basis_batch(&self, source: &PoseSource, views: Vec<usize>) -> BasisBatch {
+        let crop = source.geometry.crop;
+        let texels = crop.texels();
+        let mut codes: Vec<u32> = Vec::new();
+        let mut jobs = Vec::with_capacity(views.len());
+        let mut coefficients = 0;
+        for (j, &i) in views.iter().enumerate() {
+            let basis = &source.basis[i];
+            jobs.push(GpuRelightJob {
+                basis_offset: codes.len() as u32,
+                coefficient_offset: coefficients as u32,
+                tiles: basis.tiles.len() as u32,
+                view: i as u32,
+                layer: source.geometry.prelit_layers[i] as u32,
+                relit_offset: (j * texels) as u32,
+                pad0: 0,
+                pad1: 0,
+            });
+            coefficients += basis.scales.len();
+            for (k, tile) in basis.tiles.iter().enumerate() {
+                codes.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
+                    let alpha = if k == 0 { a as u32 } else { 0 };
+                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
+                }));
+            }
+        }
+        if codes.is_empty() {
+            codes.push(0);
+        }
+        let params = GpuRelightParams {
+            texels: texels as u32,
+            width: crop.width,
+            jobs: views.len() as u32,
+            pad: 0,
+        };
+        let buffer = |label: &str, contents: &[u8], usage| {
+            self.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents,
+                    usage,
+                })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        BasisBatch {
+            params: buffer(
+                "relight params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+            codes: buffer("basis", bytemuck::cast_slice(&codes), storage),
+            jobs: buffer("jobs", bytemuck::cast_slice(&jobs), storage),
+            views,
+            coefficients,
+        }
+    }
+
+    /// A pose's own relighting buffers over the shared `basis`, for `views` views.
+    pub(super) fn pose_relight(&self, basis: Arc<GpuBasis>, views: usize) -> PoseRelight {
+        let buffer = |label: &str, size: usize, usage| {
+            self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: size as u64,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        PoseRelight {
+            coefficients: basis
+                .batches
+                .iter()
+                .map(|b| buffer("coefficients", b.coefficients.max(1) * 16, dst))
+                .collect(),
+            peaks: buffer("peaks", views.max(1) * 4, dst),
+            basis,
+        }
+    }
+
+    /// Relights `pose` with `source`'s coefficients (the views and geometry it was made
+    /// from): see the module docs. Recorded, not submitted.
+    pub fn relight_pose(&self, pose: &GpuPose, source: &PoseSource) -> Result<()> {
+        self.scoped("relighting a resident pose", || {
+            let relight = pose.relight.as_ref().ok_or_else(|| {
+                crate::RenderError::Misuse("relighting a pose of no basis".into())
+            })?;
+            if !relight.basis.holds(&source.basis) {
+                return Err(crate::RenderError::Misuse(
+                    "relighting a pose with another pose's views".into(),
+                ));
+            }
+            self.record_relight(relight, source, pose);
+            Ok(())
+        })
+    }
+
+    /// Writes the coefficients and records the passes of [`Gpu::relight_pose`].
+    pub(super) fn record_relight(
+        &self,
+        relight: &PoseRelight,
+        source: &PoseSource,
+        pose: &GpuPose,
+    ) {
+        let basis = &relight.basis;
+        for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
+            let packed = packed_coefficients(batch, source);
+            self.queue
+                .write_buffer(buffer, 0, bytemuck::cast_slice(&packed));
+        }
+        let most_jobs = basis
+            .batches
+            .iter()
+            .map(|b| b.views.len())
+            .max()
+            .unwrap_or(0);
+        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("relit"),
+            size: (basis.texels * most_jobs.max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let target = pose.prelit_codes_view();
+        self.with_pending(|encoder| {
+            encoder.clear_buffer(&relight.peaks, 0, None);
+            for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
+                let bind = bind_group(
+                    &self.device,
+                    "relight",
+                    &self.relight.layout,
+                    vec![
+                        batch.params.as_entire_binding(),
+                        batch.codes.as_entire_binding(),
+                        coefficients.as_entire_binding(),
+                        self.relight.gamma.as_entire_binding(),
+                        relit.as_entire_binding(),
+                        relight.peaks.as_entire_binding(),
+                        wgpu::BindingResource::TextureView(&target),
+                        batch.jobs.as_entire_binding(),
+                        pose.views.as_entire_binding(),
+                    ],
+                );
+                let groups = (basis.texels as u32).div_ceil(WORKGROUP);
+                for pipeline in [&self.relight.relight, &self.relight.encode] {
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some("relight"),
+                        timestamp_writes: None,
+                    });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &bind, &[]);
+                    pass.dispatch_workgroups(groups, batch.views.len() as u32, 1);
+                }
+            }
+        });
+    }
+
+    /// Runs `f` on the pending encoder (made when there is none): work recorded between
+    /// frames (relights, shadows) that [`Gpu::submit`] sends ahead of the next.
+    pub(super) fn with_pending<T>(&self, f: impl FnOnce(&mut wgpu::CommandEncoder) -> T) -> T {
+        let mut pending = self.pending.lock().unwrap_or_else(|e| e.into_inner());
+        let encoder = pending.get_or_insert_with(|| {
+            self.device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("pending"),
+                })
+        });
+        f(encoder)
+    }
+
+    /// Submits `buffers`, after the pending work (in a submission of its own, so that a
+    /// frame the device refuses does not take the relights recorded before it along).
+    pub fn submit(
+        &self,
+        buffers: impl IntoIterator<Item = wgpu::CommandBuffer>,
+    ) -> wgpu::SubmissionIndex {
+        let pending = self
+            .pending
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take();
+        if let Some(p) = pending {
+            self.queue.submit([p.finish()]);
+        }
+        self.queue.submit(buffers)
+    }
+
+    /// Submits the pending work (before a caller submits its own encoder).
+    pub fn flush(&self) {
+        self.submit([]);
+    }
+}

@@ -1,0 +1,292 @@
+//! `frf bench frame`: what one frame of a crowd costs, by number of walkers and by
+//! lighting. The scene's first walker is copied onto a square grid (1.2 m apart, centred
+//! where it stands), each copy turned by the golden angle from the last so that every
+//! walker is relit for a heading of its own (the costly case: walkers of one heading
+//! share one relit pose). The frames are a few milliseconds of the scene's time apart,
+//! so every walker keeps its pose and only the lighting differs: held (`constant`), or
+//! turned 15° a frame (`turning`). One frame is drawn first to make the poses resident
+//! and is not counted; the medians of the counted frames are reported:
+//!
+//! - `wall_ms_per_frame`: the frame from start to its pixels read back;
+//! - `gpu_ms_per_frame`: how long the host waited on the device within it (fenced: the
+//!   device's work that the host did not overlap; on a software adapter the device is
+//!   the host's own cores);
+//! - `host_ms_per_frame`: the difference, the host's own work (planning, projecting the
+//!   light, recording and submitting, converting the pixels read back).
+
+use std::time::Instant;
+
+use frf_core::progress::Progress;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
+use frf_render::renderer::Device;
+use glam::Vec3;
+use serde::Serialize;
+
+use super::shot::{Shot, ShotOptions};
+use super::{Instance, LightKey, Scene};
+use crate::error::Result;
+use frf_core::BadArgument;
+
+/// Seconds of the scene's time between two counted frames.
+const FRAME_STEP_S: f64 = 1e-3;
+
+/// Degrees a turning light turns a frame.
+const TURN_DEG_PER_FRAME: f32 = 15.0;
+
+/// Metres between walkers on the grid.
+const SPACING_M: f32 = 1.2;
+
+/// A frame's lighting in the benchmark.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightMode {
+    /// The scene's first lighting key, held.
+    Constant,
+    /// The first key turned a further 15° every frame.
+    Turning,
+}
+
+impl LightMode {
+    /// Its name in tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightMode::Constant => "constant",
+            LightMode::Turning => "turning",
+        }
+    }
+}
+
+/// What `frf bench frame` runs.
+#[derive(Debug, Clone)]
+pub struct FrameBenchOptions {
+    /// Walker counts.
+    pub walkers: Vec<usize>,
+    /// Lightings.
+    pub lights: Vec<LightMode>,
+    /// Frames counted per row (after one not counted).
+    pub frames: usize,
+    /// Frame size.
+    pub size: (u32, u32),
+    /// How shots are rendered (memory budget, plan).
+    pub shot: ShotOptions,
+    /// Render on the CPU reference.
+    pub cpu: bool,
+}
+
+impl FrameBenchOptions {
+    /// Refuses counts no run can use.
+    pub fn check(&self) -> Result<()> {
+        if let Some(&w) = self.walkers.iter().find(|&&w| w == 0 || w > 10_000) {
+            return Err(BadArgument::new("--walkers", w, "1 to 10000 walkers").into());
+        }
+        if self.walkers.is_empty() {
+            return Err(BadArgument::new("--walkers", "(none)", "at least one count").into());
+        }
+        if self.frames == 0 || self.frames > 10_000 {
+            return Err(BadArgument::new("--frames", self.frames, "1 to 10000 frames").into());
+        }
+        Ok(())
+    }
+}
+
+/// One row: a walker count under one lighting.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameBenchRow {
+    /// Walkers drawn.
+    pub walkers: usize,
+    /// `constant` or `turning`.
+    pub light: LightMode,
+    /// Median host work per frame (wall less waits on the device), ms.
+    pub host_ms_per_frame: f64,
+    /// Median wait on the device per frame (fenced), ms.
+    pub gpu_ms_per_frame: f64,
+    /// Median frame, ms.
+    pub wall_ms_per_frame: f64,
+    /// Poses relit per counted frame (mean).
+    pub relights_per_frame: f64,
+    /// Most bytes resident at once, MB.
+    pub peak_resident_mb: f64,
+}
+
+/// What `frf bench frame` measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct FrameBenchReport {
+    /// What rendered.
+    pub device: String,
+    /// How `gpu_ms_per_frame` was measured.
+    pub gpu_clock: &'static str,
+    /// Frame size.
+    pub size: (u32, u32),
+    /// Frames counted per row.
+    pub frames: usize,
+    /// The rows.
+    pub rows: Vec<FrameBenchRow>,
+}
+
+impl FrameBenchReport {
+    /// The rows as a table, with the ratios the targets read.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{} at {}x{}, {} frames a row (medians; gpu = fenced wait on the device)\n",
+            self.device, self.size.0, self.size.1, self.frames
+        );
+        out += "walkers  light     host ms  gpu ms  wall ms  relit/frame  peak MB\n";
+        for r in &self.rows {
+            out += &format!(
+                "{:>7}  {:<8} {:>8.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
+                r.walkers,
+                r.light.name(),
+                r.host_ms_per_frame,
+                r.gpu_ms_per_frame,
+                r.wall_ms_per_frame,
+                r.relights_per_frame,
+                r.peak_resident_mb
+            );
+        }
+        let find =
+            |w: usize, l: LightMode| self.rows.iter().find(|r| r.walkers == w && r.light == l);
+        for r in &self.rows {
+            if r.light == LightMode::Turning
+                && let Some(c) = find(r.walkers, LightMode::Constant)
+            {
+                out += &format!(
+                    "{} walkers: turning / constant light, wall per frame: {:.2}x\n",
+                    r.walkers,
+                    r.wall_ms_per_frame / c.wall_ms_per_frame
+                );
+            }
+        }
+        if let (Some(lo), Some(hi)) = (
+            self.rows.iter().min_by_key(|r| r.walkers),
+            self.rows.iter().max_by_key(|r| r.walkers),
+        ) && hi.walkers > lo.walkers
+        {
+            for light in [LightMode::Constant, LightMode::Turning] {
+                if let (Some(a), Some(b)) = (find(lo.walkers, light), find(hi.walkers, light)) {
+                    out += &format!(
+                        "{light} light: host per frame at {} walkers / at {}: {:.2}x\n",
+                        b.walkers,
+                        a.walkers,
+                        b.host_ms_per_frame / a.host_ms_per_frame,
+                        light = light.name()
+                    );
+                }
+            }
+        }
+        out
+    }
+}
+
+/// `scene` with its first walker copied `n` times on a grid, lit as `light` says for
+/// `frames` frames from its start.
+pub fn bench_scene(scene: &Scene, n: usize, light: LightMode, frames: usize) -> Scene {
+    let mut s = scene.clone();
+    let first = scene.instances[0];
+    let side = (n as f32).sqrt().ceil() as usize;
+    let centre = (side as f32 - 1.0) * 0.5;
+    s.instances = (0..n)
+        .map(|k| Instance {
+            position: first.position
+                + Vec3::new(
+                    ((k % side) as f32 - centre) * SPACING_M,
+                    0.0,
+                    ((k / side) as f32 - centre) * SPACING_M,
+                ),
+            heading: first.heading + k as f32 * 137.507_77_f32.to_radians(),
+            time_offset: first.time_offset,
+        })
+        .collect();
+    let key = scene.lighting[0].clone();
+    let span = (frames + 1) as f64 * FRAME_STEP_S;
+    s.start = scene.start;
+    s.fps = 1.0 / FRAME_STEP_S;
+    s.end = scene.start + span;
+    s.lighting = match light {
+        LightMode::Constant => vec![LightKey {
+            time: scene.start,
+            ..key
+        }],
+        LightMode::Turning => vec![
+            LightKey {
+                time: scene.start,
+                ..key.clone()
+            },
+            LightKey {
+                time: s.end,
+                yaw: key.yaw + (TURN_DEG_PER_FRAME * (frames + 1) as f32).to_radians(),
+                ..key
+            },
+        ],
+    };
+    s
+}
+
+/// Runs the benchmark of `scene` on `field` (see the module docs), one progress step a
+/// frame.
+pub fn run_frame_bench<R: ReadAt>(
+    scene: &Scene,
+    field: &FieldFile<R>,
+    options: &FrameBenchOptions,
+    progress: &dyn Progress,
+) -> Result<FrameBenchReport> {
+    options.check()?;
+    let rows_wanted = options.walkers.len() * options.lights.len();
+    progress.phase("frames", rows_wanted * (options.frames + 1));
+    let mut rows = Vec::with_capacity(rows_wanted);
+    let mut device_name = String::new();
+    for &n in &options.walkers {
+        for &light in &options.lights {
+            let s = bench_scene(scene, n, light, options.frames);
+            let frames = s.shot_frames(0..options.frames + 1, options.size)?;
+            let device = Device::open(options.cpu)?;
+            device_name = device.name();
+            let mut shot = Shot::new(&s, field, device, &frames, options.shot)?;
+            let mut wall = Vec::new();
+            let mut waited = Vec::new();
+            let mut relights = 0;
+            for (k, f) in frames.iter().enumerate() {
+                let before = waited_on(shot.render_device());
+                let t = Instant::now();
+                let made = shot.render(f, false)?.made_resident.len();
+                let w = t.elapsed().as_secs_f64() * 1e3;
+                if k > 0 {
+                    wall.push(w);
+                    waited.push((waited_on(shot.render_device()) - before) * 1e3);
+                    relights += made;
+                }
+                progress.step();
+            }
+            let host: Vec<f64> = wall.iter().zip(&waited).map(|(w, g)| w - g).collect();
+            rows.push(FrameBenchRow {
+                walkers: n,
+                light,
+                host_ms_per_frame: median(&host),
+                gpu_ms_per_frame: median(&waited),
+                wall_ms_per_frame: median(&wall),
+                relights_per_frame: relights as f64 / options.frames as f64,
+                peak_resident_mb: shot.counters().peak_resident_bytes as f64 / 1e6,
+            });
+        }
+    }
+    Ok(FrameBenchReport {
+        device: device_name,
+        gpu_clock: "fenced-wall",
+        size: options.size,
+        frames: options.frames,
+        rows,
+    })
+}
+
+/// Seconds the host has waited on `device` so far (none on the CPU).
+fn waited_on(device: &Device) -> f64 {
+    match device {
+        Device::Gpu(gpu) => gpu.waited().as_secs_f64(),
+        Device::Cpu => 0.0,
+    }
+}
+
+/// The median of `v` (NaN when empty).
+fn median(v: &[f64]) -> f64 {
+    frf_render::gpu::timing::median_min(v).0
+}
