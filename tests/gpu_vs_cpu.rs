@@ -37,6 +37,33 @@ fn gpu() -> Option<Gpu> {
     }
 }
 
+/// The scales the relighting pass wrote into `pose`'s view table (never read back by the
+/// renderer itself) within 1e-5 of the CPU twin's, and its pre-lit codes within 1.
+fn assert_relit_as_the_cpu(
+    gpu: &Gpu,
+    pose: &frf_render::gpu::GpuPose,
+    cpu: &ResidentPose,
+    what: &str,
+) {
+    let scales = gpu.read_scales(pose).unwrap();
+    for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
+            "{what}, view {i}: scale {a} vs {b}"
+        );
+    }
+    let texels = gpu.read_prelit(pose).unwrap();
+    assert_eq!(texels.len(), cpu.prelit.len());
+    for (i, (a, b)) in cpu.prelit.iter().zip(&texels).enumerate() {
+        for (x, y) in a.iter().zip(b) {
+            for k in 0..4 {
+                let d = (x[k] as i32 - y[k] as i32).abs();
+                assert!(d <= 1, "{what}, view {i}: pre-lit code {x:?} vs {y:?}");
+            }
+        }
+    }
+}
+
 fn tiny_source() -> PoseSource {
     frf_testkit::tiny_field().source(&EnvMap::sky())
 }
@@ -50,25 +77,7 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     // The frames below find their quads through the cylinder's column index.
     assert!(pose.geometry.cylinder.has_column_index());
 
-    // The scales the relighting pass wrote into the pose's view table, never read back
-    // by the renderer itself.
-    let scales = gpu.read_scales(&pose).unwrap();
-    for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
-        assert!(
-            (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
-            "view {i}: scale {a} vs {b}"
-        );
-    }
-    let texels = gpu.read_prelit(&pose).unwrap();
-    assert_eq!(texels.len(), cpu.prelit.len());
-    for (i, (a, b)) in cpu.prelit.iter().zip(&texels).enumerate() {
-        for (x, y) in a.iter().zip(b) {
-            for k in 0..4 {
-                let d = (x[k] as i32 - y[k] as i32).abs();
-                assert!(d <= 1, "view {i}: pre-lit code {x:?} vs {y:?}");
-            }
-        }
-    }
+    assert_relit_as_the_cpu(&gpu, &pose, &cpu, "upload");
 
     let target = Vec3::new(0.0, 0.9, 0.0);
     let cameras = [
@@ -277,22 +286,7 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
         let source = first.relit(&field, &lighting, None).unwrap();
         gpu.relight_pose(&pose, &source).unwrap();
         let cpu = ResidentPose::relight_cpu(&source);
-        let scales = gpu.read_scales(&pose).unwrap();
-        for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
-            assert!(
-                (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
-                "frame {frame}, view {i}: scale {a} vs {b}"
-            );
-        }
-        let texels = gpu.read_prelit(&pose).unwrap();
-        for (i, (a, b)) in cpu.prelit.iter().zip(&texels).enumerate() {
-            for (x, y) in a.iter().zip(b) {
-                for k in 0..4 {
-                    let d = (x[k] as i32 - y[k] as i32).abs();
-                    assert!(d <= 1, "frame {frame}, view {i}: code {x:?} vs {y:?}");
-                }
-            }
-        }
+        assert_relit_as_the_cpu(&gpu, &pose, &cpu, &format!("frame {frame}"));
         // A copy made afresh, sharing the codes, draws the same frame.
         let fresh = gpu.upload_pose_sharing(&source, Some(&shared)).unwrap();
         assert!(std::sync::Arc::ptr_eq(fresh.basis().unwrap(), &shared));
