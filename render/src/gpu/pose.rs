@@ -44,7 +44,16 @@ pub struct GpuPose {
     /// The relit shadow of the ground, when the pose has shadow maps and a lighting.
     pub(super) shadow: Option<(wgpu::Texture, RelitShadowInfo)>,
     /// The shadow maps and weights it was relit from, kept to relight it again.
-    pub(super) shadow_maps: Option<super::shadow::MapRelight>,
+    pub(super) shadow_maps: Option<MapRelight>,
+}
+
+/// A pose's shadow maps resident with their weights and relit texture, bound
+/// ([`super::shadow`]): relit again by writing the weights.
+pub struct MapRelight {
+    pub(super) texels: u32,
+    pub(super) maps: usize,
+    pub(super) weights: wgpu::Buffer,
+    pub(super) bind: wgpu::BindGroup,
 }
 
 /// What the composite pass needs to know of a relit shadow texture.
@@ -170,9 +179,27 @@ impl Gpu {
             source.flows.table,
         );
         let relight = self.pose_relight(basis, geometry.views());
-        self.record_relight(&relight, source, &pose);
+        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose.views);
         pose.relight = Some(relight);
         Ok(pose)
+    }
+
+    /// Relights `pose` with `source`'s coefficients (the views and geometry it was made
+    /// from): new coefficients and one dispatch pair per batch of views
+    /// ([`super::relight`]), recorded with the pending work, not submitted.
+    pub fn relight_pose(&self, pose: &GpuPose, source: &PoseSource) -> Result<()> {
+        self.scoped("relighting a resident pose", || {
+            let relight = pose.relight.as_ref().ok_or_else(|| {
+                crate::RenderError::Misuse("relighting a pose of no basis".into())
+            })?;
+            if !relight.basis().holds(&source.basis) {
+                return Err(crate::RenderError::Misuse(
+                    "relighting a pose with another pose's views".into(),
+                ));
+            }
+            self.record_relight(relight, source, &pose.prelit_codes_view(), &pose.views);
+            Ok(())
+        })
     }
 
     /// The views' pre-lit colour scales as the GPU holds them (for tests and inspection).

@@ -19,7 +19,7 @@ use wgpu::util::DeviceExt;
 use super::bind::{
     bind_group, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
 };
-use super::{Gpu, GpuPose, shaders};
+use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::resident::PoseSource;
 
@@ -258,29 +258,15 @@ impl Gpu {
         }
     }
 
-    /// Relights `pose` with `source`'s coefficients (the views and geometry it was made
-    /// from): see the module docs. Recorded, not submitted.
-    pub fn relight_pose(&self, pose: &GpuPose, source: &PoseSource) -> Result<()> {
-        self.scoped("relighting a resident pose", || {
-            let relight = pose.relight.as_ref().ok_or_else(|| {
-                crate::RenderError::Misuse("relighting a pose of no basis".into())
-            })?;
-            if !relight.basis.holds(&source.basis) {
-                return Err(crate::RenderError::Misuse(
-                    "relighting a pose with another pose's views".into(),
-                ));
-            }
-            self.record_relight(relight, source, pose);
-            Ok(())
-        })
-    }
-
-    /// Writes the coefficients and records the passes of [`Gpu::relight_pose`].
+    /// Writes `source`'s coefficients into `relight`'s buffers and records the passes
+    /// that relight its views into the pre-lit layers of `target`, their scales into the
+    /// view table `views` ([`Gpu::relight_pose`]).
     pub(super) fn record_relight(
         &self,
         relight: &PoseRelight,
         source: &PoseSource,
-        pose: &GpuPose,
+        target: &wgpu::TextureView,
+        views: &wgpu::Buffer,
     ) {
         let basis = &relight.basis;
         for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
@@ -300,7 +286,6 @@ impl Gpu {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let target = pose.prelit_codes_view();
         self.with_pending(|encoder| {
             encoder.clear_buffer(&relight.peaks, 0, None);
             for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
@@ -315,9 +300,9 @@ impl Gpu {
                         self.relight.gamma.as_entire_binding(),
                         relit.as_entire_binding(),
                         relight.peaks.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&target),
+                        wgpu::BindingResource::TextureView(target),
                         batch.jobs.as_entire_binding(),
-                        pose.views.as_entire_binding(),
+                        views.as_entire_binding(),
                     ],
                 );
                 let groups = (basis.texels as u32).div_ceil(WORKGROUP);

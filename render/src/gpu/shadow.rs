@@ -7,7 +7,7 @@ use frf_core::image::{Rgb, RgbImage};
 use wgpu::util::DeviceExt;
 
 use super::bind::{bind_group, compute_pipeline, rgba32f, storage, storage_texture, uniform};
-use super::pose::{GpuPose, RelitShadowInfo};
+use super::pose::{GpuPose, MapRelight, RelitShadowInfo};
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::shadow::{RelitShadow, ShadowMaps};
@@ -39,15 +39,6 @@ impl ShadowPass {
         let pipeline = compute_pipeline(device, "shadow", &[&layout], &module, "relight_shadow");
         Self { layout, pipeline }
     }
-}
-
-/// A pose's shadow maps resident with their weights and relit texture, bound: relit
-/// again by writing the weights.
-pub struct MapRelight {
-    texels: u32,
-    maps: usize,
-    weights: wgpu::Buffer,
-    bind: wgpu::BindGroup,
 }
 
 impl Gpu {
