@@ -55,6 +55,9 @@ const EL_CELLS: usize = 180 * CELLS_PER_DEGREE;
 pub struct Projector {
     /// Nearest condition per (elevation, azimuth) cell of the dome frame.
     grid: Vec<u16>,
+    /// Per elevation row of the grid: its runs of one condition along the azimuth,
+    /// `(first cell, end cell, condition)`, covering the row once.
+    runs: Vec<Vec<(u32, u32, u16)>>,
     /// `Σ_l E_l` per condition and channel.
     delivered: Vec<Rgb>,
     floor: Vec<bool>,
@@ -66,8 +69,30 @@ fn cell_direction(ia: usize, ie: usize) -> Vec3 {
     frf_core::light::direction_from_azimuth_elevation(az, el)
 }
 
-/// One texel of an environment map: its azimuth and elevation (radians) and radiance.
-type Texel = (f32, f32, Rgb);
+/// The radiance of a map row's texels (`prefix`: its prefix sums, `w` texels) whose
+/// grid cell, at `C = c` ([`Projector::region_light_many`]), is in `a..b`: those with
+/// `frac(C − (x + ½)/w) ∈ [a, b) / AZ_CELLS`, one contiguous span of `x` for each whole
+/// turn `n` that `C − (x + ½)/w` can lie in.
+fn span_sum(prefix: &[[f64; 3]], w: usize, c: f64, (a, b): (u32, u32)) -> [f64; 3] {
+    let (lo_cell, hi_cell) = (a as f64 / AZ_CELLS as f64, b as f64 / AZ_CELLS as f64);
+    let wf = w as f64;
+    let mut out = [0.0f64; 3];
+    // Over x in 0..w, C − (x + ½)/w lies in (C − 1, C).
+    let first = (c - 1.0).floor() as i64;
+    for n in first..=c.floor() as i64 {
+        let n = n as f64;
+        // C − (x + ½)/w ∈ [lo + n, hi + n)  ⟺  x ∈ (w(C − hi − n) − ½, w(C − lo − n) − ½].
+        let from = ((wf * (c - hi_cell - n) - 0.5).floor() + 1.0).max(0.0);
+        let to = (wf * (c - lo_cell - n) - 0.5).floor().min(wf - 1.0);
+        if from <= to {
+            let (from, to) = (from as usize, to as usize);
+            for ch in 0..3 {
+                out[ch] += prefix[to + 1][ch] - prefix[from][ch];
+            }
+        }
+    }
+    out
+}
 
 impl Projector {
     /// A projector for `conditions` (dome frame).
@@ -86,7 +111,7 @@ impl Projector {
                 "a basis needs 1..65535 conditions with lights".into(),
             ));
         }
-        let grid = (0..EL_CELLS * AZ_CELLS)
+        let grid: Vec<u16> = (0..EL_CELLS * AZ_CELLS)
             .into_par_iter()
             .map(|i| {
                 let d = cell_direction(i % AZ_CELLS, i / AZ_CELLS);
@@ -95,6 +120,19 @@ impl Projector {
                     .max_by(|a, b| a.0.dot(d).total_cmp(&b.0.dot(d)))
                     .map(|l| l.1)
                     .unwrap_or(0)
+            })
+            .collect();
+        let runs: Vec<Vec<(u32, u32, u16)>> = (0..EL_CELLS)
+            .map(|ie| {
+                let row = &grid[ie * AZ_CELLS..(ie + 1) * AZ_CELLS];
+                let mut runs: Vec<(u32, u32, u16)> = Vec::new();
+                for (ia, &k) in row.iter().enumerate() {
+                    match runs.last_mut() {
+                        Some(r) if r.2 == k => r.1 = ia as u32 + 1,
+                        _ => runs.push((ia as u32, ia as u32 + 1, k)),
+                    }
+                }
+                runs
             })
             .collect();
         let delivered = conditions
@@ -107,6 +145,7 @@ impl Projector {
             .collect();
         Ok(Self {
             grid,
+            runs,
             delivered,
             floor: conditions.iter().map(|c| c.floor).collect(),
         })
@@ -136,9 +175,17 @@ impl Projector {
         self.region_light_many(env, &[turntable], floor).remove(0)
     }
 
-    /// [`Projector::region_light`] at each of `turntables`: the direction, radiance and
-    /// solid angle of each texel are found once for all of them (the same arithmetic,
-    /// so the same sums).
+    /// [`Projector::region_light`] at each of `turntables`.
+    ///
+    /// An environment map is equirectangular: a texel row has one elevation (a turn about
+    /// `+y` keeps it), hence one row of the lookup grid, and its texels' azimuths step
+    /// evenly. Texel `x` of a map `w` wide turned by `ψ`, seen at turntable `t`, falls in
+    /// grid cell `⌊frac(C − (x + ½)/w) · AZ_CELLS⌋` with `C = (3π + ψ + t) / 2π`. So each
+    /// run of one condition along the grid row takes a contiguous span of texels (two
+    /// where it wraps), summed from the row's prefix sums: a turntable angle costs rows ×
+    /// runs, not rows × texels, which is what makes relighting a crowd under a moving
+    /// light cheap for the host. Texels whose centre lies on a cell boundary (to within
+    /// rounding) may fall on its other side than a direct lookup would put them.
     pub fn region_light_many(
         &self,
         env: &EnvMap,
@@ -151,45 +198,40 @@ impl Projector {
             FloorModel::Environment => None,
             FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
         };
-        // Per row: its texels' (azimuth, elevation, radiance); and its solid angle.
-        let texels: Vec<(f64, Vec<Texel>)> = (0..h)
+        // Per row: its solid angle, its grid row and the prefix sums of its radiance.
+        let rows: Vec<(f64, usize, Vec<[f64; 3]>)> = (0..h)
             .into_par_iter()
             .map(|y| {
-                let row = (0..w)
-                    .map(|x| {
-                        let d = env.direction_of(x as f32, y as f32);
-                        let (az, el) = azimuth_elevation(d);
-                        let l = match ground {
-                            Some(g) if d.y < 0.0 => g,
-                            _ => img.get(x, y),
-                        };
-                        (az, el, l)
-                    })
-                    .collect();
-                (env.texel_solid_angle(y) as f64, row)
+                let d = env.direction_of(0.0, y as f32);
+                let el = azimuth_elevation(d).1;
+                let ie = (((el + PI / 2.0) / PI * EL_CELLS as f32) as usize).min(EL_CELLS - 1);
+                let mut prefix = Vec::with_capacity(w + 1);
+                let mut sum = [0.0f64; 3];
+                prefix.push(sum);
+                for x in 0..w {
+                    let l = match ground {
+                        Some(g) if d.y < 0.0 => g,
+                        _ => img.get(x, y),
+                    };
+                    for c in 0..3 {
+                        sum[c] += l[c] as f64;
+                    }
+                    prefix.push(sum);
+                }
+                (env.texel_solid_angle(y) as f64, ie, prefix)
             })
             .collect();
         turntables
-            .iter()
+            .par_iter()
             .map(|&turntable| {
-                let per_row: Vec<Vec<[f64; 3]>> = texels
-                    .par_iter()
-                    .map(|(omega, row)| {
-                        let mut acc = vec![[0.0f64; 3]; self.conditions()];
-                        for &(az, el, l) in row {
-                            let k = self.lookup(az + turntable, el);
-                            for c in 0..3 {
-                                acc[k][c] += l[c] as f64 * omega;
-                            }
-                        }
-                        acc
-                    })
-                    .collect();
+                let c = (3.0 * std::f64::consts::PI + env.yaw() as f64 + turntable as f64)
+                    / std::f64::consts::TAU;
                 let mut total = vec![[0.0f64; 3]; self.conditions()];
-                for row in per_row {
-                    for (t, r) in total.iter_mut().zip(row) {
-                        for c in 0..3 {
-                            t[c] += r[c];
+                for (omega, ie, prefix) in &rows {
+                    for &(a, b, k) in &self.runs[*ie] {
+                        let sum = span_sum(prefix, w, c, (a, b));
+                        for ch in 0..3 {
+                            total[k as usize][ch] += sum[ch] * omega;
                         }
                     }
                 }

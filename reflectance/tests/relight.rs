@@ -318,3 +318,48 @@ fn bad_relighting_input_is_refused() {
     let e = refused(&odd, &[[1.0; 3]; 3]);
     assert!(e.contains("basis image size: expected 8x6, got 3x3"), "{e}");
 }
+
+/// The projection sums each condition's run of grid cells over a row's prefix sums
+/// (issue 37); it equals the texel-by-texel sum of each texel into the condition of its
+/// turned direction, for a turned map, any turntable angle and both floor models.
+#[test]
+fn the_run_length_projection_equals_the_sum_texel_by_texel() {
+    let conds = conditions();
+    let projector = Projector::new(&conds).unwrap();
+    let env = textured_env(256).rotated(0.37);
+    let floors = [
+        FloorModel::Environment,
+        FloorModel::LambertianGround {
+            albedo: [0.3, 0.25, 0.2],
+        },
+    ];
+    let turntables = [0.0f32, 0.7, -2.3, 5.9, 10f32.to_radians()];
+    for floor in floors {
+        let fast = projector.region_light_many(&env, &turntables, floor);
+        let ground = match floor {
+            FloorModel::Environment => None,
+            FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
+        };
+        for (t, fast) in turntables.iter().zip(&fast) {
+            let rot = Mat3::from_rotation_y(*t);
+            let mut slow = vec![[0.0f64; 3]; conds.len()];
+            let (w, h) = env.image().size();
+            for y in 0..h {
+                let omega = env.texel_solid_angle(y) as f64;
+                for x in 0..w {
+                    let d = env.direction_of(x as f32, y as f32);
+                    let l = match ground {
+                        Some(g) if d.y < 0.0 => g,
+                        _ => env.image().get(x, y),
+                    };
+                    let k = projector.condition_of(rot * d);
+                    for c in 0..3 {
+                        slow[k][c] += l[c] as f64 * omega;
+                    }
+                }
+            }
+            let slow: Vec<Rgb> = slow.iter().map(|s| s.map(|v| v as f32)).collect();
+            close(&slow, fast, 1e-5);
+        }
+    }
+}

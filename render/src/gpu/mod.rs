@@ -77,6 +77,8 @@ pub struct Gpu {
     relight: relight::RelightPass,
     /// Work recorded between frames, sent ahead of the next ([`Gpu::submit`]).
     pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
+    /// The relighting pass's scratch buffer, kept ([`relight`]).
+    relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Nanoseconds the host has waited on the device ([`Gpu::waited`]).
     waited_ns: std::sync::atomic::AtomicU64,
     rebin: rebin::RebinPass,
@@ -146,6 +148,7 @@ impl Gpu {
         Self {
             relight: relight::RelightPass::new(&device),
             pending: std::sync::Mutex::new(None),
+            relit: std::sync::Mutex::new(None),
             waited_ns: std::sync::atomic::AtomicU64::new(0),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,
@@ -211,18 +214,25 @@ impl Gpu {
     }
 
     pub(crate) fn wait(&self) -> Result<()> {
+        self.waiting(|| self.device.poll(wgpu::PollType::wait_indefinitely()))
+            .map_err(wgpu_err("waiting on the device"))?;
+        Ok(())
+    }
+
+    /// Runs `f`, a call that may block on the device, counting its time as waiting.
+    fn waiting<T>(&self, f: impl FnOnce() -> T) -> T {
         let start = std::time::Instant::now();
-        let polled = self.device.poll(wgpu::PollType::wait_indefinitely());
+        let out = f();
         self.waited_ns.fetch_add(
             start.elapsed().as_nanos() as u64,
             std::sync::atomic::Ordering::Relaxed,
         );
-        polled.map_err(wgpu_err("waiting on the device"))?;
-        Ok(())
+        out
     }
 
-    /// How long the host has waited on the device so far (for every readback and
-    /// fence): what a frame's wall time less this is the host's own work.
+    /// How long the host has waited on the device so far (every fence and readback, and
+    /// submissions blocked behind earlier work): what a frame's wall time less this is the
+    /// host's own work.
     pub fn waited(&self) -> std::time::Duration {
         std::time::Duration::from_nanos(self.waited_ns.load(std::sync::atomic::Ordering::Relaxed))
     }

@@ -280,12 +280,7 @@ impl Gpu {
             .map(|b| b.views.len())
             .max()
             .unwrap_or(0);
-        let relit = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("relit"),
-            size: (basis.texels * most_jobs.max(1) * 16) as u64,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
+        let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
         self.with_pending(|encoder| {
             encoder.clear_buffer(&relight.peaks, 0, None);
             for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
@@ -306,17 +301,39 @@ impl Gpu {
                     ],
                 );
                 let groups = (basis.texels as u32).div_ceil(WORKGROUP);
+                // One pass: the encoding's dispatch sees the sums' (wgpu orders the
+                // two dispatches' use of the scratch and the peaks).
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("relight"),
+                    timestamp_writes: None,
+                });
+                pass.set_bind_group(0, &bind, &[]);
                 for pipeline in [&self.relight.relight, &self.relight.encode] {
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some("relight"),
-                        timestamp_writes: None,
-                    });
                     pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &bind, &[]);
                     pass.dispatch_workgroups(groups, batch.views.len() as u32, 1);
                 }
             }
         });
+    }
+
+    /// The scratch buffer relit colours go through between the two passes, at least
+    /// `size` bytes: one for every relight (their passes run in order), grown when a
+    /// larger batch needs it, instead of a new zeroed buffer each time.
+    fn relit_scratch(&self, size: u64) -> wgpu::Buffer {
+        let mut kept = self.relit.lock().unwrap_or_else(|e| e.into_inner());
+        match &*kept {
+            Some(b) if b.size() >= size => b.clone(),
+            _ => {
+                let b = self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("relit"),
+                    size,
+                    usage: wgpu::BufferUsages::STORAGE,
+                    mapped_at_creation: false,
+                });
+                *kept = Some(b.clone());
+                b
+            }
+        }
     }
 
     /// Runs `f` on the pending encoder (made when there is none): work recorded between
@@ -334,6 +351,8 @@ impl Gpu {
 
     /// Submits `buffers`, after the pending work (in a submission of its own, so that a
     /// frame the device refuses does not take the relights recorded before it along).
+    /// Time blocked in the submissions counts as waiting on the device ([`Gpu::waited`]):
+    /// a software adapter runs earlier work there before it takes more.
     pub fn submit(
         &self,
         buffers: impl IntoIterator<Item = wgpu::CommandBuffer>,
@@ -342,11 +361,15 @@ impl Gpu {
             .pending
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .take();
-        if let Some(p) = pending {
-            self.queue.submit([p.finish()]);
-        }
-        self.queue.submit(buffers)
+            .take()
+            .map(|p| p.finish());
+        let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
+        self.waiting(|| {
+            if let Some(p) = pending {
+                self.queue.submit([p]);
+            }
+            self.queue.submit(buffers)
+        })
     }
 
     /// Submits the pending work (before a caller submits its own encoder).
