@@ -38,55 +38,48 @@ impl IngestReport {
                 .into(),
         };
         lines.push("  against the virtual stage's truth:".to_string());
-        lines.push(format!(
-            "    alpha IoU                           {}",
-            f(r.alpha_iou, "", 4)
-        ));
-        lines.push(format!(
-            "    alpha mean absolute error           {}",
-            f(r.alpha_mae, "", 4)
-        ));
-        lines.push(format!(
-            "    registered basis PSNR (subject)     {}",
-            f(r.registration_psnr, " dB", 2)
-        ));
-        lines.push(format!(
-            "    same frames unregistered            {}",
-            f(r.unregistered_psnr, " dB", 2)
-        ));
         let pair = |after: Option<f64>, before: Option<f64>| match (after, before) {
             (Some(a), Some(b)) => format!("{a:.4} ({b:.4} before edge decontamination)"),
             _ => f(after, "", 4),
         };
-        lines.push(format!(
-            "    edge band error over black          {}",
-            pair(r.edge_band_error_dark, r.edge_band_error_dark_raw)
-        ));
-        lines.push(format!(
-            "    edge band error over bright         {}",
-            pair(r.edge_band_error_bright, r.edge_band_error_bright_raw)
-        ));
-        lines.push(format!(
-            "    flow EPE inside matte, horizontal   {}",
-            f(r.flow_epe_horizontal, " px", 3)
-        ));
-        lines.push(format!(
-            "    flow EPE inside matte, vertical     {}",
-            f(r.flow_epe_vertical, " px", 3)
-        ));
+        let mut rows = vec![
+            ("alpha IoU", f(r.alpha_iou, "", 4)),
+            ("alpha mean absolute error", f(r.alpha_mae, "", 4)),
+            (
+                "registered basis PSNR (subject)",
+                f(r.registration_psnr, " dB", 2),
+            ),
+            ("same frames unregistered", f(r.unregistered_psnr, " dB", 2)),
+            (
+                "edge band error over black",
+                pair(r.edge_band_error_dark, r.edge_band_error_dark_raw),
+            ),
+            (
+                "edge band error over bright",
+                pair(r.edge_band_error_bright, r.edge_band_error_bright_raw),
+            ),
+            (
+                "flow EPE inside matte, horizontal",
+                f(r.flow_epe_horizontal, " px", 3),
+            ),
+            (
+                "flow EPE inside matte, vertical",
+                f(r.flow_epe_vertical, " px", 3),
+            ),
+        ];
         if r.settings.pose_flows {
-            lines.push(format!(
-                "    flow EPE inside matte, pose to pose {}",
+            rows.push((
+                "flow EPE inside matte, pose to pose",
                 match (r.pose_flow_epe, r.pose_flow_motion) {
                     (Some(e), Some(m)) => format!("{e:.3} px (the true motion: {m:.3} px)"),
                     (e, _) => f(e, " px", 3),
-                }
+                },
             ));
         }
-        lines.push(format!(
-            "    visual hull IoU (voxels)            {}",
-            f(r.hull_iou, "", 4)
-        ));
+        rows.push(("visual hull IoU (voxels)", f(r.hull_iou, "", 4)));
+        for (label, value) in rows {
+            lines.push(format!("    {label:<36}{value}"));
+        }
         lines.push(format!(
             "  field: flow {:.1} % of 8-bit codes, basis images {:.1}:1 vs 16-bit linear, {:.2} MB",
             100.0 * r.field.flow_ratio_vs_8bit,
