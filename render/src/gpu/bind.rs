@@ -219,6 +219,21 @@ pub fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::
     })
 }
 
+/// A buffer of `usage` holding `contents`.
+pub fn buffer_with(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage,
+    })
+}
+
 /// A buffer to read `size` bytes back into.
 pub fn readback_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

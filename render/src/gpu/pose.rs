@@ -11,7 +11,7 @@ use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::Gpu;
-use super::bind::{copy_to_buffer, table_bytes};
+use super::bind::{buffer_with, copy_to_buffer, table_bytes};
 use super::formats::PoseFormats;
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
@@ -370,20 +370,14 @@ impl Gpu {
             })
             .collect();
         let buffer = |label: &str, contents: &[u8]| {
-            self.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
+            buffer_with(&self.device, label, contents, wgpu::BufferUsages::STORAGE)
         };
-        let view_buffer = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("views"),
-                contents: bytemuck::cast_slice(&gpu_views),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            });
+        let view_buffer = buffer_with(
+            &self.device,
+            "views",
+            bytemuck::cast_slice(&gpu_views),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        );
         let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
         let tables = buffer("tables", &table_bytes(&[srgb_lut(), flow_table]));
         let (index, ranges) = geometry.cylinder.column_index_gpu();

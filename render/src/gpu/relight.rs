@@ -17,7 +17,7 @@ use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
 use super::bind::{
-    bind_group, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
+    bind_group, buffer_with, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
 };
 use super::{Gpu, shaders};
 use crate::error::Result;
@@ -214,14 +214,8 @@ impl Gpu {
             jobs: views.len() as u32,
             pad: 0,
         };
-        let buffer = |label: &str, contents: &[u8], usage| {
-            self.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                })
-        };
+        let buffer =
+            |label: &str, contents: &[u8], usage| buffer_with(&self.device, label, contents, usage);
         let storage = wgpu::BufferUsages::STORAGE;
         BasisBatch {
             params: buffer(

@@ -6,7 +6,9 @@
 use frf_core::image::{Rgb, RgbImage};
 use wgpu::util::DeviceExt;
 
-use super::bind::{bind_group, compute_pipeline, rgba32f, storage, storage_texture, uniform};
+use super::bind::{
+    bind_group, buffer_with, compute_pipeline, rgba32f, storage, storage_texture, uniform,
+};
 use super::pose::{GpuPose, MapRelight, RelitShadowInfo};
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
@@ -114,14 +116,8 @@ impl Gpu {
         if texels.is_empty() {
             texels.push(0.0);
         }
-        let buffer = |label: &str, contents: &[u8], usage| {
-            self.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents,
-                    usage,
-                })
-        };
+        let buffer =
+            |label: &str, contents: &[u8], usage| buffer_with(&self.device, label, contents, usage);
         let params = GpuShadowParams {
             texels: n,
             maps: maps.maps.len() as u32,
