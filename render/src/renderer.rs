@@ -197,6 +197,15 @@ impl<'a> Walker<'a> {
     }
 }
 
+/// A frame drawn and not yet read back ([`Device::submit_frame`]): on the GPU, its
+/// submission with its staging set; on the CPU, the frame itself.
+pub enum FrameInFlight {
+    /// Submitted to the GPU, its readback mapping.
+    Gpu(crate::gpu::readback::PendingFrame),
+    /// Rendered by the CPU reference.
+    Done(Frame),
+}
+
 /// A composited frame.
 #[derive(Debug, Clone)]
 pub struct Frame {
@@ -417,20 +426,65 @@ impl Device {
         variant: Variant,
         layers: bool,
     ) -> Result<Frame> {
+        let drawn = self.submit_frame(walkers, backdrop, camera, variant, layers)?;
+        self.finish_frame(drawn)
+    }
+
+    /// Draws a frame as [`Device::render_frame`] does and, on the GPU, submits it without
+    /// waiting: [`Device::finish_frame`] reads it back, and a sequence draws the next
+    /// frame first (the walkers' poses may then be relit or replaced: the frame in flight
+    /// was recorded before). The CPU reference renders it here.
+    pub fn submit_frame(
+        &self,
+        walkers: &[Walker],
+        backdrop: &DeviceBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        layers: bool,
+    ) -> Result<FrameInFlight> {
         backdrop.cpu.check(camera)?;
         if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
             let instances = walkers
                 .iter()
                 .map(Walker::gpu_instance)
                 .collect::<Result<Vec<_>>>()?;
-            let (composite, l, stats) =
-                gpu.render_composite(&instances, b, camera, variant, layers)?;
-            return Ok(Frame {
-                composite,
-                layers: l,
-                stats,
-            });
+            let pending = gpu.submit_composite(&instances, b, camera, variant, layers)?;
+            return Ok(FrameInFlight::Gpu(pending));
         }
+        Ok(FrameInFlight::Done(self.render_frame_cpu(
+            walkers, backdrop, camera, variant, layers,
+        )?))
+    }
+
+    /// The frame `drawn` ([`Device::submit_frame`]), read back once its submission is
+    /// done.
+    pub fn finish_frame(&self, drawn: FrameInFlight) -> Result<Frame> {
+        match (drawn, self) {
+            (FrameInFlight::Done(frame), _) => Ok(frame),
+            (FrameInFlight::Gpu(pending), Device::Gpu(gpu)) => {
+                let (composite, layers, stats) = gpu.finish_drawn(pending)?;
+                Ok(Frame {
+                    composite,
+                    layers,
+                    stats,
+                })
+            }
+            (FrameInFlight::Gpu(_), Device::Cpu) => Err(crate::RenderError::Misuse(
+                "a frame submitted to the GPU finished on the CPU".into(),
+            )),
+        }
+    }
+
+    /// The CPU reference of [`Device::render_frame`]: each walker alone, stacked back to
+    /// front, then composited.
+    fn render_frame_cpu(
+        &self,
+        walkers: &[Walker],
+        backdrop: &DeviceBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        layers: bool,
+    ) -> Result<Frame> {
         // The CPU reference: each walker alone, stacked back to front, then composited.
         let positions: Vec<_> = walkers
             .iter()

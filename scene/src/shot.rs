@@ -34,7 +34,9 @@ use frf_render::footprint::PixelBox;
 use frf_render::gpu::composite::DrawnFrame;
 use frf_render::motion::pose_motion;
 use frf_render::reduced_views::ReducedViews;
-use frf_render::renderer::{Device, DeviceBackdrop, Frame, Resident, SceneShadow, Walker};
+use frf_render::renderer::{
+    Device, DeviceBackdrop, Frame, FrameInFlight, Resident, SceneShadow, Walker,
+};
 use frf_render::resident::{Lighting, PoseSource};
 use frf_render::shadow::{ShadowMaps, traced_shadow};
 
@@ -165,6 +167,15 @@ pub struct ShotResult {
     pub between: Vec<Option<(u32, f32)>>,
     /// Poses made resident (read and relit) for this frame.
     pub made_resident: Vec<u32>,
+}
+
+/// A frame of a shot drawn and submitted, not yet read back ([`Shot::submit`]).
+/// It carries [`ShotResult`]'s fields but the frame.
+pub struct ShotInFlight {
+    frame: FrameInFlight,
+    poses: Vec<u32>,
+    between: Vec<Option<(u32, f32)>>,
+    made_resident: Vec<u32>,
 }
 
 /// How far a shot's shadow reaches ([`Shot::shadow_reach`]).
@@ -528,6 +539,14 @@ impl<'a, R: ReadAt> Shot<'a, R> {
 
     /// Renders frame `frame` (one of the frames the shot was planned for).
     pub fn render(&mut self, frame: &ShotFrame, layers: bool) -> Result<ShotResult> {
+        let drawn = self.submit(frame, layers)?;
+        self.finish(drawn)
+    }
+
+    /// Draws frame `frame` as [`Shot::render`] does and submits it without waiting for
+    /// it ([`Device::submit_frame`]): a sequence submits the next frame before it
+    /// [`Shot::finish`]es this one, so that the GPU draws one while the other is read back.
+    pub fn submit(&mut self, frame: &ShotFrame, layers: bool) -> Result<ShotInFlight> {
         let fp: FramePlan = self
             .plan
             .frames
@@ -537,7 +556,17 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .ok_or_else(|| {
                 SceneError::Internal(format!("frame {} was not planned", frame.index))
             })?;
-        self.render_plan(&fp, &frame.camera, layers)
+        self.submit_plan(&fp, &frame.camera, layers)
+    }
+
+    /// Reads back a frame [`Shot::submit`] drew.
+    pub fn finish(&mut self, drawn: ShotInFlight) -> Result<ShotResult> {
+        Ok(ShotResult {
+            frame: self.device.finish_frame(drawn.frame)?,
+            poses: drawn.poses,
+            between: drawn.between,
+            made_resident: drawn.made_resident,
+        })
     }
 
     /// Renders the frame `fp` plans, seen by `camera`.
@@ -547,14 +576,25 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         camera: &frf_core::camera::Camera,
         layers: bool,
     ) -> Result<ShotResult> {
+        let drawn = self.submit_plan(fp, camera, layers)?;
+        self.finish(drawn)
+    }
+
+    /// Draws and submits the frame `fp` plans, seen by `camera`.
+    fn submit_plan(
+        &mut self,
+        fp: &FramePlan,
+        camera: &frf_core::camera::Camera,
+        layers: bool,
+    ) -> Result<ShotInFlight> {
         let (slots, made_resident) = self.prepare(fp)?;
         let walkers = self.walkers(&slots, camera);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
-        let frame_out =
+        let frame =
             self.device
-                .render_frame(&walkers, backdrop, camera, self.scene.variant, layers)?;
-        Ok(ShotResult {
-            frame: frame_out,
+                .submit_frame(&walkers, backdrop, camera, self.scene.variant, layers)?;
+        Ok(ShotInFlight {
+            frame,
             poses: fp.poses.clone(),
             between: fp.between.clone(),
             made_resident,

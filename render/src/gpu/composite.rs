@@ -19,7 +19,8 @@ use super::timing::Timestamps;
 use super::Gpu;
 use super::bind::{bind_group, cleared};
 use super::pose::{GpuPose, RelitShadowInfo};
-use super::rebin::frame_uniform;
+use super::readback::PendingFrame;
+use super::rebin::{frame_stats, frame_uniform};
 use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
@@ -178,6 +179,21 @@ impl Gpu {
         variant: Variant,
         layers: bool,
     ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
+        let pending = self.submit_composite(instances, backdrop, camera, variant, layers)?;
+        self.finish_drawn(pending)
+    }
+
+    /// Draws and submits a frame as [`Gpu::render_composite`] does, without waiting for
+    /// it: [`Gpu::finish_drawn`] reads it back, after the next frame is submitted when a
+    /// sequence overlaps its readback with drawing.
+    pub fn submit_composite(
+        &self,
+        instances: &[GpuInstanceRef],
+        backdrop: &GpuBackdrop,
+        camera: &Camera,
+        variant: Variant,
+        layers: bool,
+    ) -> Result<PendingFrame> {
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -185,7 +201,7 @@ impl Gpu {
             });
         let drawn =
             self.encode_composite(&mut encoder, instances, backdrop, camera, variant, None)?;
-        self.read_drawn(encoder, &drawn, layers)
+        self.submit_drawn(encoder, &drawn, layers)
     }
 
     /// Reads back the frame `encoder` draws (`drawn`, [`Gpu::encode_composite`]): submits
@@ -193,30 +209,60 @@ impl Gpu {
     /// happened to the walkers' pixels.
     pub fn read_drawn(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         drawn: &DrawnFrame,
         layers: bool,
     ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
-        self.scoped("reading a frame back", || {
+        let pending = self.submit_drawn(encoder, drawn, layers)?;
+        self.finish_drawn(pending)
+    }
+
+    /// Submits the frame `encoder` draws (`drawn`, [`Gpu::encode_composite`]) with the
+    /// copies of its composite (with `layers`, its layers too) and counters into a
+    /// staging set of its own ([`super::readback`]), and asks for them mapped; nothing
+    /// waits. The next frame may be drawn and submitted before this one is finished
+    /// ([`Gpu::finish_drawn`]).
+    pub fn submit_drawn(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        drawn: &DrawnFrame,
+        layers: bool,
+    ) -> Result<PendingFrame> {
+        self.scoped("submitting a frame", || {
             let t = &drawn.targets;
             // Composite, then (with layers) subject, shadow and backdrop.
-            let read: &[usize] = if layers { &[0, 3, 1, 2] } else { &[0] };
-            for &k in read {
-                t.readback[k].copy(&mut encoder, &t.targets[k]);
-            }
-            self.copy_stats(&mut encoder, &drawn.subjects);
-            self.submit([encoder.finish()]);
-            let image = self.read_rgba(&t.readback[0])?;
-            let layers = if layers {
-                Some(Layers {
-                    subject: self.read_rgba(&t.readback[3])?,
-                    shadow: self.read_rgba(&t.readback[1])?.map(|p| [p[0], p[1], p[2]]),
-                    backdrop: self.read_rgba(&t.readback[2])?,
-                })
-            } else {
-                None
+            let read: &'static [usize] = if layers { &[0, 3, 1, 2] } else { &[0] };
+            let staging = self.staging_for(drawn.size());
+            staging.copy(&mut encoder, &t.targets, read);
+            self.copy_stats(&mut encoder, &drawn.subjects, staging.stats());
+            let submission = self.submit([encoder.finish()]);
+            let outside = drawn.subjects.outside();
+            Ok(PendingFrame::mapping(staging, read, outside, submission))
+        })
+    }
+
+    /// Waits for `frame` ([`Gpu::submit_drawn`]; frames submitted after it are not
+    /// waited for) and returns the composite, the layers when they were asked for, and
+    /// what happened to the walkers' pixels.
+    pub fn finish_drawn(
+        &self,
+        frame: PendingFrame,
+    ) -> Result<(Image<Rgba>, Option<Layers>, FrameStats)> {
+        self.scoped("reading a frame back", || {
+            let (images, counts, outside) = self.read_pending(frame)?;
+            let mut images = images.into_iter();
+            let composite = images.next().ok_or_else(|| {
+                RenderError::Misuse("a frame read back without its composite".into())
+            })?;
+            let layers = match (images.next(), images.next(), images.next()) {
+                (Some(subject), Some(shadow), Some(backdrop)) => Some(Layers {
+                    subject,
+                    shadow: shadow.map(|p| [p[0], p[1], p[2]]),
+                    backdrop,
+                }),
+                _ => None,
             };
-            Ok((image, layers, self.read_stats(&drawn.subjects)?))
+            Ok((composite, layers, frame_stats(&counts, outside)))
         })
     }
 

@@ -1,15 +1,16 @@
 //! What a composited frame of one size, number of walkers and shadow-map size needs
 //! besides its inputs, made once and kept ([`Gpu::composite_targets`]): the four RGBA32F
 //! targets, the walkers' shadow maps gathered into one array, the uniforms, walker
-//! buffer and tile lists (written with `write_buffer` each frame), the frame's bind group, and the
-//! staging buffers its images are read back through.
+//! buffer and tile lists (written with `write_buffer` each frame) and the frame's bind
+//! group. Its images are read back through staging sets of their own
+//! ([`super::readback`]), so that the next frame draws into these targets while the last
+//! is mapped.
 
 use std::sync::Arc;
 
 use super::bind::{FLOAT, full_screen_pipeline, storage, texture_2d, texture_array, uniform};
 use super::bind::{rgba32f, uniform_buffer};
 use super::kept::Kept;
-use super::readback::Readback;
 use super::{Gpu, shaders};
 use crate::footprint::TileLists;
 use frf_shaders::types::{GpuComposite, GpuFrame, GpuInstance};
@@ -81,8 +82,6 @@ pub(super) struct CompositeTargets {
     /// The frame's tile lists ([`crate::footprint::TileLists`]).
     pub(super) tiles: wgpu::Buffer,
     pub(super) frame_group: wgpu::BindGroup,
-    /// One staging buffer per target, in the order of `targets`.
-    pub(super) readback: [Readback; 4],
     /// The image bind groups made for these targets, per drawn subjects and backdrop
     /// (their ids).
     pub(super) image_groups: Kept<(u64, u64), wgpu::BindGroup>,
@@ -155,7 +154,6 @@ impl CompositeTargets {
                 },
             ],
         });
-        let readback = labels.map(|label| Readback::new(device, label, size));
         Self {
             id: super::kept::unique_id(),
             targets,
@@ -166,7 +164,6 @@ impl CompositeTargets {
             instances,
             tiles,
             frame_group,
-            readback,
             image_groups: Kept::new(IMAGE_GROUPS),
         }
     }

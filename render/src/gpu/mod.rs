@@ -27,7 +27,7 @@ pub mod formats;
 pub mod kept;
 pub mod pose;
 pub mod present;
-mod readback;
+pub mod readback;
 pub mod rebin;
 pub mod relight;
 pub mod scope;
@@ -79,6 +79,8 @@ pub struct Gpu {
     pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
+    /// Staging sets of frames read back, kept for the next ([`readback`]).
+    staging: std::sync::Mutex<Vec<readback::FrameStaging>>,
     /// Nanoseconds the host has waited on the device ([`Gpu::waited`]).
     waited_ns: std::sync::atomic::AtomicU64,
     rebin: rebin::RebinPass,
@@ -149,6 +151,7 @@ impl Gpu {
             relight: relight::RelightPass::new(&device),
             pending: std::sync::Mutex::new(None),
             relit: std::sync::Mutex::new(None),
+            staging: std::sync::Mutex::new(Vec::new()),
             waited_ns: std::sync::atomic::AtomicU64::new(0),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,

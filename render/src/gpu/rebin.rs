@@ -165,7 +165,24 @@ pub(super) struct Subjects {
     places: Vec<Place>,
 }
 
+/// What happened to a frame's pixels: the counters' bytes as the class pass wrote them,
+/// and the pixels outside the walkers' bounds (missed).
+pub(super) fn frame_stats(counts: &[u8], outside: usize) -> FrameStats {
+    let counts: &[u32] = bytemuck::cast_slice(counts);
+    FrameStats {
+        inside: counts[0] as usize,
+        clamped_above: counts[1] as usize,
+        clamped_below: counts[2] as usize,
+        missed: counts[3] as usize + outside,
+    }
+}
+
 impl Subjects {
+    /// Pixels outside the walkers' bounds, summed over the walkers.
+    pub(super) fn outside(&self) -> usize {
+        self.outside
+    }
+
     /// The texture array of the subjects.
     pub fn texture(&self) -> &wgpu::Texture {
         self.targets.texture()
@@ -585,22 +602,22 @@ impl Gpu {
         );
     }
 
-    /// Copies the pixel-class counters of a drawn frame into its staging buffer.
-    pub(super) fn copy_stats(&self, encoder: &mut wgpu::CommandEncoder, subject: &Subjects) {
-        let t = &subject.targets;
-        encoder.copy_buffer_to_buffer(&t.stats, 0, &t.stats_readback, 0, 16);
+    /// Copies the pixel-class counters of a drawn frame into the staging buffer `into`
+    /// (16 bytes).
+    pub(super) fn copy_stats(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        subject: &Subjects,
+        into: &wgpu::Buffer,
+    ) {
+        encoder.copy_buffer_to_buffer(&subject.targets.stats, 0, into, 0, 16);
     }
 
-    /// The counters [`Gpu::copy_stats`] copied (after its submission).
-    pub(super) fn read_stats(&self, subject: &Subjects) -> Result<FrameStats> {
+    /// The counters [`Gpu::copy_stats`] copied into its targets' own staging buffer
+    /// (after its submission).
+    fn read_stats(&self, subject: &Subjects) -> Result<FrameStats> {
         let counts = self.read_buffer(&subject.targets.stats_readback)?;
-        let counts: &[u32] = bytemuck::cast_slice(&counts);
-        Ok(FrameStats {
-            inside: counts[0] as usize,
-            clamped_above: counts[1] as usize,
-            clamped_below: counts[2] as usize,
-            missed: counts[3] as usize + subject.outside,
-        })
+        Ok(frame_stats(&counts, subject.outside))
     }
 
     /// Copies (layer 0 of) an RGBA32F texture of `size` into a new staging buffer, for
@@ -636,7 +653,7 @@ impl Gpu {
                 self.draw_subjects(&mut encoder, &[(pose, *camera, whole)], size, variant, None);
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
-            self.copy_stats(&mut encoder, &subject);
+            self.copy_stats(&mut encoder, &subject, &t.stats_readback);
             self.submit([encoder.finish()]);
             Ok((self.read_rgba(&t.readback)?, self.read_stats(&subject)?))
         })
