@@ -62,7 +62,7 @@ pub struct ShotOptions {
 
 /// Whether a resident made from `have` serves a walker that needs `want` (`None`:
 /// everything).
-fn covers(have: &Option<PosePlan>, want: &Option<PosePlan>) -> bool {
+fn covers(have: &Option<PosePlan>, want: Option<&PosePlan>) -> bool {
     let within = |w: &[bool], h: &[bool]| w.iter().zip(h).all(|(&w, &h)| !w || h);
     match (have, want) {
         (None, _) => true,
@@ -85,8 +85,8 @@ fn cache_bytes(cache: &[Cached]) -> u64 {
     let mut seen: Vec<usize> = Vec::new();
     let mut total = 0;
     for c in cache {
-        total += c.resident.bytes();
-        let (id, bytes) = c.resident.basis();
+        total += c.bytes;
+        let (id, bytes) = c.basis;
         if !seen.contains(&id) {
             seen.push(id);
             total += bytes;
@@ -128,6 +128,10 @@ struct Cached {
     plan: Option<PosePlan>,
     lighting: LightingKey,
     resident: Resident,
+    /// The resident's own bytes, and its basis codes' identity and bytes
+    /// ([`Resident::basis`]), measured when made (relighting changes neither).
+    bytes: u64,
+    basis: (usize, u64),
     last_frame: usize,
 }
 
@@ -219,6 +223,9 @@ pub struct Shot<'a, R: ReadAt> {
     counters: ShotCounters,
     /// Frames drawn at a time and camera of the caller's ([`Shot::draw_at`]).
     live_frames: usize,
+    /// Per walker, the cache slots its poses took last frame: looked at first, so that
+    /// a frame's search of the cache grows with its walkers, not with their square.
+    last_slots: Vec<Vec<usize>>,
 }
 
 impl<'a, R: ReadAt> Shot<'a, R> {
@@ -282,6 +289,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             reduced: ReducedViews::with_budget(options.memory_budget / DECODED_SHARE),
             counters: ShotCounters::default(),
             live_frames: 0,
+            last_slots: Vec::new(),
         })
     }
 
@@ -649,11 +657,21 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         for (i, pose) in drawn {
             let heading = self.scene.instances[i].heading;
             // The walker's own needs of the pose: a resident that covers them serves it
-            // (walkers of one heading seeing the same quads share one).
-            let wanted = self.walker_plan(i, pose).cloned();
-            let found = self.cache.iter().position(|c| {
-                c.pose == pose && c.heading == heading.to_bits() && covers(&c.plan, &wanted)
-            });
+            // (walkers of one heading seeing the same quads share one); the one it had
+            // last frame, when it still does.
+            let wanted = self.walker_plan(i, pose);
+            let serves = |c: &Cached| {
+                c.pose == pose && c.heading == heading.to_bits() && covers(&c.plan, wanted)
+            };
+            let found = self
+                .last_slots
+                .get(i)
+                .and_then(|last| {
+                    last.iter()
+                        .copied()
+                        .find(|&k| self.cache.get(k).is_some_and(serves))
+                })
+                .or_else(|| self.cache.iter().position(serves));
             let slot = match found {
                 Some(k) if self.cache[k].lighting == key => k,
                 Some(k) => {
@@ -671,10 +689,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     let t = Instant::now();
                     // Another walker's copy of views that cover these lends them, basis
                     // codes and all (the first made, so that copies share one).
+                    let wanted = wanted.cloned();
                     let like = self
                         .cache
                         .iter()
-                        .position(|c| c.pose == pose && covers(&c.plan, &wanted));
+                        .position(|c| c.pose == pose && covers(&c.plan, wanted.as_ref()));
                     let resident =
                         self.make_resident(pose, heading, world.as_ref(), wanted.as_ref(), like)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
@@ -691,6 +710,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         heading: heading.to_bits(),
                         plan: wanted,
                         lighting: key.clone(),
+                        bytes: resident.bytes(),
+                        basis: resident.basis(),
                         resident,
                         last_frame: fp.index,
                     });
@@ -702,7 +723,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         }
         self.keep_within_budget(fp.index, &mut slots)?;
         let mut flat = slots.into_iter();
-        let slots = fp
+        let slots: Vec<Slot> = fp
             .between
             .iter()
             .map(|b| {
@@ -711,6 +732,15 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     k,
                     b.map(|(_, s)| (flat.next().expect("a slot per pose drawn"), s)),
                 )
+            })
+            .collect();
+        self.last_slots = slots
+            .iter()
+            .map(|&(k, after)| {
+                [Some(k), after.map(|a| a.0)]
+                    .into_iter()
+                    .flatten()
+                    .collect()
             })
             .collect();
 

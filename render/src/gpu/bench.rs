@@ -264,11 +264,7 @@ pub fn run(
                         size.0,
                         size.1
                     ));
-                    gpu.queue.write_buffer(
-                        targets.uniform(0),
-                        0,
-                        bytemuck::bytes_of(&frame_uniform(Some(&gpu_pose), &camera, v)),
-                    );
+                    targets.write_frames(&gpu.queue, &[frame_uniform(Some(&gpu_pose), &camera, v)]);
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
                         drawn.record(e, stage, t)
                     })?;
@@ -385,10 +381,9 @@ fn floor_rows(
     for &size in &options.sizes {
         let camera = bench_camera(size)?;
         let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1, 1);
-        gpu.queue.write_buffer(
-            targets.uniform(0),
-            0,
-            bytemuck::bytes_of(&frame_uniform(Some(&codes_pose), &camera, Variant::Nearest)),
+        targets.write_frames(
+            &gpu.queue,
+            &[frame_uniform(Some(&codes_pose), &camera, Variant::Nearest)],
         );
         for &stage in &options.stages {
             progress(&format!("floor {} {}x{}", stage.name(), size.0, size.1));

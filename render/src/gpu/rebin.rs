@@ -266,7 +266,6 @@ impl Place {
 /// the camera that sees it (in its subject frame) and the pixels it may show in.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct DrawnRender {
-    pub slot: usize,
     pub place: Place,
     pub camera: Camera,
     pub within: PixelBox,
@@ -300,6 +299,10 @@ pub(super) struct SubjectTargets {
     texture: wgpu::Texture,
     pages: Vec<wgpu::TextureView>,
     slots: Vec<SlotTargets>,
+    /// Every slot's frame uniform, each at its multiple of `stride`: a frame writes them
+    /// all in one write ([`SubjectTargets::write_frames`]).
+    uniforms: wgpu::Buffer,
+    stride: usize,
     stats: wgpu::Buffer,
     /// Staging buffers of the counters and of page 0.
     stats_readback: wgpu::Buffer,
@@ -307,7 +310,6 @@ pub(super) struct SubjectTargets {
 }
 
 struct SlotTargets {
-    uniform: wgpu::Buffer,
     fragment: wgpu::BindGroup,
     compute: wgpu::BindGroup,
     classes: wgpu::BindGroup,
@@ -368,12 +370,19 @@ impl SubjectTargets {
                 })
             })
             .collect();
-        let slots = (0..slots)
-            .map(|_| {
-                let uniform = uniform_buffer(device, "frame", std::mem::size_of::<GpuFrame>());
+        let size_of_frame = std::mem::size_of::<GpuFrame>();
+        let align = device.limits().min_uniform_buffer_offset_alignment as usize;
+        let stride = size_of_frame.div_ceil(align) * align;
+        let uniforms = uniform_buffer(device, "frames", stride * slots as usize);
+        let slots = (0..slots as usize)
+            .map(|slot| {
                 let frame = wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: uniform.as_entire_binding(),
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &uniforms,
+                        offset: (slot * stride) as u64,
+                        size: std::num::NonZeroU64::new(size_of_frame as u64),
+                    }),
                 };
                 let stats = wgpu::BindGroupEntry {
                     binding: 1,
@@ -394,7 +403,6 @@ impl SubjectTargets {
                         ],
                     ),
                     classes: group("frame (classes)", &pass.classes_layout, &[frame, stats]),
-                    uniform,
                 }
             })
             .collect();
@@ -403,6 +411,8 @@ impl SubjectTargets {
             texture,
             pages,
             slots,
+            uniforms,
+            stride,
             stats,
             stats_readback: readback_buffer(device, "stats readback", 16),
             readback: Readback::new(device, "subject readback", size),
@@ -416,9 +426,14 @@ impl SubjectTargets {
         &self.texture
     }
 
-    /// The frame uniform of `slot`.
-    pub(super) fn uniform(&self, slot: usize) -> &wgpu::Buffer {
-        &self.slots[slot].uniform
+    /// Writes the frame uniforms of slots `0..frames.len()`, in one write.
+    pub(super) fn write_frames(&self, queue: &wgpu::Queue, frames: &[GpuFrame]) {
+        let size = std::mem::size_of::<GpuFrame>();
+        let mut bytes = vec![0u8; self.stride * frames.len()];
+        for (slot, frame) in frames.iter().enumerate() {
+            bytes[slot * self.stride..][..size].copy_from_slice(bytemuck::bytes_of(frame));
+        }
+        queue.write_buffer(&self.uniforms, 0, &bytes);
     }
 
     /// The view of `page`.
@@ -508,6 +523,34 @@ impl RebinPass {
     }
 }
 
+impl RebinPass {
+    /// Records the compute frame pass of every render of `renders` (its slot in
+    /// `targets`, pose bind group and pixel box) in one pass, with the pass's timestamps
+    /// when given; each counts its pixel classes as it shades.
+    pub(super) fn record_compute(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &SubjectTargets,
+        renders: &[(usize, &wgpu::BindGroup, PixelBox)],
+        timestamps: Option<(&wgpu::QuerySet, u32)>,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("rebin"),
+            timestamp_writes: super::timing::compute_pass_writes(timestamps),
+        });
+        pass.set_pipeline(&self.compute);
+        for &(slot, pose_group, within) in renders {
+            let (x, y) = workgroups(within.size());
+            if x * y == 0 {
+                continue;
+            }
+            pass.set_bind_group(0, &targets.slots[slot].compute, &[]);
+            pass.set_bind_group(1, pose_group, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+}
+
 impl Gpu {
     /// The kept targets of frames of `size` with `slots` renders on `pages` pages (made
     /// on first use; the few most recently used are kept).
@@ -539,25 +582,23 @@ impl Gpu {
         let (places, pages) = places(&boxes, size, 0);
         let targets = self.subject_targets(size, instances.len().max(1) as u32, pages);
         encoder.clear_buffer(&targets.stats, 0, None);
-        let mut outside = 0;
-        for (slot, (&(pose, camera, within), &place)) in instances.iter().zip(&places).enumerate() {
-            outside += size.0 as usize * size.1 as usize - within.pixels();
-            let drawn = DrawnRender {
-                slot,
-                place,
-                camera,
-                within,
-            };
-            self.draw_render(
-                encoder,
-                &targets,
-                pose,
-                drawn,
-                variant,
-                timestamps.filter(|_| slot == 0),
-                true,
-            );
-        }
+        let outside = instances
+            .iter()
+            .map(|i| size.0 as usize * size.1 as usize - i.2.pixels())
+            .sum();
+        let renders: Vec<(&GpuPose, DrawnRender)> = instances
+            .iter()
+            .zip(&places)
+            .map(|(&(pose, camera, within), &place)| {
+                let drawn = DrawnRender {
+                    place,
+                    camera,
+                    within,
+                };
+                (pose, drawn)
+            })
+            .collect();
+        self.draw_renders(encoder, &targets, &renders, variant, timestamps, true);
         Subjects {
             targets,
             outside,
@@ -565,41 +606,55 @@ impl Gpu {
         }
     }
 
-    /// Records `pose` drawn as `drawn` says into `targets`: its slot's frame uniform
-    /// (the camera, the box and the place) written, then the frame pass
-    /// ([`RebinPass::record`], which `timestamps` and `classes` go to).
-    #[allow(clippy::too_many_arguments)] // one pass's every input, named at the call
-    pub(super) fn draw_render(
+    /// Records `renders` (render `k` into slot `k` of `targets`): their frame uniforms
+    /// (camera, box and place) written in one write, then their frame passes. The
+    /// compute path records every render in one pass (its timestamps, when given, span
+    /// them all); the fragment path a pass each ([`RebinPass::record`], `timestamps` on
+    /// the first), and their pixel classes when `classes`.
+    pub(super) fn draw_renders(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
-        pose: &GpuPose,
-        drawn: DrawnRender,
+        renders: &[(&GpuPose, DrawnRender)],
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
-        let DrawnRender {
-            slot,
-            place,
-            camera,
-            within,
-        } = drawn;
-        let mut frame = frame_uniform(Some(pose), &camera, variant);
-        frame.bounds = within.to_array();
-        frame.place = place.to_array();
-        self.queue
-            .write_buffer(targets.uniform(slot), 0, bytemuck::bytes_of(&frame));
-        self.rebin.record(
-            encoder,
-            targets,
-            (slot, place),
-            &pose.bind_group,
-            self.stage,
-            within,
-            timestamps,
-            classes,
-        );
+        let frames: Vec<GpuFrame> = renders
+            .iter()
+            .map(|(pose, d)| {
+                let mut frame = frame_uniform(Some(pose), &d.camera, variant);
+                frame.bounds = d.within.to_array();
+                frame.place = d.place.to_array();
+                frame
+            })
+            .collect();
+        targets.write_frames(&self.queue, &frames);
+        match self.stage {
+            PassKind::Compute => {
+                let groups: Vec<_> = renders
+                    .iter()
+                    .enumerate()
+                    .map(|(slot, (pose, d))| (slot, &pose.bind_group, d.within))
+                    .collect();
+                self.rebin
+                    .record_compute(encoder, targets, &groups, timestamps);
+            }
+            PassKind::Fragment => {
+                for (slot, (pose, d)) in renders.iter().enumerate() {
+                    self.rebin.record(
+                        encoder,
+                        targets,
+                        (slot, d.place),
+                        &pose.bind_group,
+                        PassKind::Fragment,
+                        d.within,
+                        timestamps.filter(|_| slot == 0),
+                        classes,
+                    );
+                }
+            }
+        }
     }
 
     /// Copies the pixel-class counters of a drawn frame into the staging buffer `into`

@@ -134,24 +134,40 @@ impl Gpu {
         let scratch = self.between_targets.get((size, slots, pages), || {
             SubjectTargets::new(&self.device, &self.rebin, size, slots, pages)
         });
+        // Every walker's three renders, in one go.
+        let places_of = &renders;
+        let drawn: Vec<(&GpuPose, DrawnRender)> = walkers
+            .iter()
+            .enumerate()
+            .flat_map(|(j, w)| {
+                let b = w.between;
+                [b.after, b.before_motion, b.after_motion]
+                    .into_iter()
+                    .enumerate()
+                    .map(move |(k, pose)| {
+                        let place = places_of[3 * j + k];
+                        let (camera, within) = (w.camera, w.within);
+                        (
+                            pose,
+                            DrawnRender {
+                                place,
+                                camera,
+                                within,
+                            },
+                        )
+                    })
+            })
+            .collect();
+        self.draw_renders(encoder, &scratch, &drawn, variant, None, false);
+        // Every walker's morph: their uniforms in one buffer, each bound at its stride,
+        // and their dispatches in one pass.
+        let size_of_uniform = std::mem::size_of::<GpuTimeMorph>();
+        let align = self.device.limits().min_uniform_buffer_offset_alignment as usize;
+        let stride = size_of_uniform.div_ceil(align) * align;
+        let mut bytes = vec![0u8; stride * n];
         for (j, w) in walkers.iter().enumerate() {
-            let b = w.between;
-            for (k, pose) in [b.after, b.before_motion, b.after_motion]
-                .into_iter()
-                .enumerate()
-            {
-                let slot = 3 * j + k;
-                let drawn = DrawnRender {
-                    slot,
-                    place: renders[slot],
-                    camera: w.camera,
-                    within: w.within,
-                };
-                self.draw_render(encoder, &scratch, pose, drawn, variant, None, false);
-            }
-            let (before, before_view) = subjects.place(w.layer);
+            let (before, _) = subjects.place(w.layer);
             let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
-            let morph = morphs[j];
             let pair = |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
             let m: Mat2 = crate::motion::motion_to_image(&w.camera);
             let uniform = GpuTimeMorph {
@@ -159,55 +175,75 @@ impl Gpu {
                 bounds: w.within.to_array(),
                 at_poses: pair(before, after),
                 at_motions: pair(before_motion, after_motion),
-                at_morph: pair(morph, morph),
-                s: b.s,
+                at_morph: pair(morphs[j], morphs[j]),
+                s: w.between.s,
                 pad0: 0.0,
                 pad1: 0.0,
                 pad2: 0.0,
             };
-            let buffer = self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("time morph"),
-                    contents: bytemuck::bytes_of(&uniform),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
-            fn view(v: &wgpu::TextureView, binding: u32) -> wgpu::BindGroupEntry<'_> {
-                wgpu::BindGroupEntry {
-                    binding,
-                    resource: wgpu::BindingResource::TextureView(v),
-                }
-            }
-            let page = |p: Place| scratch.page_view(p.page);
-            let group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("time morph"),
-                layout: &self.time_morph.layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: buffer.as_entire_binding(),
-                    },
-                    view(before_view, 1),
-                    view(page(after), 2),
-                    view(page(before_motion), 3),
-                    view(page(after_motion), 4),
-                    view(page(morph), 5),
-                ],
+            bytes[j * stride..][..size_of_uniform].copy_from_slice(bytemuck::bytes_of(&uniform));
+        }
+        let buffer = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("time morphs"),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
             });
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        fn view(v: &wgpu::TextureView, binding: u32) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(v),
+            }
+        }
+        let page = |p: Place| scratch.page_view(p.page);
+        let groups: Vec<wgpu::BindGroup> = walkers
+            .iter()
+            .enumerate()
+            .map(|(j, w)| {
+                let (_, before_view) = subjects.place(w.layer);
+                let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
+                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("time morph"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.time_morph.pipeline);
-                pass.set_bind_group(0, &group, &[]);
+                    layout: &self.time_morph.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                                buffer: &buffer,
+                                offset: (j * stride) as u64,
+                                size: std::num::NonZeroU64::new(size_of_uniform as u64),
+                            }),
+                        },
+                        view(before_view, 1),
+                        view(page(after), 2),
+                        view(page(before_motion), 3),
+                        view(page(after_motion), 4),
+                        view(page(morphs[j]), 5),
+                    ],
+                })
+            })
+            .collect();
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("time morph"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.time_morph.pipeline);
+            for (w, group) in walkers.iter().zip(&groups) {
                 let (x, y) = workgroups(w.within.size());
                 if x * y > 0 {
+                    pass.set_bind_group(0, group, &[]);
                     pass.dispatch_workgroups(x, y, 1);
                 }
             }
-            // The morphed walker, over its render in the subjects (only its box: nothing
-            // outside is read).
+        }
+        // Each morphed walker over its render in the subjects, after every morph has
+        // read the subjects (the walkers' places do not overlap).
+        for (j, w) in walkers.iter().enumerate() {
+            let (before, _) = subjects.place(w.layer);
+            let morph = morphs[j];
+            // Only its box: nothing outside is read.
             let (width, height) = w.within.size();
             if width * height == 0 {
                 continue;
