@@ -267,7 +267,7 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
     let field = FieldFile::open(&fixture.field).unwrap();
     let sky = EnvMap::sky();
     let first = fixture.source(&sky);
-    let pose = gpu.upload_pose(&first).unwrap();
+    let mut pose = gpu.upload_pose(&first).unwrap();
     let shared = pose.basis().unwrap().clone();
     let cam = Camera::look_at(
         Vec3::new(2.2, 1.4, 3.0),
@@ -284,7 +284,7 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
             floor: FloorModel::Environment,
         };
         let source = first.relit(&field, &lighting, None).unwrap();
-        gpu.relight_pose(&pose, &source).unwrap();
+        gpu.relight_pose(&mut pose, &source).unwrap();
         let cpu = ResidentPose::relight_cpu(&source);
         assert_relit_as_the_cpu(&gpu, &pose, &cpu, &format!("frame {frame}"));
         // A copy made afresh, sharing the codes, draws the same frame.
@@ -297,9 +297,25 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
             "frame {frame}: relit in place differs"
         );
     }
+    // Its codes let go of (a light that will not change), then relit after all: they
+    // are uploaded again, and it still relights as the CPU does.
+    pose.release_basis();
+    assert!(pose.basis().is_none());
+    let lighting = Lighting::Environment {
+        env: sky.rotated(5.1),
+        floor: FloorModel::Environment,
+    };
+    let source = first.relit(&field, &lighting, None).unwrap();
+    gpu.relight_pose(&mut pose, &source).unwrap();
+    assert_relit_as_the_cpu(
+        &gpu,
+        &pose,
+        &ResidentPose::relight_cpu(&source),
+        "re-uploaded",
+    );
     // Relit with another pose's views: refused, not drawn wrong.
     let other = fixture.source(&sky);
-    match gpu.relight_pose(&pose, &other) {
+    match gpu.relight_pose(&mut pose, &other) {
         Err(RenderError::Misuse(m)) => assert!(m.contains("another pose's views"), "{m}"),
         r => panic!("expected a misuse, got {:?}", r.map(|_| ())),
     }

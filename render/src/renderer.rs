@@ -281,6 +281,14 @@ impl Device {
         })
     }
 
+    /// Lets go of `resident`'s basis codes on the GPU ([`GpuPose::release_basis`]): for a
+    /// pose whose light will not change. Relighting it later uploads them again.
+    pub fn release_basis(&self, resident: &mut Resident) {
+        if let ResidentKind::Gpu(pose) = &mut resident.kind {
+            pose.release_basis();
+        }
+    }
+
     /// Relights `resident` with `source`'s coefficients, `source` being its own views
     /// under a new light ([`PoseSource::relit`]), and its shadow maps with them. On the
     /// GPU this records one relighting dispatch per batch of views and one for the shadow

@@ -129,7 +129,7 @@ struct Cached {
     lighting: LightingKey,
     resident: Resident,
     /// The resident's own bytes, and its basis codes' identity and bytes
-    /// ([`Resident::basis`]), measured when made (relighting changes neither).
+    /// ([`Resident::basis`]), measured when made or relit.
     bytes: u64,
     basis: (usize, u64),
     last_frame: usize,
@@ -226,6 +226,10 @@ pub struct Shot<'a, R: ReadAt> {
     /// Per walker, the cache slots its poses took last frame: looked at first, so that
     /// a frame's search of the cache grows with its walkers, not with their square.
     last_slots: Vec<Vec<usize>>,
+    /// Whether every frame of the planned shot has one lighting: its poses then let go
+    /// of their basis codes once lit ([`Device::release_basis`]), and hold what a
+    /// pre-lit pose holds.
+    held_light: bool,
 }
 
 impl<'a, R: ReadAt> Shot<'a, R> {
@@ -268,6 +272,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         options: ShotOptions,
     ) -> Result<Self> {
         let plan = Plan::new(&scene, field, frames)?;
+        let keys: Vec<LightingKey> = frames
+            .iter()
+            .map(|f| LightingKey::of(&scene.lighting_at(f.time)))
+            .collect();
+        let held_light = options.planned && keys.windows(2).all(|w| w[0] == w[1]);
         // Views read again (by another walker's heading, or a new light) are not decoded
         // again: a quarter of the budget keeps them decoded.
         field.keep_decoded(options.memory_budget / DECODED_SHARE);
@@ -290,6 +299,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             counters: ShotCounters::default(),
             live_frames: 0,
             last_slots: Vec::new(),
+            held_light,
         })
     }
 
@@ -682,7 +692,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     self.counters.poses_made_resident += 1;
                     self.counters.relights += 1;
                     made_resident.push(pose);
-                    self.cache[k].lighting = key.clone();
+                    let c = &mut self.cache[k];
+                    c.lighting = key.clone();
+                    // Codes let go of are uploaded again to relight.
+                    (c.bytes, c.basis) = (c.resident.bytes(), c.resident.basis());
                     k
                 }
                 None => {
@@ -860,6 +873,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             )?,
         };
         let mut resident = self.device.make_resident_sharing(&source, like)?;
+        if self.held_light {
+            self.device.release_basis(&mut resident);
+        }
         if self.plan.interpolate == TimeInterpolation::Flow {
             let motion = PoseStep::ALL.map(|step| {
                 let wanted = match plan {

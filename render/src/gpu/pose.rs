@@ -100,6 +100,16 @@ impl GpuPose {
     }
 }
 
+impl GpuPose {
+    /// Lets go of its basis codes and relighting buffers (its pre-lit views stay, as
+    /// lit): for a pose whose light will not change, which then holds what a pre-lit pose
+    /// holds. [`Gpu::relight_pose`] uploads them again if it is relit after all. Codes
+    /// other poses share stay with them.
+    pub fn release_basis(&mut self) {
+        self.relight = None;
+    }
+}
+
 impl Gpu {
     /// Makes pose `source` resident: uploads its basis codes, flows and tables and
     /// relights every view on the GPU.
@@ -187,7 +197,12 @@ impl Gpu {
     /// Relights `pose` with `source`'s coefficients (the views and geometry it was made
     /// from): new coefficients and one dispatch pair per batch of views
     /// ([`super::relight`]), recorded with the pending work, not submitted.
-    pub fn relight_pose(&self, pose: &GpuPose, source: &PoseSource) -> Result<()> {
+    pub fn relight_pose(&self, pose: &mut GpuPose, source: &PoseSource) -> Result<()> {
+        if pose.relight.is_none() {
+            // Let go of ([`GpuPose::release_basis`]): uploaded again.
+            let basis = self.upload_basis(source)?;
+            pose.relight = Some(self.pose_relight(basis, source.geometry.views()));
+        }
         self.scoped("relighting a resident pose", || {
             let relight = pose.relight.as_ref().ok_or_else(|| {
                 crate::RenderError::Misuse("relighting a pose of no basis".into())
