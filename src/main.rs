@@ -50,6 +50,9 @@ enum Command {
     Eval(Box<cmd::eval::EvalArgs>),
     /// Score views held out of a ring of photographs, rendered from their neighbours.
     EvalRing(cmd::eval::RingEvalArgs),
+    /// Score relighting on one-light-at-a-time photographs: lights held out of a
+    /// calibrated set, predicted from the others.
+    EvalOlat(cmd::olat::EvalOlatArgs),
     /// Error against run time of every stage's settings on a stage capture: JSON, plots,
     /// and one page.
     Report(cmd::report::ReportArgs),
@@ -94,6 +97,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(*args),
         Command::Eval(args) => cmd::eval::run(*args),
         Command::EvalRing(args) => cmd::eval::ring::run(args),
+        Command::EvalOlat(args) => cmd::olat::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::View(args) => cmd::view::run(*args),
         Command::Bench(args) => cmd::bench::run_bench(args),

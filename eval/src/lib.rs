@@ -31,6 +31,7 @@ pub mod error;
 pub mod ingest;
 pub mod ingest_budget;
 pub mod metrics;
+pub mod olat;
 pub mod oracle;
 pub mod paths;
 pub mod quads;

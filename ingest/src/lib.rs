@@ -21,6 +21,7 @@ pub mod evidence;
 pub mod guided;
 pub mod interview;
 pub mod matte;
+pub mod olat;
 pub mod pipeline;
 pub mod poseflow;
 pub mod rectify;

@@ -26,6 +26,7 @@ pub mod field;
 pub mod flowcodec;
 pub mod hull;
 pub mod imagecodec;
+pub mod light_fit;
 pub mod merge;
 pub mod project;
 pub mod relight;

@@ -10,6 +10,7 @@ pub mod hull;
 pub mod info;
 pub mod ingest;
 pub mod merge;
+pub mod olat;
 pub mod render;
 pub mod report;
 pub mod stage;

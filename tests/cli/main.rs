@@ -8,6 +8,7 @@ mod adapter;
 mod bad_input;
 mod bench;
 mod interrupt;
+mod olat;
 mod outputs;
 mod render;
 mod report;

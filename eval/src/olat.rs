@@ -1,0 +1,232 @@
+//! Relighting scored on real photographs: of a calibrated one-light-at-a-time set
+//! ([`frf_ingest::olat`]), `K` lights are kept (farthest-point sampling from the light
+//! nearest the camera, [`farthest_lights`]) and each other light's photograph is predicted
+//! from them and scored inside the mask, for the per-texel light fit
+//! ([`frf_reflectance::light_fit`]) and two baselines: the nearest kept light's
+//! photograph, and the interpolation of the three nearest (inverse-angle weights).
+
+use std::path::Path;
+use std::time::Instant;
+
+use frf_core::image::{Image, RgbImage};
+use frf_core::io::write_png16_rgb;
+use frf_ingest::olat::OlatSet;
+use frf_reflectance::light_fit::{LightFit, farthest_lights, nearest_weights};
+use glam::Vec3;
+use serde::Serialize;
+
+use crate::error::{EvalError, Result};
+use crate::metrics::{psnr, ssim};
+
+/// Kept lights interpolated by the `interpolated` baseline and the fit's ratio.
+const NEAREST: usize = 3;
+
+/// One prediction's score against the photograph.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Score {
+    /// PSNR inside the mask, dB (peak: the photograph's brightest value there).
+    pub psnr: f64,
+    /// Mean SSIM of the luminance inside the mask.
+    pub ssim: f64,
+}
+
+/// A held-out light: its number in the set (from 1), direction, and each method's score.
+#[derive(Debug, Clone, Serialize)]
+pub struct LightScore {
+    /// Its line in `light_directions.txt` and image number.
+    pub light: usize,
+    /// Toward the light, camera frame.
+    pub direction: [f32; 3],
+    /// Angle to the nearest kept light, degrees.
+    pub nearest_kept_deg: f32,
+    /// The light fit.
+    pub fit: Score,
+    /// The nearest kept light's photograph.
+    pub nearest: Score,
+    /// The three nearest kept lights' photographs, weighted by inverse angle.
+    pub interpolated: Score,
+}
+
+/// Means of one method over the held-out lights.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct MeanScore {
+    /// Mean PSNR, dB.
+    pub mean_psnr: f64,
+    /// Mean SSIM.
+    pub mean_ssim: f64,
+}
+
+/// The baselines' means.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Baselines {
+    /// The nearest kept light.
+    pub nearest: MeanScore,
+    /// The three nearest, by inverse angle.
+    pub interpolated: MeanScore,
+}
+
+/// What `frf eval-olat` reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct OlatReport {
+    /// The set's directory.
+    pub set: String,
+    /// Lights in the set, and those kept (numbers from 1, in the order taken).
+    pub lights: usize,
+    /// The kept lights.
+    pub kept: Vec<usize>,
+    /// The light fit's mean PSNR over the held-out lights, dB.
+    pub mean_psnr: f64,
+    /// Its mean SSIM.
+    pub mean_ssim: f64,
+    /// The baselines' means.
+    pub baselines: Baselines,
+    /// Per held-out light.
+    pub held_out: Vec<LightScore>,
+    /// Seconds fitting the kept lights, and relighting every held-out one by the fit.
+    pub seconds_fit: f64,
+    /// Seconds relighting the held-out lights by the fit.
+    pub seconds_relight: f64,
+}
+
+/// Scores `set` with `keep` of its lights kept (see the module text); writes each
+/// held-out light's photograph and predictions as PNGs into `images` when given.
+pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Result<OlatReport> {
+    let n = set.directions.len();
+    if keep < 3 || keep >= n {
+        return Err(EvalError::Argument(frf_core::BadArgument::new(
+            "--use",
+            keep,
+            format!(
+                "3 to {} of the set's {n} lights (at least three fix a normal, one is held out)",
+                n.saturating_sub(1)
+            ),
+        )));
+    }
+    let kept = farthest_lights(&set.directions, keep, Vec3::Z);
+    let dirs: Vec<Vec3> = kept.iter().map(|&k| set.directions[k]).collect();
+    let photos: Vec<&RgbImage> = kept.iter().map(|&k| &set.images[k]).collect();
+    let t = Instant::now();
+    let fit = LightFit::fit(&photos, &dirs, &set.mask);
+    let seconds_fit = t.elapsed().as_secs_f64();
+    let mask = Some(set.mask.as_slice());
+    let score = |truth: &RgbImage, test: &RgbImage| Score {
+        psnr: psnr(truth, test, mask),
+        ssim: ssim(truth, test, mask),
+    };
+    let mut held_out = Vec::new();
+    let mut seconds_relight = 0.0;
+    for (k, &l) in set.directions.iter().enumerate() {
+        if kept.contains(&k) {
+            continue;
+        }
+        let truth = &set.images[k];
+        let t = Instant::now();
+        let ours = fit.relight(&photos, &dirs, l, NEAREST);
+        seconds_relight += t.elapsed().as_secs_f64();
+        let nearest_w = nearest_weights(&dirs, l, 1);
+        let nearest = photos[nearest_w[0].0].clone();
+        let interpolated = blend(&photos, &nearest_weights(&dirs, l, NEAREST));
+        if let Some(dir) = images {
+            for (what, img) in [
+                ("photo", truth),
+                ("fit", &ours),
+                ("nearest", &nearest),
+                ("interpolated", &interpolated),
+            ] {
+                write_png16_rgb(&dir.join(format!("light_{:03}_{what}.png", k + 1)), img)?;
+            }
+        }
+        held_out.push(LightScore {
+            light: k + 1,
+            direction: l.to_array(),
+            nearest_kept_deg: dirs[nearest_w[0].0]
+                .dot(l)
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees(),
+            fit: score(truth, &ours),
+            nearest: score(truth, &nearest),
+            interpolated: score(truth, &interpolated),
+        });
+    }
+    let mean = |f: &dyn Fn(&LightScore) -> Score| {
+        let m = held_out.len().max(1) as f64;
+        MeanScore {
+            mean_psnr: held_out.iter().map(|s| f(s).psnr).sum::<f64>() / m,
+            mean_ssim: held_out.iter().map(|s| f(s).ssim).sum::<f64>() / m,
+        }
+    };
+    let ours = mean(&|s| s.fit);
+    Ok(OlatReport {
+        set: set.dir.display().to_string(),
+        lights: n,
+        kept: kept.iter().map(|k| k + 1).collect(),
+        mean_psnr: ours.mean_psnr,
+        mean_ssim: ours.mean_ssim,
+        baselines: Baselines {
+            nearest: mean(&|s| s.nearest),
+            interpolated: mean(&|s| s.interpolated),
+        },
+        held_out,
+        seconds_fit,
+        seconds_relight,
+    })
+}
+
+/// The report as a table for people.
+pub fn olat_table(r: &OlatReport) -> String {
+    let mut out = format!(
+        "{}: {} of {} lights kept ({:?}); PSNR dB / SSIM inside the mask, per held-out light:\n",
+        r.set,
+        r.kept.len(),
+        r.lights,
+        r.kept
+    );
+    out.push_str("light  nearest kept  light fit        nearest          interpolated\n");
+    for s in &r.held_out {
+        out.push_str(&format!(
+            "{:5}  {:9.1}°    {:5.2} / {:.3}   {:5.2} / {:.3}   {:5.2} / {:.3}\n",
+            s.light,
+            s.nearest_kept_deg,
+            s.fit.psnr,
+            s.fit.ssim,
+            s.nearest.psnr,
+            s.nearest.ssim,
+            s.interpolated.psnr,
+            s.interpolated.ssim
+        ));
+    }
+    out.push_str(&format!(
+        " mean                {:5.2} / {:.3}   {:5.2} / {:.3}   {:5.2} / {:.3}\n",
+        r.mean_psnr,
+        r.mean_ssim,
+        r.baselines.nearest.mean_psnr,
+        r.baselines.nearest.mean_ssim,
+        r.baselines.interpolated.mean_psnr,
+        r.baselines.interpolated.mean_ssim
+    ));
+    out.push_str(&format!(
+        "fit {:.2} s, relighting {:.3} s a light",
+        r.seconds_fit,
+        r.seconds_relight / r.held_out.len().max(1) as f64
+    ));
+    out
+}
+
+/// `Σ w_k images[k]`.
+fn blend(images: &[&RgbImage], weights: &[(usize, f32)]) -> RgbImage {
+    let (w, h) = images[0].size();
+    let pixels = (0..w * h)
+        .map(|i| {
+            let mut p = [0.0f32; 3];
+            for &(k, wk) in weights {
+                let q = images[k].pixels()[i];
+                for c in 0..3 {
+                    p[c] += wk * q[c];
+                }
+            }
+            p
+        })
+        .collect();
+    Image::from_vec(w, h, pixels).expect("sized as the photographs")
+}

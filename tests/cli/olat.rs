@@ -1,0 +1,109 @@
+//! `frf eval-olat`: relighting scored on a one-light-at-a-time set, here a synthetic
+//! glossy sphere written in the layout of calibrated sets, and a set missing an image.
+
+use std::path::Path;
+
+use frf_core::image::Image;
+use frf_core::io::write_png16_rgb;
+use glam::Vec3;
+
+use crate::common::{frf, stderr};
+
+const SIDE: usize = 64;
+
+/// Writes a sphere lit by `lights` (Lambertian, a weak highlight) as `NNN.png` with its
+/// light file and mask into `dir`.
+fn write_sphere_set(dir: &Path, lights: &[Vec3]) {
+    let normal = |i: usize| {
+        let (x, y) = (i % SIDE, i / SIDE);
+        let u = (x as f32 + 0.5) / SIDE as f32 * 2.0 - 1.0;
+        let v = 1.0 - (y as f32 + 0.5) / SIDE as f32 * 2.0;
+        let r2 = u * u + v * v;
+        (r2 < 0.9).then(|| Vec3::new(u, v, (1.0 - r2).sqrt()))
+    };
+    let mut text = String::new();
+    for (k, &l) in lights.iter().enumerate() {
+        text.push_str(&format!("{} {} {}\n", l.x, l.y, l.z));
+        let img = Image::from_fn(SIDE, SIDE, |x, y| match normal(y * SIDE + x) {
+            None => [0.0; 3],
+            Some(n) => {
+                let d = n.dot(l).max(0.0);
+                let s = if d > 0.0 {
+                    0.1 * n.dot((l + Vec3::Z).normalize()).powf(30.0)
+                } else {
+                    0.0
+                };
+                [0.7 * d + s, 0.5 * d + s, 0.3 * d + s]
+            }
+        });
+        write_png16_rgb(&dir.join(format!("{:03}.png", k + 1)), &img)
+            .expect("a photograph written");
+    }
+    std::fs::write(dir.join("light_directions.txt"), text).expect("the light file written");
+    let mask = Image::from_fn(SIDE, SIDE, |x, y| {
+        if normal(y * SIDE + x).is_some() {
+            [1.0; 3]
+        } else {
+            [0.0; 3]
+        }
+    });
+    write_png16_rgb(&dir.join("mask.png"), &mask).expect("the mask written");
+}
+
+fn lights() -> Vec<Vec3> {
+    (0..12)
+        .map(|k| {
+            let polar = if k < 4 { 20f32 } else { 50.0 }.to_radians();
+            let az = k as f32 * 2.4;
+            Vec3::new(polar.sin() * az.cos(), polar.sin() * az.sin(), polar.cos())
+        })
+        .collect()
+}
+
+#[test]
+fn eval_olat_scores_the_light_fit_above_both_baselines() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sphere_set(dir.path(), &lights());
+    let images = dir.path().join("images");
+    let o = frf(&[
+        "eval-olat",
+        dir.path().to_str().unwrap(),
+        "--use",
+        "6",
+        "--images",
+        images.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let ours = r["mean_psnr"].as_f64().unwrap();
+    let nearest = r["baselines"]["nearest"]["mean_psnr"].as_f64().unwrap();
+    let interpolated = r["baselines"]["interpolated"]["mean_psnr"]
+        .as_f64()
+        .unwrap();
+    assert!(ours > 30.0, "{ours}");
+    assert!(
+        ours >= interpolated + 3.0 && ours >= nearest + 3.0,
+        "{ours} {interpolated} {nearest}"
+    );
+    assert_eq!(r["kept"].as_array().unwrap().len(), 6);
+    let held = r["held_out"].as_array().unwrap();
+    assert_eq!(held.len(), 6);
+    assert!(held[0]["fit"]["ssim"].as_f64().unwrap() > 0.9);
+    let light = held[0]["light"].as_u64().unwrap();
+    assert!(images.join(format!("light_{light:03}_fit.png")).exists());
+}
+
+#[test]
+fn eval_olat_refuses_a_set_missing_an_image_and_too_many_kept_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sphere_set(dir.path(), &lights());
+    let o = frf(&["eval-olat", dir.path().to_str().unwrap(), "--use", "12"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--use"), "{}", stderr(&o));
+    std::fs::remove_file(dir.path().join("005.png")).unwrap();
+    let o = frf(&["eval-olat", dir.path().to_str().unwrap()]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("005.png") && e.contains("missing"), "{e}");
+}
