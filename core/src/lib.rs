@@ -28,6 +28,7 @@ pub mod manifest;
 pub mod preview;
 pub mod progress;
 pub mod shared_data;
+pub mod sun;
 pub mod volume;
 
 pub use argument::BadArgument;

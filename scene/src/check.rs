@@ -3,6 +3,7 @@
 //! the line ([`Reporter`]).
 
 use frf_core::env::EnvSource;
+use frf_core::sun::Sun;
 use frf_reflectance::project::FloorModel;
 use glam::Vec3;
 
@@ -406,4 +407,84 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
         });
     }
     Ok(instances)
+}
+
+/// `lighting.sun`, when given: refused naming the field for a direction that is not one
+/// (or given twice, or not at all), an elevation outside ±90°, an angular diameter
+/// outside (0, 20]°, or a strength that is not one finite, non-negative value.
+pub fn sun(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Sun>> {
+    let Some(at) = &l.get_ref().sun else {
+        return Ok(None);
+    };
+    let (s, span) = (at.get_ref(), at.span());
+    let bad = |field: &str, problem: String| {
+        r.error(&format!("lighting.sun.{field}"), span.clone(), problem)
+    };
+    let finite = |field: &str, v: f32| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(bad(field, format!("{v} is not a finite number")))
+        }
+    };
+    let direction = match (s.direction, s.azimuth_deg, s.elevation_deg) {
+        (Some(d), None, None) => {
+            let d = Vec3::from_array(d);
+            if !d.is_finite() || d.length() < 1e-6 {
+                return Err(bad("direction", format!("{d} is not a direction")));
+            }
+            d
+        }
+        (None, Some(az), Some(el)) => {
+            let (az, el) = (finite("azimuth_deg", az)?, finite("elevation_deg", el)?);
+            if !(-90.0..=90.0).contains(&el) {
+                return Err(bad("elevation_deg", format!("{el}° is not within ±90°")));
+            }
+            frf_core::light::direction_from_azimuth_elevation(az.to_radians(), el.to_radians())
+        }
+        _ => {
+            return Err(bad(
+                "direction",
+                "give direction = [x, y, z], or azimuth_deg and elevation_deg (not both)".into(),
+            ));
+        }
+    };
+    let diameter = finite(
+        "angular_diameter_deg",
+        s.angular_diameter_deg
+            .unwrap_or(frf_core::sun::SUN_DIAMETER_DEG),
+    )?;
+    if !(diameter > 0.0 && diameter <= frf_core::sun::MAX_DIAMETER_DEG) {
+        return Err(bad(
+            "angular_diameter_deg",
+            format!(
+                "{diameter}° is not within (0, {}]°",
+                frf_core::sun::MAX_DIAMETER_DEG
+            ),
+        ));
+    }
+    let strength = match (s.illuminance, s.radiance) {
+        (Some(e), None) => finite("illuminance", e)?,
+        (None, Some(l)) => finite("radiance", l)? * Sun::solid_angle(diameter),
+        _ => {
+            return Err(bad(
+                "illuminance",
+                "give illuminance = E or radiance = L (one of them)".into(),
+            ));
+        }
+    };
+    let colour = s.colour.unwrap_or([1.0; 3]);
+    if strength < 0.0 || colour.iter().any(|c| !c.is_finite() || *c < 0.0) {
+        return Err(bad(
+            if strength < 0.0 {
+                "illuminance"
+            } else {
+                "colour"
+            },
+            "a sun's strength and colour are finite and not negative".into(),
+        ));
+    }
+    Sun::new(direction, diameter, colour.map(|c| c * strength))
+        .map(Some)
+        .map_err(|e| bad("illuminance", e.to_string()))
 }

@@ -28,6 +28,10 @@
 //! # [[lighting.key]]                  # keyframes, piecewise linear in time; a key may
 //! # time = 1.0                        # name another map, cross-faded from the previous
 //! # yaw_deg = 90.0                    # key's; omitted values carry over
+//! # sun = { azimuth_deg = 60.0, elevation_deg = 35.0, angular_diameter_deg = 0.53,
+//! #         illuminance = 12.0 }       # or direction = [x, y, z]; or radiance = L;
+//! #                                   # colour = [r, g, b]. Added to env (turned by yaw,
+//! #                                   # scaled by intensity); alone with env = "none"
 //!
 //! [camera]                            # an orbit over the time range, or keys
 //! orbit = { radius = 3.2, height = 1.4, start_deg = -30.0, sweep_deg = 120.0,
@@ -167,6 +171,37 @@ pub struct LightingToml {
     /// Keyframes.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub key: Vec<At<LightKeyToml>>,
+    /// A sun added to the environment (or lighting alone, with `env = "none"`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sun: Option<At<SunToml>>,
+}
+
+/// `lighting.sun`: a direction (by azimuth and elevation, or a vector), an angular
+/// diameter, and a strength (an illuminance or a radiance, times a colour).
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SunToml {
+    /// Degrees from `+z` toward `+x`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub azimuth_deg: Option<f32>,
+    /// Degrees above the horizon.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elevation_deg: Option<f32>,
+    /// Toward the sun, scene frame (instead of azimuth and elevation).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f32; 3]>,
+    /// Degrees (default 0.53, the real sun's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub angular_diameter_deg: Option<f32>,
+    /// `∫ L dω` over the disc, the environment's units (or give `radiance`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub illuminance: Option<f32>,
+    /// The disc's radiance (instead of `illuminance`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radiance: Option<f32>,
+    /// Multiplies the strength per channel (default white).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub colour: Option<[f32; 3]>,
 }
 
 fn zero() -> At<f32> {

@@ -132,6 +132,8 @@ pub struct LightingAt {
     pub yaw: f32,
     /// Multiplier.
     pub intensity: f32,
+    /// The scene's sun, turned by `yaw` and scaled by `intensity` as the maps are.
+    pub sun: Option<frf_core::sun::Sun>,
 }
 
 /// One walker of the scene.
@@ -209,6 +211,8 @@ pub struct Scene {
     pub variant: Variant,
     /// Lighting keys, in time order (at least one).
     pub lighting: Vec<LightKey>,
+    /// A sun added to the lighting (`lighting.sun`; [`frf_core::sun`]).
+    pub sun: Option<frf_core::sun::Sun>,
     /// What lights the subject from below.
     pub floor: FloorModel,
     /// The camera.
@@ -283,6 +287,7 @@ impl Scene {
         let interpolate = check::interpolate(&r, &raw)?;
         let (size, exposure, preview, variant) = check::output(&r, &raw.output)?;
         let (lighting, floor) = check::lighting(&r, &raw.lighting)?;
+        let sun = check::sun(&r, &raw.lighting)?;
         let camera = check::camera(&r, &raw.camera)?;
         let (backdrop, shadow) =
             check::composite(&r, &raw.composite, (&camera, &raw.camera), &lighting)?;
@@ -301,6 +306,7 @@ impl Scene {
             preview,
             variant,
             lighting,
+            sun,
             floor,
             camera,
             backdrop,
@@ -349,11 +355,13 @@ impl Scene {
         let k = &self.lighting;
         let i = k.partition_point(|key| key.time <= t).max(1) - 1;
         let a = &k[i];
+        let sun = |yaw: f32, intensity: f32| self.sun.map(|s| s.rotated(yaw).scaled(intensity));
         let Some(b) = k.get(i + 1) else {
             return LightingAt {
                 maps: vec![(a.env.clone(), 1.0)],
                 yaw: a.yaw,
                 intensity: a.intensity,
+                sun: sun(a.yaw, a.intensity),
             };
         };
         let s = if a.time.is_finite() {
@@ -366,10 +374,15 @@ impl Scene {
         } else {
             vec![(a.env.clone(), 1.0 - s), (b.env.clone(), s)]
         };
+        let (yaw, intensity) = (
+            a.yaw + s * (b.yaw - a.yaw),
+            a.intensity + s * (b.intensity - a.intensity),
+        );
         LightingAt {
             maps,
-            yaw: a.yaw + s * (b.yaw - a.yaw),
-            intensity: a.intensity + s * (b.intensity - a.intensity),
+            yaw,
+            intensity,
+            sun: sun(yaw, intensity),
         }
     }
 

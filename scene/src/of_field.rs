@@ -27,6 +27,8 @@ pub struct FieldLook {
     pub env: EnvSource,
     /// Its yaw, radians.
     pub yaw: f32,
+    /// A sun added to it (`--sun`).
+    pub sun: Option<frf_core::sun::Sun>,
     /// What lights the subject from below.
     pub floor: FloorModel,
     /// The camera.
@@ -46,6 +48,7 @@ impl FieldLook {
         FieldLook {
             env,
             yaw,
+            sun: None,
             floor,
             camera: Trajectory::Orbit(Orbit {
                 radius: 3.2,
@@ -90,6 +93,7 @@ impl Scene {
                 yaw: look.yaw,
                 intensity: 1.0,
             }],
+            sun: look.sun,
             floor: look.floor,
             camera: look.camera,
             backdrop: look.backdrop,

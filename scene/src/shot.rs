@@ -105,6 +105,8 @@ struct LightingKey {
     maps: Vec<(String, u32)>,
     yaw: u32,
     intensity: u32,
+    /// The sun's direction, radius and illuminance, as bits.
+    sun: Option<[u32; 7]>,
 }
 
 impl LightingKey {
@@ -117,6 +119,10 @@ impl LightingKey {
                 .collect(),
             yaw: l.yaw.to_bits(),
             intensity: l.intensity.to_bits(),
+            sun: l.sun.map(|s| {
+                let (d, e) = (s.direction(), s.illuminance());
+                [d.x, d.y, d.z, s.radius(), e[0], e[1], e[2]].map(f32::to_bits)
+            }),
         }
     }
 }
@@ -394,19 +400,24 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         }
         let mut maps = Vec::new();
         for (source, weight) in &l.maps {
-            match self.env(source)? {
-                Some(e) => maps.push((e.rotated(l.yaw).scaled(l.intensity), *weight)),
-                None => {
+            match (self.env(source)?, l.sun) {
+                (Some(e), _) => maps.push((e.rotated(l.yaw).scaled(l.intensity), *weight)),
+                // A sun alone: a black sky of the built-in sky's texels holds it.
+                (None, Some(_)) => maps.push((EnvMap::uniform([0.0; 3], 128), *weight)),
+                (None, None) => {
                     self.world = Some((key, None));
                     return Ok(None);
                 }
             }
         }
-        let env = if maps.len() == 1 && maps[0].1 == 1.0 {
+        let mut env = if maps.len() == 1 && maps[0].1 == 1.0 {
             maps.remove(0).0
         } else {
             EnvMap::mix(&maps.iter().map(|(e, w)| (e, *w)).collect::<Vec<_>>())?
         };
+        if let Some(sun) = &l.sun {
+            env = sun.lit(&env)?;
+        }
         self.world = Some((key, Some(env.clone())));
         Ok(Some(env))
     }

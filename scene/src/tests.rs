@@ -143,6 +143,79 @@ fn lighting_keys_interpolate_and_cross_fade_maps() {
 }
 
 #[test]
+fn a_sun_in_the_lighting_turns_and_scales_with_it_and_bad_suns_are_refused_by_name() {
+    let with = |sun: &str| {
+        MINIMAL.replace(
+            "env = \"sky\"",
+            &format!("env = \"sky\"\nyaw_deg = 90.0\nintensity = 2.0\nsun = {{ {sun} }}"),
+        )
+    };
+    let s = scene(&with(
+        "azimuth_deg = 0.0, elevation_deg = 30.0, illuminance = 5.0",
+    ))
+    .unwrap();
+    let sun = s.lighting_at(0.0).sun.unwrap();
+    // Azimuth 0 is +z; a yaw of 90° turns it to +x; intensity 2 doubles it.
+    let d = sun.direction();
+    assert!(
+        (d.x - 30f32.to_radians().cos()).abs() < 1e-5 && d.z.abs() < 1e-5,
+        "{d}"
+    );
+    assert!((sun.illuminance()[0] - 10.0).abs() < 1e-5);
+    assert!((sun.radius().to_degrees() - 0.265).abs() < 1e-4);
+    // A radiance is its disc's solid angle times as much illuminance.
+    let s = scene(&with(
+        "direction = [0.0, 1.0, 0.0], radiance = 1000.0, angular_diameter_deg = 2.0",
+    ))
+    .unwrap();
+    let e = s.sun.unwrap().illuminance()[0];
+    assert!(
+        (e - 1000.0 * frf_core::sun::Sun::solid_angle(2.0)).abs() < 1e-3,
+        "{e}"
+    );
+    for (sun, field) in [
+        (
+            "azimuth_deg = 0.0, elevation_deg = 95.0, illuminance = 1.0",
+            "lighting.sun.elevation_deg",
+        ),
+        (
+            "elevation_deg = 30.0, illuminance = 1.0",
+            "lighting.sun.direction",
+        ),
+        (
+            "direction = [0.0, 0.0, 0.0], illuminance = 1.0",
+            "lighting.sun.direction",
+        ),
+        (
+            "direction = [0.0, 1.0, 0.0], angular_diameter_deg = 40.0, illuminance = 1.0",
+            "lighting.sun.angular_diameter_deg",
+        ),
+        (
+            "direction = [0.0, 1.0, 0.0], illuminance = -1.0",
+            "lighting.sun.illuminance",
+        ),
+        (
+            "direction = [0.0, 1.0, 0.0], illuminance = nan",
+            "lighting.sun.illuminance",
+        ),
+        ("direction = [0.0, 1.0, 0.0]", "lighting.sun.illuminance"),
+        (
+            "direction = [0.0, 1.0, 0.0], illuminance = 1.0, colour = [1.0, -1.0, 1.0]",
+            "lighting.sun.colour",
+        ),
+    ] {
+        let e = error(&with(sun));
+        assert!(e.contains(field), "{sun}: {e}");
+    }
+    assert!(
+        error(&with(
+            "direction = [0.0, 1.0, 0.0], illuminance = 1.0, size = 2"
+        ))
+        .contains("size")
+    );
+}
+
+#[test]
 fn poses_follow_the_walk_cycle_with_each_walker_s_offset() {
     let text = format!(
         "{MINIMAL}\n[[instance]]\n[[instance]]\nposition = [1.0, 0.0, 0.0]\ntime_offset = 0.5\n"

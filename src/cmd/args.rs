@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use frf_core::env::{EnvMap, EnvSource};
+use frf_core::sun::Sun;
 use frf_flow::Preset;
 use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, DEFAULT_VOXEL_M, ShadowOptions};
 use frf_reflectance::field::HullSpec;
@@ -229,9 +230,75 @@ pub struct LightingArgs {
     /// What lights the subject from below.
     #[arg(long, value_enum, default_value = "env")]
     pub floor: FloorArg,
+    /// A sun added to the environment (alone with `--env none`), turned with it by
+    /// `--yaw`: `AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]]`, degrees (azimuth from +z
+    /// toward +x) and `∫ L dω` over the disc in the environment's units (default 0.53°
+    /// and 10, about the built-in sky's sun).
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]")]
+    pub sun: Option<SunSpec>,
+}
+
+/// `--sun AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]]`.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct SunSpec {
+    /// Degrees.
+    pub azimuth_deg: f32,
+    /// Degrees.
+    pub elevation_deg: f32,
+    /// Degrees.
+    pub diameter_deg: f32,
+    /// `∫ L dω` over the disc.
+    pub illuminance: f32,
+}
+
+impl SunSpec {
+    /// The sun it names.
+    pub fn sun(&self) -> CliResult<Sun> {
+        let d = frf_core::light::direction_from_azimuth_elevation(
+            self.azimuth_deg.to_radians(),
+            self.elevation_deg.to_radians(),
+        );
+        Ok(Sun::new(d, self.diameter_deg, [self.illuminance; 3])
+            .map_err(|e| format!("--sun: {e}"))?)
+    }
+}
+
+/// Parses `--sun`.
+pub fn parse_sun(s: &str) -> Result<SunSpec, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| {
+            format!("{s:?} is not AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]] in numbers")
+        })?;
+    if !(2..=4).contains(&v.len()) || v.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "{s:?} is not AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]] (2 to 4 finite numbers)"
+        ));
+    }
+    let spec = SunSpec {
+        azimuth_deg: v[0],
+        elevation_deg: v[1],
+        diameter_deg: v.get(2).copied().unwrap_or(frf_core::sun::SUN_DIAMETER_DEG),
+        illuminance: v.get(3).copied().unwrap_or(10.0),
+    };
+    if !(-90.0..=90.0).contains(&spec.elevation_deg) {
+        return Err(format!(
+            "elevation {}° is not within ±90°",
+            spec.elevation_deg
+        ));
+    }
+    spec.sun().map_err(|e| e.to_string())?;
+    Ok(spec)
 }
 
 impl LightingArgs {
+    /// The sun asked for.
+    pub fn sun(&self) -> CliResult<Option<Sun>> {
+        self.sun.as_ref().map(SunSpec::sun).transpose()
+    }
+
     /// The environment asked for.
     pub fn source(&self) -> CliResult<&EnvSource> {
         Ok(self
@@ -244,9 +311,14 @@ impl LightingArgs {
     /// for truth renders (`None` for `none`).
     pub fn lighting(&self, conditions: usize) -> CliResult<(Lighting, Option<EnvMap>)> {
         let source = self.source()?;
-        let env = source
+        let mut env = source
             .load()
             .map_err(|e| format!("environment {source}: {e}"))?;
+        if let Some(sun) = self.sun()? {
+            // Added before the yaw, which turns it with the map; alone, a black sky.
+            let base = env.unwrap_or_else(|| EnvMap::uniform([0.0; 3], 128));
+            env = Some(sun.lit(&base)?);
+        }
         let yaw = self.yaw.to_radians();
         Ok(Lighting::of(env, yaw, self.floor.into(), conditions)?)
     }

@@ -144,6 +144,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
     let look = FieldLook {
         env: source,
         yaw: args.lighting.yaw.to_radians(),
+        sun: args.lighting.sun()?,
         floor: args.lighting.floor.into(),
         camera: trajectory,
         backdrop,

@@ -15,7 +15,7 @@ use frf_reflectance::project::FloorModel;
 use frf_render::composite::GroundLook;
 use frf_scene::file::{
     CameraToml, CompositeToml, InstanceToml, LightKeyToml, LightingToml, OutputToml, SceneToml,
-    TimeToml, written,
+    SunToml, TimeToml, written,
 };
 use frf_scene::path::Key;
 use frf_scene::{BackdropSpec, Scene, ShadowSpec};
@@ -140,6 +140,19 @@ pub fn scene_toml(
                     })
                 })
                 .collect(),
+            sun: scene.sun.map(|sun| {
+                let e = sun.illuminance();
+                let strength = e[0].max(e[1]).max(e[2]);
+                written(SunToml {
+                    azimuth_deg: None,
+                    elevation_deg: None,
+                    direction: Some(sun.direction().to_array()),
+                    angular_diameter_deg: Some(2.0 * sun.radius().to_degrees()),
+                    illuminance: Some(strength),
+                    radiance: None,
+                    colour: (strength > 0.0).then(|| e.map(|c| c / strength)),
+                })
+            }),
         }),
         camera: written(CameraToml {
             orbit: None,

@@ -1,0 +1,181 @@
+//! A sun: a distant disc of light of a given angular diameter, added to an environment
+//! ([`crate::env::EnvMap::with_sun`]) or lighting alone. Its strength is its illuminance
+//! `E = ∫ L dω` over the disc (the irradiance it gives a surface facing it), in the
+//! environment's units of radiance times steradians, or its radiance `L` (then
+//! `E = L · Ω` with `Ω = 2π (1 − cos r)` the disc's solid angle). A map holds the disc in
+//! the texels whose centres it covers, or the nearest one when it is smaller than a texel,
+//! keeping `E` exact either way.
+
+use glam::Vec3;
+
+use crate::env::EnvMap;
+use crate::error::{CoreError, Result};
+use crate::image::Rgb;
+
+/// The widest sun taken, degrees: wider is an area light, not a sun.
+pub const MAX_DIAMETER_DEG: f32 = 20.0;
+
+/// The real sun's angular diameter, degrees.
+pub const SUN_DIAMETER_DEG: f32 = 0.53;
+
+/// A distant disc of light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sun {
+    direction: Vec3,
+    diameter: f32,
+    illuminance: Rgb,
+}
+
+impl Sun {
+    /// A sun toward `direction` (scene frame, toward the sun; any length but zero) of
+    /// angular diameter `diameter_deg` and illuminance `illuminance` (per channel): values
+    /// outside what a sun can be are refused naming them.
+    pub fn new(direction: Vec3, diameter_deg: f32, illuminance: Rgb) -> Result<Self> {
+        if !direction.is_finite() || direction.length() < 1e-6 {
+            return Err(CoreError::invalid(
+                "sun direction",
+                format!("{direction} is not a direction"),
+            ));
+        }
+        if !(diameter_deg > 0.0 && diameter_deg <= MAX_DIAMETER_DEG) {
+            return Err(CoreError::invalid(
+                "sun angular diameter",
+                format!("{diameter_deg}° is not within (0, {MAX_DIAMETER_DEG}]°"),
+            ));
+        }
+        if illuminance
+            .iter()
+            .any(|c| !c.is_finite() || *c < 0.0 || *c as f64 > crate::env::MAX_TOTAL_LIGHT)
+        {
+            return Err(CoreError::invalid(
+                "sun illuminance",
+                format!("{illuminance:?} is not a finite, non-negative light"),
+            ));
+        }
+        Ok(Self {
+            direction: direction.normalize(),
+            diameter: diameter_deg.to_radians(),
+            illuminance,
+        })
+    }
+
+    /// The solid angle of a disc of angular diameter `diameter_deg`, steradians.
+    pub fn solid_angle(diameter_deg: f32) -> f32 {
+        let r = 0.5 * diameter_deg.to_radians();
+        2.0 * std::f32::consts::PI * (1.0 - r.cos())
+    }
+
+    /// Unit direction toward it.
+    pub fn direction(&self) -> Vec3 {
+        self.direction
+    }
+
+    /// Angular radius, radians.
+    pub fn radius(&self) -> f32 {
+        0.5 * self.diameter
+    }
+
+    /// `∫ L dω` over the disc, per channel.
+    pub fn illuminance(&self) -> Rgb {
+        self.illuminance
+    }
+
+    /// The same sun turned by `angle` radians about `+y` (as a yaw turns an environment).
+    pub fn rotated(&self, angle: f32) -> Self {
+        Self {
+            direction: glam::Mat3::from_rotation_y(angle) * self.direction,
+            ..*self
+        }
+    }
+
+    /// `env` with this sun added: its illuminance spread over the texels whose centres
+    /// the disc covers (the nearest texel when it covers none), so that the map's
+    /// `∫ L dω` grows by exactly the sun's.
+    pub fn lit(&self, env: &EnvMap) -> Result<EnvMap> {
+        let (w, h) = env.image().size();
+        let at = env.texel_of(self.direction);
+        let row = (at.y.round().max(0.0) as usize).min(h - 1);
+        // Rows within the disc's radius of its centre, and a texel's margin.
+        let reach = (self.radius() / (std::f32::consts::PI / h as f32)).ceil() as usize + 1;
+        let cos_r = self.radius().cos();
+        let mut covered: Vec<(usize, usize)> = Vec::new();
+        for y in row.saturating_sub(reach)..(row + reach + 1).min(h) {
+            for x in 0..w {
+                if env.direction_of(x as f32, y as f32).dot(self.direction) >= cos_r {
+                    covered.push((x, y));
+                }
+            }
+        }
+        if covered.is_empty() {
+            covered.push(((at.x.round() as i64).rem_euclid(w as i64) as usize, row));
+        }
+        let omega: f32 = covered.iter().map(|&(_, y)| env.texel_solid_angle(y)).sum();
+        let add = self.illuminance.map(|e| e / omega);
+        let mut radiance = env.image().clone();
+        for (x, y) in covered {
+            let p = radiance.get(x, y);
+            radiance.set(x, y, [p[0] + add[0], p[1] + add[1], p[2] + add[2]]);
+        }
+        Ok(EnvMap::from_image(radiance)?.rotated(env.yaw()))
+    }
+
+    /// The same sun `k` times as bright.
+    pub fn scaled(&self, k: f32) -> Self {
+        Self {
+            illuminance: self.illuminance.map(|c| c * k.max(0.0)),
+            ..*self
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_suns_are_refused_naming_the_value() {
+        let e = |r: Result<Sun>| r.unwrap_err().to_string();
+        assert!(e(Sun::new(Vec3::ZERO, 0.5, [1.0; 3])).contains("sun direction"));
+        assert!(e(Sun::new(Vec3::Y, 0.0, [1.0; 3])).contains("sun angular diameter"));
+        assert!(e(Sun::new(Vec3::Y, 45.0, [1.0; 3])).contains("sun angular diameter"));
+        assert!(e(Sun::new(Vec3::Y, 0.5, [f32::NAN; 3])).contains("sun illuminance"));
+        assert!(e(Sun::new(Vec3::Y, 0.5, [-1.0; 3])).contains("sun illuminance"));
+        let s = Sun::new(Vec3::new(0.0, 2.0, 0.0), 0.5, [1.0; 3]).unwrap();
+        assert!((s.direction().length() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_sun_adds_its_illuminance_to_a_map_where_it_is() {
+        let base = EnvMap::uniform([0.1; 3], 64).rotated(0.7);
+        let dir = crate::light::direction_from_azimuth_elevation(1.0, 0.5);
+        for diameter in [SUN_DIAMETER_DEG, 5.0] {
+            let sun = Sun::new(dir, diameter, [2.0, 1.5, 1.0]).unwrap();
+            let lit = sun.lit(&base).unwrap();
+            let (a, b) = (base.total_light(), lit.total_light());
+            for c in 0..3 {
+                let added = b[c] - a[c];
+                assert!(
+                    (added - sun.illuminance()[c]).abs() < 1e-3,
+                    "{diameter}°: {added}"
+                );
+            }
+            // The brightest texel lies toward the sun, within a texel's width.
+            let img = lit.image();
+            let (i, _) = img
+                .pixels()
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1[0].total_cmp(&b.1[0]))
+                .unwrap();
+            let seen = lit.direction_of((i % img.width()) as f32, (i / img.width()) as f32);
+            assert!(seen.dot(dir).acos().to_degrees() < 3.0 + diameter);
+        }
+    }
+
+    #[test]
+    fn the_solid_angle_of_the_real_sun() {
+        // About 6.8e-5 sr.
+        let o = Sun::solid_angle(SUN_DIAMETER_DEG);
+        assert!((o - 6.8e-5).abs() < 0.1e-5, "{o}");
+    }
+}
