@@ -493,7 +493,6 @@ impl Device {
         variant: Variant,
         layers: bool,
     ) -> Result<Frame> {
-        // The CPU reference: each walker alone, stacked back to front, then composited.
         let positions: Vec<_> = walkers
             .iter()
             .map(|w| w.world_from_subject.translation)
