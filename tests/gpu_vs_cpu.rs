@@ -342,3 +342,70 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
         );
     }
 }
+
+#[test]
+fn the_light_fit_relights_on_the_gpu_as_on_the_cpu() {
+    use frf_reflectance::light_fit::{LightFit, farthest_lights};
+    let Some(gpu) = gpu() else { return };
+    // A sphere whose albedo varies, with a highlight and a dark band (a texel the fit
+    // skips), under 12 lights; 6 kept.
+    const SIDE: usize = 48;
+    let photo = |l: Vec3| {
+        Image::from_fn(SIDE, SIDE, |x, y| {
+            let u = (x as f32 + 0.5) / SIDE as f32 * 2.0 - 1.0;
+            let v = 1.0 - (y as f32 + 0.5) / SIDE as f32 * 2.0;
+            let r2 = u * u + v * v;
+            if r2 >= 0.9 || (0.2..0.25).contains(&u) {
+                return [0.0; 3];
+            }
+            let n = Vec3::new(u, v, (1.0 - r2).sqrt());
+            let d = n.dot(l).max(0.0);
+            let s = if d > 0.0 {
+                0.2 * n.dot((l + Vec3::Z).normalize()).powf(20.0)
+            } else {
+                0.0
+            };
+            [
+                (0.5 + 0.3 * u) * d + s,
+                0.4 * d + s,
+                (0.3 - 0.2 * v) * d + s,
+            ]
+        })
+    };
+    let all: Vec<Vec3> = (0..12)
+        .map(|k| {
+            let polar = if k < 4 { 25f32 } else { 55.0 }.to_radians();
+            let az = k as f32 * 2.4;
+            Vec3::new(polar.sin() * az.cos(), polar.sin() * az.sin(), polar.cos())
+        })
+        .collect();
+    let kept = farthest_lights(&all, 6, Vec3::Z);
+    let dirs: Vec<Vec3> = kept.iter().map(|&k| all[k]).collect();
+    let images: Vec<_> = dirs.iter().map(|&l| photo(l)).collect();
+    let refs: Vec<_> = images.iter().collect();
+    let mask = vec![true; SIDE * SIDE];
+    let fit = LightFit::fit(&refs, &dirs, &mask);
+    let resident = gpu.upload_light_fit(&fit, &refs, &dirs).unwrap();
+    for (k, &l) in all.iter().enumerate().filter(|(k, _)| !kept.contains(k)) {
+        let cpu = fit.relight(&refs, &dirs, l, 3);
+        let on_gpu = gpu.relight_fit(&resident, l, 3).unwrap();
+        let worst = cpu
+            .pixels()
+            .iter()
+            .zip(on_gpu.pixels())
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / a[c].abs().max(1.0)))
+            .fold(0.0f32, f32::max);
+        assert!(
+            worst < 1e-4,
+            "light {k}: GPU differs from the CPU by {worst}"
+        );
+    }
+    // A photograph of another size is refused, not drawn wrong.
+    let small = Image::from_vec(2, 2, vec![[0.0; 3]; 4]).unwrap();
+    let mut wrong = refs.clone();
+    wrong[0] = &small;
+    assert!(matches!(
+        gpu.upload_light_fit(&fit, &wrong, &dirs),
+        Err(RenderError::Misuse(_))
+    ));
+}

@@ -31,7 +31,7 @@ const HIGHLIGHT: f32 = 0.25;
 /// to carry a ratio (a texel they barely reach, whose photographs are mostly noise and
 /// shadow there): on the UW sets at 6 of 12 lights, 0.3 scores 0.8 dB above 0.05 on
 /// the buddha, the same elsewhere; 0.5 and 0.8 score within 0.1 dB of it.
-const RATIO_FLOOR: f32 = 0.3;
+pub const RATIO_FLOOR: f32 = 0.3;
 
 /// The Lambertian fit of every texel of a set of photographs under single lights.
 pub struct LightFit {

@@ -25,6 +25,8 @@ pub const COMPOSITE: &str = include_str!("../composite.wgsl");
 pub const PRESENT: &str = include_str!("../present.wgsl");
 /// `time_morph.wgsl`: the morph in time of a frame between two poses.
 pub const TIME_MORPH: &str = include_str!("../time_morph.wgsl");
+/// `light_fit.wgsl`: photographs under single lights relit by a per-texel light fit.
+pub const LIGHT_FIT: &str = include_str!("../light_fit.wgsl");
 /// `floor.wgsl`, standalone.
 pub const FLOOR: &str = include_str!("../floor.wgsl");
 /// `rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera centres, composed
@@ -48,13 +50,14 @@ pub const FLOW_F16: &str = include_str!("../sample/flow_f16.wgsl");
 pub const FLOW_F32: &str = include_str!("../sample/flow_f32.wgsl");
 
 /// Every pass but the frame pass ([`frame_pass`]), named.
-pub const PASSES: [(&str, &str); 6] = [
+pub const PASSES: [(&str, &str); 7] = [
     ("relight", RELIGHT),
     ("shadow", SHADOW),
     ("composite", COMPOSITE),
     ("floor", FLOOR),
     ("present", PRESENT),
     ("time_morph", TIME_MORPH),
+    ("light_fit", LIGHT_FIT),
 ];
 
 /// The snippets that read the pre-lit views (one is compiled into a frame pass), named as

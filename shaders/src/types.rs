@@ -153,6 +153,26 @@ pub struct GpuRelightParams {
     pub pad: u32,
 }
 
+/// `LightFitParams` of `light_fit.wgsl`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuLightFitParams {
+    /// Texels per photograph.
+    pub texels: u32,
+    /// Photographs (lights).
+    pub lights: u32,
+    /// Nearest lights used (at most 4).
+    pub nearest: u32,
+    /// Padding.
+    pub pad0: u32,
+    /// The new light (xyz, unit) and the ratio's floor (w).
+    pub light: [f32; 4],
+    /// The nearest lights' indices.
+    pub indices: [u32; 4],
+    /// Their weights.
+    pub weights: [f32; 4],
+}
+
 /// `Job` of `relight.wgsl`: one view of a relighting batch.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

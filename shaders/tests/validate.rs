@@ -9,8 +9,8 @@ use std::mem::{offset_of, size_of};
 
 use frf_shaders as shaders;
 use frf_shaders::types::{
-    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuPresent, GpuProxy, GpuQuad,
-    GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuTimeMorph, GpuView,
+    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuLightFitParams, GpuPresent, GpuProxy,
+    GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuTimeMorph, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -252,6 +252,13 @@ fn pod_structs_match_naga_layouts() {
             pad0,
             pad1
         ]
+    );
+    let light_fit = module(&shaders::composed(shaders::LIGHT_FIT), "light_fit");
+    check_layout!(
+        &light_fit,
+        "LightFitParams",
+        GpuLightFitParams,
+        [texels, lights, nearest, pad0, light, indices, weights]
     );
     let shadow = module(&shaders::composed(shaders::SHADOW), "shadow");
     check_layout!(

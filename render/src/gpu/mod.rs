@@ -11,7 +11,10 @@
 //! - [`composite`]: the subject over a shadowed backdrop (`shaders/composite.wgsl`; twin
 //!   of [`crate::composite::compose`]);
 //! - [`present`]: a composited frame shown in a window, nothing read back
-//!   (`shaders/present.wgsl`).
+//!   (`shaders/present.wgsl`);
+//! - [`light_fit`]: photographs under single lights relit by their per-texel light fit
+//!   (`shaders/light_fit.wgsl`; twin of
+//!   [`frf_reflectance::light_fit::LightFit::relight`]).
 //!
 //! [`Gpu::new`] opens an adapter (on machines without a GPU, Mesa's lavapipe; the
 //! `WGPU_BACKEND` variable chooses a backend) and builds every pipeline once. Every
@@ -25,6 +28,7 @@ pub mod composite;
 mod composite_targets;
 pub mod formats;
 pub mod kept;
+pub mod light_fit;
 pub mod pose;
 pub mod present;
 pub mod readback;
