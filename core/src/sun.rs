@@ -15,6 +15,13 @@ use crate::image::Rgb;
 /// The widest sun taken, degrees: wider is an area light, not a sun.
 pub const MAX_DIAMETER_DEG: f32 = 20.0;
 
+/// A map's brightest texel is a sun when it is this many times the map's mean radiance
+/// ([`Sun::extract`]).
+pub const SUN_CONTRAST: f64 = 100.0;
+
+/// Texels around a sun's brightest at this share of its radiance are the sun's.
+pub const SUN_SHARE: f32 = 0.1;
+
 /// The real sun's angular diameter, degrees.
 pub const SUN_DIAMETER_DEG: f32 = 0.53;
 
@@ -119,6 +126,92 @@ impl Sun {
         Ok(EnvMap::from_image(radiance)?.rotated(env.yaw()))
     }
 
+    /// The sun baked into `env`, and `env` without it: the texels around the brightest
+    /// one whose radiance is at least [`SUN_SHARE`] of its, when that texel is at least
+    /// [`SUN_CONTRAST`] times the map's mean radiance (a sun, not a bright sky). Its
+    /// illuminance is what those texels carry above the median of the ring of texels
+    /// around them (the sky behind it), which they are set to; its direction the
+    /// energy-weighted mean of theirs; its diameter that of a disc of their solid angle.
+    /// `None` when the map has no such sun.
+    pub fn extract(env: &EnvMap) -> Result<Option<(Sun, EnvMap)>> {
+        let img = env.image();
+        let (w, h) = img.size();
+        let lum = |p: Rgb| crate::image::luminance(p);
+        let total: f64 = env.total_light().iter().map(|&c| c as f64).sum::<f64>() / 3.0;
+        let mean = total / (4.0 * std::f64::consts::PI);
+        let (peak_i, peak) = img
+            .pixels()
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (i, lum(p)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0, 0.0));
+        if !(peak as f64 > SUN_CONTRAST * mean) {
+            return Ok(None);
+        }
+        // The bright texels connected to the peak (wrapping in azimuth).
+        let mut inside = vec![false; w * h];
+        let mut stack = vec![peak_i];
+        inside[peak_i] = true;
+        let mut region = Vec::new();
+        while let Some(i) = stack.pop() {
+            region.push(i);
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let ny = y + dy;
+                if !(0..h as i64).contains(&ny) {
+                    continue;
+                }
+                let j = ny as usize * w + (x + dx).rem_euclid(w as i64) as usize;
+                if !inside[j] && lum(img.pixels()[j]) >= SUN_SHARE * peak {
+                    inside[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+        // The sky behind it: the median of the texels bordering the region.
+        let mut ring: Vec<Rgb> = Vec::new();
+        for &i in &region {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let ny = (y + dy).clamp(0, h as i64 - 1) as usize;
+                let j = ny * w + (x + dx).rem_euclid(w as i64) as usize;
+                if !inside[j] {
+                    ring.push(img.pixels()[j]);
+                }
+            }
+        }
+        ring.sort_by(|a, b| lum(*a).total_cmp(&lum(*b)));
+        let sky = ring.get(ring.len() / 2).copied().unwrap_or([0.0; 3]);
+        let mut radiance = img.clone();
+        let (mut e, mut omega, mut towards) = ([0.0f64; 3], 0.0f64, Vec3::ZERO);
+        for &i in &region {
+            let (x, y) = (i % w, i / w);
+            let o = env.texel_solid_angle(y) as f64;
+            let p = img.pixels()[i];
+            let above: Rgb = std::array::from_fn(|c| (p[c] - sky[c]).max(0.0));
+            for c in 0..3 {
+                e[c] += above[c] as f64 * o;
+            }
+            omega += o;
+            towards += env.direction_of(x as f32, y as f32) * (lum(above) as f64 * o) as f32;
+            radiance.set(x, y, sky);
+        }
+        let diameter = 2.0
+            * (1.0 - omega / (2.0 * std::f64::consts::PI))
+                .clamp(-1.0, 1.0)
+                .acos();
+        let sun = Sun::new(
+            towards,
+            (diameter as f32).to_degrees().clamp(1e-3, MAX_DIAMETER_DEG),
+            e.map(|c| c as f32),
+        )?;
+        Ok(Some((
+            sun,
+            EnvMap::from_image(radiance)?.rotated(env.yaw()),
+        )))
+    }
+
     /// The same sun `k` times as bright.
     pub fn scaled(&self, k: f32) -> Self {
         Self {
@@ -170,6 +263,55 @@ mod tests {
             let seen = lit.direction_of((i % img.width()) as f32, (i / img.width()) as f32);
             assert!(seen.dot(dir).acos().to_degrees() < 3.0 + diameter);
         }
+    }
+
+    #[test]
+    fn the_built_in_sky_s_sun_is_found_and_taken_out_of_it() {
+        let sky = EnvMap::sky().rotated(0.4);
+        let (sun, rest) = Sun::extract(&sky).unwrap().unwrap();
+        let want = crate::light::direction_from_azimuth_elevation(
+            60f32.to_radians() + 0.4,
+            40f32.to_radians(),
+        );
+        assert!(
+            sun.direction().dot(want).acos().to_degrees() < 1.0,
+            "{}",
+            sun.direction()
+        );
+        // The sky's sun is a 4° disc carrying about 70 % of its light.
+        assert!(
+            (2.0 * sun.radius().to_degrees() - 4.0).abs() < 1.0,
+            "{}",
+            sun.radius()
+        );
+        let (before, after) = (sky.total_light(), rest.total_light());
+        for c in 0..3 {
+            let kept = after[c] + sun.illuminance()[c];
+            assert!(
+                (kept - before[c]).abs() < 1e-3 * before[c],
+                "{c}: {kept} vs {}",
+                before[c]
+            );
+        }
+        assert!(
+            sun.illuminance()[0] > 0.6 * before[0],
+            "{:?}",
+            sun.illuminance()
+        );
+        // What is left has no sun, and a sun put back is found again.
+        assert!(Sun::extract(&rest).unwrap().is_none());
+        let again = sun.lit(&rest).unwrap();
+        let (found, _) = Sun::extract(&again).unwrap().unwrap();
+        assert!(found.direction().dot(sun.direction()) > 0.9998);
+        assert!(
+            (found.illuminance()[0] - sun.illuminance()[0]).abs() < 0.02 * sun.illuminance()[0]
+        );
+        // A uniform map has none.
+        assert!(
+            Sun::extract(&EnvMap::uniform([1.0; 3], 32))
+                .unwrap()
+                .is_none()
+        );
     }
 
     #[test]
