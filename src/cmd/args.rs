@@ -294,6 +294,19 @@ pub fn parse_sun(s: &str) -> Result<SunSpec, String> {
 }
 
 impl LightingArgs {
+    /// The lighting in words, for reports: the environment, and the sun when there is
+    /// one.
+    pub fn name(&self) -> CliResult<String> {
+        let env = self.source()?.to_string();
+        Ok(match &self.sun {
+            Some(s) => format!(
+                "{env} + a sun (azimuth {}°, elevation {}°, {}° across, illuminance {})",
+                s.azimuth_deg, s.elevation_deg, s.diameter_deg, s.illuminance
+            ),
+            None => env,
+        })
+    }
+
     /// The sun asked for.
     pub fn sun(&self) -> CliResult<Option<Sun>> {
         self.sun.as_ref().map(SunSpec::sun).transpose()

@@ -50,7 +50,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         "{} pose {pose} under {}: subject PSNR (dB) / SSIM, {} cameras per offset, variants on {} \
          (truth: {} median-cut lights)",
         args.field.display(),
-        args.lighting.source()?,
+        args.lighting.name()?,
         args.cameras,
         renderer.device(),
         args.lights
@@ -69,7 +69,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         let report = BudgetReport {
             field: args.field.display().to_string(),
             capture: args.capture.display().to_string(),
-            env: args.lighting.source()?.to_string(),
+            env: args.lighting.name()?,
             pose,
             device: renderer.device(),
             truth_lights: args.lights,

@@ -49,7 +49,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         ingest_budget::evaluate_fields(&made, Some(&args.field), &scoring, &bars)?;
     let report = IngestBudgetReport {
         capture: args.capture.display().to_string(),
-        env: args.lighting.source()?.to_string(),
+        env: args.lighting.name()?,
         pose: input.pose,
         device,
         truth_lights: args.lights,

@@ -41,7 +41,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         names: (
             args.field.clone(),
             args.capture.clone(),
-            args.lighting.source()?.to_string(),
+            args.lighting.name()?,
         ),
         frames,
         size: (w, h),
@@ -63,7 +63,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
          path(s) of {frames} frames at {w}x{h}, {}:",
         args.field.display(),
         input.pose,
-        args.lighting.source()?,
+        args.lighting.name()?,
         args.lights,
         report.header.truth_seconds_per_frame,
         paths.len(),

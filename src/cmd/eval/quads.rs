@@ -26,7 +26,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         names: (
             args.field.clone(),
             args.capture.clone(),
-            args.lighting.source()?.to_string(),
+            args.lighting.name()?,
         ),
         cameras: args.cameras,
         variants: &variants,
@@ -53,7 +53,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
          cameras at quad centres, {}:",
         args.field.display(),
         input.pose,
-        args.lighting.source()?,
+        args.lighting.name()?,
         args.lights,
         report.header.truth_seconds_per_frame,
         report.cameras.len(),
