@@ -146,7 +146,8 @@ impl Sun {
             .map(|(i, &p)| (i, lum(p)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((0, 0.0));
-        if !(peak as f64 > SUN_CONTRAST * mean) {
+        // (A NaN peak is no sun either.)
+        if (peak as f64).partial_cmp(&(SUN_CONTRAST * mean)) != Some(std::cmp::Ordering::Greater) {
             return Ok(None);
         }
         // The bright texels connected to the peak (wrapping in azimuth).

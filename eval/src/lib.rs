@@ -40,6 +40,7 @@ pub mod ring;
 pub mod scene;
 pub mod shot;
 pub mod storage;
+pub mod sun_fit;
 pub mod sweep;
 pub mod views;
 

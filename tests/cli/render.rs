@@ -583,3 +583,45 @@ fn a_field_without_shadow_maps_says_so() {
     );
     assert!(!said.contains("no frame sees the ground patch"), "{said}");
 }
+
+#[test]
+fn eval_sun_fit_scores_the_light_fit_above_the_basis_under_a_low_sun() {
+    let (dir, field) = fixture();
+    let o = frf(&[
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        dir.to_str().unwrap(),
+        "--env",
+        "none",
+        "--sun",
+        "60,20",
+        "--cameras",
+        "4",
+        "--lights",
+        "128",
+        "--sun-fit",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (basis, fit) = (
+        r["mean_basis_psnr"].as_f64().unwrap(),
+        r["mean_fit_psnr"].as_f64().unwrap(),
+    );
+    assert!(fit >= basis + 2.0, "fit {fit} dB, basis {basis} dB");
+    assert!(r["env"].as_str().unwrap().contains("sun"), "{r}");
+    assert_eq!(r["views"].as_array().unwrap().len(), 4);
+    // An environment without a sun is refused by name.
+    let o = frf(&[
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        dir.to_str().unwrap(),
+        "--env",
+        "uniform",
+        "--sun-fit",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--sun-fit"), "{}", stderr(&o));
+}

@@ -42,6 +42,12 @@ pub struct EvalArgs {
     /// captured views and at quad centres (`--cameras` each), beside FIELD itself.
     #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows", "budget"])]
     pub ingest_budget: bool,
+    /// An experiment toward hard light: at the captured views (`--cameras`), the basis's
+    /// relighting of an environment with a sun (`--sun`, or a map with one) against the
+    /// environment less its sun by the basis plus the sun by each view's light fit, both
+    /// against the truth (`frf_eval::sun_fit`; CPU).
+    #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows", "budget", "ingest_budget"])]
+    pub sun_fit: bool,
     /// With `--ingest-budget`: keep its fields in this directory, and reuse them when it
     /// holds them for the same capture, pose and settings (another environment costs only
     /// the renders); by default they are made in a temporary directory and removed.

@@ -14,6 +14,7 @@ mod paths;
 mod quads;
 pub mod ring;
 mod shot;
+mod sun_fit;
 
 pub use args::{EvalArgs, RingEvalArgs};
 
@@ -28,7 +29,9 @@ pub fn run(args: EvalArgs) -> CliResult {
         return Err("--plot draws a budget: give --budget or --ingest-budget".into());
     }
     let input = input::load(&args)?;
-    if args.ingest_budget {
+    if args.sun_fit {
+        sun_fit::run(&args, &input)
+    } else if args.ingest_budget {
         ingest_budget::run(&args, &input)
     } else if args.budget {
         budget::run(&args, &input)
