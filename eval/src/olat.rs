@@ -8,10 +8,10 @@
 use std::path::Path;
 use std::time::Instant;
 
-use frf_core::image::{Image, RgbImage};
+use frf_core::image::RgbImage;
 use frf_core::io::write_png16_rgb;
 use frf_ingest::olat::OlatSet;
-use frf_reflectance::light_fit::{LightFit, farthest_lights, nearest_weights};
+use frf_reflectance::light_fit::{LightFit, blend, farthest_lights, nearest_weights};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -211,22 +211,4 @@ pub fn olat_table(r: &OlatReport) -> String {
         r.seconds_relight / r.held_out.len().max(1) as f64
     ));
     out
-}
-
-/// `Σ w_k images[k]`.
-fn blend(images: &[&RgbImage], weights: &[(usize, f32)]) -> RgbImage {
-    let (w, h) = images[0].size();
-    let pixels = (0..w * h)
-        .map(|i| {
-            let mut p = [0.0f32; 3];
-            for &(k, wk) in weights {
-                let q = images[k].pixels()[i];
-                for c in 0..3 {
-                    p[c] += wk * q[c];
-                }
-            }
-            p
-        })
-        .collect();
-    Image::from_vec(w, h, pixels).expect("sized as the photographs")
 }

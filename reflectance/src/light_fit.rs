@@ -191,6 +191,16 @@ pub fn farthest_lights(directions: &[Vec3], k: usize, start: Vec3) -> Vec<usize>
     taken
 }
 
+/// `Σ w_k images[k]` over `weights` (e.g. [`nearest_weights`]): the interpolation of
+/// photographs a relight starts from, and the baseline it is scored against.
+pub fn blend(images: &[&RgbImage], weights: &[(usize, f32)]) -> RgbImage {
+    let (w, h) = images.first().map_or((0, 0), |i| i.size());
+    let pixels = (0..w * h)
+        .map(|i| weighted(weights, |k| images[k].pixels()[i]))
+        .collect();
+    Image::from_vec(w, h, pixels).expect("sized as the photographs")
+}
+
 /// `Σ w_k f(k)` over `weights`.
 fn weighted(weights: &[(usize, f32)], f: impl Fn(usize) -> [f32; 3]) -> [f32; 3] {
     let mut out = [0.0f32; 3];

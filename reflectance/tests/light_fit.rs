@@ -3,7 +3,7 @@
 //! image, beside interpolating the nearest photographs.
 
 use frf_core::image::{Image, RgbImage};
-use frf_reflectance::light_fit::{LightFit, farthest_lights, nearest_weights};
+use frf_reflectance::light_fit::{LightFit, blend, farthest_lights, nearest_weights};
 use glam::Vec3;
 
 const SIDE: usize = 96;
@@ -107,19 +107,7 @@ fn a_light_between_the_kept_ones_relights_near_the_truth_where_interpolation_fai
     for (k, &l) in all.iter().enumerate().filter(|(k, _)| !kept.contains(k)) {
         let truth = photograph(l);
         let ours = fit.relight(&refs, &dirs, l, 3);
-        let interpolated = {
-            let w = nearest_weights(&dirs, l, 3);
-            Image::from_fn(SIDE, SIDE, |x, y| {
-                let mut p = [0.0f32; 3];
-                for &(j, wj) in &w {
-                    let q = images[j].pixels()[y * SIDE + x];
-                    for c in 0..3 {
-                        p[c] += wj * q[c];
-                    }
-                }
-                p
-            })
-        };
+        let interpolated = blend(&refs, &nearest_weights(&dirs, l, 3));
         let (a, b) = (
             psnr(&truth, &ours, &mask),
             psnr(&truth, &interpolated, &mask),

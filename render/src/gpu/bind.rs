@@ -219,6 +219,13 @@ pub fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::
     })
 }
 
+/// The stride of uniforms of `size` bytes packed into one buffer and bound at offsets:
+/// `size` rounded up to the device's uniform offset alignment.
+pub fn uniform_stride(device: &wgpu::Device, size: usize) -> usize {
+    let align = device.limits().min_uniform_buffer_offset_alignment as usize;
+    size.div_ceil(align) * align
+}
+
 /// A buffer of `usage` holding `contents`.
 pub fn buffer_with(
     device: &wgpu::Device,

@@ -371,8 +371,7 @@ impl SubjectTargets {
             })
             .collect();
         let size_of_frame = std::mem::size_of::<GpuFrame>();
-        let align = device.limits().min_uniform_buffer_offset_alignment as usize;
-        let stride = size_of_frame.div_ceil(align) * align;
+        let stride = super::bind::uniform_stride(device, size_of_frame);
         let uniforms = uniform_buffer(device, "frames", stride * slots as usize);
         let slots = (0..slots as usize)
             .map(|slot| {

@@ -12,6 +12,7 @@ use frf_shaders::types::GpuTimeMorph;
 use glam::Mat2;
 use wgpu::util::DeviceExt;
 
+use super::bind::uniform_stride;
 use super::pose::GpuPose;
 use super::rebin::{DrawnRender, Place, SubjectTargets, Subjects, places, workgroups};
 use super::{Gpu, shaders};
@@ -124,47 +125,49 @@ impl Gpu {
         // Three renders a walker (pose k', and both poses' motion) packed into pages,
         // and each walker's morph into pages of its own after them: a pass never reads
         // the page it writes.
-        let n = walkers.len();
         let boxes: Vec<PixelBox> = walkers.iter().flat_map(|w| [w.within; 3]).collect();
         let (renders, render_pages) = places(&boxes, size, 0);
         let boxes: Vec<PixelBox> = walkers.iter().map(|w| w.within).collect();
         let (morphs, morph_pages) = places(&boxes, size, render_pages);
         let pages = render_pages + morph_pages;
-        let slots = 3 * n as u32;
+        let slots = 3 * walkers.len() as u32;
         let scratch = self.between_targets.get((size, slots, pages), || {
             SubjectTargets::new(&self.device, &self.rebin, size, slots, pages)
         });
-        // Every walker's three renders, in one go.
-        let places_of = &renders;
-        let drawn: Vec<(&GpuPose, DrawnRender)> = walkers
-            .iter()
-            .enumerate()
-            .flat_map(|(j, w)| {
-                let b = w.between;
-                [b.after, b.before_motion, b.after_motion]
-                    .into_iter()
-                    .enumerate()
-                    .map(move |(k, pose)| {
-                        let place = places_of[3 * j + k];
-                        let (camera, within) = (w.camera, w.within);
-                        (
-                            pose,
-                            DrawnRender {
-                                place,
-                                camera,
-                                within,
-                            },
-                        )
-                    })
-            })
-            .collect();
+        // Every walker's three renders, in one go, then their morphs in one pass.
+        let drawn = between_renders(walkers, &renders);
         self.draw_renders(encoder, &scratch, &drawn, variant, None, false);
-        // Every walker's morph: their uniforms in one buffer, each bound at its stride,
-        // and their dispatches in one pass.
+        let groups = self.morph_groups(&scratch, subjects, walkers, &renders, &morphs);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("time morph"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.time_morph.pipeline);
+            for (w, group) in walkers.iter().zip(&groups) {
+                let (x, y) = workgroups(w.within.size());
+                if x * y > 0 {
+                    pass.set_bind_group(0, group, &[]);
+                    pass.dispatch_workgroups(x, y, 1);
+                }
+            }
+        }
+        copy_morphs(encoder, &scratch, subjects, walkers, &morphs);
+    }
+
+    /// Each walker's morph bind group (`renders`: three places a walker, `morphs`: one):
+    /// their uniforms in one buffer, each bound at its stride.
+    fn morph_groups(
+        &self,
+        scratch: &SubjectTargets,
+        subjects: &Subjects,
+        walkers: &[BetweenDraw],
+        renders: &[Place],
+        morphs: &[Place],
+    ) -> Vec<wgpu::BindGroup> {
         let size_of_uniform = std::mem::size_of::<GpuTimeMorph>();
-        let align = self.device.limits().min_uniform_buffer_offset_alignment as usize;
-        let stride = size_of_uniform.div_ceil(align) * align;
-        let mut bytes = vec![0u8; stride * n];
+        let stride = uniform_stride(&self.device, size_of_uniform);
+        let mut bytes = vec![0u8; stride * walkers.len()];
         for (j, w) in walkers.iter().enumerate() {
             let (before, _) = subjects.place(w.layer);
             let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
@@ -197,7 +200,7 @@ impl Gpu {
             }
         }
         let page = |p: Place| scratch.page_view(p.page);
-        let groups: Vec<wgpu::BindGroup> = walkers
+        walkers
             .iter()
             .enumerate()
             .map(|(j, w)| {
@@ -223,53 +226,73 @@ impl Gpu {
                     ],
                 })
             })
-            .collect();
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("time morph"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.time_morph.pipeline);
-            for (w, group) in walkers.iter().zip(&groups) {
-                let (x, y) = workgroups(w.within.size());
-                if x * y > 0 {
-                    pass.set_bind_group(0, group, &[]);
-                    pass.dispatch_workgroups(x, y, 1);
-                }
-            }
+            .collect()
+    }
+}
+
+/// Every walker's three renders (pose `k'` and both poses' motion) at their places
+/// (`renders`, three a walker).
+fn between_renders<'a>(
+    walkers: &[BetweenDraw<'a>],
+    renders: &[Place],
+) -> Vec<(&'a GpuPose, DrawnRender)> {
+    walkers
+        .iter()
+        .enumerate()
+        .flat_map(|(j, w)| {
+            let b = w.between;
+            [b.after, b.before_motion, b.after_motion]
+                .into_iter()
+                .enumerate()
+                .map(move |(k, pose)| {
+                    let drawn = DrawnRender {
+                        place: renders[3 * j + k],
+                        camera: w.camera,
+                        within: w.within,
+                    };
+                    (pose, drawn)
+                })
+        })
+        .collect()
+}
+
+/// Each morphed walker copied over its render in the subjects, after every morph has
+/// read the subjects (the walkers' places do not overlap), within its box only: nothing
+/// outside is read.
+fn copy_morphs(
+    encoder: &mut wgpu::CommandEncoder,
+    scratch: &SubjectTargets,
+    subjects: &Subjects,
+    walkers: &[BetweenDraw],
+    morphs: &[Place],
+) {
+    for (w, &morph) in walkers.iter().zip(morphs) {
+        let (before, _) = subjects.place(w.layer);
+        let (width, height) = w.within.size();
+        if width * height == 0 {
+            continue;
         }
-        // Each morphed walker over its render in the subjects, after every morph has
-        // read the subjects (the walkers' places do not overlap).
-        for (j, w) in walkers.iter().enumerate() {
-            let (before, _) = subjects.place(w.layer);
-            let morph = morphs[j];
-            // Only its box: nothing outside is read.
-            let (width, height) = w.within.size();
-            if width * height == 0 {
-                continue;
-            }
-            let at = |texture, place: Place| {
-                let (x, y) = place.texel(w.within.x0, w.within.y0);
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x,
-                        y,
-                        z: place.page,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                }
-            };
-            encoder.copy_texture_to_texture(
-                at(scratch.texture(), morph),
-                at(subjects.texture(), before),
-                wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
+        let at = |texture, place: Place| {
+            let (x, y) = place.texel(w.within.x0, w.within.y0);
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x,
+                    y,
+                    z: place.page,
                 },
-            );
-        }
+                aspect: wgpu::TextureAspect::All,
+            }
+        };
+        encoder.copy_texture_to_texture(
+            at(scratch.texture(), morph),
+            at(subjects.texture(), before),
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
     }
 }
