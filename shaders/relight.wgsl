@@ -6,6 +6,12 @@
 // frame pass reads it there: nothing goes back to the host). The codes stay resident
 // between relights; a new light rewrites only the coefficients. Twin of
 // `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
+//
+// A sun the environment held is added per texel by the view's fitted normals (twin of
+// `SunLight::texel`, `reflectance/src/sun_light.rs`): the nearest conditions' images per
+// unit of their light, times the ratio of the normal's shading under the sun to its
+// shading under them; where they barely reach the texel, the normal's shading under the
+// sun times the least-squares ratio of every image to its shading under its condition.
 
 struct RelightParams {
     // Texels per view (the pose's crop) and its row length.
@@ -33,7 +39,12 @@ struct Job {
 // Per view, tiles x texels, packed RGBA8: the basis codes; tile 0's alpha byte holds the
 // view's alpha code.
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
-// Per view and tile: rgb = coefficient x tile scale; w = 0 when the condition is not used.
+// Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
+// w = 0 when the condition is not used; per tile, the direction of its condition's
+// light (xyz, the view's dome frame); per tile, the sun per unit of the condition's light
+// x tile scale (rgb); then the sun: its direction (xyz; w = 0 when there is none), the
+// nearest conditions (xyz, as f32; w: how many) and their weights (xyz; w: the ratio's
+// floor).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
@@ -50,6 +61,77 @@ struct Job {
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
+}
+
+// Tile k's linear value at texel i of `job`, per unit of its scale.
+fn tile_value(job: Job, k: u32, i: u32) -> vec3<f32> {
+    let code = basis[job.basis_offset + k * params.texels + i];
+    return vec3<f32>(
+        gamma_value(code & 255u),
+        gamma_value((code >> 8u) & 255u),
+        gamma_value((code >> 16u) & 255u),
+    );
+}
+
+// The unit normal of octahedral codes (`reflectance/src/normalcodec.rs`), zero for
+// `(0, 0)` (none fitted).
+fn normal_of(cx: u32, cy: u32) -> vec3<f32> {
+    if (cx == 0u && cy == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let x = (f32(max(cx, 1u)) - 1.0) / 254.0 * 2.0 - 1.0;
+    let y = (f32(max(cy, 1u)) - 1.0) / 254.0 * 2.0 - 1.0;
+    let z = 1.0 - abs(x) - abs(y);
+    let t = max(-z, 0.0);
+    return normalize(vec3<f32>(select(x + t, x - t, x >= 0.0), select(y + t, y - t, y >= 0.0), z));
+}
+
+// The sun's light at texel i of `job` (see the file's text). The normal's codes are the
+// alpha bytes of tiles 1 and 2.
+fn sun_light(job: Job, i: u32) -> vec3<f32> {
+    let directions = job.coefficient_offset + job.tiles;
+    let units = directions + job.tiles;
+    let head = units + job.tiles;
+    let sun = coefficients[head];
+    if (sun.w == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let nearest = coefficients[head + 1u];
+    let weights = coefficients[head + 2u];
+    let n = normal_of(
+        basis[job.basis_offset + params.texels + i] >> 24u,
+        basis[job.basis_offset + 2u * params.texels + i] >> 24u,
+    );
+    var interpolated = vec3<f32>(0.0);
+    var shaded = 0.0;
+    for (var j = 0u; j < u32(nearest.w); j++) {
+        let k = u32(nearest[j]);
+        interpolated += weights[j] * coefficients[units + k].rgb * tile_value(job, k, i);
+        shaded += weights[j] * max(dot(n, coefficients[directions + k].xyz), 0.0);
+    }
+    if (all(n == vec3<f32>(0.0))) {
+        return interpolated;
+    }
+    let wanted = max(dot(n, sun.xyz), 0.0);
+    if (wanted <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    if (shaded >= weights.w * wanted) {
+        return interpolated * wanted / shaded;
+    }
+    var num = vec3<f32>(0.0);
+    var den = 0.0;
+    for (var k = 0u; k < job.tiles; k++) {
+        let m = max(dot(n, coefficients[directions + k].xyz), 0.0);
+        if (m > 0.0) {
+            num += coefficients[units + k].rgb * tile_value(job, k, i) * m;
+            den += m * m;
+        }
+    }
+    if (den <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return wanted * num / den;
 }
 
 @compute @workgroup_size(64)
@@ -76,6 +158,7 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         out.y += c.y * gamma_value((code >> 8u) & 255u);
         out.z += c.z * gamma_value((code >> 16u) & 255u);
     }
+    out += sun_light(job, i);
     relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     atomicMax(&peaks[job.view], bitcast<u32>(max(out.x, max(out.y, out.z))));
 }

@@ -1,5 +1,6 @@
 //! The GPU renderer against its CPU twin on the virtual stage's tiny oracle field, relit
-//! by the built-in sky: the relighting pass (per-view scales and pre-lit codes) and every
+//! by the built-in sky (its sun by the views' fitted normals): the relighting pass
+//! (per-view scales and pre-lit codes) and every
 //! variant of the morph from cameras between grid views, above the grid and inside the
 //! cylinder; and a request the GPU refuses comes back as a typed error.
 //!
@@ -72,6 +73,8 @@ fn tiny_source() -> PoseSource {
 fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let Some(gpu) = gpu() else { return };
     let source = tiny_source();
+    // The sky's sun is relit by the views' fitted normals, on both.
+    assert!(source.sun.is_some() && source.holds_normals());
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
     // The frames below find their quads through the cylinder's column index.

@@ -21,6 +21,9 @@ pub enum ChunkKind {
     Shadows,
     /// The visual hull of a pose (`u = v = 0`).
     Hull,
+    /// The normals fitted to a view's basis images ([`crate::light_fit`]), which relight
+    /// it under a sun; fields written before them hold none.
+    Normals,
 }
 
 /// Which chunk: kind, pose and view.
@@ -67,6 +70,11 @@ impl std::fmt::Display for ChunkKey {
             ),
             ChunkKind::Shadows => write!(f, "shadow maps of pose {}", self.pose),
             ChunkKind::Hull => write!(f, "visual hull of pose {}", self.pose),
+            ChunkKind::Normals => write!(
+                f,
+                "normals of pose {} view ({}, {})",
+                self.pose, self.u, self.v
+            ),
         }
     }
 }

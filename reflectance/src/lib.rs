@@ -28,11 +28,13 @@ pub mod hull;
 pub mod imagecodec;
 pub mod light_fit;
 pub mod merge;
+pub mod normalcodec;
 pub mod project;
 pub mod relight;
 pub mod shadow;
 pub mod stats;
 pub mod store;
+pub mod sun_light;
 pub mod unzstd;
 pub mod verify;
 

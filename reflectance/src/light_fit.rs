@@ -21,7 +21,9 @@
 use glam::{DMat3, DVec3, Vec3};
 use rayon::prelude::*;
 
-use frf_core::image::{Image, RgbImage};
+use frf_core::image::{GrayImage, Image, Rgb, RgbImage, luminance};
+
+use crate::field::ConditionRecord;
 
 /// Below this share of its brightest light a texel counts as dark under a light.
 const DARK: f32 = 0.03;
@@ -97,44 +99,113 @@ impl LightFit {
         let pixels = (0..self.width * self.height)
             .into_par_iter()
             .map(|i| {
-                let interpolated = weighted(&weights, |k| images[k].pixels()[i]);
-                let Some(target) = self.shade(i, l) else {
-                    return interpolated;
-                };
-                let shaded = weighted(&weights, |k| {
-                    self.shade(i, directions[k]).unwrap_or([0.0; 3])
-                });
-                let (t, s) = (sum3(target), sum3(shaded));
-                if t <= 0.0 {
-                    return [0.0; 3];
-                }
-                if s >= RATIO_FLOOR * t {
-                    return std::array::from_fn(|c| {
-                        if shaded[c] > 0.0 {
-                            interpolated[c] * target[c] / shaded[c]
-                        } else {
-                            0.0
-                        }
-                    });
-                }
-                // The fit's shading, scaled by the photographs' ratio to it over every light.
-                let (mut num, mut den) = ([0.0f32; 3], [0.0f32; 3]);
-                for (k, &d) in directions.iter().enumerate() {
-                    let m = self.shade(i, d).unwrap_or([0.0; 3]);
-                    let p = images[k].pixels()[i];
-                    for c in 0..3 {
-                        num[c] += p[c] * m[c];
-                        den[c] += m[c] * m[c];
-                    }
-                }
-                std::array::from_fn(|c| {
-                    let scale = if den[c] > 0.0 { num[c] / den[c] } else { 1.0 };
-                    target[c] * scale
-                })
+                let normal = self.texels[i].map(|t| t.0);
+                relight_texel(normal, |k| images[k].pixels()[i], directions, l, &weights)
             })
             .collect();
         Image::from_vec(self.width, self.height, pixels).expect("sized by the fit")
     }
+
+    /// The fit of a view's basis images (linear, one per condition of `conditions`, as
+    /// stored) inside its matte: each image per unit of its condition's light, each
+    /// condition a light from [`condition_lights`]' direction (the dome frame of the
+    /// view's turntable angle, in which its normals then are).
+    pub fn of_basis(basis: &[RgbImage], conditions: &[ConditionRecord], alpha: &GrayImage) -> Self {
+        let lights = condition_lights(conditions);
+        let unit: Vec<RgbImage> = basis
+            .iter()
+            .zip(&lights)
+            .map(|(b, (_, e))| b.map(|p| per_unit(p, *e)))
+            .collect();
+        let refs: Vec<&RgbImage> = unit.iter().collect();
+        let dirs: Vec<Vec3> = lights.iter().map(|l| l.0).collect();
+        let mask: Vec<bool> = alpha.pixels().iter().map(|&a| a > 0.0).collect();
+        Self::fit(&refs, &dirs, &mask)
+    }
+
+    /// A fit of these normals (as a field stores them, [`crate::normalcodec`]); its
+    /// albedo is unknown (1), which relighting does not need.
+    pub fn from_normals(width: usize, height: usize, normals: &[Option<Vec3>]) -> Self {
+        Self {
+            width,
+            height,
+            texels: normals.iter().map(|n| n.map(|n| (n, [1.0; 3]))).collect(),
+        }
+    }
+
+    /// Every texel's normal, `None` where unfitted.
+    pub fn normals(&self) -> Vec<Option<Vec3>> {
+        self.texels.iter().map(|t| t.map(|t| t.0)).collect()
+    }
+}
+
+/// Per condition of a basis, one light standing for its lights: their direction
+/// weighted by their irradiance (exact for a Lambertian texel that sees all of them),
+/// and their irradiance summed, per channel.
+pub fn condition_lights(conditions: &[ConditionRecord]) -> Vec<(Vec3, Rgb)> {
+    conditions
+        .iter()
+        .map(|c| {
+            let (mut d, mut e) = (Vec3::ZERO, [0.0f32; 3]);
+            for l in &c.lights {
+                d += Vec3::from(l.direction).normalize_or_zero() * luminance(l.intensity);
+                for (sum, i) in e.iter_mut().zip(l.intensity) {
+                    *sum += i;
+                }
+            }
+            (d.normalize_or_zero(), e)
+        })
+        .collect()
+}
+
+/// `p` per unit of the light `e` (0 in a channel `e` leaves dark).
+pub fn per_unit(p: Rgb, e: Rgb) -> Rgb {
+    std::array::from_fn(|c| if e[c] > 0.0 { p[c] / e[c] } else { 0.0 })
+}
+
+/// One texel of normal `normal` (`None`: unfitted), seen under unit lights from
+/// `directions` as `photo(k)`, relit under a unit light from `l` by the photographs
+/// `weights` names (see the module text). The fit's albedo cancels from both of its
+/// ratios, so the normal alone is needed: the CPU reference of the GPU's sun term
+/// (`shaders/relight.wgsl`).
+pub fn relight_texel(
+    normal: Option<Vec3>,
+    photo: impl Fn(usize) -> Rgb,
+    directions: &[Vec3],
+    l: Vec3,
+    weights: &[(usize, f32)],
+) -> Rgb {
+    let interpolated = weighted(weights, &photo);
+    let Some(n) = normal else {
+        return interpolated;
+    };
+    let wanted = n.dot(l).max(0.0);
+    if wanted <= 0.0 {
+        return [0.0; 3];
+    }
+    let shaded: f32 = weights
+        .iter()
+        .map(|&(k, w)| w * n.dot(directions[k]).max(0.0))
+        .sum();
+    if shaded >= RATIO_FLOOR * wanted {
+        return interpolated.map(|x| x * wanted / shaded);
+    }
+    // The fit's shading, scaled by the photographs' ratio to it over every light.
+    let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
+    for (k, &d) in directions.iter().enumerate() {
+        let m = n.dot(d).max(0.0);
+        if m > 0.0 {
+            let p = photo(k);
+            for c in 0..3 {
+                num[c] += p[c] * m;
+            }
+            den += m * m;
+        }
+    }
+    if den <= 0.0 {
+        return [0.0; 3];
+    }
+    num.map(|x| wanted * x / den)
 }
 
 /// The `n` directions of `directions` nearest to `l` (by angle), weighted by the inverse

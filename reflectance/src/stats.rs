@@ -22,6 +22,9 @@ pub struct Bytes {
     /// Pose-to-pose flow maps.
     #[serde(default)]
     pub pose_flow: u64,
+    /// Fitted normals (the sun's relighting).
+    #[serde(default)]
+    pub normals: u64,
     /// Preamble, index and footer.
     pub other: u64,
 }
@@ -73,6 +76,7 @@ impl<R: ReadAt> FieldFile<R> {
                     basis_views += 1;
                 }
                 ChunkKind::Alpha => bytes.alpha += c.length,
+                ChunkKind::Normals => bytes.normals += c.length,
                 ChunkKind::Shadows => {
                     bytes.shadows += c.length;
                     shadow_poses += 1;
@@ -93,7 +97,8 @@ impl<R: ReadAt> FieldFile<R> {
                 + bytes.alpha
                 + bytes.shadows
                 + bytes.hulls
-                + bytes.pose_flow);
+                + bytes.pose_flow
+                + bytes.normals);
         let shadow_maps = shadow_poses * h.shadows.as_ref().map_or(0, |s| s.conditions.len());
         let basis_images = basis_views * h.conditions.len();
         let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { 0.0 };
@@ -158,6 +163,7 @@ impl<R: ReadAt> FieldFile<R> {
             ("alpha", s.bytes.alpha),
             ("shadow maps", s.bytes.shadows),
             ("visual hulls", s.bytes.hulls),
+            ("fitted normals", s.bytes.normals),
             ("index and framing", s.bytes.other),
         ] {
             lines.push(format!("    {kind:<18} {:>10.3}", mb(b)));

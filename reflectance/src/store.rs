@@ -14,6 +14,8 @@ use crate::hull::VoxelHull;
 use crate::imagecodec::{
     BasisCodes, decode_basis, decode_basis_codes, decode_planes, encode_basis, encode_planes,
 };
+use crate::light_fit::LightFit;
+use crate::normalcodec::{decode_normal_codes, encode_normals, normal_of};
 
 /// The encoded chunks of one view.
 #[derive(Debug, Clone)]
@@ -66,14 +68,24 @@ pub fn encode_images(
         check_size(header, "basis image", w, h, b)?;
     }
     check_size(header, "alpha", w, h, alpha)?;
-    Ok(EncodedView(vec![
+    let mut chunks = vec![
         (ChunkKind::Basis, encode_basis(basis, header.jpeg_quality)?),
         (
             ChunkKind::Alpha,
             encode_planes(std::slice::from_ref(alpha))?,
         ),
-    ]))
+    ];
+    // Three lights at least fix a normal; a basis of fewer (a ring of photographs)
+    // cannot be relit beyond itself.
+    if header.conditions.len() >= FIT_CONDITIONS {
+        let fit = LightFit::of_basis(basis, &header.conditions, alpha);
+        chunks.push((ChunkKind::Normals, encode_normals(w, h, &fit.normals())?));
+    }
+    Ok(EncodedView(chunks))
 }
+
+/// Conditions a basis needs for its views' normals to be fitted and stored.
+pub const FIT_CONDITIONS: usize = 4;
 
 /// Encodes the flows present among `flows` as chunks of their kinds, with pose `pose`'s
 /// quantizer.
@@ -279,6 +291,33 @@ impl<R: ReadAt> FieldFile<R> {
             Some(a) if planes.is_empty() && a.size() == (w, h) => Ok(a),
             _ => Err(self.chunk_error(&k, "not one plane of the field's size".into())),
         }
+    }
+
+    /// The octahedral codes of a view's fitted normals ([`crate::normalcodec`]), `None`
+    /// where the field holds none (written before them, or of too few conditions).
+    pub fn normal_codes(&self, pose: u32, u: usize, v: usize) -> Result<Option<Vec<[u8; 2]>>> {
+        let k = key(pose, u, v, ChunkKind::Normals);
+        if !self.has(&k) {
+            return Ok(None);
+        }
+        let (w, h, codes) = self.decode_chunk(&k, decode_normal_codes)?;
+        if (w, h) != (self.header().width as usize, self.header().height as usize) {
+            return Err(self.chunk_error(&k, format!("normals of {w}x{h} texels")));
+        }
+        Ok(Some(codes))
+    }
+
+    /// A view's fitted normals (dome frame of its turntable angle), `None` where the
+    /// field holds none.
+    pub fn normals(
+        &self,
+        pose: u32,
+        u: usize,
+        v: usize,
+    ) -> Result<Option<Vec<Option<glam::Vec3>>>> {
+        Ok(self
+            .normal_codes(pose, u, v)?
+            .map(|c| c.into_iter().map(normal_of).collect()))
     }
 
     /// The 8-bit log codes (two planes, `u` then `v`) of the flow from a view to a

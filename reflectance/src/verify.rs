@@ -79,6 +79,7 @@ impl<R: ReadAt> FieldFile<R> {
             ChunkKind::PoseFlow(s) => self.pose_flow(pose, u, v, s).map(drop),
             ChunkKind::Shadows => self.shadows(pose).map(drop),
             ChunkKind::Hull => self.hull(pose).map(drop),
+            ChunkKind::Normals => self.normals(pose, u, v).map(drop),
         }
     }
 }

@@ -21,11 +21,14 @@ use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::io::{linear_to_srgb, srgb_to_linear};
+use frf_core::sun::Sun;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
+use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
+use frf_reflectance::sun_light::SunLight;
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -77,9 +80,10 @@ impl Lighting {
     }
 }
 
-/// One view's codes as read from the field: basis tiles, 8-bit alpha, and the
-/// log-coded flow to each of its four neighbours (absent at the grid's edges).
-type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4]);
+/// One view's codes as read from the field: basis tiles, 8-bit alpha, the log-coded
+/// flow to each of its four neighbours (absent at the grid's edges), and its fitted
+/// normals' codes (none where the field holds none, and at reduced detail).
+type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4], Vec<[u8; 2]>);
 
 /// What relighting left out.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,8 +122,15 @@ pub struct PoseSource {
     pub basis: Arc<Vec<BasisCodes>>,
     /// Per view: alpha codes (`round(255 α)`), cropped (none for a view not read).
     pub alpha: Arc<Vec<Vec<u8>>>,
-    /// Per view and condition: relighting coefficients (RGB).
+    /// Per view: its fitted normals' octahedral codes, cropped (none where the field
+    /// holds none, at reduced detail, or for a view not read).
+    pub normals: Arc<Vec<Vec<[u8; 2]>>>,
+    /// Per view and condition: relighting coefficients (RGB), of the environment less
+    /// its sun where `sun` holds it.
     pub coefficients: Vec<Vec<Rgb>>,
+    /// The environment's sun, relit by the views' normals rather than by the basis
+    /// (`None`: no sun, or views without normals).
+    pub sun: Option<Arc<SunLight>>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
     /// relight the shadow maps; `None` without an environment.
     pub ground_coefficients: Option<Vec<Rgb>>,
@@ -144,14 +155,28 @@ impl PoseSource {
         plan: Option<&PosePlan>,
     ) -> Result<Self> {
         let read: Vec<bool> = (0..self.basis.len()).map(|i| !self.is_blank(i)).collect();
-        let (coefficients, ground_coefficients, plan) =
-            relighting(field, self.geometry.pose, lighting, plan, &read)?;
-        Ok(Self {
-            coefficients,
-            ground_coefficients,
+        let relit = relighting(
+            field,
+            self.geometry.pose,
+            lighting,
             plan,
+            (&read, self.holds_normals()),
+        )?;
+        Ok(Self {
+            coefficients: relit.coefficients,
+            ground_coefficients: relit.ground,
+            plan: relit.plan,
+            sun: relit.sun,
             ..self.clone()
         })
+    }
+
+    /// Whether every view read holds its fitted normals (what relights a sun by them).
+    pub fn holds_normals(&self) -> bool {
+        let mut read = (0..self.basis.len())
+            .filter(|&i| !self.is_blank(i))
+            .peekable();
+        read.peek().is_some() && read.all(|i| !self.normals[i].is_empty())
     }
 
     /// Bytes its basis and alpha codes hold.
@@ -209,8 +234,6 @@ impl PoseSource {
             None
         };
         let bounds = SubjectBounds::of_pose(record, hull.as_ref().and_then(|h| h.bounds()))?;
-        let (coefficients, ground_coefficients, lighting_plan) =
-            relighting(field, pose, lighting, plan, &read)?;
         let table = flow_lut(&record.flow_quantizer);
         let reading = Reading {
             field,
@@ -232,11 +255,16 @@ impl PoseSource {
         let mut basis = Vec::with_capacity(per_view.len());
         let mut alpha = Vec::with_capacity(per_view.len());
         let mut flows = Vec::with_capacity(per_view.len());
-        for (b, a, f) in per_view {
+        let mut normals = Vec::with_capacity(per_view.len());
+        for (b, a, f, n) in per_view {
             basis.push(b);
             alpha.push(a);
             flows.push(f);
+            normals.push(n);
         }
+        let held = (0..read.len()).any(|i| read[i])
+            && (0..read.len()).all(|i| !read[i] || !normals[i].is_empty());
+        let relit = relighting(field, pose, lighting, plan, (&read, held))?;
         let geometry =
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
@@ -253,9 +281,11 @@ impl PoseSource {
             }),
             basis: Arc::new(basis),
             alpha: Arc::new(alpha),
-            coefficients,
-            ground_coefficients,
-            plan: lighting_plan,
+            normals: Arc::new(normals),
+            coefficients: relit.coefficients,
+            ground_coefficients: relit.ground,
+            sun: relit.sun,
+            plan: relit.plan,
         })
     }
 }
@@ -302,31 +332,38 @@ fn views_read<R: ReadAt>(
         .collect())
 }
 
-/// Per view, the coefficients of every condition; the subject frame's own; what
-/// relighting leaves out.
-type Relighting = (Vec<Vec<Rgb>>, Option<Vec<Rgb>>, LightingPlan);
+/// A pose's relighting: per view the coefficients of every condition, the subject
+/// frame's own (for the ground), the sun relit apart, and what relighting leaves out.
+struct Relighting {
+    coefficients: Vec<Vec<Rgb>>,
+    ground: Option<Vec<Rgb>>,
+    sun: Option<Arc<SunLight>>,
+    plan: LightingPlan,
+}
 
 /// Per view of pose `pose` (those `read`), the relighting coefficients of `lighting`,
 /// with the conditions `plan` leaves out at zero; the subject frame's own (for the
-/// ground), and what relighting leaves out.
+/// ground), and what relighting leaves out. Where the views hold their fitted normals
+/// (`normals`) and the environment a sun, the sun is taken out of the views'
+/// coefficients and relit by the normals ([`SunLight`]); the floor conditions keep the
+/// whole environment's (the ground the sun lights), and so does the ground.
 fn relighting<R: ReadAt>(
     field: &FieldFile<R>,
     pose: u32,
     lighting: &Lighting,
     plan: Option<&PosePlan>,
-    read: &[bool],
+    (read, normals): (&[bool], bool),
 ) -> Result<Relighting> {
     let h = field.header();
     let record = h.pose(pose)?;
     let views = read.len();
-    let (mut coefficients, ground_coefficients): (Vec<Vec<Rgb>>, _) = match lighting {
+    let mut sun = None;
+    let (mut coefficients, ground) = match lighting {
         Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
         Lighting::Environment { env, floor } => {
             let projector = field.projector()?;
-            // One pass over the map for every view's turntable angle and the
-            // subject's own frame (angle 0), the last.
             // Views not read keep angle 0 (their coefficients are never used).
-            let mut angles: Vec<f32> = record
+            let angles: Vec<f32> = record
                 .views
                 .iter()
                 .enumerate()
@@ -338,9 +375,21 @@ fn relighting<R: ReadAt>(
                     }
                 })
                 .collect();
-            angles.push(0.0);
-            let mut all = projector.project_many(env, &angles, *floor);
+            // One pass over the map for every view's turntable angle and the
+            // subject's own frame (angle 0), the last.
+            let mut all = projector.project_many(env, &[&angles[..], &[0.0]].concat(), *floor);
             let own = all.pop();
+            if normals && let Some((found, rest)) = Sun::extract(env)? {
+                let less = projector.project_many(&rest, &angles, *floor);
+                for (c, l) in all.iter_mut().zip(less) {
+                    for k in 0..c.len() {
+                        if !projector.is_floor(k) {
+                            c[k] = l[k];
+                        }
+                    }
+                }
+                sun = Some(Arc::new(SunLight::new(&found, &h.conditions, &angles)));
+            }
             (all, own)
         }
     };
@@ -357,7 +406,7 @@ fn relighting<R: ReadAt>(
     let used: Vec<bool> = (0..h.conditions.len())
         .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
         .collect();
-    let lighting_plan = LightingPlan {
+    let plan = LightingPlan {
         skipped_conditions: h
             .conditions
             .iter()
@@ -368,7 +417,12 @@ fn relighting<R: ReadAt>(
         images_combined: views * used.iter().filter(|&&u| u).count(),
         images_total: views * h.conditions.len(),
     };
-    Ok((coefficients, ground_coefficients, lighting_plan))
+    Ok(Relighting {
+        coefficients,
+        ground,
+        sun,
+        plan,
+    })
 }
 
 /// What a load reads of a pose: the views `read`, and the flows `plan` wants.
@@ -410,6 +464,9 @@ impl<R: ReadAt> Reading<'_, R> {
                 if !self.read[i] {
                     return Ok(not_read(crop));
                 }
+                let normals = field
+                    .normal_codes(pose, u, v)?
+                    .map_or_else(Vec::new, |n| crop.rows_of(&n, full_w));
                 // Shared with every other read of the view (kept decoded, when the
                 // caller set a budget for it), cropped here.
                 let whole = field.basis_codes_shared(pose, u, v)?;
@@ -426,7 +483,7 @@ impl<R: ReadAt> Reading<'_, R> {
                         flows[n.index()] = Some(cropped);
                     }
                 }
-                Ok((b, crop.rows_of(&a, full_w), flows))
+                Ok((b, crop.rows_of(&a, full_w), flows, normals))
             })
             .collect::<Result<_>>()?;
         Ok((crop, per_view))
@@ -503,7 +560,7 @@ impl<R: ReadAt> Reading<'_, R> {
                 let flows = flows
                     .each_ref()
                     .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
-                (basis, crop.rows_of(&image.alpha, w), flows)
+                (basis, crop.rows_of(&image.alpha, w), flows, Vec::new())
             })
             .collect();
         Ok((size, crop, per_view))
@@ -518,7 +575,7 @@ fn not_read(crop: Crop) -> ViewCodes {
         tiles: Vec::new(),
         scales: Vec::new(),
     };
-    (blank, Vec::new(), Default::default())
+    (blank, Vec::new(), Default::default(), Vec::new())
 }
 
 /// Basis codes `b` (images `width` texels a row) cropped to `crop`.
@@ -597,6 +654,23 @@ pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i
         }
     }
     out
+}
+
+/// The sun's light at pixel `i` of view `view` ([`SunLight::texel`]) from the view's
+/// basis codes and the pixel's normal code.
+#[inline]
+pub fn sun_pixel(
+    sun: &SunLight,
+    view: usize,
+    basis: &BasisCodes,
+    normal: [u8; 2],
+    lut: &[f32; 256],
+    i: usize,
+) -> Rgb {
+    sun.texel(view, normal_of(normal), |k| {
+        let (p, s) = (basis.tiles[k][i], basis.scales[k]);
+        [p[0], p[1], p[2]].map(|c| s * lut[c as usize])
+    })
 }
 
 /// Views already lit, for [`ResidentPose::from_views`]: per view its camera, its RGBA8
@@ -679,13 +753,21 @@ impl ResidentPose {
                 // A transparent texel holds no light (the colour is premultiplied): it
                 // is not relit.
                 let alpha = &source.alpha[i];
+                let normals = &source.normals[i];
+                let sun = source.sun.as_deref().filter(|_| !normals.is_empty());
                 let relit: Vec<Rgb> = (0..n)
                     .map(|p| {
                         if alpha[p] == 0 {
-                            [0.0; 3]
-                        } else {
-                            relit_pixel(b, &source.coefficients[i], &lut, p)
+                            return [0.0; 3];
                         }
+                        let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
+                        if let Some(sun) = sun {
+                            let s = sun_pixel(sun, i, b, normals[p], &lut, p);
+                            for k in 0..3 {
+                                c[k] += s[k];
+                            }
+                        }
+                        c
                     })
                     .collect();
                 let peak = relit.iter().flatten().copied().fold(0.0f32, f32::max);

@@ -123,7 +123,9 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         }),
         basis: Arc::new(basis),
         alpha: Arc::new(vec![alpha; views]),
+        normals: Arc::new(vec![Vec::new(); views]),
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
+        sun: None,
         ground_coefficients: None,
         plan: LightingPlan {
             skipped_conditions: Vec::new(),

@@ -656,7 +656,9 @@ impl Plan {
                     counts.views_used += used as usize;
                     used
                 }
-                ChunkKind::Alpha => p.views.get(view).copied().unwrap_or(false),
+                ChunkKind::Alpha | ChunkKind::Normals => {
+                    p.views.get(view).copied().unwrap_or(false)
+                }
                 ChunkKind::Flow(n) => {
                     counts.flows_total += 1;
                     let used = p.flows.get(view).is_some_and(|f| f[n.index()]);

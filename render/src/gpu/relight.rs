@@ -13,6 +13,7 @@
 use std::sync::Arc;
 
 use frf_reflectance::imagecodec::BasisCodes;
+use frf_reflectance::light_fit::RATIO_FLOOR;
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -118,8 +119,17 @@ impl PoseRelight {
     }
 }
 
-/// The coefficients of `batch`'s jobs for `source`: per view and basis image, RGB times
-/// the image's scale, and whether the condition is used at all.
+/// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its
+/// coefficient, its condition's direction and the sun per unit of its light, then the
+/// sun's three.
+fn job_coefficients(tiles: usize) -> usize {
+    3 * tiles + 3
+}
+
+/// The coefficients of `batch`'s jobs for `source` (`shaders/relight.wgsl` says what each
+/// holds): per view and basis image, RGB times the image's scale, and whether the
+/// condition is used at all; then the sun's terms, zero where there is no sun or the view
+/// holds no normals.
 fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
     for &i in &batch.views {
@@ -133,6 +143,32 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             };
             out.push([c[0] * s, c[1] * s, c[2] * s, used]);
         }
+        let sun = source
+            .sun
+            .as_deref()
+            .filter(|_| !source.normals[i].is_empty());
+        let Some(sun) = sun else {
+            out.extend(std::iter::repeat_n([0.0; 4], 2 * scales.len() + 3));
+            continue;
+        };
+        out.extend(sun.directions.iter().map(|d| d.extend(0.0).to_array()));
+        out.extend(
+            sun.unit
+                .iter()
+                .zip(scales)
+                .map(|(u, &s)| [u[0] * s, u[1] * s, u[2] * s, 0.0]),
+        );
+        let view = &sun.views[i];
+        let (mut nearest, mut weights) = ([0.0f32; 4], [0.0f32; 4]);
+        for (j, &(k, w)) in view.nearest.iter().take(3).enumerate() {
+            nearest[j] = k as f32;
+            weights[j] = w;
+        }
+        nearest[3] = view.nearest.len().min(3) as f32;
+        weights[3] = RATIO_FLOOR;
+        out.push(view.direction.extend(1.0).to_array());
+        out.push(nearest);
+        out.push(weights);
     }
     if out.is_empty() {
         out.push([0.0; 4]);
@@ -178,7 +214,7 @@ impl Gpu {
     }
 
     /// One batch of `views` of `source`: codes packed RGBA8 (tile 0's alpha byte holding
-    /// the view's alpha code), jobs and parameters.
+    /// the view's alpha code, tiles 1 and 2's its normal's codes), jobs and parameters.
     fn basis_batch(&self, source: &PoseSource, views: Vec<usize>) -> BasisBatch {
         let crop = source.geometry.crop;
         let texels = crop.texels();
@@ -197,11 +233,18 @@ impl Gpu {
                 pad0: 0,
                 pad1: 0,
             });
-            coefficients += basis.scales.len();
+            coefficients += job_coefficients(basis.scales.len());
+            let normals = &source.normals[i];
             for (k, tile) in basis.tiles.iter().enumerate() {
-                codes.extend(tile.iter().zip(&source.alpha[i]).map(|(p, &a)| {
-                    let alpha = if k == 0 { a as u32 } else { 0 };
-                    p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | alpha << 24
+                codes.extend(tile.iter().enumerate().map(|(p, c)| {
+                    // The alpha bytes: tile 0's, the alpha code; tiles 1 and 2's, the
+                    // normal's codes.
+                    let fourth = match k {
+                        0 => source.alpha[i][p],
+                        1 | 2 => normals.get(p).map_or(0, |n| n[k - 1]),
+                        _ => 0,
+                    } as u32;
+                    c[0] as u32 | (c[1] as u32) << 8 | (c[2] as u32) << 16 | fourth << 24
                 }));
             }
         }

@@ -1,0 +1,129 @@
+//! A sun relit by a field's fitted normals instead of its basis (docs/design.md section
+//! 4.1): the basis integrates a sun over its condition's cell, which blurs and moves its
+//! terminator; the sun is taken out of the environment ([`Sun::extract`]), the rest
+//! relit by the basis as before, and the sun added per texel by the light fit
+//! ([`relight_texel`]): the nearest conditions' images, per unit of their light, times
+//! the ratio of the normal's shading under the sun to its shading under them.
+//!
+//! Each view sees the dome turned by its turntable angle `θ`, so the sun's direction in
+//! its dome frame (where its normals were fitted) is `R_y(θ) d`, as the projection turns
+//! an environment's texel ([`crate::project`]). The CPU reference of the GPU's sun term
+//! (`shaders/relight.wgsl`).
+
+use frf_core::image::Rgb;
+use frf_core::sun::Sun;
+use glam::{Mat3, Vec3};
+
+use crate::field::ConditionRecord;
+use crate::light_fit::{condition_lights, nearest_weights, per_unit, relight_texel};
+
+/// Conditions whose images a texel's sun is carried by.
+pub const NEAREST: usize = 3;
+
+/// One view's sun: its direction in the view's dome frame, and the nearest conditions'
+/// inverse-angle weights.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunView {
+    /// Unit, toward the sun, dome frame of the view.
+    pub direction: Vec3,
+    /// `(condition, weight)`, [`NEAREST`] of them, weights summing to 1.
+    pub nearest: Vec<(usize, f32)>,
+}
+
+/// A sun relit by a pose's normals (see the module text).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SunLight {
+    /// Per condition: the direction of the light standing for it ([`condition_lights`]).
+    pub directions: Vec<Vec3>,
+    /// Per condition: the sun's illuminance per unit of the condition's, per channel
+    /// (0 where the condition delivers none).
+    pub unit: Vec<Rgb>,
+    /// Per view.
+    pub views: Vec<SunView>,
+}
+
+impl SunLight {
+    /// `sun` (subject frame) over a basis of `conditions`, for views at turntable angles
+    /// `turntables` (radians).
+    pub fn new(sun: &Sun, conditions: &[ConditionRecord], turntables: &[f32]) -> Self {
+        let lights = condition_lights(conditions);
+        let directions: Vec<Vec3> = lights.iter().map(|l| l.0).collect();
+        let e = sun.illuminance();
+        let unit = lights
+            .iter()
+            .map(|(_, delivered)| per_unit(e, *delivered))
+            .collect();
+        let views = turntables
+            .iter()
+            .map(|&theta| {
+                let direction = (Mat3::from_rotation_y(theta) * sun.direction()).normalize();
+                SunView {
+                    direction,
+                    nearest: nearest_weights(&directions, direction, NEAREST),
+                }
+            })
+            .collect();
+        Self {
+            directions,
+            unit,
+            views,
+        }
+    }
+
+    /// The sun's light at a texel of view `view` whose normal is `normal` (`None`: none
+    /// fitted), its basis images' linear values being `photo(k)`.
+    pub fn texel(&self, view: usize, normal: Option<Vec3>, photo: impl Fn(usize) -> Rgb) -> Rgb {
+        let v = &self.views[view];
+        relight_texel(
+            normal,
+            |k| {
+                let (p, u) = (photo(k), self.unit[k]);
+                [p[0] * u[0], p[1] * u[1], p[2] * u[2]]
+            },
+            &self.directions,
+            v.direction,
+            &v.nearest,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::LightRecord;
+
+    fn condition(direction: Vec3, e: f32) -> ConditionRecord {
+        ConditionRecord {
+            name: String::new(),
+            floor: false,
+            lights: vec![LightRecord {
+                direction: direction.normalize().to_array(),
+                intensity: [e; 3],
+                solid_angle_sr: 0.5,
+            }],
+        }
+    }
+
+    #[test]
+    fn a_sun_on_a_condition_light_relights_as_its_image_scaled() {
+        let conditions: Vec<ConditionRecord> = [Vec3::Y, Vec3::X, Vec3::Z, -Vec3::X]
+            .into_iter()
+            .map(|d| condition(d, 2.0))
+            .collect();
+        // The sun at +X of the subject frame: +X in the dome at θ = 0, −Z at θ = 90°.
+        let sun = Sun::new(Vec3::X, 0.53, [4.0, 4.0, 4.0]).unwrap();
+        let light = SunLight::new(&sun, &conditions, &[0.0, std::f32::consts::FRAC_PI_2]);
+        assert_eq!(light.views[0].nearest, vec![(1, 1.0)]);
+        assert!(light.views[1].direction.distance(-Vec3::Z) < 1e-5);
+        let photo = |k: usize| [k as f32 + 1.0, 0.5, 0.0];
+        // A texel facing the sun: the condition's image, times 4 / 2.
+        let lit = light.texel(0, Some(Vec3::X), photo);
+        assert!(
+            (lit[0] - 4.0).abs() < 1e-5 && (lit[1] - 1.0).abs() < 1e-5,
+            "{lit:?}"
+        );
+        // A texel facing away is dark; one without a normal takes the interpolation.
+        assert_eq!(light.texel(0, Some(-Vec3::X), photo), [0.0; 3]);
+        assert_eq!(light.texel(0, None, photo), [4.0, 1.0, 0.0]);
+    }
+}
