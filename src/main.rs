@@ -50,8 +50,11 @@ enum Command {
     Eval(Box<cmd::eval::EvalArgs>),
     /// Score views held out of a ring of photographs, rendered from their neighbours.
     EvalRing(cmd::eval::RingEvalArgs),
+    /// Turn a calibrated one-light-at-a-time set of photographs into a one-view field
+    /// whose basis is its lights.
+    IngestOlat(cmd::olat::IngestOlatArgs),
     /// Score relighting on one-light-at-a-time photographs: lights held out of a
-    /// calibrated set, predicted from the others.
+    /// calibrated set (or of a field of it), predicted from the others.
     EvalOlat(cmd::olat::EvalOlatArgs),
     /// Error against run time of every stage's settings on a stage capture: JSON, plots,
     /// and one page.
@@ -97,6 +100,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(*args),
         Command::Eval(args) => cmd::eval::run(*args),
         Command::EvalRing(args) => cmd::eval::ring::run(args),
+        Command::IngestOlat(args) => cmd::olat::run_ingest(args),
         Command::EvalOlat(args) => cmd::olat::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::View(args) => cmd::view::run(*args),

@@ -11,6 +11,8 @@ use std::time::Instant;
 use frf_core::image::RgbImage;
 use frf_core::io::write_png16_rgb;
 use frf_ingest::olat::OlatSet;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
 use frf_reflectance::light_fit::{LightFit, blend, farthest_lights, nearest_weights};
 use glam::Vec3;
 use serde::Serialize;
@@ -70,9 +72,12 @@ pub struct Baselines {
 pub struct OlatReport {
     /// The set's directory.
     pub set: String,
-    /// Lights in the set, and those kept (numbers from 1, in the order taken).
-    pub lights: usize,
-    /// The kept lights.
+    /// The field relit (`frf eval-olat F.frf --photos DIR`), if any: the lights kept are
+    /// its basis, decoded as it stores them, and the fit its stored normals.
+    pub field: Option<String>,
+    /// Lights in the set.
+    pub lights_in_set: usize,
+    /// The kept lights (numbers from 1, in the order taken).
     pub kept: Vec<usize>,
     /// The light fit's mean PSNR over the held-out lights, dB.
     pub mean_psnr: f64,
@@ -81,11 +86,21 @@ pub struct OlatReport {
     /// The baselines' means.
     pub baselines: Baselines,
     /// Per held-out light.
-    pub held_out: Vec<LightScore>,
-    /// Seconds fitting the kept lights, and relighting every held-out one by the fit.
+    pub lights: Vec<LightScore>,
+    /// Seconds fitting the kept lights (0 for a field: its normals are stored).
     pub seconds_fit: f64,
     /// Seconds relighting the held-out lights by the fit.
     pub seconds_relight: f64,
+}
+
+/// The lights a prediction starts from: their photographs (per unit intensity), their
+/// numbers in the set (from 0) and directions, and the fit of them.
+struct Kept {
+    numbers: Vec<usize>,
+    photos: Vec<RgbImage>,
+    directions: Vec<Vec3>,
+    fit: LightFit,
+    seconds_fit: f64,
 }
 
 /// Scores `set` with `keep` of its lights kept (see the module text); writes each
@@ -102,30 +117,116 @@ pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Resul
             ),
         )));
     }
-    let kept = farthest_lights(&set.directions, keep, Vec3::Z);
-    let dirs: Vec<Vec3> = kept.iter().map(|&k| set.directions[k]).collect();
-    let photos: Vec<&RgbImage> = kept.iter().map(|&k| &set.images[k]).collect();
+    let numbers = farthest_lights(&set.directions, keep, Vec3::Z);
+    let directions: Vec<Vec3> = numbers.iter().map(|&k| set.directions[k]).collect();
+    let photos: Vec<RgbImage> = numbers.iter().map(|&k| set.images[k].clone()).collect();
     let t = Instant::now();
-    let fit = LightFit::fit(&photos, &dirs, &set.mask);
-    let seconds_fit = t.elapsed().as_secs_f64();
+    let fit = LightFit::fit(&photos.iter().collect::<Vec<_>>(), &directions, &set.mask);
+    let kept = Kept {
+        numbers,
+        photos,
+        directions,
+        fit,
+        seconds_fit: t.elapsed().as_secs_f64(),
+    };
+    score_held_out(set, None, &kept, images)
+}
+
+/// How far (degrees) a field's light may be from the set's to be that light.
+const SAME_LIGHT_DEG: f32 = 0.05;
+
+/// Scores the one-view field `field` of a set's lights (`frf ingest-olat`) against the
+/// photographs of `set` under every light it does not hold: the kept lights are its
+/// basis images as stored and the fit its stored normals.
+pub fn evaluate_olat_field<R: ReadAt>(
+    field: &FieldFile<R>,
+    set: &OlatSet,
+    images: Option<&Path>,
+) -> Result<OlatReport> {
+    let h = field.header();
+    let refuse =
+        |problem: String| EvalError::from(frf_core::CoreError::bad_file(field.path(), problem));
+    if h.columns * h.rows != 1 || h.poses.len() != 1 {
+        return Err(refuse(format!(
+            "a field of one view of one pose (frf ingest-olat) is scored against photographs; this one has {}x{} views and {} poses",
+            h.columns,
+            h.rows,
+            h.poses.len()
+        )));
+    }
+    if (h.width as usize, h.height as usize) != set.images[0].size() {
+        return Err(refuse(format!(
+            "its images are {}x{}, the set's {}x{}",
+            h.width,
+            h.height,
+            set.images[0].width(),
+            set.images[0].height()
+        )));
+    }
+    let mut numbers = Vec::with_capacity(h.conditions.len());
+    let mut directions = Vec::with_capacity(h.conditions.len());
+    for c in &h.conditions {
+        let [light] = c.lights.as_slice() else {
+            return Err(refuse(format!(
+                "condition {:?} has {} lights, not one of the set's",
+                c.name,
+                c.lights.len()
+            )));
+        };
+        let d = Vec3::from(light.direction).normalize_or_zero();
+        let k = (0..set.directions.len())
+            .find(|&k| set.directions[k].angle_between(d).to_degrees() < SAME_LIGHT_DEG)
+            .ok_or_else(|| {
+                refuse(format!(
+                    "condition {:?} is lit from {d}, which is none of the set's lights",
+                    c.name
+                ))
+            })?;
+        numbers.push(k);
+        directions.push(set.directions[k]);
+    }
+    let pose = h.poses[0].pose;
+    let normals = field.normals(pose, 0, 0)?.ok_or_else(|| {
+        refuse("holds no fitted normals (a field of fewer than three lights)".into())
+    })?;
+    let fit = LightFit::from_normals(h.width as usize, h.height as usize, &normals);
+    let kept = Kept {
+        numbers,
+        photos: field.basis(pose, 0, 0)?,
+        directions,
+        fit,
+        seconds_fit: 0.0,
+    };
+    score_held_out(set, Some(field.path()), &kept, images)
+}
+
+/// Every light of `set` that `kept` does not hold, predicted from it and scored.
+fn score_held_out(
+    set: &OlatSet,
+    field: Option<&Path>,
+    kept: &Kept,
+    images: Option<&Path>,
+) -> Result<OlatReport> {
+    let (dirs, fit) = (&kept.directions, &kept.fit);
+    let photos: Vec<&RgbImage> = kept.photos.iter().collect();
     let mask = Some(set.mask.as_slice());
     let score = |truth: &RgbImage, test: &RgbImage| Score {
         psnr: psnr(truth, test, mask),
         ssim: ssim(truth, test, mask),
     };
-    let mut held_out = Vec::new();
+    let mut lights = Vec::new();
     let mut seconds_relight = 0.0;
     for (k, &l) in set.directions.iter().enumerate() {
-        if kept.contains(&k) {
+        if kept.numbers.contains(&k) {
             continue;
         }
         let truth = &set.images[k];
         let t = Instant::now();
-        let ours = fit.relight(&photos, &dirs, l, NEAREST);
+        let ours = fit.relight(&photos, dirs, l, NEAREST);
         seconds_relight += t.elapsed().as_secs_f64();
-        let nearest_w = nearest_weights(&dirs, l, 1);
+        let nearest_w = nearest_weights(dirs, l, 1);
         let nearest = photos[nearest_w[0].0].clone();
-        let interpolated = blend(&photos, &nearest_weights(&dirs, l, NEAREST));
+        let interpolated = blend(&photos, &nearest_weights(dirs, l, NEAREST));
         if let Some(dir) = images {
             for (what, img) in [
                 ("photo", truth),
@@ -136,7 +237,7 @@ pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Resul
                 write_png16_rgb(&dir.join(format!("light_{:03}_{what}.png", k + 1)), img)?;
             }
         }
-        held_out.push(LightScore {
+        lights.push(LightScore {
             light: k + 1,
             direction: l.to_array(),
             nearest_kept_deg: dirs[nearest_w[0].0]
@@ -149,26 +250,34 @@ pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Resul
             interpolated: score(truth, &interpolated),
         });
     }
+    if lights.is_empty() {
+        return Err(EvalError::Argument(frf_core::BadArgument::new(
+            "--photos",
+            set.dir.display(),
+            "a set with a light the field does not hold, to predict and score",
+        )));
+    }
     let mean = |f: &dyn Fn(&LightScore) -> Score| {
-        let m = held_out.len().max(1) as f64;
+        let m = lights.len() as f64;
         MeanScore {
-            mean_psnr: held_out.iter().map(|s| f(s).psnr).sum::<f64>() / m,
-            mean_ssim: held_out.iter().map(|s| f(s).ssim).sum::<f64>() / m,
+            mean_psnr: lights.iter().map(|s| f(s).psnr).sum::<f64>() / m,
+            mean_ssim: lights.iter().map(|s| f(s).ssim).sum::<f64>() / m,
         }
     };
     let ours = mean(&|s| s.fit);
     Ok(OlatReport {
         set: set.dir.display().to_string(),
-        lights: n,
-        kept: kept.iter().map(|k| k + 1).collect(),
+        field: field.map(|f| f.display().to_string()),
+        lights_in_set: set.directions.len(),
+        kept: kept.numbers.iter().map(|k| k + 1).collect(),
         mean_psnr: ours.mean_psnr,
         mean_ssim: ours.mean_ssim,
         baselines: Baselines {
             nearest: mean(&|s| s.nearest),
             interpolated: mean(&|s| s.interpolated),
         },
-        held_out,
-        seconds_fit,
+        lights,
+        seconds_fit: kept.seconds_fit,
         seconds_relight,
     })
 }
@@ -179,11 +288,11 @@ pub fn olat_table(r: &OlatReport) -> String {
         "{}: {} of {} lights kept ({:?}); PSNR dB / SSIM inside the mask, per held-out light:\n",
         r.set,
         r.kept.len(),
-        r.lights,
+        r.lights_in_set,
         r.kept
     );
     out.push_str("light  nearest kept  light fit        nearest          interpolated\n");
-    for s in &r.held_out {
+    for s in &r.lights {
         out.push_str(&format!(
             "{:5}  {:9.1}°    {:5.2} / {:.3}   {:5.2} / {:.3}   {:5.2} / {:.3}\n",
             s.light,
@@ -208,7 +317,7 @@ pub fn olat_table(r: &OlatReport) -> String {
     out.push_str(&format!(
         "fit {:.2} s, relighting {:.3} s a light",
         r.seconds_fit,
-        r.seconds_relight / r.held_out.len().max(1) as f64
+        r.seconds_relight / r.lights.len().max(1) as f64
     ));
     out
 }

@@ -22,6 +22,7 @@ pub mod guided;
 pub mod interview;
 pub mod matte;
 pub mod olat;
+pub mod olat_field;
 pub mod pipeline;
 pub mod poseflow;
 pub mod rectify;

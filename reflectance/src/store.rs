@@ -85,7 +85,7 @@ pub fn encode_images(
 }
 
 /// Conditions a basis needs for its views' normals to be fitted and stored.
-pub const FIT_CONDITIONS: usize = 4;
+pub const FIT_CONDITIONS: usize = 3;
 
 /// Encodes the flows present among `flows` as chunks of their kinds, with pose `pose`'s
 /// quantizer.

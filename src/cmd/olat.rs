@@ -1,23 +1,69 @@
-//! `frf eval-olat DIR [--use K] [--images OUT] [--json]`: relighting scored on a calibrated
-//! one-light-at-a-time set of photographs ([`frf_eval::olat`]).
+//! `frf ingest-olat DIR --out F.frf [--use K]`: a calibrated one-light-at-a-time set as a
+//! one-view field whose basis is its lights ([`frf_ingest::olat_field`]); and
+//! `frf eval-olat DIR|F.frf [--photos DIR] [--use K] [--images OUT] [--json]`: relighting
+//! scored on the set's photographs ([`frf_eval::olat`]), from the set's own kept lights
+//! or from such a field.
 
 use std::path::PathBuf;
 
 use clap::Args;
-use frf_eval::olat::{evaluate_olat, olat_table};
+use frf_eval::olat::{evaluate_olat, evaluate_olat_field, olat_table};
 use frf_ingest::olat::OlatSet;
+use frf_reflectance::FieldFile;
 
 use crate::CliResult;
 
+/// What a set's directory holds, for the help of both commands.
+const SET_LAYOUT: &str = "`NNN.png` (8- or 16-bit, linear), `light_directions.txt` (unit vectors, camera frame: x right, y up, z toward the camera), optional `light_intensities.txt` (`r g b` a line) and `mask.png`";
+
+/// Arguments of `frf ingest-olat`.
+#[derive(Args)]
+pub struct IngestOlatArgs {
+    /// The set's directory (see `frf eval-olat --help` for its layout).
+    pub dir: PathBuf,
+    /// The field file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Lights kept as the basis (farthest-point sampling from the one nearest the
+    /// camera); the others are held out for `frf eval-olat F.frf --photos DIR`. Default:
+    /// every light.
+    #[arg(long = "use", value_name = "K")]
+    pub keep: Option<usize>,
+    /// JPEG quality of the basis images.
+    #[arg(long, default_value_t = 95)]
+    pub jpeg_quality: u8,
+}
+
+/// Runs `frf ingest-olat`.
+pub fn run_ingest(args: IngestOlatArgs) -> CliResult {
+    let _claim = crate::cmd::claim::claim(&args.out, &[])?;
+    let set = OlatSet::read(&args.dir)?;
+    let r = frf_ingest::olat_field::ingest_olat(&set, &args.out, args.keep, args.jpeg_quality)?;
+    println!(
+        "{} of {} lights ({:?}) written to {} as one view's basis with its fitted normals: {:.2} MB in {:.1} s (wall)",
+        r.kept.len(),
+        r.lights,
+        r.kept,
+        args.out.display(),
+        r.bytes as f64 / 1e6,
+        r.seconds
+    );
+    Ok(())
+}
+
 /// Arguments of `frf eval-olat`.
 #[derive(Args)]
+#[command(after_help = format!("A set's directory holds {SET_LAYOUT}."))]
 pub struct EvalOlatArgs {
-    /// The set: `NNN.png` (8- or 16-bit, linear), `light_directions.txt` (unit vectors,
-    /// camera frame: x right, y up, z toward the camera), optional `light_intensities.txt`
-    /// (`r g b` a line) and `mask.png`.
-    pub dir: PathBuf,
-    /// Lights kept (farthest-point sampling from the one nearest the camera); the others
-    /// are predicted from them and scored. Default: half of the set.
+    /// The set's directory (its kept lights predict the others), or a field written by
+    /// `frf ingest-olat` (its basis predicts the lights of `--photos` it does not hold).
+    pub source: PathBuf,
+    /// With a field: the set's directory, whose photographs the predictions are scored
+    /// against.
+    #[arg(long, value_name = "DIR")]
+    pub photos: Option<PathBuf>,
+    /// With a directory: lights kept (farthest-point sampling from the one nearest the
+    /// camera); the others are predicted from them and scored. Default: half of the set.
     #[arg(long = "use", value_name = "K")]
     pub keep: Option<usize>,
     /// Write each held-out light's photograph and predictions here
@@ -30,16 +76,49 @@ pub struct EvalOlatArgs {
     pub json: bool,
 }
 
+/// Runs `frf eval-olat`.
 pub fn run(args: EvalOlatArgs) -> CliResult {
-    let set = OlatSet::read(&args.dir)?;
-    let keep = args.keep.unwrap_or(set.directions.len() / 2);
     if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
     }
-    let report = evaluate_olat(&set, keep, args.images.as_deref())?;
+    let images = args.images.as_deref();
+    let report = if args.source.is_dir() {
+        if args.photos.is_some() {
+            return Err(bad("--photos", &args, "a field file as the first argument"));
+        }
+        let set = OlatSet::read(&args.source)?;
+        let keep = args.keep.unwrap_or(set.directions.len() / 2);
+        evaluate_olat(&set, keep, images)?
+    } else {
+        let Some(photos) = &args.photos else {
+            return Err(bad(
+                "--photos",
+                &args,
+                "the set's directory, to score a field's predictions against",
+            ));
+        };
+        if args.keep.is_some() {
+            return Err(bad(
+                "--use",
+                &args,
+                "a set's directory as the first argument (a field's lights were chosen by frf ingest-olat --use)",
+            ));
+        }
+        let field = FieldFile::open(&args.source)?;
+        evaluate_olat_field(&field, &OlatSet::read(photos)?, images)?
+    };
     eprintln!("{}", olat_table(&report));
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
     Ok(())
+}
+
+/// `flag` misused with `args.source`.
+fn bad(
+    flag: &'static str,
+    args: &EvalOlatArgs,
+    wanted: &str,
+) -> Box<dyn std::error::Error + Send + Sync> {
+    frf_core::BadArgument::new(flag, args.source.display(), wanted).into()
 }

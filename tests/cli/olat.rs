@@ -1,5 +1,6 @@
-//! `frf eval-olat`: relighting scored on a one-light-at-a-time set, here a synthetic
-//! glossy sphere written in the layout of calibrated sets, and a set missing an image.
+//! `frf ingest-olat` and `frf eval-olat`: relighting scored on a one-light-at-a-time
+//! set, here a synthetic glossy sphere written in the layout of calibrated sets, from
+//! the set itself and from a field of it; and sets and fields either refuses.
 
 use std::path::Path;
 
@@ -87,7 +88,7 @@ fn eval_olat_scores_the_light_fit_above_both_baselines() {
         "{ours} {interpolated} {nearest}"
     );
     assert_eq!(r["kept"].as_array().unwrap().len(), 6);
-    let held = r["held_out"].as_array().unwrap();
+    let held = r["lights"].as_array().unwrap();
     assert_eq!(held.len(), 6);
     assert!(held[0]["fit"]["ssim"].as_f64().unwrap() > 0.9);
     let light = held[0]["light"].as_u64().unwrap();
@@ -106,4 +107,103 @@ fn eval_olat_refuses_a_set_missing_an_image_and_too_many_kept_lights() {
     assert!(!o.status.success());
     let e = stderr(&o);
     assert!(e.contains("005.png") && e.contains("missing"), "{e}");
+}
+
+#[test]
+fn a_field_ingested_from_a_set_relights_its_held_out_lights_as_the_set_does() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sphere_set(dir.path(), &lights());
+    let set = dir.path().to_str().unwrap();
+    let field = dir.path().join("sphere.frf");
+    let o = frf(&[
+        "ingest-olat",
+        set,
+        "--out",
+        field.to_str().unwrap(),
+        "--use",
+        "6",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let field = field.to_str().unwrap();
+    let o = frf(&["eval-olat", field, "--photos", set, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let from_field: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let o = frf(&["eval-olat", set, "--use", "6", "--json"]);
+    let from_set: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // The same lights are held out, and the field's stored basis and normals predict
+    // them within 1 dB of the set's own photographs, above both baselines.
+    assert_eq!(from_field["kept"], from_set["kept"]);
+    let lights = from_field["lights"].as_array().unwrap();
+    assert_eq!(lights.len(), 6);
+    let psnr = |r: &serde_json::Value| r["mean_psnr"].as_f64().unwrap();
+    assert!(psnr(&from_field) > 30.0, "{}", psnr(&from_field));
+    assert!(
+        (psnr(&from_field) - psnr(&from_set)).abs() < 1.0,
+        "{} {}",
+        psnr(&from_field),
+        psnr(&from_set)
+    );
+    let interpolated = from_field["baselines"]["interpolated"]["mean_psnr"]
+        .as_f64()
+        .unwrap();
+    assert!(psnr(&from_field) >= interpolated + 3.0);
+    // Each light held out is scored on its own.
+    for l in lights {
+        assert!(l["fit"]["psnr"].as_f64().unwrap() > 25.0, "{l}");
+    }
+}
+
+#[test]
+fn ingest_olat_and_eval_olat_refuse_bad_sets_and_fields_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sphere_set(dir.path(), &lights());
+    let set = dir.path().to_str().unwrap();
+    let out = dir.path().join("f.frf");
+    let out = out.to_str().unwrap();
+    // Fewer than three lights fix no normal.
+    let o = frf(&["ingest-olat", set, "--out", out, "--use", "2"]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--use"),
+        "{}",
+        stderr(&o)
+    );
+    // A field needs the photographs to be scored against.
+    assert!(
+        frf(&["ingest-olat", set, "--out", out, "--use", "6"])
+            .status
+            .success()
+    );
+    let o = frf(&["eval-olat", out]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--photos"),
+        "{}",
+        stderr(&o)
+    );
+    // A light file one line short.
+    let lights_file = dir.path().join("light_directions.txt");
+    let text = std::fs::read_to_string(&lights_file).unwrap();
+    let short: Vec<&str> = text.lines().take(11).collect();
+    std::fs::write(&lights_file, short.join("\n") + "\n").unwrap();
+    let o = frf(&["eval-olat", out, "--photos", set]);
+    let e = stderr(&o);
+    assert!(
+        !o.status.success() && e.contains("light_directions.txt"),
+        "{e}"
+    );
+    let o = frf(&["ingest-olat", set, "--out", out]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("012.png"),
+        "{}",
+        stderr(&o)
+    );
+    // A field of another set: its lights are none of these (mirrored left to right).
+    let mirrored: String = lights()
+        .iter()
+        .map(|l| format!("{} {} {}\n", -l.x, l.y, l.z))
+        .collect();
+    std::fs::write(&lights_file, mirrored).unwrap();
+    let o = frf(&["eval-olat", out, "--photos", set]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(e.contains("f.frf") && e.contains("none of the set"), "{e}");
 }
