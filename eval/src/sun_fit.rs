@@ -1,127 +1,82 @@
-//! Toward relighting fields under a sun by the per-texel light fit
-//! ([`frf_reflectance::light_fit`]): at a pose's captured views, under an environment
-//! holding a sun, the basis's relighting (which integrates the sun over its condition's
-//! cell) against the environment less its sun ([`Sun::extract`]) relit by the basis plus
-//! the sun relit by each view's light fit, both scored against the stage's truth. The fit
-//! is made from the view's basis images, each condition a light at its lights'
-//! irradiance-weighted direction, turned into the subject frame by the view's turntable
-//! angle. A CPU experiment: fields do not relight this way yet.
+//! A field's sun relit by its views' fitted normals ([`frf_reflectance::sun_light`]),
+//! as every render does, against the same sun relit by its basis (integrated over its
+//! condition's cell, as fields without normals are relit), at a pose's captured views,
+//! both scored against the stage's truth: what the normals gain under a sun, judged
+//! through the renderer in one run (`frf eval --sun-fit`).
 
-use frf_core::env::EnvMap;
-use frf_core::image::{Image, Rgb, RgbImage, luminance};
-use frf_core::io::rgba_from;
-use frf_core::sun::Sun;
+use frf_core::light::DirLight;
+use frf_core::progress::Progress;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
-use frf_reflectance::light_fit::LightFit;
-use frf_reflectance::project::FloorModel;
-use frf_reflectance::relight::relight;
+use frf_render::morph::Variant;
+use frf_render::renderer::Renderer;
+use frf_render::resident::{Lighting, PoseSource};
 use frf_stage::Stage;
-use glam::{Mat3, Vec3};
 use serde::Serialize;
 
 use crate::error::{EvalError, Result};
-use crate::metrics::{psnr, ssim, subject_mask};
-use crate::views::truth_frame;
+use crate::views::{VariantScore, evaluate, grid_view_cameras, truth_frames};
 
-/// One captured view's scores.
+/// The two relightings' scores at the captured views.
 #[derive(Debug, Clone, Serialize)]
-pub struct SunFitScore {
-    /// Column and row.
-    pub view: (usize, usize),
-    /// The basis alone: subject PSNR dB and SSIM.
-    pub basis_psnr: f64,
-    /// SSIM.
-    pub basis_ssim: f64,
-    /// The environment less its sun by the basis, plus the sun by the light fit.
-    pub fit_psnr: f64,
-    /// SSIM.
-    pub fit_ssim: f64,
+pub struct SunFitReport {
+    /// The sun by the basis alone.
+    pub basis: VariantScore,
+    /// The sun by the views' fitted normals.
+    pub fit: VariantScore,
 }
 
-/// Scores `views` of `pose` under `env` (see the module text), the truth lit by
-/// `lights` (the environment's median cut).
+/// Scores `source` (pose `pose` of `field` under `lighting`, whose environment holds a
+/// sun and whose views hold their normals) at `cameras` captured views, its sun by the
+/// normals and by the basis, against the truth lit by `lights`; on the CPU reference
+/// when `cpu`.
+#[allow(clippy::too_many_arguments)]
 pub fn score_sun_fit<R: ReadAt>(
     field: &FieldFile<R>,
-    stage: &Stage,
-    pose: u32,
-    (env, floor): (&EnvMap, FloorModel),
-    views: &[((usize, usize), frf_core::camera::Camera)],
-    lights: &[frf_core::light::DirLight],
-) -> Result<Vec<SunFitScore>> {
-    let Some((sun, rest)) = Sun::extract(env)? else {
+    source: &PoseSource,
+    lighting: &Lighting,
+    (stage, pose, lights): (&Stage, u32, &[DirLight]),
+    cameras: usize,
+    cpu: bool,
+    progress: &dyn Progress,
+) -> Result<SunFitReport> {
+    if source.sun.is_none() {
+        let why = if source.holds_normals() {
+            "an environment with a sun (--sun, or a map with one)"
+        } else {
+            "a field whose views hold fitted normals (written since they were; this one has none)"
+        };
         return Err(EvalError::Argument(frf_core::BadArgument::new(
             "--sun-fit",
-            "the environment",
-            "an environment with a sun (--sun, or a map with one)",
+            field.path().display(),
+            why,
         )));
-    };
-    let h = field.header();
-    let record = h.poses.iter().find(|p| p.pose == pose).ok_or_else(|| {
-        EvalError::Argument(frf_core::BadArgument::new(
-            "--pose",
-            pose,
-            "a pose of the field",
-        ))
-    })?;
-    let projector = field.projector()?;
-    // Each condition as one light: its lights' direction weighted by their irradiance,
-    // and their irradiance summed.
-    let conditions: Vec<(Vec3, Rgb)> = h
-        .conditions
-        .iter()
-        .map(|c| {
-            let (mut d, mut e) = (Vec3::ZERO, [0.0f32; 3]);
-            for l in &c.lights {
-                d += Vec3::from(l.direction).normalize() * luminance(l.intensity);
-                for (sum, i) in e.iter_mut().zip(l.intensity) {
-                    *sum += i;
-                }
-            }
-            (d.normalize_or_zero(), e)
-        })
-        .collect();
-    let mut scores = Vec::with_capacity(views.len());
-    for &((u, v), camera) in views {
-        let theta = record.views[u * h.rows + v].turntable_deg.to_radians();
-        let to_subject = Mat3::from_rotation_y(-theta);
-        let dirs: Vec<Vec3> = conditions.iter().map(|(d, _)| to_subject * *d).collect();
-        let basis = field.basis(pose, u, v)?;
-        let alpha = field.alpha(pose, u, v)?;
-        // Each basis image per unit irradiance of its condition.
-        let unit: Vec<RgbImage> = basis
-            .iter()
-            .zip(&conditions)
-            .map(|(b, (_, e))| {
-                b.map(|p| std::array::from_fn(|c| if e[c] > 0.0 { p[c] / e[c] } else { 0.0 }))
-            })
-            .collect();
-        let refs: Vec<&RgbImage> = unit.iter().collect();
-        let mask: Vec<bool> = alpha.pixels().iter().map(|&a| a > 0.5).collect();
-        let fit = LightFit::fit(&refs, &dirs, &mask);
-        let by_basis = relight(&basis, &projector.project(env, theta, floor))?;
-        let smooth = relight(&basis, &projector.project(&rest, theta, floor))?;
-        let e = sun.illuminance();
-        let by_sun = fit.relight(&refs, &dirs, sun.direction(), 3);
-        let by_fit = Image::from_fn(smooth.width(), smooth.height(), |x, y| {
-            let (a, b) = (smooth.get(x, y), by_sun.get(x, y));
-            std::array::from_fn(|c| a[c] + e[c] * b[c])
-        });
-        let truth = truth_frame(stage, pose, &camera, lights)?;
-        let score = |img: &RgbImage| -> Result<(f64, f64)> {
-            let test = rgba_from(img, &alpha)?;
-            let m = subject_mask(&truth, &test);
-            Ok((psnr(&truth, &test, Some(&m)), ssim(&truth, &test, Some(&m))))
-        };
-        let (basis_psnr, basis_ssim) = score(&by_basis)?;
-        let (fit_psnr, fit_ssim) = score(&by_fit)?;
-        scores.push(SunFitScore {
-            view: (u, v),
-            basis_psnr,
-            basis_ssim,
-            fit_psnr,
-            fit_ssim,
-        });
     }
-    Ok(scores)
+    let basis_only = PoseSource {
+        normals: std::sync::Arc::new(vec![Vec::new(); source.normals.len()]),
+        ..source.clone()
+    }
+    .relit(field, lighting, None)?;
+    let at_views = grid_view_cameras(&source.geometry, cameras)?;
+    let all: Vec<_> = at_views.iter().map(|c| c.camera).collect();
+    progress.phase("truth frames", all.len());
+    let (truths, _) = truth_frames(stage, pose, &all, lights, progress)?;
+    progress.finish();
+    let score = |src: &PoseSource, name: &str| -> Result<VariantScore> {
+        let renderer = Renderer::open(src, cpu)?;
+        let mut s = evaluate(
+            &renderer,
+            &at_views,
+            &truths,
+            &[Variant::FourWay],
+            &mut |_, _, _| Ok(()),
+        )?
+        .remove(0);
+        s.name = name.into();
+        Ok(s)
+    };
+    Ok(SunFitReport {
+        basis: score(&basis_only, "sun by the basis")?,
+        fit: score(source, "sun by the normals")?,
+    })
 }

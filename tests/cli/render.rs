@@ -606,12 +606,12 @@ fn eval_sun_fit_scores_the_light_fit_above_the_basis_under_a_low_sun() {
     assert!(o.status.success(), "{}", stderr(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let (basis, fit) = (
-        r["mean_basis_psnr"].as_f64().unwrap(),
-        r["mean_fit_psnr"].as_f64().unwrap(),
+        r["basis"]["psnr_subject"].as_f64().unwrap(),
+        r["fit"]["psnr_subject"].as_f64().unwrap(),
     );
     assert!(fit >= basis + 2.0, "fit {fit} dB, basis {basis} dB");
     assert!(r["env"].as_str().unwrap().contains("sun"), "{r}");
-    assert_eq!(r["views"].as_array().unwrap().len(), 4);
+    assert_eq!(r["fit"]["frames"].as_array().unwrap().len(), 4);
     // An environment without a sun is refused by name.
     let o = frf(&[
         "eval",
