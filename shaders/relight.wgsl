@@ -40,11 +40,12 @@ struct Job {
 // view's alpha code.
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
 // Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
-// w = 0 when the condition is not used; per tile, the direction of its condition's
-// light (xyz, the view's dome frame); per tile, the sun per unit of the condition's light
-// x tile scale (rgb); then the sun: its direction (xyz; w = 0 when there is none), the
-// nearest conditions (xyz, as f32; w: how many) and their weights (xyz; w: the ratio's
-// floor).
+// w = 0 when the condition is not used; per tile, where its condition's lights are
+// (x: the first, y: how many, as f32); per tile, the sun per unit of the condition's light
+// x tile scale (rgb); then the sun: its direction (xyz, the view's dome frame; w = 0
+// when there is none), the nearest conditions (xyz, as f32; w: how many) and their
+// weights (xyz; w: the ratio's floor). After every view's: the conditions' lights, each
+// its direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
@@ -86,6 +87,18 @@ fn normal_of(cx: u32, cy: u32) -> vec3<f32> {
     return normalize(vec3<f32>(select(x + t, x - t, x >= 0.0), select(y + t, y - t, y >= 0.0), z));
 }
 
+// Condition k's shading of normal n per unit of its light (`group_shading`,
+// `reflectance/src/light_fit.rs`): its lights' max(n . l, 0) weighted by their shares.
+fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
+    var s = 0.0;
+    let first = u32(lights.x);
+    for (var j = first; j < first + u32(lights.y); j++) {
+        let l = coefficients[j];
+        s += l.w * max(dot(n, l.xyz), 0.0);
+    }
+    return s;
+}
+
 // The sun's light at texel i of `job` (see the file's text). The normal's codes are the
 // alpha bytes of tiles 1 and 2.
 fn sun_light(job: Job, i: u32) -> vec3<f32> {
@@ -107,7 +120,7 @@ fn sun_light(job: Job, i: u32) -> vec3<f32> {
     for (var j = 0u; j < u32(nearest.w); j++) {
         let k = u32(nearest[j]);
         interpolated += weights[j] * coefficients[units + k].rgb * tile_value(job, k, i);
-        shaded += weights[j] * max(dot(n, coefficients[directions + k].xyz), 0.0);
+        shaded += weights[j] * shading(coefficients[directions + k], n);
     }
     if (all(n == vec3<f32>(0.0))) {
         return interpolated;
@@ -122,7 +135,7 @@ fn sun_light(job: Job, i: u32) -> vec3<f32> {
     var num = vec3<f32>(0.0);
     var den = 0.0;
     for (var k = 0u; k < job.tiles; k++) {
-        let m = max(dot(n, coefficients[directions + k].xyz), 0.0);
+        let m = shading(coefficients[directions + k], n);
         if (m > 0.0) {
             num += coefficients[units + k].rgb * tile_value(job, k, i) * m;
             den += m * m;

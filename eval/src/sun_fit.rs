@@ -5,6 +5,10 @@
 //! through the renderer in one run (`frf eval --sun-fit`).
 
 use frf_core::light::DirLight;
+use std::path::Path;
+
+use frf_core::image::{Image, Rgba};
+use frf_core::io::write_png8_srgba;
 use frf_core::progress::Progress;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
@@ -29,7 +33,8 @@ pub struct SunFitReport {
 /// Scores `source` (pose `pose` of `field` under `lighting`, whose environment holds a
 /// sun and whose views hold their normals) at `cameras` captured views, its sun by the
 /// normals and by the basis, against the truth lit by `lights`; on the CPU reference
-/// when `cpu`.
+/// when `cpu`; each view's truth and both renders written as PNGs into `images` when
+/// given (`view{i}_{truth,basis,fit}.png`).
 #[allow(clippy::too_many_arguments)]
 pub fn score_sun_fit<R: ReadAt>(
     field: &FieldFile<R>,
@@ -37,7 +42,7 @@ pub fn score_sun_fit<R: ReadAt>(
     lighting: &Lighting,
     (stage, pose, lights): (&Stage, u32, &[DirLight]),
     cameras: usize,
-    cpu: bool,
+    (cpu, images): (bool, Option<&Path>),
     progress: &dyn Progress,
 ) -> Result<SunFitReport> {
     if source.sun.is_none() {
@@ -62,14 +67,30 @@ pub fn score_sun_fit<R: ReadAt>(
     progress.phase("truth frames", all.len());
     let (truths, _) = truth_frames(stage, pose, &all, lights, progress)?;
     progress.finish();
+    let write = |i: usize, what: &str, img: &Image<Rgba>| match images {
+        Some(dir) => Ok(write_png8_srgba(
+            &dir.join(format!("view{i:02}_{what}.png")),
+            img,
+            1.0,
+        )?),
+        None => Ok(()),
+    };
+    for (i, t) in truths.iter().enumerate() {
+        write(i, "truth", t)?;
+    }
     let score = |src: &PoseSource, name: &str| -> Result<VariantScore> {
         let renderer = Renderer::open(src, cpu)?;
+        let what = if name.contains("basis") {
+            "basis"
+        } else {
+            "fit"
+        };
         let mut s = evaluate(
             &renderer,
             &at_views,
             &truths,
             &[Variant::FourWay],
-            &mut |_, _, _| Ok(()),
+            &mut |i, _, img| write(i, what, img),
         )?
         .remove(0);
         s.name = name.into();

@@ -48,6 +48,15 @@ impl LightFit {
     /// Fits every texel of `mask` from `images` (linear, one per light, all one size)
     /// lit from `directions` (unit, toward the light).
     pub fn fit(images: &[&RgbImage], directions: &[Vec3], mask: &[bool]) -> Self {
+        let lights: Vec<Vec<(Vec3, f32)>> = directions.iter().map(|&d| vec![(d, 1.0)]).collect();
+        Self::fit_lights(images, &lights, mask)
+    }
+
+    /// [`LightFit::fit`] of images each lit by a group of distant lights (a basis
+    /// condition): per image, its lights' unit directions and shares of its light
+    /// ([`condition_light_shares`]). A group counts where the fit sees all its lights:
+    /// its shading is then linear in the scaled normal, `b · Σ share l`.
+    pub fn fit_lights(images: &[&RgbImage], lights: &[Vec<(Vec3, f32)>], mask: &[bool]) -> Self {
         let (width, height) = images.first().map_or((0, 0), |i| i.size());
         let texels = (0..width * height)
             .into_par_iter()
@@ -56,7 +65,7 @@ impl LightFit {
                     return None;
                 }
                 let colours: Vec<[f32; 3]> = images.iter().map(|img| img.pixels()[i]).collect();
-                fit_texel(&colours, directions)
+                fit_texel(&colours, lights)
             })
             .collect();
         Self {
@@ -100,7 +109,9 @@ impl LightFit {
             .into_par_iter()
             .map(|i| {
                 let normal = self.texels[i].map(|t| t.0);
-                relight_texel(normal, |k| images[k].pixels()[i], directions, l, &weights)
+                let shading = |k: usize, n: Vec3| n.dot(directions[k]).max(0.0);
+                let photo = |k: usize| images[k].pixels()[i];
+                relight_texel(normal, photo, (shading, directions.len()), l, &weights)
             })
             .collect();
         Image::from_vec(self.width, self.height, pixels).expect("sized by the fit")
@@ -118,9 +129,8 @@ impl LightFit {
             .map(|(b, (_, e))| b.map(|p| per_unit(p, *e)))
             .collect();
         let refs: Vec<&RgbImage> = unit.iter().collect();
-        let dirs: Vec<Vec3> = lights.iter().map(|l| l.0).collect();
         let mask: Vec<bool> = alpha.pixels().iter().map(|&a| a > 0.0).collect();
-        Self::fit(&refs, &dirs, &mask)
+        Self::fit_lights(&refs, &condition_light_shares(conditions), &mask)
     }
 
     /// A fit of these normals (as a field stores them, [`crate::normalcodec`]); its
@@ -158,20 +168,53 @@ pub fn condition_lights(conditions: &[ConditionRecord]) -> Vec<(Vec3, Rgb)> {
         .collect()
 }
 
+/// Per condition of a basis, its lights' unit directions and shares of its light (by
+/// luminance): what its image is per unit of its light, `Σ share · max(n · l, 0)` for a
+/// Lambertian texel of normal `n` and unit albedo.
+pub fn condition_light_shares(conditions: &[ConditionRecord]) -> Vec<Vec<(Vec3, f32)>> {
+    conditions
+        .iter()
+        .map(|c| {
+            let total: f32 = c.lights.iter().map(|l| luminance(l.intensity)).sum();
+            c.lights
+                .iter()
+                .map(|l| {
+                    let share = if total > 0.0 {
+                        luminance(l.intensity) / total
+                    } else {
+                        0.0
+                    };
+                    (Vec3::from(l.direction).normalize_or_zero(), share)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A group of lights' shading of a normal `n`: `Σ share · max(n · l, 0)`.
+pub fn group_shading(lights: &[(Vec3, f32)], n: Vec3) -> f32 {
+    lights
+        .iter()
+        .map(|&(l, share)| share * n.dot(l).max(0.0))
+        .sum()
+}
+
 /// `p` per unit of the light `e` (0 in a channel `e` leaves dark).
 pub fn per_unit(p: Rgb, e: Rgb) -> Rgb {
     std::array::from_fn(|c| if e[c] > 0.0 { p[c] / e[c] } else { 0.0 })
 }
 
-/// One texel of normal `normal` (`None`: unfitted), seen under unit lights from
-/// `directions` as `photo(k)`, relit under a unit light from `l` by the photographs
-/// `weights` names (see the module text). The fit's albedo cancels from both of its
-/// ratios, so the normal alone is needed: the CPU reference of the GPU's sun term
-/// (`shaders/relight.wgsl`).
+/// One texel of normal `normal` (`None`: unfitted), seen under unit lights as
+/// `photo(k)`, relit under a unit light from `l` by the photographs `weights` names (see
+/// the module text). `shading(k, n)` is the shading of a normal `n` by light `k` per unit
+/// of its light (`max(n · l_k, 0)` for a single distant light; for a condition of several
+/// lights, their sum weighted by their share of its light). The fit's albedo cancels from
+/// both of its ratios, so the normal alone is needed: the CPU reference of the GPU's sun
+/// term (`shaders/relight.wgsl`).
 pub fn relight_texel(
     normal: Option<Vec3>,
     photo: impl Fn(usize) -> Rgb,
-    directions: &[Vec3],
+    (shading, lights): (impl Fn(usize, Vec3) -> f32, usize),
     l: Vec3,
     weights: &[(usize, f32)],
 ) -> Rgb {
@@ -183,17 +226,14 @@ pub fn relight_texel(
     if wanted <= 0.0 {
         return [0.0; 3];
     }
-    let shaded: f32 = weights
-        .iter()
-        .map(|&(k, w)| w * n.dot(directions[k]).max(0.0))
-        .sum();
+    let shaded: f32 = weights.iter().map(|&(k, w)| w * shading(k, n)).sum();
     if shaded >= RATIO_FLOOR * wanted {
         return interpolated.map(|x| x * wanted / shaded);
     }
     // The fit's shading, scaled by the photographs' ratio to it over every light.
     let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
-    for (k, &d) in directions.iter().enumerate() {
-        let m = n.dot(d).max(0.0);
+    for k in 0..lights {
+        let m = shading(k, n);
         if m > 0.0 {
             let p = photo(k);
             for c in 0..3 {
@@ -288,25 +328,31 @@ fn sum3(v: [f32; 3]) -> f32 {
     v[0] + v[1] + v[2]
 }
 
-/// One texel's normal and albedo from its colour under each light (see the module
-/// text), or `None` when fewer than three lights reach it or they do not fix a normal.
-fn fit_texel(colours: &[[f32; 3]], directions: &[Vec3]) -> Option<(Vec3, [f32; 3])> {
+/// One texel's normal and albedo from its colour under each group of lights (see the
+/// module text), or `None` when fewer than three groups reach it or they do not fix a
+/// normal.
+fn fit_texel(colours: &[[f32; 3]], lights: &[Vec<(Vec3, f32)>]) -> Option<(Vec3, [f32; 3])> {
     let grey: Vec<f32> = colours.iter().map(|c| sum3(*c) / 3.0).collect();
     let brightest = grey.iter().copied().fold(0.0f32, f32::max);
     if brightest <= 0.0 {
         return None;
     }
+    // Each group's shading of the scaled normal where it sees all of the group's lights.
+    let mean: Vec<Vec3> = lights
+        .iter()
+        .map(|g| g.iter().map(|&(l, share)| l * share).sum())
+        .collect();
     let mut used: Vec<usize> = (0..grey.len())
         .filter(|&k| grey[k] > DARK * brightest)
         .collect();
-    let mut b = solve(&grey, directions, &used)?;
-    // Lights the fit says cannot reach it, then one highlight, are dropped.
+    let mut b = solve(&grey, &mean, &used)?;
+    // Groups the fit says do not wholly reach it, then one highlight, are dropped.
     let before = used.len();
-    used.retain(|&k| b.dot(directions[k]) > 0.0);
+    used.retain(|&k| b.dot(mean[k]) > 0.0);
     if used.len() >= 4 {
         let (worst, excess) = used
             .iter()
-            .map(|&k| (k, grey[k] - b.dot(directions[k])))
+            .map(|&k| (k, grey[k] - b.dot(mean[k])))
             .max_by(|a, c| a.1.total_cmp(&c.1))
             .expect("not empty");
         if excess > HIGHLIGHT * grey[worst] {
@@ -314,12 +360,12 @@ fn fit_texel(colours: &[[f32; 3]], directions: &[Vec3]) -> Option<(Vec3, [f32; 3
         }
     }
     if used.len() != before {
-        b = solve(&grey, directions, &used)?;
+        b = solve(&grey, &mean, &used)?;
     }
     let n = b.try_normalize()?;
     let (mut num, mut den) = ([0.0f32; 3], 0.0f32);
     for &k in &used {
-        let s = n.dot(directions[k]).max(0.0);
+        let s = group_shading(&lights[k], n);
         for c in 0..3 {
             num[c] += colours[k][c] * s;
         }

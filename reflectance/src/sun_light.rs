@@ -15,7 +15,10 @@ use frf_core::sun::Sun;
 use glam::{Mat3, Vec3};
 
 use crate::field::ConditionRecord;
-use crate::light_fit::{condition_lights, nearest_weights, per_unit, relight_texel};
+use crate::light_fit::{
+    condition_light_shares, condition_lights, group_shading, nearest_weights, per_unit,
+    relight_texel,
+};
 
 /// Conditions whose images a texel's sun is carried by.
 pub const NEAREST: usize = 3;
@@ -35,6 +38,8 @@ pub struct SunView {
 pub struct SunLight {
     /// Per condition: the direction of the light standing for it ([`condition_lights`]).
     pub directions: Vec<Vec3>,
+    /// Per condition: its lights' directions and shares of its light (luminance).
+    pub lights: Vec<Vec<(Vec3, f32)>>,
     /// Per condition: the sun's illuminance per unit of the condition's, per channel
     /// (0 where the condition delivers none).
     pub unit: Vec<Rgb>,
@@ -53,6 +58,7 @@ impl SunLight {
             .iter()
             .map(|(_, delivered)| per_unit(e, *delivered))
             .collect();
+        let lights = condition_light_shares(conditions);
         let views = turntables
             .iter()
             .map(|&theta| {
@@ -65,9 +71,16 @@ impl SunLight {
             .collect();
         Self {
             directions,
+            lights,
             unit,
             views,
         }
+    }
+
+    /// Condition `k`'s shading of a normal `n`, per unit of its light: its lights'
+    /// `max(n · l, 0)` weighted by their shares.
+    pub fn shading(&self, k: usize, n: Vec3) -> f32 {
+        group_shading(&self.lights[k], n)
     }
 
     /// The sun's light at a texel of view `view` whose normal is `normal` (`None`: none
@@ -80,7 +93,7 @@ impl SunLight {
                 let (p, u) = (photo(k), self.unit[k]);
                 [p[0] * u[0], p[1] * u[1], p[2] * u[2]]
             },
-            &self.directions,
+            (|k: usize, n: Vec3| self.shading(k, n), self.lights.len()),
             v.direction,
             &v.nearest,
         )

@@ -26,6 +26,7 @@ use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
+use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
 use frf_reflectance::sun_light::SunLight;
@@ -125,6 +126,9 @@ pub struct PoseSource {
     /// Per view: its fitted normals' octahedral codes, cropped (none where the field
     /// holds none, at reduced detail, or for a view not read).
     pub normals: Arc<Vec<Vec<[u8; 2]>>>,
+    /// Per condition: its lights' directions (dome frame) and shares of its light
+    /// ([`condition_light_shares`]), which shade the normals under a sun.
+    pub condition_lights: Arc<Vec<Vec<(glam::Vec3, f32)>>>,
     /// Per view and condition: relighting coefficients (RGB), of the environment less
     /// its sun where `sun` holds it.
     pub coefficients: Vec<Vec<Rgb>>,
@@ -282,6 +286,7 @@ impl PoseSource {
             basis: Arc::new(basis),
             alpha: Arc::new(alpha),
             normals: Arc::new(normals),
+            condition_lights: Arc::new(condition_light_shares(&h.conditions)),
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
             sun: relit.sun,

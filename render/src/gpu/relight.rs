@@ -120,10 +120,20 @@ impl PoseRelight {
 }
 
 /// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its
-/// coefficient, its condition's direction and the sun per unit of its light, then the
-/// sun's three.
+/// coefficient, where its condition's lights are and the sun per unit of its light, then
+/// the sun's three.
 fn job_coefficients(tiles: usize) -> usize {
     3 * tiles + 3
+}
+
+/// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
+/// where the pose's views hold normals (only they are shaded by them).
+fn light_coefficients(source: &PoseSource) -> usize {
+    if source.normals.iter().any(|n| !n.is_empty()) {
+        source.condition_lights.iter().map(Vec::len).sum()
+    } else {
+        0
+    }
 }
 
 /// The coefficients of `batch`'s jobs for `source` (`shaders/relight.wgsl` says what each
@@ -132,6 +142,18 @@ fn job_coefficients(tiles: usize) -> usize {
 /// holds no normals.
 fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
+    // The conditions' lights follow the jobs: where each condition's start.
+    let jobs: usize = batch
+        .views
+        .iter()
+        .map(|&i| job_coefficients(source.basis[i].scales.len()))
+        .sum();
+    let mut ranges = Vec::with_capacity(source.condition_lights.len());
+    let mut start = jobs;
+    for lights in source.condition_lights.iter() {
+        ranges.push([start as f32, lights.len() as f32, 0.0, 0.0]);
+        start += lights.len();
+    }
     for &i in &batch.views {
         let scales = &source.basis[i].scales;
         for (k, &s) in scales.iter().enumerate() {
@@ -151,7 +173,7 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             out.extend(std::iter::repeat_n([0.0; 4], 2 * scales.len() + 3));
             continue;
         };
-        out.extend(sun.directions.iter().map(|d| d.extend(0.0).to_array()));
+        out.extend(ranges.iter().take(scales.len()));
         out.extend(
             sun.unit
                 .iter()
@@ -169,6 +191,11 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
         out.push(view.direction.extend(1.0).to_array());
         out.push(nearest);
         out.push(weights);
+    }
+    if out.len() < batch.coefficients {
+        for lights in source.condition_lights.iter() {
+            out.extend(lights.iter().map(|(d, share)| d.extend(*share).to_array()));
+        }
     }
     if out.is_empty() {
         out.push([0.0; 4]);
@@ -234,6 +261,9 @@ impl Gpu {
                 pad1: 0,
             });
             coefficients += job_coefficients(basis.scales.len());
+            if j + 1 == views.len() {
+                coefficients += light_coefficients(source);
+            }
             let normals = &source.normals[i];
             for (k, tile) in basis.tiles.iter().enumerate() {
                 codes.extend(tile.iter().enumerate().map(|(p, c)| {

@@ -13,6 +13,9 @@ use crate::CliResult;
 
 /// Runs `frf eval --sun-fit`.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
+    if let Some(dir) = &args.images {
+        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
+    }
     let lights = environment_lights(&input.env, args.lights);
     let (lighting, _) = args
         .lighting
@@ -23,7 +26,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         &lighting,
         (&input.stage, input.pose, &lights),
         args.cameras,
-        args.compare.cpu,
+        (args.compare.cpu, args.images.as_deref()),
         &Bars::default(),
     )?;
     eprintln!(
