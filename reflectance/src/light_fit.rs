@@ -251,6 +251,11 @@ pub fn relight_texel(
 /// The `n` directions of `directions` nearest to `l` (by angle), weighted by the inverse
 /// of their angle and normalised to sum to 1; a direction equal to `l` takes all.
 pub fn nearest_weights(directions: &[Vec3], l: Vec3, n: usize) -> Vec<(usize, f32)> {
+    nearest_weights_by(directions, l, n, 1.0)
+}
+
+/// [`nearest_weights`] by the inverse of the angle to the power `power`.
+pub fn nearest_weights_by(directions: &[Vec3], l: Vec3, n: usize, power: f32) -> Vec<(usize, f32)> {
     let mut by_angle: Vec<(usize, f32)> = directions
         .iter()
         .enumerate()
@@ -261,10 +266,10 @@ pub fn nearest_weights(directions: &[Vec3], l: Vec3, n: usize) -> Vec<(usize, f3
     if by_angle[0].1 < 1e-6 {
         return vec![(by_angle[0].0, 1.0)];
     }
-    let total: f32 = by_angle.iter().map(|(_, a)| 1.0 / a).sum();
+    let total: f32 = by_angle.iter().map(|(_, a)| 1.0 / a.powf(power)).sum();
     by_angle
         .iter()
-        .map(|&(k, a)| (k, 1.0 / a / total))
+        .map(|&(k, a)| (k, 1.0 / a.powf(power) / total))
         .collect()
 }
 

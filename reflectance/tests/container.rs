@@ -171,10 +171,15 @@ fn reading_one_view_touches_only_its_chunks() {
     let reads: Vec<(u64, u64)> = std::mem::take(&mut *field_reads(&field));
     let own: Vec<(u64, u64)> = field
         .chunks()
-        .filter(|c| (c.key.pose, c.key.u, c.key.v) == (0, 2, 1) && c.key.kind != ChunkKind::Shadows)
+        .filter(|c| {
+            (c.key.pose, c.key.u, c.key.v) == (0, 2, 1)
+                && !matches!(c.key.kind, ChunkKind::Shadows | ChunkKind::Normals)
+        })
         .map(|c| (c.offset, c.length))
         .collect();
     assert_eq!(own.len(), 2 + 4, "basis, alpha and 4 flows");
+    // Its fitted normals are stored beside them, read only to relight a sun.
+    assert!(field.normals(0, 2, 1).unwrap().is_some());
     for r in &reads {
         assert!(
             own.contains(r),
