@@ -1,7 +1,9 @@
 //! Frame time of the renderer: the wgpu renderer (lavapipe on machines without a GPU)
 //! against the CPU reference in one run, per variant. The field is `FRF_BENCH_FIELD` (e.g. a paper-size field from
 //! `frf ingest`), or else the tiny stage's oracle field, built first (about 10 s).
-//! Frames are the field's image size, from a camera between grid views.
+//! Frames are the field's image size, from a camera between grid views. Relighting a
+//! pose under the built-in sky (a new light: the GPU's relight pass, waited for; the CPU
+//! twin), its sun by the views' fitted normals against the same sun by the basis alone.
 //! Run: `cargo bench --bench render`.
 
 #![allow(clippy::unwrap_used)] // benchmarks: a failed unwrap is a failed run
@@ -16,7 +18,7 @@ use frf_reflectance::project::FloorModel;
 use frf_render::gpu::Gpu;
 use frf_render::morph::Variant;
 use frf_render::renderer::Renderer;
-use frf_render::resident::{Lighting, PoseSource};
+use frf_render::resident::{Lighting, PoseSource, ResidentPose};
 
 fn field() -> PathBuf {
     match std::env::var("FRF_BENCH_FIELD") {
@@ -64,6 +66,34 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| r.render(&camera, variant).unwrap())
             });
         }
+    }
+    group.finish();
+    relight(c, &field, &source, &lighting);
+}
+
+/// A pose relit, its sun by the normals and by the basis alone (normals left out).
+fn relight(c: &mut Criterion, field: &FieldFile, by_normals: &PoseSource, lighting: &Lighting) {
+    let by_basis = PoseSource {
+        normals: std::sync::Arc::new(vec![Vec::new(); by_normals.normals.len()]),
+        ..by_normals.clone()
+    }
+    .relit(field, lighting, None)
+    .unwrap();
+    assert!(by_normals.sun.is_some() && by_basis.sun.is_none());
+    let gpu = Gpu::new().unwrap();
+    let mut group = c.benchmark_group("relight");
+    group.sample_size(10);
+    for (name, source) in [("sun by normals", by_normals), ("sun by basis", &by_basis)] {
+        let mut pose = gpu.upload_pose(source).unwrap();
+        group.bench_function(format!("{name}/gpu"), |b| {
+            b.iter(|| {
+                gpu.relight_pose(&mut pose, source).unwrap();
+                gpu.read_scales(&pose).unwrap()
+            })
+        });
+        group.bench_function(format!("{name}/cpu"), |b| {
+            b.iter(|| ResidentPose::relight_cpu(source))
+        });
     }
     group.finish();
 }
