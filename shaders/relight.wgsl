@@ -19,7 +19,12 @@ struct RelightParams {
     width: u32,
     // Views in the batch.
     jobs: u32,
-    pad: u32,
+    // The crop's corner in the image, pixels.
+    x0: u32,
+    y0: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // One view of the batch: where its codes and coefficients start, how many basis images
@@ -44,7 +49,8 @@ struct Job {
 // (x: the first, y: how many, as f32); per tile, the sun per unit of the condition's light
 // x tile scale (rgb); then the sun: its direction (xyz, the view's dome frame; w = 0
 // when there is none), the nearest conditions (xyz, as f32; w: how many) and their
-// weights (xyz; w: the ratio's floor). After every view's: the conditions' lights, each
+// weights (xyz; w: the ratio's floor), its direction in the subject frame (xyz; w: how
+// far from the hull's surface its shadow ray starts, 0 for no shadow). After every view's: the conditions' lights, each
 // its direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
@@ -59,6 +65,9 @@ struct Job {
 @group(0) @binding(7) var<storage, read> jobs: array<Job>;
 // The pose's view table, whose `scale` the encoding sets.
 @group(0) @binding(8) var<storage, read_write> views: array<View>;
+// The pose's visual hull (`rebin/proxy.wgsl` traces it): a sun's cast shadows.
+@group(0) @binding(9) var<storage, read> proxy: Proxy;
+@group(0) @binding(10) var<storage, read> hull_bits: array<u32>;
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
@@ -99,6 +108,26 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     return s;
 }
 
+// Whether the sun (`subject`: its direction in the subject frame, w the shadow ray's
+// offset) reaches texel i of `job` as far as the visual hull can tell: twin of
+// `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
+fn sunlit(job: Job, i: u32, subject: vec4<f32>) -> bool {
+    if (subject.w <= 0.0 || proxy.present == 0u) {
+        return true;
+    }
+    let view = views[job.view];
+    let k = view.intrinsics;
+    let pixel = vec2<f32>(f32(params.x0 + i % params.width), f32(params.y0 + i / params.width));
+    let dc = vec3<f32>((pixel.x - k.z) / k.x, (pixel.y - k.w) / k.y, 1.0);
+    let dir = normalize(quat_to_axes(view.rotation) * dc);
+    let t = hull_first_hit(view.centre, dir);
+    if (t < 0.0) {
+        return true;
+    }
+    let start = view.centre + dir * t + subject.xyz * subject.w;
+    return hull_first_hit(start, subject.xyz) < 0.0;
+}
+
 // The sun's light at texel i of `job` (see the file's text). The normal's codes are the
 // alpha bytes of tiles 1 and 2.
 fn sun_light(job: Job, i: u32) -> vec3<f32> {
@@ -111,6 +140,9 @@ fn sun_light(job: Job, i: u32) -> vec3<f32> {
     }
     let nearest = coefficients[head + 1u];
     let weights = coefficients[head + 2u];
+    if (!sunlit(job, i, coefficients[head + 3u])) {
+        return vec3<f32>(0.0);
+    }
     let n = normal_of(
         basis[job.basis_offset + params.texels + i] >> 24u,
         basis[job.basis_offset + 2u * params.texels + i] >> 24u,

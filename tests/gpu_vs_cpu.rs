@@ -73,8 +73,10 @@ fn tiny_source() -> PoseSource {
 fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let Some(gpu) = gpu() else { return };
     let source = tiny_source();
-    // The sky's sun is relit by the views' fitted normals, on both.
+    // The sky's sun is relit by the views' fitted normals, its cast shadows traced
+    // through the visual hull, on both.
     assert!(source.sun.is_some() && source.holds_normals());
+    assert!(source.geometry.proxy.hull().is_some());
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
     // The frames below find their quads through the cylinder's column index.

@@ -15,6 +15,7 @@ use frf_core::sun::Sun;
 use glam::{Mat3, Vec3};
 
 use crate::field::ConditionRecord;
+use crate::hull::VoxelHull;
 use crate::light_fit::{
     condition_light_shares, condition_lights, group_shading, nearest_weights_by, per_unit,
     relight_texel,
@@ -29,6 +30,16 @@ use crate::light_fit::{
 pub const NEAREST: usize = 2;
 /// See [`NEAREST`].
 pub const WEIGHT_POWER: f32 = 2.0;
+/// How far from the visual hull's surface a shadow ray toward the sun starts, metres.
+/// The hull is wider than the body and its surface point lies ahead of the true one, so
+/// occluders near the texel are the hull's own error; far ones (a leg over the other, an
+/// arm over the torso) are cast shadows. Measured at the captured views of the small
+/// oracle field (2 cm voxels; subject PSNR, a sun alone at 20°, 40°, 70° / the built-in
+/// sky): no shadow 31.97, 31.41, 29.00 / 33.23 dB; 0.04 m 31.09, 30.24, - / 31.64; 0.16 m
+/// 32.00, -, - / 32.80; 0.32 m 32.40, 31.93, 30.58 / 33.64; 0.48 m 31.97, 31.80, - / 33.51.
+/// Leaving the hull's voxels around the point before looking for an occluder, instead
+/// of a fixed offset, scored 0.5-1.2 dB under no shadow.
+pub const SHADOW_OFFSET_M: f32 = 0.32;
 
 /// One view's sun: its direction in the view's dome frame, and the nearest conditions'
 /// inverse-angle weights.
@@ -52,6 +63,8 @@ pub struct SunLight {
     pub unit: Vec<Rgb>,
     /// Per view.
     pub views: Vec<SunView>,
+    /// Unit, toward the sun, subject frame (where the visual hull is).
+    pub subject: Vec3,
 }
 
 impl SunLight {
@@ -81,6 +94,7 @@ impl SunLight {
             lights,
             unit,
             views,
+            subject: sun.direction(),
         }
     }
 
@@ -88,6 +102,18 @@ impl SunLight {
     /// `max(n · l, 0)` weighted by their shares.
     pub fn shading(&self, k: usize, n: Vec3) -> f32 {
         group_shading(&self.lights[k], n)
+    }
+
+    /// Whether the sun reaches the point where the ray `origin + t dir` (subject frame)
+    /// meets `hull`, as far as the hull can tell: the ray's first occupied voxel, left
+    /// toward the sun from [`SHADOW_OFFSET_M`] on, meets no other. A ray that misses the
+    /// hull is sunlit. (`shaders/relight.wgsl` is its twin.)
+    pub fn sunlit(&self, hull: &VoxelHull, origin: Vec3, dir: Vec3) -> bool {
+        let Some(t) = hull.first_hit(origin, dir) else {
+            return true;
+        };
+        let start = origin + dir * t + self.subject * SHADOW_OFFSET_M;
+        !hull.blocks(start, self.subject)
     }
 
     /// The sun's light at a texel of view `view` whose normal is `normal` (`None`: none

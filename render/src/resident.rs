@@ -760,13 +760,25 @@ impl ResidentPose {
                 let alpha = &source.alpha[i];
                 let normals = &source.normals[i];
                 let sun = source.sun.as_deref().filter(|_| !normals.is_empty());
+                let (camera, crop) = (&source.geometry.cameras[i], source.geometry.crop);
+                let hull = source.geometry.proxy.hull();
+                let sunlit = |p: usize| {
+                    let (Some(sun), Some(hull)) = (sun, hull) else {
+                        return true;
+                    };
+                    let pixel = glam::Vec2::new(
+                        (crop.x0 as usize + p % crop.width as usize) as f32,
+                        (crop.y0 as usize + p / crop.width as usize) as f32,
+                    );
+                    sun.sunlit(hull, camera.centre(), camera.ray_direction(pixel))
+                };
                 let relit: Vec<Rgb> = (0..n)
                     .map(|p| {
                         if alpha[p] == 0 {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
-                        if let Some(sun) = sun {
+                        if let Some(sun) = sun.filter(|_| sunlit(p)) {
                             let s = sun_pixel(sun, i, b, normals[p], &lut, p);
                             for k in 0..3 {
                                 c[k] += s[k];

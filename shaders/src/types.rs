@@ -149,8 +149,17 @@ pub struct GpuRelightParams {
     pub width: u32,
     /// Views in the batch.
     pub jobs: u32,
+    /// The crop's corner in the image, pixels: a texel's pixel is this plus its place
+    /// in the crop.
+    pub x0: u32,
+    /// See `x0`.
+    pub y0: u32,
     /// Padding to 16 bytes.
-    pub pad: u32,
+    pub pad0: u32,
+    /// Padding.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
 }
 
 /// `LightFitParams` of `light_fit.wgsl`.

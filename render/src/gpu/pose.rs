@@ -35,6 +35,9 @@ pub struct GpuPose {
     prelit: wgpu::Texture,
     /// The view table (whose scales the relighting pass sets).
     pub(super) views: wgpu::Buffer,
+    /// The proxy's description and its hull's occupancy words (the relighting pass
+    /// traces a sun's cast shadows through them).
+    pub(super) hull: (wgpu::Buffer, wgpu::Buffer),
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
     pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
@@ -189,7 +192,7 @@ impl Gpu {
             source.flows.table,
         );
         let relight = self.pose_relight(basis, geometry.views());
-        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose.views);
+        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose);
         pose.relight = Some(relight);
         Ok(pose)
     }
@@ -212,7 +215,7 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(relight, source, &pose.prelit_codes_view(), &pose.views);
+            self.record_relight(relight, source, &pose.prelit_codes_view(), pose);
             Ok(())
         })
     }
@@ -464,6 +467,7 @@ impl Gpu {
             bind_group,
             prelit,
             views: view_buffer,
+            hull: (proxy_buffer, hull_buffer),
             relight: None,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,

@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
+use frf_reflectance::sun_light::SHADOW_OFFSET_M;
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -41,7 +42,7 @@ pub struct RelightPass {
 impl RelightPass {
     /// Builds the pass on `device`.
     pub fn new(device: &wgpu::Device) -> Self {
-        let module = shaders::module(device, "relight", shaders::RELIGHT);
+        let module = shaders::module(device, "relight", shaders::RELIGHT_PASS);
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("relight"),
@@ -55,6 +56,8 @@ impl RelightPass {
                 storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
                 storage::<GpuRelightJob>(7, true, c),
                 storage::<frf_shaders::types::GpuView>(8, false, c),
+                storage::<frf_shaders::types::GpuProxy>(9, true, c),
+                storage::<u32>(10, true, c),
             ],
         });
         let compute = |entry: &str| compute_pipeline(device, entry, &[&layout], &module, entry);
@@ -121,9 +124,9 @@ impl PoseRelight {
 
 /// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its
 /// coefficient, where its condition's lights are and the sun per unit of its light, then
-/// the sun's three.
+/// the sun's four.
 fn job_coefficients(tiles: usize) -> usize {
-    3 * tiles + 3
+    3 * tiles + 4
 }
 
 /// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
@@ -170,7 +173,7 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             .as_deref()
             .filter(|_| !source.normals[i].is_empty());
         let Some(sun) = sun else {
-            out.extend(std::iter::repeat_n([0.0; 4], 2 * scales.len() + 3));
+            out.extend(std::iter::repeat_n([0.0; 4], 2 * scales.len() + 4));
             continue;
         };
         out.extend(ranges.iter().take(scales.len()));
@@ -191,6 +194,12 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
         out.push(view.direction.extend(1.0).to_array());
         out.push(nearest);
         out.push(weights);
+        let offset = if source.geometry.proxy.hull().is_some() {
+            SHADOW_OFFSET_M
+        } else {
+            0.0
+        };
+        out.push(sun.subject.extend(offset).to_array());
     }
     if out.len() < batch.coefficients {
         for lights in source.condition_lights.iter() {
@@ -285,7 +294,11 @@ impl Gpu {
             texels: texels as u32,
             width: crop.width,
             jobs: views.len() as u32,
-            pad: 0,
+            x0: crop.x0,
+            y0: crop.y0,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         };
         let buffer =
             |label: &str, contents: &[u8], usage| buffer_with(&self.device, label, contents, usage);
@@ -327,14 +340,15 @@ impl Gpu {
 
     /// Writes `source`'s coefficients into `relight`'s buffers and records the passes
     /// that relight its views into the pre-lit layers of `target`, their scales into the
-    /// view table `views` ([`Gpu::relight_pose`]).
+    /// pose's view table ([`Gpu::relight_pose`]).
     pub(super) fn record_relight(
         &self,
         relight: &PoseRelight,
         source: &PoseSource,
         target: &wgpu::TextureView,
-        views: &wgpu::Buffer,
+        pose: &super::GpuPose,
     ) {
+        let views = &pose.views;
         let basis = &relight.basis;
         for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
             let packed = packed_coefficients(batch, source);
@@ -365,6 +379,8 @@ impl Gpu {
                         wgpu::BindingResource::TextureView(target),
                         batch.jobs.as_entire_binding(),
                         views.as_entire_binding(),
+                        pose.hull.0.as_entire_binding(),
+                        pose.hull.1.as_entire_binding(),
                     ],
                 );
                 let groups = (basis.texels as u32).div_ceil(WORKGROUP);
