@@ -108,10 +108,11 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     return s;
 }
 
-// Whether the sun (`subject`: its direction in the subject frame, w the shadow ray's
-// offset) reaches texel i of `job` as far as the visual hull can tell: twin of
-// `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
-fn sunlit(job: Job, i: u32, subject: vec4<f32>) -> bool {
+// Whether the sun (its direction in the subject frame and the shadow ray's offset, the
+// job's last coefficient) reaches texel i of `job` as far as the visual hull can tell:
+// twin of `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
+fn sunlit(job: Job, i: u32) -> bool {
+    let subject = coefficients[job.coefficient_offset + 3u * job.tiles + 3u];
     if (subject.w <= 0.0 || proxy.present == 0u) {
         return true;
     }
@@ -140,9 +141,6 @@ fn sun_light(job: Job, i: u32) -> vec3<f32> {
     }
     let nearest = coefficients[head + 1u];
     let weights = coefficients[head + 2u];
-    if (!sunlit(job, i, coefficients[head + 3u])) {
-        return vec3<f32>(0.0);
-    }
     let n = normal_of(
         basis[job.basis_offset + params.texels + i] >> 24u,
         basis[job.basis_offset + 2u * params.texels + i] >> 24u,
@@ -203,7 +201,11 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         out.y += c.y * gamma_value((code >> 8u) & 255u);
         out.z += c.z * gamma_value((code >> 16u) & 255u);
     }
-    out += sun_light(job, i);
+    // The shadow is traced only where the sun would light.
+    let sun = sun_light(job, i);
+    if (any(sun != vec3<f32>(0.0)) && sunlit(job, i)) {
+        out += sun;
+    }
     relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     atomicMax(&peaks[job.view], bitcast<u32>(max(out.x, max(out.y, out.z))));
 }

@@ -778,10 +778,13 @@ impl ResidentPose {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
-                        if let Some(sun) = sun.filter(|_| sunlit(p)) {
+                        if let Some(sun) = sun {
+                            // The shadow is traced only where the sun would light.
                             let s = sun_pixel(sun, i, b, normals[p], &lut, p);
-                            for k in 0..3 {
-                                c[k] += s[k];
+                            if s != [0.0; 3] && sunlit(p) {
+                                for k in 0..3 {
+                                    c[k] += s[k];
+                                }
                             }
                         }
                         c
