@@ -3,15 +3,18 @@
 //!
 //! **The fit.** Per texel, a Lambertian model by photometric stereo: the scaled normal
 //! `b` that best explains the texel's brightness under the lights that reach it,
-//! `g_k ≈ b · l_k`, solved by least squares over the lights that neither leave it dark
-//! (a shadow) nor flare far above the fit (a highlight, dropped once when four or more
-//! lights remain); then the normal `b / |b|` and per channel the albedo that best
-//! explains the colour under those lights.
+//! `g_k ≈ b · m_k` (`m_k` the light's direction; for a group of lights, a basis
+//! condition, their directions weighted by their shares of its light), solved by least
+//! squares over the lights that neither leave it dark (a shadow) nor flare far above the
+//! fit (a highlight, dropped once when four or more lights remain); then the normal
+//! `b / |b|` and per channel the albedo that best explains the colour under those lights.
 //!
 //! **Relighting** under a light `l`: the photographs of the nearest captured lights,
 //! weighted by inverse angle ([`nearest_weights`]), times the ratio of the fit's shading
 //! under `l` to its shading under those lights:
-//! `I(l) = Σ w_k I_k · M(l) / Σ w_k M(l_k)`. The fit carries how shading moves between
+//! `I(l) = Σ w_k I_k · S(l) / Σ w_k S_k`, `S(l) = max(n · l, 0)` and `S_k` the same
+//! summed over group `k`'s lights by their shares (the albedo cancels, so the normal
+//! alone relights: [`relight_texel`]). The fit carries how shading moves between
 //! the lights (the terminator, which interpolating photographs smears into two soft
 //! ones); the photographs carry what the fit does not model (texture, gloss, cast
 //! shadows, light bounced between surfaces). Where the nearest lights barely reach the

@@ -7,7 +7,9 @@
 //!
 //! Each view sees the dome turned by its turntable angle `θ`, so the sun's direction in
 //! its dome frame (where its normals were fitted) is `R_y(θ) d`, as the projection turns
-//! an environment's texel ([`crate::project`]). The CPU reference of the GPU's sun term
+//! an environment's texel ([`crate::project`]). The nearest images carry their own
+//! directions' cast shadows, not the sun's: a texel the pose's visual hull hides from the
+//! sun gets none of it ([`SunLight::sunlit`]). The CPU reference of the GPU's sun term
 //! (`shaders/relight.wgsl`).
 
 use frf_core::image::Rgb;

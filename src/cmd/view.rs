@@ -14,7 +14,9 @@ use frf_scene::{FieldLook, Scene};
 use frf_view::ViewOptions;
 
 use crate::CliResult;
-use crate::cmd::args::{FloorArg, VariantArg, parse_degrees, parse_env, parse_size};
+use crate::cmd::args::{
+    FloorArg, SunSpec, VariantArg, parse_degrees, parse_env, parse_size, parse_sun,
+};
 
 /// Memory the resident poses may hold by default, MB.
 const DEFAULT_BUDGET_MB: u64 = 2048;
@@ -39,6 +41,11 @@ pub struct ViewArgs {
     /// What lights a field's subject from below.
     #[arg(long, value_enum, default_value = "env")]
     pub floor: FloorArg,
+    /// A sun added to a field's environment (alone with `--env none`), turned with it:
+    /// `AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]]`, as `frf render --sun` (a scene file
+    /// names its own in `lighting.sun`).
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]")]
+    pub sun: Option<SunSpec>,
     /// Window size `WxH` (the frame size while the window keeps it).
     #[arg(long, value_parser = parse_size, default_value = "960x540")]
     pub size: (u32, u32),
@@ -67,7 +74,10 @@ pub struct ViewArgs {
 fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
     let h = field.header();
     let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
-    let look = FieldLook::viewer(env, args.yaw.to_radians(), args.floor.into());
+    let look = FieldLook {
+        sun: args.sun.as_ref().map(SunSpec::sun).transpose()?,
+        ..FieldLook::viewer(env, args.yaw.to_radians(), args.floor.into())
+    };
     // The walk plays from pose 0.
     Ok(Scene {
         end: h.cycle_seconds,
@@ -85,6 +95,9 @@ pub fn run(args: ViewArgs) -> CliResult {
         Some(p) => Some((p.clone(), frf_view::script::load(p)?)),
         None => None,
     };
+    if is_scene && args.sun.is_some() {
+        return Err("--sun lights a field; a scene file names its sun in [lighting.sun]".into());
+    }
     let (scene, field_path) = if is_scene {
         let (mut scene, field) = Scene::load_overridden(&args.input, None, args.field.as_deref())?;
         if let Some(v) = args.variant {

@@ -109,7 +109,8 @@ fn a_screenshot_equals_frf_render_of_the_same_camera() {
         "camera 2.2 1.3 2.6  0 0.9 0  32\nscreenshot {0}/shot.exr\nscreenshot {0}/shot.png\nquit\n",
         d.display()
     );
-    let o = ok(view(d, field(), &script, "--size 96x72 --json"));
+    // Under the sky and a low sun of the viewer's own (relit by the field's normals).
+    let o = ok(view(d, field(), &script, "--size 96x72 --sun 60,25 --json"));
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["ended"], "Quit", "{report}");
     assert!(report["frames"].as_u64().unwrap() >= 1, "{report}");
@@ -126,6 +127,8 @@ fn a_screenshot_equals_frf_render_of_the_same_camera() {
         d.join("path.toml").to_str().unwrap(),
         "--env",
         "sky",
+        "--sun",
+        "60,25",
         "--backdrop",
         "env",
         "--size",

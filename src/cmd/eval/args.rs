@@ -42,10 +42,11 @@ pub struct EvalArgs {
     /// captured views and at quad centres (`--cameras` each), beside FIELD itself.
     #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows", "budget"])]
     pub ingest_budget: bool,
-    /// An experiment toward hard light: at the captured views (`--cameras`), the basis's
-    /// relighting of an environment with a sun (`--sun`, or a map with one) against the
-    /// environment less its sun by the basis plus the sun by each view's light fit, both
-    /// against the truth (`frf_eval::sun_fit`; CPU).
+    /// Hard light at the captured views (`--cameras`), in one run: the field's sun (`--sun`,
+    /// or one found in the map) relit by its views' fitted normals with the hull's cast
+    /// shadows, as renders do, against the same sun relit by the basis alone (as fields
+    /// without normals are), both against the truth (`frf_eval::sun_fit`); `--images`
+    /// writes each view's truth and both renders
     #[arg(long, conflicts_with_all = ["camera", "orbit", "suite", "shadows", "budget", "ingest_budget"])]
     pub sun_fit: bool,
     /// With `--ingest-budget`: keep its fields in this directory, and reuse them when it
