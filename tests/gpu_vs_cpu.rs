@@ -414,3 +414,23 @@ fn the_light_fit_relights_on_the_gpu_as_on_the_cpu() {
         Err(RenderError::Misuse(_))
     ));
 }
+
+/// A pose at a reduced level of detail (a far walker) keeps its views' normals, averaged
+/// over each block: its sun is relit by them on both twins, as at full detail.
+#[test]
+fn a_reduced_pose_relights_its_sun_by_its_normals_on_both() {
+    use frf_reflectance::project::FloorModel;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let lighting = Lighting::Environment {
+        env: EnvMap::sky(),
+        floor: FloorModel::Environment,
+    };
+    let source = PoseSource::load_at(&field, 0, &lighting, None, 1, None).unwrap();
+    assert!(source.sun.is_some() && source.holds_normals());
+    let cpu = ResidentPose::relight_cpu(&source);
+    let pose = gpu.upload_pose(&source).unwrap();
+    assert_relit_as_the_cpu(&gpu, &pose, &cpu, "level 1");
+}

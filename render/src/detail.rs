@@ -16,6 +16,7 @@
 use frf_core::camera::Camera;
 use frf_reflectance::flowcodec::quant::UNKNOWN_CODE;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
+use frf_reflectance::normalcodec::{normal_code, normal_of};
 
 use crate::geometry::Crop;
 
@@ -178,6 +179,25 @@ pub fn reduce_basis(b: &BasisCodes, from: Crop, to: Crop, level: u8, alpha: &[u8
     }
 }
 
+/// Fitted normals' octahedral codes (cropped by `from`, [`normal_of`]) reduced by
+/// `level` into the crop `to`: the fitted normals of each block averaged and coded again;
+/// none where none is fitted, and where `alpha` (the reduced alpha codes) is 0.
+pub fn reduce_normals(
+    codes: &[[u8; 2]],
+    from: Crop,
+    to: Crop,
+    level: u8,
+    alpha: &[u8],
+) -> Vec<[u8; 2]> {
+    let add = |sum: &mut glam::Vec3, c: &[u8; 2]| {
+        if let Some(n) = normal_of(*c) {
+            *sum += n;
+        }
+    };
+    let finish = |sum: glam::Vec3, _| sum.try_normalize().map_or([0, 0], normal_code);
+    reduce(codes, from, to, level, Some(alpha), add, finish)
+}
+
 /// Alpha codes (cropped by `from`) reduced by `level` into the crop `to`.
 pub fn reduce_alpha(a: &[u8], from: Crop, to: Crop, level: u8) -> Vec<u8> {
     let add = |sum: &mut u32, &v: &u8| *sum += v as u32;
@@ -230,6 +250,26 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+
+    #[test]
+    fn normals_reduce_to_the_mean_of_the_fitted_ones_of_each_block() {
+        let crop = |w, h| Crop {
+            x0: 0,
+            y0: 0,
+            width: w,
+            height: h,
+        };
+        let a = Vec3::new(1.0, 0.0, 1.0).normalize();
+        let b = Vec3::new(-1.0, 0.0, 1.0).normalize();
+        // A 4 x 1 strip: a block of two normals, and a block of one normal and none.
+        let codes = [normal_code(a), normal_code(b), normal_code(a), [0, 0]];
+        let out = reduce_normals(&codes, crop(4, 1), crop(2, 1), 1, &[255, 255]);
+        assert!(normal_of(out[0]).unwrap().angle_between(Vec3::Z) < 0.01);
+        assert!(normal_of(out[1]).unwrap().angle_between(a) < 0.01);
+        // A transparent reduced texel holds none.
+        let out = reduce_normals(&codes, crop(4, 1), crop(2, 1), 1, &[0, 255]);
+        assert_eq!(out[0], [0, 0]);
+    }
 
     #[test]
     fn the_level_halves_with_the_pixels_per_metre() {

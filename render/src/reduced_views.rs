@@ -19,12 +19,14 @@ pub struct ReducedImage {
     pub basis: BasisCodes,
     /// The alpha codes.
     pub alpha: Vec<u8>,
+    /// The fitted normals' codes (none where the field holds none).
+    pub normals: Vec<[u8; 2]>,
 }
 
 impl ReducedImage {
     fn bytes(&self) -> u64 {
         let tiles: usize = self.basis.tiles.iter().map(|t| 3 * t.len()).sum();
-        (tiles + self.alpha.len()) as u64
+        (tiles + self.alpha.len() + 2 * self.normals.len()) as u64
     }
 }
 
@@ -129,6 +131,7 @@ mod tests {
                 scales: vec![1.0],
             },
             alpha: vec![255; n],
+            normals: Vec::new(),
         }
     }
 

@@ -33,7 +33,9 @@ use frf_reflectance::sun_light::SunLight;
 use glam::Vec2;
 use rayon::prelude::*;
 
-use crate::detail::{reduce_alpha, reduce_basis, reduce_flow, reduced_camera, reduced_image};
+use crate::detail::{
+    reduce_alpha, reduce_basis, reduce_flow, reduce_normals, reduced_camera, reduced_image,
+};
 use crate::error::{RenderError, Result};
 use crate::extend::extend_flow;
 use crate::footprint::SubjectBounds;
@@ -83,7 +85,7 @@ impl Lighting {
 
 /// One view's codes as read from the field: basis tiles, 8-bit alpha, the log-coded
 /// flow to each of its four neighbours (absent at the grid's edges), and its fitted
-/// normals' codes (none where the field holds none, and at reduced detail).
+/// normals' codes (none where the field holds none).
 type ViewCodes = (BasisCodes, Vec<u8>, [Option<Vec<[i8; 2]>>; 4], Vec<[u8; 2]>);
 
 /// What relighting left out.
@@ -124,7 +126,7 @@ pub struct PoseSource {
     /// Per view: alpha codes (`round(255 α)`), cropped (none for a view not read).
     pub alpha: Arc<Vec<Vec<u8>>>,
     /// Per view: its fitted normals' octahedral codes, cropped (none where the field
-    /// holds none, at reduced detail, or for a view not read).
+    /// holds none, or for a view not read).
     pub normals: Arc<Vec<Vec<[u8; 2]>>>,
     /// Per condition: its lights' directions (dome frame) and shares of its light
     /// ([`condition_light_shares`]), which shade the normals under a sun.
@@ -524,9 +526,13 @@ impl<R: ReadAt> Reading<'_, R> {
                     let alpha = alpha_codes(&field.alpha(pose, u, v)?);
                     let basis = field.basis_codes_shared(pose, u, v)?;
                     let alpha = reduce_alpha(&alpha, full, to, level);
+                    let normals = field
+                        .normal_codes(pose, u, v)?
+                        .map_or_else(Vec::new, |n| reduce_normals(&n, full, to, level, &alpha));
                     Ok(ReducedImage {
                         basis: reduce_basis(&basis, full, to, level, &alpha),
                         alpha,
+                        normals,
                     })
                 })?;
                 let mut flows: [Option<Arc<Vec<[i8; 2]>>>; 4] = Default::default();
@@ -565,7 +571,12 @@ impl<R: ReadAt> Reading<'_, R> {
                 let flows = flows
                     .each_ref()
                     .map(|f| f.as_ref().map(|f| crop.rows_of(f, w)));
-                (basis, crop.rows_of(&image.alpha, w), flows, Vec::new())
+                let normals = if image.normals.is_empty() {
+                    Vec::new()
+                } else {
+                    crop.rows_of(&image.normals, w)
+                };
+                (basis, crop.rows_of(&image.alpha, w), flows, normals)
             })
             .collect();
         Ok((size, crop, per_view))
