@@ -88,14 +88,6 @@ impl LightFit {
         self.texels[i]
     }
 
-    /// Texel `i`'s fitted shading under a unit light from `l` (`None` where unfitted).
-    pub fn shade(&self, i: usize, l: Vec3) -> Option<[f32; 3]> {
-        self.texels[i].map(|(n, a)| {
-            let c = n.dot(l).max(0.0);
-            a.map(|x| x * c)
-        })
-    }
-
     /// The photographs `images` (lit from `directions`, those the fit was made from or
     /// any others of the same texels) relit under a unit light from `l`: see the module
     /// text. Texels without a fit take the interpolation of the nearest `nearest`

@@ -201,7 +201,9 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
         };
         out.push(sun.subject.extend(offset).to_array());
     }
-    if out.len() < batch.coefficients {
+    // Every batch holds the conditions' lights after its jobs, where the views hold
+    // normals ([`light_coefficients`]).
+    if light_coefficients(source) > 0 {
         for lights in source.condition_lights.iter() {
             out.extend(lights.iter().map(|(d, share)| d.extend(*share).to_array()));
         }
