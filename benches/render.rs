@@ -79,7 +79,7 @@ fn relight(c: &mut Criterion, field: &FieldFile, by_normals: &PoseSource, lighti
     }
     .relit(field, lighting, None)
     .unwrap();
-    assert!(by_normals.sun.is_some() && by_basis.sun.is_none());
+    assert!(!by_normals.suns.is_empty() && by_basis.suns.is_empty());
     let gpu = Gpu::new().unwrap();
     let mut group = c.benchmark_group("relight");
     group.sample_size(10);

@@ -7,7 +7,7 @@
 // between relights; a new light rewrites only the coefficients. Twin of
 // `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
 //
-// A sun the environment held is added per texel by the view's fitted normals (twin of
+// Each sun the environment held is added per texel by the view's fitted normals (twin of
 // `SunLight::texel`, `reflectance/src/sun_light.rs`): the nearest conditions' images per
 // unit of their light, times the ratio of the normal's shading under the sun to its
 // shading under them; where they barely reach the texel, the normal's shading under the
@@ -22,7 +22,8 @@ struct RelightParams {
     // The crop's corner in the image, pixels.
     x0: u32,
     y0: u32,
-    pad0: u32,
+    // Sun slots per job.
+    sun_slots: u32,
     pad1: u32,
     pad2: u32,
 }
@@ -46,12 +47,13 @@ struct Job {
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
 // Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
 // w = 0 when the condition is not used; per tile, where its condition's lights are
-// (x: the first, y: how many, as f32); per tile, the sun per unit of the condition's light
-// x tile scale (rgb); then the sun: its direction (xyz, the view's dome frame; w = 0
-// when there is none), the nearest conditions (xyz, as f32; w: how many) and their
-// weights (xyz; w: the ratio's floor), its direction in the subject frame (xyz; w: how
-// far from the hull's surface its shadow ray starts, 0 for no shadow). After every view's: the conditions' lights, each
-// its direction (xyz, dome frame) and share of its condition's light (w).
+// (x: the first, y: how many, as f32); then `sun_slots` slots of a sun, those in use
+// first: per tile, the sun per unit of the condition's light x tile scale (rgb); the
+// sun's direction (xyz, the view's dome frame; w = 0 for an unused slot), the nearest
+// conditions (xyz, as f32; w: how many) and their weights (xyz; w: the ratio's floor),
+// its direction in the subject frame (xyz; w: how far from the hull's surface its shadow
+// ray starts, 0 for no shadow). After every view's: the conditions' lights, each its
+// direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
@@ -108,11 +110,16 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     return s;
 }
 
-// Whether the sun (its direction in the subject frame and the shadow ray's offset, the
-// job's last coefficient) reaches texel i of `job` as far as the visual hull can tell:
-// twin of `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
-fn sunlit(job: Job, i: u32) -> bool {
-    let subject = coefficients[job.coefficient_offset + 3u * job.tiles + 3u];
+// Where sun slot `s` of `job` starts (its per-tile units; its four follow them).
+fn sun_slot(job: Job, s: u32) -> u32 {
+    return job.coefficient_offset + 2u * job.tiles + s * (job.tiles + 4u);
+}
+
+// Whether the sun of `slot` (its direction in the subject frame and the shadow ray's
+// offset, the slot's last coefficient) reaches texel i of `job` as far as the visual hull
+// can tell: twin of `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
+fn sunlit(job: Job, slot: u32, i: u32) -> bool {
+    let subject = coefficients[slot + job.tiles + 3u];
     if (subject.w <= 0.0 || proxy.present == 0u) {
         return true;
     }
@@ -129,22 +136,15 @@ fn sunlit(job: Job, i: u32) -> bool {
     return hull_first_hit(start, subject.xyz) < 0.0;
 }
 
-// The sun's light at texel i of `job` (see the file's text). The normal's codes are the
-// alpha bytes of tiles 1 and 2.
-fn sun_light(job: Job, i: u32) -> vec3<f32> {
+// The light of the sun of `slot` at texel i of `job`, whose normal is n (see the file's
+// text).
+fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     let directions = job.coefficient_offset + job.tiles;
-    let units = directions + job.tiles;
+    let units = slot;
     let head = units + job.tiles;
     let sun = coefficients[head];
-    if (sun.w == 0.0) {
-        return vec3<f32>(0.0);
-    }
     let nearest = coefficients[head + 1u];
     let weights = coefficients[head + 2u];
-    let n = normal_of(
-        basis[job.basis_offset + params.texels + i] >> 24u,
-        basis[job.basis_offset + 2u * params.texels + i] >> 24u,
-    );
     var interpolated = vec3<f32>(0.0);
     var shaded = 0.0;
     for (var j = 0u; j < u32(nearest.w); j++) {
@@ -201,10 +201,23 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         out.y += c.y * gamma_value((code >> 8u) & 255u);
         out.z += c.z * gamma_value((code >> 16u) & 255u);
     }
-    // The shadow is traced only where the sun would light.
-    let sun = sun_light(job, i);
-    if (any(sun != vec3<f32>(0.0)) && sunlit(job, i)) {
-        out += sun;
+    // A view with a sun holds normals: their codes are the alpha bytes of tiles 1 and 2.
+    if (params.sun_slots > 0u && coefficients[sun_slot(job, 0u) + job.tiles].w != 0.0) {
+        let n = normal_of(
+            basis[job.basis_offset + params.texels + i] >> 24u,
+            basis[job.basis_offset + 2u * params.texels + i] >> 24u,
+        );
+        for (var s = 0u; s < params.sun_slots; s++) {
+            let slot = sun_slot(job, s);
+            if (coefficients[slot + job.tiles].w == 0.0) {
+                break;
+            }
+            // The shadow is traced only where the sun would light.
+            let sun = sun_light(job, slot, i, n);
+            if (any(sun != vec3<f32>(0.0)) && sunlit(job, slot, i)) {
+                out += sun;
+            }
+        }
     }
     relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     atomicMax(&peaks[job.view], bitcast<u32>(max(out.x, max(out.y, out.z))));

@@ -75,7 +75,7 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let source = tiny_source();
     // The sky's sun is relit by the views' fitted normals, its cast shadows traced
     // through the visual hull, on both.
-    assert!(source.sun.is_some() && source.holds_normals());
+    assert!(source.suns.len() == 1 && source.holds_normals());
     assert!(source.geometry.proxy.hull().is_some());
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
@@ -416,20 +416,29 @@ fn the_light_fit_relights_on_the_gpu_as_on_the_cpu() {
 }
 
 /// A pose at a reduced level of detail (a far walker) keeps its views' normals, averaged
-/// over each block: its sun is relit by them on both twins, as at full detail.
+/// over each block: its suns (here two: the sky's and another, lower and behind) are
+/// relit by them on both twins, as at full detail.
 #[test]
-fn a_reduced_pose_relights_its_sun_by_its_normals_on_both() {
+fn a_reduced_pose_relights_its_suns_by_its_normals_on_both() {
     use frf_reflectance::project::FloorModel;
     use frf_render::resident::Lighting;
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
+    let second = frf_core::light::direction_from_azimuth_elevation(
+        200f32.to_radians(),
+        25f32.to_radians(),
+    );
+    let env = frf_core::sun::Sun::new(second, 2.0, [6.0, 5.0, 4.0])
+        .unwrap()
+        .lit(&EnvMap::sky())
+        .unwrap();
     let lighting = Lighting::Environment {
-        env: EnvMap::sky(),
+        env,
         floor: FloorModel::Environment,
     };
     let source = PoseSource::load_at(&field, 0, &lighting, None, 1, None).unwrap();
-    assert!(source.sun.is_some() && source.holds_normals());
+    assert!(source.suns.len() == 2 && source.holds_normals());
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
     assert_relit_as_the_cpu(&gpu, &pose, &cpu, "level 1");

@@ -45,7 +45,7 @@ pub fn score_sun_fit<R: ReadAt>(
     (cpu, images): (bool, Option<&Path>),
     progress: &dyn Progress,
 ) -> Result<SunFitReport> {
-    if source.sun.is_none() {
+    if source.suns.is_empty() {
         let why = if source.holds_normals() {
             "an environment with a sun (--sun, or a map with one)"
         } else {

@@ -30,7 +30,7 @@ use frf_core::filter::extend_nearest;
 use frf_core::flo::{UNKNOWN, is_known};
 use frf_core::image::{Border, FlowImage, GrayImage, Image, RgbImage};
 use frf_flow::FlowParams;
-use frf_reflectance::hull::{Silhouette, VoxelHull};
+use frf_reflectance::hull::{Silhouette, VoxelHull, voxel_per_pixel};
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -71,21 +71,13 @@ const VOXEL_PER_PIXEL: f32 = 0.5;
 /// The band carve starts from voxels this many times larger ([`VoxelHull::carve_banded`]).
 const BAND_COARSE: u32 = 4;
 /// Bounds of the flow hull's voxel side, metres: finer costs memory (a 2.5 mm grid of
-/// the walker's box holds about 80 million voxels), coarser is the shadow hull's.
+/// the walker's box holds about 80 million voxels); 2 cm is the coarsest hull stored.
 const VOXEL_RANGE_M: (f32, f32) = (0.0025, 0.02);
 
 /// The flow hull's voxel side for these cameras: [`VOXEL_PER_PIXEL`] of the smallest
 /// pixel footprint on the turntable axis, within [`VOXEL_RANGE_M`].
 pub fn flow_hull_voxel_m(cameras: &[Camera]) -> f32 {
-    let footprint = cameras
-        .iter()
-        .map(|c| (c.centre() - c.axis_point()).length() / c.intrinsics.fx.max(c.intrinsics.fy))
-        .filter(|f| f.is_finite() && *f > 0.0)
-        .fold(f32::INFINITY, f32::min);
-    if !footprint.is_finite() {
-        return VOXEL_RANGE_M.1;
-    }
-    (footprint * VOXEL_PER_PIXEL).clamp(VOXEL_RANGE_M.0, VOXEL_RANGE_M.1)
+    voxel_per_pixel(cameras, VOXEL_PER_PIXEL, VOXEL_RANGE_M)
 }
 
 /// The hull the flows are guided by, carved from the views' mattes (cameras in the

@@ -346,13 +346,12 @@ fn settings(capture: &Capture, options: &IngestOptions) -> Settings {
         shadows: options.shadows.map_or_else(
             || "none".to_string(),
             |s| {
+                let voxel = s
+                    .hull_voxel_m
+                    .map_or("half a pixel".into(), |v| format!("{v} m"));
                 format!(
-                    "hull {} m, {} misses; ground {} texels over {} m, {} samples per light",
-                    s.hull.voxel_m,
-                    s.hull.misses,
-                    s.ground.texels,
-                    s.ground.extent_m,
-                    s.light_samples
+                    "hull {voxel}, {} misses; ground {} texels over {} m, {} samples per light",
+                    s.hull_misses, s.ground.texels, s.ground.extent_m, s.light_samples
                 )
             },
         ),
@@ -800,9 +799,9 @@ fn shadow_step(
 ) -> Result<PoseShadows> {
     progress.begin(pose, "visual hull and shadow maps", 1);
     let (cams, mattes) = ingested_views(cameras, alphas);
-    let mut s = *options;
-    s.hull.misses = crate::shadows::misses_for(s.hull.misses, cams.len(), cameras.len());
-    let r = pose_shadows(&cams, &mattes, &header.conditions, &s)?;
+    let mut hull = options.hull(header);
+    hull.misses = crate::shadows::misses_for(hull.misses, cams.len(), cameras.len());
+    let r = pose_shadows(&cams, &mattes, &header.conditions, hull, options)?;
     steps.push(Step {
         name: "visual hull".into(),
         seconds: r.hull_seconds,
@@ -869,7 +868,7 @@ pub fn pose_header(capture: &Capture, pose: u32, options: &IngestOptions) -> Res
     )?;
     header.flow_predicted = options.predict_flow;
     header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
-    header.hulls = options.shadows.map(|s| s.hull);
+    header.hulls = options.shadows.map(|s| s.hull(&header));
     Ok(header)
 }
 
@@ -888,7 +887,7 @@ pub fn flow_guide(
     let (cams, mattes) = ingested_views(cameras, alphas);
     let asked = options
         .shadows
-        .map_or(crate::shadows::DEFAULT_MISSES, |s| s.hull.misses);
+        .map_or(crate::shadows::DEFAULT_MISSES, |s| s.hull_misses);
     let misses = crate::shadows::misses_for(asked, cams.len(), cameras.len());
     flow_hull(&cams, &mattes, misses)
 }

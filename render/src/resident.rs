@@ -29,7 +29,7 @@ use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
-use frf_reflectance::sun_light::SunLight;
+use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -132,11 +132,11 @@ pub struct PoseSource {
     /// ([`condition_light_shares`]), which shade the normals under a sun.
     pub condition_lights: Arc<Vec<Vec<(glam::Vec3, f32)>>>,
     /// Per view and condition: relighting coefficients (RGB), of the environment less
-    /// its sun where `sun` holds it.
+    /// the suns `suns` holds.
     pub coefficients: Vec<Vec<Rgb>>,
-    /// The environment's sun, relit by the views' normals rather than by the basis
-    /// (`None`: no sun, or views without normals).
-    pub sun: Option<Arc<SunLight>>,
+    /// The environment's suns, relit by the views' normals rather than by the basis
+    /// (none: no sun, or views without normals), brightest first.
+    pub suns: Arc<[SunLight]>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
     /// relight the shadow maps; `None` without an environment.
     pub ground_coefficients: Option<Vec<Rgb>>,
@@ -172,7 +172,7 @@ impl PoseSource {
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
             plan: relit.plan,
-            sun: relit.sun,
+            suns: relit.suns,
             ..self.clone()
         })
     }
@@ -291,7 +291,7 @@ impl PoseSource {
             condition_lights: Arc::new(condition_light_shares(&h.conditions)),
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
-            sun: relit.sun,
+            suns: relit.suns,
             plan: relit.plan,
         })
     }
@@ -344,7 +344,7 @@ fn views_read<R: ReadAt>(
 struct Relighting {
     coefficients: Vec<Vec<Rgb>>,
     ground: Option<Vec<Rgb>>,
-    sun: Option<Arc<SunLight>>,
+    suns: Arc<[SunLight]>,
     plan: LightingPlan,
 }
 
@@ -364,7 +364,7 @@ fn relighting<R: ReadAt>(
     let h = field.header();
     let record = h.pose(pose)?;
     let views = read.len();
-    let mut sun = None;
+    let mut suns = Vec::new();
     let (mut coefficients, ground) = match lighting {
         Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
         Lighting::Environment { env, floor } => {
@@ -386,7 +386,15 @@ fn relighting<R: ReadAt>(
             // subject's own frame (angle 0), the last.
             let mut all = projector.project_many(env, &[&angles[..], &[0.0]].concat(), *floor);
             let own = all.pop();
-            if normals && let Some((found, rest)) = Sun::extract(env)? {
+            let mut rest = None;
+            while normals && suns.len() < MAX_SUNS {
+                let Some((found, less)) = Sun::extract(rest.as_ref().unwrap_or(env))? else {
+                    break;
+                };
+                suns.push(SunLight::new(&found, &h.conditions, &angles));
+                rest = Some(less);
+            }
+            if let Some(rest) = rest {
                 let less = projector.project_many(&rest, &angles, *floor);
                 for (c, l) in all.iter_mut().zip(less) {
                     for k in 0..c.len() {
@@ -395,7 +403,6 @@ fn relighting<R: ReadAt>(
                         }
                     }
                 }
-                sun = Some(Arc::new(SunLight::new(&found, &h.conditions, &angles)));
             }
             (all, own)
         }
@@ -427,7 +434,7 @@ fn relighting<R: ReadAt>(
     Ok(Relighting {
         coefficients,
         ground,
-        sun,
+        suns: suns.into(),
         plan,
     })
 }
@@ -770,11 +777,15 @@ impl ResidentPose {
                 // is not relit.
                 let alpha = &source.alpha[i];
                 let normals = &source.normals[i];
-                let sun = source.sun.as_deref().filter(|_| !normals.is_empty());
+                let suns: &[SunLight] = if normals.is_empty() {
+                    &[]
+                } else {
+                    &source.suns
+                };
                 let (camera, crop) = (&source.geometry.cameras[i], source.geometry.crop);
                 let hull = source.geometry.proxy.hull();
-                let sunlit = |p: usize| {
-                    let (Some(sun), Some(hull)) = (sun, hull) else {
+                let sunlit = |sun: &SunLight, p: usize| {
+                    let Some(hull) = hull else {
                         return true;
                     };
                     let pixel = glam::Vec2::new(
@@ -789,10 +800,10 @@ impl ResidentPose {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
-                        if let Some(sun) = sun {
+                        for sun in suns {
                             // The shadow is traced only where the sun would light.
                             let s = sun_pixel(sun, i, b, normals[p], &lut, p);
-                            if s != [0.0; 3] && sunlit(p) {
+                            if s != [0.0; 3] && sunlit(sun, p) {
                                 for k in 0..3 {
                                     c[k] += s[k];
                                 }

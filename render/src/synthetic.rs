@@ -126,7 +126,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         normals: Arc::new(vec![Vec::new(); views]),
         condition_lights: Arc::new(Vec::new()),
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
-        sun: None,
+        suns: Arc::from([]),
         ground_coefficients: None,
         plan: LightingPlan {
             skipped_conditions: Vec::new(),

@@ -154,9 +154,10 @@ pub struct GpuRelightParams {
     pub x0: u32,
     /// See `x0`.
     pub y0: u32,
+    /// Sun slots per job: each job's coefficients hold this many suns, those unused last
+    /// and marked empty.
+    pub sun_slots: u32,
     /// Padding to 16 bytes.
-    pub pad0: u32,
-    /// Padding.
     pub pad1: u32,
     /// Padding.
     pub pad2: u32,

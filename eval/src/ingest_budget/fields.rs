@@ -287,7 +287,15 @@ pub fn write_fields(
     let carve = |mattes: Vec<&GrayImage>| -> Result<Option<PoseShadows>> {
         options
             .shadows
-            .map(|s| Ok(pose_shadows(&cameras, &mattes, &header.conditions, &s)?))
+            .map(|s| {
+                Ok(pose_shadows(
+                    &cameras,
+                    &mattes,
+                    &header.conditions,
+                    s.hull(&header),
+                    &s,
+                )?)
+            })
             .transpose()
     };
     let shadows = (

@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
-use frf_reflectance::sun_light::SHADOW_OFFSET_M;
+use frf_reflectance::sun_light::{MAX_SUNS, SHADOW_OFFSET_M, SunLight};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -122,11 +122,11 @@ impl PoseRelight {
     }
 }
 
-/// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its
-/// coefficient, where its condition's lights are and the sun per unit of its light, then
-/// the sun's four.
+/// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its coefficient
+/// and where its condition's lights are, then [`MAX_SUNS`] slots of a sun: per image the
+/// sun per unit of its light, then the sun's four.
 fn job_coefficients(tiles: usize) -> usize {
-    3 * tiles + 4
+    2 * tiles + MAX_SUNS * (tiles + 4)
 }
 
 /// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
@@ -141,8 +141,9 @@ fn light_coefficients(source: &PoseSource) -> usize {
 
 /// The coefficients of `batch`'s jobs for `source` (`shaders/relight.wgsl` says what each
 /// holds): per view and basis image, RGB times the image's scale, and whether the
-/// condition is used at all; then the sun's terms, zero where there is no sun or the view
-/// holds no normals.
+/// condition is used at all; where its condition's lights are; then [`MAX_SUNS`] slots of
+/// a sun's terms, the suns first and the rest zero (all zero where the view holds no
+/// normals).
 fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
     // The conditions' lights follow the jobs: where each condition's start.
@@ -168,38 +169,23 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             };
             out.push([c[0] * s, c[1] * s, c[2] * s, used]);
         }
-        let sun = source
-            .sun
-            .as_deref()
-            .filter(|_| !source.normals[i].is_empty());
-        let Some(sun) = sun else {
-            out.extend(std::iter::repeat_n([0.0; 4], 2 * scales.len() + 4));
-            continue;
-        };
-        out.extend(ranges.iter().take(scales.len()));
-        out.extend(
-            sun.unit
-                .iter()
-                .zip(scales)
-                .map(|(u, &s)| [u[0] * s, u[1] * s, u[2] * s, 0.0]),
-        );
-        let view = &sun.views[i];
-        let (mut nearest, mut weights) = ([0.0f32; 4], [0.0f32; 4]);
-        for (j, &(k, w)) in view.nearest.iter().take(3).enumerate() {
-            nearest[j] = k as f32;
-            weights[j] = w;
-        }
-        nearest[3] = view.nearest.len().min(3) as f32;
-        weights[3] = RATIO_FLOOR;
-        out.push(view.direction.extend(1.0).to_array());
-        out.push(nearest);
-        out.push(weights);
-        let offset = if source.geometry.proxy.hull().is_some() {
-            SHADOW_OFFSET_M
+        let suns: &[SunLight] = if source.normals[i].is_empty() {
+            &[]
         } else {
-            0.0
+            &source.suns[..source.suns.len().min(MAX_SUNS)]
         };
-        out.push(sun.subject.extend(offset).to_array());
+        out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
+        for sun in suns {
+            pack_sun(
+                &mut out,
+                sun,
+                i,
+                scales,
+                source.geometry.proxy.hull().is_some(),
+            );
+        }
+        let empty = MAX_SUNS - suns.len();
+        out.extend(std::iter::repeat_n([0.0; 4], empty * (scales.len() + 4)));
     }
     // Every batch holds the conditions' lights after its jobs, where the views hold
     // normals ([`light_coefficients`]).
@@ -212,6 +198,30 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
         out.push([0.0; 4]);
     }
     out
+}
+
+/// One slot of view `i`'s job for `sun` (`shaders/relight.wgsl` says what each holds),
+/// its shadow traced through the hull where the pose has one (`shadows`).
+fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], shadows: bool) {
+    out.extend(
+        sun.unit
+            .iter()
+            .zip(scales)
+            .map(|(u, &s)| [u[0] * s, u[1] * s, u[2] * s, 0.0]),
+    );
+    let view = &sun.views[i];
+    let (mut nearest, mut weights) = ([0.0f32; 4], [0.0f32; 4]);
+    for (j, &(k, w)) in view.nearest.iter().take(3).enumerate() {
+        nearest[j] = k as f32;
+        weights[j] = w;
+    }
+    nearest[3] = view.nearest.len().min(3) as f32;
+    weights[3] = RATIO_FLOOR;
+    out.push(view.direction.extend(1.0).to_array());
+    out.push(nearest);
+    out.push(weights);
+    let offset = if shadows { SHADOW_OFFSET_M } else { 0.0 };
+    out.push(sun.subject.extend(offset).to_array());
 }
 
 impl Gpu {
@@ -298,7 +308,7 @@ impl Gpu {
             jobs: views.len() as u32,
             x0: crop.x0,
             y0: crop.y0,
-            pad0: 0,
+            sun_slots: MAX_SUNS as u32,
             pad1: 0,
             pad2: 0,
         };
