@@ -2,9 +2,10 @@
 //! against the CPU reference in one run, per variant. The field is `FRF_BENCH_FIELD` (e.g. a paper-size field from
 //! `frf ingest`), or else the tiny stage's oracle field, built first (about 10 s).
 //! Frames are the field's image size, from a camera between grid views. Relighting a
-//! pose under the built-in sky (a new light: the GPU's relight pass, waited for; the CPU
-//! twin), its sun by the views' fitted normals against the same sun by the basis alone.
-//! Run: `cargo bench --bench render`.
+//! pose under the built-in sky, or the map `FRF_BENCH_ENV` (an HDR file; a new light: the
+//! GPU's relight pass, waited for; the CPU twin; the host's coefficients and suns before
+//! either), its suns by the views' fitted normals against the same suns by the basis
+//! alone. Run: `cargo bench --bench render`.
 
 #![allow(clippy::unwrap_used)] // benchmarks: a failed unwrap is a failed run
 
@@ -31,8 +32,12 @@ fn bench(c: &mut Criterion) {
     let path = field();
     let field = FieldFile::open(&path).unwrap();
     let pose = field.header().poses[0].pose;
+    let env = match std::env::var("FRF_BENCH_ENV") {
+        Ok(path) => EnvMap::load(std::path::Path::new(&path)).unwrap(),
+        Err(_) => EnvMap::sky(),
+    };
     let lighting = Lighting::Environment {
-        env: EnvMap::sky(),
+        env,
         floor: FloorModel::Environment,
     };
     let source = PoseSource::load(&field, pose, &lighting).unwrap();
@@ -80,6 +85,7 @@ fn relight(c: &mut Criterion, field: &FieldFile, by_normals: &PoseSource, lighti
     .relit(field, lighting, None)
     .unwrap();
     assert!(!by_normals.suns.is_empty() && by_basis.suns.is_empty());
+    eprintln!("relight: {} suns by the normals", by_normals.suns.len());
     let gpu = Gpu::new().unwrap();
     let mut group = c.benchmark_group("relight");
     group.sample_size(10);
@@ -93,6 +99,11 @@ fn relight(c: &mut Criterion, field: &FieldFile, by_normals: &PoseSource, lighti
         });
         group.bench_function(format!("{name}/cpu"), |b| {
             b.iter(|| ResidentPose::relight_cpu(source))
+        });
+        // The host's part of a new light, before either: the map projected for every
+        // view, the suns found and their maps of the hull made.
+        group.bench_function(format!("{name}/host"), |b| {
+            b.iter(|| source.relit(field, lighting, None).unwrap())
         });
     }
     group.finish();

@@ -88,7 +88,9 @@ struct Proxy {
     // 1 when the pose has a hull.
     present: u32,
     axis: vec2<f32>,
-    pad: vec2<f32>,
+    // Where the hull's blocks' bits start in its words, and voxels along a block's side.
+    block_words_at: u32,
+    block: u32,
 }
 
 // sRGB code -> linear, and flow code + 128 -> displacement (unknown -> 0).

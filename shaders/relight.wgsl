@@ -37,7 +37,9 @@ struct Job {
     view: u32,
     layer: u32,
     relit_offset: u32,
-    pad0: u32,
+    // 1 when its codes are followed by its texels' points on the hull (`t` along their
+    // camera rays, as f32 bits).
+    surface: u32,
     pad1: u32,
 }
 
@@ -52,8 +54,11 @@ struct Job {
 // sun's direction (xyz, the view's dome frame; w = 0 for an unused slot), the nearest
 // conditions (xyz, as f32; w: how many) and their weights (xyz; w: the ratio's floor),
 // its direction in the subject frame (xyz; w: how far from the hull's surface its shadow
-// ray starts, 0 for no shadow). After every view's: the conditions' lights, each its
-// direction (xyz, dome frame) and share of its condition's light (w).
+// ray starts, 0 for no shadow); its map of the hull (`SunDepth`,
+// `reflectance/src/sun_depth.rs`): its x axis (xyz) and corner's x (w), its y axis and
+// corner's y, and (texel side, texels along x, along y, where its values start in
+// `sun_depths`, as f32). After every view's: the conditions' lights, each its direction
+// (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
@@ -67,9 +72,9 @@ struct Job {
 @group(0) @binding(7) var<storage, read> jobs: array<Job>;
 // The pose's view table, whose `scale` the encoding sets.
 @group(0) @binding(8) var<storage, read_write> views: array<View>;
-// The pose's visual hull (`rebin/proxy.wgsl` traces it): a sun's cast shadows.
-@group(0) @binding(9) var<storage, read> proxy: Proxy;
-@group(0) @binding(10) var<storage, read> hull_bits: array<u32>;
+// The suns' maps of the hull, one after the other: per texel (x fastest), how far toward
+// its sun the hull reaches along its line.
+@group(0) @binding(9) var<storage, read> sun_depths: array<f32>;
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
@@ -110,30 +115,49 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     return s;
 }
 
-// Where sun slot `s` of `job` starts (its per-tile units; its four follow them).
+// Where sun slot `s` of `job` starts (its per-tile units; its seven follow them).
 fn sun_slot(job: Job, s: u32) -> u32 {
-    return job.coefficient_offset + 2u * job.tiles + s * (job.tiles + 4u);
+    return job.coefficient_offset + 2u * job.tiles + s * (job.tiles + 7u);
 }
 
-// Whether the sun of `slot` (its direction in the subject frame and the shadow ray's
-// offset, the slot's last coefficient) reaches texel i of `job` as far as the visual hull
-// can tell: twin of `SunLight::sunlit` (`reflectance/src/sun_light.rs`).
-fn sunlit(job: Job, slot: u32, i: u32) -> bool {
-    let subject = coefficients[slot + job.tiles + 3u];
-    if (subject.w <= 0.0 || proxy.present == 0u) {
-        return true;
+// Where texel i of `job`'s camera ray meets the visual hull (xyz, w = 1), or w = 2 where it
+// misses or there is none: `t` along the ray, found at load, follows the job's codes.
+fn texel_surface(job: Job, i: u32) -> vec4<f32> {
+    if (job.surface == 0u) {
+        return vec4<f32>(0.0, 0.0, 0.0, 2.0);
     }
+    let t = bitcast<f32>(basis[job.basis_offset + job.tiles * params.texels + i]);
     let view = views[job.view];
     let k = view.intrinsics;
     let pixel = vec2<f32>(f32(params.x0 + i % params.width), f32(params.y0 + i / params.width));
     let dc = vec3<f32>((pixel.x - k.z) / k.x, (pixel.y - k.w) / k.y, 1.0);
     let dir = normalize(quat_to_axes(view.rotation) * dc);
-    let t = hull_first_hit(view.centre, dir);
     if (t < 0.0) {
+        return vec4<f32>(0.0, 0.0, 0.0, 2.0);
+    }
+    return vec4<f32>(view.centre + dir * t, 1.0);
+}
+
+// Whether the sun of `slot` reaches `surface`, a texel's point on the hull, as far as the
+// hull can tell: from the slot's offset toward the sun on, the hull does not lie between
+// it and the sun along its line of the sun's map. Twin of `SunLight::sunlit`
+// (`reflectance/src/sun_light.rs`).
+fn sunlit(job: Job, slot: u32, surface: vec3<f32>) -> bool {
+    let head = slot + job.tiles;
+    let subject = coefficients[head + 3u];
+    if (subject.w <= 0.0) {
         return true;
     }
-    let start = view.centre + dir * t + subject.xyz * subject.w;
-    return hull_first_hit(start, subject.xyz) < 0.0;
+    let ax = coefficients[head + 4u];
+    let ay = coefficients[head + 5u];
+    let m = coefficients[head + 6u];
+    let p = surface + subject.xyz * subject.w;
+    let c = floor((vec2<f32>(dot(ax.xyz, p), dot(ay.xyz, p)) - vec2<f32>(ax.w, ay.w)) / m.x);
+    if (!(c.x >= 0.0 && c.y >= 0.0 && c.x < m.y && c.y < m.z)) {
+        return true;
+    }
+    let reach = sun_depths[u32(m.w) + u32(c.y) * u32(m.y) + u32(c.x)];
+    return !(reach > dot(subject.xyz, p));
 }
 
 // The light of the sun of `slot` at texel i of `job`, whose normal is n (see the file's
@@ -145,6 +169,11 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     let sun = coefficients[head];
     let nearest = coefficients[head + 1u];
     let weights = coefficients[head + 2u];
+    let none = all(n == vec3<f32>(0.0));
+    let wanted = max(dot(n, sun.xyz), 0.0);
+    if (!none && wanted <= 0.0) {
+        return vec3<f32>(0.0);
+    }
     var interpolated = vec3<f32>(0.0);
     var shaded = 0.0;
     for (var j = 0u; j < u32(nearest.w); j++) {
@@ -152,12 +181,8 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
         interpolated += weights[j] * coefficients[units + k].rgb * tile_value(job, k, i);
         shaded += weights[j] * shading(coefficients[directions + k], n);
     }
-    if (all(n == vec3<f32>(0.0))) {
+    if (none) {
         return interpolated;
-    }
-    let wanted = max(dot(n, sun.xyz), 0.0);
-    if (wanted <= 0.0) {
-        return vec3<f32>(0.0);
     }
     if (shaded >= weights.w * wanted) {
         return interpolated * wanted / shaded;
@@ -207,15 +232,21 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
             basis[job.basis_offset + params.texels + i] >> 24u,
             basis[job.basis_offset + 2u * params.texels + i] >> 24u,
         );
+        var surface = vec4<f32>(0.0);
         for (var s = 0u; s < params.sun_slots; s++) {
             let slot = sun_slot(job, s);
             if (coefficients[slot + job.tiles].w == 0.0) {
                 break;
             }
-            // The shadow is traced only where the sun would light.
+            // The texel's point on the hull is found once, where a sun would light.
             let sun = sun_light(job, slot, i, n);
-            if (any(sun != vec3<f32>(0.0)) && sunlit(job, slot, i)) {
-                out += sun;
+            if (any(sun != vec3<f32>(0.0))) {
+                if (surface.w == 0.0) {
+                    surface = texel_surface(job, i);
+                }
+                if (surface.w == 2.0 || sunlit(job, slot, surface.xyz)) {
+                    out += sun;
+                }
             }
         }
     }

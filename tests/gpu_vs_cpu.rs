@@ -425,10 +425,8 @@ fn a_reduced_pose_relights_its_suns_by_its_normals_on_both() {
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
-    let second = frf_core::light::direction_from_azimuth_elevation(
-        200f32.to_radians(),
-        25f32.to_radians(),
-    );
+    let second =
+        frf_core::light::direction_from_azimuth_elevation(200f32.to_radians(), 25f32.to_radians());
     let env = frf_core::sun::Sun::new(second, 2.0, [6.0, 5.0, 4.0])
         .unwrap()
         .lit(&EnvMap::sky())

@@ -11,8 +11,13 @@
 //!   intersection eats thin limbs). The box is found by a coarse carve of a generous
 //!   region ([`search_region`]), grown by one coarse voxel, then carved at the asked
 //!   resolution.
-//! - **Tracing** ([`VoxelHull::blocks`]): a ray is blocked when it passes through an
-//!   occupied voxel (3D digital differential analyser, Amanatides & Woo 1987).
+//! - **Tracing** ([`VoxelHull::first_hit`], [`VoxelHull::blocks`]): a ray is blocked when
+//!   it passes through an occupied voxel (3D digital differential analyser, Amanatides &
+//!   Woo 1987), walked over blocks of [`BLOCK`]³ voxels first and inside the occupied
+//!   ones only: at 5 mm voxels most of a ray's way is empty 2 cm blocks. Relighting the
+//!   small field's pose with a sun traced from every texel took 2.9x the basis's time on
+//!   the CPU with the voxels walked one by one, 2.2x with blocks of 4 and 2.3x with
+//!   blocks of 8.
 //! - **Storage**: the grid and a bit per voxel, zstd-compressed; decoding checks the grid
 //!   and the declared size before allocating.
 
@@ -70,6 +75,9 @@ pub struct Silhouette<'a> {
 pub struct VoxelHull {
     grid: VoxelGrid,
     bits: Vec<u64>,
+    /// A bit per block of [`BLOCK`]³ voxels: whether any is occupied ([`VoxelHull::first_hit`]
+    /// steps over empty blocks whole).
+    blocks: Vec<u64>,
 }
 
 /// Whether view `s` puts the point `p` outside the subject: behind the camera, outside
@@ -96,13 +104,94 @@ fn outside(s: &Silhouette, p: Vec3) -> bool {
     s.alpha.sample_bilinear(pixel.x, pixel.y, Border::Clamp) < INSIDE_ALPHA
 }
 
+/// Voxels along each side of a block ([`VoxelHull::first_hit`] steps over empty blocks):
+/// at 5 mm voxels, 2 cm blocks, which a shadow ray mostly crosses empty.
+pub const BLOCK: usize = 4;
+
+/// Blocks along x, y, z of `grid`.
+fn block_dims(grid: &VoxelGrid) -> [i64; 3] {
+    grid.dims.map(|d| i64::from(d.div_ceil(BLOCK as u32)))
+}
+
+/// Bit `(i, j, k)` of a grid of `dims` stored x fastest in `words`; outside is 0.
+fn bit(words: &[u64], dims: [i64; 3], [i, j, k]: [i64; 3]) -> bool {
+    if i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2] {
+        return false;
+    }
+    let index = ((k * dims[1] + j) * dims[0] + i) as usize;
+    words[index / 64] >> (index % 64) & 1 == 1
+}
+
+/// Visits, in order, the cells of the grid of lowest corner `lo`, cell side `side` and
+/// `dims` that the ray `origin + t dir` crosses for `t` in `enter..=exit`, each with the
+/// `t` at which the ray enters and leaves it, until `visit` returns something (3D
+/// digital differential analyser).
+fn walk<R>(
+    (origin, dir): (Vec3, Vec3),
+    (lo, side, dims): (Vec3, f32, [i64; 3]),
+    (enter, exit): (f32, f32),
+    mut visit: impl FnMut([i64; 3], f32, f32) -> Option<R>,
+) -> Option<R> {
+    let p = origin + dir * enter;
+    let mut cell = [0i64; 3];
+    let (mut t_next, mut t_delta, mut step) = ([f32::INFINITY; 3], [f32::INFINITY; 3], [0i64; 3]);
+    for a in 0..3 {
+        cell[a] = (((p[a] - lo[a]) / side).floor() as i64).clamp(0, dims[a] - 1);
+        if dir[a] != 0.0 {
+            step[a] = if dir[a] > 0.0 { 1 } else { -1 };
+            let boundary = lo[a] + (cell[a] + (step[a] > 0) as i64) as f32 * side;
+            t_next[a] = (boundary - origin[a]) / dir[a];
+            t_delta[a] = side / dir[a].abs();
+        }
+    }
+    // Where the ray entered the current cell.
+    let mut t_cell = enter;
+    loop {
+        let a = if t_next[0] <= t_next[1] && t_next[0] <= t_next[2] {
+            0
+        } else if t_next[1] <= t_next[2] {
+            1
+        } else {
+            2
+        };
+        if let Some(r) = visit(cell, t_cell, t_next[a].min(exit)) {
+            return Some(r);
+        }
+        if t_next[a] > exit {
+            return None;
+        }
+        t_cell = t_next[a];
+        cell[a] += step[a];
+        t_next[a] += t_delta[a];
+        if cell[a] < 0 || cell[a] >= dims[a] {
+            return None;
+        }
+    }
+}
+
 impl VoxelHull {
     /// A hull with every voxel of `grid` empty.
     pub fn empty(grid: VoxelGrid) -> Self {
-        Self {
-            grid,
-            bits: vec![0; grid.len().div_ceil(64)],
+        Self::of_bits(grid, vec![0; grid.len().div_ceil(64)])
+    }
+
+    /// The hull of `grid` whose occupancy is `bits` (voxel `index` at bit `index % 64` of
+    /// word `index / 64`), with its blocks.
+    fn of_bits(grid: VoxelGrid, bits: Vec<u64>) -> Self {
+        let dims = block_dims(&grid);
+        let b = BLOCK as u32;
+        let mut blocks = vec![0u64; (dims.iter().product::<i64>() as usize).div_ceil(64)];
+        for (w, &word) in bits.iter().enumerate() {
+            let mut rest = word;
+            while rest != 0 {
+                let index = w * 64 + rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let [i, j, k] = grid.cell(index).map(|c| (c / b) as i64);
+                let block = ((k * dims[1] + j) * dims[0] + i) as usize;
+                blocks[block / 64] |= 1 << (block % 64);
+            }
         }
+        Self { grid, bits, blocks }
     }
 
     /// A hull with every voxel of `grid` occupied.
@@ -114,7 +203,7 @@ impl VoxelHull {
         {
             *last = (1u64 << (n % 64)) - 1;
         }
-        Self { grid, bits }
+        Self::of_bits(grid, bits)
     }
 
     /// Carves `grid` from `views` (see the module docs): a voxel survives when at most
@@ -123,6 +212,12 @@ impl VoxelHull {
         Self::from_test(grid, |[i, j, k]| {
             !views.is_empty() && inside(views, grid.centre(i, j, k), misses)
         })
+    }
+
+    /// The hull of `grid` whose voxels are occupied where `occupied` holds at their
+    /// centres (a shape known in closed form, as tests use).
+    pub fn from_fn(grid: VoxelGrid, occupied: impl Fn(Vec3) -> bool + Sync) -> Self {
+        Self::from_test(grid, |[i, j, k]| occupied(grid.centre(i, j, k)))
     }
 
     /// The hull of `grid` whose voxel `(i, j, k)` is occupied where `occupied` says, the
@@ -145,7 +240,7 @@ impl VoxelHull {
                 word
             })
             .collect();
-        Self { grid, bits: words }
+        Self::of_bits(grid, words)
     }
 
     /// The hull of `views` at voxel side `voxel_m`, in a box found by a coarse carve of
@@ -296,8 +391,8 @@ impl VoxelHull {
     }
 
     /// The parameter `t ≥ 0` at which the ray `origin + t dir` enters its first occupied
-    /// voxel, or `None` when it passes through none (3D DDA; `shaders/rebin/proxy.wgsl` is its
-    /// twin).
+    /// voxel, or `None` when it passes through none: a 3D DDA over the blocks, and inside
+    /// each occupied block over its voxels (`shaders/rebin/proxy.wgsl` is its twin).
     pub fn first_hit(&self, origin: Vec3, dir: Vec3) -> Option<f32> {
         if !(dir.is_finite() && origin.is_finite()) || dir == Vec3::ZERO {
             return None;
@@ -320,53 +415,44 @@ impl VoxelHull {
         if enter > exit || enter.is_nan() || exit.is_nan() {
             return None;
         }
+        let ray = (origin, dir);
         let s = g.voxel_m;
-        let dims = g.dims.map(|n| n as i64);
-        let p = origin + dir * enter;
-        let mut cell = [0i64; 3];
-        let (mut t_next, mut t_delta, mut step) =
-            ([f32::INFINITY; 3], [f32::INFINITY; 3], [0i64; 3]);
-        for a in 0..3 {
-            cell[a] = (((p[a] - lo[a]) / s).floor() as i64).clamp(0, dims[a] - 1);
-            if dir[a] != 0.0 {
-                step[a] = if dir[a] > 0.0 { 1 } else { -1 };
-                let boundary = lo[a] + (cell[a] + (step[a] > 0) as i64) as f32 * s;
-                t_next[a] = (boundary - origin[a]) / dir[a];
-                t_delta[a] = s / dir[a].abs();
-            }
-        }
-        // Where the ray entered the current cell.
-        let mut t_cell = enter;
-        loop {
-            if self.at(cell[0], cell[1], cell[2]) {
-                return Some(t_cell);
-            }
-            let a = if t_next[0] <= t_next[1] && t_next[0] <= t_next[2] {
-                0
-            } else if t_next[1] <= t_next[2] {
-                1
-            } else {
-                2
-            };
-            if t_next[a] > exit {
-                return None;
-            }
-            t_cell = t_next[a];
-            cell[a] += step[a];
-            t_next[a] += t_delta[a];
-            if cell[a] < 0 || cell[a] >= dims[a] {
-                return None;
-            }
-        }
+        let (dims, blocks) = (g.dims.map(i64::from), block_dims(g));
+        walk(
+            ray,
+            (lo, s * BLOCK as f32, blocks),
+            (enter, exit),
+            |b, t0, t1| {
+                if !bit(&self.blocks, blocks, b) {
+                    return None;
+                }
+                walk(ray, (lo, s, dims), (t0, t1), |c, t, _| {
+                    bit(&self.bits, dims, c).then_some(t)
+                })
+            },
+        )
     }
 
     /// The occupancy bits as 32-bit words, voxel `index` at bit `index % 32` of word
-    /// `index / 32` (what the GPU reads).
+    /// `index / 32`, then from word [`VoxelHull::block_words_at`] on the blocks' bits the
+    /// same way (what the GPU reads).
     pub fn words(&self) -> Vec<u32> {
-        self.bits
-            .iter()
+        let mut words: Vec<u32> = (self.bits.iter())
             .flat_map(|w| [*w as u32, (*w >> 32) as u32])
-            .collect()
+            .collect();
+        words.truncate(self.block_words_at());
+        words.extend((self.blocks.iter()).flat_map(|w| [*w as u32, (*w >> 32) as u32]));
+        words
+    }
+
+    /// Where the blocks' bits start in [`VoxelHull::words`]: the voxels' words.
+    pub fn block_words_at(&self) -> usize {
+        self.grid.len().div_ceil(32)
+    }
+
+    /// How many [`VoxelHull::words`] there are.
+    pub fn word_count(&self) -> usize {
+        self.block_words_at() + 2 * self.blocks.len()
     }
 
     /// The stored form: the grid, then the occupancy bits, zstd-compressed.
@@ -412,7 +498,7 @@ impl VoxelHull {
             .chunks_exact(8)
             .map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes")))
             .collect();
-        Ok(Self { grid, bits })
+        Ok(Self::of_bits(grid, bits))
     }
 
     /// Writes the hull's surface as a PLY mesh (binary little-endian): one quad per face
@@ -594,6 +680,64 @@ mod tests {
         assert_eq!(one.count(), VoxelHull::carve(&s, 0.02, 1).unwrap().count());
     }
 
+    /// The walk over blocks finds the first occupied voxel that a test of the ray against
+    /// every occupied voxel's box finds, on a shape of thin parts whose grid is no multiple
+    /// of a block.
+    #[test]
+    fn the_walk_over_blocks_finds_the_voxel_a_test_of_every_voxel_finds() {
+        let grid = VoxelGrid::covering(Vec3::ZERO, Vec3::new(0.41, 0.37, 0.29), 0.01).unwrap();
+        assert!(grid.dims.iter().any(|d| d % BLOCK as u32 != 0));
+        // Two thin bars and a ball.
+        let hull = VoxelHull::from_fn(grid, |p| {
+            (p.x - 0.1).abs() < 0.012 && (p.z - 0.1).abs() < 0.012
+                || (p.y - 0.25).abs() < 0.008 && (p.z - 0.2).abs() < 0.01
+                || p.distance(Vec3::new(0.3, 0.15, 0.15)) < 0.07
+        });
+        let boxes: Vec<(Vec3, Vec3)> = (0..grid.len())
+            .filter(|&i| hull.occupied(i))
+            .map(|i| {
+                let [a, b, c] = grid.cell(i);
+                let centre = grid.centre(a, b, c);
+                (centre - 0.005, centre + 0.005)
+            })
+            .collect();
+        // The first entry into a box the ray crosses for at least `path` metres.
+        let first = |o: Vec3, d: Vec3, path: f32| {
+            boxes
+                .iter()
+                .filter_map(|&(lo, hi)| {
+                    let (a, b) = ((lo - o) / d, (hi - o) / d);
+                    let (enter, exit) = (a.min(b).max_element().max(0.0), a.max(b).min_element());
+                    (exit - enter >= path).then_some(enter)
+                })
+                .min_by(f32::total_cmp)
+        };
+        let (mut hits, mut seed) = (0, 7u32);
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        for _ in 0..2000 {
+            let o = Vec3::new(next(), next(), next()) * 1.2 - 0.4;
+            let target = Vec3::new(next() * 0.41, next() * 0.37, next() * 0.29);
+            let d = (target - o).normalize();
+            // A ray that crosses a voxel by a hair may be found either way.
+            let (strict, touching) = (first(o, d, 1e-4), first(o, d, -1e-5));
+            match hull.first_hit(o, d) {
+                Some(t) => {
+                    hits += 1;
+                    let (lo, hi) = (touching.unwrap(), strict.unwrap_or(f32::INFINITY));
+                    assert!(
+                        t >= lo - 1e-4 && t <= hi + 1e-4,
+                        "{o} {d}: {t} not in {lo}..{hi}"
+                    );
+                }
+                None => assert!(strict.is_none(), "{o} {d}: missed the hit at {strict:?}"),
+            }
+        }
+        assert!(hits > 500, "{hits} rays hit");
+    }
+
     #[test]
     fn rays_through_the_hull_are_blocked_and_others_pass() {
         let views = sphere_views(8);
@@ -650,8 +794,7 @@ mod tests {
     #[test]
     fn the_surface_mesh_is_closed_and_the_ply_is_written() {
         let grid = VoxelGrid::covering(Vec3::ZERO, Vec3::splat(0.3), 0.1).unwrap();
-        let mut hull = VoxelHull::empty(grid);
-        hull.bits[0] |= 1 << grid.index(1, 1, 1);
+        let hull = VoxelHull::from_test(grid, |c| c == [1, 1, 1]);
         let (v, f) = hull.surface();
         assert_eq!((v.len(), f.len()), (8, 6));
         // Every edge of a closed quad mesh is shared by two faces, once each way.

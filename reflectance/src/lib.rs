@@ -34,6 +34,7 @@ pub mod relight;
 pub mod shadow;
 pub mod stats;
 pub mod store;
+pub mod sun_depth;
 pub mod sun_light;
 pub mod unzstd;
 pub mod verify;

@@ -213,14 +213,14 @@ pub fn relight_texel(
     l: Vec3,
     weights: &[(usize, f32)],
 ) -> Rgb {
-    let interpolated = weighted(weights, &photo);
     let Some(n) = normal else {
-        return interpolated;
+        return weighted(weights, &photo);
     };
     let wanted = n.dot(l).max(0.0);
     if wanted <= 0.0 {
         return [0.0; 3];
     }
+    let interpolated = weighted(weights, &photo);
     let shaded: f32 = weights.iter().map(|&(k, w)| w * shading(k, n)).sum();
     if shaded >= RATIO_FLOOR * wanted {
         return interpolated.map(|x| x * wanted / shaded);

@@ -28,7 +28,7 @@
 use std::sync::Arc;
 
 use bytemuck::Zeroable;
-use frf_reflectance::hull::VoxelHull;
+use frf_reflectance::hull::{BLOCK, VoxelHull};
 use glam::{Vec2, Vec3};
 
 use frf_shaders::types::GpuProxy;
@@ -83,6 +83,8 @@ impl Proxy {
                         voxel: g.voxel_m,
                         dims: g.dims,
                         present: 1,
+                        block_words_at: h.block_words_at() as u32,
+                        block: BLOCK as u32,
                         ..Zeroable::zeroed()
                     },
                     h.words(),
@@ -101,10 +103,7 @@ impl Proxy {
 
     /// Bytes the proxy holds where it is rendered.
     pub fn resident_bytes(&self) -> u64 {
-        let words = self
-            .hull
-            .as_deref()
-            .map_or(1, |h| h.grid().len().div_ceil(32).max(1));
+        let words = self.hull.as_deref().map_or(1, |h| h.word_count().max(1));
         (4 * words + std::mem::size_of::<GpuProxy>()) as u64
     }
 

@@ -25,6 +25,7 @@ use frf_core::sun::Sun;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
+use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
@@ -128,6 +129,11 @@ pub struct PoseSource {
     /// Per view: its fitted normals' octahedral codes, cropped (none where the field
     /// holds none, or for a view not read).
     pub normals: Arc<Vec<Vec<[u8; 2]>>>,
+    /// Per view: where each texel's camera ray (cropped) meets the pose's visual hull, as
+    /// `t` along the ray's unit direction, `-1` where it misses; the suns' shadows are
+    /// judged from these points. Found once, at load ([`hull_surfaces`]); none for a view
+    /// without normals, or a pose without a hull.
+    pub surfaces: Arc<Vec<Vec<f32>>>,
     /// Per condition: its lights' directions (dome frame) and shares of its light
     /// ([`condition_light_shares`]), which shade the normals under a sun.
     pub condition_lights: Arc<Vec<Vec<(glam::Vec3, f32)>>>,
@@ -167,6 +173,7 @@ impl PoseSource {
             lighting,
             plan,
             (&read, self.holds_normals()),
+            self.geometry.proxy.hull(),
         )?;
         Ok(Self {
             coefficients: relit.coefficients,
@@ -270,7 +277,7 @@ impl PoseSource {
         }
         let held = (0..read.len()).any(|i| read[i])
             && (0..read.len()).all(|i| !read[i] || !normals[i].is_empty());
-        let relit = relighting(field, pose, lighting, plan, (&read, held))?;
+        let relit = relighting(field, pose, lighting, plan, (&read, held), hull.as_ref())?;
         let geometry =
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
@@ -278,7 +285,9 @@ impl PoseSource {
             .with_bounds(bounds)
             .with_proxy(Proxy::new(hull))
             .with_held(|i| read[i]);
+        let surfaces = hull_surfaces(&geometry, &normals);
         Ok(Self {
+            surfaces: Arc::new(surfaces),
             geometry: Arc::new(geometry),
             flows: Arc::new(PoseFlows {
                 codes: flows,
@@ -339,8 +348,41 @@ fn views_read<R: ReadAt>(
         .collect())
 }
 
+/// Per view of `geometry` holding `normals`: where each cropped texel's camera ray meets
+/// the pose's hull (`t` along the ray's unit direction, `-1` where it misses); nothing for
+/// a view without normals, or without a hull (see [`PoseSource::surfaces`]).
+fn hull_surfaces(geometry: &PoseGeometry, normals: &[Vec<[u8; 2]>]) -> Vec<Vec<f32>> {
+    let Some(hull) = geometry.proxy.hull() else {
+        return vec![Vec::new(); normals.len()];
+    };
+    let crop = geometry.crop;
+    (0..normals.len())
+        .into_par_iter()
+        .map(|i| {
+            if normals[i].is_empty() {
+                return Vec::new();
+            }
+            let camera = &geometry.cameras[i];
+            (0..crop.texels())
+                .map(|p| {
+                    let (o, d) = (camera.centre(), camera.ray_direction(texel_pixel(crop, p)));
+                    hull.first_hit(o, d).unwrap_or(-1.0)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The pixel of cropped texel `p` of `crop`.
+fn texel_pixel(crop: Crop, p: usize) -> glam::Vec2 {
+    glam::Vec2::new(
+        (crop.x0 as usize + p % crop.width as usize) as f32,
+        (crop.y0 as usize + p / crop.width as usize) as f32,
+    )
+}
+
 /// A pose's relighting: per view the coefficients of every condition, the subject
-/// frame's own (for the ground), the sun relit apart, and what relighting leaves out.
+/// frame's own (for the ground), the suns relit apart, and what relighting leaves out.
 struct Relighting {
     coefficients: Vec<Vec<Rgb>>,
     ground: Option<Vec<Rgb>>,
@@ -351,15 +393,17 @@ struct Relighting {
 /// Per view of pose `pose` (those `read`), the relighting coefficients of `lighting`,
 /// with the conditions `plan` leaves out at zero; the subject frame's own (for the
 /// ground), and what relighting leaves out. Where the views hold their fitted normals
-/// (`normals`) and the environment a sun, the sun is taken out of the views'
-/// coefficients and relit by the normals ([`SunLight`]); the floor conditions keep the
-/// whole environment's (the ground the sun lights), and so does the ground.
+/// (`normals`) and the environment suns (up to [`MAX_SUNS`], each found in what the last
+/// left), they are taken out of the views' coefficients and relit by the normals
+/// ([`SunLight`]); the floor conditions keep the whole environment's (the ground the suns
+/// light), and so does the ground.
 fn relighting<R: ReadAt>(
     field: &FieldFile<R>,
     pose: u32,
     lighting: &Lighting,
     plan: Option<&PosePlan>,
     (read, normals): (&[bool], bool),
+    hull: Option<&VoxelHull>,
 ) -> Result<Relighting> {
     let h = field.header();
     let record = h.pose(pose)?;
@@ -391,7 +435,7 @@ fn relighting<R: ReadAt>(
                 let Some((found, less)) = Sun::extract(rest.as_ref().unwrap_or(env))? else {
                     break;
                 };
-                suns.push(SunLight::new(&found, &h.conditions, &angles));
+                suns.push(SunLight::new(&found, &h.conditions, &angles, hull));
                 rest = Some(less);
             }
             if let Some(rest) = rest {
@@ -783,16 +827,13 @@ impl ResidentPose {
                     &source.suns
                 };
                 let (camera, crop) = (&source.geometry.cameras[i], source.geometry.crop);
-                let hull = source.geometry.proxy.hull();
-                let sunlit = |sun: &SunLight, p: usize| {
-                    let Some(hull) = hull else {
-                        return true;
-                    };
-                    let pixel = glam::Vec2::new(
-                        (crop.x0 as usize + p % crop.width as usize) as f32,
-                        (crop.y0 as usize + p / crop.width as usize) as f32,
-                    );
-                    sun.sunlit(hull, camera.centre(), camera.ray_direction(pixel))
+                // The texel's point on the visual hull (`None`: its ray misses it, or
+                // there is none), which the suns' shadows are judged from.
+                let surfaces = &source.surfaces[i];
+                let surface = |p: usize| {
+                    let t = *surfaces.get(p)?;
+                    let (o, d) = (camera.centre(), camera.ray_direction(texel_pixel(crop, p)));
+                    (t >= 0.0).then(|| o + d * t)
                 };
                 let relit: Vec<Rgb> = (0..n)
                     .map(|p| {
@@ -800,10 +841,15 @@ impl ResidentPose {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
+                        // Found once, and only where a sun would light.
+                        let mut at = None;
                         for sun in suns {
-                            // The shadow is traced only where the sun would light.
                             let s = sun_pixel(sun, i, b, normals[p], &lut, p);
-                            if s != [0.0; 3] && sunlit(sun, p) {
+                            if s == [0.0; 3] {
+                                continue;
+                            }
+                            if (*at.get_or_insert_with(|| surface(p))).is_none_or(|x| sun.sunlit(x))
+                            {
                                 for k in 0..3 {
                                     c[k] += s[k];
                                 }

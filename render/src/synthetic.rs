@@ -124,6 +124,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         basis: Arc::new(basis),
         alpha: Arc::new(vec![alpha; views]),
         normals: Arc::new(vec![Vec::new(); views]),
+        surfaces: Arc::new(vec![Vec::new(); views]),
         condition_lights: Arc::new(Vec::new()),
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
         suns: Arc::from([]),

@@ -13,15 +13,8 @@ pub mod types;
 
 /// `common.wgsl`: the structures and pure functions every pass shares.
 pub const COMMON: &str = include_str!("../common.wgsl");
-/// `relight.wgsl`, standalone.
+/// `relight.wgsl`: the relighting pass.
 pub const RELIGHT: &str = include_str!("../relight.wgsl");
-/// The relighting pass as compiled: `relight.wgsl` with the proxy's hull it traces a
-/// sun's cast shadows through (`rebin/proxy.wgsl`).
-pub const RELIGHT_PASS: &str = concat!(
-    include_str!("../relight.wgsl"),
-    "\n",
-    include_str!("../rebin/proxy.wgsl")
-);
 /// `rebin.wgsl`, standalone: the frame pass, before its pieces.
 pub const REBIN: &str = include_str!("../rebin.wgsl");
 /// `shadow.wgsl`, standalone.
@@ -39,8 +32,7 @@ pub const FLOOR: &str = include_str!("../floor.wgsl");
 /// `rebin/cylinder.wgsl`: a ray's entry into the cylinder of camera centres, composed
 /// after the frame pass.
 pub const CYLINDER: &str = include_str!("../rebin/cylinder.wgsl");
-/// `rebin/proxy.wgsl`: the geometric proxy, composed after the frame pass (and the
-/// relighting pass, [`RELIGHT_PASS`]).
+/// `rebin/proxy.wgsl`: the geometric proxy, composed after the frame pass.
 pub const PROXY: &str = include_str!("../rebin/proxy.wgsl");
 /// `morph/e06.wgsl`: E06's morphs, composed after the frame pass.
 pub const E06: &str = include_str!("../morph/e06.wgsl");
@@ -59,7 +51,7 @@ pub const FLOW_F32: &str = include_str!("../sample/flow_f32.wgsl");
 
 /// Every pass but the frame pass ([`frame_pass`]), named.
 pub const PASSES: [(&str, &str); 7] = [
-    ("relight", RELIGHT_PASS),
+    ("relight", RELIGHT),
     ("shadow", SHADOW),
     ("composite", COMPOSITE),
     ("floor", FLOOR),

@@ -135,8 +135,10 @@ pub struct GpuProxy {
     pub present: u32,
     /// `(x, z)` of the fallback's vertical axis.
     pub axis: [f32; 2],
-    /// Padding to 16 bytes.
-    pub pad: [f32; 2],
+    /// Where the hull's blocks' bits start in its words (`VoxelHull::words`).
+    pub block_words_at: u32,
+    /// Voxels along a block's side.
+    pub block: u32,
 }
 
 /// `RelightParams` of `relight.wgsl`.
@@ -199,8 +201,9 @@ pub struct GpuRelightJob {
     pub layer: u32,
     /// Its first texel in the batch's relit scratch.
     pub relit_offset: u32,
-    /// Padding.
-    pub pad0: u32,
+    /// 1 when its codes are followed by its texels' points on the hull (`t` along their
+    /// camera rays, the bits of an f32), 0 without.
+    pub surface: u32,
     /// Padding.
     pub pad1: u32,
 }

@@ -49,13 +49,6 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
                 }
             }
         } else {
-            // The relighting pass traces the proxy's hull.
-            let text = if name == "relight.wgsl" {
-                assert_eq!(text, shaders::RELIGHT, "{name} as compiled");
-                shaders::RELIGHT_PASS.to_string()
-            } else {
-                text
-            };
             let m = module(&shaders::composed(&text), &name);
             assert!(!m.entry_points.is_empty(), "{name} has no entry point");
             passes += 1;
@@ -197,7 +190,7 @@ fn pod_structs_match_naga_layouts() {
         &rebin,
         "Proxy",
         GpuProxy,
-        [origin, voxel, dims, present, axis, pad]
+        [origin, voxel, dims, present, axis, block_words_at, block]
     );
     check_layout!(
         &rebin,
@@ -238,12 +231,12 @@ fn pod_structs_match_naga_layouts() {
         fields,
         [("header".to_string(), 0), ("ranges".to_string(), ranges)]
     );
-    let relight = module(&shaders::composed(shaders::RELIGHT_PASS), "relight");
+    let relight = module(&shaders::composed(shaders::RELIGHT), "relight");
     check_layout!(
         &relight,
         "RelightParams",
         GpuRelightParams,
-        [texels, width, jobs, x0, y0, pad0, pad1, pad2]
+        [texels, width, jobs, x0, y0, sun_slots, pad1, pad2]
     );
     check_layout!(
         &relight,
@@ -256,7 +249,7 @@ fn pod_structs_match_naga_layouts() {
             view,
             layer,
             relit_offset,
-            pad0,
+            surface,
             pad1
         ]
     );

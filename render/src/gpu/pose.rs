@@ -35,9 +35,6 @@ pub struct GpuPose {
     prelit: wgpu::Texture,
     /// The view table (whose scales the relighting pass sets).
     pub(super) views: wgpu::Buffer,
-    /// The proxy's description and its hull's occupancy words (the relighting pass
-    /// traces a sun's cast shadows through them).
-    pub(super) hull: (wgpu::Buffer, wgpu::Buffer),
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
     pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
@@ -467,7 +464,6 @@ impl Gpu {
             bind_group,
             prelit,
             views: view_buffer,
-            hull: (proxy_buffer, hull_buffer),
             relight: None,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,

@@ -42,7 +42,7 @@ pub struct RelightPass {
 impl RelightPass {
     /// Builds the pass on `device`.
     pub fn new(device: &wgpu::Device) -> Self {
-        let module = shaders::module(device, "relight", shaders::RELIGHT_PASS);
+        let module = shaders::module(device, "relight", shaders::RELIGHT);
         let c = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("relight"),
@@ -56,8 +56,7 @@ impl RelightPass {
                 storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
                 storage::<GpuRelightJob>(7, true, c),
                 storage::<frf_shaders::types::GpuView>(8, false, c),
-                storage::<frf_shaders::types::GpuProxy>(9, true, c),
-                storage::<u32>(10, true, c),
+                storage::<f32>(9, true, c),
             ],
         });
         let compute = |entry: &str| compute_pipeline(device, entry, &[&layout], &module, entry);
@@ -124,9 +123,21 @@ impl PoseRelight {
 
 /// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its coefficient
 /// and where its condition's lights are, then [`MAX_SUNS`] slots of a sun: per image the
-/// sun per unit of its light, then the sun's four.
+/// sun per unit of its light, then the sun's seven.
 fn job_coefficients(tiles: usize) -> usize {
-    2 * tiles + MAX_SUNS * (tiles + 4)
+    2 * tiles + MAX_SUNS * (tiles + 7)
+}
+
+/// The suns' maps of the hull ([`SunLight::depth`]) one after the other, as the relight
+/// pass reads them (one value where there are none: a binding is never empty).
+fn sun_depths(source: &PoseSource) -> Vec<f32> {
+    let mut out: Vec<f32> = (source.suns.iter().take(MAX_SUNS))
+        .flat_map(|s| s.depth.iter().flat_map(|m| m.reach.iter().copied()))
+        .collect();
+    if out.is_empty() {
+        out.push(f32::MIN);
+    }
+    out
 }
 
 /// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
@@ -175,17 +186,13 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             &source.suns[..source.suns.len().min(MAX_SUNS)]
         };
         out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
+        let mut depth_at = 0;
         for sun in suns {
-            pack_sun(
-                &mut out,
-                sun,
-                i,
-                scales,
-                source.geometry.proxy.hull().is_some(),
-            );
+            pack_sun(&mut out, sun, i, scales, depth_at);
+            depth_at += sun.depth.as_ref().map_or(0, |m| m.reach.len());
         }
         let empty = MAX_SUNS - suns.len();
-        out.extend(std::iter::repeat_n([0.0; 4], empty * (scales.len() + 4)));
+        out.extend(std::iter::repeat_n([0.0; 4], empty * (scales.len() + 7)));
     }
     // Every batch holds the conditions' lights after its jobs, where the views hold
     // normals ([`light_coefficients`]).
@@ -201,8 +208,8 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
 }
 
 /// One slot of view `i`'s job for `sun` (`shaders/relight.wgsl` says what each holds),
-/// its shadow traced through the hull where the pose has one (`shadows`).
-fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], shadows: bool) {
+/// its map of the hull, if any, from `depth_at` on in [`sun_depths`].
+fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], depth_at: usize) {
     out.extend(
         sun.unit
             .iter()
@@ -220,8 +227,16 @@ fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], s
     out.push(view.direction.extend(1.0).to_array());
     out.push(nearest);
     out.push(weights);
-    let offset = if shadows { SHADOW_OFFSET_M } else { 0.0 };
-    out.push(sun.subject.extend(offset).to_array());
+    let Some(m) = &sun.depth else {
+        out.push(sun.subject.extend(0.0).to_array());
+        out.extend([[0.0; 4]; 3]);
+        return;
+    };
+    out.push(sun.subject.extend(SHADOW_OFFSET_M).to_array());
+    out.push(m.axes[0].extend(m.corner.x).to_array());
+    out.push(m.axes[1].extend(m.corner.y).to_array());
+    let [w, h] = m.size;
+    out.push([m.texel, w as f32, h as f32, depth_at as f32]);
 }
 
 impl Gpu {
@@ -262,7 +277,8 @@ impl Gpu {
     }
 
     /// One batch of `views` of `source`: codes packed RGBA8 (tile 0's alpha byte holding
-    /// the view's alpha code, tiles 1 and 2's its normal's codes), jobs and parameters.
+    /// the view's alpha code, tiles 1 and 2's its normal's codes), then the view's texels'
+    /// points on the hull where it has them; jobs and parameters.
     fn basis_batch(&self, source: &PoseSource, views: Vec<usize>) -> BasisBatch {
         let crop = source.geometry.crop;
         let texels = crop.texels();
@@ -278,7 +294,7 @@ impl Gpu {
                 view: i as u32,
                 layer: source.geometry.prelit_layers[i] as u32,
                 relit_offset: (j * texels) as u32,
-                pad0: 0,
+                surface: u32::from(!source.surfaces[i].is_empty()),
                 pad1: 0,
             });
             coefficients += job_coefficients(basis.scales.len());
@@ -298,6 +314,7 @@ impl Gpu {
                     c[0] as u32 | (c[1] as u32) << 8 | (c[2] as u32) << 16 | fourth << 24
                 }));
             }
+            codes.extend(source.surfaces[i].iter().map(|t| t.to_bits()));
         }
         if codes.is_empty() {
             codes.push(0);
@@ -374,6 +391,12 @@ impl Gpu {
             .max()
             .unwrap_or(0);
         let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
+        let depths = buffer_with(
+            &self.device,
+            "sun depths",
+            bytemuck::cast_slice(&sun_depths(source)),
+            wgpu::BufferUsages::STORAGE,
+        );
         self.with_pending(|encoder| {
             encoder.clear_buffer(&relight.peaks, 0, None);
             for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
@@ -391,8 +414,7 @@ impl Gpu {
                         wgpu::BindingResource::TextureView(target),
                         batch.jobs.as_entire_binding(),
                         views.as_entire_binding(),
-                        pose.hull.0.as_entire_binding(),
-                        pose.hull.1.as_entire_binding(),
+                        depths.as_entire_binding(),
                     ],
                 );
                 let groups = (basis.texels as u32).div_ceil(WORKGROUP);
