@@ -195,7 +195,7 @@ pub fn write_oracle_field(
         FieldHeader::from_capture(&capture, &options.poses, quantizer, options.jpeg_quality)?;
     header.flow_predicted = options.predict_flow;
     header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
-    header.hulls = options.shadows.map(|s| s.hull(&header));
+    header.hulls = options.shadows.map(|s| s.hull(capture.cameras()));
     header.description = format!("oracle field (stage ground truth): {}", header.description);
     if options.pose_flows {
         for &p in &options.poses {
@@ -232,7 +232,13 @@ pub fn write_oracle_field(
                 .map(|j| stage.subject_camera(pose, j / rows, j % rows))
                 .collect::<std::result::Result<_, _>>()?;
             let mattes: Vec<&GrayImage> = alphas[i * per_pose..(i + 1) * per_pose].iter().collect();
-            let r = pose_shadows(&cameras, &mattes, &header.conditions, s.hull(&header), s)?;
+            let r = pose_shadows(
+                &cameras,
+                &mattes,
+                &header.conditions,
+                s.hull(capture.cameras()),
+                s,
+            )?;
             writer.add_hull(pose, &r.hull)?;
             writer.add_shadows(pose, &r.maps)?;
         }

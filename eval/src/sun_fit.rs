@@ -28,6 +28,8 @@ pub struct SunFitReport {
     pub basis: VariantScore,
     /// The sun by the views' fitted normals.
     pub fit: VariantScore,
+    /// The suns found in the lighting and relit by the normals.
+    pub suns: usize,
 }
 
 /// Scores `source` (pose `pose` of `field` under `lighting`, whose environment holds a
@@ -99,5 +101,6 @@ pub fn score_sun_fit<R: ReadAt>(
     Ok(SunFitReport {
         basis: score(&basis_only, "sun by the basis")?,
         fit: score(source, "sun by the normals")?,
+        suns: source.suns.len(),
     })
 }

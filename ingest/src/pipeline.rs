@@ -799,7 +799,8 @@ fn shadow_step(
 ) -> Result<PoseShadows> {
     progress.begin(pose, "visual hull and shadow maps", 1);
     let (cams, mattes) = ingested_views(cameras, alphas);
-    let mut hull = options.hull(header);
+    // The header's, which every part of the field agrees on.
+    let mut hull = header.hulls.unwrap_or_else(|| options.hull(cameras));
     hull.misses = crate::shadows::misses_for(hull.misses, cams.len(), cameras.len());
     let r = pose_shadows(&cams, &mattes, &header.conditions, hull, options)?;
     steps.push(Step {
@@ -868,7 +869,7 @@ pub fn pose_header(capture: &Capture, pose: u32, options: &IngestOptions) -> Res
     )?;
     header.flow_predicted = options.predict_flow;
     header.shadows = options.shadows.map(|s| s.spec(&header.conditions));
-    header.hulls = options.shadows.map(|s| s.hull(&header));
+    header.hulls = options.shadows.map(|s| s.hull(capture.cameras()));
     Ok(header)
 }
 

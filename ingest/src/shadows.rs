@@ -8,7 +8,7 @@ use std::time::Instant;
 use frf_core::camera::Camera;
 use frf_core::image::GrayImage;
 use frf_core::volume::GroundGrid;
-use frf_reflectance::field::{ConditionRecord, FieldHeader, HullSpec, ShadowSpec};
+use frf_reflectance::field::{ConditionRecord, HullSpec, ShadowSpec};
 use frf_reflectance::hull::{Silhouette, VoxelHull, voxel_per_pixel};
 use frf_reflectance::shadow::{attenuation_maps, shadow_spec};
 
@@ -87,18 +87,14 @@ impl Default for ShadowOptions {
 pub const MAX_AUTO_TEXELS: u32 = 256;
 
 impl ShadowOptions {
-    /// The hulls of a field of `header`'s views: their voxel side and tolerance (what its
-    /// header records and every pose is carved with).
-    pub fn hull(&self, header: &FieldHeader) -> HullSpec {
-        let voxel_m = self.hull_voxel_m.unwrap_or_else(|| {
-            let cameras: Vec<Camera> = (header.poses.iter())
-                .flat_map(|p| &p.views)
-                .filter_map(|v| v.camera.to_camera().ok())
-                .collect();
-            hull_voxel_m(&cameras)
-        });
+    /// The hulls of a field of a capture whose cameras (world frame, the turntable's axis
+    /// vertical through the origin) are `cameras`: their voxel side and tolerance, what
+    /// its header records and every pose is carved with. (A pose's own views, in its
+    /// subject frame, give slightly different footprints, and the poses ingested apart
+    /// must agree to merge.)
+    pub fn hull(&self, cameras: &[Camera]) -> HullSpec {
         HullSpec {
-            voxel_m,
+            voxel_m: self.hull_voxel_m.unwrap_or_else(|| hull_voxel_m(cameras)),
             misses: self.hull_misses,
         }
     }

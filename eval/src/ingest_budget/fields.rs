@@ -292,7 +292,7 @@ pub fn write_fields(
                     &cameras,
                     &mattes,
                     &header.conditions,
-                    s.hull(&header),
+                    s.hull(capture.cameras()),
                     &s,
                 )?)
             })

@@ -30,10 +30,11 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         &Bars::default(),
     )?;
     eprintln!(
-        "{} pose {} under {} at {} captured views (truth: {} lights):",
+        "{} pose {} under {} ({} suns) at {} captured views (truth: {} lights):",
         args.field.display(),
         input.pose,
         args.lighting.name()?,
+        r.suns,
         r.fit.frames.len(),
         args.lights
     );
@@ -47,6 +48,7 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
                 "field": args.field,
                 "env": args.lighting.name()?,
                 "pose": input.pose,
+                "suns": r.suns,
                 "basis": r.basis,
                 "fit": r.fit,
             }))?
