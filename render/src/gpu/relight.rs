@@ -257,7 +257,7 @@ impl Gpu {
                     bytes = 0;
                 }
                 groups.last_mut().expect("pushed").push(i);
-                bytes += source.basis[i].tiles.len() * texels * 4;
+                bytes += (source.basis[i].tiles.len() * texels + source.surfaces[i].len()) * 4;
             }
             let batches: Vec<BasisBatch> = groups
                 .into_iter()
