@@ -724,17 +724,17 @@ pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i
 }
 
 /// The sun's light at pixel `i` of view `view` ([`SunLight::texel`]) from the view's
-/// basis codes and the pixel's normal code.
+/// basis codes and the pixel's normal (`None`: none fitted).
 #[inline]
 pub fn sun_pixel(
     sun: &SunLight,
     view: usize,
     basis: &BasisCodes,
-    normal: [u8; 2],
+    normal: Option<glam::Vec3>,
     lut: &[f32; 256],
     i: usize,
 ) -> Rgb {
-    sun.texel(view, normal_of(normal), |k| {
+    sun.texel(view, normal, |k| {
         let (p, s) = (basis.tiles[k][i], basis.scales[k]);
         [p[0], p[1], p[2]].map(|c| s * lut[c as usize])
     })
@@ -843,8 +843,13 @@ impl ResidentPose {
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
                         // Found once, and only where a sun would light.
                         let mut at = None;
+                        let normal = if suns.is_empty() {
+                            None
+                        } else {
+                            normal_of(normals[p])
+                        };
                         for sun in suns {
-                            let s = sun_pixel(sun, i, b, normals[p], &lut, p);
+                            let s = sun_pixel(sun, i, b, normal, &lut, p);
                             if s == [0.0; 3] {
                                 continue;
                             }
