@@ -611,6 +611,8 @@ fn eval_sun_fit_scores_the_light_fit_above_the_basis_under_a_low_sun() {
     );
     assert!(fit >= basis + 2.0, "fit {fit} dB, basis {basis} dB");
     assert!(r["env"].as_str().unwrap().contains("sun"), "{r}");
+    // The one sun given is the one sun found.
+    assert_eq!(r["suns"], 1, "{r}");
     assert_eq!(r["fit"]["frames"].as_array().unwrap().len(), 4);
     // An environment without a sun is refused by name.
     let o = frf(&[

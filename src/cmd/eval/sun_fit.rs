@@ -30,11 +30,12 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
         &Bars::default(),
     )?;
     eprintln!(
-        "{} pose {} under {} ({} suns) at {} captured views (truth: {} lights):",
+        "{} pose {} under {} ({} sun{}) at {} captured views (truth: {} lights):",
         args.field.display(),
         input.pose,
         args.lighting.name()?,
         r.suns,
+        if r.suns == 1 { "" } else { "s" },
         r.fit.frames.len(),
         args.lights
     );
