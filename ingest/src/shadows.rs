@@ -173,11 +173,7 @@ pub fn pose_shadows(
         .map(|(camera, alpha)| Silhouette { camera, alpha })
         .collect();
     let coarse = (BAND_PARENT_M / hull.voxel_m).floor() as u32;
-    let hull = if coarse >= 2 {
-        VoxelHull::carve_banded(&views, hull.voxel_m, coarse, hull.misses)?
-    } else {
-        VoxelHull::carve(&views, hull.voxel_m, hull.misses)?
-    };
+    let hull = VoxelHull::carve_banded(&views, hull.voxel_m, coarse, hull.misses)?;
     let hull_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let maps = attenuation_maps(&hull, conditions, &options.spec(conditions));

@@ -274,14 +274,17 @@ impl VoxelHull {
     /// full carve at `voxel_m` wherever the surface's features are larger than a
     /// coarse voxel (the walker's thinnest part, a hand, spans 2.5 coarse voxels of
     /// 2 cm), at a small part of its cost: a full carve at 2.5 mm took 38 s for the
-    /// small preset's 108 views, the band 2 s (2 cores, loaded).
+    /// small preset's 108 views, the band 2 s (2 cores, loaded). A `coarse` of 1 or
+    /// less is the full carve.
     pub fn carve_banded(
         views: &[Silhouette],
         voxel_m: f32,
         coarse: u32,
         misses: usize,
     ) -> Result<Self> {
-        let coarse = coarse.max(1);
+        if coarse <= 1 {
+            return Self::carve(views, voxel_m, misses);
+        }
         let parent = Self::carve(views, voxel_m * coarse as f32, misses)?;
         let pg = parent.grid;
         let grid = VoxelGrid {

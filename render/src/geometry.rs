@@ -103,6 +103,14 @@ impl Crop {
         self.width as usize * self.height as usize
     }
 
+    /// The pixel `(x, y)` of the full image that texel `k` of the crop (row by row) is.
+    pub fn pixel(&self, k: usize) -> (usize, usize) {
+        (
+            self.x0 as usize + k % self.width as usize,
+            self.y0 as usize + k / self.width as usize,
+        )
+    }
+
     /// The crop's rows of a full image of row length `full_width`.
     pub fn rows_of<T: Copy>(&self, data: &[T], full_width: usize) -> Vec<T> {
         let mut out = Vec::with_capacity(self.texels());

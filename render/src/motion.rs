@@ -135,10 +135,7 @@ pub fn pose_motion<R: ReadAt>(
             }
             let mut metres: Vec<Option<Vec2>> = (0..crop.texels())
                 .map(|k| {
-                    let (x, y) = (
-                        crop.x0 as usize + k % crop.width as usize,
-                        crop.y0 as usize + k / crop.width as usize,
-                    );
+                    let (x, y) = crop.pixel(k);
                     let at = Vec2::new(x as f32, y as f32);
                     subject_motion(camera, &later, at, flow.get(x, y)).map(|m| to_metres * m)
                 })

@@ -373,12 +373,10 @@ fn hull_surfaces(geometry: &PoseGeometry, normals: &[Vec<[u8; 2]>]) -> Vec<Vec<f
         .collect()
 }
 
-/// The pixel of cropped texel `p` of `crop`.
+/// The pixel of cropped texel `p` of `crop`, as a point.
 fn texel_pixel(crop: Crop, p: usize) -> glam::Vec2 {
-    glam::Vec2::new(
-        (crop.x0 as usize + p % crop.width as usize) as f32,
-        (crop.y0 as usize + p / crop.width as usize) as f32,
-    )
+    let (x, y) = crop.pixel(p);
+    glam::Vec2::new(x as f32, y as f32)
 }
 
 /// A pose's relighting: per view the coefficients of every condition, the subject

@@ -189,7 +189,7 @@ impl Gpu {
             source.flows.table,
         );
         let relight = self.pose_relight(basis, geometry.views());
-        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose);
+        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose.views);
         pose.relight = Some(relight);
         Ok(pose)
     }
@@ -212,7 +212,7 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(relight, source, &pose.prelit_codes_view(), pose);
+            self.record_relight(relight, source, &pose.prelit_codes_view(), &pose.views);
             Ok(())
         })
     }

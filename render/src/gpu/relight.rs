@@ -369,15 +369,14 @@ impl Gpu {
 
     /// Writes `source`'s coefficients into `relight`'s buffers and records the passes
     /// that relight its views into the pre-lit layers of `target`, their scales into the
-    /// pose's view table ([`Gpu::relight_pose`]).
+    /// pose's view table `views` ([`Gpu::relight_pose`]).
     pub(super) fn record_relight(
         &self,
         relight: &PoseRelight,
         source: &PoseSource,
         target: &wgpu::TextureView,
-        pose: &super::GpuPose,
+        views: &wgpu::Buffer,
     ) {
-        let views = &pose.views;
         let basis = &relight.basis;
         for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
             let packed = packed_coefficients(batch, source);
