@@ -62,13 +62,15 @@ struct Frame {
     centre: vec4<f32>,
     intrinsics: vec4<f32>,
     size: vec2<u32>,
+    // The morph the frame is drawn with (the frame pass reads its pipeline's overrides
+    // `KIND` and `FLAGS` instead; these say what it was given).
     variant: u32,
     quad_count: u32,
     columns: u32,
     rows: u32,
     crop_origin: vec2<u32>,
     crop_size: vec2<u32>,
-    // Refinements: 1 rays beyond the rows through the proxy, 2 occlusion-aware morphs.
+    // Its refinements: 1 rays beyond the rows through the proxy, 2 occlusion-aware morphs.
     flags: u32,
     pad: u32,
     // The pixels shaded, [x0, y0, x1, y1] (ends exclusive): the walker is transparent

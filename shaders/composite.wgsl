@@ -7,7 +7,11 @@
 // the walkers alone. Twin of `compose` in `render/src/composite.rs`. Compiled after
 // `common.wgsl`.
 //
-// Bind group 0 holds per-frame data (the camera and these settings), group 1 the images.
+// A compute pass, 8 x 8 pixels a workgroup: drawn as a full-screen fragment pass it took
+// an H100 4.7 ms at 1920x1080, as compute 0.1 ms (docs/results/realtime.md).
+//
+// Bind group 0 holds per-frame data (the camera and these settings) and the four
+// targets, group 1 the images.
 
 struct Composite {
     // 0: none (transparent, the shadow a black layer), 1: environment, 2: plate.
@@ -56,6 +60,11 @@ struct Instance {
 // does not list is transparent and casts no shadow there (`TileLists` in
 // render/src/footprint.rs).
 @group(0) @binding(3) var<storage, read> tiles: array<u32>;
+// The targets: the composite, the relative irradiance S, the backdrop, the walkers alone.
+@group(0) @binding(4) var composite_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(5) var shadow_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(6) var backdrop_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(7) var subject_out: texture_storage_2d<rgba32float, write>;
 
 // The rendered walkers, premultiplied linear RGBA, one texel per pixel, packed into
 // pages (each walker's `place`).
@@ -68,10 +77,10 @@ struct Instance {
 @group(1) @binding(3) var shadows: texture_2d_array<f32>;
 
 struct Layers {
-    @location(0) composite: vec4<f32>,
-    @location(1) shadow: vec4<f32>,
-    @location(2) backdrop: vec4<f32>,
-    @location(3) subject: vec4<f32>,
+    composite: vec4<f32>,
+    shadow: vec4<f32>,
+    backdrop: vec4<f32>,
+    subject: vec4<f32>,
 }
 
 const PI: f32 = 3.14159265358979;
@@ -172,9 +181,9 @@ fn luminance(c: vec3<f32>) -> f32 {
     return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
 }
 
-@fragment
-fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
-    let pixel = vec2<i32>(floor(position.xy));
+// The layers of the pixel at `pixel`.
+fn composite_pixel(pixel: vec2<i32>) -> Layers {
+    let position = vec4<f32>(vec2<f32>(pixel) + 0.5, 0.0, 1.0);
     let tile = (u32(pixel.y) / params.tile_side) * params.tile_columns + u32(pixel.x) / params.tile_side;
     let first = tiles[2u * tile];
     let listed = tiles[2u * tile + 1u];
@@ -224,4 +233,17 @@ fn fs_composite(@builtin(position) position: vec4<f32>) -> Layers {
     out.backdrop = back;
     out.subject = front;
     return out;
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_composite(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id.xy >= frame.size)) {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    let out = composite_pixel(pixel);
+    textureStore(composite_out, pixel, out.composite);
+    textureStore(shadow_out, pixel, out.shadow);
+    textureStore(backdrop_out, pixel, out.backdrop);
+    textureStore(subject_out, pixel, out.subject);
 }

@@ -9,13 +9,26 @@
 // morph (`morph/solved.wgsl`, variant 4).
 // Entry points: `fs_main` (a full-screen triangle into a colour target, scissored to the
 // frame's bounds), `cs_main` (the pixels of the frame's bounds from a compute pass into a
-// storage texture, and what happened to each pixel's ray counted per workgroup, then once
-// per workgroup into `stats`), `cs_classes` (those counts alone, for frames drawn by
-// `fs_main`).
+// storage texture, and the pixels whose rays were clamped or missed counted into
+// `stats`), `cs_classes` (those counts alone, for frames drawn by `fs_main`).
 // Bind group 0 holds per-frame data, bind group 1 the resident pose.
+//
+// A pipeline is made per morph (`frf_render::morph::Variant`): its interpolation and its
+// refinements are constants of the pipeline (the overrides `KIND` and `FLAGS`), so the
+// shader compiled holds that morph alone (measured on an H100 and on lavapipe, docs/
+// results/realtime.md).
+
+// The interpolation (`Variant::index`: 0 nearest, 1 linear, 2 two-way, 3 E06's four-way,
+// 4 the solved four-way).
+override KIND: u32;
+// Refinements (`Variant::flags`): 1 rays beyond the rows through the proxy, 2
+// occlusion-aware morphs.
+override FLAGS: u32;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// Pixels inside the grid, clamped above, clamped below, missed (compute entry points).
+// Pixels clamped above, clamped below and missed, at 1 to 3 (compute entry points; those
+// inside the grid, the rest of the shaded pixels, are not counted: a count of every pixel
+// would be an atomic per pixel on one word).
 @group(0) @binding(1) var<storage, read_write> stats: array<atomic<u32>, 4>;
 // The compute pass's target (`cs_main` only): pixel p of the frame goes to texel
 // p + frame.place.xy of layer frame.place.z.
@@ -99,7 +112,7 @@ fn classify(position: vec2<f32>) -> Classified {
     if (hit.clamped == 3u) {
         return out;
     }
-    if (frame.variant == 4u) {
+    if (KIND == 4u) {
         // The solved morph looks the ray up in the quad's rectified frame.
         out.solved = solved_output(hit, frame.centre.xyz, dir);
         if (out.solved.ok) {
@@ -123,7 +136,7 @@ fn classify(position: vec2<f32>) -> Classified {
     }
     // Clamped to a row: the ray's point on the proxy, seen from the camera on the row.
     var ray = dir;
-    if ((frame.flags & 1u) != 0u && hit.clamped != 0u) {
+    if ((FLAGS & 1u) != 0u && hit.clamped != 0u) {
         let point = proxy_point(frame.centre.xyz, dir);
         if (point.w > 0.0) {
             var centre = vec3<f32>(0.0);
@@ -148,7 +161,7 @@ fn shade_classified(c: Classified) -> vec4<f32> {
     if (c.kind == 3u) {
         return vec4<f32>(0.0);
     }
-    if (frame.variant == 4u) {
+    if (KIND == 4u) {
         return solved_morph(c.hit, c.solved);
     }
     return morph(c.hit, c.s);
@@ -165,46 +178,29 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     return shade(position.xy - vec2<f32>(frame.place.xy));
 }
 
-// Per workgroup, how many of its pixels fell in each class; added to `stats` once.
-var<workgroup> class_counts: array<atomic<u32>, 4>;
-
-fn clear_counts(local: u32) {
-    if (local < 4u) {
-        atomicStore(&class_counts[local], 0u);
-    }
-    workgroupBarrier();
-}
-
-fn flush_counts(local: u32) {
-    workgroupBarrier();
-    if (local < 4u) {
-        let n = atomicLoad(&class_counts[local]);
-        if (n > 0u) {
-            atomicAdd(&stats[local], n);
-        }
+// Counts a pixel of class `kind` (those inside are not counted, see `stats`).
+fn count_class(kind: u32) {
+    if (kind != 0u) {
+        atomicAdd(&stats[kind], 1u);
     }
 }
 
 // The frame pass as a compute dispatch: shades and counts the pixel classes.
 @compute @workgroup_size(8, 8)
-fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    clear_counts(local);
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         let c = classify(vec2<f32>(p) + 0.5);
         textureStore(target_image, vec2<i32>(p) + frame.place.xy, frame.place.z, shade_classified(c));
-        atomicAdd(&class_counts[c.kind], 1u);
+        count_class(c.kind);
     }
-    flush_counts(local);
 }
 
 // The pixel classes alone, for frames drawn by the fragment pass.
 @compute @workgroup_size(8, 8)
-fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    clear_counts(local);
+fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
-        atomicAdd(&class_counts[classify(vec2<f32>(p) + 0.5).kind], 1u);
+        count_class(classify(vec2<f32>(p) + 0.5).kind);
     }
-    flush_counts(local);
 }

@@ -242,7 +242,7 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     pub(crate) decoded: crate::decoded::DecodedBasis,
     /// The projector of the field's conditions, made on first use
     /// ([`FieldFile::projector`]).
-    pub(crate) projector: std::sync::OnceLock<crate::project::Projector>,
+    pub(crate) projector: std::sync::OnceLock<std::sync::Arc<crate::project::Projector>>,
 }
 
 impl FieldFile<FileSource> {

@@ -38,6 +38,8 @@ pub mod sun_depth;
 pub mod sun_light;
 pub mod unzstd;
 pub mod verify;
+pub mod yaw_light;
+pub mod yaw_table;
 
 pub use container::{FieldFile, FieldWriter};
 pub use field::{FieldHeader, ViewData};

@@ -94,6 +94,58 @@ fn span_sum(prefix: &[[f64; 3]], w: usize, c: f64, (a, b): (u32, u32)) -> [f64; 
     out
 }
 
+/// The turn `C = (3π + ψ + t) / 2π` at which a map turned by `ψ` (radians) is seen by a
+/// subject at turntable angle `t` (radians); a whole turn later is the same light.
+pub fn turn_of(yaw: f32, turntable: f32) -> f64 {
+    (3.0 * std::f64::consts::PI + yaw as f64 + turntable as f64) / std::f64::consts::TAU
+}
+
+/// A map made ready to project at any turn: per texel row, its solid angle, its row of the
+/// lookup grid and the prefix sums of its radiance (below the horizon, the ground's under
+/// [`FloorModel::LambertianGround`]). Made once per map (`rows × width` additions); each
+/// turn then costs `rows × runs` ([`Projector::region_light_at`]).
+#[derive(Debug, Clone)]
+pub struct PreparedMap {
+    width: usize,
+    rows: Vec<(f64, usize, Vec<[f64; 3]>)>,
+}
+
+impl PreparedMap {
+    /// `env`'s rows (its yaw plays no part: turns are given to
+    /// [`Projector::region_light_at`]), with the floor conditions lit by `floor`.
+    pub fn new(env: &EnvMap, floor: FloorModel) -> Self {
+        let img = env.image();
+        let (w, h) = img.size();
+        let ground = match floor {
+            FloorModel::Environment => None,
+            FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
+        };
+        let rows = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let d = env.direction_of(0.0, y as f32);
+                let el = azimuth_elevation(d).1;
+                let ie = (((el + PI / 2.0) / PI * EL_CELLS as f32) as usize).min(EL_CELLS - 1);
+                let mut prefix = Vec::with_capacity(w + 1);
+                let mut sum = [0.0f64; 3];
+                prefix.push(sum);
+                for x in 0..w {
+                    let l = match ground {
+                        Some(g) if d.y < 0.0 => g,
+                        _ => img.get(x, y),
+                    };
+                    for c in 0..3 {
+                        sum[c] += l[c] as f64;
+                    }
+                    prefix.push(sum);
+                }
+                (env.texel_solid_angle(y) as f64, ie, prefix)
+            })
+            .collect();
+        Self { width: w, rows }
+    }
+}
+
 impl Projector {
     /// A projector for `conditions` (dome frame).
     pub fn new(conditions: &[ConditionRecord]) -> Result<Self> {
@@ -180,63 +232,49 @@ impl Projector {
     /// An environment map is equirectangular: a texel row has one elevation (a turn about
     /// `+y` keeps it), hence one row of the lookup grid, and its texels' azimuths step
     /// evenly. Texel `x` of a map `w` wide turned by `ψ`, seen at turntable `t`, falls in
-    /// grid cell `⌊frac(C − (x + ½)/w) · AZ_CELLS⌋` with `C = (3π + ψ + t) / 2π`. So each
-    /// run of one condition along the grid row takes a contiguous span of texels (two
-    /// where it wraps), summed from the row's prefix sums: a turntable angle costs rows ×
-    /// runs, not rows × texels, which is what makes relighting a crowd under a moving
-    /// light cheap for the host. Texels whose centre lies on a cell boundary (to within
-    /// rounding) may fall on its other side than a direct lookup would put them.
+    /// grid cell `⌊frac(C − (x + ½)/w) · AZ_CELLS⌋` with `C = (3π + ψ + t) / 2π`
+    /// ([`turn_of`]). So each run of one condition along the grid row takes a contiguous
+    /// span of texels (two where it wraps), summed from the row's prefix sums
+    /// ([`PreparedMap`]): a turntable angle costs rows × runs, not rows × texels, which is
+    /// what makes relighting a crowd under a moving light cheap for the host. Texels whose
+    /// centre lies on a cell boundary (to within rounding) may fall on its other side than
+    /// a direct lookup would put them.
     pub fn region_light_many(
         &self,
         env: &EnvMap,
         turntables: &[f32],
         floor: FloorModel,
     ) -> Vec<Vec<Rgb>> {
-        let img = env.image();
-        let (w, h) = img.size();
-        let ground = match floor {
-            FloorModel::Environment => None,
-            FloorModel::LambertianGround { albedo } => Some(env.lambertian_ground(albedo)),
-        };
-        // Per row: its solid angle, its grid row and the prefix sums of its radiance.
-        let rows: Vec<(f64, usize, Vec<[f64; 3]>)> = (0..h)
-            .into_par_iter()
-            .map(|y| {
-                let d = env.direction_of(0.0, y as f32);
-                let el = azimuth_elevation(d).1;
-                let ie = (((el + PI / 2.0) / PI * EL_CELLS as f32) as usize).min(EL_CELLS - 1);
-                let mut prefix = Vec::with_capacity(w + 1);
-                let mut sum = [0.0f64; 3];
-                prefix.push(sum);
-                for x in 0..w {
-                    let l = match ground {
-                        Some(g) if d.y < 0.0 => g,
-                        _ => img.get(x, y),
-                    };
-                    for c in 0..3 {
-                        sum[c] += l[c] as f64;
-                    }
-                    prefix.push(sum);
-                }
-                (env.texel_solid_angle(y) as f64, ie, prefix)
-            })
-            .collect();
+        let prepared = PreparedMap::new(env, floor);
         turntables
             .par_iter()
-            .map(|&turntable| {
-                let c = (3.0 * std::f64::consts::PI + env.yaw() as f64 + turntable as f64)
-                    / std::f64::consts::TAU;
-                let mut total = vec![[0.0f64; 3]; self.conditions()];
-                for (omega, ie, prefix) in &rows {
-                    for &(a, b, k) in &self.runs[*ie] {
-                        let sum = span_sum(prefix, w, c, (a, b));
-                        for ch in 0..3 {
-                            total[k as usize][ch] += sum[ch] * omega;
-                        }
-                    }
+            .map(|&t| self.region_light_at(&prepared, turn_of(env.yaw(), t)))
+            .collect()
+    }
+
+    /// `∫ L dω` of a prepared map over each condition's region at turn `c` (see
+    /// [`Projector::region_light_many`]; `c` and `c + 1` are one turn).
+    pub fn region_light_at(&self, map: &PreparedMap, c: f64) -> Vec<Rgb> {
+        let mut total = vec![[0.0f64; 3]; self.conditions()];
+        for (omega, ie, prefix) in &map.rows {
+            for &(a, b, k) in &self.runs[*ie] {
+                let sum = span_sum(prefix, map.width, c, (a, b));
+                for ch in 0..3 {
+                    total[k as usize][ch] += sum[ch] * omega;
                 }
-                total.into_iter().map(|t| t.map(|v| v as f32)).collect()
-            })
+            }
+        }
+        total.into_iter().map(|t| t.map(|v| v as f32)).collect()
+    }
+
+    /// The relighting coefficients of the light `light` (per condition, as
+    /// [`Projector::region_light`] gives it): divided by the light each condition
+    /// delivers.
+    pub fn coefficients_of(&self, light: &[Rgb]) -> Vec<Rgb> {
+        light
+            .iter()
+            .zip(&self.delivered)
+            .map(|(light, d)| [0, 1, 2].map(|c| if d[c] > 0.0 { light[c] / d[c] } else { 0.0 }))
             .collect()
     }
 
@@ -260,18 +298,7 @@ impl Projector {
             }
         }
         let lights = self.region_light_many(env, &distinct, floor);
-        let coefficients: Vec<Vec<Rgb>> = lights
-            .iter()
-            .map(|light| {
-                light
-                    .iter()
-                    .zip(&self.delivered)
-                    .map(|(light, d)| {
-                        [0, 1, 2].map(|c| if d[c] > 0.0 { light[c] / d[c] } else { 0.0 })
-                    })
-                    .collect()
-            })
-            .collect();
+        let coefficients: Vec<Vec<Rgb>> = lights.iter().map(|l| self.coefficients_of(l)).collect();
         turntables
             .iter()
             .map(|t| {

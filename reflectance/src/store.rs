@@ -264,10 +264,15 @@ impl<R: ReadAt> FieldFile<R> {
     /// The projector of the field's conditions ([`crate::project::Projector`]: environments to
     /// relighting coefficients), made once and shared by every pose relit.
     pub fn projector(&self) -> Result<&crate::project::Projector> {
+        Ok(self.projector_shared()?)
+    }
+
+    /// [`FieldFile::projector`], to keep (what a [`crate::yaw_table::YawTable`] holds).
+    pub fn projector_shared(&self) -> Result<&std::sync::Arc<crate::project::Projector>> {
         if let Some(p) = self.projector.get() {
             return Ok(p);
         }
-        let made = crate::project::Projector::new(&self.header().conditions)?;
+        let made = std::sync::Arc::new(crate::project::Projector::new(&self.header().conditions)?);
         Ok(self.projector.get_or_init(|| made))
     }
 

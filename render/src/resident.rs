@@ -21,7 +21,6 @@ use frf_core::env::EnvMap;
 use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::io::{linear_to_srgb, srgb_to_linear};
-use frf_core::sun::Sun;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
@@ -30,7 +29,8 @@ use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
-use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
+use frf_reflectance::sun_light::SunLight;
+use frf_reflectance::yaw_light::YawLight;
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -55,6 +55,9 @@ pub enum Lighting {
         /// Where the floor conditions' light comes from.
         floor: FloorModel,
     },
+    /// A light of turned, weighted maps read through their yaw tables (what a shot
+    /// relights its walkers with: a turning light and every heading share the tables).
+    Tabled(YawLight),
     /// Every condition at coefficient 1 (for fields of photographs: no relighting).
     Unlit,
 }
@@ -407,47 +410,37 @@ fn relighting<R: ReadAt>(
     let record = h.pose(pose)?;
     let views = read.len();
     let mut suns = Vec::new();
+    // Views not read keep angle 0 (their coefficients are never used).
+    let angles: Vec<f32> = record
+        .views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            if read[i] {
+                v.turntable_deg.to_radians()
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    // The views' coefficients and the ground's under a light read from its yaw tables;
+    // where the views hold their normals, its suns apart, relit by them.
+    let by_table = |light: &YawLight, angles: &[f32], normals: bool, suns: &mut Vec<SunLight>| {
+        let lit = light.lighting(angles, normals)?;
+        suns.extend(
+            lit.suns
+                .iter()
+                .map(|s| SunLight::new(s, &h.conditions, angles, hull)),
+        );
+        Ok::<_, RenderError>((lit.coefficients, Some(lit.ground)))
+    };
     let (mut coefficients, ground) = match lighting {
         Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
         Lighting::Environment { env, floor } => {
-            let projector = field.projector()?;
-            // Views not read keep angle 0 (their coefficients are never used).
-            let angles: Vec<f32> = record
-                .views
-                .iter()
-                .enumerate()
-                .map(|(i, v)| {
-                    if read[i] {
-                        v.turntable_deg.to_radians()
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            // One pass over the map for every view's turntable angle and the
-            // subject's own frame (angle 0), the last.
-            let mut all = projector.project_many(env, &[&angles[..], &[0.0]].concat(), *floor);
-            let own = all.pop();
-            let mut rest = None;
-            while normals && suns.len() < MAX_SUNS {
-                let Some((found, less)) = Sun::extract(rest.as_ref().unwrap_or(env))? else {
-                    break;
-                };
-                suns.push(SunLight::new(&found, &h.conditions, &angles, hull));
-                rest = Some(less);
-            }
-            if let Some(rest) = rest {
-                let less = projector.project_many(&rest, &angles, *floor);
-                for (c, l) in all.iter_mut().zip(less) {
-                    for k in 0..c.len() {
-                        if !projector.is_floor(k) {
-                            c[k] = l[k];
-                        }
-                    }
-                }
-            }
-            (all, own)
+            let light = YawLight::of_env(field.projector_shared()?.clone(), env, *floor);
+            by_table(&light, &angles, normals, &mut suns)?
         }
+        Lighting::Tabled(light) => by_table(light, &angles, normals, &mut suns)?,
     };
     if let Some(p) = plan {
         // Conditions the plan leaves out have zero weight at every frame.

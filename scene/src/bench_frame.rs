@@ -19,6 +19,7 @@ use std::time::Instant;
 use frf_core::progress::Progress;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
+use frf_render::gpu::pass_clock::PassTime;
 use frf_render::renderer::Device;
 use glam::Vec3;
 use serde::Serialize;
@@ -107,6 +108,9 @@ pub struct FrameBenchRow {
     pub relights_per_frame: f64,
     /// Most bytes resident at once, MB.
     pub peak_resident_mb: f64,
+    /// Per pass, its median device time per counted frame by GPU timestamps (empty where
+    /// the adapter has none, and on the CPU).
+    pub passes: Vec<PassTime>,
 }
 
 /// What `frf bench frame` measured.
@@ -116,6 +120,8 @@ pub struct FrameBenchReport {
     pub device: String,
     /// How `gpu_ms_per_frame` was measured.
     pub gpu_clock: &'static str,
+    /// How the rows' `passes` were measured (`gpu-timestamps`, or `none`).
+    pub pass_clock: &'static str,
     /// Frame size.
     pub size: (u32, u32),
     /// Frames counted per row.
@@ -143,6 +149,22 @@ impl FrameBenchReport {
                 r.relights_per_frame,
                 r.peak_resident_mb
             );
+        }
+        if self.rows.iter().any(|r| !r.passes.is_empty()) {
+            out += "device ms per frame by pass (GPU timestamps, medians; passes per frame):\n";
+            for r in &self.rows {
+                let passes: Vec<String> = r
+                    .passes
+                    .iter()
+                    .map(|p| format!("{} {:.1} ({})", p.pass, p.ms, p.passes))
+                    .collect();
+                out += &format!(
+                    "{:>7}  {:<8} {}\n",
+                    r.walkers,
+                    r.light.name(),
+                    passes.join(", ")
+                );
+            }
         }
         let find =
             |w: usize, l: LightMode| self.rows.iter().find(|r| r.walkers == w && r.light == l);
@@ -235,25 +257,35 @@ pub fn run_frame_bench<R: ReadAt>(
     progress.phase("frames", rows_wanted * (options.frames + 1));
     let mut rows = Vec::with_capacity(rows_wanted);
     let mut device_name = String::new();
+    let mut pass_clock = "none";
     for &n in &options.walkers {
         for &light in &options.lights {
             let s = bench_scene(scene, n, light, options.frames);
             let frames = s.shot_frames(0..options.frames + 1, options.size)?;
             let device = Device::open(options.cpu)?;
             device_name = device.name();
+            if let Device::Gpu(gpu) = &device
+                && gpu.clock_passes()
+            {
+                pass_clock = "gpu-timestamps";
+            }
             let mut shot = Shot::new(&s, field, device, &frames, options.shot)?;
             let mut wall = Vec::new();
             let mut waited = Vec::new();
+            let mut passes: Vec<Vec<PassTime>> = Vec::new();
             let mut relights = 0;
             for (k, f) in frames.iter().enumerate() {
                 let before = waited_on(shot.render_device());
                 let t = Instant::now();
                 let made = shot.render(f, false)?.made_resident.len();
                 let w = t.elapsed().as_secs_f64() * 1e3;
+                // Read after the frame's time is taken (reading waits on the device).
+                let times = pass_times(shot.render_device())?;
                 if k > 0 {
                     wall.push(w);
                     waited.push((waited_on(shot.render_device()) - before) * 1e3);
                     relights += made;
+                    passes.push(times);
                 }
                 progress.step();
             }
@@ -266,12 +298,14 @@ pub fn run_frame_bench<R: ReadAt>(
                 wall_ms_per_frame: median(&wall),
                 relights_per_frame: relights as f64 / options.frames as f64,
                 peak_resident_mb: shot.counters().peak_resident_bytes as f64 / 1e6,
+                passes: median_passes(&passes),
             });
         }
     }
     Ok(FrameBenchReport {
         device: device_name,
         gpu_clock: "fenced-wall",
+        pass_clock,
         size: options.size,
         frames: options.frames,
         rows,
@@ -284,6 +318,40 @@ fn waited_on(device: &Device) -> f64 {
         Device::Gpu(gpu) => gpu.waited().as_secs_f64(),
         Device::Cpu => 0.0,
     }
+}
+
+/// The device time of each pass since the last call (none on the CPU).
+fn pass_times(device: &Device) -> Result<Vec<PassTime>> {
+    Ok(match device {
+        Device::Gpu(gpu) => gpu.pass_times()?,
+        Device::Cpu => Vec::new(),
+    })
+}
+
+/// Per pass (in the order first seen), the median over `frames` of its time per frame
+/// (0 in a frame without it) and the mean count.
+fn median_passes(frames: &[Vec<PassTime>]) -> Vec<PassTime> {
+    let mut names: Vec<String> = Vec::new();
+    for f in frames {
+        for p in f {
+            if !names.contains(&p.pass) {
+                names.push(p.pass.clone());
+            }
+        }
+    }
+    names
+        .into_iter()
+        .map(|name| {
+            let of = |f: &Vec<PassTime>| f.iter().find(|p| p.pass == name).cloned();
+            let ms: Vec<f64> = frames.iter().map(|f| of(f).map_or(0.0, |p| p.ms)).collect();
+            let count: usize = frames.iter().map(|f| of(f).map_or(0, |p| p.passes)).sum();
+            PassTime {
+                passes: count / frames.len().max(1),
+                ms: median(&ms),
+                pass: name,
+            }
+        })
+        .collect()
 }
 
 /// The median of `v` (NaN when empty).

@@ -15,6 +15,7 @@
 
 use std::borrow::Cow;
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use frf_core::env::{EnvMap, EnvSource};
@@ -22,6 +23,8 @@ use frf_core::image::RgbImage;
 use frf_core::io::read_photo;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
+use frf_reflectance::yaw_light::{YawLight, YawTerm};
+use frf_reflectance::yaw_table::YawTable;
 
 use super::plan::{FramePlan, Plan, PosePlan, ShotFrame};
 use super::{BackdropSpec, LightingAt, Scene, ShadowSpec, TimeInterpolation};
@@ -127,6 +130,14 @@ impl LightingKey {
     }
 }
 
+/// A frame's lighting in the scene frame: the map it composes (what the backdrop and
+/// traced shadows show) and the same light as its maps' yaw tables read it (what relights
+/// the walkers).
+struct World {
+    env: EnvMap,
+    light: YawLight,
+}
+
 struct Cached {
     pose: u32,
     heading: u32,
@@ -219,7 +230,10 @@ pub struct Shot<'a, R: ReadAt> {
     plan: Plan,
     options: ShotOptions,
     envs: HashMap<String, EnvMap>,
-    world: Option<(LightingKey, Option<EnvMap>)>,
+    /// The yaw tables of the maps lit so far (and of a scene's sun in a map of its own),
+    /// by map: every walker and every turn of the light reads them.
+    tables: HashMap<String, Arc<YawTable>>,
+    world: Option<(LightingKey, Option<Arc<World>>)>,
     backdrop: Option<(LightingKey, DeviceBackdrop)>,
     plate: Option<RgbImage>,
     cache: Vec<Cached>,
@@ -297,6 +311,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             plan,
             options,
             envs: HashMap::new(),
+            tables: HashMap::new(),
             world: None,
             backdrop: None,
             plate,
@@ -390,18 +405,42 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(Some(e))
     }
 
+    /// The yaw table of the map `key` (made by `map` the first time).
+    fn table(
+        &mut self,
+        key: String,
+        map: impl FnOnce() -> Result<EnvMap>,
+    ) -> Result<Arc<YawTable>> {
+        if let Some(t) = self.tables.get(&key) {
+            return Ok(t.clone());
+        }
+        let projector = self.field.projector_shared()?.clone();
+        let table = Arc::new(YawTable::new(projector, &map()?, self.scene.floor));
+        self.tables.insert(key, table.clone());
+        Ok(table)
+    }
+
     /// The lighting of the scene frame at `l`: `None` without an environment.
-    fn world_lighting(&mut self, l: &LightingAt) -> Result<Option<EnvMap>> {
+    fn world_lighting(&mut self, l: &LightingAt) -> Result<Option<Arc<World>>> {
         let key = LightingKey::of(l);
-        if let Some((k, env)) = &self.world
+        if let Some((k, world)) = &self.world
             && *k == key
         {
-            return Ok(env.clone());
+            return Ok(world.clone());
         }
         let mut maps = Vec::new();
+        let mut terms = Vec::new();
         for (source, weight) in &l.maps {
             match (self.env(source)?, l.sun) {
-                (Some(e), _) => maps.push((e.rotated(l.yaw).scaled(l.intensity), *weight)),
+                (Some(e), _) => {
+                    let table = self.table(source.to_string(), || Ok(e.clone()))?;
+                    terms.push(YawTerm {
+                        table,
+                        weight: weight * l.intensity,
+                        yaw: l.yaw,
+                    });
+                    maps.push((e.rotated(l.yaw).scaled(l.intensity), *weight));
+                }
                 // A sun alone: a black sky of the built-in sky's texels holds it.
                 (None, Some(_)) => maps.push((EnvMap::uniform([0.0; 3], 128), *weight)),
                 (None, None) => {
@@ -416,10 +455,27 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             EnvMap::mix(&maps.iter().map(|(e, w)| (e, *w)).collect::<Vec<_>>())?
         };
         if let Some(sun) = &l.sun {
+            // The sun stays put in the scene frame while the maps turn: a map of its own,
+            // black but for it, of the world map's texels.
+            let (w, h) = env.image().size();
+            let bits = LightingKey::of(l).sun;
+            let table = self.table(format!("sun {bits:?} {w}x{h}"), || {
+                let black = EnvMap::from_image(RgbImage::new(w, h, [0.0; 3]))?;
+                Ok(sun.lit(&black)?)
+            })?;
+            terms.push(YawTerm {
+                table,
+                weight: 1.0,
+                yaw: 0.0,
+            });
             env = sun.lit(&env)?;
         }
-        self.world = Some((key, Some(env.clone())));
-        Ok(Some(env))
+        let world = Arc::new(World {
+            env,
+            light: YawLight::new(terms),
+        });
+        self.world = Some((key, Some(world.clone())));
+        Ok(Some(world))
     }
 
     /// The scene shot.
@@ -455,6 +511,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let scene = &self.scene;
         if (scene.floor, scene.shadow) != (before.0, before.1) {
             self.cache.clear();
+        }
+        if scene.floor != before.0 {
+            // The tables light the floor conditions by the floor.
+            self.tables.clear();
+            self.world = None;
         }
         if scene.backdrop != before.2 {
             self.backdrop = None;
@@ -543,7 +604,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// scene shows the field unlit.
     pub fn lighting_at(&mut self, t: f64) -> Result<Option<EnvMap>> {
         let l = self.scene.lighting_at(t);
-        self.world_lighting(&l)
+        Ok(self.world_lighting(&l)?.map(|w| w.env.clone()))
     }
 
     /// The backdrop of the scene under `world` (the lighting of a frame).
@@ -666,6 +727,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let lighting = self.scene.lighting_at(fp.time);
         let key = LightingKey::of(&lighting);
         let world = self.world_lighting(&lighting)?;
+        let world = world.as_deref();
 
         // Every walker's pose (both, between two), resident and relit for this lighting.
         let mut made_resident = Vec::new();
@@ -698,7 +760,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 Some(k) => {
                     // The same views under a new light: relit where they are.
                     let t = Instant::now();
-                    self.relight_cached(k, world.as_ref())?;
+                    self.relight_cached(k, world)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     self.counters.poses_made_resident += 1;
                     self.counters.relights += 1;
@@ -719,7 +781,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         .iter()
                         .position(|c| c.pose == pose && covers(&c.plan, wanted.as_ref()));
                     let resident =
-                        self.make_resident(pose, heading, world.as_ref(), wanted.as_ref(), like)?;
+                        self.make_resident(pose, heading, world, wanted.as_ref(), like)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     (
                         self.counters.basis_views_reused,
@@ -771,7 +833,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         // The backdrop of this lighting.
         let stale = self.backdrop.as_ref().is_none_or(|(k, _)| *k != key);
         if stale {
-            let backdrop = self.backdrop_of(world.as_ref())?;
+            let backdrop = self.backdrop_of(world.map(|w| &w.env))?;
             self.backdrop = Some((key, self.device.backdrop(backdrop)?));
         }
         Ok((slots, made_resident))
@@ -788,23 +850,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     /// The lighting of a walker of `heading` under the scene frame's lighting `world`.
-    fn walker_lighting(&self, heading: f32, world: Option<&EnvMap>) -> (Option<EnvMap>, Lighting) {
-        let env = world.map(|e| e.rotated(-heading));
-        let lighting = match &env {
-            Some(e) => Lighting::Environment {
-                env: e.clone(),
-                floor: self.scene.floor,
-            },
+    fn walker_lighting(&self, heading: f32, world: Option<&World>) -> Lighting {
+        match world {
+            Some(w) => Lighting::Tabled(w.light.turned(-heading)),
             None => Lighting::Unlit,
-        };
-        (env, lighting)
+        }
     }
 
     /// Relights cache entry `k` for its walker's heading under `world`: its views' new
     /// coefficients, relit where they are resident, with its shadow.
-    fn relight_cached(&mut self, k: usize, world: Option<&EnvMap>) -> Result<()> {
+    fn relight_cached(&mut self, k: usize, world: Option<&World>) -> Result<()> {
         let heading = f32::from_bits(self.cache[k].heading);
-        let (env, lighting) = self.walker_lighting(heading, world);
+        let lighting = self.walker_lighting(heading, world);
         let entry = &self.cache[k];
         let source = entry
             .resident
@@ -812,7 +869,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .relit(self.field, &lighting, entry.plan.as_ref())?;
         let traced = match self.scene.shadow {
             ShadowSpec::Traced if entry.resident.has_shadow() => {
-                self.traced_shadow(entry.pose, env.as_ref())?
+                self.traced_shadow(entry.pose, world, heading)?
             }
             _ => None,
         };
@@ -825,16 +882,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(())
     }
 
-    /// The shadow of pose `pose`'s hull under `env` (traced), when it has a hull and
-    /// there is an environment.
+    /// The shadow of pose `pose`'s hull under `world` seen by a walker of `heading`
+    /// (traced), when it has a hull and there is an environment.
     fn traced_shadow(
         &self,
         pose: u32,
-        env: Option<&EnvMap>,
+        world: Option<&World>,
+        heading: f32,
     ) -> Result<Option<frf_render::shadow::RelitShadow>> {
-        let (Some(hull), Some(env)) = (self.field.hull(pose)?, env) else {
+        let (Some(hull), Some(world)) = (self.field.hull(pose)?, world) else {
             return Ok(None);
         };
+        let env = world.env.rotated(-heading);
         let ground = self
             .field
             .header()
@@ -853,11 +912,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         &self,
         pose: u32,
         heading: f32,
-        world: Option<&EnvMap>,
+        world: Option<&World>,
         plan: Option<&PosePlan>,
         like: Option<usize>,
     ) -> Result<Resident> {
-        let (env, lighting) = self.walker_lighting(heading, world);
+        let lighting = self.walker_lighting(heading, world);
         let level = self
             .options
             .detail
@@ -913,7 +972,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 }
             }
             ShadowSpec::Traced if wants(plan.is_some_and(|p| p.hull)) => {
-                if let Some(shadow) = self.traced_shadow(pose, env.as_ref())? {
+                if let Some(shadow) = self.traced_shadow(pose, world, heading)? {
                     self.device
                         .set_shadow(&mut resident, SceneShadow::Relit(shadow))?;
                 }

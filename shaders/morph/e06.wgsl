@@ -38,9 +38,9 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
     let b = 1.0 - beta;
     let g = 1.0 - gamma;
     let w = bilinear_weights(beta, gamma);
-    let occlusion = (frame.flags & 2u) != 0u;
+    let occlusion = (FLAGS & 2u) != 0u;
     var out = vec4<f32>(0.0);
-    switch frame.variant {
+    switch KIND {
         case 0u: {
             // Nearest: the last vertex of largest weight.
             var k = 0u;
@@ -72,7 +72,7 @@ fn morph(hit: Hit, s: vec2<f32>) -> vec4<f32> {
             var frac = array<vec2<f32>, 4>(
                 vec2<f32>(beta, gamma), vec2<f32>(b, gamma), vec2<f32>(beta, g), vec2<f32>(b, g),
             );
-            if (frame.variant == 2u) {
+            if (KIND == 2u) {
                 var p = q.x;
                 var r = q.y;
                 if (gamma >= 0.5) {

@@ -91,7 +91,7 @@ fn solved_output(hit: Hit, origin: vec3<f32>, dir: vec3<f32>) -> SolvedOutput {
         return out;
     }
     var point = vec4<f32>(0.0);
-    if ((frame.flags & 1u) != 0u) {
+    if ((FLAGS & 1u) != 0u) {
         point = proxy_point(origin, dir);
     }
     var centre = hit.point;

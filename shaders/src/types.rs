@@ -97,7 +97,8 @@ pub struct GpuFrame {
     pub intrinsics: [f32; 4],
     /// Output size.
     pub size: [u32; 2],
-    /// `frf_render::morph::Variant::index`.
+    /// `frf_render::morph::Variant::index`: what the frame was drawn with, for inspection
+    /// (the frame pass's pipeline is specialized to it, its override `KIND`).
     pub variant: u32,
     /// Number of quads.
     pub quad_count: u32,
@@ -109,7 +110,7 @@ pub struct GpuFrame {
     pub crop_origin: [u32; 2],
     /// Crop size.
     pub crop_size: [u32; 2],
-    /// `frf_render::morph::Variant::flags`.
+    /// `frf_render::morph::Variant::flags`: as `variant` (the override `FLAGS`).
     pub flags: u32,
     /// Padding to 16 bytes.
     pub pad: u32,

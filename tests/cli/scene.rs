@@ -708,7 +708,8 @@ fn a_turning_light_relit_in_place_draws_what_a_fresh_residency_draws() {
 }
 
 /// `frf bench frame` (issue 37): a row per walker count and lighting, the fields its JSON
-/// promises, turning rows relighting every walker every frame and constant ones none.
+/// promises, turning rows relighting every walker every frame and constant ones none;
+/// per-pass device times where the adapter has timestamps (issue 47).
 #[test]
 fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let dir = tempfile::tempdir().unwrap();
@@ -752,6 +753,22 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
             other => panic!("light {other}"),
         }
         assert!(r["wall_ms_per_frame"].as_f64().unwrap() > 0.0);
+        let passes = r["passes"].as_array().unwrap();
+        let pass = |name: &str| passes.iter().find(|p| p["pass"] == name);
+        if report["pass_clock"] == "gpu-timestamps" {
+            for name in ["frame", "composite"] {
+                let p = pass(name).unwrap_or_else(|| panic!("no {name} pass: {r}"));
+                assert!(p["passes"].as_u64().unwrap() >= 1, "{r}");
+                assert!(p["ms"].as_f64().unwrap() >= 0.0, "{r}");
+            }
+            assert_eq!(pass("relight").is_some(), r["light"] == "turning", "{r}");
+        } else {
+            assert!(passes.is_empty(), "{r}");
+        }
+    }
+    if gpu_flag().is_none() {
+        // Lavapipe and real GPUs have timestamp queries.
+        assert_eq!(report["pass_clock"], "gpu-timestamps", "{report}");
     }
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());

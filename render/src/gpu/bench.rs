@@ -266,12 +266,12 @@ pub fn run(
                     ));
                     targets.write_frames(&gpu.queue, &[frame_uniform(Some(&gpu_pose), &camera, v)]);
                     let times = gpu.time_passes(options.warmup, options.repeats, &mut |e, t| {
-                        drawn.record(e, stage, t)
+                        drawn.record(e, (stage, v), t)
                     })?;
                     let timing = median_min(&times);
                     let error = match reference.iter().find(|(rv, _)| *rv == v) {
                         Some((_, cpu)) if Some(size) == options.sizes.first().copied() => {
-                            Some(drawn.max_abs_error(stage, cpu)?)
+                            Some(drawn.max_abs_error((stage, v), cpu)?)
                         }
                         _ => None,
                     };
@@ -423,14 +423,19 @@ struct Drawn<'a> {
 
 impl Drawn<'_> {
     /// Records the frame pass as `stage` into `encoder`, timed by `timestamps`.
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, stage: PassKind, timestamps: Timestamps) {
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        (stage, variant): (PassKind, Variant),
+        timestamps: Timestamps,
+    ) {
         let whole = crate::footprint::PixelBox::whole(self.size.0, self.size.1);
         self.pass.record(
             encoder,
             self.targets,
             (0, Place::FRAME),
             &self.pose.bind_group,
-            stage,
+            (stage, variant),
             whole,
             timestamps,
             false,
@@ -439,10 +444,14 @@ impl Drawn<'_> {
 
     /// The largest absolute difference of any channel of the frame drawn as `stage` from
     /// the CPU reference's `cpu`.
-    fn max_abs_error(&self, stage: PassKind, cpu: &Image<Rgba>) -> Result<f64> {
+    fn max_abs_error(
+        &self,
+        (stage, variant): (PassKind, Variant),
+        cpu: &Image<Rgba>,
+    ) -> Result<f64> {
         let gpu = self.gpu;
         let mut e = gpu.device.create_command_encoder(&Default::default());
-        self.record(&mut e, stage, None);
+        self.record(&mut e, (stage, variant), None);
         let copied = gpu.copy_rgba(&mut e, self.targets.texture(), self.size);
         gpu.submit([e.finish()]);
         let img = gpu.read_rgba(&copied)?;

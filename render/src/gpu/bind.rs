@@ -108,14 +108,15 @@ pub fn table_bytes(tables: &[[f32; 256]]) -> Vec<u8> {
         .collect()
 }
 
-/// A 2D texture binding visible to the fragment stage, read with `textureLoad`.
+/// A 2D texture binding visible to the fragment and compute stages, read with
+/// `textureLoad`.
 pub fn texture_2d(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
 ) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
+        visibility: wgpu::ShaderStages::FRAGMENT.union(wgpu::ShaderStages::COMPUTE),
         ty: wgpu::BindingType::Texture {
             sample_type,
             view_dimension: wgpu::TextureViewDimension::D2,
@@ -285,6 +286,19 @@ pub fn full_screen_pipeline_into(
     entry: &str,
     formats: &[wgpu::TextureFormat],
 ) -> wgpu::RenderPipeline {
+    full_screen_pipeline_with(device, (label, layouts), module, entry, formats, &[])
+}
+
+/// [`full_screen_pipeline_into`] with the module's overrides set to `constants`
+/// (`(name, value)`): a pipeline specialized to them.
+pub fn full_screen_pipeline_with(
+    device: &wgpu::Device,
+    (label, layouts): (&str, &[&wgpu::BindGroupLayout]),
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    formats: &[wgpu::TextureFormat],
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
@@ -315,7 +329,10 @@ pub fn full_screen_pipeline_into(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             targets: &targets,
         }),
         multiview_mask: None,
@@ -331,6 +348,18 @@ pub fn compute_pipeline(
     module: &wgpu::ShaderModule,
     entry: &str,
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_with(device, label, layouts, (module, entry), &[])
+}
+
+/// [`compute_pipeline`] with the module's overrides set to `constants` (`(name,
+/// value)`): a pipeline specialized to them.
+pub fn compute_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    (module, entry): (&wgpu::ShaderModule, &str),
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
@@ -341,7 +370,10 @@ pub fn compute_pipeline(
         layout: Some(&layout),
         module,
         entry_point: Some(entry),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     })
 }
@@ -354,19 +386,6 @@ pub fn loaded(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachmen
         resolve_target: None,
         ops: wgpu::Operations {
             load: wgpu::LoadOp::Load,
-            store: wgpu::StoreOp::Store,
-        },
-    })
-}
-
-/// A colour attachment cleared to transparent black and stored.
-pub fn cleared(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
-    Some(wgpu::RenderPassColorAttachment {
-        view,
-        depth_slice: None,
-        resolve_target: None,
-        ops: wgpu::Operations {
-            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
             store: wgpu::StoreOp::Store,
         },
     })

@@ -17,7 +17,7 @@ use super::time_morph::{BetweenDraw, GpuBetween};
 use super::timing::Timestamps;
 
 use super::Gpu;
-use super::bind::{bind_group, cleared};
+use super::bind::bind_group;
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::readback::PendingFrame;
 use super::rebin::{frame_stats, frame_uniform};
@@ -401,18 +401,18 @@ impl Gpu {
                     .collect(),
             )
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("composite"),
-            color_attachments: &t.target_views.iter().map(cleared).collect::<Vec<_>>(),
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
+            timestamp_writes: super::timing::compute_pass_writes(
+                self.pass_timestamps("composite", None),
+            ),
         });
         pass.set_pipeline(&self.composite.pipeline);
         pass.set_bind_group(0, &t.frame_group, &[]);
         pass.set_bind_group(1, &*image_group, &[]);
-        pass.draw(0..3, 0..1);
+        let size = t.targets[0].size();
+        let (x, y) = super::rebin::workgroups((size.width, size.height));
+        pass.dispatch_workgroups(x, y, 1);
     }
 }
 

@@ -8,8 +8,8 @@
 
 use std::sync::Arc;
 
-use super::bind::{FLOAT, full_screen_pipeline, storage, texture_2d, texture_array, uniform};
-use super::bind::{rgba32f, uniform_buffer};
+use super::bind::{FLOAT, compute_pipeline, storage, texture_2d, texture_array, uniform};
+use super::bind::{rgba32f, storage_texture, uniform_buffer};
 use super::kept::Kept;
 use super::{Gpu, shaders};
 use crate::footprint::TileLists;
@@ -19,21 +19,26 @@ use frf_shaders::types::{GpuComposite, GpuFrame, GpuInstance};
 pub struct CompositePass {
     pub(super) frame_layout: wgpu::BindGroupLayout,
     pub(super) image_layout: wgpu::BindGroupLayout,
-    pub(super) pipeline: wgpu::RenderPipeline,
+    pub(super) pipeline: wgpu::ComputePipeline,
 }
 
 impl CompositePass {
     /// Builds the pass on `device`.
     pub fn new(device: &wgpu::Device) -> Self {
         let module = shaders::module(device, "composite", shaders::COMPOSITE);
-        let f = wgpu::ShaderStages::FRAGMENT;
+        let c = wgpu::ShaderStages::COMPUTE;
+        let target = |binding| storage_texture(binding, wgpu::TextureFormat::Rgba32Float);
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite frame"),
             entries: &[
-                uniform::<GpuFrame>(0, f),
-                uniform::<GpuComposite>(1, f),
-                storage::<GpuInstance>(2, true, f),
-                storage::<u32>(3, true, f),
+                uniform::<GpuFrame>(0, c),
+                uniform::<GpuComposite>(1, c),
+                storage::<GpuInstance>(2, true, c),
+                storage::<u32>(3, true, c),
+                target(4),
+                target(5),
+                target(6),
+                target(7),
             ],
         });
         let image_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -45,13 +50,12 @@ impl CompositePass {
                 texture_array(3, FLOAT),
             ],
         });
-        let pipeline = full_screen_pipeline(
+        let pipeline = compute_pipeline(
             device,
             "composite",
             &[&frame_layout, &image_layout],
             &module,
-            "fs_composite",
-            4,
+            "cs_composite",
         );
         Self {
             frame_layout,
@@ -73,7 +77,6 @@ pub(super) struct CompositeTargets {
     pub(super) id: u64,
     /// Composite, relative irradiance (shadow), backdrop, subjects alone.
     pub(super) targets: [wgpu::Texture; 4],
-    pub(super) target_views: [wgpu::TextureView; 4],
     /// Per walker (back to front), its relit shadow map.
     pub(super) shadows: wgpu::Texture,
     pub(super) frame: wgpu::Buffer,
@@ -90,8 +93,9 @@ pub(super) struct CompositeTargets {
 impl CompositeTargets {
     fn new(device: &wgpu::Device, pass: &CompositePass, key: CompositeKey) -> Self {
         let (size, walkers, texels) = key;
-        // Bound as textures by a window's present pass ([`super::present`]).
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+        // Written by the compute pass; bound as textures by a window's present pass
+        // ([`super::present`]).
+        let usage = wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::TEXTURE_BINDING;
         let labels = [
@@ -152,12 +156,27 @@ impl CompositeTargets {
                     binding: 3,
                     resource: tiles.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&target_views[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&target_views[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&target_views[2]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(&target_views[3]),
+                },
             ],
         });
         Self {
             id: super::kept::unique_id(),
             targets,
-            target_views,
             shadows,
             frame,
             params,

@@ -29,6 +29,7 @@ mod composite_targets;
 pub mod formats;
 pub mod kept;
 pub mod light_fit;
+pub mod pass_clock;
 pub mod pose;
 pub mod present;
 pub mod readback;
@@ -102,6 +103,8 @@ pub struct Gpu {
         kept::Kept<composite_targets::CompositeKey, composite_targets::CompositeTargets>,
     /// Whether passes can be timed on the GPU (`Features::TIMESTAMP_QUERY`).
     timestamps: bool,
+    /// Every pass timed, once switched on ([`Gpu::clock_passes`]).
+    pass_clock: std::sync::OnceLock<pass_clock::PassClock>,
     shadow: shadow::ShadowPass,
     composite: composite_targets::CompositePass,
 }
@@ -164,6 +167,7 @@ impl Gpu {
             time_morph: time_morph::TimeMorphPass::new(&device),
             composite_targets: kept::Kept::new(KEPT_TARGETS),
             timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            pass_clock: std::sync::OnceLock::new(),
             shadow: shadow::ShadowPass::new(&device),
             composite: composite_targets::CompositePass::new(&device),
             device,

@@ -11,8 +11,8 @@ use frf_core::image::{Image, Rgba};
 
 use super::Gpu;
 use super::bind::{
-    compute_pipeline, full_screen_pipeline, loaded, readback_buffer, sampler, storage, storage_min,
-    storage_texture_array, texture_array, uniform, uniform_buffer,
+    compute_pipeline_with, full_screen_pipeline_with, loaded, readback_buffer, sampler, storage,
+    storage_min, storage_texture_array, texture_array, uniform, uniform_buffer,
 };
 use super::formats::PoseFormats;
 use super::pose::{GpuPose, PoseBinding};
@@ -58,6 +58,20 @@ pub struct RebinPass {
     pub(super) frame_layout: wgpu::BindGroupLayout,
     pub(super) compute_layout: wgpu::BindGroupLayout,
     pub(super) classes_layout: wgpu::BindGroupLayout,
+    device: wgpu::Device,
+    module: wgpu::ShaderModule,
+    /// Per morph ([`Variant::index`] and [`Variant::flags`]), its pipelines, made the first
+    /// time a frame is drawn with it.
+    pipelines: std::sync::Mutex<Vec<(MorphKey, Arc<MorphPipelines>)>>,
+}
+
+/// A morph as the frame pass's overrides hold it: `KIND` ([`Variant::index`]) and
+/// `FLAGS` ([`Variant::flags`]).
+type MorphKey = (u32, u32);
+
+/// The frame pass's pipelines specialized to one morph (the shader's overrides `KIND` and
+/// `FLAGS`).
+pub(super) struct MorphPipelines {
     pub(super) fragment: wgpu::RenderPipeline,
     pub(super) compute: wgpu::ComputePipeline,
     pub(super) classes: wgpu::ComputePipeline,
@@ -109,28 +123,6 @@ impl RebinPass {
                 storage::<GpuQuadFrame>(9, true, both),
             ],
         );
-        let fragment = full_screen_pipeline(
-            device,
-            "rebin",
-            &[&frame_layout, &pose_layout],
-            &module,
-            "fs_main",
-            1,
-        );
-        let compute = compute_pipeline(
-            device,
-            "rebin",
-            &[&compute_layout, &pose_layout],
-            &module,
-            "cs_main",
-        );
-        let classes = compute_pipeline(
-            device,
-            "classes",
-            &[&classes_layout, &pose_layout],
-            &module,
-            "cs_classes",
-        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("bilinear"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -146,10 +138,46 @@ impl RebinPass {
             frame_layout,
             compute_layout,
             classes_layout,
-            fragment,
-            compute,
-            classes,
+            device: device.clone(),
+            module,
+            pipelines: std::sync::Mutex::new(Vec::new()),
         }
+    }
+
+    /// The pipelines of `variant` (made on first use: compiling the frame pass takes a
+    /// software adapter a good fraction of a second a pipeline).
+    pub(super) fn pipelines(&self, variant: Variant) -> Arc<MorphPipelines> {
+        let key = (variant.index(), variant.flags());
+        let mut made = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, p)) = made.iter().find(|(k, _)| *k == key) {
+            return p.clone();
+        }
+        let constants = [("KIND", f64::from(key.0)), ("FLAGS", f64::from(key.1))];
+        let device = &self.device;
+        let pose_layout = &self.pose.layout;
+        let compute = |label, layout, entry| {
+            compute_pipeline_with(
+                device,
+                label,
+                &[layout, pose_layout],
+                (&self.module, entry),
+                &constants,
+            )
+        };
+        let p = Arc::new(MorphPipelines {
+            fragment: full_screen_pipeline_with(
+                device,
+                ("rebin", &[&self.frame_layout, pose_layout]),
+                &self.module,
+                "fs_main",
+                &[wgpu::TextureFormat::Rgba32Float],
+                &constants,
+            ),
+            compute: compute("rebin", &self.compute_layout, "cs_main"),
+            classes: compute("classes", &self.classes_layout, "cs_classes"),
+        });
+        made.push((key, p.clone()));
+        p
     }
 }
 
@@ -165,12 +193,14 @@ pub(super) struct Subjects {
     places: Vec<Place>,
 }
 
-/// What happened to a frame's pixels: the counters' bytes as the class pass wrote them,
-/// and the pixels outside the walkers' bounds (missed).
+/// What happened to a frame's pixels: the counters' bytes as the class pass left them
+/// (the pixels shaded, then those clamped above, below and missed), and the pixels
+/// outside the walkers' bounds (missed).
 pub(super) fn frame_stats(counts: &[u8], outside: usize) -> FrameStats {
     let counts: &[u32] = bytemuck::cast_slice(counts);
+    let counted = counts[1] as usize + counts[2] as usize + counts[3] as usize;
     FrameStats {
-        inside: counts[0] as usize,
+        inside: (counts[0] as usize).saturating_sub(counted),
         clamped_above: counts[1] as usize,
         clamped_below: counts[2] as usize,
         missed: counts[3] as usize + outside,
@@ -467,12 +497,13 @@ impl RebinPass {
         targets: &SubjectTargets,
         (slot, place): (usize, Place),
         pose_group: &wgpu::BindGroup,
-        stage: PassKind,
+        (stage, variant): (PassKind, Variant),
         within: PixelBox,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
         let t = &targets.slots[slot];
+        let pipelines = self.pipelines(variant);
         let size = within.size();
         match stage {
             PassKind::Fragment => {
@@ -487,7 +518,7 @@ impl RebinPass {
                 if within.pixels() > 0 {
                     let (x, y) = place.texel(within.x0, within.y0);
                     pass.set_scissor_rect(x, y, size.0, size.1);
-                    pass.set_pipeline(&self.fragment);
+                    pass.set_pipeline(&pipelines.fragment);
                     pass.set_bind_group(0, &t.fragment, &[]);
                     pass.set_bind_group(1, pose_group, &[]);
                     pass.draw(0..3, 0..1);
@@ -498,7 +529,7 @@ impl RebinPass {
                     label: Some("rebin"),
                     timestamp_writes: super::timing::compute_pass_writes(timestamps),
                 });
-                pass.set_pipeline(&self.compute);
+                pass.set_pipeline(&pipelines.compute);
                 pass.set_bind_group(0, &t.compute, &[]);
                 pass.set_bind_group(1, pose_group, &[]);
                 let (x, y) = workgroups(size);
@@ -513,7 +544,7 @@ impl RebinPass {
                 label: Some("classes"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&self.classes);
+            pass.set_pipeline(&pipelines.classes);
             pass.set_bind_group(0, &t.classes, &[]);
             pass.set_bind_group(1, pose_group, &[]);
             let (x, y) = workgroups(size);
@@ -531,13 +562,15 @@ impl RebinPass {
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
         renders: &[(usize, &wgpu::BindGroup, PixelBox)],
+        variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) {
+        let pipelines = self.pipelines(variant);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("rebin"),
             timestamp_writes: super::timing::compute_pass_writes(timestamps),
         });
-        pass.set_pipeline(&self.compute);
+        pass.set_pipeline(&pipelines.compute);
         for &(slot, pose_group, within) in renders {
             let (x, y) = workgroups(within.size());
             if x * y == 0 {
@@ -580,7 +613,10 @@ impl Gpu {
         let boxes: Vec<PixelBox> = instances.iter().map(|i| i.2).collect();
         let (places, pages) = places(&boxes, size, 0);
         let targets = self.subject_targets(size, instances.len().max(1) as u32, pages);
-        encoder.clear_buffer(&targets.stats, 0, None);
+        // The pixels shaded; the pass counts those clamped or missed beside them.
+        let shaded = instances.iter().map(|i| i.2.pixels() as u32).sum::<u32>();
+        self.queue
+            .write_buffer(&targets.stats, 0, bytemuck::cast_slice(&[shaded, 0, 0, 0]));
         let outside = instances
             .iter()
             .map(|i| size.0 as usize * size.1 as usize - i.2.pixels())
@@ -636,8 +672,9 @@ impl Gpu {
                     .enumerate()
                     .map(|(slot, (pose, d))| (slot, &pose.bind_group, d.within))
                     .collect();
+                let timestamps = self.pass_timestamps("frame", timestamps);
                 self.rebin
-                    .record_compute(encoder, targets, &groups, timestamps);
+                    .record_compute(encoder, targets, &groups, variant, timestamps);
             }
             PassKind::Fragment => {
                 for (slot, (pose, d)) in renders.iter().enumerate() {
@@ -646,9 +683,9 @@ impl Gpu {
                         targets,
                         (slot, d.place),
                         &pose.bind_group,
-                        PassKind::Fragment,
+                        (PassKind::Fragment, variant),
                         d.within,
-                        timestamps.filter(|_| slot == 0),
+                        self.pass_timestamps("frame", timestamps.filter(|_| slot == 0)),
                         classes,
                     );
                 }

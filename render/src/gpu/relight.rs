@@ -21,6 +21,7 @@ use wgpu::util::DeviceExt;
 use super::bind::{
     bind_group, buffer_with, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
 };
+use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::resident::PoseSource;
@@ -421,7 +422,7 @@ impl Gpu {
                 // two dispatches' use of the scratch and the peaks).
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("relight"),
-                    timestamp_writes: None,
+                    timestamp_writes: compute_pass_writes(self.pass_timestamps("relight", None)),
                 });
                 pass.set_bind_group(0, &bind, &[]);
                 for pipeline in [&self.relight.relight, &self.relight.encode] {

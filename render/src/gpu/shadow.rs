@@ -10,6 +10,7 @@ use super::bind::{
     bind_group, buffer_with, compute_pipeline, rgba32f, storage, storage_texture, uniform,
 };
 use super::pose::{GpuPose, MapRelight, RelitShadowInfo};
+use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::shadow::{RelitShadow, ShadowMaps};
@@ -87,7 +88,7 @@ impl Gpu {
             self.with_pending(|encoder| {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("shadow"),
-                    timestamp_writes: None,
+                    timestamp_writes: compute_pass_writes(self.pass_timestamps("shadow", None)),
                 });
                 pass.set_pipeline(&self.shadow.pipeline);
                 pass.set_bind_group(0, &relight.bind, &[]);

@@ -15,6 +15,7 @@ use wgpu::util::DeviceExt;
 use super::bind::uniform_stride;
 use super::pose::GpuPose;
 use super::rebin::{DrawnRender, Place, SubjectTargets, Subjects, places, workgroups};
+use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::footprint::PixelBox;
 use crate::morph::Variant;
@@ -141,7 +142,7 @@ impl Gpu {
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("time morph"),
-                timestamp_writes: None,
+                timestamp_writes: compute_pass_writes(self.pass_timestamps("time morph", None)),
             });
             pass.set_pipeline(&self.time_morph.pipeline);
             for (w, group) in walkers.iter().zip(&groups) {

@@ -1,0 +1,151 @@
+//! A light as its renderer relights it: a sum of environment maps, each turned by a yaw
+//! and weighted (a map turned by a scene's lighting keys, two maps cross-fading, a scene's
+//! sun in a map of its own), read through each map's [`YawTable`] (docs/design.md section
+//! 4.1, *The yaw table*). Coefficients are linear in the light, so the sum's are the sum of
+//! the tables' at each map's own turn; a walker's heading turns every map alike
+//! ([`YawLight::turned`]), and a light that turns changes only the yaws: no map is
+//! projected again and no sun found again.
+
+use std::sync::Arc;
+
+use frf_core::env::EnvMap;
+use frf_core::image::{Rgb, luminance};
+use frf_core::sun::Sun;
+
+use crate::error::Result;
+use crate::project::{FloorModel, Projector};
+use crate::sun_light::MAX_SUNS;
+use crate::yaw_table::{Part, YawTable};
+
+/// One map of a light: its table, its weight and its turn (radians about `+y`).
+#[derive(Debug, Clone)]
+pub struct YawTerm {
+    /// The map's table.
+    pub table: Arc<YawTable>,
+    /// Its weight (a cross-fade's share times the light's intensity).
+    pub weight: f32,
+    /// Its turn, radians.
+    pub yaw: f32,
+}
+
+/// A light as a sum of turned, weighted maps (see the module text).
+#[derive(Debug, Clone)]
+pub struct YawLight {
+    terms: Vec<YawTerm>,
+}
+
+/// What relights a pose under a light: per view its coefficients (with the suns taken out
+/// where they are relit by the normals), the suns, and the ground's coefficients.
+#[derive(Debug, Clone)]
+pub struct ViewLighting {
+    /// Per turntable angle asked: the coefficients of every condition.
+    pub coefficients: Vec<Vec<Rgb>>,
+    /// The suns relit by the normals (scene frame of the light, brightest first).
+    pub suns: Vec<Sun>,
+    /// The coefficients at turntable angle 0 of the whole light (the ground's frame).
+    pub ground: Vec<Rgb>,
+}
+
+impl YawLight {
+    /// A light of `terms`.
+    pub fn new(terms: Vec<YawTerm>) -> Self {
+        Self { terms }
+    }
+
+    /// `env` (turned by its own yaw) as a light of one map, through a table of its own.
+    pub fn of_env(projector: Arc<Projector>, env: &EnvMap, floor: FloorModel) -> Self {
+        Self::new(vec![YawTerm {
+            table: Arc::new(YawTable::new(projector, env, floor)),
+            weight: 1.0,
+            yaw: env.yaw(),
+        }])
+    }
+
+    /// Its maps.
+    pub fn terms(&self) -> &[YawTerm] {
+        &self.terms
+    }
+
+    /// The same light turned by a further `angle` radians (a walker's heading turns its
+    /// light by minus the heading).
+    pub fn turned(&self, angle: f32) -> Self {
+        Self::new(
+            self.terms
+                .iter()
+                .map(|t| YawTerm {
+                    yaw: t.yaw + angle,
+                    ..t.clone()
+                })
+                .collect(),
+        )
+    }
+
+    /// Its coefficients at each of `turntables` (radians). With `suns`, the maps' suns
+    /// (up to [`MAX_SUNS`] in all: a map's suns are taken whole or not at all, the maps of
+    /// brightest suns first) are returned apart and taken out of the coefficients of the
+    /// upper conditions ([`Part::LessSuns`]).
+    pub fn lighting(&self, turntables: &[f32], suns: bool) -> Result<ViewLighting> {
+        let conditions = self
+            .terms
+            .first()
+            .map_or(0, |t| t.table.projector().conditions());
+        let mut parts = vec![Part::Whole; self.terms.len()];
+        let mut taken: Vec<Sun> = Vec::new();
+        if suns {
+            let mut by_sun: Vec<(usize, f32)> = Vec::new();
+            for (i, t) in self.terms.iter().enumerate() {
+                if let Some(first) = t.table.suns()?.first() {
+                    by_sun.push((i, t.weight * luminance(first.illuminance())));
+                }
+            }
+            // Brightest first; of equals, the first map's.
+            by_sun.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            for (i, _) in by_sun {
+                let t = &self.terms[i];
+                let found = t.table.suns()?;
+                if t.weight > 0.0 && taken.len() + found.len() <= MAX_SUNS {
+                    parts[i] = Part::LessSuns;
+                    taken.extend(found.iter().map(|s| turned_sun(s, t)));
+                }
+            }
+        }
+        let mut coefficients = vec![vec![[0.0f32; 3]; conditions]; turntables.len()];
+        let mut ground = vec![[0.0f32; 3]; conditions];
+        for (t, part) in self.terms.iter().zip(&parts) {
+            let c = t.table.coefficients(*part, t.yaw, turntables)?;
+            for (sum, c) in coefficients.iter_mut().zip(&c) {
+                add_weighted(sum, c, t.weight);
+            }
+            let own = t.table.coefficients(Part::Whole, t.yaw, &[0.0])?;
+            add_weighted(&mut ground, &own[0], t.weight);
+        }
+        Ok(ViewLighting {
+            coefficients,
+            suns: taken,
+            ground,
+        })
+    }
+}
+
+/// A map's sun as its term turns and weighs it (itself for a term of weight 1, unturned).
+fn turned_sun(sun: &Sun, t: &YawTerm) -> Sun {
+    let s = if t.yaw == 0.0 {
+        *sun
+    } else {
+        sun.rotated(t.yaw)
+    };
+    if t.weight == 1.0 {
+        s
+    } else {
+        s.scaled(t.weight)
+    }
+}
+
+/// `sum += w · c`, per condition and channel (`c` itself when `sum` is zero and `w` 1).
+fn add_weighted(sum: &mut [Rgb], c: &[Rgb], w: f32) {
+    for (s, c) in sum.iter_mut().zip(c) {
+        for ch in 0..3 {
+            s[ch] += w * c[ch];
+        }
+    }
+}
