@@ -440,4 +440,20 @@ fn a_reduced_pose_relights_its_suns_by_its_normals_on_both() {
     let cpu = ResidentPose::relight_cpu(&source);
     let pose = gpu.upload_pose(&source).unwrap();
     assert_relit_as_the_cpu(&gpu, &pose, &cpu, "level 1");
+    // The suns' maps of the hull: made on the GPU, traced on the host by the CPU twin.
+    let maps = gpu.read_sun_maps(&pose, &source.suns).unwrap();
+    assert_eq!(maps.len(), 2);
+    for (sun, gpu_map) in source.suns.iter().zip(&maps) {
+        let cpu_map = sun.depth.as_ref().unwrap().reach();
+        assert_eq!(cpu_map.len(), gpu_map.len());
+        let hits = cpu_map.iter().filter(|&&r| r > f32::MIN).count();
+        assert!(hits > 100, "{hits} texels reach the hull");
+        // The same walk in f32 on both: equal but where a line grazes a voxel's edge.
+        let differ = cpu_map
+            .iter()
+            .zip(gpu_map)
+            .filter(|(a, b)| (*a - *b).abs() > 1e-4)
+            .count();
+        assert!(differ * 1000 <= hits, "{differ} of {hits} texels differ");
+    }
 }

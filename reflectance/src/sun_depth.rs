@@ -7,8 +7,13 @@
 //! rendering, made by one ray per texel of the map from the sun's side).
 //!
 //! The map's texel is [`TEXEL_PER_VOXEL`] of the hull's voxel (1 cm at 5 mm voxels), so a
-//! point's line is within half a texel of the one traced for it. The GPU reads [`SunDepth::reach`] as
-//! built here (`shaders/relight.wgsl`).
+//! point's line is within half a texel of the one traced for it. The map's frame is set
+//! on the host; its values are traced on the host when the CPU reference first reads them
+//! ([`SunDepth::reach`]), and on the GPU by `shaders/sun_depth.wgsl`, the same walk through
+//! the hull (`shaders/rebin/proxy.wgsl`), where the relight pass reads them: a turning
+//! sun costs the host no walk.
+
+use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -22,8 +27,10 @@ use crate::hull::VoxelHull;
 /// texel of every view gave 34.35 / 32.73 dB.
 pub const TEXEL_PER_VOXEL: f32 = 2.0;
 
-/// How far the hull reaches toward a sun (see the module text).
-#[derive(Debug, Clone, PartialEq)]
+/// How far the hull reaches toward a sun (see the module text): the map's frame, and its
+/// values made when first read on the host ([`SunDepth::reach`]; the GPU makes its own
+/// from the frame, `shaders/sun_depth.wgsl`).
+#[derive(Debug, Clone)]
 pub struct SunDepth {
     /// Unit, toward the sun (subject frame).
     pub toward: Vec3,
@@ -35,54 +42,68 @@ pub struct SunDepth {
     pub texel: f32,
     /// Texels along x and y.
     pub size: [u32; 2],
-    /// Per texel (x fastest): the largest `toward · p` of the hull along its centre's
-    /// line, `f32::MIN` where the line misses the hull.
-    pub reach: Vec<f32>,
+    /// `toward · p` where each texel's ray starts, a texel beyond the hull's box on the
+    /// sun's side.
+    pub far: f32,
+    hull: Arc<VoxelHull>,
+    reach: OnceLock<Vec<f32>>,
 }
 
 impl SunDepth {
     /// The map of `hull` seen from the direction `toward` (any length but zero).
-    pub fn new(hull: &VoxelHull, toward: Vec3) -> Self {
+    pub fn new(hull: &Arc<VoxelHull>, toward: Vec3) -> Self {
         let d = toward.normalize_or(Vec3::Y);
         let (x, y) = d.any_orthonormal_pair();
         let g = hull.grid();
         let texel = g.voxel_m * TEXEL_PER_VOXEL;
-        let (lo, hi) = (Vec3::from(g.origin), g.max_corner());
-        let corners = (0..8).map(|c| {
-            Vec3::new(
-                if c & 1 == 0 { lo.x } else { hi.x },
-                if c & 2 == 0 { lo.y } else { hi.y },
-                if c & 4 == 0 { lo.z } else { hi.z },
-            )
-        });
-        let (mut min, mut max, mut far) = (Vec2::INFINITY, Vec2::NEG_INFINITY, f32::NEG_INFINITY);
-        for p in corners {
-            let q = Vec2::new(x.dot(p), y.dot(p));
-            min = min.min(q);
-            max = max.max(q);
-            far = far.max(d.dot(p));
-        }
+        let (min, max, far) = projected_box(hull, [x, y, d]);
         // Rays start a texel beyond the box on the sun's side.
         let far = far + texel;
         let size = ((max - min) / texel).ceil().max(Vec2::ONE);
-        let size = [size.x as u32, size.y as u32];
-        let reach = (0..size[0] as usize * size[1] as usize)
-            .into_par_iter()
-            .map(|i| {
-                let (i, j) = (i % size[0] as usize, i / size[0] as usize);
-                let q = min + (Vec2::new(i as f32, j as f32) + 0.5) * texel;
-                let origin = x * q.x + y * q.y + d * far;
-                hull.first_hit(origin, -d).map_or(f32::MIN, |t| far - t)
-            })
-            .collect();
         Self {
             toward: d,
             axes: [x, y],
             corner: min,
             texel,
-            size,
-            reach,
+            size: [size.x as u32, size.y as u32],
+            far,
+            hull: hull.clone(),
+            reach: OnceLock::new(),
         }
+    }
+
+    /// The most texels a map of `hull` can have, whatever the sun's direction: the box's
+    /// diagonal across, a texel more, on each axis.
+    pub fn most_texels(hull: &VoxelHull) -> usize {
+        let g = hull.grid();
+        let diagonal = (g.max_corner() - Vec3::from(g.origin)).length();
+        let side = (diagonal / (g.voxel_m * TEXEL_PER_VOXEL)).ceil() as usize + 1;
+        side * side
+    }
+
+    /// Its texels.
+    pub fn texels(&self) -> usize {
+        self.size[0] as usize * self.size[1] as usize
+    }
+
+    /// Per texel (x fastest): the largest `toward · p` of the hull along its centre's
+    /// line, `f32::MIN` where the line misses the hull; made on the first call.
+    pub fn reach(&self) -> &[f32] {
+        self.reach.get_or_init(|| {
+            let [x, y] = self.axes;
+            let w = self.size[0] as usize;
+            (0..self.texels())
+                .into_par_iter()
+                .map(|i| {
+                    let q = self.corner
+                        + (Vec2::new((i % w) as f32, (i / w) as f32) + 0.5) * self.texel;
+                    let origin = x * q.x + y * q.y + self.toward * self.far;
+                    self.hull
+                        .first_hit(origin, -self.toward)
+                        .map_or(f32::MIN, |t| self.far - t)
+                })
+                .collect()
+        })
     }
 
     /// Whether the hull lies between `p` and the sun: it reaches past `p` along the line
@@ -93,8 +114,28 @@ impl SunDepth {
         if !(i >= 0.0 && j >= 0.0 && i < self.size[0] as f32 && j < self.size[1] as f32) {
             return false;
         }
-        self.reach[j as usize * self.size[0] as usize + i as usize] > self.toward.dot(p)
+        self.reach()[j as usize * self.size[0] as usize + i as usize] > self.toward.dot(p)
     }
+}
+
+/// The hull's box seen along `axes` (`[x, y, toward]`): the least and most of its corners'
+/// `(x · p, y · p)`, and the most of their `toward · p`.
+fn projected_box(hull: &VoxelHull, [x, y, d]: [Vec3; 3]) -> (Vec2, Vec2, f32) {
+    let g = hull.grid();
+    let (lo, hi) = (Vec3::from(g.origin), g.max_corner());
+    let (mut min, mut max, mut far) = (Vec2::INFINITY, Vec2::NEG_INFINITY, f32::NEG_INFINITY);
+    for c in 0..8 {
+        let p = Vec3::new(
+            if c & 1 == 0 { lo.x } else { hi.x },
+            if c & 2 == 0 { lo.y } else { hi.y },
+            if c & 4 == 0 { lo.z } else { hi.z },
+        );
+        let q = Vec2::new(x.dot(p), y.dot(p));
+        min = min.min(q);
+        max = max.max(q);
+        far = far.max(d.dot(p));
+    }
+    (min, max, far)
 }
 
 #[cfg(test)]
@@ -103,9 +144,9 @@ mod tests {
     use frf_core::volume::VoxelGrid;
 
     /// A ball of radius `r` about `c`, voxels of side `s`.
-    fn ball(c: Vec3, r: f32, s: f32) -> VoxelHull {
+    fn ball(c: Vec3, r: f32, s: f32) -> Arc<VoxelHull> {
         let grid = VoxelGrid::covering(c - Vec3::splat(r + s), c + Vec3::splat(r + s), s).unwrap();
-        VoxelHull::from_fn(grid, |p| p.distance(c) <= r)
+        Arc::new(VoxelHull::from_fn(grid, |p| p.distance(c) <= r))
     }
 
     #[test]

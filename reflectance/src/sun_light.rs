@@ -14,6 +14,8 @@
 
 use frf_core::image::Rgb;
 use frf_core::sun::Sun;
+use std::sync::Arc;
+
 use glam::{Mat3, Vec3};
 
 use crate::field::ConditionRecord;
@@ -67,7 +69,7 @@ pub struct SunView {
 }
 
 /// A sun relit by a pose's normals (see the module text).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct SunLight {
     /// Per condition: the direction of the light standing for it ([`condition_lights`]).
     pub directions: Vec<Vec3>,
@@ -92,7 +94,7 @@ impl SunLight {
         sun: &Sun,
         conditions: &[ConditionRecord],
         turntables: &[f32],
-        hull: Option<&VoxelHull>,
+        hull: Option<&Arc<VoxelHull>>,
     ) -> Self {
         let lights = condition_lights(conditions);
         let directions: Vec<Vec3> = lights.iter().map(|l| l.0).collect();

@@ -66,6 +66,11 @@ impl Proxy {
         self.hull.as_deref()
     }
 
+    /// The hull, to keep (a sun's map of it, [`frf_reflectance::sun_depth::SunDepth`]).
+    pub fn hull_shared(&self) -> Option<&Arc<VoxelHull>> {
+        self.hull.as_ref()
+    }
+
     /// `(x, z)` of the fallback's vertical axis.
     pub fn axis(&self) -> Vec2 {
         self.axis

@@ -176,7 +176,7 @@ impl PoseSource {
             lighting,
             plan,
             (&read, self.holds_normals()),
-            self.geometry.proxy.hull(),
+            self.geometry.proxy.hull_shared(),
         )?;
         Ok(Self {
             coefficients: relit.coefficients,
@@ -280,7 +280,6 @@ impl PoseSource {
         }
         let held = (0..read.len()).any(|i| read[i])
             && (0..read.len()).all(|i| !read[i] || !normals[i].is_empty());
-        let relit = relighting(field, pose, lighting, plan, (&read, held), hull.as_ref())?;
         let geometry =
             PoseGeometry::new(pose, columns, rows, h.wraps, size, crop, cameras, |i, n| {
                 flows[i][n.index()].is_some()
@@ -288,6 +287,14 @@ impl PoseSource {
             .with_bounds(bounds)
             .with_proxy(Proxy::new(hull))
             .with_held(|i| read[i]);
+        let relit = relighting(
+            field,
+            pose,
+            lighting,
+            plan,
+            (&read, held),
+            geometry.proxy.hull_shared(),
+        )?;
         let surfaces = hull_surfaces(&geometry, &normals);
         Ok(Self {
             surfaces: Arc::new(surfaces),
@@ -404,7 +411,7 @@ fn relighting<R: ReadAt>(
     lighting: &Lighting,
     plan: Option<&PosePlan>,
     (read, normals): (&[bool], bool),
-    hull: Option<&VoxelHull>,
+    hull: Option<&Arc<VoxelHull>>,
 ) -> Result<Relighting> {
     let h = field.header();
     let record = h.pose(pose)?;

@@ -49,7 +49,12 @@ pub const FLOW_F16: &str = include_str!("../sample/flow_f16.wgsl");
 /// `sample/flow_f32.wgsl`: flows as floats.
 pub const FLOW_F32: &str = include_str!("../sample/flow_f32.wgsl");
 
-/// Every pass but the frame pass ([`frame_pass`]), named.
+/// `sun_depth.wgsl`: a sun's map of a pose's hull, composed with the hull's walk
+/// ([`sun_depth_pass`]).
+pub const SUN_DEPTH: &str = include_str!("../sun_depth.wgsl");
+
+/// Every pass but the frame pass ([`frame_pass`]) and the sun's map ([`sun_depth_pass`]),
+/// named.
 pub const PASSES: [(&str, &str); 7] = [
     ("relight", RELIGHT),
     ("shadow", SHADOW),
@@ -76,4 +81,10 @@ pub fn composed(pass: &str) -> String {
 /// [`PRELIT`]) and one reading the flows (of [`FLOW`]).
 pub fn frame_pass(prelit: &str, flow: &str) -> String {
     [COMMON, prelit, flow, REBIN, CYLINDER, PROXY, E06, SOLVED].join("\n")
+}
+
+/// The sun-depth pass's full source: the shared definitions, the pass, and the walk
+/// through the hull it shares with the frame pass ([`PROXY`]).
+pub fn sun_depth_pass() -> String {
+    [COMMON, SUN_DEPTH, PROXY].join("\n")
 }

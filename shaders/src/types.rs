@@ -142,6 +142,23 @@ pub struct GpuProxy {
     pub block: u32,
 }
 
+/// `SunDepthJob` of `sun_depth.wgsl`: one sun's map of the hull, its frame and where its
+/// values go.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuSunDepthJob {
+    /// Unit, toward the sun (subject frame); w: `far`, `toward · p` where rays start.
+    pub toward: [f32; 4],
+    /// The map's x axis (xyz) and its corner's x (w).
+    pub axis_x: [f32; 4],
+    /// Its y axis and its corner's y.
+    pub axis_y: [f32; 4],
+    /// Texels along x and y, where its values start, 1 when the slot is in use.
+    pub size: [u32; 4],
+    /// Texel side, metres (x; the rest unused).
+    pub texel: [f32; 4],
+}
+
 /// `RelightParams` of `relight.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

@@ -10,7 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuLightFitParams, GpuPresent, GpuProxy,
-    GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuTimeMorph, GpuView,
+    GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuSunDepthJob,
+    GpuTimeMorph, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -48,6 +49,11 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
                     assert_eq!(m.entry_points.len(), 4, "{name}");
                 }
             }
+        } else if name == "sun_depth.wgsl" {
+            assert_eq!(text, shaders::SUN_DEPTH, "{name} as compiled");
+            let m = module(&shaders::sun_depth_pass(), &name);
+            // vs_main (of every pass), sun_depth.
+            assert_eq!(m.entry_points.len(), 2, "{name}");
         } else {
             let m = module(&shaders::composed(&text), &name);
             assert!(!m.entry_points.is_empty(), "{name} has no entry point");
@@ -137,6 +143,13 @@ macro_rules! check_layout {
 
 #[test]
 fn pod_structs_match_naga_layouts() {
+    let sun_depth = module(&shaders::sun_depth_pass(), "sun_depth");
+    check_layout!(
+        &sun_depth,
+        "SunDepthJob",
+        GpuSunDepthJob,
+        [toward, axis_x, axis_y, size, texel]
+    );
     let rebin = module(
         &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES),
         "rebin",

@@ -3,7 +3,9 @@
 //!
 //! - [`pose`]: a pose made resident;
 //! - [`relight`]: its views relit from basis codes kept resident (`shaders/relight.wgsl`;
-//!   twin of [`crate::resident::ResidentPose::relight_cpu`]);
+//!   twin of [`crate::resident::ResidentPose::relight_cpu`]), after [`sun_depth`] made its
+//!   suns' maps of the hull (`shaders/sun_depth.wgsl`; twin of
+//!   [`frf_reflectance::sun_depth::SunDepth::reach`]);
 //! - [`rebin`]: the subject of a frame, re-binned and morphed (`shaders/rebin.wgsl`; twin
 //!   of [`crate::cpu::render_cpu`]);
 //! - [`shadow`]: the pose's shadow maps relit (`shaders/shadow.wgsl`; twin of
@@ -37,6 +39,7 @@ pub mod rebin;
 pub mod relight;
 pub mod scope;
 pub mod shadow;
+pub mod sun_depth;
 pub mod time_morph;
 pub mod timing;
 
@@ -107,6 +110,7 @@ pub struct Gpu {
     pass_clock: std::sync::OnceLock<pass_clock::PassClock>,
     shadow: shadow::ShadowPass,
     composite: composite_targets::CompositePass,
+    sun_depth: sun_depth::SunDepthPass,
 }
 
 impl Gpu {
@@ -170,6 +174,7 @@ impl Gpu {
             pass_clock: std::sync::OnceLock::new(),
             shadow: shadow::ShadowPass::new(&device),
             composite: composite_targets::CompositePass::new(&device),
+            sun_depth: sun_depth::SunDepthPass::new(&device),
             device,
             queue,
             adapter,

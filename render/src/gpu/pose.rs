@@ -7,11 +7,13 @@
 use std::sync::Arc;
 
 use frf_core::volume::GroundGrid;
+use frf_reflectance::hull::VoxelHull;
+use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
 use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::Gpu;
-use super::bind::{buffer_with, copy_to_buffer, table_bytes};
+use super::bind::{buffer_with, copy_to_buffer, readback_buffer, table_bytes};
 use super::formats::PoseFormats;
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
@@ -35,6 +37,10 @@ pub struct GpuPose {
     prelit: wgpu::Texture,
     /// The view table (whose scales the relighting pass sets).
     pub(super) views: wgpu::Buffer,
+    /// The hull's grid and its words, as the frame pass binds them (the suns' maps walk
+    /// it too, [`super::sun_depth`]).
+    pub(super) proxy: wgpu::Buffer,
+    pub(super) hull: wgpu::Buffer,
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
     pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
@@ -66,6 +72,13 @@ pub struct RelitShadowInfo {
 }
 
 impl GpuPose {
+    /// Its hull, and the hull's grid and words as the frame pass binds them (none without
+    /// a hull).
+    pub(super) fn hull(&self) -> Option<(&VoxelHull, &wgpu::Buffer, &wgpu::Buffer)> {
+        let hull = self.geometry.proxy.hull()?;
+        Some((hull, &self.proxy, &self.hull))
+    }
+
     /// A view of the pre-lit texture array.
     pub(super) fn prelit_codes_view(&self) -> wgpu::TextureView {
         self.prelit.create_view(&wgpu::TextureViewDescriptor {
@@ -188,8 +201,8 @@ impl Gpu {
             &flows,
             source.flows.table,
         );
-        let relight = self.pose_relight(basis, geometry.views());
-        self.record_relight(&relight, source, &pose.prelit_codes_view(), &pose.views);
+        let relight = self.pose_relight(basis, geometry.views(), pose.hull());
+        self.record_relight(&relight, source, (&pose.prelit_codes_view(), &pose.views));
         pose.relight = Some(relight);
         Ok(pose)
     }
@@ -201,7 +214,8 @@ impl Gpu {
         if pose.relight.is_none() {
             // Let go of ([`GpuPose::release_basis`]): uploaded again.
             let basis = self.upload_basis(source)?;
-            pose.relight = Some(self.pose_relight(basis, source.geometry.views()));
+            let relight = self.pose_relight(basis, source.geometry.views(), pose.hull());
+            pose.relight = Some(relight);
         }
         self.scoped("relighting a resident pose", || {
             let relight = pose.relight.as_ref().ok_or_else(|| {
@@ -212,7 +226,7 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(relight, source, &pose.prelit_codes_view(), &pose.views);
+            self.record_relight(relight, source, (&pose.prelit_codes_view(), &pose.views));
             Ok(())
         })
     }
@@ -464,6 +478,8 @@ impl Gpu {
             bind_group,
             prelit,
             views: view_buffer,
+            proxy: proxy_buffer,
+            hull: hull_buffer,
             relight: None,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,
@@ -518,5 +534,38 @@ impl Gpu {
                     .collect()
             })
             .collect())
+    }
+}
+
+impl Gpu {
+    /// The suns' maps of `pose` as the GPU made them at its last relight (per sun of
+    /// `suns`, its map's values; for tests and inspection): none without a hull.
+    pub fn read_sun_maps(&self, pose: &GpuPose, suns: &[SunLight]) -> Result<Vec<Vec<f32>>> {
+        let Some(maps) = pose.relight.as_ref().and_then(|r| r.sun_maps()) else {
+            return Ok(Vec::new());
+        };
+        self.scoped("reading the suns' maps back", || {
+            let size = maps.reach.size();
+            let readback = readback_buffer(&self.device, "sun depths readback", size);
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("sun depths readback"),
+                });
+            encoder.copy_buffer_to_buffer(&maps.reach, 0, &readback, 0, size);
+            self.submit([encoder.finish()]);
+            let bytes = self.read_buffer(&readback)?;
+            let all: &[f32] = bytemuck::cast_slice(&bytes);
+            Ok(suns
+                .iter()
+                .take(MAX_SUNS)
+                .enumerate()
+                .filter_map(|(s, sun)| {
+                    let n = sun.depth.as_ref()?.texels();
+                    let start = maps.slot_start(s);
+                    Some(all[start..start + n].to_vec())
+                })
+                .collect())
+        })
     }
 }

@@ -12,8 +12,10 @@
 
 use std::sync::Arc;
 
+use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
+use frf_reflectance::sun_depth::SunDepth;
 use frf_reflectance::sun_light::{MAX_SUNS, SHADOW_OFFSET_M, SunLight};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
@@ -21,6 +23,7 @@ use wgpu::util::DeviceExt;
 use super::bind::{
     bind_group, buffer_with, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
 };
+use super::sun_depth::PoseSunMaps;
 use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::Result;
@@ -38,6 +41,9 @@ pub struct RelightPass {
     relight: wgpu::ComputePipeline,
     encode: wgpu::ComputePipeline,
     gamma: wgpu::Buffer,
+    /// The suns' maps bound for a pose without a hull (never read: its suns cast no
+    /// shadow; a binding is never empty).
+    no_depths: wgpu::Buffer,
 }
 
 impl RelightPass {
@@ -66,11 +72,17 @@ impl RelightPass {
             contents: &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
             usage: wgpu::BufferUsages::STORAGE,
         });
+        let no_depths = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("no sun depths"),
+            contents: bytemuck::bytes_of(&f32::MIN),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         Self {
             relight: compute("relight"),
             encode: compute("encode"),
             layout,
             gamma,
+            no_depths,
         }
     }
 }
@@ -113,12 +125,19 @@ pub struct PoseRelight {
     basis: Arc<GpuBasis>,
     coefficients: Vec<wgpu::Buffer>,
     peaks: wgpu::Buffer,
+    /// Its suns' maps of the hull, made on the GPU (none without a hull).
+    sun_maps: Option<PoseSunMaps>,
 }
 
 impl PoseRelight {
     /// The shared codes.
     pub fn basis(&self) -> &Arc<GpuBasis> {
         &self.basis
+    }
+
+    /// Its suns' maps (none without a hull).
+    pub(super) fn sun_maps(&self) -> Option<&PoseSunMaps> {
+        self.sun_maps.as_ref()
     }
 }
 
@@ -127,18 +146,6 @@ impl PoseRelight {
 /// sun per unit of its light, then the sun's seven.
 fn job_coefficients(tiles: usize) -> usize {
     2 * tiles + MAX_SUNS * (tiles + 7)
-}
-
-/// The suns' maps of the hull ([`SunLight::depth`]) one after the other, as the relight
-/// pass reads them (one value where there are none: a binding is never empty).
-fn sun_depths(source: &PoseSource) -> Vec<f32> {
-    let mut out: Vec<f32> = (source.suns.iter().take(MAX_SUNS))
-        .flat_map(|s| s.depth.iter().flat_map(|m| m.reach.iter().copied()))
-        .collect();
-    if out.is_empty() {
-        out.push(f32::MIN);
-    }
-    out
 }
 
 /// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
@@ -156,7 +163,11 @@ fn light_coefficients(source: &PoseSource) -> usize {
 /// condition is used at all; where its condition's lights are; then [`MAX_SUNS`] slots of
 /// a sun's terms, the suns first and the rest zero (all zero where the view holds no
 /// normals).
-fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]> {
+fn packed_coefficients(
+    batch: &BasisBatch,
+    source: &PoseSource,
+    maps: Option<&PoseSunMaps>,
+) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
     // The conditions' lights follow the jobs: where each condition's start.
     let jobs: usize = batch
@@ -187,10 +198,8 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
             &source.suns[..source.suns.len().min(MAX_SUNS)]
         };
         out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
-        let mut depth_at = 0;
-        for sun in suns {
-            pack_sun(&mut out, sun, i, scales, depth_at);
-            depth_at += sun.depth.as_ref().map_or(0, |m| m.reach.len());
+        for (s, sun) in suns.iter().enumerate() {
+            pack_sun(&mut out, sun, (i, scales), maps.map(|m| m.slot_start(s)));
         }
         let empty = MAX_SUNS - suns.len();
         out.extend(std::iter::repeat_n([0.0; 4], empty * (scales.len() + 7)));
@@ -209,8 +218,14 @@ fn packed_coefficients(batch: &BasisBatch, source: &PoseSource) -> Vec<[f32; 4]>
 }
 
 /// One slot of view `i`'s job for `sun` (`shaders/relight.wgsl` says what each holds),
-/// its map of the hull, if any, from `depth_at` on in [`sun_depths`].
-fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], depth_at: usize) {
+/// its map of the hull, if any, from `depth_at` on in the pose's maps
+/// ([`PoseSunMaps::reach`]; `None`: no maps, no cast shadows).
+fn pack_sun(
+    out: &mut Vec<[f32; 4]>,
+    sun: &SunLight,
+    (i, scales): (usize, &[f32]),
+    depth_at: Option<usize>,
+) {
     out.extend(
         sun.unit
             .iter()
@@ -228,7 +243,7 @@ fn pack_sun(out: &mut Vec<[f32; 4]>, sun: &SunLight, i: usize, scales: &[f32], d
     out.push(view.direction.extend(1.0).to_array());
     out.push(nearest);
     out.push(weights);
-    let Some(m) = &sun.depth else {
+    let (Some(m), Some(depth_at)) = (&sun.depth, depth_at) else {
         out.push(sun.subject.extend(0.0).to_array());
         out.extend([[0.0; 4]; 3]);
         return;
@@ -346,8 +361,17 @@ impl Gpu {
         }
     }
 
-    /// A pose's own relighting buffers over the shared `basis`, for `views` views.
-    pub(super) fn pose_relight(&self, basis: Arc<GpuBasis>, views: usize) -> PoseRelight {
+    /// A pose's own relighting buffers over the shared `basis`, for `views` views, and the
+    /// slots of its suns' maps where it has a hull (`hull`: the hull, and its grid and
+    /// words as the frame pass binds them).
+    pub(super) fn pose_relight(
+        &self,
+        basis: Arc<GpuBasis>,
+        views: usize,
+        hull: Option<(&VoxelHull, &wgpu::Buffer, &wgpu::Buffer)>,
+    ) -> PoseRelight {
+        let sun_maps = hull
+            .map(|(h, proxy, words)| self.pose_sun_maps(proxy, words, SunDepth::most_texels(h)));
         let buffer = |label: &str, size: usize, usage| {
             self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -365,22 +389,24 @@ impl Gpu {
                 .collect(),
             peaks: buffer("peaks", views.max(1) * 4, dst),
             basis,
+            sun_maps,
         }
     }
 
     /// Writes `source`'s coefficients into `relight`'s buffers and records the passes
-    /// that relight its views into the pre-lit layers of `target`, their scales into the
-    /// pose's view table `views` ([`Gpu::relight_pose`]).
+    /// that make its suns' maps ([`super::sun_depth`]) and relight its views into the
+    /// pre-lit array `target`, their scales into the pose's view table `views`
+    /// ([`Gpu::relight_pose`]).
     pub(super) fn record_relight(
         &self,
         relight: &PoseRelight,
         source: &PoseSource,
-        target: &wgpu::TextureView,
-        views: &wgpu::Buffer,
+        (target, views): (&wgpu::TextureView, &wgpu::Buffer),
     ) {
+        let maps = relight.sun_maps.as_ref();
         let basis = &relight.basis;
         for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
-            let packed = packed_coefficients(batch, source);
+            let packed = packed_coefficients(batch, source, maps);
             self.queue
                 .write_buffer(buffer, 0, bytemuck::cast_slice(&packed));
         }
@@ -391,13 +417,11 @@ impl Gpu {
             .max()
             .unwrap_or(0);
         let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
-        let depths = buffer_with(
-            &self.device,
-            "sun depths",
-            bytemuck::cast_slice(&sun_depths(source)),
-            wgpu::BufferUsages::STORAGE,
-        );
+        let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
         self.with_pending(|encoder| {
+            if let Some(maps) = maps {
+                self.record_sun_maps(encoder, maps, &source.suns);
+            }
             encoder.clear_buffer(&relight.peaks, 0, None);
             for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
                 let bind = bind_group(
