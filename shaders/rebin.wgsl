@@ -13,17 +13,11 @@
 // `stats`), `cs_classes` (those counts alone, for frames drawn by `fs_main`).
 // Bind group 0 holds per-frame data, bind group 1 the resident pose.
 //
-// A pipeline is made per morph (`frf_render::morph::Variant`): its interpolation and its
-// refinements are constants of the pipeline (the overrides `KIND` and `FLAGS`), so the
-// shader compiled holds that morph alone (measured on an H100 and on lavapipe, docs/
-// results/realtime.md).
-
-// The interpolation (`Variant::index`: 0 nearest, 1 linear, 2 two-way, 3 E06's four-way,
-// 4 the solved four-way).
-override KIND: u32;
-// Refinements (`Variant::flags`): 1 rays beyond the rows through the proxy, 2
-// occlusion-aware morphs.
-override FLAGS: u32;
+// A module is compiled per morph (`frf_render::morph::Variant`): its interpolation `KIND`
+// (`Variant::index`: 0 nearest, 1 linear, 2 two-way, 3 E06's four-way, 4 the solved
+// four-way) and its refinements `FLAGS` (`Variant::flags`: 1 rays beyond the rows through
+// the proxy, 2 occlusion-aware morphs) are constants written before the pass
+// (`frf_shaders::frame_pass`), so the shader compiled holds that morph alone.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 // Pixels clamped above, clamped below and missed, at 1 to 3 (compute entry points; those

@@ -253,6 +253,19 @@ pub fn run_frame_bench<R: ReadAt>(
     progress: &dyn Progress,
 ) -> Result<FrameBenchReport> {
     options.check()?;
+    // Counts the device cannot draw are refused before any is drawn.
+    let device = Device::open(options.cpu)?;
+    if let Some(most) = device.max_walkers()
+        && let Some(&n) = options.walkers.iter().find(|&&n| n > most)
+    {
+        return Err(BadArgument::new(
+            "--walkers",
+            n,
+            format!("at most {most} walkers a frame on {}", device.name()),
+        )
+        .into());
+    }
+    drop(device);
     let rows_wanted = options.walkers.len() * options.lights.len();
     progress.phase("frames", rows_wanted * (options.frames + 1));
     let mut rows = Vec::with_capacity(rows_wanted);

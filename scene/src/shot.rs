@@ -291,6 +291,16 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         frames: &[ShotFrame],
         options: ShotOptions,
     ) -> Result<Self> {
+        if let Some(most) = device.max_walkers()
+            && scene.instances.len() > most
+        {
+            return Err(BadArgument::new(
+                "[[instance]]",
+                format!("{} walkers", scene.instances.len()),
+                format!("at most {most} walkers a frame on {}", device.name()),
+            )
+            .into());
+        }
         let plan = Plan::new(&scene, field, frames)?;
         let keys: Vec<LightingKey> = frames
             .iter()

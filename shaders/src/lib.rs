@@ -78,9 +78,16 @@ pub fn composed(pass: &str) -> String {
 }
 
 /// The frame pass's full source with one snippet reading the pre-lit views (of
-/// [`PRELIT`]) and one reading the flows (of [`FLOW`]).
-pub fn frame_pass(prelit: &str, flow: &str) -> String {
-    [COMMON, prelit, flow, REBIN, CYLINDER, PROXY, E06, SOLVED].join("\n")
+/// [`PRELIT`]) and one reading the flows (of [`FLOW`]), for one morph: `(kind, flags)`,
+/// the interpolation and its refinements (`frf_render::morph::Variant::index` and
+/// `flags`), written into the source as the constants `KIND` and `FLAGS`, so that the
+/// module compiled holds that morph alone (docs/design.md section 4.5).
+pub fn frame_pass(prelit: &str, flow: &str, (kind, flags): (u32, u32)) -> String {
+    let morph = format!("const KIND: u32 = {kind}u;\nconst FLAGS: u32 = {flags}u;");
+    [
+        COMMON, &morph, prelit, flow, REBIN, CYLINDER, PROXY, E06, SOLVED,
+    ]
+    .join("\n")
 }
 
 /// The sun-depth pass's full source: the shared definitions, the pass, and the walk

@@ -41,12 +41,16 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         } else if name == "rebin.wgsl" {
             // The frame pass, composed with every choice of its sampling snippets.
             assert_eq!(text, shaders::REBIN, "{name} as compiled");
+            // Every morph: the interpolations 0 to 4, without refinements, through the
+            // proxy, occlusion-aware.
             for (image, prelit) in shaders::PRELIT {
                 for (flow, flows) in shaders::FLOW {
-                    let name = format!("{image}/{flow}");
-                    let m = module(&shaders::frame_pass(prelit, flows), &name);
-                    // vs_main, fs_main, cs_main, cs_classes.
-                    assert_eq!(m.entry_points.len(), 4, "{name}");
+                    for morph in (0..5).flat_map(|kind| [(kind, 0), (kind, 1), (kind, 3)]) {
+                        let name = format!("{image}/{flow} {morph:?}");
+                        let m = module(&shaders::frame_pass(prelit, flows, morph), &name);
+                        // vs_main, fs_main, cs_main, cs_classes.
+                        assert_eq!(m.entry_points.len(), 4, "{name}");
+                    }
                 }
             }
         } else if name == "sun_depth.wgsl" {
@@ -74,7 +78,9 @@ fn every_piece_of_the_frame_pass_is_compiled_into_it() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf();
     let sources: Vec<String> = shaders::PRELIT
         .into_iter()
-        .flat_map(|(_, prelit)| shaders::FLOW.map(|(_, flow)| shaders::frame_pass(prelit, flow)))
+        .flat_map(|(_, prelit)| {
+            shaders::FLOW.map(|(_, flow)| shaders::frame_pass(prelit, flow, (4, 1)))
+        })
         .collect();
     let mut pieces = 0;
     for folder in ["sample", "rebin", "morph"] {
@@ -96,7 +102,7 @@ fn every_piece_of_the_frame_pass_is_compiled_into_it() {
 fn a_broken_shader_is_refused() {
     // The validation above can fail: a type error in an otherwise valid pass.
     let broken = shaders::REBIN.replacen("fn ", "fn broken() -> f32 { return 1u; }\nfn ", 1);
-    let source = shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES)
+    let source = shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES, (4, 1))
         .replace(shaders::REBIN, &broken);
     let parsed = naga::front::wgsl::parse_str(&source);
     let problem = match parsed {
@@ -151,7 +157,7 @@ fn pod_structs_match_naga_layouts() {
         [toward, axis_x, axis_y, size, texel]
     );
     let rebin = module(
-        &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES),
+        &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES, (4, 1)),
         "rebin",
     );
     check_layout!(

@@ -773,4 +773,22 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
+    if gpu_flag().is_none() {
+        // More walkers than the device's array textures hold: refused up front, by name,
+        // before any pose is read (it panicked in wgpu, issue 48).
+        let many = frf(&[
+            "bench",
+            "frame",
+            scene.to_str().unwrap(),
+            "--walkers",
+            "5000",
+        ]);
+        assert!(!many.status.success());
+        let text = stderr(&many);
+        assert!(
+            text.contains("--walkers 5000") && text.contains("at most 682 walkers"),
+            "{text}"
+        );
+        assert!(!text.contains("panicked"), "{text}");
+    }
 }

@@ -286,19 +286,6 @@ pub fn full_screen_pipeline_into(
     entry: &str,
     formats: &[wgpu::TextureFormat],
 ) -> wgpu::RenderPipeline {
-    full_screen_pipeline_with(device, (label, layouts), module, entry, formats, &[])
-}
-
-/// [`full_screen_pipeline_into`] with the module's overrides set to `constants`
-/// (`(name, value)`): a pipeline specialized to them.
-pub fn full_screen_pipeline_with(
-    device: &wgpu::Device,
-    (label, layouts): (&str, &[&wgpu::BindGroupLayout]),
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    formats: &[wgpu::TextureFormat],
-    constants: &[(&str, f64)],
-) -> wgpu::RenderPipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
@@ -329,10 +316,7 @@ pub fn full_screen_pipeline_with(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants,
-                ..Default::default()
-            },
+            compilation_options: Default::default(),
             targets: &targets,
         }),
         multiview_mask: None,
@@ -348,18 +332,6 @@ pub fn compute_pipeline(
     module: &wgpu::ShaderModule,
     entry: &str,
 ) -> wgpu::ComputePipeline {
-    compute_pipeline_with(device, label, layouts, (module, entry), &[])
-}
-
-/// [`compute_pipeline`] with the module's overrides set to `constants` (`(name,
-/// value)`): a pipeline specialized to them.
-pub fn compute_pipeline_with(
-    device: &wgpu::Device,
-    label: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-    (module, entry): (&wgpu::ShaderModule, &str),
-    constants: &[(&str, f64)],
-) -> wgpu::ComputePipeline {
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts.iter().map(|l| Some(*l)).collect::<Vec<_>>(),
@@ -370,10 +342,7 @@ pub fn compute_pipeline_with(
         layout: Some(&layout),
         module,
         entry_point: Some(entry),
-        compilation_options: wgpu::PipelineCompilationOptions {
-            constants,
-            ..Default::default()
-        },
+        compilation_options: Default::default(),
         cache: None,
     })
 }

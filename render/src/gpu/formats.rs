@@ -156,8 +156,9 @@ impl PoseFormats {
         format!("{}/{}", self.image.name(), self.flow.name())
     }
 
-    /// The frame pass's source with these formats' sampling.
-    pub fn rebin_source(self) -> String {
-        shaders::frame_pass(self.image.snippet(), self.flow.snippet())
+    /// The frame pass's source with these formats' sampling, for the morph `(kind, flags)`
+    /// ([`crate::morph::Variant::index`], [`crate::morph::Variant::flags`]).
+    pub fn rebin_source(self, morph: (u32, u32)) -> String {
+        shaders::frame_pass(self.image.snippet(), self.flow.snippet(), morph)
     }
 }

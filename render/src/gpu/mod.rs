@@ -214,6 +214,11 @@ impl Gpu {
         self.timestamps
     }
 
+    /// The most layers of an array texture the device takes.
+    pub fn max_texture_layers(&self) -> u32 {
+        self.device.limits().max_texture_array_layers
+    }
+
     /// The largest texture side the device takes, pixels.
     pub fn max_texture_side(&self) -> u32 {
         self.device.limits().max_texture_dimension_2d

@@ -11,8 +11,8 @@ use frf_core::image::{Image, Rgba};
 
 use super::Gpu;
 use super::bind::{
-    compute_pipeline_with, full_screen_pipeline_with, loaded, readback_buffer, sampler, storage,
-    storage_min, storage_texture_array, texture_array, uniform, uniform_buffer,
+    compute_pipeline, full_screen_pipeline, loaded, readback_buffer, sampler, storage, storage_min,
+    storage_texture_array, texture_array, uniform, uniform_buffer,
 };
 use super::formats::PoseFormats;
 use super::pose::{GpuPose, PoseBinding};
@@ -59,18 +59,17 @@ pub struct RebinPass {
     pub(super) compute_layout: wgpu::BindGroupLayout,
     pub(super) classes_layout: wgpu::BindGroupLayout,
     device: wgpu::Device,
-    module: wgpu::ShaderModule,
-    /// Per morph ([`Variant::index`] and [`Variant::flags`]), its pipelines, made the first
-    /// time a frame is drawn with it.
+    /// Per morph ([`Variant::index`] and [`Variant::flags`]), its module and pipelines,
+    /// made the first time a frame is drawn with it.
     pipelines: std::sync::Mutex<Vec<(MorphKey, Arc<MorphPipelines>)>>,
 }
 
-/// A morph as the frame pass's overrides hold it: `KIND` ([`Variant::index`]) and
-/// `FLAGS` ([`Variant::flags`]).
+/// A morph as the frame pass's constants hold it: `KIND` ([`Variant::index`]) and `FLAGS`
+/// ([`Variant::flags`]).
 type MorphKey = (u32, u32);
 
-/// The frame pass's pipelines specialized to one morph (the shader's overrides `KIND` and
-/// `FLAGS`).
+/// The frame pass's pipelines of one morph (its module compiled with the constants `KIND`
+/// and `FLAGS`, [`frf_shaders::frame_pass`]).
 pub(super) struct MorphPipelines {
     pub(super) fragment: wgpu::RenderPipeline,
     pub(super) compute: wgpu::ComputePipeline,
@@ -80,10 +79,6 @@ pub(super) struct MorphPipelines {
 impl RebinPass {
     /// Builds the pass on `device` for poses stored as `formats`.
     pub fn new(device: &wgpu::Device, formats: PoseFormats) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("rebin"),
-            source: wgpu::ShaderSource::Wgsl(formats.rebin_source().into()),
-        });
         let both = wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let layout = |label: &str, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -139,7 +134,6 @@ impl RebinPass {
             compute_layout,
             classes_layout,
             device: device.clone(),
-            module,
             pipelines: std::sync::Mutex::new(Vec::new()),
         }
     }
@@ -152,26 +146,23 @@ impl RebinPass {
         if let Some((_, p)) = made.iter().find(|(k, _)| *k == key) {
             return p.clone();
         }
-        let constants = [("KIND", f64::from(key.0)), ("FLAGS", f64::from(key.1))];
         let device = &self.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("rebin"),
+            source: wgpu::ShaderSource::Wgsl(self.pose.formats.rebin_source(key).into()),
+        });
         let pose_layout = &self.pose.layout;
         let compute = |label, layout, entry| {
-            compute_pipeline_with(
-                device,
-                label,
-                &[layout, pose_layout],
-                (&self.module, entry),
-                &constants,
-            )
+            compute_pipeline(device, label, &[layout, pose_layout], &module, entry)
         };
         let p = Arc::new(MorphPipelines {
-            fragment: full_screen_pipeline_with(
+            fragment: full_screen_pipeline(
                 device,
-                ("rebin", &[&self.frame_layout, pose_layout]),
-                &self.module,
+                "rebin",
+                &[&self.frame_layout, pose_layout],
+                &module,
                 "fs_main",
-                &[wgpu::TextureFormat::Rgba32Float],
-                &constants,
+                1,
             ),
             compute: compute("rebin", &self.compute_layout, "cs_main"),
             classes: compute("classes", &self.classes_layout, "cs_classes"),
