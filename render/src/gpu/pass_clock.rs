@@ -14,9 +14,10 @@ use super::bind::readback_buffer;
 use super::timing::Timestamps;
 use crate::error::Result;
 
-/// Passes timed between two reads: later ones go untimed (a frame of 100 walkers between
-/// poses records under 20 passes).
-const CAPACITY: u32 = 256;
+/// Passes timed between two reads, later ones untimed: half of wgpu's most queries in a
+/// set (4096). A frame of 100 walkers between poses under a turning light records about
+/// 600 (a sun's map, a relight and a shadow for each of its 200 poses, and the frame's).
+const CAPACITY: u32 = 2048;
 
 /// The device time of the passes of one name.
 #[derive(Debug, Clone, Serialize, PartialEq)]
