@@ -81,8 +81,20 @@ fn die_quietly_on_a_closed_pipe() {
     }
 }
 
+/// An interrupt (Ctrl-C, SIGTERM) ends the program as before (status 130), after removing
+/// the lock files and temporaries of the outputs it was writing
+/// ([`frf_core::claim::abandon_live_claims`]); whole files already written stay, and a
+/// rerun resumes from them.
+fn clean_up_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        frf_core::claim::abandon_live_claims();
+        std::process::exit(130);
+    });
+}
+
 fn main() -> ExitCode {
     die_quietly_on_a_closed_pipe();
+    clean_up_on_interrupt();
     let cli = Cli::parse();
     if !matches!(cli.command, Command::View(_)) {
         frf_render::gpu::adapter::keep_the_display_probe_quiet();

@@ -13,8 +13,30 @@
 
 use std::fs::{File, OpenOptions, TryLockError};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::{CoreError, Result};
+
+/// The outputs claimed and not yet released, by their lock files, for
+/// [`abandon_live_claims`].
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// What an interrupted process does with its claims before it exits (the binary calls
+/// it from its interrupt handler): removes their lock files and the temporaries of their
+/// outputs, so that an interrupt leaves nothing behind. (A process killed outright leaves
+/// them; the next claim of the same output clears its temporaries.)
+pub fn abandon_live_claims() {
+    let live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
+    for lock in live.iter() {
+        if let (Some(dir), Some(name)) = (lock.parent(), lock.file_name()) {
+            // `.NAME.lock` → the temporaries `.NAME.*.tmp`.
+            let name = name.to_string_lossy();
+            let output = name.trim_start_matches('.').trim_end_matches(".lock");
+            remove_temporaries(dir, &format!("{output}."));
+        }
+        let _ = std::fs::remove_file(lock);
+    }
+}
 
 /// A claimed output; the lock is released (and its file removed) when it is dropped.
 #[derive(Debug)]
@@ -61,6 +83,9 @@ impl Drop for OutputClaim {
         // that is about to disappear unnoticed (they check the name after locking).
         let _ = std::fs::remove_file(&self.lock_path);
         drop(self.lock.take());
+        LIVE.lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .retain(|p| p != &self.lock_path);
     }
 }
 
@@ -146,6 +171,9 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
     };
     let _ = std::fs::write(&lock_path, format!("{}\n", std::process::id()));
     let removed = remove_temporaries(parent, &format!("{name}."));
+    LIVE.lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(lock_path.clone());
     Ok(OutputClaim {
         lock_path,
         lock: Some(lock),
@@ -156,6 +184,22 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn claims_abandoned_on_an_interrupt_leave_no_lock_or_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("f.frf");
+        let claim = claim_output(&out).unwrap();
+        let lock = out.with_file_name(".f.frf.lock");
+        let half = out.with_file_name(".f.frf.77.tmp");
+        std::fs::write(&half, b"half a field").unwrap();
+        assert!(lock.exists());
+        abandon_live_claims();
+        assert!(!lock.exists() && !half.exists());
+        drop(claim);
+        // Released claims are not abandoned again.
+        assert!(LIVE.lock().unwrap().iter().all(|p| p != &lock));
+    }
 
     #[test]
     fn a_claim_refuses_a_second_writer_and_a_directory_and_clears_old_temporaries() {

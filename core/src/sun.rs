@@ -38,12 +38,18 @@ impl Sun {
     /// angular diameter `diameter_deg` and illuminance `illuminance` (per channel): values
     /// outside what a sun can be are refused naming them.
     pub fn new(direction: Vec3, diameter_deg: f32, illuminance: Rgb) -> Result<Self> {
-        if !direction.is_finite() || direction.length() < 1e-6 {
+        // Any finite, non-zero vector names a direction, however short or long: it is
+        // scaled to its largest component before it is normalised, so that neither its
+        // length's square underflows (a sun found in a dim map) nor overflows (one of
+        // 1e20) in 32-bit floats.
+        let longest = direction.abs().max_element();
+        if !direction.is_finite() || longest <= 0.0 {
             return Err(CoreError::invalid(
                 "sun direction",
                 format!("{direction} is not a direction"),
             ));
         }
+        let direction = (direction / longest).normalize();
         if !(diameter_deg > 0.0 && diameter_deg <= MAX_DIAMETER_DEG) {
             return Err(CoreError::invalid(
                 "sun angular diameter",
@@ -52,7 +58,7 @@ impl Sun {
         }
         if illuminance
             .iter()
-            .any(|c| !c.is_finite() || *c < 0.0 || *c as f64 > crate::env::MAX_TOTAL_LIGHT)
+            .any(|c| !c.is_finite() || *c < 0.0 || *c > crate::env::MAX_TOTAL_LIGHT as f32)
         {
             return Err(CoreError::invalid(
                 "sun illuminance",
@@ -60,7 +66,7 @@ impl Sun {
             ));
         }
         Ok(Self {
-            direction: direction.normalize(),
+            direction,
             diameter: diameter_deg.to_radians(),
             illuminance,
         })
@@ -127,8 +133,11 @@ impl Sun {
     }
 
     /// The sun baked into `env`, and `env` without it: the texels around the brightest
-    /// one whose radiance is at least [`SUN_SHARE`] of its, when that texel is at least
-    /// [`SUN_CONTRAST`] times the map's mean radiance (a sun, not a bright sky). Its
+    /// one above the horizon whose radiance is at least [`SUN_SHARE`] of its, when that
+    /// texel is at least [`SUN_CONTRAST`] times the map's mean radiance (a sun, not a
+    /// bright sky). Below the horizon a map holds what the ground sends up: a bright spot
+    /// there stays in the map (lit through the basis' floor conditions, or replaced by a
+    /// ground lit from above, `FloorModel`), and is never a sun. Its
     /// illuminance is what those texels carry above the median of the ring of texels
     /// around them (the sky behind it), which they are set to; its direction the
     /// energy-weighted mean of theirs; its diameter that of a disc of their solid angle.
@@ -139,10 +148,15 @@ impl Sun {
         let lum = |p: Rgb| crate::image::luminance(p);
         let total: f64 = env.total_light().iter().map(|&c| c as f64).sum::<f64>() / 3.0;
         let mean = total / (4.0 * std::f64::consts::PI);
+        // Rows whose texel centres lie above the horizon: a sun is light from the sky.
+        let above: Vec<bool> = (0..h)
+            .map(|y| env.direction_of(0.0, y as f32).y > 0.0)
+            .collect();
         let (peak_i, peak) = img
             .pixels()
             .iter()
             .enumerate()
+            .filter(|(i, _)| above[i / w])
             .map(|(i, &p)| (i, lum(p)))
             .max_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap_or((0, 0.0));
@@ -160,7 +174,7 @@ impl Sun {
             let (x, y) = ((i % w) as i64, (i / w) as i64);
             for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
                 let ny = y + dy;
-                if !(0..h as i64).contains(&ny) {
+                if !(0..h as i64).contains(&ny) || !above[ny as usize] {
                     continue;
                 }
                 let j = ny as usize * w + (x + dx).rem_euclid(w as i64) as usize;
@@ -185,7 +199,7 @@ impl Sun {
         ring.sort_by(|a, b| lum(*a).total_cmp(&lum(*b)));
         let sky = ring.get(ring.len() / 2).copied().unwrap_or([0.0; 3]);
         let mut radiance = img.clone();
-        let (mut e, mut omega, mut towards) = ([0.0f64; 3], 0.0f64, Vec3::ZERO);
+        let (mut e, mut omega, mut towards) = ([0.0f64; 3], 0.0f64, glam::DVec3::ZERO);
         for &i in &region {
             let (x, y) = (i % w, i / w);
             let o = env.texel_solid_angle(y) as f64;
@@ -195,22 +209,41 @@ impl Sun {
                 e[c] += above[c] as f64 * o;
             }
             omega += o;
-            towards += env.direction_of(x as f32, y as f32) * (lum(above) as f64 * o) as f32;
+            towards += env.direction_of(x as f32, y as f32).as_dvec3() * (lum(above) as f64 * o);
             radiance.set(x, y, sky);
         }
         let diameter = 2.0
             * (1.0 - omega / (2.0 * std::f64::consts::PI))
                 .clamp(-1.0, 1.0)
                 .acos();
+        // Texels no brighter than the sky behind them carry no sun.
+        if e.iter().all(|&c| c <= 0.0) || towards == glam::DVec3::ZERO {
+            return Ok(None);
+        }
         let sun = Sun::new(
-            towards,
+            towards.normalize().as_vec3(),
             (diameter as f32).to_degrees().clamp(1e-3, MAX_DIAMETER_DEG),
-            e.map(|c| c as f32),
+            // (No more than a map may carry, which rounding could pass.)
+            e.map(|c| c.min(crate::env::MAX_TOTAL_LIGHT) as f32),
         )?;
         Ok(Some((
             sun,
             EnvMap::from_image(radiance)?.rotated(env.yaw()),
         )))
+    }
+
+    /// What a sun below the horizon does (`None` above it), for a note to the user: under
+    /// a ground floor it lights nothing (the ground hides it); otherwise it is light from
+    /// below, which the map's lower hemisphere carries through the basis' floor conditions
+    /// ([`Sun::extract`] never takes it for a sun).
+    pub fn below_horizon(&self, ground_floor: bool) -> Option<&'static str> {
+        (self.direction.y <= 0.0).then_some(if ground_floor {
+            "the sun is below the horizon, under the ground floor: it lights nothing"
+        } else {
+            "the sun is below the horizon: it lights the subject from below as the \
+             environment's lower hemisphere does, through the field's floor conditions \
+             (no sharp shading or shadow)"
+        })
     }
 
     /// The same sun `k` times as bright.
@@ -313,6 +346,61 @@ mod tests {
                 .unwrap()
                 .is_none()
         );
+    }
+
+    #[test]
+    fn suns_from_the_faintest_to_the_brightest_accepted_keep_their_direction() {
+        // A sun of 1e20 and above once lost its direction (its length's square overflowed
+        // to infinity, the direction normalised to zero: black frames); one found in a
+        // dim map was refused as "not a direction" (the square underflowed).
+        let dir = crate::light::direction_from_azimuth_elevation(1.0, 0.5);
+        for (sky, e) in [(1e-15f32, 1e-12f32), (1e-8, 1e-6), (0.1, 1e20), (0.1, 1e30)] {
+            let sun = Sun::new(dir * e, SUN_DIAMETER_DEG, [e; 3]).unwrap();
+            assert!(
+                sun.direction().distance(dir) < 1e-6,
+                "{e}: {}",
+                sun.direction()
+            );
+            let lit = sun.lit(&EnvMap::uniform([sky; 3], 64)).unwrap();
+            let (found, rest) = Sun::extract(&lit)
+                .unwrap()
+                .unwrap_or_else(|| panic!("{e}: no sun found"));
+            assert!(
+                found.direction().dot(dir) > 0.999,
+                "{e}: {}",
+                found.direction()
+            );
+            let ratio = found.illuminance()[0] / e;
+            assert!((ratio - 1.0).abs() < 1e-3, "{e}: found {ratio} of it");
+            assert!(rest.total_light()[0].is_finite());
+        }
+    }
+
+    #[test]
+    fn a_sun_below_the_horizon_is_not_taken_for_a_sun() {
+        let base = EnvMap::uniform([0.1; 3], 64);
+        for el in [-5f32, -60.0, -90.0] {
+            let dir = crate::light::direction_from_azimuth_elevation(1.0, el.to_radians());
+            let lit = Sun::new(dir, SUN_DIAMETER_DEG, [100.0; 3])
+                .unwrap()
+                .lit(&base)
+                .unwrap();
+            assert!(Sun::extract(&lit).unwrap().is_none(), "{el}°");
+        }
+        // One above the horizon is found beside a brighter one below it.
+        let below = crate::light::direction_from_azimuth_elevation(1.0, -0.5);
+        let up = crate::light::direction_from_azimuth_elevation(-1.0, 0.5);
+        let both = Sun::new(up, SUN_DIAMETER_DEG, [50.0; 3])
+            .unwrap()
+            .lit(
+                &Sun::new(below, 2.0, [100.0; 3])
+                    .unwrap()
+                    .lit(&base)
+                    .unwrap(),
+            )
+            .unwrap();
+        let (found, _) = Sun::extract(&both).unwrap().unwrap();
+        assert!(found.direction().dot(up) > 0.999);
     }
 
     #[test]

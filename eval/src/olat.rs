@@ -190,14 +190,55 @@ pub fn evaluate_olat_field<R: ReadAt>(
         refuse("holds no fitted normals (a field of fewer than three lights)".into())
     })?;
     let fit = LightFit::from_normals(h.width as usize, h.height as usize, &normals);
+    let photos = field.basis(pose, 0, 0)?;
+    // The kept lights' images are the set's photographs (as stored, compressed): a field
+    // of another object under the same lights is refused, not scored.
+    for ((c, photo), &k) in h.conditions.iter().zip(&photos).zip(&numbers) {
+        let r = correlation(photo, &set.images[k], &set.mask);
+        if !(r >= SAME_PHOTO_CORRELATION) {
+            return Err(refuse(format!(
+                "its image of condition {:?} is not the set's photograph {:03}.png (their \
+                 correlation inside the mask is {r:.3}, under {SAME_PHOTO_CORRELATION}): \
+                 the field was made from another set",
+                c.name,
+                k + 1
+            )));
+        }
+    }
     let kept = Kept {
         numbers,
-        photos: field.basis(pose, 0, 0)?,
+        photos,
         directions,
         fit,
         seconds_fit: 0.0,
     };
     score_held_out(set, Some(field.path()), &kept, images)
+}
+
+/// The least correlation of a field's image of a light with the set's photograph of it
+/// for the field to be of that set. The tests' synthetic sphere against itself moved by
+/// a quarter of the image: 0.26 at its first kept light.
+const SAME_PHOTO_CORRELATION: f64 = 0.9;
+
+/// Pearson correlation of the luminance of `a` and `b` over the pixels of `mask` (NaN
+/// where either is constant there).
+fn correlation(a: &RgbImage, b: &RgbImage, mask: &[bool]) -> f64 {
+    let lum = |p: [f32; 3]| frf_core::image::luminance(p) as f64;
+    let pairs: Vec<(f64, f64)> = (a.pixels().iter().zip(b.pixels()).zip(mask))
+        .filter(|(_, m)| **m)
+        .map(|((p, q), _)| (lum(*p), lum(*q)))
+        .collect();
+    let n = pairs.len() as f64;
+    let (ma, mb) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(x, y), (p, q)| (x + p / n, y + q / n));
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (p, q) in &pairs {
+        sab += (p - ma) * (q - mb);
+        saa += (p - ma) * (p - ma);
+        sbb += (q - mb) * (q - mb);
+    }
+    sab / (saa * sbb).sqrt()
 }
 
 /// Every light of `set` that `kept` does not hold, predicted from it and scored.
@@ -214,6 +255,17 @@ fn score_held_out(
         psnr: psnr(truth, test, mask),
         ssim: ssim(truth, test, mask),
     };
+    if (0..set.directions.len()).all(|k| kept.numbers.contains(&k)) {
+        return Err(EvalError::Argument(frf_core::BadArgument::new(
+            "--photos",
+            set.dir.display(),
+            "a set with a light the field does not hold, to predict and score",
+        )));
+    }
+    // Made only once the set and the field have passed every check.
+    if let Some(dir) = images {
+        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
+    }
     let mut lights = Vec::new();
     let mut seconds_relight = 0.0;
     for (k, &l) in set.directions.iter().enumerate() {
@@ -249,13 +301,6 @@ fn score_held_out(
             nearest: score(truth, &nearest),
             interpolated: score(truth, &interpolated),
         });
-    }
-    if lights.is_empty() {
-        return Err(EvalError::Argument(frf_core::BadArgument::new(
-            "--photos",
-            set.dir.display(),
-            "a set with a light the field does not hold, to predict and score",
-        )));
     }
     let mean = |f: &dyn Fn(&LightScore) -> Score| {
         let m = lights.len() as f64;

@@ -74,10 +74,16 @@ impl OlatSet {
                 .into());
             }
             for (line, v) in &rows {
-                if v.iter().any(|&c| c <= 0.0) {
+                if v.iter()
+                    .any(|&c| !(INTENSITY_RANGE.0..=INTENSITY_RANGE.1).contains(&c))
+                {
                     return Err(CoreError::bad_file(
                         &intensities_path,
-                        format!("line {line}: the intensity {v:?} is not positive"),
+                        format!(
+                            "line {line}: the intensity {v:?} is not within {:e} to {:e} \
+                             (the photographs are divided by it: a light's relative strength)",
+                            INTENSITY_RANGE.0, INTENSITY_RANGE.1
+                        ),
                     )
                     .into());
                 }
@@ -144,10 +150,19 @@ impl OlatSet {
                 )
                 .into());
             }
-            m.pixels()
+            let mask: Vec<bool> = m
+                .pixels()
                 .iter()
                 .map(|p| p[0] + p[1] + p[2] > 1.5)
-                .collect()
+                .collect();
+            if !mask.contains(&true) {
+                return Err(CoreError::bad_file(
+                    &mask_path,
+                    "selects no pixel (white marks the object): nothing would be scored",
+                )
+                .into());
+            }
+            mask
         } else {
             vec![true; w * h]
         };
@@ -159,6 +174,11 @@ impl OlatSet {
         })
     }
 }
+
+/// The intensities a light file may give, per channel: relative strengths of the
+/// lights (calibrated sets give 0.2 to 5). Outside, dividing a 16-bit photograph by it
+/// reaches values whose squared errors overflow (1e-38 gave −740 dB and NaN).
+pub const INTENSITY_RANGE: (f32, f32) = (1e-6, 1e6);
 
 /// The rows of three numbers of a light file, with their line numbers (blank lines and
 /// `#` comments skipped); a row that is not three finite numbers is refused naming the

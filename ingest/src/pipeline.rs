@@ -457,9 +457,10 @@ fn ingest_pose(
 
     let mut header = pose_header(capture, pose, options)?;
     header.description = format!(
-        "ingested from {} with flow {}",
+        "ingested from {} with flow {}, inter-view flow {}",
         capture.dir().display(),
-        settings(capture, options).flow_preset
+        settings(capture, options).flow_preset,
+        options.inter_view_flow.name()
     );
 
     let selected = options.selection.as_ref();

@@ -293,6 +293,19 @@ impl<R: ReadAt> FieldFile<R> {
             .read_exact_at(size - FOOTER_BYTES, &mut footer)
             .map_err(|e| io(path, e))?;
         if &footer[24..] != END_MAGIC {
+            // Bytes after a whole field's end read otherwise as a truncation.
+            let tail = size.min(1 << 20);
+            let mut last = vec![0u8; tail as usize];
+            source
+                .read_exact_at(size - tail, &mut last)
+                .map_err(|e| io(path, e))?;
+            if let Some(at) = last.windows(END_MAGIC.len()).rposition(|w| w == END_MAGIC) {
+                let extra = tail - (at + END_MAGIC.len()) as u64;
+                return Err(bad(format!(
+                    "{extra} bytes follow the field's end (appended to it, or two files joined): \
+                     the file is not as it was written"
+                )));
+            }
             return Err(bad(
                 "footer missing: the file is truncated or was not finished".into(),
             ));
@@ -467,6 +480,89 @@ impl<R: ReadAt> FieldFile<R> {
     }
 }
 
+/// Whether the file at `path` begins as a field file does (its magic bytes), for
+/// commands that take another kind of file to say what they were given instead.
+pub fn is_field_file(path: &Path) -> bool {
+    let mut head = [0u8; 8];
+    // (Only a regular file is opened: a FIFO would block the read.)
+    std::fs::metadata(path).is_ok_and(|m| m.is_file())
+        && std::fs::File::open(path)
+            .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+            .is_ok_and(|()| &head == MAGIC)
+}
+
+/// What differs between two parts' headers (beyond their poses), each with both values.
+fn differences(a: &FieldHeader, b: &FieldHeader) -> String {
+    let mut out = Vec::new();
+    let mut differ = |what: &str, x: String, y: String| {
+        if x != y {
+            out.push(format!("{what} ({x} against {y})"));
+        }
+    };
+    differ(
+        "the grid of views",
+        format!("{}x{} wraps {}", a.columns, a.rows, a.wraps),
+        format!("{}x{} wraps {}", b.columns, b.rows, b.wraps),
+    );
+    differ(
+        "the image size",
+        format!("{}x{}", a.width, a.height),
+        format!("{}x{}", b.width, b.height),
+    );
+    differ(
+        "the cycle",
+        format!("{} s, {} poses", a.cycle_seconds, a.poses_per_cycle),
+        format!("{} s, {} poses", b.cycle_seconds, b.poses_per_cycle),
+    );
+    let basis = |h: &FieldHeader| match h.conditions == a.conditions {
+        true => format!("{} conditions", h.conditions.len()),
+        false => format!("{} other conditions", h.conditions.len()),
+    };
+    differ("the lighting basis", basis(a), basis(b));
+    differ(
+        "the codec",
+        format!(
+            "JPEG {}, predicted flow {}",
+            a.jpeg_quality, a.flow_predicted
+        ),
+        format!(
+            "JPEG {}, predicted flow {}",
+            b.jpeg_quality, b.flow_predicted
+        ),
+    );
+    differ(
+        "the shadow maps",
+        format!("{:?}", a.shadows),
+        format!("{:?}", b.shadows),
+    );
+    differ(
+        "the visual hulls",
+        format!("{:?}", a.hulls),
+        format!("{:?}", b.hulls),
+    );
+    if out.is_empty() {
+        out.push("the headers".into());
+    }
+    out.join(", ")
+}
+
+/// The description of parts merged: theirs when they agree, else each part's with its
+/// poses (parts ingested with different flow settings keep the record of each).
+fn merged_description(files: &[FieldFile]) -> String {
+    let first = &files[0].header().description;
+    if files.iter().all(|f| &f.header().description == first) {
+        return first.clone();
+    }
+    let parts: Vec<String> = files
+        .iter()
+        .map(|f| {
+            let poses: Vec<u32> = f.header().poses.iter().map(|p| p.pose).collect();
+            format!("poses {poses:?} {}", f.header().description)
+        })
+        .collect();
+    format!("merged from {} parts: {}", files.len(), parts.join("; "))
+}
+
 /// Merges field files that hold disjoint poses of the same grid, basis and codec
 /// settings into one file at `out`, copying chunks byte for byte (each pose keeps its
 /// own flow quantizer). Used to assemble a field ingested pose by pose.
@@ -490,7 +586,8 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
             return Err(ReflectanceError::Incompatible {
                 part: f.path().to_path_buf(),
                 problem: format!(
-                    "grid, basis or codec settings differ from {}",
+                    "{} differ from {}'s",
+                    differences(f.header(), first.header()),
                     first.path().display()
                 ),
             });
@@ -506,6 +603,7 @@ pub fn merge_fields(parts: &[PathBuf], out: &Path) -> Result<()> {
         }
     }
     header.poses.sort_by_key(|p| p.pose);
+    header.description = merged_description(&files);
     // Every part with pose-to-pose flows or none: a field with them for some poses only
     // fails three frames into a render between poses.
     let holds = |f: &FieldFile| {

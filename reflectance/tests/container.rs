@@ -376,6 +376,7 @@ fn poses_written_apart_merge_into_one_field() {
     for pose in [1u32, 0] {
         let mut hp = h.clone();
         hp.poses.retain(|p| p.pose == pose);
+        hp.description = format!("ingested with flow preset {pose}");
         hp.pose_mut(pose).unwrap().flow_quantizer =
             LogQuantizer::new(0.1 + pose as f32, 12.0).unwrap();
         let path = dir.path().join(format!("p{pose}.frf"));
@@ -407,6 +408,13 @@ fn poses_written_apart_merge_into_one_field() {
         m.header().pose(1).unwrap().flow_quantizer,
         single.header().pose(1).unwrap().flow_quantizer
     );
+    // Parts ingested with different settings keep the record of each.
+    let said = &m.header().description;
+    assert!(
+        said.contains("poses [1] ingested with flow preset 1")
+            && said.contains("poses [0] ingested with flow preset 0"),
+        "{said}"
+    );
     // The same pose twice is refused.
     let e =
         frf_reflectance::container::merge_fields(&[parts[0].clone(), parts[0].clone()], &merged)
@@ -416,6 +424,20 @@ fn poses_written_apart_merge_into_one_field() {
         e.contains(&parts[0].display().to_string()) && e.contains("pose 1 is in two parts"),
         "{e}"
     );
+    // A part whose hulls were carved at another voxel is refused naming that alone.
+    let other = dir.path().join("other.frf");
+    let mut ho = FieldFile::open(&parts[1]).unwrap().header().clone();
+    ho.hulls = Some(frf_reflectance::field::HullSpec {
+        voxel_m: 0.005,
+        misses: 1,
+    });
+    let w = FieldWriter::create(&other, ho).unwrap();
+    w.finish().unwrap();
+    let e = frf_reflectance::container::merge_fields(&[parts[0].clone(), other], &merged)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the visual hulls") && e.contains("0.005"), "{e}");
+    assert!(!e.contains("grid") && !e.contains("codec"), "{e}");
 }
 
 /// The fuzz targets start from small valid inputs (`fuzz/seeds/{container,huffman,images}`)
@@ -516,7 +538,28 @@ fn verify_reads_every_chunk_and_finds_each_damaged_one() {
     let path = root.join("tests/bad/damaged_chunks.frf");
     let damaged = FieldFile::open(&path).unwrap();
     let v = damaged.verify(&|| {}).unwrap();
-    assert!(v.damaged.len() >= 2, "{:?}", v.damaged);
+    // The chunks holding a byte that differs from the whole field's, each named once.
+    let (a, b) = (
+        std::fs::read(whole.path()).unwrap(),
+        std::fs::read(&path).unwrap(),
+    );
+    let changed: Vec<u64> = (0..a.len() as u64)
+        .filter(|&i| a[i as usize] != b[i as usize])
+        .collect();
+    assert_eq!(changed.len(), 5, "the corpus file changes five bytes");
+    let mut hit: Vec<String> = damaged
+        .chunks()
+        .filter(|c| {
+            changed
+                .iter()
+                .any(|&i| (c.offset..c.offset + c.length).contains(&i))
+        })
+        .map(|c| c.key.to_string())
+        .collect();
+    hit.sort();
+    let mut found: Vec<String> = v.damaged.iter().map(|(k, _)| k.clone()).collect();
+    found.sort();
+    assert_eq!(found, hit, "{:?}", v.damaged);
     let said = v.error(&path).unwrap().to_string();
     assert!(said.contains(&v.damaged[0].0), "{said}");
     assert!(

@@ -45,6 +45,15 @@ pub enum RenderError {
         /// Its lighting conditions.
         conditions: usize,
     },
+    /// A field the renderer cannot draw from any camera (one column of views: nothing to
+    /// interpolate between).
+    #[error("{}: {what}", field.display())]
+    NotRenderable {
+        /// The field file.
+        field: std::path::PathBuf,
+        /// What it is and why it cannot be drawn.
+        what: String,
+    },
     /// A camera stored in the field that is not a camera.
     #[error("a camera of the field: {0}")]
     BadCamera(String),
@@ -96,7 +105,8 @@ impl RenderError {
             RenderError::Argument(_)
             | RenderError::Mismatch { .. }
             | RenderError::ViewNotHeld { .. }
-            | RenderError::NotRelightable { .. } => Fault::Usage,
+            | RenderError::NotRelightable { .. }
+            | RenderError::NotRenderable { .. } => Fault::Usage,
             RenderError::BadCamera(_) => Fault::Damaged,
             RenderError::Misuse(_) => Fault::Internal,
             RenderError::Gpu(_)

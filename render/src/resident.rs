@@ -234,6 +234,7 @@ impl PoseSource {
         level: u8,
         kept: Option<&ReducedViews>,
     ) -> Result<Self> {
+        check_renderable(field)?;
         let h = field.header();
         let record = h.pose(pose)?;
         let (columns, rows) = (h.columns, h.rows);
@@ -396,6 +397,34 @@ struct Relighting {
     ground: Option<Vec<Rgb>>,
     suns: Arc<[SunLight]>,
     plan: LightingPlan,
+}
+
+/// Refuses, naming it, a field the renderer cannot draw: one of a single column of views
+/// (`frf ingest-olat` writes one view: a one-light-at-a-time set's photographs as a
+/// basis, for `frf eval-olat`), where a camera's ray has no views to interpolate between.
+pub fn check_renderable<R: ReadAt>(field: &FieldFile<R>) -> Result<()> {
+    let h = field.header();
+    if h.columns >= 2 {
+        return Ok(());
+    }
+    let what = if h.columns * h.rows == 1 {
+        format!(
+            "a field of one view ({} lighting conditions; frf ingest-olat writes such a field \
+             of a one-light-at-a-time set, which frf eval-olat scores): rendering \
+             interpolates between the views around the subject, and this field has one",
+            h.conditions.len()
+        )
+    } else {
+        format!(
+            "a field of one column of {} views: rendering interpolates between columns of \
+             views around the subject",
+            h.rows
+        )
+    };
+    Err(RenderError::NotRenderable {
+        field: field.path().to_path_buf(),
+        what,
+    })
 }
 
 /// Per view of pose `pose` (those `read`), the relighting coefficients of `lighting`,

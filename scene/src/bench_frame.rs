@@ -2,17 +2,23 @@
 //! lighting. The scene's first walker is copied onto a square grid (1.2 m apart, centred
 //! where it stands), each copy turned by the golden angle from the last so that every
 //! walker is relit for a heading of its own (the costly case: walkers of one heading
-//! share one relit pose). The frames are a few milliseconds of the scene's time apart,
-//! so every walker keeps its pose and only the lighting differs: held (`constant`), or
-//! turned 15° a frame (`turning`). One frame is drawn first to make the poses resident
-//! and is not counted; the medians of the counted frames are reported:
+//! share one relit pose). The lighting is held (`constant`) or turned 15° a frame
+//! (`turning`). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
+//! apart (`held`: every walker keeps its pose, only the lighting differs) or as the
+//! scene's own frames are (`shot`: poses stream in and out as in a render). The shot's
+//! plan is made once before the frames, as `frf render` makes it, and is not timed. One
+//! frame is drawn first to make the poses resident and is not counted; the medians of
+//! the counted frames are reported:
 //!
 //! - `wall_ms_per_frame`: the frame from start to its pixels read back;
 //! - `gpu_ms_per_frame`: how long the host waited on the device within it (fenced: the
 //!   device's work that the host did not overlap; on a software adapter the device is
 //!   the host's own cores);
-//! - `host_ms_per_frame`: the difference, the host's own work (planning, projecting the
-//!   light, recording and submitting, converting the pixels read back).
+//! - `host_ms_per_frame`: the difference, the host's own work (choosing what to make
+//!   resident, projecting the light, recording and submitting the passes, converting the
+//!   pixels read back);
+//! - `gpu_timestamps_ms_per_frame`: the device's time in the frame's passes by GPU
+//!   timestamp queries, where the adapter has them (`passes` gives each pass's).
 
 use std::time::Instant;
 
@@ -58,9 +64,21 @@ impl LightMode {
     }
 }
 
+/// How far apart the counted frames are in the scene's time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Spacing {
+    /// A millisecond: every walker keeps its pose, only the lighting changes.
+    Held,
+    /// The scene's own frame interval: poses stream in as a shot's do.
+    Shot,
+}
+
 /// What `frf bench frame` runs.
 #[derive(Debug, Clone)]
 pub struct FrameBenchOptions {
+    /// How far apart the frames are.
+    pub spacing: Spacing,
     /// Walker counts.
     pub walkers: Vec<usize>,
     /// Lightings.
@@ -104,6 +122,9 @@ pub struct FrameBenchRow {
     pub gpu_ms_per_frame: f64,
     /// Median frame, ms.
     pub wall_ms_per_frame: f64,
+    /// Median device time in the frame's passes by GPU timestamps, ms (`None` where the
+    /// adapter has no timestamp queries, and on the CPU).
+    pub gpu_timestamps_ms_per_frame: Option<f64>,
     /// Poses relit per counted frame (mean).
     pub relights_per_frame: f64,
     /// Most bytes resident at once, MB.
@@ -122,6 +143,8 @@ pub struct FrameBenchReport {
     pub gpu_clock: &'static str,
     /// How the rows' `passes` were measured (`gpu-timestamps`, or `none`).
     pub pass_clock: &'static str,
+    /// How far apart the counted frames were.
+    pub spacing: Spacing,
     /// Frame size.
     pub size: (u32, u32),
     /// Frames counted per row.
@@ -133,8 +156,13 @@ pub struct FrameBenchReport {
 impl FrameBenchReport {
     /// The rows as a table, with the ratios the targets read.
     pub fn table(&self) -> String {
+        let spacing = match self.spacing {
+            Spacing::Held => "1 ms apart, poses held",
+            Spacing::Shot => "spaced as the shot's",
+        };
         let mut out = format!(
-            "{} at {}x{}, {} frames a row (medians; gpu = fenced wait on the device)\n",
+            "{} at {}x{}, {} frames a row, {spacing} (medians; gpu = fenced wait on the \
+             device)\n",
             self.device, self.size.0, self.size.1, self.frames
         );
         out += "walkers  light     host ms  gpu ms  wall ms  relit/frame  peak MB\n";
@@ -151,7 +179,8 @@ impl FrameBenchReport {
             );
         }
         if self.rows.iter().any(|r| !r.passes.is_empty()) {
-            out += "device ms per frame by pass (GPU timestamps, medians; passes per frame):\n";
+            out += "device ms per frame by pass (GPU timestamps, medians; passes per frame), \
+                    and in all:\n";
             for r in &self.rows {
                 let passes: Vec<String> = r
                     .passes
@@ -159,10 +188,11 @@ impl FrameBenchReport {
                     .map(|p| format!("{} {:.1} ({})", p.pass, p.ms, p.passes))
                     .collect();
                 out += &format!(
-                    "{:>7}  {:<8} {}\n",
+                    "{:>7}  {:<8} {}; all {:.1}\n",
                     r.walkers,
                     r.light.name(),
-                    passes.join(", ")
+                    passes.join(", "),
+                    r.gpu_timestamps_ms_per_frame.unwrap_or(f64::NAN)
                 );
             }
         }
@@ -202,7 +232,12 @@ impl FrameBenchReport {
 
 /// `scene` with its first walker copied `n` times on a grid, lit as `light` says for
 /// `frames` frames from its start.
-pub fn bench_scene(scene: &Scene, n: usize, light: LightMode, frames: usize) -> Scene {
+pub fn bench_scene(
+    scene: &Scene,
+    n: usize,
+    light: LightMode,
+    (frames, spacing): (usize, Spacing),
+) -> Scene {
     let mut s = scene.clone();
     let first = scene.instances[0];
     let side = (n as f32).sqrt().ceil() as usize;
@@ -220,9 +255,13 @@ pub fn bench_scene(scene: &Scene, n: usize, light: LightMode, frames: usize) -> 
         })
         .collect();
     let key = scene.lighting[0].clone();
-    let span = (frames + 1) as f64 * FRAME_STEP_S;
+    let step = match spacing {
+        Spacing::Held => FRAME_STEP_S,
+        Spacing::Shot => 1.0 / scene.fps,
+    };
+    let span = (frames + 1) as f64 * step;
     s.start = scene.start;
-    s.fps = 1.0 / FRAME_STEP_S;
+    s.fps = 1.0 / step;
     s.end = scene.start + span;
     s.lighting = match light {
         LightMode::Constant => vec![LightKey {
@@ -273,7 +312,7 @@ pub fn run_frame_bench<R: ReadAt>(
     let mut pass_clock = "none";
     for &n in &options.walkers {
         for &light in &options.lights {
-            let s = bench_scene(scene, n, light, options.frames);
+            let s = bench_scene(scene, n, light, (options.frames, options.spacing));
             let frames = s.shot_frames(0..options.frames + 1, options.size)?;
             let device = Device::open(options.cpu)?;
             device_name = device.name();
@@ -309,6 +348,13 @@ pub fn run_frame_bench<R: ReadAt>(
                 host_ms_per_frame: median(&host),
                 gpu_ms_per_frame: median(&waited),
                 wall_ms_per_frame: median(&wall),
+                gpu_timestamps_ms_per_frame: (pass_clock == "gpu-timestamps").then(|| {
+                    let sums: Vec<f64> = passes
+                        .iter()
+                        .map(|f| f.iter().map(|p| p.ms).sum())
+                        .collect();
+                    median(&sums)
+                }),
                 relights_per_frame: relights as f64 / options.frames as f64,
                 peak_resident_mb: shot.counters().peak_resident_bytes as f64 / 1e6,
                 passes: median_passes(&passes),
@@ -319,6 +365,7 @@ pub fn run_frame_bench<R: ReadAt>(
         device: device_name,
         gpu_clock: "fenced-wall",
         pass_clock,
+        spacing: options.spacing,
         size: options.size,
         frames: options.frames,
         rows,

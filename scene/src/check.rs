@@ -430,7 +430,7 @@ pub fn sun(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Sun>> {
     let direction = match (s.direction, s.azimuth_deg, s.elevation_deg) {
         (Some(d), None, None) => {
             let d = Vec3::from_array(d);
-            if !d.is_finite() || d.length() < 1e-6 {
+            if !d.is_finite() || d == Vec3::ZERO {
                 return Err(bad("direction", format!("{d} is not a direction")));
             }
             d

@@ -275,6 +275,15 @@ impl Scene {
 
     /// Reads and checks the scene file at `path`.
     pub fn load(path: &Path) -> Result<Self> {
+        if frf_reflectance::container::is_field_file(path) {
+            return Err(SceneError::Syntax {
+                path: path.to_path_buf(),
+                line: String::new(),
+                problem: "is a field file, not a scene file (TOML): give it as --field, or \
+                          render it with its own flags (frf render FIELD.frf --env ... --orbit ...)"
+                    .into(),
+            });
+        }
         let text = frf_core::io::read_text(path, MAX_FILE_BYTES)?;
         Self::parse(path, &text)
     }

@@ -327,6 +327,9 @@ impl LightingArgs {
             .load()
             .map_err(|e| format!("environment {source}: {e}"))?;
         if let Some(sun) = self.sun()? {
+            if let Some(note) = sun.below_horizon(self.floor == FloorArg::Ground) {
+                eprintln!("--sun: {note}");
+            }
             // Added before the yaw, which turns it with the map; alone, a black sky.
             let base = env.unwrap_or_else(|| EnvMap::uniform([0.0; 3], 128));
             env = Some(sun.lit(&base)?);

@@ -18,7 +18,7 @@ use super::args::{LightingArgs, parse_size};
 use crate::CliResult;
 use frf_core::bars::{Bars, bar};
 use frf_scene::Scene;
-use frf_scene::bench_frame::{FrameBenchOptions, LightMode, run_frame_bench};
+use frf_scene::bench_frame::{FrameBenchOptions, LightMode, Spacing, run_frame_bench};
 use frf_scene::shot::ShotOptions;
 
 /// `frf bench ...`.
@@ -66,6 +66,10 @@ struct FrameArgs {
     /// Frames counted per row (one more is drawn first, not counted).
     #[arg(long, default_value_t = 6)]
     frames: usize,
+    /// How far apart the frames are: `held` (1 ms: every walker keeps its pose, only the
+    /// light changes) or `shot` (the scene's frame interval: poses stream in as in a render).
+    #[arg(long, value_enum, default_value = "held")]
+    spacing: SpacingArg,
     /// Frame size, WxH (default: the scene's, else the field's).
     #[arg(long, value_parser = parse_size)]
     size: Option<(u32, u32)>,
@@ -78,6 +82,15 @@ struct FrameArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
+}
+
+/// `--spacing`.
+#[derive(Clone, Copy, ValueEnum)]
+enum SpacingArg {
+    /// 1 ms apart: poses held.
+    Held,
+    /// As the scene's frames.
+    Shot,
 }
 
 /// Which storage formats to time.
@@ -149,6 +162,7 @@ pub fn run_bench(args: BenchArgs) -> CliResult {
 fn frame(args: FrameArgs) -> CliResult {
     let (scene, field_path) = Scene::load_overridden(&args.scene, None, args.field.as_deref())?;
     let field = FieldFile::open(&field_path)?;
+    frf_render::resident::check_renderable(&field)?;
     let h = field.header();
     let size = scene.frame_size(args.size, (h.width, h.height))?;
     let options = FrameBenchOptions {
@@ -159,6 +173,10 @@ fn frame(args: FrameArgs) -> CliResult {
             LightArg::Both => vec![LightMode::Constant, LightMode::Turning],
         },
         frames: args.frames,
+        spacing: match args.spacing {
+            SpacingArg::Held => Spacing::Held,
+            SpacingArg::Shot => Spacing::Shot,
+        },
         size,
         shot: ShotOptions {
             memory_budget: args.memory_budget.saturating_mul(1_000_000),
@@ -180,6 +198,7 @@ fn interp(args: InterpArgs) -> CliResult {
     let source = match &args.field {
         Some(path) => {
             let field = FieldFile::open(path)?;
+            frf_render::resident::check_renderable(&field)?;
             let conditions = field.header().conditions.len();
             let lighting = match args.lighting.env {
                 Some(_) => args.lighting.lighting(conditions)?.0,

@@ -58,7 +58,7 @@ pub struct IngestMethodArgs {
     #[arg(long = "flow-set", value_name = "KEY=VALUE")]
     flow_set: Vec<String>,
     /// JPEG quality of the basis mosaics (95 keeps relit PSNR above 40 dB on stage data).
-    #[arg(long, default_value_t = 95)]
+    #[arg(long, default_value_t = 95, value_parser = clap::value_parser!(u8).range(1..=100))]
     jpeg_quality: u8,
     /// Do not predict flow codes from their neighbours.
     #[arg(long)]
@@ -216,7 +216,7 @@ pub struct RingArgs {
     #[arg(long, value_enum, default_value = "accurate")]
     flow_preset: FlowPresetArg,
     /// JPEG quality of the images.
-    #[arg(long, default_value_t = 95)]
+    #[arg(long, default_value_t = 95, value_parser = clap::value_parser!(u8).range(1..=100))]
     jpeg_quality: u8,
     /// Keep every n-th view in azimuth order (the others are held out for
     /// `frf eval-ring`).

@@ -30,7 +30,7 @@ pub struct IngestOlatArgs {
     #[arg(long = "use", value_name = "K")]
     pub keep: Option<usize>,
     /// JPEG quality of the basis images.
-    #[arg(long, default_value_t = 95)]
+    #[arg(long, default_value_t = 95, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub jpeg_quality: u8,
 }
 
@@ -78,31 +78,47 @@ pub struct EvalOlatArgs {
 
 /// Runs `frf eval-olat`.
 pub fn run(args: EvalOlatArgs) -> CliResult {
-    if let Some(dir) = &args.images {
-        std::fs::create_dir_all(dir).map_err(|e| frf_core::CoreError::io(dir, e))?;
-    }
     let images = args.images.as_deref();
     let report = if args.source.is_dir() {
-        if args.photos.is_some() {
-            return Err(bad("--photos", &args, "a field file as the first argument"));
+        if let Some(photos) = &args.photos {
+            return Err(format!(
+                "--photos {}: scores a field file's predictions, but the first argument ({}) is \
+                 a set's directory, whose own kept lights predict the others: give the set \
+                 alone, or the field first (frf eval-olat F.frf --photos DIR)",
+                photos.display(),
+                args.source.display()
+            )
+            .into());
         }
         let set = OlatSet::read(&args.source)?;
-        let keep = args.keep.unwrap_or(set.directions.len() / 2);
+        let n = set.directions.len();
+        // Three kept lights fix a normal, and one light at least is held out.
+        if args.keep.is_none() && n < 4 {
+            return Err(frf_core::CoreError::bad_file(
+                &args.source,
+                format!("holds {n} lights: scoring keeps 3 (to fix a normal) and holds out the rest, so it needs 4 or more"),
+            )
+            .into());
+        }
+        let keep = args.keep.unwrap_or((n / 2).max(3));
         evaluate_olat(&set, keep, images)?
     } else {
         let Some(photos) = &args.photos else {
-            return Err(bad(
-                "--photos",
-                &args,
-                "the set's directory, to score a field's predictions against",
-            ));
+            return Err(format!(
+                "{} is not a set's directory; as a field file it needs --photos DIR, the set \
+                 whose photographs score its predictions",
+                args.source.display()
+            )
+            .into());
         };
-        if args.keep.is_some() {
-            return Err(bad(
-                "--use",
-                &args,
-                "a set's directory as the first argument (a field's lights were chosen by frf ingest-olat --use)",
-            ));
+        if let Some(k) = args.keep {
+            return Err(format!(
+                "--use {k}: chooses the lights kept from a set's directory, but the first \
+                 argument ({}) is a field file, whose kept lights were chosen when it was made \
+                 (frf ingest-olat --use)",
+                args.source.display()
+            )
+            .into());
         }
         let field = FieldFile::open(&args.source)?;
         evaluate_olat_field(&field, &OlatSet::read(photos)?, images)?
@@ -112,13 +128,4 @@ pub fn run(args: EvalOlatArgs) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
     Ok(())
-}
-
-/// `flag` misused with `args.source`.
-fn bad(
-    flag: &'static str,
-    args: &EvalOlatArgs,
-    wanted: &str,
-) -> Box<dyn std::error::Error + Send + Sync> {
-    frf_core::BadArgument::new(flag, args.source.display(), wanted).into()
 }

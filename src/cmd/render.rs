@@ -172,12 +172,27 @@ fn scene_of(args: &RenderArgs) -> CliResult<(Scene, PathBuf)> {
         )
         .into());
     }
+    if args.lighting.yaw != 0.0 {
+        return Err(format!(
+            "{}: --yaw is for field renders; a scene's lighting keys give the yaw (`yaw_deg`)",
+            args.input.display()
+        )
+        .into());
+    }
     let env = args.lighting.env.as_ref();
-    Ok(Scene::load_overridden(
-        &args.input,
-        env,
-        args.field.as_deref(),
-    )?)
+    let (mut scene, field) = Scene::load_overridden(&args.input, env, args.field.as_deref())?;
+    // A sun given by flag replaces the scene's (or adds one), said so, never ignored.
+    if let Some(sun) = args.lighting.sun()? {
+        eprintln!(
+            "--sun: {}",
+            match scene.sun {
+                Some(_) => "replaces the scene's sun",
+                None => "added to the scene's lighting",
+            }
+        );
+        scene.sun = Some(sun);
+    }
+    Ok((scene, field))
 }
 
 /// The frames of `scene` the arguments ask for, of `size`.
@@ -215,6 +230,13 @@ fn print_plan(plan: &Plan, json: bool) -> CliResult {
 pub fn run(args: RenderArgs) -> CliResult {
     let (mut scene, field_path) = scene_of(&args)?;
     let field_render = !Scene::is_scene_file(&args.input);
+    let ground = matches!(
+        scene.floor,
+        frf_reflectance::project::FloorModel::LambertianGround { .. }
+    );
+    if let Some(note) = scene.sun.and_then(|s| s.below_horizon(ground)) {
+        eprintln!("{note}");
+    }
     if let Some(v) = args.variant {
         scene.variant = v.into();
     }
@@ -224,6 +246,7 @@ pub fn run(args: RenderArgs) -> CliResult {
     frf_core::argument::within("--exposure", scene.exposure, -30.0, 30.0, "stops")?;
     scene.layers |= args.layers;
     let field = FieldFile::open(&field_path)?;
+    frf_render::resident::check_renderable(&field)?;
     let h = field.header();
     let size = scene.frame_size(args.size, (h.width, h.height))?;
     let (frames, total) = frames_of(&args, &scene, size, field_render)?;

@@ -26,7 +26,7 @@ pub struct FieldArgs {
     out: PathBuf,
     /// JPEG quality of the basis mosaics (1-100); 95 keeps relit PSNR above 40 dB on
     /// the stage's data (see `frf stage codec-curve`).
-    #[arg(long, default_value_t = 95)]
+    #[arg(long, default_value_t = 95, value_parser = clap::value_parser!(u8).range(1..=100))]
     jpeg_quality: u8,
     /// Do not left-predict flow codes before Huffman coding.
     #[arg(long)]

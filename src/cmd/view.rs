@@ -109,6 +109,7 @@ pub fn run(args: ViewArgs) -> CliResult {
         let field = FieldFile::open(&field_path)?;
         (field_scene(&args, &field)?, field_path)
     };
+    frf_render::resident::check_renderable(&FieldFile::open(&field_path)?)?;
     let mut envs = args.env.clone();
     for e in [EnvSource::Sky, EnvSource::Uniform] {
         if !envs.contains(&e) {

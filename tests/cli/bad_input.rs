@@ -177,7 +177,7 @@ const CASES: &[Case] = &[
             "{out}/o",
         ],
         file: "--memory-budget",
-        problem: &["0"],
+        problem: &["'0'", "is not in 1.."],
     },
     // Chunks damaged in five places: `frf info` read only the index and said nothing;
     // `--check` reads every chunk, names the first damaged one and counts the rest.
@@ -436,6 +436,54 @@ const CASES: &[Case] = &[
         ],
         file: "huge.hdr",
         problem: &["limit"],
+    },
+    // Bytes appended to a whole field (were reported as a truncation).
+    Case {
+        args: &["info", "{bad}/appended.frf"],
+        file: "appended.frf",
+        problem: &["300 bytes follow the field's end"],
+    },
+    // A field where a scene belongs (was "line 1 is not UTF-8 text").
+    Case {
+        args: &["bench", "frame", "{bad}/appended.frf"],
+        file: "appended.frf",
+        problem: &["is a field file, not a scene file"],
+    },
+    // A mask selecting no pixel (scored every light inf dB, SSIM 1, exit 0), and nothing
+    // made for `--images`.
+    Case {
+        args: &[
+            "eval-olat",
+            "{bad}/olat_black_mask",
+            "--images",
+            "{out}/images",
+        ],
+        file: "mask.png",
+        problem: &["selects no pixel"],
+    },
+    // Intensities of 1e-38 (the photographs scaled by 1e38: -740 dB and NaN, exit 0).
+    Case {
+        args: &[
+            "ingest-olat",
+            "{bad}/olat_tiny_intensity",
+            "--out",
+            "{out}/f.frf",
+        ],
+        file: "light_intensities.txt",
+        problem: &["line 1", "is not within"],
+    },
+    // A JPEG quality of 0 (exited 70, internal, naming no flag).
+    Case {
+        args: &[
+            "ingest-olat",
+            "{bad}/olat_black_mask",
+            "--out",
+            "{out}/f.frf",
+            "--jpeg-quality",
+            "0",
+        ],
+        file: "--jpeg-quality",
+        problem: &["1..=100"],
     },
 ];
 

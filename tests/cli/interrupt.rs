@@ -210,3 +210,46 @@ fn a_read_only_output_directory_is_refused_naming_it() {
     assert_refused_for_permission(&o, target.to_str().unwrap());
     assert!(std::fs::read_dir(&fields).unwrap().next().is_none());
 }
+
+/// An interrupted write of one file (Ctrl-C during `frf ingest`) ends with status 130 and
+/// leaves neither its lock file nor its temporaries (`ingest-olat` once left
+/// `.NAME.frf.lock`).
+#[test]
+fn an_interrupted_ingest_leaves_no_lock_or_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let cap = crate::common::staged_capture(dir.path());
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let field = out.join("f.frf");
+    let mut child = frf_command(&[
+        "ingest",
+        cap.to_str().unwrap(),
+        "--no-eval",
+        "--out",
+        field.to_str().unwrap(),
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::null())
+    .spawn()
+    .unwrap();
+    let lock = out.join(".f.frf.lock");
+    while !lock.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the ingest ended before it could be interrupted"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    let left: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}

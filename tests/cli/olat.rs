@@ -15,9 +15,14 @@ const SIDE: usize = 64;
 /// Writes a sphere lit by `lights` (Lambertian, a weak highlight) as `NNN.png` with its
 /// light file and mask into `dir`.
 fn write_sphere_set(dir: &Path, lights: &[Vec3]) {
+    write_shifted_sphere_set(dir, lights, 0.0);
+}
+
+/// [`write_sphere_set`] of a sphere moved right by `shift` of the image's half width.
+fn write_shifted_sphere_set(dir: &Path, lights: &[Vec3], shift: f32) {
     let normal = |i: usize| {
         let (x, y) = (i % SIDE, i / SIDE);
-        let u = (x as f32 + 0.5) / SIDE as f32 * 2.0 - 1.0;
+        let u = (x as f32 + 0.5) / SIDE as f32 * 2.0 - 1.0 - shift;
         let v = 1.0 - (y as f32 + 0.5) / SIDE as f32 * 2.0;
         let r2 = u * u + v * v;
         (r2 < 0.9).then(|| Vec3::new(u, v, (1.0 - r2).sqrt()))
@@ -129,6 +134,7 @@ fn a_field_ingested_from_a_set_relights_its_held_out_lights_as_the_set_does() {
     assert!(o.status.success(), "{}", stderr(&o));
     let from_field: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let o = frf(&["eval-olat", set, "--use", "6", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let from_set: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     // The same lights are held out, and the field's stored basis and normals predict
     // them within 1 dB of the set's own photographs, above both baselines.
@@ -206,4 +212,61 @@ fn ingest_olat_and_eval_olat_refuse_bad_sets_and_fields_by_name() {
     let e = stderr(&o);
     assert!(!o.status.success(), "{e}");
     assert!(e.contains("f.frf") && e.contains("none of the set"), "{e}");
+}
+
+#[test]
+fn eval_olat_refuses_a_field_of_another_object_under_the_same_lights() {
+    let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    write_sphere_set(a.path(), &lights());
+    write_shifted_sphere_set(b.path(), &lights(), 0.5);
+    let field = a.path().join("a.frf");
+    let field = field.to_str().unwrap();
+    let o = frf(&[
+        "ingest-olat",
+        a.path().to_str().unwrap(),
+        "--out",
+        field,
+        "--use",
+        "6",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = frf(&["eval-olat", field, "--photos", b.path().to_str().unwrap()]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(e.contains("a.frf") && e.contains("another set"), "{e}");
+    // Its own set is scored.
+    let o = frf(&["eval-olat", field, "--photos", a.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn a_mask_selecting_nothing_and_vanishing_intensities_are_refused_by_file() {
+    let dir = tempfile::tempdir().unwrap();
+    write_sphere_set(dir.path(), &lights());
+    let set = dir.path().to_str().unwrap();
+    // Intensities that would scale the photographs by 1e38.
+    let tiny: String = lights().iter().map(|_| "1e-38 1e-38 1e-38\n").collect();
+    let intensities = dir.path().join("light_intensities.txt");
+    std::fs::write(&intensities, tiny).unwrap();
+    let o = frf(&["eval-olat", set]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("light_intensities.txt") && e.contains("line 1"),
+        "{e}"
+    );
+    std::fs::remove_file(&intensities).unwrap();
+    // A black mask.
+    let black = Image::new(SIDE, SIDE, [0.0f32; 3]);
+    write_png16_rgb(&dir.path().join("mask.png"), &black).unwrap();
+    let images = dir.path().join("images");
+    let o = frf(&["eval-olat", set, "--images", images.to_str().unwrap()]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("mask.png") && e.contains("selects no pixel"),
+        "{e}"
+    );
+    // Nothing made for a run refused.
+    assert!(!images.exists());
 }

@@ -233,6 +233,34 @@ fn eval_budget_scores_every_offset_and_draws_its_plot() {
     );
 }
 
+/// The ingest budget scores against the unperturbed walker: a capture filmed with
+/// perturbation (its `stage.toml` says so) is refused before anything is ingested.
+#[test]
+fn the_ingest_budget_refuses_a_perturbed_capture() {
+    let (dir, field) = fixture();
+    let cap = tempfile::tempdir().unwrap();
+    let stage_file = frf_stage::writer::STAGE_FILE;
+    let text = std::fs::read_to_string(dir.join(stage_file)).unwrap();
+    let perturbed = text.replace("perturbation = 0.0", "perturbation = 0.5");
+    assert_ne!(text, perturbed, "the tiny stage is unperturbed");
+    std::fs::write(cap.path().join(stage_file), perturbed).unwrap();
+    let o = frf(&[
+        "eval",
+        field.to_str().unwrap(),
+        "--capture",
+        cap.path().to_str().unwrap(),
+        "--env",
+        "sky",
+        "--ingest-budget",
+    ]);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("perturbation 0.5") && e.contains("--perturbation 0"),
+        "{e}"
+    );
+}
+
 #[test]
 fn bad_arguments_are_refused_naming_the_problem() {
     let (dir, field) = fixture();
@@ -626,4 +654,51 @@ fn eval_sun_fit_scores_the_light_fit_above_the_basis_under_a_low_sun() {
     ]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--sun-fit"), "{}", stderr(&o));
+}
+
+/// Renders the tiny field from one camera on the CPU lit by `--sun SUN` alone (over
+/// `--floor FLOOR`); the frame's linear RGB summed.
+fn sunlit_sum(sun: &str, floor: &str) -> f64 {
+    let (_, field) = fixture();
+    let out = tempfile::tempdir().unwrap();
+    let o = frf(&[
+        "render",
+        field.to_str().unwrap(),
+        "--env",
+        "none",
+        "--sun",
+        sun,
+        "--floor",
+        floor,
+        "--orbit",
+        "3,1.2",
+        "--frames",
+        "1",
+        "--size",
+        "24x32",
+        "--cpu",
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{sun}: {}", stderr(&o));
+    let img = frf_core::io::read_hdr_rgb(&out.path().join("frame_0000.exr")).unwrap();
+    let sum: f64 = img.pixels().iter().flatten().map(|&c| c as f64).sum();
+    assert!(sum.is_finite(), "{sun}: {sum}");
+    sum
+}
+
+/// Light is linear from the faintest sun to the brightest accepted (one of 1e20 and
+/// above once rendered black with exit 0: its direction's length overflowed); a sun below
+/// the horizon lights nothing over a ground floor.
+#[test]
+fn a_sun_lights_in_proportion_to_its_illuminance_and_not_through_the_ground() {
+    let one = sunlit_sum("60,40,0.53,1", "env");
+    assert!(one > 0.0);
+    for e in [1e20, 1e30] {
+        let bright = sunlit_sum(&format!("60,40,0.53,{e:e}"), "env");
+        let ratio = bright / one / e;
+        assert!((ratio - 1.0).abs() < 1e-3, "{e}: {ratio}");
+    }
+    assert_eq!(sunlit_sum("60,-40,0.53,10", "ground"), 0.0);
+    assert!(sunlit_sum("60,40,0.53,10", "ground") > 0.0);
 }

@@ -752,7 +752,16 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
             "constant" => assert_eq!(relit, 0.0, "{r}"),
             other => panic!("light {other}"),
         }
-        assert!(r["wall_ms_per_frame"].as_f64().unwrap() > 0.0);
+        // Host and device time are parts of the frame's: each frame's wait on the device
+        // is within its wall time, and so are their medians.
+        let ms = |key: &str| r[key].as_f64().unwrap();
+        let (host, gpu, wall) = (
+            ms("host_ms_per_frame"),
+            ms("gpu_ms_per_frame"),
+            ms("wall_ms_per_frame"),
+        );
+        assert!(host > 0.0 && host <= wall, "{r}");
+        assert!(gpu >= 0.0 && gpu <= wall, "{r}");
         let passes = r["passes"].as_array().unwrap();
         let pass = |name: &str| passes.iter().find(|p| p["pass"] == name);
         if report["pass_clock"] == "gpu-timestamps" {
@@ -762,14 +771,39 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
                 assert!(p["ms"].as_f64().unwrap() >= 0.0, "{r}");
             }
             assert_eq!(pass("relight").is_some(), r["light"] == "turning", "{r}");
+            assert!(ms("gpu_timestamps_ms_per_frame") > 0.0, "{r}");
         } else {
             assert!(passes.is_empty(), "{r}");
+            assert!(r["gpu_timestamps_ms_per_frame"].is_null(), "{r}");
         }
     }
     if gpu_flag().is_none() {
         // Lavapipe and real GPUs have timestamp queries.
         assert_eq!(report["pass_clock"], "gpu-timestamps", "{report}");
     }
+    assert_eq!(report["spacing"], "held", "{report}");
+    // Frames spaced as the shot's (10 fps; the tiny field holds one pose, so none streams
+    // in here).
+    let shot = ok(&[
+        "bench",
+        "frame",
+        scene.to_str().unwrap(),
+        "--walkers",
+        "1",
+        "--light",
+        "constant",
+        "--frames",
+        "3",
+        "--spacing",
+        "shot",
+        "--json",
+    ]);
+    let shot: serde_json::Value = serde_json::from_slice(&shot.stdout).unwrap();
+    assert_eq!(shot["spacing"], "shot", "{shot}");
+    assert!(
+        shot["rows"][0]["wall_ms_per_frame"].as_f64().unwrap() > 0.0,
+        "{shot}"
+    );
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
@@ -791,4 +825,49 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         );
         assert!(!text.contains("panicked"), "{text}");
     }
+}
+
+/// `--sun` on a scene replaces the scene's sun and says so (it was once ignored
+/// silently); `--yaw`, which a scene's lighting keys give, is refused.
+#[test]
+fn a_sun_flag_on_a_scene_is_used_and_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "one.toml",
+        "[[instance]]\n",
+        "[1.2, 1.3, 3.0]",
+        "[1.2, 1.3, 3.0]",
+    );
+    let render = |out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--frames",
+            "0..1",
+            "--cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = ok(&args);
+        (read_exr(&out.join("frame_0000.exr")), stderr(&o))
+    };
+    let (plain, _) = render("plain", &[]);
+    let (sunlit, said) = render("sunlit", &["--sun", "22,30,0.53,500"]);
+    assert!(
+        said.contains("--sun: added to the scene's lighting"),
+        "{said}"
+    );
+    let sum = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>();
+    assert!(
+        sum(&sunlit) > sum(&plain) * 1.05,
+        "{} {}",
+        sum(&sunlit),
+        sum(&plain)
+    );
+    let o = frf(&["render", scene.to_str().unwrap(), "--yaw", "30", "--plan"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--yaw"), "{}", stderr(&o));
 }

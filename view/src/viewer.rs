@@ -312,9 +312,13 @@ impl<'a> Viewer<'a> {
             self.env = self.env_index();
         }
         if self.env.is_none() {
-            return Err(ViewError::Bad(
-                "the field is shown unlit: choose an environment first".into(),
-            ));
+            let now = match self.shot.scene().sun {
+                Some(_) => "the field is lit by a sun alone (no environment)",
+                None => "the field is shown unlit",
+            };
+            return Err(ViewError::Bad(format!(
+                "{now}: choose an environment first to turn or scale the light"
+            )));
         }
         self.relight()
     }

@@ -251,8 +251,8 @@ impl Gpu {
         out
     }
 
-    /// How long the host has waited on the device so far (every fence and readback, and
-    /// submissions blocked behind earlier work): what a frame's wall time less this is the
+    /// How long the host has waited on the device so far (every fence and readback; not
+    /// submissions, which are host work): what a frame's wall time less this is the
     /// host's own work.
     pub fn waited(&self) -> std::time::Duration {
         std::time::Duration::from_nanos(self.waited_ns.load(std::sync::atomic::Ordering::Relaxed))

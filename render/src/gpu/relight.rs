@@ -492,8 +492,8 @@ impl Gpu {
 
     /// Submits `buffers`, after the pending work (in a submission of its own, so that a
     /// frame the device refuses does not take the relights recorded before it along).
-    /// Time blocked in the submissions counts as waiting on the device ([`Gpu::waited`]):
-    /// a software adapter runs earlier work there before it takes more.
+    /// Submitting is the host's work (wgpu validates and hands the buffers over): its
+    /// time is not counted as waiting on the device ([`Gpu::waited`]).
     pub fn submit(
         &self,
         buffers: impl IntoIterator<Item = wgpu::CommandBuffer>,
@@ -505,12 +505,10 @@ impl Gpu {
             .take()
             .map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
-        self.waiting(|| {
-            if let Some(p) = pending {
-                self.queue.submit([p]);
-            }
-            self.queue.submit(buffers)
-        })
+        if let Some(p) = pending {
+            self.queue.submit([p]);
+        }
+        self.queue.submit(buffers)
     }
 
     /// Submits the pending work (before a caller submits its own encoder).

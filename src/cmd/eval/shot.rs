@@ -21,6 +21,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
         Scene::load_overridden(&args.field, env, args.scene_field.as_deref())?;
     frf_core::argument::within("--lights", args.lights, 1, 65536, "")?;
     let field = FieldFile::open(&field_path)?;
+    frf_render::resident::check_renderable(&field)?;
     let stage = frf_stage::open_stage(&args.capture)?;
     let report = evaluate_shot(
         &scene,
