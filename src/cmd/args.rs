@@ -232,7 +232,9 @@ pub struct LightingArgs {
     /// A sun added to the environment (alone with `--env none`), turned with it by
     /// `--yaw`: `AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]]`, degrees (azimuth from +z
     /// toward +x) and `∫ L dω` over the disc in the environment's units (default 0.53°
-    /// and 10, about the built-in sky's sun).
+    /// and 10, about the built-in sky's sun). Below the horizon it is not a sun: over
+    /// `--floor ground` it lights nothing, over `env` it lights from below through the
+    /// floor conditions.
     #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]")]
     pub sun: Option<SunSpec>,
 }

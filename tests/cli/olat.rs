@@ -137,14 +137,16 @@ fn a_field_ingested_from_a_set_relights_its_held_out_lights_as_the_set_does() {
     assert!(o.status.success(), "{}", stderr(&o));
     let from_set: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     // The same lights are held out, and the field's stored basis and normals predict
-    // them within 1 dB of the set's own photographs, above both baselines.
+    // them within 0.75 dB of the set's own photographs, above both baselines.
     assert_eq!(from_field["kept"], from_set["kept"]);
     let lights = from_field["lights"].as_array().unwrap();
     assert_eq!(lights.len(), 6);
     let psnr = |r: &serde_json::Value| r["mean_psnr"].as_f64().unwrap();
     assert!(psnr(&from_field) > 30.0, "{}", psnr(&from_field));
+    // What storing costs (JPEG 95 and the normals' quantization): 0.58 dB on this smooth
+    // sphere when written (35.26 against 35.84), 0.1-0.4 dB on the UW sets.
     assert!(
-        (psnr(&from_field) - psnr(&from_set)).abs() < 1.0,
+        (psnr(&from_field) - psnr(&from_set)).abs() < 0.75,
         "{} {}",
         psnr(&from_field),
         psnr(&from_set)
