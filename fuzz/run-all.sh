@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 seconds=${1:-600}
-targets=${TARGETS:-"container huffman images flo manifest scene env"}
+targets=${TARGETS:-"container huffman images flo manifest scene env olat"}
 mkdir -p logs
 RUSTC_BOOTSTRAP=1 cargo fuzz build -s none
 for t in $targets; do

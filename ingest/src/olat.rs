@@ -22,7 +22,7 @@ use crate::error::Result;
 
 /// How far from unit length a light direction may be (calibration files round to six
 /// digits).
-const UNIT_TOLERANCE: f32 = 0.02;
+pub const UNIT_TOLERANCE: f32 = 0.02;
 
 /// A calibrated one-light-at-a-time set, read and checked.
 pub struct OlatSet {
@@ -180,11 +180,16 @@ impl OlatSet {
 /// reaches values whose squared errors overflow (1e-38 gave −740 dB and NaN).
 pub const INTENSITY_RANGE: (f32, f32) = (1e-6, 1e6);
 
-/// The rows of three numbers of a light file, with their line numbers (blank lines and
-/// `#` comments skipped); a row that is not three finite numbers is refused naming the
-/// file and line.
+/// The rows of three numbers of the light file at `path` ([`parse_rows`]).
 fn read_rows(path: &Path) -> Result<Vec<(usize, [f32; 3])>, CoreError> {
     let text = std::fs::read_to_string(path).map_err(|e| CoreError::io(path, e))?;
+    parse_rows(path, &text)
+}
+
+/// The rows of three numbers of a light file's `text`, with their line numbers (blank
+/// lines and `#` comments skipped); a row that is not three finite numbers is refused
+/// naming the file (`path`) and line.
+pub fn parse_rows(path: &Path, text: &str) -> Result<Vec<(usize, [f32; 3])>, CoreError> {
     let mut rows = Vec::new();
     for (k, line) in text.lines().enumerate() {
         let line_no = k + 1;
