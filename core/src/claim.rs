@@ -17,9 +17,9 @@ use std::sync::Mutex;
 
 use crate::error::{CoreError, Result};
 
-/// The outputs claimed and not yet released, by their lock files, for
-/// [`abandon_live_claims`].
-static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// The outputs claimed and not yet released, for [`abandon_live_claims`]: each one's lock
+/// file, and the directory and prefix (`NAME.`) of its temporaries.
+static LIVE: Mutex<Vec<(PathBuf, PathBuf, String)>> = Mutex::new(Vec::new());
 
 /// What an interrupted process does with its claims before it exits (the binary calls
 /// it from its interrupt handler): removes their lock files and the temporaries of their
@@ -27,13 +27,8 @@ static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// them; the next claim of the same output clears its temporaries.)
 pub fn abandon_live_claims() {
     let live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
-    for lock in live.iter() {
-        if let (Some(dir), Some(name)) = (lock.parent(), lock.file_name()) {
-            // `.NAME.lock` → the temporaries `.NAME.*.tmp`.
-            let name = name.to_string_lossy();
-            let output = name.trim_start_matches('.').trim_end_matches(".lock");
-            remove_temporaries(dir, &format!("{output}."));
-        }
+    for (lock, dir, prefix) in live.iter() {
+        remove_temporaries(dir, prefix);
         let _ = std::fs::remove_file(lock);
     }
 }
@@ -85,7 +80,7 @@ impl Drop for OutputClaim {
         drop(self.lock.take());
         LIVE.lock()
             .unwrap_or_else(|e| e.into_inner())
-            .retain(|p| p != &self.lock_path);
+            .retain(|(lock, _, _)| lock != &self.lock_path);
     }
 }
 
@@ -170,10 +165,13 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
         }
     };
     let _ = std::fs::write(&lock_path, format!("{}\n", std::process::id()));
-    let removed = remove_temporaries(parent, &format!("{name}."));
-    LIVE.lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .push(lock_path.clone());
+    let prefix = format!("{name}.");
+    let removed = remove_temporaries(parent, &prefix);
+    LIVE.lock().unwrap_or_else(|e| e.into_inner()).push((
+        lock_path.clone(),
+        parent.to_path_buf(),
+        prefix,
+    ));
     Ok(OutputClaim {
         lock_path,
         lock: Some(lock),
@@ -198,7 +196,7 @@ mod tests {
         assert!(!lock.exists() && !half.exists());
         drop(claim);
         // Released claims are not abandoned again.
-        assert!(LIVE.lock().unwrap().iter().all(|p| p != &lock));
+        assert!(LIVE.lock().unwrap().iter().all(|(p, _, _)| p != &lock));
     }
 
     #[test]

@@ -177,6 +177,7 @@ fn the_budget_refuses_what_it_cannot_build() {
     let mut config = StageConfig::preset(StagePreset::Tiny);
     config.poses = vec![0];
     config.cycles = 4;
+    config.perturbation = 0.0;
     config.set_flow_truth = SetFlowTruth::None;
     let stage = Stage::new(config).unwrap();
     write_capture(&stage, &cap, &|_, _| {}).unwrap();

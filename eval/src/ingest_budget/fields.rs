@@ -220,6 +220,22 @@ pub fn write_fields(
     dir: &Path,
     progress: &dyn Progress,
 ) -> Result<Vec<(Component, PathBuf)>> {
+    // The fields are scored against the unperturbed walker: on a capture whose cycles
+    // differ, even the oracle field scores below the renderer's floor and the shares come
+    // out negative.
+    let perturbation = stage.config().perturbation;
+    if perturbation != 0.0 {
+        return Err(frf_core::BadArgument::new(
+            "--capture",
+            capture_dir.display(),
+            format!(
+                "for the ingest budget, a capture whose walk cycles repeat exactly (`frf stage \
+                 --perturbation 0`); this one was filmed with perturbation {perturbation} (its \
+                 stage.toml)"
+            ),
+        )
+        .into());
+    }
     options.validate()?;
     let made = FieldsMade {
         capture: capture_dir.display().to_string(),

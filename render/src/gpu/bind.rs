@@ -242,6 +242,21 @@ pub fn buffer_with(
     })
 }
 
+/// A buffer of `size` bytes for `usage`, its contents left to the passes.
+pub fn empty_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    size: usize,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size as u64,
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
 /// A buffer to read `size` bytes back into.
 pub fn readback_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

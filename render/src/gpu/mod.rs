@@ -258,6 +258,19 @@ impl Gpu {
         std::time::Duration::from_nanos(self.waited_ns.load(std::sync::atomic::Ordering::Relaxed))
     }
 
+    /// The whole of `buffer` (a `COPY_SRC` buffer the passes write), copied to a readback
+    /// buffer labelled `label` and read once the device has written it.
+    pub(crate) fn read_back(&self, buffer: &wgpu::Buffer, label: &str) -> Result<Vec<u8>> {
+        let size = buffer.size();
+        let readback = bind::readback_buffer(&self.device, label, size);
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        encoder.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
+        self.submit([encoder.finish()]);
+        self.read_buffer(&readback)
+    }
+
     pub(crate) fn read_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
         let slice = buffer.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();

@@ -13,7 +13,7 @@ use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::Gpu;
-use super::bind::{buffer_with, copy_to_buffer, readback_buffer, table_bytes};
+use super::bind::{buffer_with, copy_to_buffer, table_bytes};
 use super::formats::PoseFormats;
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
@@ -234,21 +234,7 @@ impl Gpu {
     /// The views' pre-lit colour scales as the GPU holds them (for tests and inspection).
     pub fn read_scales(&self, pose: &GpuPose) -> Result<Vec<f32>> {
         self.scoped("reading a pose's scales back", || {
-            let size = pose.views.size();
-            let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("views readback"),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("views readback"),
-                });
-            encoder.copy_buffer_to_buffer(&pose.views, 0, &readback, 0, size);
-            self.submit([encoder.finish()]);
-            let bytes = self.read_buffer(&readback)?;
+            let bytes = self.read_back(&pose.views, "views readback")?;
             let views: &[GpuView] = bytemuck::cast_slice(&bytes);
             Ok(views[..pose.geometry.views()]
                 .iter()
@@ -545,16 +531,7 @@ impl Gpu {
             return Ok(Vec::new());
         };
         self.scoped("reading the suns' maps back", || {
-            let size = maps.reach.size();
-            let readback = readback_buffer(&self.device, "sun depths readback", size);
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("sun depths readback"),
-                });
-            encoder.copy_buffer_to_buffer(&maps.reach, 0, &readback, 0, size);
-            self.submit([encoder.finish()]);
-            let bytes = self.read_buffer(&readback)?;
+            let bytes = self.read_back(&maps.reach, "sun depths readback")?;
             let all: &[f32] = bytemuck::cast_slice(&bytes);
             Ok(suns
                 .iter()

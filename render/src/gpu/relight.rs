@@ -21,7 +21,8 @@ use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
 use super::bind::{
-    bind_group, buffer_with, compute_pipeline, storage, storage_texture_array, table_bytes, uniform,
+    bind_group, buffer_with, compute_pipeline, empty_buffer, storage, storage_texture_array,
+    table_bytes, uniform,
 };
 use super::sun_depth::PoseSunMaps;
 use super::timing::compute_pass_writes;
@@ -372,14 +373,8 @@ impl Gpu {
     ) -> PoseRelight {
         let sun_maps = hull
             .map(|(h, proxy, words)| self.pose_sun_maps(proxy, words, SunDepth::most_texels(h)));
-        let buffer = |label: &str, size: usize, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size as u64,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
+        let buffer =
+            |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
         let dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         PoseRelight {
             coefficients: basis

@@ -10,7 +10,7 @@ use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
 use frf_shaders::types::GpuSunDepthJob;
 
 use super::Gpu;
-use super::bind::{bind_group, compute_pipeline, storage};
+use super::bind::{bind_group, compute_pipeline, empty_buffer, storage};
 use super::timing::compute_pass_writes;
 
 /// Workgroup size of the pass (`@workgroup_size(64)`).
@@ -88,14 +88,8 @@ impl Gpu {
         hull: &wgpu::Buffer,
         slot_texels: usize,
     ) -> PoseSunMaps {
-        let buffer = |label: &str, size: usize, usage| {
-            self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: size as u64,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
+        let buffer =
+            |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
         let storage = wgpu::BufferUsages::STORAGE;
         let jobs = buffer(
             "sun depth jobs",

@@ -13,19 +13,6 @@ use frf_eval::report::plot::{plot_format, write_plot};
 
 /// Runs the ingest budget.
 pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
-    // The budget's fields are scored against the unperturbed walker: on a capture whose
-    // cycles differ, even the oracle field scores below the renderer's floor and the
-    // shares come out negative.
-    let perturbation = input.stage.config().perturbation;
-    if perturbation != 0.0 {
-        return Err(format!(
-            "--ingest-budget: {} was filmed with perturbation {perturbation} (its stage.toml): \
-             the budget needs walk cycles that repeat exactly, a capture made with `frf stage \
-             --perturbation 0`",
-            args.capture.display()
-        )
-        .into());
-    }
     let plot_png = plot_format(args.plot.as_deref())?;
     let options = args.method.options()?;
     let (lighting, _) = args
