@@ -16,7 +16,8 @@
 //!   the host's own cores);
 //! - `host_ms_per_frame`: the difference, the host's own work (choosing what to make
 //!   resident, projecting the light, recording and submitting the passes, converting the
-//!   pixels read back);
+//!   pixels read back); on a software adapter a submission may run earlier work before
+//!   it returns, which then counts here (docs/results/realtime.md measures how much);
 //! - `gpu_timestamps_ms_per_frame`: the device's time in the frame's passes by GPU
 //!   timestamp queries, where the adapter has them (`passes` gives each pass's).
 
