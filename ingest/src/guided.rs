@@ -16,7 +16,7 @@
 //! (horizontal neighbours are consecutive cycles), and where it is concave. So the
 //! flow is the hull's, refined on the images ([`guided_flow`]): the neighbour is warped
 //! onto the view by the hull's flow, the residual flow between the view and the warped
-//! neighbour is estimated over a short range ([`RESIDUAL_SEARCH_PX`]), and the two are
+//! neighbour is estimated over a short range ([`RESIDUAL_SEARCH_M`]), and the two are
 //! composed. On the perturbed small preset: 0.65 px by image matching (through the
 //! plane of the turntable's axis, [`crate::rectify`]), 0.72 px by the hull alone, 0.31
 //! px guided.
@@ -30,7 +30,7 @@ use frf_core::filter::extend_nearest;
 use frf_core::flo::{UNKNOWN, is_known};
 use frf_core::image::{Border, FlowImage, GrayImage, Image, RgbImage};
 use frf_flow::FlowParams;
-use frf_reflectance::hull::{Silhouette, VoxelHull, voxel_per_pixel};
+use frf_reflectance::hull::{Silhouette, VoxelHull, pixel_footprint_m, voxel_per_pixel};
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -58,11 +58,19 @@ impl InterViewFlow {
 }
 
 /// The residual flow between a view and its neighbour warped by the hull's flow is
-/// searched over this many pixels: the cycle-to-cycle differences move a foot by up to
-/// about 2 px at 160x224 (a 1.2° joint perturbation on a 0.8 m leg), and the hull errs by
-/// less than a pixel in concave places. Measured on the perturbed small preset: 1 px
-/// 0.38, 4 px 0.31, 8 px 0.31 px end-point error.
-pub const RESIDUAL_SEARCH_PX: f32 = 4.0;
+/// searched this far on the subject, metres ([`residual_search_px`] turns it into pixels
+/// of the views at hand): the cycle-to-cycle differences move a foot by up to about 2 cm
+/// (a 1.2° joint perturbation on a 0.8 m leg), and the hull errs by less than a pixel in
+/// concave places. Chosen on the perturbed small preset (160x224, a pixel's footprint 9.8
+/// mm on the axis): 1 px 0.38, 4 px 0.31, 8 px 0.31 px end-point error; 4 px is 0.039 m.
+/// The tiny and paper sizes' check is in docs/results/ingest.md.
+pub const RESIDUAL_SEARCH_M: f32 = 0.039;
+
+/// `metres` on the turntable axis in pixels of `cameras` ([`pixel_footprint_m`]), at
+/// least one; `metres` at a 1 cm footprint where the cameras give none.
+pub fn residual_search_px(metres: f32, cameras: &[Camera]) -> f32 {
+    (metres / pixel_footprint_m(cameras).unwrap_or(0.01)).max(1.0)
+}
 
 /// The flow hull's voxel is this fraction of a pixel's footprint on the turntable axis.
 /// Measured on the small preset without perturbation (footprint 9.8 mm), the hull's own
@@ -125,7 +133,7 @@ pub fn hull_flow(
 
 /// The flow from image `a` to image `b` (views with cameras `camera_a` and `camera_b`,
 /// subject frame) guided by `hull` (see the module docs): the hull's flow refined on the
-/// images over [`RESIDUAL_SEARCH_PX`] ([`refine_flow`]).
+/// images over [`RESIDUAL_SEARCH_M`] ([`refine_flow`]).
 pub fn guided_flow(
     a: &RgbImage,
     b: &RgbImage,
@@ -144,7 +152,8 @@ pub fn guided_flow(
             "no ray of the view meets the pose's hull: it cannot guide the flow".into(),
         ));
     }
-    refine_flow(a, b, &prior, params, RESIDUAL_SEARCH_PX)
+    let search = residual_search_px(RESIDUAL_SEARCH_M, &[*camera_a, *camera_b]);
+    refine_flow(a, b, &prior, params, search)
 }
 
 /// The flow from image `a` to image `b` that `prior` predicts, refined on the images:
@@ -220,6 +229,24 @@ mod tests {
     }
 
     #[test]
+    fn the_residual_search_is_a_distance_on_the_subject() {
+        // The stage's cameras: 4.5 m away, 27.5° vertical field of view.
+        let camera = |h: u32| {
+            let eye = Vec3::new(0.0, 0.9, 4.5);
+            let (target, fov) = (Vec3::new(0.0, 0.9, 0.0), 27.5f32.to_radians());
+            Camera::look_at(eye, target, Vec3::Y, fov, h * 5 / 7, h).unwrap()
+        };
+        let at = |h: u32| residual_search_px(RESIDUAL_SEARCH_M, &[camera(h)]);
+        // What it was chosen as at the small preset, and the same metres at the others.
+        let (tiny, small, paper) = (at(90), at(224), at(448));
+        assert!((3.9..=4.0).contains(&small), "{small}");
+        assert!((small / paper - 0.5).abs() < 1e-3, "{small} {paper}");
+        assert!((tiny / small - 90.0 / 224.0).abs() < 1e-3, "{tiny} {small}");
+        // Never below a pixel.
+        assert_eq!(residual_search_px(1e-6, &[camera(224)]), 1.0);
+    }
+
+    #[test]
     fn the_hull_flow_of_a_sphere_is_its_reprojection() {
         let views = ring(24, 160);
         let cameras: Vec<Camera> = views.iter().map(|v| v.0).collect();
@@ -292,7 +319,7 @@ mod tests {
         });
         let prior = Image::new(64, 64, [shift.x + 1.5, shift.y]);
         let params = FlowParams::preset(frf_flow::Preset::Balanced);
-        let f = refine_flow(&a, &b, &prior, &params, RESIDUAL_SEARCH_PX).unwrap();
+        let f = refine_flow(&a, &b, &prior, &params, 4.0).unwrap();
         let (mut sum, mut count) = (0.0, 0);
         for y in 8..56 {
             for x in 8..56 {

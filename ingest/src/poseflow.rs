@@ -36,16 +36,17 @@ use frf_reflectance::hull::VoxelHull;
 use rayon::prelude::*;
 
 use crate::error::Result;
-use crate::guided::{hull_flow, refine_flow};
+use crate::guided::{hull_flow, refine_flow, residual_search_px};
 use crate::interview::{keep_near_subject, rectified_flow};
 use crate::matte::{MatteInput, MatteRule, alpha as matte_alpha, premultiply};
 
 /// The residual flow between a view and the other cycle's view warped by the hull's
-/// reprojection is searched over this many pixels: besides another cycle's perturbation
-/// (what the inter-view flows' [`crate::guided::RESIDUAL_SEARCH_PX`] allows for), the
-/// walker has moved by the poses' difference of phase, a pose apart at least (2 px on
-/// average at 160x224, a foot's swing several).
-pub const RESIDUAL_SEARCH_PX: f32 = 8.0;
+/// reprojection is searched this far on the subject, metres: besides another cycle's
+/// perturbation (what the inter-view flows' [`crate::guided::RESIDUAL_SEARCH_M`] allows
+/// for), the walker has moved by the poses' difference of phase, a pose apart at least
+/// (2 cm on average, a foot's swing several). Twice the inter-view search: 8 px at the
+/// small preset's 160x224.
+pub const RESIDUAL_SEARCH_M: f32 = 2.0 * crate::guided::RESIDUAL_SEARCH_M;
 
 /// The reference track frame of view `(u, v)` of `pose`, matted onto black with the
 /// matte of the frame after it (`clean`: camera `v`'s clean plates by slot).
@@ -118,7 +119,13 @@ pub fn pose_flows(
                     // reprojection predicts the flow, the images refine it.
                     Some(hull) if to_u != u => {
                         let prior = hull_flow(hull, &from, &to, a.width(), a.height());
-                        refine_flow(a, &b, &prior, params, RESIDUAL_SEARCH_PX)?
+                        refine_flow(
+                            a,
+                            &b,
+                            &prior,
+                            params,
+                            residual_search_px(RESIDUAL_SEARCH_M, &[from, to]),
+                        )?
                     }
                     _ => rectified_flow(a, &b, &from, &to, params)?,
                 };

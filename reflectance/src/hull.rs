@@ -47,19 +47,22 @@ pub fn search_region() -> (Vec3, Vec3) {
     (Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 2.6, 2.0))
 }
 
-/// A voxel side of `per_pixel` times the smallest footprint of a pixel of `cameras` on
-/// the turntable axis (the scale at which their mattes can tell the subject's shape),
-/// within `range` (metres); the range's top when no camera gives a finite footprint.
-pub fn voxel_per_pixel(cameras: &[Camera], per_pixel: f32, range: (f32, f32)) -> f32 {
+/// The smallest footprint of a pixel of `cameras` on the turntable axis, metres (the
+/// scale at which their images tell the subject's shape); `None` when no camera gives a
+/// finite one.
+pub fn pixel_footprint_m(cameras: &[Camera]) -> Option<f32> {
     let footprint = cameras
         .iter()
         .map(|c| (c.centre() - c.axis_point()).length() / c.intrinsics.fx.max(c.intrinsics.fy))
         .filter(|f| f.is_finite() && *f > 0.0)
         .fold(f32::INFINITY, f32::min);
-    if !footprint.is_finite() {
-        return range.1;
-    }
-    (footprint * per_pixel).clamp(range.0, range.1)
+    footprint.is_finite().then_some(footprint)
+}
+
+/// A voxel side of `per_pixel` times [`pixel_footprint_m`], within `range` (metres); the
+/// range's top when no camera gives a finite footprint.
+pub fn voxel_per_pixel(cameras: &[Camera], per_pixel: f32, range: (f32, f32)) -> f32 {
+    pixel_footprint_m(cameras).map_or(range.1, |f| (f * per_pixel).clamp(range.0, range.1))
 }
 
 /// One view as carving needs it: its camera (subject frame) and its matte.

@@ -44,19 +44,22 @@ pub const WEIGHT_POWER: f32 = 2.0;
 /// built-in sky) or a soft one (`forest_slope`, `st_fagans_interior`) score the same
 /// with 1 or 4. Each sun costs a shadow ray where it would light a texel.
 pub const MAX_SUNS: usize = 4;
-/// How far from the visual hull's surface a shadow ray toward the sun starts, metres.
+/// How far from the visual hull's surface a shadow ray toward the sun starts, as a
+/// fraction of the height of the hull's grid (the subject's height and a margin; 1.88 m
+/// for the stage's walker), so that it scales with the subject.
 /// The hull is wider than the body and its surface point lies ahead of the true one, so
 /// occluders near the texel are the hull's own error; far ones (a leg over the other, an
-/// arm over the torso) are cast shadows. Measured at the captured views of the small
-/// oracle field (2 cm voxels; subject PSNR, a sun alone at 20°, 40°, 70° / the built-in
-/// sky): no shadow 31.97, 31.41, 29.00 / 33.23 dB; 0.04 m 31.09, 30.24, - / 31.64; 0.16 m
-/// 32.00, -, - / 32.80; 0.32 m 32.40, 31.93, 30.58 / 33.64; 0.48 m 31.97, 31.80, - / 33.51.
-/// With the hull at 5 mm voxels (a sun at 20°, 70° / the sky): 0.16 m 32.65, 31.92 /
-/// 34.01; 0.24 m 32.74, 31.79 / 34.14; 0.32 m 32.45, 30.86 / 34.35; 0.40 m 32.02, 30.47 /
-/// 34.40.
+/// arm over the torso) are cast shadows. Chosen at the captured views of the small
+/// oracle field of pose 0, as metres (2 cm voxels; subject PSNR, a sun alone at 20°,
+/// 40°, 70° / the built-in sky): no shadow 31.97, 31.41, 29.00 / 33.23 dB; 0.04 m 31.09,
+/// 30.24, - / 31.64; 0.16 m 32.00, -, - / 32.80; 0.32 m 32.40, 31.93, 30.58 / 33.64;
+/// 0.48 m 31.97, 31.80, - / 33.51. With the hull at 5 mm voxels (a sun at 20°, 70° / the
+/// sky): 0.16 m 32.65, 31.92 / 34.01; 0.24 m 32.74, 31.79 / 34.14; 0.32 m 32.45, 30.86 /
+/// 34.35; 0.40 m 32.02, 30.47 / 34.40. Reported on pose 1 and checked at the tiny and
+/// paper sizes in docs/results/hard_light.md.
 /// Leaving the hull's voxels around the point before looking for an occluder, instead
 /// of a fixed offset, scored 0.5-1.2 dB under no shadow.
-pub const SHADOW_OFFSET_M: f32 = 0.32;
+pub const SHADOW_OFFSET_PER_HEIGHT: f32 = 0.17;
 
 /// One view's sun: its direction in the view's dome frame, and the nearest conditions'
 /// inverse-angle weights.
@@ -85,6 +88,14 @@ pub struct SunLight {
     /// The pose's visual hull seen from the sun, which casts its shadows (`None`: no
     /// hull, no cast shadows).
     pub depth: Option<SunDepth>,
+    /// How far from a texel's point its shadow ray starts, metres ([`shadow_offset_m`]).
+    pub shadow_offset_m: f32,
+}
+
+/// [`SHADOW_OFFSET_PER_HEIGHT`] of the height of `hull`'s grid, metres.
+pub fn shadow_offset_m(hull: &VoxelHull) -> f32 {
+    let g = hull.grid();
+    SHADOW_OFFSET_PER_HEIGHT * g.dims[1] as f32 * g.voxel_m
 }
 
 impl SunLight {
@@ -121,6 +132,7 @@ impl SunLight {
             views,
             subject: sun.direction(),
             depth: hull.map(|h| SunDepth::new(h, sun.direction())),
+            shadow_offset_m: hull.map_or(0.0, |h| shadow_offset_m(h)),
         }
     }
 
@@ -131,11 +143,12 @@ impl SunLight {
     }
 
     /// Whether the sun reaches `surface`, a texel's point on the visual hull (subject
-    /// frame), as far as the hull can tell: from [`SHADOW_OFFSET_M`] toward the sun on,
+    /// frame), as far as the hull can tell: from [`SunLight::shadow_offset_m`] toward the sun on,
     /// the hull does not lie between it and the sun ([`SunDepth::shades`]). Without a
     /// hull, always. (`shaders/relight.wgsl` is its twin.)
     pub fn sunlit(&self, surface: Vec3) -> bool {
-        (self.depth.as_ref()).is_none_or(|m| !m.shades(surface + self.subject * SHADOW_OFFSET_M))
+        (self.depth.as_ref())
+            .is_none_or(|m| !m.shades(surface + self.subject * self.shadow_offset_m))
     }
 
     /// The sun's light at a texel of view `view` whose normal is `normal` (`None`: none
@@ -170,6 +183,33 @@ mod tests {
                 solid_angle_sr: 0.5,
             }],
         }
+    }
+
+    #[test]
+    fn the_shadow_offset_scales_with_the_subject() {
+        let hull = |height: f32| {
+            let grid = frf_core::volume::VoxelGrid::covering(
+                Vec3::new(-0.3, 0.0, -0.3),
+                Vec3::new(0.3, height, 0.3),
+                0.05,
+            );
+            Arc::new(VoxelHull::from_fn(grid.unwrap(), |p| p.y < 0.9 * height))
+        };
+        let sun = Sun::new(Vec3::Y, 0.53, [1.0; 3]).unwrap();
+        let conditions = vec![condition(Vec3::Y, 1.0)];
+        let offset =
+            |h: f32| SunLight::new(&sun, &conditions, &[0.0], Some(&hull(h))).shadow_offset_m;
+        let (walker, child) = (offset(1.9), offset(0.95));
+        assert!(
+            (walker - SHADOW_OFFSET_PER_HEIGHT * 1.9).abs() < 0.03,
+            "{walker}"
+        );
+        assert!((child / walker - 0.5).abs() < 0.03, "{child} {walker}");
+        // Without a hull nothing is cast, and nothing is offset.
+        assert_eq!(
+            SunLight::new(&sun, &conditions, &[0.0], None).shadow_offset_m,
+            0.0
+        );
     }
 
     #[test]

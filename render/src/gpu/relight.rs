@@ -16,7 +16,7 @@ use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
 use frf_reflectance::sun_depth::SunDepth;
-use frf_reflectance::sun_light::{MAX_SUNS, SHADOW_OFFSET_M, SunLight};
+use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -249,7 +249,7 @@ fn pack_sun(
         out.extend([[0.0; 4]; 3]);
         return;
     };
-    out.push(sun.subject.extend(SHADOW_OFFSET_M).to_array());
+    out.push(sun.subject.extend(sun.shadow_offset_m).to_array());
     out.push(m.axes[0].extend(m.corner.x).to_array());
     out.push(m.axes[1].extend(m.corner.y).to_array());
     let [w, h] = m.size;
