@@ -62,6 +62,9 @@ enum Command {
     /// Look at a field or a scene in a window: move the camera, play the walk, turn the
     /// light; record a camera move as a scene file.
     View(Box<cmd::view::ViewArgs>),
+    /// An environment's light as nine RGB spherical-harmonic coefficients (L2, the
+    /// engines' light probes) in a JSON file frf and players relight by.
+    EnvSh(cmd::env_sh::EnvShArgs),
     /// Benchmarks: `frf bench interp` times the GPU interpolation passes.
     Bench(cmd::bench::BenchArgs),
     /// Optical flow from image A to image B, written as a Middlebury .flo file.
@@ -116,6 +119,7 @@ fn main() -> ExitCode {
         Command::EvalOlat(args) => cmd::olat::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::View(args) => cmd::view::run(*args),
+        Command::EnvSh(args) => cmd::env_sh::run(args),
         Command::Bench(args) => cmd::bench::run_bench(args),
         Command::Flow(args) => cmd::flow::run(args),
         Command::FlowBench(args) => cmd::flow::run_bench(args),

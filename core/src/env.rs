@@ -32,6 +32,9 @@ use crate::light::DirLight;
 /// that relit sums and exposures stay finite.
 pub const MAX_TOTAL_LIGHT: f64 = 1e30;
 
+/// Rows of the map an L2 light becomes: its finest detail is a band-2 lobe, 60° wide.
+pub const SH_MAP_HEIGHT: usize = 128;
+
 /// A latitude–longitude HDR environment of radiance.
 #[derive(Debug, Clone)]
 pub struct EnvMap {
@@ -43,8 +46,16 @@ pub struct EnvMap {
 impl EnvMap {
     /// Loads a `.hdr` (Radiance RGBE) or `.exr` map (an 8-bit image is refused,
     /// [`crate::io::read_hdr_rgb`]); a map whose every texel is zero or negative is
-    /// refused too: it lights nothing (`none` shows a field unlit).
+    /// refused too: it lights nothing (`none` shows a field unlit). A `.json` file is an
+    /// L2 light ([`crate::sh::ShLight`], what `frf env-sh` writes), made a map of
+    /// [`SH_MAP_HEIGHT`] rows.
     pub fn load(path: &Path) -> Result<Self> {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            return crate::sh::ShLight::load(path)?.to_env(SH_MAP_HEIGHT);
+        }
         let img = crate::io::read_hdr_rgb(path)?;
         let env = Self::from_image(img).map_err(|e| match e {
             CoreError::InvalidArgument { problem, .. } => CoreError::bad_file(path, problem),
@@ -110,6 +121,28 @@ impl EnvMap {
             yaw: 0.0,
             clamped_texels,
         })
+    }
+
+    /// Wraps a signed image, negative texels kept: not light, but a function on the
+    /// sphere to integrate over the basis's regions (an SH basis function,
+    /// [`crate::sh`]); non-finite texels are refused.
+    pub fn signed(radiance: RgbImage) -> Result<Self> {
+        let mut env = Self::from_image(Image::new(1, 1, [0.0; 3]))?;
+        if let Some(i) = radiance
+            .pixels()
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(CoreError::invalid(
+                "signed map",
+                format!("texel {i} is not finite"),
+            ));
+        }
+        if radiance.width() == 0 || radiance.height() == 0 {
+            return Err(CoreError::invalid("signed map", "empty image"));
+        }
+        env.radiance = radiance;
+        Ok(env)
     }
 
     /// A constant environment of radiance `value` on a `2n x n` grid.

@@ -27,6 +27,7 @@ pub mod lru;
 pub mod manifest;
 pub mod preview;
 pub mod progress;
+pub mod sh;
 pub mod shared_data;
 pub mod sun;
 pub mod volume;

@@ -31,6 +31,7 @@ pub mod merge;
 pub mod normalcodec;
 pub mod project;
 pub mod relight;
+pub mod sh_transfer;
 pub mod shadow;
 pub mod stats;
 pub mod store;

@@ -3,6 +3,7 @@
 pub mod args;
 pub mod bench;
 pub mod claim;
+pub mod env_sh;
 pub mod eval;
 pub mod flow;
 pub mod for_scene;

@@ -15,6 +15,7 @@ mod report;
 mod resume;
 mod ring;
 mod scene;
+mod sh;
 mod stage;
 mod status;
 mod time;

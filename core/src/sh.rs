@@ -1,0 +1,496 @@
+//! Light as real spherical harmonics up to band 2 ("L2": 9 coefficients per colour
+//! channel), the form of the light probes of three.js, Unity, Unreal and Godot.
+//!
+//! **The convention** (declared in every file frf writes, [`Convention`]): the radiance
+//! arriving from unit direction `d = (x, y, z)` is `L(d) = Σ_i c_i Y_i(d)`, with `d` in
+//! frf's subject frame, which is glTF's and three.js's world frame (`+y` up,
+//! right-handed; an environment map's centre looks toward `-z`, [`crate::env`]). The
+//! basis is the orthonormal real one (`∫ Y_i Y_j dω = δ_ij`) in three.js's
+//! `SphericalHarmonics3` order and signs, without the Condon–Shortley phase:
+//!
+//! | i | (l, m) | `Y_i(x, y, z)` |
+//! |---|---|---|
+//! | 0 | (0, 0) | 0.282095 |
+//! | 1 | (1, −1) | 0.488603 y |
+//! | 2 | (1, 0) | 0.488603 z |
+//! | 3 | (1, 1) | 0.488603 x |
+//! | 4 | (2, −2) | 1.092548 xy |
+//! | 5 | (2, −1) | 1.092548 yz |
+//! | 6 | (2, 0) | 0.315392 (3z² − 1) |
+//! | 7 | (2, 1) | 1.092548 xz |
+//! | 8 | (2, 2) | 0.546274 (x² − y²) |
+//!
+//! The coefficients are of radiance (what three.js's `LightProbe.sh` holds and its
+//! `getAt` evaluates), not of irradiance; [`ShLight::irradiance`] is the cosine-convolved
+//! light a matte surface receives (Ramamoorthi and Hanrahan's factors π, 2π/3, π/4 per
+//! band). The Condon–Shortley form negates the four coefficients of odd `m`
+//! ([`ShLight::condon_shortley`]); Unity's shader form is seven vectors
+//! ([`ShLight::unity_shader_vectors`]). docs/export.md says how engines map onto it.
+//!
+//! An L2 light is smooth: a sun in it is a broad lobe, and its reconstruction rings
+//! negative opposite a bright source ([`ShLight::to_env`] clamps and counts those texels).
+
+use std::f32::consts::PI;
+use std::path::Path;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::env::{EnvMap, MAX_TOTAL_LIGHT};
+use crate::error::{CoreError, Result};
+use crate::image::{Image, Rgb};
+
+/// Coefficients per channel of an L2 light.
+pub const SH_COUNT: usize = 9;
+
+/// `(l, m)` of each coefficient, in order.
+pub const SH_ORDER: [(i32, i32); SH_COUNT] = [
+    (0, 0),
+    (1, -1),
+    (1, 0),
+    (1, 1),
+    (2, -2),
+    (2, -1),
+    (2, 0),
+    (2, 1),
+    (2, 2),
+];
+
+/// The format name of frf's SH light files.
+pub const SH_FORMAT: &str = "frf-sh-l2";
+/// Their version.
+pub const SH_VERSION: u32 = 1;
+
+/// The basis functions at unit direction `d` (see the module text).
+pub fn sh_basis(d: Vec3) -> [f32; SH_COUNT] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_095,
+        0.488_603 * y,
+        0.488_603 * z,
+        0.488_603 * x,
+        1.092_548 * x * y,
+        1.092_548 * y * z,
+        0.315_392 * (3.0 * z * z - 1.0),
+        1.092_548 * x * z,
+        0.546_274 * (x * x - y * y),
+    ]
+}
+
+/// The cosine lobe's factor per band (`Â_l`): the irradiance's coefficient is `Â_l c_i`.
+pub const COSINE_LOBE: [f32; 3] = [PI, 2.0 * PI / 3.0, PI / 4.0];
+
+/// The convention a file declares (see the module text); a file declaring another is
+/// refused rather than misread.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Convention {
+    /// `"l,m"` of each coefficient, in order.
+    pub order: Vec<String>,
+    /// How the basis is normalised.
+    pub normalisation: String,
+    /// Whether the Condon–Shortley phase `(−1)^m` is in the basis.
+    pub condon_shortley_phase: bool,
+    /// What the coefficients are of.
+    pub quantity: String,
+    /// The frame of the directions.
+    pub frame: String,
+}
+
+impl Convention {
+    /// frf's convention.
+    pub fn frf() -> Self {
+        Self {
+            order: SH_ORDER.iter().map(|(l, m)| format!("{l},{m}")).collect(),
+            normalisation: "orthonormal real (three.js SphericalHarmonics3)".into(),
+            condon_shortley_phase: false,
+            quantity: "radiance".into(),
+            frame: "+y up, right-handed, the map's centre toward -z (glTF, three.js)".into(),
+        }
+    }
+}
+
+/// An L2 light: radiance coefficients per channel (see the module text).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShLight {
+    /// `c_i`, RGB.
+    pub coefficients: [Rgb; SH_COUNT],
+}
+
+/// The file form of an [`ShLight`].
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct ShFile {
+    format: String,
+    version: u32,
+    convention: Convention,
+    coefficients: Vec<[f32; 3]>,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    source: String,
+}
+
+impl ShLight {
+    /// The projection of `env` (its yaw included) onto the basis: `c_i = ∫ L Y_i dω`,
+    /// summed over its texels in f64.
+    pub fn project(env: &EnvMap) -> Self {
+        let img = env.image();
+        let mut sum = [[0.0f64; 3]; SH_COUNT];
+        for y in 0..img.height() {
+            let omega = env.texel_solid_angle(y) as f64;
+            for (x, l) in img.row(y).iter().enumerate() {
+                let basis = sh_basis(env.direction_of(x as f32, y as f32));
+                for (s, b) in sum.iter_mut().zip(basis) {
+                    for c in 0..3 {
+                        s[c] += l[c] as f64 * b as f64 * omega;
+                    }
+                }
+            }
+        }
+        Self {
+            coefficients: sum.map(|s| s.map(|v| v as f32)),
+        }
+    }
+
+    /// Radiance from unit direction `d`.
+    pub fn radiance(&self, d: Vec3) -> Rgb {
+        weighted(&self.coefficients, sh_basis(d))
+    }
+
+    /// Irradiance on a surface of unit normal `n`, `∫ L max(n · ω, 0) dω`, of the light
+    /// as L2 represents it.
+    pub fn irradiance(&self, n: Vec3) -> Rgb {
+        let mut basis = sh_basis(n);
+        for (b, (l, _)) in basis.iter_mut().zip(SH_ORDER) {
+            *b *= COSINE_LOBE[l as usize];
+        }
+        weighted(&self.coefficients, basis)
+    }
+
+    /// The light as a `2h x h` latitude–longitude map (negative texels, the ringing
+    /// opposite a bright source, clamped to zero and counted by the map).
+    pub fn to_env(&self, h: usize) -> Result<EnvMap> {
+        let h = h.max(2);
+        let probe = EnvMap::uniform([0.0; 3], h);
+        let img = Image::from_fn(2 * h, h, |x, y| {
+            self.radiance(probe.direction_of(x as f32, y as f32))
+        });
+        EnvMap::from_image(img)
+    }
+
+    /// The coefficients with the Condon–Shortley phase: those of odd `m` negated (the
+    /// ordering of many papers and tools). Its own inverse.
+    pub fn condon_shortley(&self) -> [Rgb; SH_COUNT] {
+        let mut c = self.coefficients;
+        for (i, (_, m)) in SH_ORDER.iter().enumerate() {
+            if m % 2 != 0 {
+                c[i] = c[i].map(|v| -v);
+            }
+        }
+        c
+    }
+
+    /// From coefficients with the Condon–Shortley phase ([`ShLight::condon_shortley`]).
+    pub fn from_condon_shortley(c: [Rgb; SH_COUNT]) -> Self {
+        Self::from_coefficients(Self::from_coefficients(c).condon_shortley())
+    }
+
+    /// Wraps coefficients in frf's convention.
+    pub fn from_coefficients(coefficients: [Rgb; SH_COUNT]) -> Self {
+        Self { coefficients }
+    }
+
+    /// Unity's seven shader vectors (`unity_SHAr, SHAg, SHAb, SHBr, SHBg, SHBb, SHC`),
+    /// whose `ShadeSH9(n)` — `SHA·(n, 1) + SHB·(xy, yz, z², zx) + SHC·(x² − y²)` per
+    /// channel — is [`ShLight::irradiance`] over π (what a matte albedo multiplies), for
+    /// `n` in this frame. SHC's fourth component is 1.
+    pub fn unity_shader_vectors(&self) -> [[f32; 4]; 7] {
+        let c = &self.coefficients;
+        let (a0, a1, a2) = (
+            COSINE_LOBE[0] / PI,
+            COSINE_LOBE[1] / PI,
+            COSINE_LOBE[2] / PI,
+        );
+        let mut out = [[0.0f32; 4]; 7];
+        for ch in 0..3 {
+            out[ch] = [
+                a1 * 0.488_603 * c[3][ch],
+                a1 * 0.488_603 * c[1][ch],
+                a1 * 0.488_603 * c[2][ch],
+                a0 * 0.282_095 * c[0][ch] - a2 * 0.315_392 * c[6][ch],
+            ];
+            out[3 + ch] = [
+                a2 * 1.092_548 * c[4][ch],
+                a2 * 1.092_548 * c[5][ch],
+                a2 * 3.0 * 0.315_392 * c[6][ch],
+                a2 * 1.092_548 * c[7][ch],
+            ];
+            out[6][ch] = a2 * 0.546_274 * c[8][ch];
+        }
+        out[6][3] = 1.0;
+        out
+    }
+
+    /// Writes the light as JSON (temporary file, then renamed), naming `source`.
+    pub fn save(&self, path: &Path, source: &str) -> Result<()> {
+        let file = ShFile {
+            format: SH_FORMAT.into(),
+            version: SH_VERSION,
+            convention: Convention::frf(),
+            coefficients: self.coefficients.to_vec(),
+            source: source.into(),
+        };
+        let text = serde_json::to_string_pretty(&file)
+            .map_err(|e| CoreError::bad_file(path, e.to_string()))?;
+        crate::atomic::write_bytes_atomic(path, text.as_bytes())
+    }
+
+    /// Reads a light written by [`ShLight::save`] (or by hand in its form), refusing
+    /// another format, version or convention, a count other than 9, non-finite values
+    /// and a total light beyond [`MAX_TOTAL_LIGHT`].
+    pub fn load(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path).map_err(|e| CoreError::io(path, e))?;
+        let file: ShFile = serde_json::from_slice(&bytes).map_err(|e| {
+            CoreError::bad_file(path, format!("not an SH light ({SH_FORMAT} JSON): {e}"))
+        })?;
+        let bad = |m: String| Err(CoreError::bad_file(path, m));
+        if file.format != SH_FORMAT {
+            return bad(format!("format {:?}, expected {SH_FORMAT:?}", file.format));
+        }
+        if file.version != SH_VERSION {
+            return bad(format!(
+                "version {} of {SH_FORMAT}; this frf reads version {SH_VERSION}",
+                file.version
+            ));
+        }
+        if file.convention != Convention::frf() {
+            return bad(format!(
+                "its convention {:?} is not frf's {:?} (convert it first: docs/export.md)",
+                file.convention,
+                Convention::frf()
+            ));
+        }
+        let coefficients: [Rgb; SH_COUNT] = match file.coefficients.try_into() {
+            Ok(c) => c,
+            Err(c) => {
+                let c: Vec<[f32; 3]> = c;
+                return bad(format!("{} coefficients, expected {SH_COUNT}", c.len()));
+            }
+        };
+        if let Some(i) = coefficients
+            .iter()
+            .position(|c| c.iter().any(|v| !v.is_finite()))
+        {
+            return bad(format!("coefficient {i} is not finite"));
+        }
+        // ∫ L dω = √(4π) c_0: the band-0 term carries all of the total light.
+        let total = coefficients[0].map(|c| (c as f64 * (4.0 * std::f64::consts::PI).sqrt()).abs());
+        if total.iter().any(|&t| t > MAX_TOTAL_LIGHT) {
+            return bad(format!(
+                "its total light {:.1e} is beyond what relighting can sum (at most {MAX_TOTAL_LIGHT:.0e})",
+                total.iter().fold(0.0f64, |a, &b| a.max(b))
+            ));
+        }
+        Ok(Self { coefficients })
+    }
+}
+
+/// `Σ_i c_i w_i` per channel.
+fn weighted(c: &[Rgb; SH_COUNT], w: [f32; SH_COUNT]) -> Rgb {
+    let mut out = [0.0f32; 3];
+    for (ci, wi) in c.iter().zip(w) {
+        for ch in 0..3 {
+            out[ch] += ci[ch] * wi;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit directions spread over the sphere.
+    fn directions(n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|i| {
+                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+                let phi = i as f32 * 2.399_963;
+                let r = (1.0 - y * y).sqrt();
+                Vec3::new(r * phi.cos(), y, r * phi.sin())
+            })
+            .collect()
+    }
+
+    fn light() -> ShLight {
+        let mut c = [[0.0f32; 3]; SH_COUNT];
+        for (i, ci) in c.iter_mut().enumerate() {
+            let i = i as f32;
+            *ci = [0.3 / (1.0 + i), 0.1 - 0.03 * i, 0.3 * (i * 0.7).sin()];
+        }
+        // Band 0 above the others' largest sum: positive everywhere.
+        c[0] = [6.0, 5.5, 5.0];
+        ShLight::from_coefficients(c)
+    }
+
+    #[test]
+    fn the_basis_is_orthonormal_and_a_projection_recovers_a_band_limited_light() {
+        let probe = EnvMap::uniform([0.0; 3], 256);
+        let mut gram = [[0.0f64; SH_COUNT]; SH_COUNT];
+        for y in 0..256 {
+            let omega = probe.texel_solid_angle(y) as f64;
+            for x in 0..512 {
+                let b = sh_basis(probe.direction_of(x as f32, y as f32));
+                for i in 0..SH_COUNT {
+                    for j in 0..SH_COUNT {
+                        gram[i][j] += b[i] as f64 * b[j] as f64 * omega;
+                    }
+                }
+            }
+        }
+        for (i, row) in gram.iter().enumerate() {
+            for (j, g) in row.iter().enumerate() {
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((g - want).abs() < 2e-3, "<Y{i}, Y{j}> = {g}");
+            }
+        }
+        let l = light();
+        let back = ShLight::project(&l.to_env(256).unwrap());
+        for (a, b) in l.coefficients.iter().zip(back.coefficients) {
+            for c in 0..3 {
+                assert!(
+                    (a[c] - b[c]).abs() < 2e-3 * (1.0 + a[c].abs()),
+                    "{a:?} {b:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn irradiance_is_the_cosine_integral_and_matches_three_js_constants() {
+        let l = light();
+        let env = l.to_env(256).unwrap();
+        assert_eq!(env.clamped_texels(), 0, "the test light is positive");
+        for n in directions(12) {
+            // The cosine integral of the map itself.
+            let mut e = [0.0f64; 3];
+            for y in 0..256 {
+                let omega = env.texel_solid_angle(y) as f64;
+                for x in 0..512 {
+                    let d = env.direction_of(x as f32, y as f32);
+                    let cos = n.dot(d).max(0.0) as f64;
+                    let r = env.image().get(x, y);
+                    for c in 0..3 {
+                        e[c] += r[c] as f64 * cos * omega;
+                    }
+                }
+            }
+            // Three.js's getIrradianceAt, its published constants.
+            let (x, y, z) = (n.x, n.y, n.z);
+            let k = [
+                0.886_227,
+                2.0 * 0.511_664 * y,
+                2.0 * 0.511_664 * z,
+                2.0 * 0.511_664 * x,
+                2.0 * 0.429_043 * x * y,
+                2.0 * 0.429_043 * y * z,
+                0.743_125 * z * z - 0.247_708,
+                2.0 * 0.429_043 * x * z,
+                0.429_043 * (x * x - y * y),
+            ];
+            let three = weighted(&l.coefficients, k);
+            let ours = l.irradiance(n);
+            for c in 0..3 {
+                assert!(
+                    (ours[c] - three[c]).abs() < 1e-4 * (1.0 + three[c].abs()),
+                    "{ours:?} {three:?}"
+                );
+                // Exact for a band-limited light (the lobe's higher bands meet none of
+                // it): quadrature error only.
+                assert!(
+                    (ours[c] as f64 - e[c]).abs() < 1e-3 * e[c].abs(),
+                    "{ours:?} {e:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn conventions_round_trip() {
+        let l = light();
+        // Condon–Shortley: odd m negated, and back.
+        let cs = l.condon_shortley();
+        assert_eq!(cs[1], l.coefficients[1].map(|v| -v));
+        assert_eq!(cs[2], l.coefficients[2]);
+        assert_eq!(cs[7], l.coefficients[7].map(|v| -v));
+        assert_eq!(ShLight::from_condon_shortley(cs), l);
+        // With the phase in the basis too, the light is the same.
+        for d in directions(20) {
+            let mut b = sh_basis(d);
+            for (i, (_, m)) in SH_ORDER.iter().enumerate() {
+                if m % 2 != 0 {
+                    b[i] = -b[i];
+                }
+            }
+            let (a, r) = (weighted(&cs, b), l.radiance(d));
+            assert!((0..3).all(|c| (a[c] - r[c]).abs() < 1e-5), "{a:?} {r:?}");
+        }
+        // Unity's seven vectors give the irradiance over π.
+        let v = l.unity_shader_vectors();
+        for n in directions(20) {
+            let (x, y, z) = (n.x, n.y, n.z);
+            let e = l.irradiance(n);
+            for c in 0..3 {
+                let (a, b) = (v[c], v[3 + c]);
+                let shade = a[0] * x
+                    + a[1] * y
+                    + a[2] * z
+                    + a[3]
+                    + b[0] * x * y
+                    + b[1] * y * z
+                    + b[2] * z * z
+                    + b[3] * z * x
+                    + v[6][c] * (x * x - y * y);
+                assert!((shade - e[c] / PI).abs() < 1e-5, "{shade} {}", e[c] / PI);
+            }
+        }
+    }
+
+    #[test]
+    fn files_round_trip_and_bad_ones_are_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("light.json");
+        let l = light();
+        l.save(&path, "test").unwrap();
+        assert_eq!(ShLight::load(&path).unwrap(), l);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let cases = [
+            (
+                text.replace("\"version\": 1", "\"version\": 2"),
+                "version 2",
+            ),
+            (
+                text.replace(
+                    "\"condon_shortley_phase\": false",
+                    "\"condon_shortley_phase\": true",
+                ),
+                "convention",
+            ),
+            (text.replace("frf-sh-l2", "other"), "format"),
+            (text[..text.len() / 2].to_string(), "not an SH light"),
+        ];
+        for (bad, want) in cases {
+            std::fs::write(&path, bad).unwrap();
+            let e = ShLight::load(&path).unwrap_err().to_string();
+            assert!(e.contains(want) && e.contains("light.json"), "{e}");
+        }
+        let mut f: serde_json::Value = serde_json::from_str(&text).unwrap();
+        f["coefficients"].as_array_mut().unwrap().pop();
+        std::fs::write(&path, f.to_string()).unwrap();
+        let e = ShLight::load(&path).unwrap_err().to_string();
+        assert!(e.contains("8 coefficients"), "{e}");
+        f["coefficients"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!([1e39, 0, 0]));
+        std::fs::write(&path, f.to_string()).unwrap();
+        assert!(ShLight::load(&path).is_err());
+    }
+}

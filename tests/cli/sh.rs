@@ -1,0 +1,76 @@
+//! `frf env-sh` and SH lights as `--env`: the file holds the map's projection; a light
+//! that is L2 already (a uniform furnace) renders the same through its SH file as
+//! itself; a damaged SH file is refused by name and nothing is written.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use crate::common::{frf, stderr};
+
+/// Renders one frame of the tiny oracle field under `env` into `out`; its PNG's pixels.
+fn one_frame(env: &str, out: &std::path::Path) -> Result<image::RgbaImage, String> {
+    let f = frf_testkit::tiny_field();
+    let mut args = vec![
+        "render",
+        f.field.to_str().unwrap(),
+        "--env",
+        env,
+        "--orbit",
+        "3.2,1.3",
+        "--frames",
+        "1",
+        "--size",
+        "48x64",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(frf_testkit::cpu_flag());
+    let o = frf(&args);
+    if !o.status.success() {
+        return Err(stderr(&o));
+    }
+    Ok(image::open(out.join("frame_0000.png")).unwrap().to_rgba8())
+}
+
+#[test]
+fn env_sh_writes_the_projection_and_renders_an_l2_light_as_itself() {
+    let dir = tempfile::tempdir().unwrap();
+    let sky = dir.path().join("sky.json");
+    let o = frf(&["env-sh", "sky", "--out", sky.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("energy kept by L2"), "{text}");
+    let written = frf_core::sh::ShLight::load(&sky).unwrap();
+    let want = frf_core::sh::ShLight::project(&frf_core::env::EnvMap::sky());
+    assert_eq!(written, want);
+
+    // A furnace is band 0 alone: through its file it lights as itself.
+    let uniform = dir.path().join("uniform.json");
+    let o = frf(&["env-sh", "uniform", "--out", uniform.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let direct = one_frame("uniform", &dir.path().join("direct")).unwrap();
+    let by_sh = one_frame(uniform.to_str().unwrap(), &dir.path().join("sh")).unwrap();
+    let lit = direct.pixels().filter(|p| p[3] > 128 && p[0] > 10).count();
+    assert!(lit > 200, "{lit} lit pixels");
+    // The subject (the ground's shadow is cast by lights sampled from the map, whose
+    // samples move with its resolution).
+    let worst = direct
+        .pixels()
+        .zip(by_sh.pixels())
+        .filter(|(a, _)| a[3] > 200)
+        .map(|(a, b)| (0..4).map(|c| a[c].abs_diff(b[c])).max().unwrap())
+        .max()
+        .unwrap();
+    assert!(worst <= 1, "the SH furnace differs by {worst} codes");
+
+    // A damaged file: refused, naming it; no frame written.
+    let bad = dir.path().join("bad.json");
+    let cut = std::fs::read_to_string(&uniform).unwrap();
+    std::fs::write(&bad, &cut[..cut.len() / 3]).unwrap();
+    let out = dir.path().join("bad_out");
+    let e = one_frame(bad.to_str().unwrap(), &out).unwrap_err();
+    assert!(
+        e.contains("bad.json") && e.contains("not an SH light"),
+        "{e}"
+    );
+    assert!(!out.join("frame_0000.png").exists());
+}
