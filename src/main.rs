@@ -62,6 +62,9 @@ enum Command {
     /// Look at a field or a scene in a window: move the camera, play the walk, turn the
     /// light; record a camera move as a scene file.
     View(Box<cmd::view::ViewArgs>),
+    /// The walker as binary glTF (`.glb`) for engines and the web player: hull meshes
+    /// that walk in any viewer, and per view its SH transfer, normals, albedo and flows.
+    Export(cmd::export::ExportArgs),
     /// An environment's light as nine RGB spherical-harmonic coefficients (L2, the
     /// engines' light probes) in a JSON file frf and players relight by.
     EnvSh(cmd::env_sh::EnvShArgs),
@@ -119,6 +122,7 @@ fn main() -> ExitCode {
         Command::EvalOlat(args) => cmd::olat::run(args),
         Command::Report(args) => cmd::report::run(args),
         Command::View(args) => cmd::view::run(*args),
+        Command::Export(args) => cmd::export::run(args),
         Command::EnvSh(args) => cmd::env_sh::run(args),
         Command::Bench(args) => cmd::bench::run_bench(args),
         Command::Flow(args) => cmd::flow::run(args),
@@ -157,7 +161,8 @@ fn fault_of(e: &(dyn std::error::Error + 'static)) -> Fault {
         frf_scene::SceneError,
         frf_stage::StageError,
         frf_eval::EvalError,
-        frf_view::ViewError
+        frf_view::ViewError,
+        frf_export::ExportError
     );
     if e.downcast_ref::<std::io::Error>().is_some() {
         return Fault::Io;

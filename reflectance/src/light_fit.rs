@@ -142,6 +142,15 @@ impl LightFit {
         }
     }
 
+    /// Every texel's albedo (radiance per unit of irradiance at normal incidence), zero
+    /// where unfitted.
+    pub fn albedo(&self) -> Vec<[f32; 3]> {
+        self.texels
+            .iter()
+            .map(|t| t.map_or([0.0; 3], |t| t.1))
+            .collect()
+    }
+
     /// Every texel's normal, `None` where unfitted.
     pub fn normals(&self) -> Vec<Option<Vec3>> {
         self.texels.iter().map(|t| t.map(|t| t.0)).collect()

@@ -5,6 +5,7 @@ pub mod bench;
 pub mod claim;
 pub mod env_sh;
 pub mod eval;
+pub mod export;
 pub mod flow;
 pub mod for_scene;
 pub mod hull;

@@ -1,0 +1,205 @@
+//! Reading an export back (what a player does, in Rust: the reference for loaders and
+//! the tests' round trip): the GLB's chunks checked, the extension's version checked,
+//! a view's transfer decoded and relit by an L2 light.
+
+use std::path::{Path, PathBuf};
+
+use frf_core::image::{Image, Rgb, RgbImage};
+use frf_core::sh::{SH_COUNT, ShLight};
+use serde_json::Value;
+
+use crate::error::{ExportError, Result};
+use crate::format::{ATLAS_COLUMNS, EXTENSION, VERSION};
+
+/// An export, read.
+#[derive(Debug)]
+pub struct Export {
+    path: PathBuf,
+    /// The glTF document.
+    pub document: Value,
+    bin: Vec<u8>,
+}
+
+impl Export {
+    /// Reads and checks `path`: a GLB 2.0 of a JSON and a binary chunk, whole, holding the
+    /// extension at a version this reader knows.
+    pub fn open(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path).map_err(|e| frf_core::CoreError::io(path, e))?;
+        Self::from_bytes(path, &bytes)
+    }
+
+    /// [`Export::open`] of bytes read already.
+    pub fn from_bytes(path: &Path, bytes: &[u8]) -> Result<Self> {
+        let bad = |problem: String| ExportError::BadFile {
+            file: path.to_path_buf(),
+            problem,
+        };
+        let word = |at: usize| -> Option<u32> {
+            bytes
+                .get(at..at + 4)
+                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        };
+        if bytes.get(0..4) != Some(b"glTF") {
+            return Err(bad("not a binary glTF file (no glTF magic)".into()));
+        }
+        if word(4) != Some(2) {
+            return Err(bad(format!(
+                "glTF container version {:?}, expected 2",
+                word(4)
+            )));
+        }
+        let total = word(8).unwrap_or(0) as usize;
+        if total != bytes.len() {
+            return Err(bad(format!(
+                "its header says {total} bytes and it has {}: truncated or appended to",
+                bytes.len()
+            )));
+        }
+        let json_len = word(12).ok_or_else(|| bad("no JSON chunk".into()))? as usize;
+        if bytes.get(16..20) != Some(b"JSON") || 20 + json_len > bytes.len() {
+            return Err(bad("the first chunk is not a whole JSON chunk".into()));
+        }
+        let document: Value = serde_json::from_slice(&bytes[20..20 + json_len])
+            .map_err(|e| bad(format!("its JSON chunk does not parse: {e}")))?;
+        let at = 20 + json_len;
+        let bin_len = word(at).ok_or_else(|| bad("no binary chunk".into()))? as usize;
+        if bytes.get(at + 4..at + 8) != Some(b"BIN\0") || at + 8 + bin_len > bytes.len() {
+            return Err(bad("the second chunk is not a whole binary chunk".into()));
+        }
+        let bin = bytes[at + 8..at + 8 + bin_len].to_vec();
+        let ext = &document["extensions"][EXTENSION];
+        if ext.is_null() {
+            return Err(bad(format!(
+                "it holds no {EXTENSION}: a glTF file, but not a walker exported by frf"
+            )));
+        }
+        if ext["version"].as_u64() != Some(VERSION as u64) {
+            return Err(bad(format!(
+                "{EXTENSION} version {}; this reader knows version {VERSION}",
+                ext["version"]
+            )));
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            document,
+            bin,
+        })
+    }
+
+    /// The extension's object.
+    pub fn field(&self) -> &Value {
+        &self.document["extensions"][EXTENSION]
+    }
+
+    fn bad(&self, problem: String) -> ExportError {
+        ExportError::BadFile {
+            file: self.path.clone(),
+            problem,
+        }
+    }
+
+    /// The bytes of image `index`.
+    pub fn image_bytes(&self, index: usize) -> Result<&[u8]> {
+        let image = &self.document["images"][index];
+        let view = &self.document["bufferViews"]
+            [image["bufferView"].as_u64().unwrap_or(u64::MAX) as usize];
+        let (start, len) = (
+            view["byteOffset"].as_u64().unwrap_or(0) as usize,
+            view["byteLength"].as_u64().unwrap_or(0) as usize,
+        );
+        self.bin
+            .get(start..start + len)
+            .ok_or_else(|| self.bad(format!("image {index} lies outside the binary chunk")))
+    }
+
+    /// The view `(u, v)` of `pose`'s record.
+    pub fn view(&self, pose: u32, u: usize, v: usize) -> Result<&Value> {
+        let poses = self.field()["poses"]
+            .as_array()
+            .ok_or_else(|| self.bad("no poses".into()))?;
+        let p = poses
+            .iter()
+            .find(|p| p["pose"].as_u64() == Some(pose as u64))
+            .ok_or_else(|| self.bad(format!("pose {pose} is not in the export")))?;
+        p["views"]
+            .as_array()
+            .and_then(|vs| {
+                vs.iter().find(|x| {
+                    x["u"].as_u64() == Some(u as u64) && x["v"].as_u64() == Some(v as u64)
+                })
+            })
+            .ok_or_else(|| self.bad(format!("view {u},{v} of pose {pose} is not in the export")))
+    }
+
+    /// A view's transfer, decoded: per texel, nine RGB coefficients.
+    pub fn transfer(&self, pose: u32, u: usize, v: usize) -> Result<Image<[Rgb; SH_COUNT]>> {
+        let view = self.view(pose, u, v)?;
+        let t = &view["transfer"];
+        let atlas = (0..3)
+            .map(|c| {
+                let index = t["images"][c].as_u64().unwrap_or(u64::MAX) as usize;
+                image::load_from_memory(self.image_bytes(index)?)
+                    .map(|i| i.to_luma8())
+                    .map_err(|e| self.bad(format!("the transfer atlas {c} of view {u},{v}: {e}")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if atlas
+            .iter()
+            .any(|a| a.dimensions() != atlas[0].dimensions())
+        {
+            return Err(self.bad(format!(
+                "the transfer atlases of view {u},{v} differ in size"
+            )));
+        }
+        let coefficients = |key: &str| -> Result<[Rgb; SH_COUNT]> {
+            serde_json::from_value(t[key].clone())
+                .map_err(|e| self.bad(format!("the transfer {key} of view {u},{v}: {e}")))
+        };
+        let (scale, offset) = (coefficients("scale")?, coefficients("offset")?);
+        let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS) as u32;
+        let (w, h) = (
+            atlas[0].width() / ATLAS_COLUMNS as u32,
+            atlas[0].height() / rows,
+        );
+        Ok(Image::from_fn(w as usize, h as usize, |x, y| {
+            std::array::from_fn(|i| {
+                let (ax, ay) = (
+                    (i % ATLAS_COLUMNS) as u32 * w + x as u32,
+                    (i / ATLAS_COLUMNS) as u32 * h + y as u32,
+                );
+                std::array::from_fn(|c| {
+                    offset[i][c] + scale[i][c] * atlas[c].get_pixel(ax, ay)[0] as f32
+                })
+            })
+        }))
+    }
+
+    /// A view's alpha.
+    pub fn alpha(&self, pose: u32, u: usize, v: usize) -> Result<frf_core::image::GrayImage> {
+        let view = self.view(pose, u, v)?;
+        let png = image::load_from_memory(
+            self.image_bytes(view["alpha"].as_u64().unwrap_or(u64::MAX) as usize)?,
+        )
+        .map_err(|e| self.bad(format!("the alpha of view {u},{v}: {e}")))?
+        .to_luma8();
+        Ok(Image::from_fn(
+            png.width() as usize,
+            png.height() as usize,
+            |x, y| png.get_pixel(x as u32, y as u32)[0] as f32 / 255.0,
+        ))
+    }
+
+    /// A view relit by `light`: `Σ_i c_i T_i` per texel.
+    pub fn relight(&self, pose: u32, u: usize, v: usize, light: &ShLight) -> Result<RgbImage> {
+        let t = self.transfer(pose, u, v)?;
+        Ok(t.map(|t| {
+            let mut out = [0.0f32; 3];
+            for (ti, ci) in t.iter().zip(&light.coefficients) {
+                for c in 0..3 {
+                    out[c] += ti[c] * ci[c];
+                }
+            }
+            out
+        }))
+    }
+}

@@ -1,0 +1,158 @@
+//! A view's maps as web images (docs/export.md): the SH transfer as three grey JPEG
+//! atlases (red, green, blue; a colour JPEG's chroma subsampling would mix the
+//! channels, which are not a colour), each of 3 x 3 tiles with a scale and offset per
+//! tile and channel (`value = offset + scale · code`, codes 0–255 linear), alpha as an 8-bit grey PNG, normals (subject frame) as an
+//! RGBA PNG (`n = 2 · rgb / 255 − 1`, alpha 0 where none was fitted), albedo as an RGB PNG
+//! with a scale per channel, and flows as 16-bit grey-alpha PNGs ([`crate::format`]).
+
+use std::io::Cursor;
+
+use frf_core::image::{FlowImage, GrayImage, Rgb};
+use frf_core::sh::SH_COUNT;
+use glam::Vec3;
+use image::codecs::jpeg::JpegEncoder;
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder};
+
+use crate::error::{ExportError, Result};
+use crate::format::{ATLAS_COLUMNS, FLOW_OFFSET_PX, FLOW_SCALE};
+
+/// A transfer's atlases and how to read their codes back.
+#[derive(Debug, Clone)]
+pub struct Atlas {
+    /// JPEG bytes, one grey atlas per channel.
+    pub jpeg: [Vec<u8>; 3],
+    /// Per coefficient and channel: value per code.
+    pub scale: [Rgb; SH_COUNT],
+    /// Per coefficient and channel: value of code 0.
+    pub offset: [Rgb; SH_COUNT],
+}
+
+fn encoding_error(what: &str, e: image::ImageError) -> ExportError {
+    ExportError::Field(format!("encoding {what}: {e}"))
+}
+
+/// The atlas of a view's transfer (`w x h` texels, row-major), its ranges taken inside
+/// `alpha`; texels outside take the code of zero.
+pub fn transfer_atlas(
+    transfer: &[[Rgb; SH_COUNT]],
+    alpha: &GrayImage,
+    quality: u8,
+) -> Result<Atlas> {
+    let (w, h) = alpha.size();
+    let mut lo = [[f32::INFINITY; 3]; SH_COUNT];
+    let mut hi = [[f32::NEG_INFINITY; 3]; SH_COUNT];
+    for (t, &a) in transfer.iter().zip(alpha.pixels()) {
+        if a > 0.0 {
+            for i in 0..SH_COUNT {
+                for c in 0..3 {
+                    lo[i][c] = lo[i][c].min(t[i][c]);
+                    hi[i][c] = hi[i][c].max(t[i][c]);
+                }
+            }
+        }
+    }
+    let mut scale = [[0.0f32; 3]; SH_COUNT];
+    let mut offset = [[0.0f32; 3]; SH_COUNT];
+    for i in 0..SH_COUNT {
+        for c in 0..3 {
+            if lo[i][c] > hi[i][c] {
+                (lo[i][c], hi[i][c]) = (0.0, 0.0);
+            }
+            offset[i][c] = lo[i][c];
+            scale[i][c] = ((hi[i][c] - lo[i][c]) / 255.0).max(f32::MIN_POSITIVE);
+        }
+    }
+    let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS);
+    let (aw, ah) = (w * ATLAS_COLUMNS, h * rows);
+    let channel = |c: usize| -> Result<Vec<u8>> {
+        let mut pixels = vec![0u8; aw * ah];
+        for i in 0..SH_COUNT {
+            let (tx, ty) = ((i % ATLAS_COLUMNS) * w, (i / ATLAS_COLUMNS) * h);
+            for y in 0..h {
+                for x in 0..w {
+                    let code = (transfer[y * w + x][i][c] - offset[i][c]) / scale[i][c];
+                    pixels[(ty + y) * aw + tx + x] = code.round().clamp(0.0, 255.0) as u8;
+                }
+            }
+        }
+        let mut jpeg = Vec::new();
+        JpegEncoder::new_with_quality(&mut jpeg, quality)
+            .write_image(&pixels, aw as u32, ah as u32, ExtendedColorType::L8)
+            .map_err(|e| encoding_error("a transfer atlas", e))?;
+        Ok(jpeg)
+    };
+    let jpeg = [channel(0)?, channel(1)?, channel(2)?];
+    Ok(Atlas {
+        jpeg,
+        scale,
+        offset,
+    })
+}
+
+fn png(bytes: &[u8], w: usize, h: usize, kind: ExtendedColorType) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    PngEncoder::new(Cursor::new(&mut out))
+        .write_image(bytes, w as u32, h as u32, kind)
+        .map_err(|e| encoding_error("a PNG", e))?;
+    Ok(out)
+}
+
+/// Alpha as an 8-bit grey PNG.
+pub fn alpha_png(alpha: &GrayImage) -> Result<Vec<u8>> {
+    let (w, h) = alpha.size();
+    let codes: Vec<u8> = alpha
+        .pixels()
+        .iter()
+        .map(|a| (a.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    png(&codes, w, h, ExtendedColorType::L8)
+}
+
+/// Normals (already in the subject frame) as an RGBA PNG.
+pub fn normals_png(normals: &[Option<Vec3>], w: usize, h: usize) -> Result<Vec<u8>> {
+    let bytes: Vec<u8> = normals
+        .iter()
+        .flat_map(|n| match n {
+            Some(n) => {
+                let c = |v: f32| ((v.clamp(-1.0, 1.0) * 0.5 + 0.5) * 255.0).round() as u8;
+                [c(n.x), c(n.y), c(n.z), 255]
+            }
+            None => [128, 128, 128, 0],
+        })
+        .collect();
+    png(&bytes, w, h, ExtendedColorType::Rgba8)
+}
+
+/// Albedo as an RGB PNG and its scale per channel (`albedo = scale · code`).
+pub fn albedo_png(albedo: &[Rgb], w: usize, h: usize) -> Result<(Vec<u8>, Rgb)> {
+    let mut top = [0.0f32; 3];
+    for a in albedo {
+        for c in 0..3 {
+            top[c] = top[c].max(a[c]);
+        }
+    }
+    let scale = top.map(|t| (t / 255.0).max(f32::MIN_POSITIVE));
+    let bytes: Vec<u8> = albedo
+        .iter()
+        .flat_map(|a| [0, 1, 2].map(|c| (a[c] / scale[c]).round().clamp(0.0, 255.0) as u8))
+        .collect();
+    Ok((png(&bytes, w, h, ExtendedColorType::Rgb8)?, scale))
+}
+
+/// A flow as a 16-bit grey-alpha PNG (`u` in grey, `v` in alpha).
+pub fn flow_png(flow: &FlowImage) -> Result<Vec<u8>> {
+    let (w, h) = flow.size();
+    let q = |f: f32| {
+        ((f + FLOW_OFFSET_PX) * FLOW_SCALE)
+            .round()
+            .clamp(0.0, 65535.0) as u16
+    };
+    let bytes: Vec<u8> = flow
+        .pixels()
+        .iter()
+        .flat_map(|f| [q(f[0]), q(f[1])])
+        .flat_map(|v| v.to_ne_bytes())
+        .collect();
+    png(&bytes, w, h, ExtendedColorType::La16)
+}

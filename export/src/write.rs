@@ -1,0 +1,369 @@
+//! The export itself: what is taken from the field, in which order, into the GLB.
+
+use std::path::Path;
+use std::time::Instant;
+
+use frf_core::grid::Neighbour;
+use frf_core::image::{GrayImage, Rgb};
+use frf_core::sh::{Convention, SH_COUNT};
+use frf_reflectance::FieldFile;
+use frf_reflectance::light_fit::LightFit;
+use frf_reflectance::sh_transfer::{sh_weights, texel_transfer};
+use glam::{Mat3, Vec3};
+use rayon::prelude::*;
+use serde_json::{Value, json};
+
+use crate::error::{ExportError, Result};
+use crate::format::{EXTENSION, VERSION};
+use crate::glb::Glb;
+use crate::hull_mesh::hull_mesh;
+use crate::view_maps::{albedo_png, alpha_png, flow_png, normals_png, transfer_atlas};
+
+/// Which views of each pose are exported.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ViewSelection {
+    /// Every view of the grid.
+    All,
+    /// One row of cameras (`v`), all the way round.
+    Ring(usize),
+    /// These `(u, v)`.
+    List(Vec<(usize, usize)>),
+}
+
+/// What to export.
+#[derive(Debug, Clone)]
+pub struct ExportOptions {
+    /// Poses (default: every pose of the field).
+    pub poses: Option<Vec<u32>>,
+    /// Views.
+    pub views: ViewSelection,
+    /// Voxel side of the hull meshes, metres (never finer than the hull's own).
+    pub mesh_voxel_m: f32,
+    /// JPEG quality of the transfer atlases.
+    pub jpeg_quality: u8,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        Self {
+            poses: None,
+            views: ViewSelection::All,
+            mesh_voxel_m: 0.02,
+            jpeg_quality: 95,
+        }
+    }
+}
+
+/// What an export wrote.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ExportReport {
+    /// The file's bytes.
+    pub bytes: u64,
+    /// Poses exported.
+    pub poses: usize,
+    /// Views per pose.
+    pub views_per_pose: usize,
+    /// Triangles of all hull meshes.
+    pub triangles: usize,
+    /// Bytes of the transfer atlases, alpha, normals, albedo, flows and meshes.
+    pub section_bytes: [(String, u64); 6],
+    /// Wall seconds.
+    pub seconds: f64,
+}
+
+/// One view's maps, encoded.
+struct ViewOut {
+    u: usize,
+    v: usize,
+    turntable_deg: f32,
+    camera: Value,
+    atlas: crate::view_maps::Atlas,
+    alpha: Vec<u8>,
+    normals: Option<Vec<u8>>,
+    albedo: (Vec<u8>, Rgb),
+    flows: Vec<(Neighbour, Vec<u8>)>,
+}
+
+/// Exports `field` to `out` (written to a temporary file and renamed).
+pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<ExportReport> {
+    let started = Instant::now();
+    let field = FieldFile::open(field_path)?;
+    frf_render_free_checks(&field)?;
+    let header = field.header().clone();
+    let poses = match &options.poses {
+        Some(p) => p
+            .iter()
+            .map(|&p| field.pose_or_first(Some(p)))
+            .collect::<std::result::Result<Vec<_>, _>>()?,
+        None => header.pose_list(),
+    };
+    let views: Vec<(usize, usize)> = match &options.views {
+        ViewSelection::All => (0..header.columns)
+            .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
+            .collect(),
+        ViewSelection::Ring(v) if *v < header.rows => {
+            (0..header.columns).map(|u| (u, *v)).collect()
+        }
+        ViewSelection::Ring(v) => {
+            return Err(ExportError::Option(format!(
+                "--views ring {v}: the field has camera rows 0..{}",
+                header.rows
+            )));
+        }
+        ViewSelection::List(l) => {
+            if let Some(bad) = l
+                .iter()
+                .find(|(u, v)| *u >= header.columns || *v >= header.rows)
+            {
+                return Err(ExportError::Option(format!(
+                    "--views {},{}: outside the field's {}x{} grid",
+                    bad.0, bad.1, header.columns, header.rows
+                )));
+            }
+            l.clone()
+        }
+    };
+    if !(1..=100).contains(&options.jpeg_quality) {
+        return Err(ExportError::Option(format!(
+            "--jpeg-quality {}: expected 1 to 100",
+            options.jpeg_quality
+        )));
+    }
+    if !(options.mesh_voxel_m.is_finite()
+        && options.mesh_voxel_m > 0.0
+        && options.mesh_voxel_m <= 0.5)
+    {
+        return Err(ExportError::Option(format!(
+            "--mesh-voxel {}: expected a side in metres, above 0 and at most 0.5",
+            options.mesh_voxel_m
+        )));
+    }
+    let projector = field.projector()?;
+    let mut glb = Glb::default();
+    let mut sizes = [0u64; 6];
+    let mut nodes = vec![json!({"name": "walker", "children": []})];
+    let mut meshes = Vec::new();
+    let mut pose_json = Vec::new();
+    let mut triangles = 0;
+    for &pose in &poses {
+        let record = header.pose(pose)?.clone();
+        let hull = field.hull(pose)?.ok_or_else(|| {
+            ExportError::Field(format!(
+                "pose {pose} has no visual hull (ingest it without --no-shadows)"
+            ))
+        })?;
+        let mesh = hull_mesh(&hull, options.mesh_voxel_m)?;
+        let before = glb.binary_bytes();
+        let positions = glb.vec3(&mesh.positions);
+        let indices = glb.indices(&mesh.indices);
+        sizes[5] += (glb.binary_bytes() - before) as u64;
+        triangles += mesh.indices.len() / 3;
+        meshes.push(json!({
+            "name": format!("hull of pose {pose}"),
+            "primitives": [{"attributes": {"POSITION": positions}, "indices": indices, "material": 0}]
+        }));
+        nodes.push(json!({"name": format!("pose {pose}"), "mesh": meshes.len() - 1}));
+        let node = nodes.len() - 1;
+        nodes[0]["children"]
+            .as_array_mut()
+            .expect("an array")
+            .push(json!(node));
+
+        let turntables: Vec<f32> = views
+            .iter()
+            .map(|&(u, v)| {
+                record.views[header.view_index(u, v)]
+                    .turntable_deg
+                    .to_radians()
+            })
+            .collect();
+        let weights = sh_weights(projector, &turntables)?;
+        let encoded: Vec<ViewOut> = views
+            .par_iter()
+            .zip(&weights)
+            .map(|(&(u, v), w)| {
+                let rec = &record.views[header.view_index(u, v)];
+                encode_view(&field, pose, (u, v), rec, w, options.jpeg_quality)
+            })
+            .collect::<Result<_>>()?;
+        let mut view_json = Vec::new();
+        for e in encoded {
+            let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
+            let before = glb.binary_bytes();
+            let rgb = ["red", "green", "blue"];
+            let atlas: Vec<usize> = (0..3)
+                .map(|c| {
+                    glb.image(
+                        &e.atlas.jpeg[c],
+                        "image/jpeg",
+                        name(&format!("transfer {}", rgb[c])),
+                    )
+                })
+                .collect();
+            sizes[0] += (glb.binary_bytes() - before) as u64;
+            let before = glb.binary_bytes();
+            let alpha = glb.image(&e.alpha, "image/png", name("alpha"));
+            sizes[1] += (glb.binary_bytes() - before) as u64;
+            let before = glb.binary_bytes();
+            let normals = e
+                .normals
+                .as_ref()
+                .map(|n| glb.image(n, "image/png", name("normals")));
+            sizes[2] += (glb.binary_bytes() - before) as u64;
+            let before = glb.binary_bytes();
+            let albedo = glb.image(&e.albedo.0, "image/png", name("albedo"));
+            sizes[3] += (glb.binary_bytes() - before) as u64;
+            let before = glb.binary_bytes();
+            let mut flows = serde_json::Map::new();
+            for (n, bytes) in &e.flows {
+                let image = glb.image(bytes, "image/png", name(&format!("flow {}", n.name())));
+                flows.insert(n.name().to_string(), json!(image));
+            }
+            sizes[4] += (glb.binary_bytes() - before) as u64;
+            view_json.push(json!({
+                "u": e.u, "v": e.v, "turntable_deg": e.turntable_deg, "camera": e.camera,
+                "alpha": alpha,
+                "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset},
+                "normals": normals,
+                "albedo": {"image": albedo, "scale": e.albedo.1},
+                "flows": flows,
+            }));
+        }
+        pose_json
+            .push(json!({"pose": pose, "time_s": record.time_s, "node": node, "views": view_json}));
+    }
+    let animation = pose_animation(&mut glb, &poses, &header, &pose_json);
+    let document = json!({
+        "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
+        "extensionsUsed": [EXTENSION],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{"name": "hull", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
+        "animations": [animation],
+        "extensions": {EXTENSION: {
+            "version": VERSION,
+            "sh": Convention::frf(),
+            "grid": {"columns": header.columns, "rows": header.rows, "wraps": header.wraps,
+                     "width": header.width, "height": header.height},
+            "cycle_seconds": header.cycle_seconds,
+            "poses_per_cycle": header.poses_per_cycle,
+            "source": field_path.file_name().map(|n| n.to_string_lossy().into_owned()),
+            "poses": pose_json,
+        }},
+    });
+    let bytes = glb.finish(document);
+    frf_core::atomic::write_bytes_atomic(out, &bytes)?;
+    let names = ["transfer", "alpha", "normals", "albedo", "flows", "meshes"];
+    Ok(ExportReport {
+        bytes: bytes.len() as u64,
+        poses: poses.len(),
+        views_per_pose: views.len(),
+        triangles,
+        section_bytes: std::array::from_fn(|i| (names[i].to_string(), sizes[i])),
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// A field of one view (an OLAT set) or one condition (a ring of photographs) has
+/// nothing to relight or morph between.
+fn frf_render_free_checks(field: &FieldFile) -> Result<()> {
+    let h = field.header();
+    if h.columns * h.rows < 2 || h.conditions.len() < 2 {
+        return Err(ExportError::Field(format!(
+            "{}: {} view(s) of {} condition(s); an export needs a grid of views under a basis of lights",
+            field.path().display(),
+            h.columns * h.rows,
+            h.conditions.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Encodes view `(u, v)` of `pose`.
+fn encode_view(
+    field: &FieldFile,
+    pose: u32,
+    (u, v): (usize, usize),
+    rec: &frf_reflectance::field::ViewRecord,
+    weights: &frf_reflectance::sh_transfer::ShWeights,
+    quality: u8,
+) -> Result<ViewOut> {
+    let basis = field.basis(pose, u, v)?;
+    let alpha: GrayImage = field.alpha(pose, u, v)?;
+    let (w, h) = alpha.size();
+    let transfer: Vec<[Rgb; SH_COUNT]> = (0..w * h)
+        .map(|i| {
+            if alpha.pixels()[i] > 0.0 {
+                texel_transfer(weights, basis.iter().map(|b| b.pixels()[i]))
+            } else {
+                [[0.0; 3]; SH_COUNT]
+            }
+        })
+        .collect();
+    let atlas = transfer_atlas(&transfer, &alpha, quality)?;
+    let to_subject = Mat3::from_rotation_y(-rec.turntable_deg.to_radians());
+    let normals = field
+        .normals(pose, u, v)?
+        .map(|n| {
+            let n: Vec<Option<Vec3>> = n.iter().map(|n| n.map(|n| to_subject * n)).collect();
+            normals_png(&n, w, h)
+        })
+        .transpose()?;
+    let fit = LightFit::of_basis(&basis, &field.header().conditions, &alpha);
+    let albedo: Vec<Rgb> = fit.albedo();
+    let albedo = albedo_png(&albedo, w, h)?;
+    let mut flows = Vec::new();
+    for n in Neighbour::ALL {
+        if let Some(f) = field.flow(pose, u, v, n)? {
+            flows.push((n, flow_png(&f)?));
+        }
+    }
+    let c = &rec.camera;
+    Ok(ViewOut {
+        u,
+        v,
+        turntable_deg: rec.turntable_deg,
+        camera: json!({"width": c.width, "height": c.height, "intrinsics": c.intrinsics,
+                       "world_from_camera": c.world_from_camera}),
+        atlas,
+        alpha: alpha_png(&alpha)?,
+        normals,
+        albedo,
+        flows,
+    })
+}
+
+/// The walk: each pose's node at scale 1 from its time to the next pose's, 0 otherwise,
+/// over one cycle.
+fn pose_animation(
+    glb: &mut Glb,
+    poses: &[u32],
+    header: &frf_reflectance::FieldHeader,
+    pose_json: &[Value],
+) -> Value {
+    let period = header.cycle_seconds as f32 / header.poses_per_cycle.max(1) as f32;
+    // A last key at the cycle's end shows the first pose again: the walk loops.
+    let times: Vec<f32> = (0..=poses.len()).map(|i| i as f32 * period).collect();
+    let input = glb.scalars(&times);
+    let mut samplers = Vec::new();
+    let mut channels = Vec::new();
+    for (i, p) in pose_json.iter().enumerate() {
+        let scales: Vec<[f32; 3]> = (0..=poses.len())
+            .map(|k| {
+                if k % poses.len() == i {
+                    [1.0; 3]
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect();
+        let output = glb.vec3_values(&scales);
+        samplers.push(json!({"input": input, "output": output, "interpolation": "STEP"}));
+        channels.push(
+            json!({"sampler": samplers.len() - 1, "target": {"node": p["node"], "path": "scale"}}),
+        );
+    }
+    json!({"name": "walk", "samplers": samplers, "channels": channels})
+}

@@ -1,0 +1,155 @@
+//! An export read back as a player reads it: the GLB's transfer relit by an L2 light
+//! against frf's own relighting of the field's basis images under the same light (its
+//! map, `FloorModel::Environment`), view by view inside the matte; the hull meshes and
+//! the walk animation present; damaged files and bad options refused by name.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use frf_core::env::SH_MAP_HEIGHT;
+use frf_core::sh::ShLight;
+use frf_export::read::Export;
+use frf_export::{ExportOptions, ViewSelection, export};
+use frf_reflectance::FieldFile;
+use frf_reflectance::project::FloorModel;
+use frf_reflectance::relight::relight;
+
+/// The built-in sky's L2 light.
+fn light() -> ShLight {
+    ShLight::project(&frf_core::env::EnvMap::sky())
+}
+
+#[test]
+fn the_exported_transfer_relights_as_frf_does() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let views = vec![(0, 0), (7, 1), (20, 2)];
+    let options = ExportOptions {
+        views: ViewSelection::List(views.clone()),
+        ..ExportOptions::default()
+    };
+    let report = export(&f.field, &out, &options).unwrap();
+    assert_eq!((report.poses, report.views_per_pose), (1, 3));
+    assert!(report.triangles > 100);
+    let glb = Export::open(&out).unwrap();
+    let field = FieldFile::open(&f.field).unwrap();
+    let projector = field.projector().unwrap();
+    let light = light();
+    // The L2 sky rings below zero opposite its sun; a signed map keeps it the same light.
+    let probe = frf_core::env::EnvMap::uniform([0.0; 3], SH_MAP_HEIGHT);
+    let map = frf_core::env::EnvMap::signed(frf_core::image::Image::from_fn(
+        2 * SH_MAP_HEIGHT,
+        SH_MAP_HEIGHT,
+        |x, y| light.radiance(probe.direction_of(x as f32, y as f32)),
+    ))
+    .unwrap();
+    for (u, v) in views {
+        let turntable = field.header().poses[0].views[field.header().view_index(u, v)]
+            .turntable_deg
+            .to_radians();
+        let a = projector.project(&map, turntable, FloorModel::Environment);
+        let want = relight(&field.basis(0, u, v).unwrap(), &a).unwrap();
+        let got = glb.relight(0, u, v, &light).unwrap();
+        let alpha = glb.alpha(0, u, v).unwrap();
+        let (mut se, mut n, mut peak) = (0.0f64, 0usize, 0.0f32);
+        for ((w, g), &al) in want.pixels().iter().zip(got.pixels()).zip(alpha.pixels()) {
+            if al > 0.5 {
+                for c in 0..3 {
+                    se += ((w[c] - g[c]) as f64).powi(2);
+                    peak = peak.max(w[c]);
+                }
+                n += 3;
+            }
+        }
+        assert!(n > 300, "view {u},{v}: {n} samples");
+        let psnr = 10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10();
+        eprintln!("view {u},{v}: exported transfer against frf's relighting {psnr:.2} dB");
+        assert!(psnr > 38.0, "view {u},{v}: {psnr:.2} dB");
+    }
+    // The walk: a node per pose under the walker, an animation switching them.
+    let d = &glb.document;
+    assert_eq!(d["nodes"][0]["children"].as_array().unwrap().len(), 1);
+    assert_eq!(d["animations"][0]["channels"].as_array().unwrap().len(), 1);
+    assert!(d["meshes"][0]["primitives"][0]["attributes"]["POSITION"].is_u64());
+}
+
+/// `bytes` with the first `from` replaced by `to` (of the same length).
+fn replaced(bytes: &[u8], from: &[u8], to: &[u8]) -> Vec<u8> {
+    let at = bytes.windows(from.len()).position(|w| w == from).unwrap();
+    let mut out = bytes.to_vec();
+    out[at..at + to.len()].copy_from_slice(to);
+    out
+}
+
+#[test]
+fn damaged_exports_and_bad_options_are_refused_by_name() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let options = ExportOptions {
+        views: ViewSelection::Ring(1),
+        ..ExportOptions::default()
+    };
+    export(&f.field, &out, &options).unwrap();
+    let bytes = std::fs::read(&out).unwrap();
+    let cases: Vec<(Vec<u8>, &str)> = vec![
+        (bytes[..bytes.len() - 100].to_vec(), "truncated"),
+        ([bytes.as_slice(), b"tail"].concat(), "appended"),
+        (b"PK\x03\x04 not a glb".to_vec(), "no glTF magic"),
+        (
+            replaced(&bytes, b"\"version\":1}", b"\"version\":9}"),
+            "version 9",
+        ),
+    ];
+    let bad = dir.path().join("bad.glb");
+    for (b, want) in cases {
+        std::fs::write(&bad, b).unwrap();
+        let e = Export::open(&bad).unwrap_err().to_string();
+        assert!(e.contains("bad.glb") && e.contains(want), "{want}: {e}");
+    }
+    // Options outside the field, and a field that is not a grid: no file written.
+    let refused = dir.path().join("refused.glb");
+    for (options, want) in [
+        (
+            ExportOptions {
+                views: ViewSelection::Ring(3),
+                ..ExportOptions::default()
+            },
+            "ring 3",
+        ),
+        (
+            ExportOptions {
+                views: ViewSelection::List(vec![(36, 0)]),
+                ..ExportOptions::default()
+            },
+            "36,0",
+        ),
+        (
+            ExportOptions {
+                poses: Some(vec![5]),
+                ..ExportOptions::default()
+            },
+            "pose 5",
+        ),
+        (
+            ExportOptions {
+                jpeg_quality: 0,
+                ..ExportOptions::default()
+            },
+            "--jpeg-quality 0",
+        ),
+        (
+            ExportOptions {
+                mesh_voxel_m: f32::NAN,
+                ..ExportOptions::default()
+            },
+            "--mesh-voxel",
+        ),
+    ] {
+        let e = export(&f.field, &refused, &options)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(want), "{want}: {e}");
+        assert!(!refused.exists());
+    }
+}
