@@ -6,10 +6,14 @@
 # - Xvfb (a display without a screen), xauth and xdotool, for the viewer's tests (`frf view`
 #   under `xvfb-run`), and the X libraries winit opens at run time (cursor, input,
 #   keyboard) that they do not bring;
+# - Node.js and npm, and the web player's npm packages (player/package-lock.json: the
+#   Khronos glTF validator), for the export's tests;
 # - the rustfmt and clippy components, for the checks in .ci/run.
 set -euo pipefail
 
 packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool libxcursor1 libxi6 libxkbcommon-x11-0)
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
@@ -26,4 +30,12 @@ if command -v rustup >/dev/null 2>&1; then
   for c in rustfmt clippy; do
     rustup component list --installed 2>/dev/null | grep -q "^$c" || rustup component add "$c" >/dev/null 2>&1 || true
   done
+fi
+
+# The player's packages, as its lock file pins them (again when the lock file changes).
+player="$(dirname "$0")/../player"
+if [ ! -f "$player/node_modules/.package-lock.json" ] ||
+   [ "$player/package-lock.json" -nt "$player/node_modules/.package-lock.json" ]; then
+  echo "setup: installing the player's npm packages"
+  (cd "$player" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
 fi

@@ -18,8 +18,8 @@ pub struct ExportArgs {
     #[arg(long)]
     out: PathBuf,
     /// Poses, e.g. `0,1` or `0..4` (default: all of the field's).
-    #[arg(long, value_parser = parse_poses)]
-    poses: Option<Vec<u32>>,
+    #[arg(long)]
+    poses: Option<String>,
     /// Views: `all`, `ring:V` (camera row V all the way round) or a list `U,V;U,V;...`.
     #[arg(long, default_value = "all", value_parser = parse_views)]
     views: ViewSelection,
@@ -64,8 +64,16 @@ fn parse_views(s: &str) -> Result<ViewSelection, String> {
 
 /// Runs `frf export`.
 pub fn run(args: ExportArgs) -> CliResult {
+    let poses = args
+        .poses
+        .as_deref()
+        .map(parse_poses)
+        .transpose()
+        .map_err(|e| {
+            frf_core::BadArgument::new("--poses", args.poses.as_deref().unwrap_or(""), e)
+        })?;
     let options = ExportOptions {
-        poses: args.poses,
+        poses,
         views: args.views,
         mesh_voxel_m: args.mesh_voxel,
         jpeg_quality: args.jpeg_quality,

@@ -7,6 +7,7 @@ mod common;
 mod adapter;
 mod bad_input;
 mod bench;
+mod export;
 mod interrupt;
 mod olat;
 mod outputs;

@@ -1,0 +1,100 @@
+//! `frf export` as a user runs it: the tiny oracle field's walker written as a .glb that
+//! the Khronos glTF validator passes with no error or warning (player/validate.mjs,
+//! installed by scripts/setup.sh), its sizes reported, bad options and a field that is
+//! not a grid refused by name with nothing written.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::Path;
+use std::process::Command;
+
+use crate::common::{frf, stderr};
+
+/// The repository's `player/` directory.
+fn player() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/player"))
+}
+
+#[test]
+fn export_writes_a_glb_the_khronos_validator_passes() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let o = frf(&[
+        "export",
+        f.field.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("x the field's"), "{text}");
+    let json_at = text.find('{').unwrap();
+    let report: serde_json::Value = serde_json::from_str(&text[json_at..]).unwrap();
+    assert_eq!(report["views_per_pose"], 108);
+    assert_eq!(
+        report["bytes"].as_u64().unwrap(),
+        std::fs::metadata(&out).unwrap().len()
+    );
+
+    assert!(
+        player().join("node_modules/gltf-validator").exists(),
+        "the player's npm packages are missing: run scripts/setup.sh"
+    );
+    let v = Command::new("node")
+        .arg(player().join("validate.mjs"))
+        .arg(&out)
+        .output()
+        .expect("node runs (scripts/setup.sh installs it)");
+    let line = String::from_utf8_lossy(&v.stdout);
+    assert!(
+        v.status.success(),
+        "{line} {}",
+        String::from_utf8_lossy(&v.stderr)
+    );
+    let r: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+    assert_eq!(
+        (r["errors"].as_u64(), r["warnings"].as_u64()),
+        (Some(0), Some(0)),
+        "{line}"
+    );
+}
+
+#[test]
+fn export_refuses_bad_options_and_fields_it_cannot_export() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    for (flag, value, want) in [
+        ("--views", "ring:3", "ring 3"),
+        ("--views", "1;2", "expected U,V"),
+        ("--poses", "7", "pose 7"),
+        ("--jpeg-quality", "0", "--jpeg-quality 0"),
+        ("--mesh-voxel", "0", "--mesh-voxel 0"),
+    ] {
+        let o = frf(&[
+            "export",
+            f.field.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            flag,
+            value,
+        ]);
+        assert!(!o.status.success(), "{flag} {value} accepted");
+        assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
+        assert!(!out.exists());
+    }
+    // Not a field at all.
+    let junk = dir.path().join("junk.frf");
+    std::fs::write(&junk, b"not a field").unwrap();
+    let o = frf(&[
+        "export",
+        junk.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("junk.frf"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
