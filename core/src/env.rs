@@ -48,13 +48,14 @@ impl EnvMap {
     /// [`crate::io::read_hdr_rgb`]); a map whose every texel is zero or negative is
     /// refused too: it lights nothing (`none` shows a field unlit). A `.json` file is an
     /// L2 light ([`crate::sh::ShLight`], what `frf env-sh` writes), made a map of
-    /// [`SH_MAP_HEIGHT`] rows.
+    /// [`SH_MAP_HEIGHT`] rows with its negative lobes kept (the band-limited light a
+    /// player relights by, exactly).
     pub fn load(path: &Path) -> Result<Self> {
         if path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
         {
-            return crate::sh::ShLight::load(path)?.to_env(SH_MAP_HEIGHT);
+            return crate::sh::ShLight::load(path)?.to_signed_env(SH_MAP_HEIGHT);
         }
         let img = crate::io::read_hdr_rgb(path)?;
         let env = Self::from_image(img).map_err(|e| match e {

@@ -175,6 +175,18 @@ impl ShLight {
         EnvMap::from_image(img)
     }
 
+    /// The light as a `2h x h` map with its negative lobes kept ([`EnvMap::signed`]): the
+    /// band-limited light itself, which relighting by the basis reproduces exactly as a
+    /// player's `Σ c_i T_i` does (`frf_reflectance::sh_transfer`). What `--env SH.json`
+    /// renders.
+    pub fn to_signed_env(&self, h: usize) -> Result<EnvMap> {
+        let h = h.max(2);
+        let probe = EnvMap::uniform([0.0; 3], h);
+        EnvMap::signed(Image::from_fn(2 * h, h, |x, y| {
+            self.radiance(probe.direction_of(x as f32, y as f32))
+        }))
+    }
+
     /// The coefficients with the Condon–Shortley phase: those of odd `m` negated (the
     /// ordering of many papers and tools). Its own inverse.
     pub fn condon_shortley(&self) -> [Rgb; SH_COUNT] {

@@ -35,14 +35,8 @@ fn the_exported_transfer_relights_as_frf_does() {
     let field = FieldFile::open(&f.field).unwrap();
     let projector = field.projector().unwrap();
     let light = light();
-    // The L2 sky rings below zero opposite its sun; a signed map keeps it the same light.
-    let probe = frf_core::env::EnvMap::uniform([0.0; 3], SH_MAP_HEIGHT);
-    let map = frf_core::env::EnvMap::signed(frf_core::image::Image::from_fn(
-        2 * SH_MAP_HEIGHT,
-        SH_MAP_HEIGHT,
-        |x, y| light.radiance(probe.direction_of(x as f32, y as f32)),
-    ))
-    .unwrap();
+    // The L2 sky rings below zero opposite its sun; its signed map is the same light.
+    let map = light.to_signed_env(SH_MAP_HEIGHT).unwrap();
     for (u, v) in views {
         let turntable = field.header().poses[0].views[field.header().view_index(u, v)]
             .turntable_deg

@@ -58,7 +58,7 @@ pub fn run(args: EnvShArgs) -> CliResult {
         100.0 * kept
     );
     println!(
-        "  texels where the L2 light rings below zero (clamped when rendered): {:.1} %",
+        "  texels where the L2 light rings below zero (kept when frf renders the file, as a player relights it): {:.1} %",
         100.0 * ringing.clamped_texels() as f64 / texels as f64
     );
     Ok(())
