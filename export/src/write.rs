@@ -7,6 +7,7 @@ use frf_core::grid::Neighbour;
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::sh::{Convention, SH_COUNT};
 use frf_reflectance::FieldFile;
+use frf_reflectance::chunk::{ChunkKey, ChunkKind};
 use frf_reflectance::light_fit::LightFit;
 use frf_reflectance::sh_transfer::{sh_weights, texel_transfer};
 use glam::{Mat3, Vec3};
@@ -61,8 +62,8 @@ pub struct ExportReport {
     pub bytes: u64,
     /// Poses exported.
     pub poses: usize,
-    /// Views per pose.
-    pub views_per_pose: usize,
+    /// Views exported, all poses together.
+    pub views: usize,
     /// Triangles of all hull meshes.
     pub triangles: usize,
     /// Bytes of the transfer atlases, alpha, normals, albedo, flows and meshes.
@@ -97,7 +98,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             .collect::<std::result::Result<Vec<_>, _>>()?,
         None => header.pose_list(),
     };
-    let views: Vec<(usize, usize)> = match &options.views {
+    let wanted: Vec<(usize, usize)> = match &options.views {
         ViewSelection::All => (0..header.columns)
             .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
             .collect(),
@@ -145,6 +146,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let mut meshes = Vec::new();
     let mut pose_json = Vec::new();
     let mut triangles = 0;
+    let mut exported_views = 0;
     for &pose in &poses {
         let record = header.pose(pose)?.clone();
         let hull = field.hull(pose)?.ok_or_else(|| {
@@ -169,6 +171,27 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             .expect("an array")
             .push(json!(node));
 
+        // A field ingested for a scene holds some views of a pose: `all` takes those.
+        let held = |&(u, v): &(usize, usize)| {
+            field.has(&ChunkKey {
+                pose,
+                u: u as u32,
+                v: v as u32,
+                kind: ChunkKind::Basis,
+            })
+        };
+        let views: Vec<(usize, usize)> = wanted.iter().copied().filter(held).collect();
+        if options.views != ViewSelection::All && views.len() < wanted.len() {
+            let missing = wanted.iter().find(|w| !held(w)).expect("one is missing");
+            return Err(ExportError::Option(format!(
+                "--views: view {},{} of pose {pose} is not in the field",
+                missing.0, missing.1
+            )));
+        }
+        if views.is_empty() {
+            return Err(ExportError::Field(format!("pose {pose} holds no view")));
+        }
+        exported_views += views.len();
         let turntables: Vec<f32> = views
             .iter()
             .map(|&(u, v)| {
@@ -259,7 +282,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     Ok(ExportReport {
         bytes: bytes.len() as u64,
         poses: poses.len(),
-        views_per_pose: views.len(),
+        views: exported_views,
         triangles,
         section_bytes: std::array::from_fn(|i| (names[i].to_string(), sizes[i])),
         seconds: started.elapsed().as_secs_f64(),

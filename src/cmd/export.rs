@@ -81,10 +81,10 @@ pub fn run(args: ExportArgs) -> CliResult {
     let report = frf_export::export(&args.field, &args.out, &options)?;
     let field_bytes = std::fs::metadata(&args.field).map(|m| m.len()).unwrap_or(0);
     println!(
-        "{} written: {} pose(s) of {} view(s), {:.2} MB ({:.2}x the field's {:.2} MB), in {:.1} s",
+        "{} written: {} pose(s), {} view(s) in all, {:.2} MB ({:.2}x the field's {:.2} MB), in {:.1} s",
         args.out.display(),
         report.poses,
-        report.views_per_pose,
+        report.views,
         report.bytes as f64 / 1e6,
         report.bytes as f64 / field_bytes.max(1) as f64,
         field_bytes as f64 / 1e6,
