@@ -43,6 +43,10 @@ step plan $frf render "$scene" --field "$out/walker.frf" --plan
 step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot" --overwrite
 step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 3 \
   --lights 256
+# The walker leaving frf: a .glb any glTF viewer walks (hull meshes) and a player
+# relights (docs/export.md), with the forest's L2 light beside it.
+step export $frf export "$out/walker.frf" --out "$out/walker.glb"
+step env-sh $frf env-sh assets/envmaps/forest_slope_1k.hdr --out "$out/forest_sh.json"
 
 {
   echo "frf demo: $scene, $(nproc) cores, $(date -u +%Y-%m-%dT%H:%MZ)"
@@ -61,6 +65,9 @@ step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" 
   echo
   echo "frames of the shot against their true composites:"
   sed 's/^/  /' "$out/eval.log"
+  echo
+  echo "export (the walker as glTF, docs/export.md):"
+  sed 's/^/  /' "$out/export.log"
 } > "$out/report.txt"
 cat "$out/report.txt"
-echo "demo: the shot in $out/shot/ (frames, preview.png animated, contact.png), report $out/report.txt"
+echo "demo: the shot in $out/shot/ (frames, preview.png animated, contact.png), the walker as $out/walker.glb, report $out/report.txt"
