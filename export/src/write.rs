@@ -70,6 +70,8 @@ pub struct ExportReport {
     pub section_bytes: [(String, u64); 6],
     /// Wall seconds.
     pub seconds: f64,
+    /// What the export lacks that a player may expect (a field without normals).
+    pub notes: Vec<String>,
 }
 
 /// One view's maps, encoded.
@@ -279,6 +281,14 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
     let names = ["transfer", "alpha", "normals", "albedo", "flows", "meshes"];
+    let mut notes = Vec::new();
+    if sizes[2] == 0 {
+        notes.push(format!(
+            "{} holds no fitted normals (written before them, or of too few conditions): \
+             the export's views have none, and a player cannot add a sun by them",
+            field_path.display()
+        ));
+    }
     Ok(ExportReport {
         bytes: bytes.len() as u64,
         poses: poses.len(),
@@ -286,6 +296,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         triangles,
         section_bytes: std::array::from_fn(|i| (names[i].to_string(), sizes[i])),
         seconds: started.elapsed().as_secs_f64(),
+        notes,
     })
 }
 

@@ -169,3 +169,35 @@ fn damaged_exports_and_bad_options_are_refused_by_name() {
         assert!(!refused.exists());
     }
 }
+
+#[test]
+fn a_field_without_normals_exports_without_them_and_says_so() {
+    use frf_reflectance::FieldWriter;
+    use frf_reflectance::chunk::ChunkKind;
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    // The tiny field less its normals' chunks.
+    let field = FieldFile::open(&f.field).unwrap();
+    let bare = dir.path().join("bare.frf");
+    let mut w = FieldWriter::create(&bare, field.header().clone()).unwrap();
+    let keys: Vec<_> = field.chunks().map(|c| c.key).collect();
+    for key in keys.into_iter().filter(|k| k.kind != ChunkKind::Normals) {
+        w.add_chunk(key, &field.read_chunk(&key).unwrap()).unwrap();
+    }
+    w.finish().unwrap();
+    let out = dir.path().join("bare.glb");
+    let options = ExportOptions {
+        views: ViewSelection::List(vec![(3, 1)]),
+        ..ExportOptions::default()
+    };
+    let report = export(&bare, &out, &options).unwrap();
+    assert!(
+        report.notes.iter().any(|n| n.contains("no fitted normals")),
+        "{:?}",
+        report.notes
+    );
+    let glb = Export::open(&out).unwrap();
+    assert!(glb.view(0, 3, 1).unwrap()["normals"].is_null());
+    // Relighting by the transfer does not need them.
+    assert!(glb.relight(0, 3, 1, &light()).is_ok());
+}

@@ -94,6 +94,9 @@ pub fn run(args: ExportArgs) -> CliResult {
         println!("  {name:<9} {:>8.2} MB", *bytes as f64 / 1e6);
     }
     println!("  hull meshes: {} triangles", report.triangles);
+    for note in &report.notes {
+        eprintln!("note: {note}");
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
