@@ -124,8 +124,8 @@ fn an_l2_light_with_negative_lobes_relights_as_on_the_cpu() {
     let Some(gpu) = gpu() else { return };
     // The sky's L2 light rings below zero opposite its sun: some texels relight negative,
     // which the per-view peak of the relit codes must not take for the brightest.
-    let light = frf_core::sh::ShLight::project(&EnvMap::sky());
-    let env = light.to_signed_env(frf_core::env::SH_MAP_HEIGHT).unwrap();
+    let light = EnvMap::sky().to_sh();
+    let env = EnvMap::from_sh(&light, frf_core::env::SH_MAP_HEIGHT).unwrap();
     assert!(env.image().pixels().iter().any(|p| p[0] < 0.0));
     let source = frf_testkit::tiny_field().source(&env);
     let cpu = ResidentPose::relight_cpu(&source);

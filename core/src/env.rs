@@ -26,11 +26,9 @@ use glam::{Mat3, Vec2, Vec3};
 use crate::error::{CoreError, Result};
 use crate::image::{Border, Image, Rgb, RgbImage, luminance};
 use crate::light::DirLight;
+use crate::sh::{SH_COUNT, ShLight, sh_basis};
 
-/// The largest total light (`∫ L dω`, any channel) a loaded map may carry: far above any
-/// real scene (the sun's is about 1e5 in units of sky radiance), far below f32's 3.4e38, so
-/// that relit sums and exposures stay finite.
-pub const MAX_TOTAL_LIGHT: f64 = 1e30;
+pub use crate::light::MAX_TOTAL_LIGHT;
 
 /// Rows of the map an L2 light becomes: its finest detail is a band-2 lobe, 60° wide.
 pub const SH_MAP_HEIGHT: usize = 128;
@@ -55,7 +53,7 @@ impl EnvMap {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
         {
-            return crate::sh::ShLight::load(path)?.to_signed_env(SH_MAP_HEIGHT);
+            return Self::from_sh(&crate::sh::ShLight::load(path)?, SH_MAP_HEIGHT);
         }
         let img = crate::io::read_hdr_rgb(path)?;
         let env = Self::from_image(img).map_err(|e| match e {
@@ -144,6 +142,45 @@ impl EnvMap {
         }
         env.radiance = radiance;
         Ok(env)
+    }
+
+    /// The projection of the map (its yaw included) onto the L2 basis ([`crate::sh`]):
+    /// `c_i = ∫ L Y_i dω`, summed over its texels in f64.
+    pub fn to_sh(&self) -> ShLight {
+        let mut sum = [[0.0f64; 3]; SH_COUNT];
+        for y in 0..self.radiance.height() {
+            let omega = self.texel_solid_angle(y) as f64;
+            for (x, l) in self.radiance.row(y).iter().enumerate() {
+                let basis = sh_basis(self.direction_of(x as f32, y as f32));
+                for (s, b) in sum.iter_mut().zip(basis) {
+                    for c in 0..3 {
+                        s[c] += l[c] as f64 * b as f64 * omega;
+                    }
+                }
+            }
+        }
+        ShLight::from_coefficients(sum.map(|s| s.map(|v| v as f32)))
+    }
+
+    /// An L2 light as a `2h x h` map with its negative lobes kept ([`EnvMap::signed`]):
+    /// the band-limited light itself, which relighting by the basis reproduces exactly as
+    /// a player's `Σ c_i T_i` does. What `--env SH.json` renders.
+    pub fn from_sh(sh: &ShLight, h: usize) -> Result<Self> {
+        Self::signed(Self::sh_image(sh, h))
+    }
+
+    /// [`EnvMap::from_sh`] with the negative texels (the ringing opposite a bright
+    /// source) clamped to zero and counted ([`EnvMap::clamped_texels`]).
+    pub fn from_sh_clamped(sh: &ShLight, h: usize) -> Result<Self> {
+        Self::from_image(Self::sh_image(sh, h))
+    }
+
+    fn sh_image(sh: &ShLight, h: usize) -> RgbImage {
+        let h = h.max(2);
+        let probe = Self::uniform([0.0; 3], h);
+        Image::from_fn(2 * h, h, |x, y| {
+            sh.radiance(probe.direction_of(x as f32, y as f32))
+        })
     }
 
     /// A constant environment of radiance `value` on a `2n x n` grid.

@@ -6,6 +6,11 @@ use glam::Vec3;
 
 use crate::image::Rgb;
 
+/// The largest total light (`∫ L dω`, any channel) a loaded map or light may carry: far
+/// above any real scene (the sun's is about 1e5 in units of sky radiance), far below
+/// f32's 3.4e38, so that relit sums and exposures stay finite.
+pub const MAX_TOTAL_LIGHT: f64 = 1e30;
+
 /// A distant light: the unit direction from the subject toward it, and its RGB
 /// irradiance at normal incidence.
 #[derive(Debug, Clone, Copy, PartialEq)]

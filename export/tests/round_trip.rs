@@ -15,7 +15,7 @@ use frf_reflectance::relight::relight;
 
 /// The built-in sky's L2 light.
 fn light() -> ShLight {
-    ShLight::project(&frf_core::env::EnvMap::sky())
+    frf_core::env::EnvMap::sky().to_sh()
 }
 
 #[test]
@@ -36,7 +36,7 @@ fn the_exported_transfer_relights_as_frf_does() {
     let projector = field.projector().unwrap();
     let light = light();
     // The L2 sky rings below zero opposite its sun; its signed map is the same light.
-    let map = light.to_signed_env(SH_MAP_HEIGHT).unwrap();
+    let map = frf_core::env::EnvMap::from_sh(&light, SH_MAP_HEIGHT).unwrap();
     for (u, v) in views {
         let turntable = field.header().poses[0].views[field.header().view_index(u, v)]
             .turntable_deg

@@ -37,7 +37,7 @@ fn the_transfer_relights_an_l2_light_as_the_basis_does() {
             .conditions;
     let projector = Projector::new(&conditions).unwrap();
     let light = light();
-    let env = light.to_env(SH_MAP_HEIGHT).unwrap();
+    let env = frf_core::env::EnvMap::from_sh_clamped(&light, SH_MAP_HEIGHT).unwrap();
     assert_eq!(env.clamped_texels(), 0);
     let turntables = [0.0f32, 1.3, 4.0];
     let weights = sh_weights(&projector, &turntables).unwrap();

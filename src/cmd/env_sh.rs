@@ -8,8 +8,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use frf_core::env::{EnvSource, SH_MAP_HEIGHT};
-use frf_core::sh::ShLight;
+use frf_core::env::{EnvMap, EnvSource, SH_MAP_HEIGHT};
 
 use crate::CliResult;
 
@@ -38,9 +37,9 @@ pub fn run(args: EnvShArgs) -> CliResult {
         .env
         .load_required("the light to project")?
         .rotated(args.yaw.to_radians());
-    let sh = ShLight::project(&env);
+    let sh = env.to_sh();
     let kept = energy_kept(&env, &sh);
-    let ringing = sh.to_env(SH_MAP_HEIGHT)?;
+    let ringing = EnvMap::from_sh_clamped(&sh, SH_MAP_HEIGHT)?;
     let texels = ringing.image().pixels().len();
     sh.save(&args.out, &args.env.name())?;
     println!(
@@ -65,7 +64,7 @@ pub fn run(args: EnvShArgs) -> CliResult {
 }
 
 /// `Σ c_i² / ∫ L² dω` of the luminance: 1 for a light that is L2 already.
-fn energy_kept(env: &frf_core::env::EnvMap, sh: &ShLight) -> f64 {
+fn energy_kept(env: &EnvMap, sh: &frf_core::sh::ShLight) -> f64 {
     let lum = |c: [f32; 3]| frf_core::image::luminance(c) as f64;
     let img = env.image();
     let mut total = 0.0f64;

@@ -1,0 +1,211 @@
+//! L2 lights (`frf_core::sh`) and their maps (`frf_core::env`): the basis is orthonormal,
+//! a projection recovers a band-limited light, irradiance is the cosine integral and
+//! three.js's published constants, the conventions round trip, and files round trip or
+//! are refused by name.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::f32::consts::PI;
+
+use frf_core::env::EnvMap;
+use frf_core::image::Rgb;
+use frf_core::sh::{SH_COUNT, SH_ORDER, ShLight, sh_basis};
+use glam::Vec3;
+
+/// `Σ_i c_i w_i` per channel.
+fn weighted_sum(c: &[Rgb; SH_COUNT], w: [f32; SH_COUNT]) -> Rgb {
+    let mut out = [0.0f32; 3];
+    for (ci, wi) in c.iter().zip(w) {
+        for ch in 0..3 {
+            out[ch] += ci[ch] * wi;
+        }
+    }
+    out
+}
+
+/// Unit directions spread over the sphere.
+fn directions(n: usize) -> Vec<Vec3> {
+    (0..n)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let phi = i as f32 * 2.399_963;
+            let r = (1.0 - y * y).sqrt();
+            Vec3::new(r * phi.cos(), y, r * phi.sin())
+        })
+        .collect()
+}
+
+fn light() -> ShLight {
+    let mut c = [[0.0f32; 3]; SH_COUNT];
+    for (i, ci) in c.iter_mut().enumerate() {
+        let i = i as f32;
+        *ci = [0.3 / (1.0 + i), 0.1 - 0.03 * i, 0.3 * (i * 0.7).sin()];
+    }
+    // Band 0 above the others' largest sum: positive everywhere.
+    c[0] = [6.0, 5.5, 5.0];
+    ShLight::from_coefficients(c)
+}
+
+#[test]
+fn the_basis_is_orthonormal_and_a_projection_recovers_a_band_limited_light() {
+    let probe = EnvMap::uniform([0.0; 3], 256);
+    let mut gram = [[0.0f64; SH_COUNT]; SH_COUNT];
+    for y in 0..256 {
+        let omega = probe.texel_solid_angle(y) as f64;
+        for x in 0..512 {
+            let b = sh_basis(probe.direction_of(x as f32, y as f32));
+            for i in 0..SH_COUNT {
+                for j in 0..SH_COUNT {
+                    gram[i][j] += b[i] as f64 * b[j] as f64 * omega;
+                }
+            }
+        }
+    }
+    for (i, row) in gram.iter().enumerate() {
+        for (j, g) in row.iter().enumerate() {
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((g - want).abs() < 2e-3, "<Y{i}, Y{j}> = {g}");
+        }
+    }
+    let l = light();
+    let back = EnvMap::from_sh(&l, 256).unwrap().to_sh();
+    for (a, b) in l.coefficients.iter().zip(back.coefficients) {
+        for c in 0..3 {
+            assert!(
+                (a[c] - b[c]).abs() < 2e-3 * (1.0 + a[c].abs()),
+                "{a:?} {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn irradiance_is_the_cosine_integral_and_matches_three_js_constants() {
+    let l = light();
+    let env = EnvMap::from_sh_clamped(&l, 256).unwrap();
+    assert_eq!(env.clamped_texels(), 0, "the test light is positive");
+    for n in directions(12) {
+        // The cosine integral of the map itself.
+        let mut e = [0.0f64; 3];
+        for y in 0..256 {
+            let omega = env.texel_solid_angle(y) as f64;
+            for x in 0..512 {
+                let d = env.direction_of(x as f32, y as f32);
+                let cos = n.dot(d).max(0.0) as f64;
+                let r = env.image().get(x, y);
+                for c in 0..3 {
+                    e[c] += r[c] as f64 * cos * omega;
+                }
+            }
+        }
+        // Three.js's getIrradianceAt, its published constants.
+        let (x, y, z) = (n.x, n.y, n.z);
+        let k = [
+            0.886_227,
+            2.0 * 0.511_664 * y,
+            2.0 * 0.511_664 * z,
+            2.0 * 0.511_664 * x,
+            2.0 * 0.429_043 * x * y,
+            2.0 * 0.429_043 * y * z,
+            0.743_125 * z * z - 0.247_708,
+            2.0 * 0.429_043 * x * z,
+            0.429_043 * (x * x - y * y),
+        ];
+        let three = weighted_sum(&l.coefficients, k);
+        let ours = l.irradiance(n);
+        for c in 0..3 {
+            assert!(
+                (ours[c] - three[c]).abs() < 1e-4 * (1.0 + three[c].abs()),
+                "{ours:?} {three:?}"
+            );
+            // Exact for a band-limited light (the lobe's higher bands meet none of
+            // it): quadrature error only.
+            assert!(
+                (ours[c] as f64 - e[c]).abs() < 1e-3 * e[c].abs(),
+                "{ours:?} {e:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn conventions_round_trip() {
+    let l = light();
+    // Condon–Shortley: odd m negated, and back.
+    let cs = l.condon_shortley();
+    assert_eq!(cs[1], l.coefficients[1].map(|v| -v));
+    assert_eq!(cs[2], l.coefficients[2]);
+    assert_eq!(cs[7], l.coefficients[7].map(|v| -v));
+    assert_eq!(ShLight::from_condon_shortley(cs), l);
+    // With the phase in the basis too, the light is the same.
+    for d in directions(20) {
+        let mut b = sh_basis(d);
+        for (i, (_, m)) in SH_ORDER.iter().enumerate() {
+            if m % 2 != 0 {
+                b[i] = -b[i];
+            }
+        }
+        let (a, r) = (weighted_sum(&cs, b), l.radiance(d));
+        assert!((0..3).all(|c| (a[c] - r[c]).abs() < 1e-5), "{a:?} {r:?}");
+    }
+    // Unity's seven vectors give the irradiance over π.
+    let v = l.unity_shader_vectors();
+    for n in directions(20) {
+        let (x, y, z) = (n.x, n.y, n.z);
+        let e = l.irradiance(n);
+        for c in 0..3 {
+            let (a, b) = (v[c], v[3 + c]);
+            let shade = a[0] * x
+                + a[1] * y
+                + a[2] * z
+                + a[3]
+                + b[0] * x * y
+                + b[1] * y * z
+                + b[2] * z * z
+                + b[3] * z * x
+                + v[6][c] * (x * x - y * y);
+            assert!((shade - e[c] / PI).abs() < 1e-5, "{shade} {}", e[c] / PI);
+        }
+    }
+}
+
+#[test]
+fn files_round_trip_and_bad_ones_are_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("light.json");
+    let l = light();
+    l.save(&path, "test").unwrap();
+    assert_eq!(ShLight::load(&path).unwrap(), l);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let cases = [
+        (
+            text.replace("\"version\": 1", "\"version\": 2"),
+            "version 2",
+        ),
+        (
+            text.replace(
+                "\"condon_shortley_phase\": false",
+                "\"condon_shortley_phase\": true",
+            ),
+            "convention",
+        ),
+        (text.replace("frf-sh-l2", "other"), "format"),
+        (text[..text.len() / 2].to_string(), "not an SH light"),
+    ];
+    for (bad, want) in cases {
+        std::fs::write(&path, bad).unwrap();
+        let e = ShLight::load(&path).unwrap_err().to_string();
+        assert!(e.contains(want) && e.contains("light.json"), "{e}");
+    }
+    let mut f: serde_json::Value = serde_json::from_str(&text).unwrap();
+    f["coefficients"].as_array_mut().unwrap().pop();
+    std::fs::write(&path, f.to_string()).unwrap();
+    let e = ShLight::load(&path).unwrap_err().to_string();
+    assert!(e.contains("8 coefficients"), "{e}");
+    f["coefficients"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!([1e39, 0, 0]));
+    std::fs::write(&path, f.to_string()).unwrap();
+    assert!(ShLight::load(&path).is_err());
+}
