@@ -93,7 +93,21 @@ impl EnvMap {
 
     /// Wraps a radiance image (width should be twice the height, but any size of at least
     /// 1x1 is accepted). Non-finite texels are refused, negative ones clamped to zero.
-    pub fn from_image(mut radiance: RgbImage) -> Result<Self> {
+    pub fn from_image(radiance: RgbImage) -> Result<Self> {
+        let mut env = Self::signed(radiance)?;
+        for p in env.radiance.pixels_mut() {
+            if p.iter().any(|&c| c < 0.0) {
+                env.clamped_texels += 1;
+                *p = p.map(|c| c.max(0.0));
+            }
+        }
+        Ok(env)
+    }
+
+    /// Wraps an image with its negative texels kept: a light with negative lobes (an L2
+    /// light, [`EnvMap::from_sh`]) or a function on the sphere to integrate over the
+    /// basis's regions (an SH basis function); non-finite texels are refused.
+    pub fn signed(radiance: RgbImage) -> Result<Self> {
         if radiance.width() == 0 || radiance.height() == 0 {
             return Err(CoreError::invalid("environment", "empty image"));
         }
@@ -108,40 +122,11 @@ impl EnvMap {
                 format!("texel ({}, {}) is not finite", i % w, i / w),
             ));
         }
-        let mut clamped_texels = 0;
-        for p in radiance.pixels_mut() {
-            if p.iter().any(|&c| c < 0.0) {
-                clamped_texels += 1;
-                *p = p.map(|c| c.max(0.0));
-            }
-        }
         Ok(Self {
             radiance,
             yaw: 0.0,
-            clamped_texels,
+            clamped_texels: 0,
         })
-    }
-
-    /// Wraps a signed image, negative texels kept: not light, but a function on the
-    /// sphere to integrate over the basis's regions (an SH basis function,
-    /// [`crate::sh`]); non-finite texels are refused.
-    pub fn signed(radiance: RgbImage) -> Result<Self> {
-        let mut env = Self::from_image(Image::new(1, 1, [0.0; 3]))?;
-        if let Some(i) = radiance
-            .pixels()
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
-            return Err(CoreError::invalid(
-                "signed map",
-                format!("texel {i} is not finite"),
-            ));
-        }
-        if radiance.width() == 0 || radiance.height() == 0 {
-            return Err(CoreError::invalid("signed map", "empty image"));
-        }
-        env.radiance = radiance;
-        Ok(env)
     }
 
     /// The projection of the map (its yaw included) onto the L2 basis ([`crate::sh`]):
