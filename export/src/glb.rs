@@ -20,7 +20,7 @@ impl Glb {
     /// Appends bytes as a buffer view; its index. `target`: a vertex (34962) or index
     /// (34963) buffer, or none (images).
     pub fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let mut v = json!({"buffer": 0, "byteOffset": self.bin.len(), "byteLength": bytes.len()});
@@ -104,7 +104,7 @@ impl Glb {
 
     /// The GLB file: `document` completed with the buffer, views, accessors and images.
     pub fn finish(mut self, mut document: Value) -> Vec<u8> {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         document["buffers"] = json!([{"byteLength": self.bin.len()}]);
@@ -114,7 +114,7 @@ impl Glb {
             document["images"] = Value::Array(self.images);
         }
         let mut text = serde_json::to_vec(&document).expect("a JSON value serializes");
-        while text.len() % 4 != 0 {
+        while !text.len().is_multiple_of(4) {
             text.push(b' ');
         }
         let total = 12 + 8 + text.len() + 8 + self.bin.len();
