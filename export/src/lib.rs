@@ -23,4 +23,4 @@ pub mod view_maps;
 mod write;
 
 pub use error::{ExportError, Result};
-pub use write::{ExportOptions, ExportReport, ViewSelection, export};
+pub use write::{ExportOptions, ExportReport, Tier, ViewSelection, export};

@@ -135,7 +135,13 @@ impl Export {
     pub fn transfer(&self, pose: u32, u: usize, v: usize) -> Result<Image<[Rgb; SH_COUNT]>> {
         let view = self.view(pose, u, v)?;
         let t = &view["transfer"];
-        let atlas = (0..3)
+        let images = t["images"].as_array().map_or(0, Vec::len);
+        if images != 3 && images != 1 {
+            return Err(self.bad(format!(
+                "view {u},{v} has {images} transfer atlases, expected 3 or 1"
+            )));
+        }
+        let atlas = (0..images)
             .map(|c| {
                 let index = t["images"][c].as_u64().unwrap_or(u64::MAX) as usize;
                 image::load_from_memory(self.image_bytes(index)?)
@@ -151,6 +157,20 @@ impl Export {
                 "the transfer atlases of view {u},{v} differ in size"
             )));
         }
+        // The compact tier: one grey atlas and a colour per texel.
+        let colour = if images == 1 {
+            let c = &t["colour"];
+            let png = image::load_from_memory(
+                self.image_bytes(c["image"].as_u64().unwrap_or(u64::MAX) as usize)?,
+            )
+            .map_err(|e| self.bad(format!("the transfer colour of view {u},{v}: {e}")))?
+            .to_rgb8();
+            let scale: Rgb = serde_json::from_value(c["scale"].clone())
+                .map_err(|e| self.bad(format!("the transfer colour scale of view {u},{v}: {e}")))?;
+            Some((png, scale))
+        } else {
+            None
+        };
         let coefficients = |key: &str| -> Result<[Rgb; SH_COUNT]> {
             serde_json::from_value(t[key].clone())
                 .map_err(|e| self.bad(format!("the transfer {key} of view {u},{v}: {e}")))
@@ -167,9 +187,15 @@ impl Export {
                     (i % ATLAS_COLUMNS) as u32 * w + x as u32,
                     (i / ATLAS_COLUMNS) as u32 * h + y as u32,
                 );
-                std::array::from_fn(|c| {
-                    offset[i][c] + scale[i][c] * atlas[c].get_pixel(ax, ay)[0] as f32
-                })
+                let code = |c: usize| atlas[c.min(atlas.len() - 1)].get_pixel(ax, ay)[0] as f32;
+                match &colour {
+                    None => std::array::from_fn(|c| offset[i][c] + scale[i][c] * code(c)),
+                    Some((png, s)) => {
+                        let grey = offset[i][0] + scale[i][0] * code(0);
+                        let p = png.get_pixel(x as u32, y as u32);
+                        std::array::from_fn(|c| grey * s[c] * p[c] as f32)
+                    }
+                }
             })
         }))
     }

@@ -20,8 +20,8 @@ use crate::format::{ATLAS_COLUMNS, FLOW_OFFSET_PX, FLOW_SCALE};
 /// A transfer's atlases and how to read their codes back.
 #[derive(Debug, Clone)]
 pub struct Atlas {
-    /// JPEG bytes, one grey atlas per channel.
-    pub jpeg: [Vec<u8>; 3],
+    /// JPEG bytes, one grey atlas per channel encoded.
+    pub jpeg: Vec<Vec<u8>>,
     /// Per coefficient and channel: value per code.
     pub scale: [Rgb; SH_COUNT],
     /// Per coefficient and channel: value of code 0.
@@ -32,12 +32,14 @@ fn encoding_error(what: &str, e: image::ImageError) -> ExportError {
     ExportError::Field(format!("encoding {what}: {e}"))
 }
 
-/// The atlas of a view's transfer (`w x h` texels, row-major), its ranges taken inside
-/// `alpha`; texels outside take the code of zero.
+/// The atlases of a view's transfer (`w x h` texels, row-major) for its first
+/// `channels` channels (3; 1 for the compact tier's grey transfer), its ranges taken
+/// inside `alpha`; texels outside take the code of zero.
 pub fn transfer_atlas(
     transfer: &[[Rgb; SH_COUNT]],
     alpha: &GrayImage,
     quality: u8,
+    channels: usize,
 ) -> Result<Atlas> {
     let (w, h) = alpha.size();
     let mut lo = [[f32::INFINITY; 3]; SH_COUNT];
@@ -82,7 +84,7 @@ pub fn transfer_atlas(
             .map_err(|e| encoding_error("a transfer atlas", e))?;
         Ok(jpeg)
     };
-    let jpeg = [channel(0)?, channel(1)?, channel(2)?];
+    let jpeg = (0..channels.min(3)).map(channel).collect::<Result<_>>()?;
     Ok(Atlas {
         jpeg,
         scale,
@@ -124,8 +126,9 @@ pub fn normals_png(normals: &[Option<Vec3>], w: usize, h: usize) -> Result<Vec<u
     png(&bytes, w, h, ExtendedColorType::Rgba8)
 }
 
-/// Albedo as an RGB PNG and its scale per channel (`albedo = scale · code`).
-pub fn albedo_png(albedo: &[Rgb], w: usize, h: usize) -> Result<(Vec<u8>, Rgb)> {
+/// Non-negative RGB values (albedo, the compact tier's colour) as an RGB PNG and its
+/// scale per channel (`value = scale · code`).
+pub fn scaled_rgb_png(albedo: &[Rgb], w: usize, h: usize) -> Result<(Vec<u8>, Rgb)> {
     let mut top = [0.0f32; 3];
     for a in albedo {
         for c in 0..3 {

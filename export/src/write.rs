@@ -18,7 +18,7 @@ use crate::error::{ExportError, Result};
 use crate::format::{EXTENSION, VERSION};
 use crate::glb::Glb;
 use crate::hull_mesh::hull_mesh;
-use crate::view_maps::{albedo_png, alpha_png, flow_png, normals_png, transfer_atlas};
+use crate::view_maps::{alpha_png, flow_png, normals_png, scaled_rgb_png, transfer_atlas};
 
 /// Which views of each pose are exported.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,9 +31,23 @@ pub enum ViewSelection {
     List(Vec<(usize, usize)>),
 }
 
+/// How much of the transfer is kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tier {
+    /// Nine RGB coefficients per texel (three grey atlases).
+    Full,
+    /// Nine grey coefficients (the transfer's luminance, one atlas) and one colour per
+    /// texel (its band-0 transfer over its luminance): `T_i ≈ colour · t_i`. A third of
+    /// the transfer's bytes; exact where a texel's colour does not change with the
+    /// light's direction.
+    Compact,
+}
+
 /// What to export.
 #[derive(Debug, Clone)]
 pub struct ExportOptions {
+    /// The transfer's tier.
+    pub tier: Tier,
     /// Poses (default: every pose of the field).
     pub poses: Option<Vec<u32>>,
     /// Views.
@@ -47,6 +61,7 @@ pub struct ExportOptions {
 impl Default for ExportOptions {
     fn default() -> Self {
         Self {
+            tier: Tier::Full,
             poses: None,
             views: ViewSelection::All,
             mesh_voxel_m: 0.02,
@@ -81,6 +96,7 @@ struct ViewOut {
     turntable_deg: f32,
     camera: Value,
     atlas: crate::view_maps::Atlas,
+    colour: Option<(Vec<u8>, Rgb)>,
     alpha: Vec<u8>,
     normals: Option<Vec<u8>>,
     albedo: (Vec<u8>, Rgb),
@@ -208,7 +224,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             .zip(&weights)
             .map(|(&(u, v), w)| {
                 let rec = &record.views[header.view_index(u, v)];
-                encode_view(&field, pose, (u, v), rec, w, options.jpeg_quality)
+                encode_view(&field, pose, (u, v), rec, w, options)
             })
             .collect::<Result<_>>()?;
         let mut view_json = Vec::new();
@@ -216,7 +232,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
             let before = glb.binary_bytes();
             let rgb = ["red", "green", "blue"];
-            let atlas: Vec<usize> = (0..3)
+            let atlas: Vec<usize> = (0..e.atlas.jpeg.len())
                 .map(|c| {
                     glb.image(
                         &e.atlas.jpeg[c],
@@ -225,6 +241,9 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                     )
                 })
                 .collect();
+            let colour = e.colour.as_ref().map(|(png, scale)| {
+                json!({"image": glb.image(png, "image/png", name("transfer colour")), "scale": scale})
+            });
             sizes[0] += (glb.binary_bytes() - before) as u64;
             let before = glb.binary_bytes();
             let alpha = glb.image(&e.alpha, "image/png", name("alpha"));
@@ -248,7 +267,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             view_json.push(json!({
                 "u": e.u, "v": e.v, "turntable_deg": e.turntable_deg, "camera": e.camera,
                 "alpha": alpha,
-                "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset},
+                "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset, "colour": colour},
                 "normals": normals,
                 "albedo": {"image": albedo, "scale": e.albedo.1},
                 "flows": flows,
@@ -269,6 +288,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         "animations": [animation],
         "extensions": {EXTENSION: {
             "version": VERSION,
+            "tier": match options.tier { Tier::Full => "full", Tier::Compact => "compact" },
             "sh": Convention::frf(),
             "grid": {"columns": header.columns, "rows": header.rows, "wraps": header.wraps,
                      "width": header.width, "height": header.height},
@@ -322,7 +342,7 @@ fn encode_view(
     (u, v): (usize, usize),
     rec: &frf_reflectance::field::ViewRecord,
     weights: &frf_reflectance::sh_transfer::ShWeights,
-    quality: u8,
+    options: &ExportOptions,
 ) -> Result<ViewOut> {
     let basis = field.basis(pose, u, v)?;
     let alpha: GrayImage = field.alpha(pose, u, v)?;
@@ -336,7 +356,32 @@ fn encode_view(
             }
         })
         .collect();
-    let atlas = transfer_atlas(&transfer, &alpha, quality)?;
+    let quality = options.jpeg_quality;
+    let (atlas, colour) = match options.tier {
+        Tier::Full => (transfer_atlas(&transfer, &alpha, quality, 3)?, None),
+        Tier::Compact => {
+            let lum = |c: Rgb| frf_core::image::luminance(c);
+            let grey: Vec<[Rgb; SH_COUNT]> = transfer
+                .iter()
+                .map(|t| t.map(|c| [lum(c), 0.0, 0.0]))
+                .collect();
+            let colour: Vec<Rgb> = transfer
+                .iter()
+                .map(|t| {
+                    let l = lum(t[0]);
+                    if l > 0.0 {
+                        t[0].map(|c| (c / l).max(0.0))
+                    } else {
+                        [1.0; 3]
+                    }
+                })
+                .collect();
+            (
+                transfer_atlas(&grey, &alpha, quality, 1)?,
+                Some(scaled_rgb_png(&colour, w, h)?),
+            )
+        }
+    };
     let to_subject = Mat3::from_rotation_y(-rec.turntable_deg.to_radians());
     let normals = field
         .normals(pose, u, v)?
@@ -347,7 +392,7 @@ fn encode_view(
         .transpose()?;
     let fit = LightFit::of_basis(&basis, &field.header().conditions, &alpha);
     let albedo: Vec<Rgb> = fit.albedo();
-    let albedo = albedo_png(&albedo, w, h)?;
+    let albedo = scaled_rgb_png(&albedo, w, h)?;
     let mut flows = Vec::new();
     for n in Neighbour::ALL {
         if let Some(f) = field.flow(pose, u, v, n)? {
@@ -362,6 +407,7 @@ fn encode_view(
         camera: json!({"width": c.width, "height": c.height, "intrinsics": c.intrinsics,
                        "world_from_camera": c.world_from_camera}),
         atlas,
+        colour,
         alpha: alpha_png(&alpha)?,
         normals,
         albedo,

@@ -8,7 +8,7 @@
 use frf_core::env::SH_MAP_HEIGHT;
 use frf_core::sh::ShLight;
 use frf_export::read::Export;
-use frf_export::{ExportOptions, ViewSelection, export};
+use frf_export::{ExportOptions, Tier, ViewSelection, export};
 use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
 use frf_reflectance::relight::relight;
@@ -20,11 +20,22 @@ fn light() -> ShLight {
 
 #[test]
 fn the_exported_transfer_relights_as_frf_does() {
+    relights_as_frf(Tier::Full, 40.0);
+}
+
+#[test]
+fn the_compact_tier_relights_near_frf() {
+    relights_as_frf(Tier::Compact, 38.0);
+}
+
+/// Exports three views in `tier` and checks them relit against frf above `floor_db`.
+fn relights_as_frf(tier: Tier, floor_db: f64) {
     let f = frf_testkit::tiny_field();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("walker.glb");
     let views = vec![(0, 0), (7, 1), (20, 2)];
     let options = ExportOptions {
+        tier,
         views: ViewSelection::List(views.clone()),
         ..ExportOptions::default()
     };
@@ -57,8 +68,8 @@ fn the_exported_transfer_relights_as_frf_does() {
         }
         assert!(n > 300, "view {u},{v}: {n} samples");
         let psnr = 10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10();
-        eprintln!("view {u},{v}: exported transfer against frf's relighting {psnr:.2} dB");
-        assert!(psnr > 40.0, "view {u},{v}: {psnr:.2} dB");
+        eprintln!("{tier:?} view {u},{v}: exported transfer against frf's relighting {psnr:.2} dB");
+        assert!(psnr > floor_db, "{tier:?} view {u},{v}: {psnr:.2} dB");
     }
     // What the schema requires is there.
     let schema: serde_json::Value = serde_json::from_str(include_str!(
@@ -80,7 +91,12 @@ fn the_exported_transfer_relights_as_frf_does() {
         for key in required(&schema["$defs"]["view"]) {
             assert!(!view[&key].is_null(), "a view lacks {key}");
         }
-        assert_eq!(view["transfer"]["images"].as_array().unwrap().len(), 3);
+        let atlases = if tier == Tier::Full { 3 } else { 1 };
+        assert_eq!(
+            view["transfer"]["images"].as_array().unwrap().len(),
+            atlases
+        );
+        assert_eq!(view["transfer"]["colour"].is_null(), tier == Tier::Full);
     }
     // The walk: a node per pose under the walker, an animation switching them.
     let d = &glb.document;

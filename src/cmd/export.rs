@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use frf_export::{ExportOptions, ViewSelection};
+use frf_export::{ExportOptions, Tier, ViewSelection};
 
 use crate::CliResult;
 use crate::cmd::args::parse_poses;
@@ -26,12 +26,24 @@ pub struct ExportArgs {
     /// Voxel side of the hull meshes, metres (a walking silhouette for any viewer).
     #[arg(long, default_value_t = 0.02)]
     mesh_voxel: f32,
+    /// The transfer's tier: `full` (nine RGB coefficients a texel) or `compact` (nine
+    /// grey coefficients and a colour: a third of the transfer's bytes).
+    #[arg(long, default_value = "full", value_parser = parse_tier)]
+    tier: Tier,
     /// JPEG quality of the SH transfer atlases.
     #[arg(long, default_value_t = 95)]
     jpeg_quality: u8,
     /// Also print the report as JSON.
     #[arg(long)]
     json: bool,
+}
+
+fn parse_tier(s: &str) -> Result<Tier, String> {
+    match s {
+        "full" => Ok(Tier::Full),
+        "compact" => Ok(Tier::Compact),
+        other => Err(format!("{other:?}: expected full or compact")),
+    }
 }
 
 fn parse_views(s: &str) -> Result<ViewSelection, String> {
@@ -73,6 +85,7 @@ pub fn run(args: ExportArgs) -> CliResult {
             frf_core::BadArgument::new("--poses", args.poses.as_deref().unwrap_or(""), e)
         })?;
     let options = ExportOptions {
+        tier: args.tier,
         poses,
         views: args.views,
         mesh_voxel_m: args.mesh_voxel,
