@@ -72,6 +72,7 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
         ("--poses", "7", "pose 7"),
         ("--jpeg-quality", "0", "--jpeg-quality 0"),
         ("--mesh-voxel", "0", "--mesh-voxel 0"),
+        ("--tier", "tiny", "expected full or compact"),
     ] {
         let o = frf(&[
             "export",
