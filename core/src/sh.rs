@@ -261,8 +261,9 @@ impl ShLight {
     }
 }
 
-/// `Σ_i c_i w_i` per channel.
-fn weighted(c: &[Rgb; SH_COUNT], w: [f32; SH_COUNT]) -> Rgb {
+/// `Σ_i c_i w_i` per channel: coefficients weighted by the basis (or any nine weights:
+/// the cosine-convolved basis, another convention's).
+pub fn weighted(c: &[Rgb; SH_COUNT], w: [f32; SH_COUNT]) -> Rgb {
     let mut out = [0.0f32; 3];
     for (ci, wi) in c.iter().zip(w) {
         for ch in 0..3 {

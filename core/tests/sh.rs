@@ -8,20 +8,8 @@
 use std::f32::consts::PI;
 
 use frf_core::env::EnvMap;
-use frf_core::image::Rgb;
-use frf_core::sh::{SH_COUNT, SH_ORDER, ShLight, sh_basis};
+use frf_core::sh::{SH_COUNT, SH_ORDER, ShLight, sh_basis, weighted};
 use glam::Vec3;
-
-/// `Σ_i c_i w_i` per channel.
-fn weighted_sum(c: &[Rgb; SH_COUNT], w: [f32; SH_COUNT]) -> Rgb {
-    let mut out = [0.0f32; 3];
-    for (ci, wi) in c.iter().zip(w) {
-        for ch in 0..3 {
-            out[ch] += ci[ch] * wi;
-        }
-    }
-    out
-}
 
 /// Unit directions spread over the sphere.
 fn directions(n: usize) -> Vec<Vec3> {
@@ -111,7 +99,7 @@ fn irradiance_is_the_cosine_integral_and_matches_three_js_constants() {
             2.0 * 0.429_043 * x * z,
             0.429_043 * (x * x - y * y),
         ];
-        let three = weighted_sum(&l.coefficients, k);
+        let three = weighted(&l.coefficients, k);
         let ours = l.irradiance(n);
         for c in 0..3 {
             assert!(
@@ -145,7 +133,7 @@ fn conventions_round_trip() {
                 b[i] = -b[i];
             }
         }
-        let (a, r) = (weighted_sum(&cs, b), l.radiance(d));
+        let (a, r) = (weighted(&cs, b), l.radiance(d));
         assert!((0..3).all(|c| (a[c] - r[c]).abs() < 1e-5), "{a:?} {r:?}");
     }
     // Unity's seven vectors give the irradiance over π.
