@@ -107,56 +107,9 @@ struct ViewOut {
 pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<ExportReport> {
     let started = Instant::now();
     let field = FieldFile::open(field_path)?;
-    frf_render_free_checks(&field)?;
+    check_exportable(&field)?;
     let header = field.header().clone();
-    let poses = match &options.poses {
-        Some(p) => p
-            .iter()
-            .map(|&p| field.pose_or_first(Some(p)))
-            .collect::<std::result::Result<Vec<_>, _>>()?,
-        None => header.pose_list(),
-    };
-    let wanted: Vec<(usize, usize)> = match &options.views {
-        ViewSelection::All => (0..header.columns)
-            .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
-            .collect(),
-        ViewSelection::Ring(v) if *v < header.rows => {
-            (0..header.columns).map(|u| (u, *v)).collect()
-        }
-        ViewSelection::Ring(v) => {
-            return Err(ExportError::Option(format!(
-                "--views ring {v}: the field has camera rows 0..{}",
-                header.rows
-            )));
-        }
-        ViewSelection::List(l) => {
-            if let Some(bad) = l
-                .iter()
-                .find(|(u, v)| *u >= header.columns || *v >= header.rows)
-            {
-                return Err(ExportError::Option(format!(
-                    "--views {},{}: outside the field's {}x{} grid",
-                    bad.0, bad.1, header.columns, header.rows
-                )));
-            }
-            l.clone()
-        }
-    };
-    if !(1..=100).contains(&options.jpeg_quality) {
-        return Err(ExportError::Option(format!(
-            "--jpeg-quality {}: expected 1 to 100",
-            options.jpeg_quality
-        )));
-    }
-    if !(options.mesh_voxel_m.is_finite()
-        && options.mesh_voxel_m > 0.0
-        && options.mesh_voxel_m <= 0.5)
-    {
-        return Err(ExportError::Option(format!(
-            "--mesh-voxel {}: expected a side in metres, above 0 and at most 0.5",
-            options.mesh_voxel_m
-        )));
-    }
+    let (poses, wanted) = selection(&field, options)?;
     let projector = field.projector()?;
     let mut glb = Glb::default();
     let mut sizes = [0u64; 6];
@@ -227,52 +180,10 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                 encode_view(&field, pose, (u, v), rec, w, options)
             })
             .collect::<Result<_>>()?;
-        let mut view_json = Vec::new();
-        for e in encoded {
-            let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
-            let before = glb.binary_bytes();
-            let rgb = ["red", "green", "blue"];
-            let atlas: Vec<usize> = (0..e.atlas.jpeg.len())
-                .map(|c| {
-                    glb.image(
-                        &e.atlas.jpeg[c],
-                        "image/jpeg",
-                        name(&format!("transfer {}", rgb[c])),
-                    )
-                })
-                .collect();
-            let colour = e.colour.as_ref().map(|(png, scale)| {
-                json!({"image": glb.image(png, "image/png", name("transfer colour")), "scale": scale})
-            });
-            sizes[0] += (glb.binary_bytes() - before) as u64;
-            let before = glb.binary_bytes();
-            let alpha = glb.image(&e.alpha, "image/png", name("alpha"));
-            sizes[1] += (glb.binary_bytes() - before) as u64;
-            let before = glb.binary_bytes();
-            let normals = e
-                .normals
-                .as_ref()
-                .map(|n| glb.image(n, "image/png", name("normals")));
-            sizes[2] += (glb.binary_bytes() - before) as u64;
-            let before = glb.binary_bytes();
-            let albedo = glb.image(&e.albedo.0, "image/png", name("albedo"));
-            sizes[3] += (glb.binary_bytes() - before) as u64;
-            let before = glb.binary_bytes();
-            let mut flows = serde_json::Map::new();
-            for (n, bytes) in &e.flows {
-                let image = glb.image(bytes, "image/png", name(&format!("flow {}", n.name())));
-                flows.insert(n.name().to_string(), json!(image));
-            }
-            sizes[4] += (glb.binary_bytes() - before) as u64;
-            view_json.push(json!({
-                "u": e.u, "v": e.v, "turntable_deg": e.turntable_deg, "camera": e.camera,
-                "alpha": alpha,
-                "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset, "colour": colour},
-                "normals": normals,
-                "albedo": {"image": albedo, "scale": e.albedo.1},
-                "flows": flows,
-            }));
-        }
+        let view_json: Vec<Value> = encoded
+            .into_iter()
+            .map(|e| add_view(&mut glb, &mut sizes, pose, e))
+            .collect();
         pose_json
             .push(json!({"pose": pose, "time_s": record.time_s, "node": node, "views": view_json}));
     }
@@ -320,9 +231,115 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     })
 }
 
+/// Poses, and views `(u, v)`.
+type Selection = (Vec<u32>, Vec<(usize, usize)>);
+
+/// The poses and views `options` ask for, checked against `field`, and the options
+/// checked.
+fn selection(field: &FieldFile, options: &ExportOptions) -> Result<Selection> {
+    let header = field.header();
+    let poses = match &options.poses {
+        Some(p) => p
+            .iter()
+            .map(|&p| field.pose_or_first(Some(p)))
+            .collect::<std::result::Result<Vec<_>, _>>()?,
+        None => header.pose_list(),
+    };
+    let wanted: Vec<(usize, usize)> = match &options.views {
+        ViewSelection::All => (0..header.columns)
+            .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
+            .collect(),
+        ViewSelection::Ring(v) if *v < header.rows => {
+            (0..header.columns).map(|u| (u, *v)).collect()
+        }
+        ViewSelection::Ring(v) => {
+            return Err(ExportError::Option(format!(
+                "--views ring {v}: the field has camera rows 0..{}",
+                header.rows
+            )));
+        }
+        ViewSelection::List(l) => {
+            if let Some(bad) = l
+                .iter()
+                .find(|(u, v)| *u >= header.columns || *v >= header.rows)
+            {
+                return Err(ExportError::Option(format!(
+                    "--views {},{}: outside the field's {}x{} grid",
+                    bad.0, bad.1, header.columns, header.rows
+                )));
+            }
+            l.clone()
+        }
+    };
+    if !(1..=100).contains(&options.jpeg_quality) {
+        return Err(ExportError::Option(format!(
+            "--jpeg-quality {}: expected 1 to 100",
+            options.jpeg_quality
+        )));
+    }
+    if !(options.mesh_voxel_m.is_finite()
+        && options.mesh_voxel_m > 0.0
+        && options.mesh_voxel_m <= 0.5)
+    {
+        return Err(ExportError::Option(format!(
+            "--mesh-voxel {}: expected a side in metres, above 0 and at most 0.5",
+            options.mesh_voxel_m
+        )));
+    }
+    Ok((poses, wanted))
+}
+
+/// Adds view `e` of `pose`'s images to `glb` (their bytes counted in `sizes`, by
+/// section) and returns its record in the extension.
+fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> Value {
+    let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
+    let before = glb.binary_bytes();
+    let rgb = ["red", "green", "blue"];
+    let atlas: Vec<usize> = (0..e.atlas.jpeg.len())
+        .map(|c| {
+            glb.image(
+                &e.atlas.jpeg[c],
+                "image/jpeg",
+                name(&format!("transfer {}", rgb[c])),
+            )
+        })
+        .collect();
+    let colour = e.colour.as_ref().map(|(png, scale)| {
+        json!({"image": glb.image(png, "image/png", name("transfer colour")), "scale": scale})
+    });
+    sizes[0] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let alpha = glb.image(&e.alpha, "image/png", name("alpha"));
+    sizes[1] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let normals = e
+        .normals
+        .as_ref()
+        .map(|n| glb.image(n, "image/png", name("normals")));
+    sizes[2] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let albedo = glb.image(&e.albedo.0, "image/png", name("albedo"));
+    sizes[3] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let mut flows = serde_json::Map::new();
+    for (n, bytes) in &e.flows {
+        let image = glb.image(bytes, "image/png", name(&format!("flow {}", n.name())));
+        flows.insert(n.name().to_string(), json!(image));
+    }
+    sizes[4] += (glb.binary_bytes() - before) as u64;
+    json!({
+        "u": e.u, "v": e.v, "turntable_deg": e.turntable_deg, "camera": e.camera,
+        "alpha": alpha,
+        "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset, "colour": colour},
+        "normals": normals,
+        "albedo": {"image": albedo, "scale": e.albedo.1},
+        "flows": flows,
+    })
+}
+
 /// A field of one view (an OLAT set) or one condition (a ring of photographs) has
 /// nothing to relight or morph between.
-fn frf_render_free_checks(field: &FieldFile) -> Result<()> {
+fn check_exportable(field: &FieldFile) -> Result<()> {
     let h = field.header();
     if h.columns * h.rows < 2 || h.conditions.len() < 2 {
         return Err(ExportError::Field(format!(
