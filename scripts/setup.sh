@@ -6,14 +6,17 @@
 # - Xvfb (a display without a screen), xauth and xdotool, for the viewer's tests (`frf view`
 #   under `xvfb-run`), and the X libraries winit opens at run time (cursor, input,
 #   keyboard) that they do not bring;
-# - Node.js and npm, and the web player's npm packages (player/package-lock.json: the
-#   Khronos glTF validator), for the export's tests;
+# - Node.js and npm, and the web player's npm packages (player/package-lock.json: three.js,
+#   fast-png, puppeteer-core and the Khronos glTF validator), for the export's and the
+#   player's tests;
+# - Debian's Chromium, the real browser the player's tests drive headless (software GL);
 # - the rustfmt and clippy components, for the checks in .ci/run.
 set -euo pipefail
 
 packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool libxcursor1 libxi6 libxkbcommon-x11-0)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
+command -v chromium >/dev/null 2>&1 || packages+=(chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

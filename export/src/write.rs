@@ -184,8 +184,17 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             .into_iter()
             .map(|e| add_view(&mut glb, &mut sizes, pose, e))
             .collect();
-        pose_json
-            .push(json!({"pose": pose, "time_s": record.time_s, "node": node, "views": view_json}));
+        // Every camera of the grid (u-major), the held views' and the others': a player
+        // re-bins rays through the cylinder of all their centres.
+        let cameras: Vec<Value> = (0..header.columns)
+            .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
+            .map(|(u, v)| camera_json(&record.views[header.view_index(u, v)].camera))
+            .collect();
+        // Where frf starts a sun's shadow ray from the hull (a player's sun does the same).
+        let offset = frf_reflectance::sun_light::shadow_offset_m(&hull);
+        pose_json.push(json!({"pose": pose, "time_s": record.time_s, "node": node,
+                              "cameras": cameras, "sun_shadow_offset_m": offset,
+                              "views": view_json}));
     }
     let animation = pose_animation(&mut glb, &poses, &header, &pose_json);
     let document = json!({
@@ -412,17 +421,22 @@ fn encode_view(
     let albedo = scaled_rgb_png(&albedo, w, h)?;
     let mut flows = Vec::new();
     for n in Neighbour::ALL {
-        if let Some(f) = field.flow(pose, u, v, n)? {
+        if let Some(mut f) = field.flow(pose, u, v, n)? {
+            // Beyond the subject as frf reads it when it loads a pose: each unknown texel
+            // takes its nearest known one's flow (docs/design.md section 4.2).
+            let (fw, fh) = f.size();
+            frf_core::filter::extend_nearest(f.pixels_mut(), fw, fh, |p| {
+                p[0].abs() < frf_core::flo::UNKNOWN_THRESHOLD
+                    && p[1].abs() < frf_core::flo::UNKNOWN_THRESHOLD
+            });
             flows.push((n, flow_png(&f)?));
         }
     }
-    let c = &rec.camera;
     Ok(ViewOut {
         u,
         v,
         turntable_deg: rec.turntable_deg,
-        camera: json!({"width": c.width, "height": c.height, "intrinsics": c.intrinsics,
-                       "world_from_camera": c.world_from_camera}),
+        camera: camera_json(&rec.camera),
         atlas,
         colour,
         alpha: alpha_png(&alpha)?,
@@ -430,6 +444,12 @@ fn encode_view(
         albedo,
         flows,
     })
+}
+
+/// A camera as the extension holds it.
+fn camera_json(c: &frf_reflectance::field::CameraRecord) -> Value {
+    json!({"width": c.width, "height": c.height, "intrinsics": c.intrinsics,
+           "world_from_camera": c.world_from_camera})
 }
 
 /// The walk: each pose's node at scale 1 from its time to the next pose's, 0 otherwise,

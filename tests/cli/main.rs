@@ -11,6 +11,7 @@ mod export;
 mod interrupt;
 mod olat;
 mod outputs;
+mod player;
 mod render;
 mod report;
 mod resume;

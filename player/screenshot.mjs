@@ -1,0 +1,113 @@
+// Renders one frame of a walker (`frf export`) in headless Chromium (software GL) and
+// writes it as a PNG (8-bit sRGB, straight alpha: as `frf render` writes its frames):
+//
+//   node player/screenshot.mjs --glb F --pose N --camera X,Y,Z --look-at X,Y,Z --fov DEG \
+//     --size WxH --sh SH.json [--sun AZ,EL,E] --out OUT.png [--time-frames K] [--json]
+//
+// The camera is frf's `look_at` (subject frame, +y up, vertical field of view in
+// degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun at azimuth AZ (from +z
+// toward +x) and elevation EL, degrees, of illuminance E, lighting by the normals.
+// `--time-frames K` times K frames after the first (ms per frame). Chromium is found at
+// $CHROMIUM, else /usr/bin/chromium (scripts/setup.sh installs it).
+import { readFile, writeFile, rename, stat } from 'node:fs/promises';
+import { basename, resolve } from 'node:path';
+import puppeteer from 'puppeteer-core';
+import { encode } from 'fast-png';
+import { serve } from './serve.mjs';
+
+function fail(message) {
+  console.error(`screenshot: ${message}`);
+  process.exit(1);
+}
+
+function parse(argv) {
+  const o = { pose: null, fov: 35, timeFrames: 0, json: false };
+  const numbers = (flag, text, n) => {
+    const v = text.split(',').map(Number);
+    if (v.length !== n || v.some((x) => !Number.isFinite(x))) fail(`${flag} ${text}: expected ${n} numbers separated by commas`);
+    return v;
+  };
+  // `--flag value` or `--flag=value` (the form for values starting with a minus sign).
+  argv = argv.flatMap((a) => (/^--[a-z-]+=/.test(a) ? [a.slice(0, a.indexOf('=')), a.slice(a.indexOf('=') + 1)] : [a]));
+  for (let i = 0; i < argv.length; i++) {
+    const flag = argv[i];
+    const value = () => {
+      if (i + 1 >= argv.length) fail(`${flag} needs a value`);
+      return argv[++i];
+    };
+    switch (flag) {
+      case '--glb': o.glb = value(); break;
+      case '--pose': o.pose = numbers(flag, value(), 1)[0]; break;
+      case '--camera': o.camera = numbers(flag, value(), 3); break;
+      case '--look-at': o.lookAt = numbers(flag, value(), 3); break;
+      case '--fov': o.fov = numbers(flag, value(), 1)[0]; break;
+      case '--size': {
+        const m = /^(\d+)x(\d+)$/.exec(value());
+        if (!m) fail(`--size ${argv[i]}: expected WxH`);
+        [o.width, o.height] = [Number(m[1]), Number(m[2])];
+        break;
+      }
+      case '--sh': o.sh = value(); break;
+      case '--sun': o.sun = numbers(flag, value(), 3); break;
+      case '--out': o.out = value(); break;
+      case '--time-frames': o.timeFrames = numbers(flag, value(), 1)[0]; break;
+      case '--json': o.json = true; break;
+      default: fail(`unknown flag ${flag}`);
+    }
+  }
+  for (const k of ['glb', 'camera', 'sh', 'out', 'width']) {
+    if (o[k] === undefined) fail(`--${k === 'width' ? 'size' : k} is required`);
+  }
+  o.lookAt ??= [0, 0.9, 0];
+  if (!(o.width >= 1 && o.height >= 1 && o.width <= 8192 && o.height <= 8192)) fail(`--size ${o.width}x${o.height}: 1 to 8192 pixels a side`);
+  if (!(o.fov > 0.1 && o.fov < 170)) fail(`--fov ${o.fov}: expected degrees in (0.1, 170)`);
+  if (!(Number.isInteger(o.timeFrames) && o.timeFrames >= 0 && o.timeFrames <= 1000)) fail(`--time-frames ${o.timeFrames}: 0 to 1000`);
+  if (o.sun && !(o.sun[2] >= 0)) fail(`--sun ${o.sun}: the illuminance must be at least 0`);
+  return o;
+}
+
+const o = parse(process.argv.slice(2));
+const glbPath = resolve(o.glb);
+await stat(glbPath).catch(() => fail(`${o.glb}: no such file`));
+const shText = await readFile(o.sh, 'utf8').catch((e) => fail(`${o.sh}: ${e.message}`));
+const server = await serve(0, { '/job/walker.glb': glbPath });
+const base = `http://127.0.0.1:${server.address().port}`;
+const browser = await puppeteer.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  headless: true,
+  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox',
+    '--disable-dev-shm-usage', '--js-flags=--max-old-space-size=8192'],
+});
+let result;
+try {
+  const page = await browser.newPage();
+  const logs = [];
+  page.on('console', (m) => logs.push(m.text()));
+  page.on('pageerror', (e) => logs.push(String(e)));
+  await page.goto(`${base}/headless.html`);
+  await page.waitForFunction('window.frfReady === true', { timeout: 60000 }).catch(() => {
+    throw new Error(`the player's page did not start: ${logs.join(' | ')}`);
+  });
+  result = await page.evaluate((job) => window.frfRender(job), {
+    glbUrl: '/job/walker.glb', glbName: basename(o.glb), shText, shName: basename(o.sh),
+    pose: o.pose, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
+    sun: o.sun ?? null, timedFrames: o.timeFrames,
+  });
+} catch (e) {
+  await browser.close();
+  server.close();
+  fail(String(e.message ?? e).replace(/^Error: /, '').split('\n')[0]);
+}
+await browser.close();
+server.close();
+const rgba = Buffer.from(result.rgba, 'base64');
+const png = encode({ width: o.width, height: o.height, data: new Uint8Array(rgba), channels: 4, depth: 8 });
+const tmp = `${o.out}.tmp-${process.pid}`;
+await writeFile(tmp, png);
+await rename(tmp, o.out);
+const report = {
+  out: o.out, pose: result.pose, width: o.width, height: o.height,
+  ms_per_frame: result.msPerFrame, timed_frames: o.timeFrames, load_ms: result.loadMs,
+  gl_renderer: result.renderer, notes: result.notes,
+};
+console.log(o.json ? JSON.stringify(report) : `wrote ${o.out} (${o.width}x${o.height}, pose ${result.pose}${result.msPerFrame ? `, ${result.msPerFrame.toFixed(1)} ms per frame on ${result.renderer}` : ''})`);

@@ -1,0 +1,198 @@
+// The geometry a pose is drawn with, computed once per pose on the CPU: the grid's
+// cameras, the cylinder of their centres (quads and the walls above and below it) and
+// each quad's rectified frame. Twins of frf's `render/src/cylinder.rs`,
+// `render/src/rectified.rs` and `render/src/geometry.rs` (docs/design.md sections 4.2
+// and 4.3 derive them); the frame shader (shaders.js) reads them from data textures.
+
+const WALL_HEIGHT_M = 1e3;
+
+const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const scale = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const length = (a) => Math.sqrt(dot(a, a));
+const normalizeOrZero = (a) => {
+  const l = length(a);
+  return l > 0 ? scale(a, 1 / l) : [0, 0, 0];
+};
+
+/** A camera of the extension: intrinsics, rotation columns (right, down, forward), centre. */
+export function cameraOf(record) {
+  const m = record.world_from_camera;
+  const [fx, fy, cx, cy] = record.intrinsics;
+  return {
+    width: record.width,
+    height: record.height,
+    k: { fx, fy, cx, cy },
+    // Columns of R: the camera's axes in the subject frame.
+    axes: [0, 1, 2].map((j) => [m[0][j], m[1][j], m[2][j]]),
+    centre: [m[0][3], m[1][3], m[2][3]],
+  };
+}
+
+/** The camera frf's `Camera::look_at` makes (vertical field of view in radians). */
+export function lookAt(eye, target, fovY, width, height) {
+  const forward = normalizeOrZero(sub(target, eye));
+  const right = normalizeOrZero(cross(forward, [0, 1, 0]));
+  if (length(forward) === 0 || length(right) === 0) {
+    throw new Error(`camera at ${eye} looking at ${target}: no view direction, or straight up or down`);
+  }
+  const down = cross(forward, right);
+  const f = height / 2 / Math.tan(fovY / 2);
+  return {
+    width,
+    height,
+    k: { fx: f, fy: f, cx: (width - 1) / 2, cy: (height - 1) / 2 },
+    axes: [right, down, forward],
+    centre: eye,
+  };
+}
+
+// 3x3 matrices as arrays of three columns.
+const matMul = (a, b) => b.map((col) => [0, 1, 2].map((r) => a[0][r] * col[0] + a[1][r] * col[1] + a[2][r] * col[2]));
+const transpose = (m) => [0, 1, 2].map((c) => [m[0][c], m[1][c], m[2][c]]);
+function inverse(m) {
+  const [a, b, c] = m; // columns
+  const r0 = cross(b, c);
+  const r1 = cross(c, a);
+  const r2 = cross(a, b);
+  const det = dot(a, r0);
+  if (!(Math.abs(det) > 0)) return null;
+  // Rows of the inverse are r0, r1, r2 over det: as columns, transpose.
+  return transpose([scale(r0, 1 / det), scale(r1, 1 / det), scale(r2, 1 / det)]);
+}
+const kMatrix = (k) => [[k.fx, 0, 0], [0, k.fy, 0], [k.cx, k.cy, 1]];
+const kInverse = (k) => [[1 / k.fx, 0, 0], [0, 1 / k.fy, 0], [-k.cx / k.fx, -k.cy / k.fy, 1]];
+
+/** The point nearest, in the least-squares sense, to the optical axes of `cams`. */
+function fixation(cams) {
+  let a = [[0, 0, 0], [0, 0, 0], [0, 0, 0]];
+  let b = [0, 0, 0];
+  for (const c of cams) {
+    const d = c.axes[2];
+    const m = [0, 1, 2].map((j) => [0, 1, 2].map((i) => (i === j ? 1 : 0) - d[i] * d[j]));
+    a = a.map((col, j) => add(col, m[j]));
+    b = add(b, matMul(m, [c.centre])[0]);
+  }
+  const det = dot(a[0], cross(a[1], a[2]));
+  if (Math.abs(det) <= 1e-9) return null;
+  return matMul(inverse(a), [b])[0];
+}
+
+/** The rectified frame of the quad of cameras [A, B, C, D] (twin of `QuadFrame::new`), or null. */
+export function quadFrame(cams) {
+  const c = cams.map((k) => k.centre);
+  const forward = cams.reduce((s, k) => add(s, k.axes[2]), [0, 0, 0]);
+  const diagonal = cross(sub(c[3], c[0]), sub(c[2], c[1]));
+  const d30 = sub(c[3], c[0]);
+  let n = length(diagonal) > 1e-6 * Math.max(dot(d30, d30), 1e-12)
+    ? normalizeOrZero(diagonal)
+    : normalizeOrZero(cross(sub(c[1], c[0]), [0, 1, 0]));
+  if (dot(n, forward) < 0) n = scale(n, -1);
+  if (length(n) === 0 || dot(n, normalizeOrZero(forward)) < 0.2) return null;
+  const right = cams.reduce((s, k) => add(s, k.axes[0]), [0, 0, 0]);
+  const x = normalizeOrZero(sub(right, scale(n, dot(right, n))));
+  if (length(x) === 0) return null;
+  const rotation = [x, cross(n, x), n];
+  const mean = (f) => cams.reduce((s, k) => s + f(k.k), 0) / 4;
+  const k = { fx: mean((q) => q.fx), fy: mean((q) => q.fy), cx: mean((q) => q.cx), cy: mean((q) => q.cy) };
+  const kq = kMatrix(k);
+  const rt = transpose(rotation);
+  const toRectified = cams.map((cam) => matMul(matMul(matMul(kq, rt), cam.axes), kInverse(cam.k)));
+  const fromRectified = toRectified.map(inverse);
+  if (fromRectified.some((h) => !h || h.flat().some((v) => !Number.isFinite(v)))) return null;
+  const centres = c.map((p) => matMul(rt, [p])[0].slice(0, 2));
+  const meanCentre = scale(c.reduce(add, [0, 0, 0]), 0.25);
+  const p = fixation(cams);
+  let depth = p ? dot(n, sub(p, meanCentre)) : NaN;
+  if (!(Number.isFinite(depth) && depth > 1e-3)) depth = 1;
+  return { rotation, k, toRectified, fromRectified, centres, fixationDepth: depth };
+}
+
+/** One quad of the cylinder (twin of `Quad::new`): wall 0 inside, 1 above, 2 below. */
+function quad(u, v, [p00, p10, p01, p11], wall, wallGamma) {
+  return {
+    u, v, p00,
+    e1: sub(p10, p00),
+    e2: sub(p01, p00),
+    e3: add(sub(sub(p00, p10), p01), p11),
+    normal: normalizeOrZero(cross(sub(p11, p00), sub(p01, p10))),
+    wall, wallGamma,
+  };
+}
+
+/**
+ * A pose's geometry: the grid's cameras (u-major), the cylinder's quads (twin of
+ * `Cylinder::new`), the rectified frames (twin of `PoseGeometry::new`) and the
+ * fallback axis of the proxy (the hull's box centre).
+ */
+export function poseGeometry(grid, cameraRecords, hullPositions) {
+  const { columns, rows, wraps } = grid;
+  const cameras = cameraRecords.map(cameraOf);
+  const at = (u, v) => cameras[(u % columns) * rows + Math.min(v, rows - 1)];
+  const centre = (u, v) => at(u, v).centre;
+  const spans = wraps ? columns : columns - 1;
+  const up = [0, WALL_HEIGHT_M, 0];
+  const quads = [];
+  for (let u = 0; u < spans; u++) {
+    for (let v = 0; v + 1 < rows; v++) {
+      quads.push(quad(u, v, [centre(u, v), centre(u + 1, v), centre(u, v + 1), centre(u + 1, v + 1)], 0, 0));
+    }
+    const top = rows - 1;
+    const [vt, gt] = rows >= 2 ? [rows - 2, 1] : [0, 0];
+    quads.push(quad(u, vt, [centre(u, top), centre(u + 1, top), add(centre(u, top), up), add(centre(u + 1, top), up)], 1, gt));
+    quads.push(quad(u, 0, [centre(u, 0), centre(u + 1, 0), sub(centre(u, 0), up), sub(centre(u + 1, 0), up)], 2, 0));
+  }
+  const frameRows = Math.max(rows - 1, 1);
+  const frames = [];
+  for (let i = 0; i < columns * frameRows; i++) {
+    const u = Math.floor(i / frameRows);
+    const v = i % frameRows;
+    const top = rows > 1 ? v + 1 : v;
+    frames.push(quadFrame([at(u, v), at(u + 1, v), at(u, top), at(u + 1, top)]));
+  }
+  let lo = [Infinity, Infinity, Infinity];
+  let hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < hullPositions.length; i += 3) {
+    for (let a = 0; a < 3; a++) {
+      lo[a] = Math.min(lo[a], hullPositions[i + a]);
+      hi[a] = Math.max(hi[a], hullPositions[i + a]);
+    }
+  }
+  const axis = hullPositions.length ? [(lo[0] + hi[0]) / 2, (lo[2] + hi[2]) / 2] : [0, 0];
+  return { cameras, quads, frames, frameRows, axis, hasHull: hullPositions.length > 0 };
+}
+
+/** Quads as RGBA32F texels, 5 per quad: p00+u, e1+v, e2+wall, e3+wallGamma, normal. */
+export function quadTexels(quads) {
+  const out = new Float32Array(quads.length * 5 * 4);
+  quads.forEach((q, i) => {
+    out.set([...q.p00, q.u, ...q.e1, q.v, ...q.e2, q.wall, ...q.e3, q.wallGamma, ...q.normal, 0], i * 20);
+  });
+  return out;
+}
+
+/** Per frame 32 RGBA32F texels (the layout `frameTexel` of shaders.js reads). */
+export const FRAME_TEXELS = 32;
+export function frameTexels(frames) {
+  const out = new Float32Array(frames.length * FRAME_TEXELS * 4);
+  frames.forEach((f, i) => {
+    if (!f) return; // valid = 0
+    const t = [];
+    t.push(...f.rotation[0], 1, ...f.rotation[1], 0, ...f.rotation[2], 0);
+    t.push(f.k.fx, f.k.fy, f.k.cx, f.k.cy);
+    for (const h of f.toRectified) for (const col of h) t.push(...col, 0);
+    for (const h of f.fromRectified) for (const col of h) t.push(...col, 0);
+    const c = f.centres;
+    t.push(c[0][0], c[0][1], c[1][0], c[1][1], c[2][0], c[2][1], c[3][0], c[3][1]);
+    t.push(f.fixationDepth, 0, 0, 0);
+    out.set(t, i * FRAME_TEXELS * 4);
+  });
+  return out;
+}
+
+/** The direction toward a sun at `azimuth`, `elevation` (radians): frf's convention. */
+export function sunDirection(azimuth, elevation) {
+  return [Math.sin(azimuth) * Math.cos(elevation), Math.sin(elevation), Math.cos(azimuth) * Math.cos(elevation)];
+}

@@ -1,0 +1,67 @@
+// The page the headless screenshot drives (screenshot.mjs): renders one frame of a pose
+// into a float target and hands back straight-alpha sRGB codes, as `frf render` writes
+// its PNG frames, and the time per frame.
+import * as THREE from 'three';
+import { FrfPlayer } from './player.js';
+import { parseShLight } from './sh.js';
+import { sunDirection } from './geometry.js';
+
+THREE.ColorManagement.enabled = false;
+
+/** linear -> sRGB code, clamped. */
+function srgbCode(x) {
+  const v = Math.min(Math.max(x, 0), 1);
+  const s = v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055;
+  return Math.round(s * 255);
+}
+
+window.frfRender = async (job) => {
+  const canvas = document.createElement('canvas');
+  canvas.width = job.width;
+  canvas.height = job.height;
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, alpha: true, preserveDrawingBuffer: true });
+  const player = new FrfPlayer(renderer);
+  const response = await fetch(job.glbUrl);
+  if (!response.ok) throw new Error(`${job.glbName}: ${response.status} ${response.statusText}`);
+  const bytes = new Uint8Array(await response.arrayBuffer());
+  const started = performance.now();
+  const ext = player.load(bytes, job.glbName);
+  const sh = parseShLight(job.shText, job.shName, ext.sh);
+  const sun = job.sun
+    ? { direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180), illuminance: [job.sun[2], job.sun[2], job.sun[2]] }
+    : undefined;
+  player.setLight(sh, sun);
+  const pose = job.pose ?? player.poseNumbers()[0];
+  await player.preparePose(pose);
+  const loadMs = performance.now() - started;
+  const camera = FrfPlayer.camera(job.camera, job.lookAt, job.fov, job.width, job.height);
+  const target = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+  const pixels = new Float32Array(4 * job.width * job.height);
+  const gl = renderer.getContext();
+  // One frame to compile, then the timed ones (each waits for the GPU by a readback).
+  player.draw(pose, camera, target);
+  renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
+  const t0 = performance.now();
+  for (let i = 0; i < job.timedFrames; i++) {
+    player.draw(pose, camera, target);
+    gl.finish();
+    renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
+  }
+  const msPerFrame = job.timedFrames > 0 ? (performance.now() - t0) / job.timedFrames : null;
+  renderer.readRenderTargetPixels(target, 0, 0, job.width, job.height, pixels);
+  // Rows bottom up in the target; the PNG's top down. Straight alpha, sRGB.
+  const out = new Uint8Array(4 * job.width * job.height);
+  for (let y = 0; y < job.height; y++) {
+    for (let x = 0; x < job.width; x++) {
+      const i = 4 * ((job.height - 1 - y) * job.width + x);
+      const o = 4 * (y * job.width + x);
+      const a = Math.min(Math.max(pixels[i + 3], 0), 1);
+      for (let c = 0; c < 3; c++) out[o + c] = a > 0 ? srgbCode(pixels[i + c] / a) : 0;
+      out[o + 3] = Math.round(a * 255);
+    }
+  }
+  let binary = '';
+  for (let i = 0; i < out.length; i += 0x8000) binary += String.fromCharCode(...out.subarray(i, i + 0x8000));
+  return { rgba: btoa(binary), msPerFrame, loadMs, pose, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+};
+window.frfReady = true;

@@ -1,0 +1,453 @@
+// The reference web player of frf's walker exports (docs/export.md): a pose's views are
+// relit on the GPU by an L2 light (the SH transfer) and an optional sun (the fitted
+// normals and albedo) into pre-lit layers, and each frame re-bins every pixel's ray
+// through the cylinder of camera centres and morphs the quad's views by the solved
+// four-way morph, as `frf render` does. A pose's textures are made when it is first
+// shown and kept; the pre-lit layers are redone when the light changes.
+import * as THREE from 'three';
+import { parseGlb, poseMesh, BadFile } from './glb.js';
+import { png, greyJpeg, expect } from './images.js';
+import { poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt } from './geometry.js';
+import {
+  FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
+  SUN_MAP_VERTEX, SUN_MAP_FRAGMENT,
+} from './shaders.js';
+
+/** The sun's map of the hull, texels a side. */
+const SUN_MAP_SIZE = 512;
+/**
+ * How far toward the sun a texel's shadow ray starts from the hull, as a fraction of the
+ * hull's height, where the export does not say (frf's `SHADOW_OFFSET_PER_HEIGHT` is of
+ * its hull grid's height, which the export gives as `sun_shadow_offset_m`).
+ */
+const SHADOW_OFFSET_PER_HEIGHT = 0.17;
+
+const NEIGHBOURS = ['right', 'left', 'up', 'down'];
+
+function arrayTexture(data, width, height, depth, format, type) {
+  const t = new THREE.DataArrayTexture(data, width, height, depth);
+  t.format = format;
+  t.type = type;
+  t.minFilter = THREE.NearestFilter;
+  t.magFilter = THREE.NearestFilter;
+  t.unpackAlignment = 1;
+  t.needsUpdate = true;
+  return t;
+}
+
+function dataTexture(data, width, height) {
+  const t = new THREE.DataTexture(data, width, height, THREE.RGBAFormat, THREE.FloatType);
+  t.minFilter = THREE.NearestFilter;
+  t.magFilter = THREE.NearestFilter;
+  t.needsUpdate = true;
+  return t;
+}
+
+function fullscreen(material) {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.frustumCulled = false;
+  const scene = new THREE.Scene();
+  scene.add(mesh);
+  return scene;
+}
+
+/** A light: nine RGB radiance coefficients (three.js order) and an optional sun. */
+export const NO_SUN = { direction: [0, 1, 0], illuminance: [0, 0, 0] };
+
+export class FrfPlayer {
+  /** `renderer`: a THREE.WebGLRenderer (WebGL 2). */
+  constructor(renderer) {
+    this.renderer = renderer;
+    this.poses = new Map();
+    this.sh = Array.from({ length: 9 }, () => [0, 0, 0]);
+    this.sun = NO_SUN;
+    this.lightVersion = 0;
+    this.camera = new THREE.Camera();
+    this.prelitMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: PRELIT_FRAGMENT,
+      uniforms: {
+        uAtlas: { value: null }, uAlpha: { value: null }, uNormals: { value: null }, uAlbedo: { value: null },
+        uLayer: { value: 0 }, uCompact: { value: 0 },
+        uScale: { value: [] }, uOffset: { value: [] }, uSh: { value: [] },
+        uAlbedoScale: { value: new THREE.Vector3() }, uColourScale: { value: new THREE.Vector3() },
+        uSunDir: { value: new THREE.Vector3() }, uSunE: { value: new THREE.Vector3() }, uHasNormals: { value: 0 },
+        uViewHull: { value: null }, uViewCentre: { value: new THREE.Vector3() }, uViewAxes: { value: new THREE.Matrix3() },
+        uViewK: { value: new THREE.Vector4() }, uSunMap: { value: null }, uSunAxisX: { value: new THREE.Vector3() },
+        uSunAxisY: { value: new THREE.Vector3() }, uSunBox: { value: new THREE.Vector4() }, uSunOffset: { value: -1 },
+      },
+      depthTest: false, depthWrite: false,
+    });
+    this.prelitScene = fullscreen(this.prelitMaterial);
+    this.frameMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: FRAME_FRAGMENT,
+      uniforms: {
+        uEye: { value: new THREE.Vector3() }, uAxes: { value: new THREE.Matrix3() }, uK: { value: new THREE.Vector4() },
+        uHeight: { value: 0 }, uQuads: { value: null }, uQuadCount: { value: 0 }, uFrames: { value: null },
+        uViews: { value: null }, uColumns: { value: 0 }, uRows: { value: 0 }, uFrameRows: { value: 0 },
+        uPrelit: { value: null }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
+        uAxis: { value: new THREE.Vector2() },
+      },
+      depthTest: false, depthWrite: false, transparent: false, blending: THREE.NoBlending,
+    });
+    this.frameScene = fullscreen(this.frameMaterial);
+    this.sunMapMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: SUN_MAP_VERTEX, fragmentShader: SUN_MAP_FRAGMENT,
+      uniforms: {
+        uSunDir: { value: new THREE.Vector3() }, uSunAxisX: { value: new THREE.Vector3() },
+        uSunAxisY: { value: new THREE.Vector3() }, uSunBox: { value: new THREE.Vector4() }, uReach: { value: new THREE.Vector2() },
+      },
+      side: THREE.DoubleSide,
+    });
+    this.hullMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: HULL_VERTEX, fragmentShader: HULL_FRAGMENT,
+      uniforms: { uViewProjection: { value: new THREE.Matrix4() }, uEye: { value: new THREE.Vector3() } },
+      side: THREE.DoubleSide,
+    });
+  }
+
+  /** Reads an export's bytes (`name` for messages); throws BadFile on a bad file. */
+  load(bytes, name) {
+    this.glb = parseGlb(bytes, name);
+    this.ext = this.glb.ext;
+    this.grid = this.ext.grid;
+    this.notes = [];
+    if (this.ext.poses.some((p) => p.views.some((v) => v.normals === null || v.normals === undefined))) {
+      this.notes.push(`${name} holds no fitted normals for some views: a sun lights only the SH part there`);
+    }
+    for (const p of this.poses.values()) p.dispose();
+    this.poses.clear();
+    return this.ext;
+  }
+
+  /** The pose numbers the export holds, in order. */
+  poseNumbers() { return this.ext.poses.map((p) => p.pose); }
+
+  /** The L2 light (9 RGB radiance coefficients) and an optional sun { direction, illuminance RGB }. */
+  setLight(sh, sun = NO_SUN) {
+    if (!Array.isArray(sh) || sh.length !== 9 || sh.some((c) => c.length !== 3 || c.some((v) => !Number.isFinite(v)))) {
+      throw new Error('an L2 light is nine finite [r, g, b] coefficients');
+    }
+    this.sh = sh.map((c) => [...c]);
+    this.sun = sun;
+    this.lightVersion++;
+  }
+
+  /** Makes pose `number` ready to draw (decoding its images the first time) and relit. */
+  async preparePose(number) {
+    let pose = this.poses.get(number);
+    if (!pose) {
+      const record = this.ext.poses.find((p) => p.pose === number);
+      if (!record) throw new BadFile(this.glb.name, `pose ${number} is not in the export (it has ${this.poseNumbers().join(', ')})`);
+      pose = await this.#makePose(record);
+      this.poses.set(number, pose);
+    }
+    if (pose.lightVersion !== this.lightVersion) {
+      this.#relight(pose);
+      pose.lightVersion = this.lightVersion;
+    }
+    return pose;
+  }
+
+  async #makePose(record) {
+    const { width: w, height: h, columns, rows } = this.grid;
+    const glb = this.glb;
+    const compact = this.ext.tier === 'compact';
+    const views = record.views;
+    const n = views.length;
+    const mesh = poseMesh(glb, record);
+    const geometry = poseGeometry(this.grid, record.cameras, mesh.positions);
+    const channels = compact ? 1 : 3;
+    const atlas = new Uint8Array(9 * w * h * channels * n);
+    const alpha = new Uint8Array(w * h * n);
+    const normals = new Uint8Array(4 * w * h * n);
+    const albedo = new Uint8Array(4 * w * h * 2 * n);
+    const flowCount = views.reduce((s, v) => s + NEIGHBOURS.filter((k) => v.flows?.[k] !== undefined).length, 0);
+    const flows = new Float32Array(2 * w * h * Math.max(flowCount, 1));
+    const viewTable = new Float32Array(columns * rows * 2 * 4).fill(-1);
+    geometry.cameras.forEach((c, g) => viewTable.set([...c.centre, -1], g * 8));
+    let flowLayer = 0;
+    for (let i = 0; i < n; i++) {
+      const v = views[i];
+      const what = (s) => `pose ${record.pose} view ${v.u},${v.v} ${s}`;
+      for (let c = 0; c < channels; c++) {
+        const img = await greyJpeg(glb, v.transfer.images[c], what('transfer'));
+        expect(glb, img, 3 * w, 3 * h, null, what('transfer atlas'));
+        atlas.set(img.data, (i * channels + c) * 9 * w * h);
+      }
+      const a = png(glb, v.alpha, what('alpha'));
+      expect(glb, a, w, h, 1, what('alpha'));
+      alpha.set(a.data, i * w * h);
+      if (v.normals !== null && v.normals !== undefined) {
+        const nm = png(glb, v.normals, what('normals'));
+        expect(glb, nm, w, h, 4, what('normals'));
+        normals.set(nm.data, i * 4 * w * h);
+      }
+      const rgbInto = (img, layer) => {
+        for (let t = 0; t < w * h; t++) {
+          albedo.set([img.data[3 * t], img.data[3 * t + 1], img.data[3 * t + 2], 255], (layer * w * h + t) * 4);
+        }
+      };
+      const al = png(glb, v.albedo.image, what('albedo'));
+      expect(glb, al, w, h, 3, what('albedo'));
+      rgbInto(al, 2 * i);
+      if (compact) {
+        const col = png(glb, v.transfer.colour.image, what('transfer colour'));
+        expect(glb, col, w, h, 3, what('transfer colour'));
+        rgbInto(col, 2 * i + 1);
+      }
+      const g = v.u * rows + v.v;
+      viewTable[g * 8 + 3] = i;
+      NEIGHBOURS.forEach((k, d) => {
+        if (v.flows?.[k] === undefined) return;
+        const f = png(glb, v.flows[k], what(`flow ${k}`));
+        expect(glb, f, w, h, 2, what(`flow ${k}`));
+        if (f.depth !== 16) throw new BadFile(glb.name, `${what(`flow ${k}`)}: ${f.depth}-bit, expected 16-bit`);
+        const out = flows.subarray(flowLayer * 2 * w * h, (flowLayer + 1) * 2 * w * h);
+        for (let t = 0; t < 2 * w * h; t++) out[t] = f.data[t] / 256 - 128;
+        viewTable[g * 8 + 4 + d] = flowLayer;
+        flowLayer++;
+      });
+    }
+    const pose = {
+      record, geometry, n,
+      atlas: arrayTexture(atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
+      alpha: arrayTexture(alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
+      normals: arrayTexture(normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
+      albedo: arrayTexture(albedo, w, h, 2 * n, THREE.RGBAFormat, THREE.UnsignedByteType),
+      flows: arrayTexture(flows, w, h, Math.max(flowCount, 1), THREE.RGFormat, THREE.FloatType),
+      views: dataTexture(viewTable, 2, columns * rows),
+      quads: dataTexture(quadTexels(geometry.quads), 5, geometry.quads.length),
+      frames: dataTexture(frameTexels(geometry.frames), FRAME_TEXELS, geometry.frames.length),
+      prelit: new THREE.WebGLArrayRenderTarget(w, h, n, {
+        type: THREE.HalfFloatType, format: THREE.RGBAFormat, depthBuffer: false,
+        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      }),
+      hull: this.#hullMesh(mesh),
+      mesh,
+      viewHull: new THREE.WebGLArrayRenderTarget(w, h, n, {
+        type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
+        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      }),
+      shadowOffset: record.sun_shadow_offset_m ?? SHADOW_OFFSET_PER_HEIGHT * meshHeight(mesh.positions),
+      lightVersion: -1,
+      hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
+      dispose() {
+        for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t.dispose();
+        this.prelit.dispose();
+        this.viewHull.dispose();
+        this.hull.geometry.dispose();
+      },
+    };
+    // Each view texel's distance to the hull along its ray (the sun's shadow rays start there).
+    views.forEach((v, i) => {
+      const camera = geometry.cameras[v.u * rows + v.v];
+      this.#drawHull(pose, camera, pose.viewHull, i, false);
+    });
+    return pose;
+  }
+
+  #hullMesh(mesh) {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
+    g.setIndex(new THREE.BufferAttribute(mesh.indices, 1));
+    const m = new THREE.Mesh(g, this.hullMaterial);
+    m.frustumCulled = false;
+    return m;
+  }
+
+  #relight(pose) {
+    const u = this.prelitMaterial.uniforms;
+    const compact = this.ext.tier === 'compact';
+    u.uAtlas.value = pose.atlas;
+    u.uAlpha.value = pose.alpha;
+    u.uNormals.value = pose.normals;
+    u.uAlbedo.value = pose.albedo;
+    u.uCompact.value = compact ? 1 : 0;
+    u.uSh.value = this.sh.map((c) => new THREE.Vector3(...c));
+    u.uSunDir.value.set(...this.sun.direction);
+    u.uSunE.value.set(...this.sun.illuminance);
+    u.uViewHull.value = pose.viewHull.texture;
+    const shadows = this.sun.illuminance.some((e) => e > 0) && pose.geometry.hasHull;
+    u.uSunOffset.value = shadows ? pose.shadowOffset : -1;
+    if (shadows) this.#sunMap(pose, u);
+    const saved = this.renderer.getRenderTarget();
+    pose.record.views.forEach((v, i) => {
+      const camera = pose.geometry.cameras[v.u * this.grid.rows + v.v];
+      const [r, d, f] = camera.axes;
+      u.uViewCentre.value.set(...camera.centre);
+      u.uViewAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
+      u.uViewK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
+      u.uLayer.value = i;
+      u.uScale.value = v.transfer.scale.map((c) => new THREE.Vector3(...c));
+      u.uOffset.value = v.transfer.offset.map((c) => new THREE.Vector3(...c));
+      u.uAlbedoScale.value.set(...v.albedo.scale);
+      if (compact) u.uColourScale.value.set(...v.transfer.colour.scale);
+      u.uHasNormals.value = pose.hasNormals[i] ? 1 : 0;
+      this.renderer.setRenderTarget(pose.prelit, i);
+      this.renderer.render(this.prelitScene, this.camera);
+    });
+    this.renderer.setRenderTarget(saved);
+  }
+
+  /** The camera frf's `Camera::look_at` makes: eye, target (metres), vertical fov (degrees). */
+  static camera(eye, target, fovDeg, width, height) {
+    return lookAt(eye, target, (fovDeg * Math.PI) / 180, width, height);
+  }
+
+  /**
+   * Draws pose `number` (prepared) from `camera` (FrfPlayer.camera) into `target` (a
+   * render target of the camera's size, or null for the canvas): premultiplied linear RGBA.
+   */
+  draw(number, camera, target) {
+    const pose = this.poses.get(number);
+    if (!pose || pose.lightVersion !== this.lightVersion) throw new Error(`pose ${number} is not prepared`);
+    const hullTarget = this.#hullTarget(camera.width, camera.height);
+    const saved = this.renderer.getRenderTarget();
+    this.#drawHull(pose, camera, hullTarget, 0, true);
+    // The frame pass.
+    const u = this.frameMaterial.uniforms;
+    const [r, d, f] = camera.axes;
+    u.uEye.value.set(...camera.centre);
+    u.uAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
+    u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
+    u.uHeight.value = camera.height;
+    u.uQuads.value = pose.quads;
+    u.uQuadCount.value = pose.geometry.quads.length;
+    u.uFrames.value = pose.frames;
+    u.uViews.value = pose.views;
+    u.uColumns.value = this.grid.columns;
+    u.uRows.value = this.grid.rows;
+    u.uFrameRows.value = pose.geometry.frameRows;
+    u.uPrelit.value = pose.prelit.texture;
+    u.uFlows.value = pose.flows;
+    u.uHullT.value = hullTarget.texture;
+    u.uHasHull.value = pose.geometry.hasHull ? 1 : 0;
+    u.uAxis.value.set(...pose.geometry.axis);
+    this.renderer.setRenderTarget(target);
+    this.renderer.render(this.frameScene, this.camera);
+    this.renderer.setRenderTarget(saved);
+  }
+
+  /**
+   * The hull pass: each pixel's distance to the hull along its ray plus 1, 0 where none,
+   * into `target` (layer `layer` of an array target); rows bottom up when `flipRows` (a
+   * frame), top down (a view's layer, read as its data textures are).
+   */
+  #drawHull(pose, camera, target, layer, flipRows) {
+    const hu = this.hullMaterial.uniforms;
+    hu.uViewProjection.value.copy(viewProjection(camera, flipRows));
+    hu.uEye.value.set(...camera.centre);
+    const saved = this.renderer.getRenderTarget();
+    this.renderer.setRenderTarget(target, layer);
+    this.renderer.setClearColor(0x000000, 0);
+    this.renderer.clear(true, true, false);
+    const scene = new THREE.Scene();
+    scene.add(pose.hull);
+    this.renderer.render(scene, this.camera);
+    this.renderer.setRenderTarget(saved);
+  }
+
+  /** The sun's map of the pose's hull (`SunDepth` of frf), and its uniforms in `u`. */
+  #sunMap(pose, u) {
+    const l = this.sun.direction;
+    const axisX = new THREE.Vector3(...l).cross(Math.abs(l[1]) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0)).normalize();
+    const axisY = new THREE.Vector3(...l).cross(axisX).normalize();
+    const p = pose.mesh.positions;
+    const lo = [Infinity, Infinity, Infinity];
+    const hi = [-Infinity, -Infinity, -Infinity];
+    const sun = new THREE.Vector3(...l);
+    const q = new THREE.Vector3();
+    for (let i = 0; i < p.length; i += 3) {
+      q.set(p[i], p[i + 1], p[i + 2]);
+      const v = [axisX.dot(q), axisY.dot(q), sun.dot(q)];
+      for (let a = 0; a < 3; a++) {
+        lo[a] = Math.min(lo[a], v[a]);
+        hi[a] = Math.max(hi[a], v[a]);
+      }
+    }
+    const margin = 0.05;
+    const box = new THREE.Vector4(lo[0] - margin, lo[1] - margin, hi[0] + margin, hi[1] + margin);
+    this.sunTarget ??= new THREE.WebGLRenderTarget(SUN_MAP_SIZE, SUN_MAP_SIZE, {
+      type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
+      minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+    });
+    const m = this.sunMapMaterial.uniforms;
+    m.uSunDir.value.copy(sun);
+    m.uSunAxisX.value.copy(axisX);
+    m.uSunAxisY.value.copy(axisY);
+    m.uSunBox.value.copy(box);
+    m.uReach.value.set(lo[2] - margin, hi[2] + margin);
+    const saved = this.renderer.getRenderTarget();
+    this.renderer.setRenderTarget(this.sunTarget);
+    this.renderer.setClearColor(0x000000, 0);
+    this.renderer.clear(true, true, false);
+    const mesh = new THREE.Mesh(pose.hull.geometry, this.sunMapMaterial);
+    mesh.frustumCulled = false;
+    const scene = new THREE.Scene();
+    scene.add(mesh);
+    this.renderer.render(scene, this.camera);
+    this.renderer.setRenderTarget(saved);
+    u.uSunMap.value = this.sunTarget.texture;
+    u.uSunAxisX.value.copy(axisX);
+    u.uSunAxisY.value.copy(axisY);
+    u.uSunBox.value.copy(box);
+  }
+
+  #hullTarget(width, height) {
+    if (!this.hullTarget || this.hullTarget.width !== width || this.hullTarget.height !== height) {
+      this.hullTarget?.dispose();
+      this.hullTarget = new THREE.WebGLRenderTarget(width, height, {
+        type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
+        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      });
+    }
+    return this.hullTarget;
+  }
+}
+
+/** The height of a mesh's positions' box. */
+function meshHeight(positions) {
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let i = 1; i < positions.length; i += 3) {
+    lo = Math.min(lo, positions[i]);
+    hi = Math.max(hi, positions[i]);
+  }
+  return positions.length ? hi - lo : 0;
+}
+
+/**
+ * The clip transform of a camera whose pixel (x, y) (y down, centres at integers) lands
+ * on the centre of the render target's fragment (x, height - 1 - y), or (x, y) without
+ * `flipRows`.
+ */
+export function viewProjection(camera, flipRows = true) {
+  const { width: w, height: h } = camera;
+  const { fx, fy, cx, cy } = camera.k;
+  const [r, d, f] = camera.axes;
+  const e = camera.centre;
+  const near = 0.01;
+  const far = 1000;
+  const a = (far + near) / (far - near);
+  const b = (-2 * far * near) / (far - near);
+  // Camera coordinates (x right, y down, z forward) from world.
+  const view = new THREE.Matrix4().set(
+    r[0], r[1], r[2], -(r[0] * e[0] + r[1] * e[1] + r[2] * e[2]),
+    d[0], d[1], d[2], -(d[0] * e[0] + d[1] * e[1] + d[2] * e[2]),
+    f[0], f[1], f[2], -(f[0] * e[0] + f[1] * e[1] + f[2] * e[2]),
+    0, 0, 0, 1,
+  );
+  // ndc x = 2 (fx x / z + cx + 0.5) / w - 1; ndc y = 2 (h - 0.5 - (fy y / z + cy)) / h - 1
+  // with rows flipped, else 2 (fy y / z + cy + 0.5) / h - 1.
+  const sy = flipRows ? -1 : 1;
+  const ty = flipRows ? (2 * (h - 0.5 - cy)) / h - 1 : (2 * (cy + 0.5)) / h - 1;
+  const projection = new THREE.Matrix4().set(
+    (2 * fx) / w, 0, (2 * (cx + 0.5)) / w - 1, 0,
+    0, (sy * 2 * fy) / h, ty, 0,
+    0, 0, a, b,
+    0, 0, 1, 0,
+  );
+  return projection.multiply(view);
+}

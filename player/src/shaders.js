@@ -1,0 +1,475 @@
+// The player's GLSL (WebGL 2): the pre-lit pass relights each view's texels by an L2
+// light (the SH transfer) and a sun (normals and albedo); the hull pass gives each pixel
+// of the frame its ray's distance to the pose's hull mesh (the proxy); the frame pass
+// re-bins each pixel's ray through the cylinder of camera centres and morphs the quad's
+// pre-lit views by the solved four-way morph. Twins, operation for operation, of frf's
+// `shaders/relight.wgsl` (the SH part: `reflectance/src/sh_transfer.rs`),
+// `shaders/rebin.wgsl`, `shaders/common.wgsl`, `shaders/rebin/*.wgsl` and
+// `shaders/morph/solved.wgsl`, whose comments and docs/design.md derive them.
+
+export const FULLSCREEN_VERTEX = /* glsl */ `
+precision highp float;
+in vec3 position;
+void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }
+`;
+
+/** The pre-lit pass: one view's texels (layer uLayer) relit. */
+export const PRELIT_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+precision highp sampler2DArray;
+uniform sampler2DArray uAtlas;    // R8: layer 3 * view + channel (compact: 1 per view)
+uniform sampler2DArray uAlpha;    // R8
+uniform sampler2DArray uNormals;  // RGBA8: n = 2 rgb - 1, a = 0 where none
+uniform sampler2DArray uAlbedo;   // RGBA8 (rgb) of the albedo, and of the compact colour
+uniform int uLayer;
+uniform int uCompact;
+uniform vec3 uScale[9];
+uniform vec3 uOffset[9];
+uniform vec3 uSh[9];              // the light's radiance coefficients (three.js order)
+uniform vec3 uAlbedoScale;
+uniform vec3 uColourScale;
+uniform vec3 uSunDir;             // toward the sun, subject frame
+uniform vec3 uSunE;               // its illuminance; 0: no sun
+uniform int uHasNormals;
+// The sun's shadow (frf's SunLight::sunlit): each texel's point on the hull (its ray's
+// distance + 1 in uViewHull, 0: the ray misses the hull, lit), moved uSunOffset toward the
+// sun, is shaded where the hull reaches farther toward the sun along its line (uSunMap:
+// the largest l . p of the hull + 100 per texel across the sun, 0 where none).
+uniform sampler2DArray uViewHull;
+uniform vec3 uViewCentre;
+uniform mat3 uViewAxes;
+uniform vec4 uViewK;
+uniform sampler2D uSunMap;
+uniform vec3 uSunAxisX;
+uniform vec3 uSunAxisY;
+uniform vec4 uSunBox;             // lo x, lo y, hi x, hi y along the axes
+uniform float uSunOffset;         // metres; < 0: no shadows
+out vec4 outColor;
+
+bool sunlit(ivec2 p) {
+  if (uSunOffset < 0.0) return true;
+  float t = texelFetch(uViewHull, ivec3(p, uLayer), 0).r - 1.0;
+  if (t < 0.0) return true;
+  vec3 dc = vec3((float(p.x) - uViewK.z) / uViewK.x, (float(p.y) - uViewK.w) / uViewK.y, 1.0);
+  vec3 surface = uViewCentre + normalize(uViewAxes * dc) * t;
+  vec3 q = surface + uSunDir * uSunOffset;
+  vec2 size = vec2(textureSize(uSunMap, 0));
+  vec2 m = (vec2(dot(uSunAxisX, q), dot(uSunAxisY, q)) - uSunBox.xy) / (uSunBox.zw - uSunBox.xy) * size;
+  if (any(lessThan(m, vec2(0.0))) || any(greaterThanEqual(m, size))) return true;
+  float reach = texelFetch(uSunMap, ivec2(m), 0).r;
+  if (reach == 0.0) return true;
+  return !(reach - 100.0 > dot(uSunDir, q));
+}
+
+void main() {
+  // Texel (x, y) of the view, y down: row y of the layer, as the views' data textures
+  // (uploaded top row first) are read by texelFetch.
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 size = ivec2(textureSize(uAlpha, 0).xy);
+  float alpha = texelFetch(uAlpha, ivec3(p, uLayer), 0).r;
+  vec3 rgb = vec3(0.0);
+  if (alpha > 0.0) {
+    for (int i = 0; i < 9; i++) {
+      ivec2 a = p + ivec2((i % 3) * size.x, (i / 3) * size.y);
+      vec3 t;
+      if (uCompact == 1) {
+        float code = texelFetch(uAtlas, ivec3(a, uLayer), 0).r * 255.0;
+        vec3 colour = texelFetch(uAlbedo, ivec3(p, 2 * uLayer + 1), 0).rgb * 255.0 * uColourScale;
+        t = (uOffset[i].x + uScale[i].x * code) * colour;
+      } else {
+        vec3 code = vec3(texelFetch(uAtlas, ivec3(a, 3 * uLayer), 0).r,
+                         texelFetch(uAtlas, ivec3(a, 3 * uLayer + 1), 0).r,
+                         texelFetch(uAtlas, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
+        t = uOffset[i] + uScale[i] * code;
+      }
+      rgb += uSh[i] * t;
+    }
+    if (uHasNormals == 1 && any(greaterThan(uSunE, vec3(0.0)))) {
+      vec4 n = texelFetch(uNormals, ivec3(p, uLayer), 0);
+      if (n.a > 0.0 && sunlit(p)) {
+        vec3 albedo = texelFetch(uAlbedo, ivec3(p, 2 * uLayer), 0).rgb * 255.0 * uAlbedoScale;
+        rgb += albedo * max(dot(normalize(n.rgb * 2.0 - 1.0), uSunDir), 0.0) * uSunE;
+      }
+    }
+  }
+  // Texels that relight negative (an L2 light rings below zero) are black, as in frf.
+  outColor = vec4(max(rgb, vec3(0.0)), alpha);
+}
+`;
+
+/**
+ * The hull passes: each pixel's distance along its unit ray to the hull mesh, plus 1 (0:
+ * none); and the sun's map of the hull: l . p + 100 of the surface nearest the sun.
+ */
+export const HULL_VERTEX = /* glsl */ `
+precision highp float;
+in vec3 position;
+uniform mat4 uViewProjection;
+out vec3 vWorld;
+void main() {
+  vWorld = position;
+  gl_Position = uViewProjection * vec4(position, 1.0);
+}
+`;
+export const HULL_FRAGMENT = /* glsl */ `
+precision highp float;
+in vec3 vWorld;
+uniform vec3 uEye;
+out vec4 outColor;
+void main() { outColor = vec4(length(vWorld - uEye) + 1.0, 0.0, 0.0, 1.0); }
+`;
+export const SUN_MAP_VERTEX = /* glsl */ `
+precision highp float;
+in vec3 position;
+uniform vec3 uSunDir;
+uniform vec3 uSunAxisX;
+uniform vec3 uSunAxisY;
+uniform vec4 uSunBox;
+uniform vec2 uReach;              // the range of l . p over the hull: nearest the sun in front
+out float vReach;
+void main() {
+  vReach = dot(uSunDir, position);
+  vec2 m = (vec2(dot(uSunAxisX, position), dot(uSunAxisY, position)) - uSunBox.xy) / (uSunBox.zw - uSunBox.xy);
+  gl_Position = vec4(m * 2.0 - 1.0, 1.0 - 2.0 * (vReach - uReach.x) / (uReach.y - uReach.x), 1.0);
+}
+`;
+export const SUN_MAP_FRAGMENT = /* glsl */ `
+precision highp float;
+in float vReach;
+out vec4 outColor;
+void main() { outColor = vec4(vReach + 100.0, 0.0, 0.0, 1.0); }
+`;
+
+/** The frame pass. */
+export const FRAME_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+precision highp sampler2DArray;
+uniform vec3 uEye;
+uniform mat3 uAxes;      // columns: right, down, forward (subject frame)
+uniform vec4 uK;         // fx, fy, cx, cy
+uniform int uHeight;     // the frame's rows
+uniform sampler2D uQuads;
+uniform int uQuadCount;
+uniform sampler2D uFrames;
+uniform sampler2D uViews;       // per grid view: centre + pre-lit layer, flow layers
+uniform int uColumns;
+uniform int uRows;
+uniform int uFrameRows;
+uniform sampler2DArray uPrelit; // RGBA16F, premultiplied linear
+uniform sampler2DArray uFlows;  // RG32F, pixels
+uniform sampler2D uHullT;       // R32F: distance to the hull along the ray + 1, 0 none
+uniform int uHasHull;
+uniform vec2 uAxis;
+out vec4 outColor;
+
+const int SOLVE_ITERATIONS = 2;
+const float SETTLED_PX = 0.01;
+const float SETTLE_PX = 2.0;
+const float SETTLE_FLOOR = 1e-3;
+const float BIG = 3.4e38;
+
+float cross2(vec2 m, vec2 n) { return m.x * n.y - m.y * n.x; }
+bool finite(float x) { return abs(x) <= BIG; }
+vec3 normalizeOrZero(vec3 v) { float l = length(v); return l > 0.0 ? v / l : vec3(0.0); }
+float outside(vec2 bg) {
+  return max(max(-bg.x, bg.x - 1.0), 0.0) + max(max(-bg.y, bg.y - 1.0), 0.0);
+}
+float betaFor(float g, vec2 q, vec2 a, vec2 b, vec2 c) {
+  vec2 d = a + c * g;
+  if (abs(d.x) >= abs(d.y)) return (q.x - g * b.x) / d.x;
+  return (q.y - g * b.y) / d.y;
+}
+
+// The inverse bilinear map on a quad, in its plane; .z = 1 when solved.
+vec3 inverseBilinear(vec3 p, vec3 p00, vec3 e1, vec3 e2, vec3 e3, vec3 normal) {
+  vec3 xAxis = normalizeOrZero(e1);
+  vec3 yAxis = cross(normal, xAxis);
+  vec2 q = vec2(dot(p - p00, xAxis), dot(p - p00, yAxis));
+  vec2 a = vec2(dot(e1, xAxis), dot(e1, yAxis));
+  vec2 b = vec2(dot(e2, xAxis), dot(e2, yAxis));
+  vec2 c = vec2(dot(e3, xAxis), dot(e3, yAxis));
+  float k2 = cross2(c, b);
+  float k1 = cross2(a, b) - cross2(c, q);
+  float k0 = -cross2(a, q);
+  float scale = max(max(abs(k1), abs(k0)), 1e-30);
+  vec3 best = vec3(0.0);
+  float bestOut = BIG;
+  float roots[2];
+  int count = 0;
+  if (abs(k2) <= 1e-6 * scale) {
+    if (abs(k1) < 1e-30) return best;
+    roots[0] = -k0 / k1;
+    count = 1;
+  } else {
+    float disc = k1 * k1 - 4.0 * k2 * k0;
+    if (disc < 0.0) return best;
+    float s = sqrt(disc);
+    float qq = -0.5 * (k1 + (k1 >= 0.0 ? 1.0 : -1.0) * s);
+    roots[0] = qq / k2;
+    count = 1;
+    if (abs(qq) > 1e-30) { roots[1] = k0 / qq; count = 2; }
+  }
+  for (int i = 0; i < count; i++) {
+    float g = roots[i];
+    float beta = betaFor(g, q, a, b, c);
+    if (!finite(beta)) continue;
+    float o = outside(vec2(beta, g));
+    if (o < bestOut) { bestOut = o; best = vec3(beta, g, 1.0); }
+  }
+  return best;
+}
+
+struct Hit { int u; int v; float beta; float gamma; vec3 point; float t; int clamped; };
+
+vec4 quadTexel(int i, int k) { return texelFetch(uQuads, ivec2(k, i), 0); }
+
+// Where the ray enters the cylinder: the smallest t of all hits, unless none lies ahead
+// (clamped = 3). Every quad is tested (frf prunes them by a column index: same hit).
+Hit intersect(vec3 origin, vec3 dir) {
+  Hit best = Hit(0, 0, 0.0, 0.0, vec3(0.0), BIG, 3);
+  bool anyAhead = false;
+  for (int i = 0; i < uQuadCount; i++) {
+    vec4 t0 = quadTexel(i, 0), t1 = quadTexel(i, 1), t2 = quadTexel(i, 2), t3 = quadTexel(i, 3), t4 = quadTexel(i, 4);
+    vec3 normal = t4.xyz;
+    float denom = dot(normal, dir);
+    if (abs(denom) < 1e-9) continue;
+    float t = dot(normal, t0.xyz - origin) / denom;
+    vec3 p = origin + dir * t;
+    vec3 r = inverseBilinear(p, t0.xyz, t1.xyz, t2.xyz, t3.xyz, normal);
+    if (r.z == 0.0 || outside(r.xy) > 1e-4) continue;
+    if (t >= 0.0) anyAhead = true;
+    if (t < best.t) {
+      int wall = int(t2.w);
+      float gamma = wall != 0 ? t3.w : clamp(r.y, 0.0, 1.0);
+      best = Hit(int(t0.w), int(t1.w), clamp(r.x, 0.0, 1.0), gamma, p, t, wall);
+    }
+  }
+  if (!anyAhead) best.clamped = 3;
+  return best;
+}
+
+vec4 bilinearWeights(float beta, float gamma) {
+  float b = 1.0 - beta, g = 1.0 - gamma;
+  return vec4(b * g, beta * g, b * gamma, beta * gamma);
+}
+
+ivec4 quadViews(Hit hit) {
+  int top = uRows > 1 ? hit.v + 1 : hit.v;
+  int bottom = min(hit.v, uRows - 1);
+  int upper = min(top, uRows - 1);
+  int u0 = hit.u % uColumns, u1 = (hit.u + 1) % uColumns;
+  return ivec4(u0 * uRows + bottom, u1 * uRows + bottom, u0 * uRows + upper, u1 * uRows + upper);
+}
+
+vec4 viewTexel(int view, int k) { return texelFetch(uViews, ivec2(k, view), 0); }
+
+// The rectified frame of a quad: 32 texels (geometry.js frameTexels).
+vec4 frameTexel(int f, int k) { return texelFetch(uFrames, ivec2(k, f), 0); }
+int frameIndex(Hit hit) { return (hit.u % uColumns) * uFrameRows + min(hit.v, uFrameRows - 1); }
+mat3 frameMatrix(int f, int first) {
+  return mat3(frameTexel(f, first).xyz, frameTexel(f, first + 1).xyz, frameTexel(f, first + 2).xyz);
+}
+mat3 toRectified(int f, int k) { return frameMatrix(f, 4 + 3 * k); }
+mat3 fromRectified(int f, int k) { return frameMatrix(f, 16 + 3 * k); }
+vec2 frameCentre(int f, int k) {
+  vec4 pair = frameTexel(f, 28 + k / 2);
+  return (k % 2 == 0) ? pair.xy : pair.zw;
+}
+vec3 toPlane(int f, vec3 p) {
+  return vec3(dot(frameTexel(f, 0).xyz, p), dot(frameTexel(f, 1).xyz, p), dot(frameTexel(f, 2).xyz, p));
+}
+vec3 projectRectified(int f, vec3 dir) {
+  vec3 d = toPlane(f, dir);
+  if (d.z <= 1e-6 * length(dir)) return vec3(0.0);
+  vec4 k = frameTexel(f, 3);
+  return vec3(k.x * d.x / d.z + k.z, k.y * d.y / d.z + k.w, 1.0);
+}
+vec2 homography(mat3 h, vec2 p) {
+  vec3 q = h * vec3(p, 1.0);
+  float z = abs(q.z) < 1e-6 ? 1e-6 : q.z;
+  return q.xy / z;
+}
+
+// The ray's point on the proxy (w = 1), or w = 0: its hit on the hull mesh, else its
+// point nearest the hull's vertical axis.
+vec4 proxyPoint(vec3 origin, vec3 dir) {
+  if (uHasHull == 0) return vec4(0.0);
+  float t = texelFetch(uHullT, ivec2(gl_FragCoord.xy), 0).r - 1.0;
+  if (t >= 0.0) return vec4(origin + dir * t, 1.0);
+  vec2 o = origin.xz - uAxis;
+  vec2 d = dir.xz;
+  float dd = dot(d, d);
+  if (dd < 1e-8) return vec4(0.0);
+  return vec4(origin + dir * max(-dot(o, d) / dd, 0.0), 1.0);
+}
+
+struct Output { vec2 centre; vec2 s; float inverseDepth; bool ok; };
+
+Output solvedOutput(Hit hit, vec3 origin, vec3 dir) {
+  Output out_ = Output(vec2(0.0), vec2(0.0), 0.0, false);
+  int f = frameIndex(hit);
+  if (frameTexel(f, 0).w == 0.0) return out_;
+  vec4 point = proxyPoint(origin, dir);
+  vec3 centre = hit.point;
+  vec3 r;
+  if (hit.clamped == 0 || uRows == 1) {
+    r = projectRectified(f, dir);
+  } else {
+    ivec4 q = quadViews(hit);
+    vec4 w = bilinearWeights(hit.beta, hit.gamma);
+    centre = vec3(0.0);
+    for (int i = 0; i < 4; i++) centre += viewTexel(q[i], 0).xyz * w[i];
+    r = point.w > 0.0 ? projectRectified(f, point.xyz - centre) : projectRectified(f, dir);
+  }
+  if (r.z == 0.0) return out_;
+  vec3 plane = toPlane(f, centre);
+  float inverseDepth = 1.0 / frameTexel(f, 30).x;
+  if (point.w > 0.0) {
+    float v = 1.0 / (toPlane(f, point.xyz).z - plane.z);
+    if (finite(v) && v > 0.0) inverseDepth = v;
+  }
+  return Output(plane.xy, r.xy, inverseDepth, true);
+}
+
+// Bilinear sample of a view's flow toward neighbour dir (0 right, 1 left, 2 up, 3 down)
+// at pixel s (centres at integers, the edge repeated); absent flows are zero.
+vec2 sampleFlow(int view, int dir, vec2 s) {
+  int layer = int(viewTexel(view, 1)[dir]);
+  if (layer < 0) return vec2(0.0);
+  ivec2 size = textureSize(uFlows, 0).xy;
+  vec2 p = clamp(s, vec2(-1.0), vec2(size));
+  vec2 p0 = floor(p);
+  vec2 fr = p - p0;
+  ivec2 a = clamp(ivec2(p0), ivec2(0), size - 1);
+  ivec2 b = clamp(ivec2(p0) + 1, ivec2(0), size - 1);
+  vec2 f00 = texelFetch(uFlows, ivec3(a, layer), 0).rg;
+  vec2 f10 = texelFetch(uFlows, ivec3(b.x, a.y, layer), 0).rg;
+  vec2 f01 = texelFetch(uFlows, ivec3(a.x, b.y, layer), 0).rg;
+  vec2 f11 = texelFetch(uFlows, ivec3(b, layer), 0).rg;
+  return mix(mix(f00, f10, fr.x), mix(f01, f11, fr.x), fr.y);
+}
+
+vec4 samplePrelit(int view, vec2 s) {
+  int layer = int(viewTexel(view, 0).w);
+  if (layer < 0) return vec4(0.0);
+  ivec2 size = textureSize(uPrelit, 0).xy;
+  vec2 p = clamp(s, vec2(-1.0), vec2(size));
+  vec2 p0 = floor(p);
+  vec2 fr = p - p0;
+  ivec2 a = clamp(ivec2(p0), ivec2(0), size - 1);
+  ivec2 b = clamp(ivec2(p0) + 1, ivec2(0), size - 1);
+  vec4 c00 = texelFetch(uPrelit, ivec3(a, layer), 0);
+  vec4 c10 = texelFetch(uPrelit, ivec3(b.x, a.y, layer), 0);
+  vec4 c01 = texelFetch(uPrelit, ivec3(a.x, b.y, layer), 0);
+  vec4 c11 = texelFetch(uPrelit, ivec3(b, layer), 0);
+  return mix(mix(c00, c10, fr.x), mix(c01, c11, fr.x), fr.y);
+}
+
+vec2 solveFractions(int f, int k, bool vertical, vec2 to) {
+  vec2 c = frameCentre(f, k);
+  vec2 o = to - c;
+  vec2 b1 = frameCentre(f, k ^ 1) - c;
+  vec2 b2 = frameCentre(f, k ^ 2) - c;
+  float det = cross2(b1, b2);
+  if (vertical && abs(det) > 1e-9) return vec2(cross2(o, b2) / det, cross2(b1, o) / det);
+  return vec2(dot(o, b1) / max(dot(b1, b1), 1e-12), 0.0);
+}
+
+// The pixel of vertex k that shows the output's point (.xy), and the last step (.z).
+vec3 solveSource(int f, ivec4 q, int k, Output o) {
+  int h = k ^ 1;
+  int v = k ^ 2;
+  bool vertical = q[v] != q[k];
+  vec2 ac = solveFractions(f, k, vertical, o.centre);
+  int towardH = (k % 2 == 0) ? 0 : 1;
+  int towardV = (k < 2) ? 2 : 3;
+  int view = q[k];
+  vec4 kf = frameTexel(f, 3);
+  vec2 focal = kf.xy;
+  vec2 across = vec2(0.0);
+  vec2 along = vec2(0.0);
+  if (!vertical) {
+    vec2 c = frameCentre(f, k);
+    vec2 b = frameCentre(f, h) - c;
+    across = (o.centre - c - b * ac.x) * focal;
+    vec2 p = b * focal;
+    along = p / max(dot(p, p), 1e-12);
+  }
+  mat3 fromK = fromRectified(f, k);
+  mat3 toH = toRectified(f, h);
+  mat3 toV = toRectified(f, v);
+  vec2 here = o.s + (o.centre - frameCentre(f, k)) * focal * o.inverseDepth;
+  vec2 x = homography(fromK, here);
+  float step_ = 0.0;
+  for (int i = 0; i < SOLVE_ITERATIONS; i++) {
+    vec2 d = vec2(0.0);
+    if (ac.x != 0.0 || any(notEqual(across, vec2(0.0)))) {
+      vec2 fh = sampleFlow(view, towardH, x);
+      vec2 dh = homography(toH, x + fh) - here;
+      d += ac.x * dh + across * dot(dh, along);
+    }
+    if (ac.y != 0.0) {
+      vec2 fv = sampleFlow(view, towardV, x);
+      d += ac.y * (homography(toV, x + fv) - here);
+    }
+    here = o.s - d;
+    vec2 next = homography(fromK, here);
+    step_ = length(next - x);
+    x = next;
+    if (step_ < SETTLED_PX) break;
+  }
+  return vec3(x, step_);
+}
+
+vec4 solvedMorph(Hit hit, Output o) {
+  int f = frameIndex(hit);
+  ivec4 q = quadViews(hit);
+  vec4 w = bilinearWeights(hit.beta, hit.gamma);
+  vec4 acc = vec4(0.0);
+  float total = 0.0;
+  for (int k = 0; k < 4; k++) {
+    if (w[k] <= 0.0) continue;
+    vec3 r = solveSource(f, q, k, o);
+    float settle = r.z / SETTLE_PX;
+    float wk = w[k] * max(exp(-(settle * settle)), SETTLE_FLOOR);
+    acc += samplePrelit(q[k], r.xy) * wk;
+    total += wk;
+  }
+  return total > 0.0 ? acc / total : acc;
+}
+
+void main() {
+  // Pixel (x, y), y down, centres at integers (the target's rows run bottom up).
+  vec2 pixel = vec2(floor(gl_FragCoord.x), float(uHeight - 1) - floor(gl_FragCoord.y));
+  vec3 dc = vec3((pixel.x - uK.z) / uK.x, (pixel.y - uK.w) / uK.y, 1.0);
+  vec3 dir = normalize(uAxes * dc);
+  Hit hit = intersect(uEye, dir);
+  outColor = vec4(0.0);
+  if (hit.clamped == 3) return;
+  Output o = solvedOutput(hit, uEye, dir);
+  if (!o.ok) return;
+  outColor = solvedMorph(hit, o);
+}
+`;
+
+/** The page's present pass: a frame (premultiplied linear) over a backdrop, exposed, sRGB. */
+export const PRESENT_FRAGMENT = /* glsl */ `
+precision highp float;
+uniform sampler2D uFrame;
+uniform float uExposure;          // a factor
+uniform vec3 uTop;
+uniform vec3 uBottom;
+uniform vec2 uSize;
+out vec4 outColor;
+vec3 srgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+void main() {
+  vec4 f = texelFetch(uFrame, ivec2(gl_FragCoord.xy), 0);
+  vec3 backdrop = mix(uBottom, uTop, gl_FragCoord.y / uSize.y);
+  outColor = vec4(srgb(f.rgb * uExposure + backdrop * (1.0 - f.a)), 1.0);
+}
+`;

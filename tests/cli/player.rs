@@ -1,0 +1,328 @@
+//! The web player (`player/`) in a real browser: Debian's Chromium driven headless by
+//! puppeteer-core on software GL (SwiftShader), as `scripts/setup.sh` installs them. The
+//! tiny oracle field's walker is exported, lit by the built-in sky's L2 light, drawn by
+//! `node player/screenshot.mjs` and by `frf render` from the same camera and pose, and
+//! the two frames compared (subject PSNR); damaged files are refused by the player by
+//! name with nothing written, and a walker without normals is drawn without its sun and
+//! said so.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use frf_core::io::srgb_to_linear;
+use serde_json::Value;
+
+use crate::common::{frf, stderr};
+
+fn player() -> PathBuf {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/player")).to_path_buf()
+}
+
+/// A camera of the screenshot's flags: centre, a point looked at, vertical fov (degrees).
+struct Shot {
+    eye: [f32; 3],
+    look_at: [f32; 3],
+    fov_deg: f32,
+}
+
+/// The camera blended bilinearly from pose 0's grid cameras at fractional `(u, v)`:
+/// a captured view at integers, a quad's centre at halves.
+fn grid_camera(document: &Value, u: f32, v: f32) -> Shot {
+    let ext = &document["extensions"]["FRF_flowed_reflectance_field"];
+    let rows = ext["grid"]["rows"].as_u64().unwrap() as usize;
+    let columns = ext["grid"]["columns"].as_u64().unwrap() as usize;
+    let cameras = ext["poses"][0]["cameras"].as_array().unwrap();
+    let (u0, v0) = (u.floor() as usize, v.floor() as usize);
+    let (fu, fv) = (u - u0 as f32, v - v0 as f32);
+    let mut eye = [0.0f32; 3];
+    let mut forward = [0.0f32; 3];
+    let mut fy = 0.0;
+    for (du, dv, w) in [
+        (0, 0, (1.0 - fu) * (1.0 - fv)),
+        (1, 0, fu * (1.0 - fv)),
+        (0, 1, (1.0 - fu) * fv),
+        (1, 1, fu * fv),
+    ] {
+        if w == 0.0 {
+            continue;
+        }
+        let c = &cameras[((u0 + du) % columns) * rows + (v0 + dv).min(rows - 1)];
+        let m = &c["world_from_camera"];
+        for (i, (e, f)) in eye.iter_mut().zip(forward.iter_mut()).enumerate() {
+            *e += w * m[i][3].as_f64().unwrap() as f32;
+            *f += w * m[i][2].as_f64().unwrap() as f32;
+        }
+        fy += w * c["intrinsics"][1].as_f64().unwrap() as f32;
+    }
+    let height = cameras[0]["height"].as_f64().unwrap() as f32;
+    Shot {
+        eye,
+        look_at: [0, 1, 2].map(|i| eye[i] + forward[i]),
+        fov_deg: (2.0 * (height / 2.0 / fy).atan()).to_degrees(),
+    }
+}
+
+fn list(v: [f32; 3]) -> String {
+    format!("{},{},{}", v[0], v[1], v[2])
+}
+
+/// `node player/screenshot.mjs` of `shot`.
+fn screenshot(
+    glb: &Path,
+    sh: &Path,
+    shot: &Shot,
+    size: &str,
+    sun: Option<&str>,
+    out: &Path,
+) -> Output {
+    assert!(
+        player().join("node_modules/puppeteer-core").exists(),
+        "the player's npm packages are missing: run scripts/setup.sh"
+    );
+    let mut c = Command::new("node");
+    c.arg(player().join("screenshot.mjs"))
+        .arg("--glb")
+        .arg(glb)
+        .args(["--pose", "0", "--size", size, "--json"])
+        .arg(format!("--camera={}", list(shot.eye)))
+        .arg(format!("--look-at={}", list(shot.look_at)))
+        .args(["--fov", &shot.fov_deg.to_string()])
+        .arg("--sh")
+        .arg(sh)
+        .arg("--out")
+        .arg(out);
+    if let Some(s) = sun {
+        c.args(["--sun", s]);
+    }
+    c.output()
+        .expect("node runs (scripts/setup.sh installs it)")
+}
+
+/// `frf render` of `shot` (one frame, no ground shadow), its PNG's path.
+fn frf_frame(
+    field: &Path,
+    sh: &Path,
+    shot: &Shot,
+    size: &str,
+    sun: Option<&str>,
+    dir: &Path,
+) -> PathBuf {
+    let path = dir.join("camera.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "[[key]]\ntime = 0.0\nposition = [{}]\nlook_at = [{}]\nfov_deg = {}\n",
+            list(shot.eye),
+            list(shot.look_at),
+            shot.fov_deg
+        ),
+    )
+    .unwrap();
+    let out = dir.join("frf");
+    let mut args = vec![
+        "render".to_string(),
+        field.display().to_string(),
+        "--env".into(),
+        sh.display().to_string(),
+        "--camera".into(),
+        path.display().to_string(),
+        "--frames".into(),
+        "1".into(),
+        "--shadow".into(),
+        "none".into(),
+        "--detail".into(),
+        "0".into(),
+        "--size".into(),
+        size.into(),
+        "--out".into(),
+        out.display().to_string(),
+    ];
+    if let Some(s) = sun {
+        // AZ,EL,E of the player is AZ,EL,DIAMETER,E of frf (its default disc).
+        let p: Vec<&str> = s.split(',').collect();
+        args.extend(["--sun".into(), format!("{},{},0.53,{}", p[0], p[1], p[2])]);
+    }
+    args.extend(frf_testkit::cpu_flag().map(String::from));
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = frf(&refs);
+    assert!(o.status.success(), "{}", stderr(&o));
+    out.join("frame_0000.png")
+}
+
+/// Subject PSNR of `b` against `a` (8-bit sRGB, straight alpha): linear premultiplied
+/// colour over the pixels either covers by half, peak `a`'s brightest.
+fn subject_psnr(a: &Path, b: &Path) -> f64 {
+    let load = |p: &Path| image::open(p).unwrap().to_rgba8();
+    let (a, b) = (load(a), load(b));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let lin = |p: &image::Rgba<u8>| {
+        let alpha = p[3] as f64 / 255.0;
+        (
+            [0, 1, 2].map(|c| srgb_to_linear(p[c] as f32 / 255.0) as f64 * alpha),
+            alpha,
+        )
+    };
+    let (mut se, mut n, mut peak) = (0.0, 0usize, 0.0f64);
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
+        let ((ca, aa), (cb, ab)) = (lin(pa), lin(pb));
+        if aa > 0.5 || ab > 0.5 {
+            for c in 0..3 {
+                se += (ca[c] - cb[c]).powi(2);
+                peak = peak.max(ca[c]);
+            }
+            n += 3;
+        }
+    }
+    assert!(n > 300, "{n} subject samples");
+    10.0 * (peak * peak / (se / n as f64)).log10()
+}
+
+/// The tiny oracle field's pose 0 exported, and the built-in sky's L2 light.
+fn exported(dir: &Path) -> (PathBuf, PathBuf) {
+    let f = frf_testkit::tiny_field();
+    let glb = dir.join("walker.glb");
+    let o = frf(&[
+        "export",
+        f.field.to_str().unwrap(),
+        "--poses",
+        "0",
+        "--out",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sh = dir.join("sky.json");
+    let o = frf(&["env-sh", "sky", "--out", sh.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (glb, sh)
+}
+
+#[test]
+fn the_player_in_chromium_draws_what_frf_renders() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, sh) = exported(dir.path());
+    let document = frf_export::read::Export::open(&glb).unwrap().document;
+    // (u, v, sun, least subject PSNR): a captured view, a quad's centre, a captured view
+    // with a sun lighting by the normals (the targets).
+    for (u, v, sun, least) in [
+        (3.0, 1.0, None, 35.0),
+        (3.5, 0.5, None, 30.0),
+        (20.0, 0.0, Some("60,40,3"), 30.0),
+    ] {
+        let shot = grid_camera(&document, u, v);
+        let case = dir.path().join(format!("{u}-{v}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let out = case.join("player.png");
+        let o = screenshot(&glb, &sh, &shot, "64x90", sun, &out);
+        assert!(
+            o.status.success(),
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            stderr(&o)
+        );
+        let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report["pose"], 0);
+        let reference = frf_frame(&f.field, &sh, &shot, "64x90", sun, &case);
+        let psnr = subject_psnr(&reference, &out);
+        eprintln!("player against frf render at ({u}, {v}), sun {sun:?}: {psnr:.2} dB");
+        assert!(
+            psnr >= least,
+            "({u}, {v}), sun {sun:?}: {psnr:.2} dB < {least}"
+        );
+    }
+}
+
+/// The GLB `bytes` with its JSON chunk changed by `edit` (chunks re-padded).
+fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let json_len = word(12);
+    let mut doc: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    edit(&mut doc);
+    let mut json = serde_json::to_vec(&doc).unwrap();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let bin = &bytes[20 + json_len..];
+    let total = 12 + 8 + json.len() + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(bin);
+    out
+}
+
+#[test]
+fn the_player_refuses_damaged_walkers_and_draws_one_without_normals_without_its_sun() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, sh) = exported(dir.path());
+    let bytes = std::fs::read(&glb).unwrap();
+    let shot = Shot {
+        eye: [0.0, 1.0, 4.5],
+        look_at: [0.0, 0.9, 0.0],
+        fov_deg: 30.0,
+    };
+    let truncated = dir.path().join("truncated.glb");
+    std::fs::write(&truncated, &bytes[..bytes.len() - 1000]).unwrap();
+    let future = dir.path().join("future.glb");
+    std::fs::write(
+        &future,
+        with_json(&bytes, |d| {
+            d["extensions"]["FRF_flowed_reflectance_field"]["version"] = 2.into()
+        }),
+    )
+    .unwrap();
+    for (file, want) in [
+        (&truncated, "truncated.glb: its header says"),
+        (
+            &future,
+            "future.glb: FRF_flowed_reflectance_field version 2",
+        ),
+    ] {
+        let out = dir.path().join("refused.png");
+        let o = screenshot(file, &sh, &shot, "32x45", None, &out);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(want), "{}", stderr(&o));
+        assert!(!out.exists(), "nothing is written for {}", file.display());
+    }
+
+    // Normals gone: the sun cannot light it; the SH part draws, and the player says so.
+    let bare = dir.path().join("bare.glb");
+    std::fs::write(
+        &bare,
+        with_json(&bytes, |d| {
+            for p in d["extensions"]["FRF_flowed_reflectance_field"]["poses"]
+                .as_array_mut()
+                .unwrap()
+            {
+                for v in p["views"].as_array_mut().unwrap() {
+                    v["normals"] = Value::Null;
+                }
+            }
+        }),
+    )
+    .unwrap();
+    let (lit, plain) = (dir.path().join("sun.png"), dir.path().join("plain.png"));
+    let o = screenshot(&bare, &sh, &shot, "32x45", Some("60,40,10"), &lit);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        report["notes"][0]
+            .as_str()
+            .unwrap()
+            .contains("no fitted normals"),
+        "{report}"
+    );
+    let o = screenshot(&bare, &sh, &shot, "32x45", None, &plain);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        image::open(&lit).unwrap().to_rgba8(),
+        image::open(&plain).unwrap().to_rgba8(),
+        "without normals a sun adds nothing"
+    );
+}
