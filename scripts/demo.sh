@@ -44,9 +44,13 @@ step render $frf render "$scene" --field "$out/walker.frf" --out "$out/shot" --o
 step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" --frames 3 \
   --lights 256
 # The walker leaving frf: a .glb any glTF viewer walks (hull meshes) and a player
-# relights (docs/export.md), with the forest's L2 light beside it.
+# relights (docs/export.md), with the forest's L2 light beside it (turned as the scene
+# turns it), drawn by the web player in headless Chromium from the shot's camera at 1 s.
 step export $frf export "$out/walker.frf" --out "$out/walker.glb"
-step env-sh $frf env-sh assets/envmaps/forest_slope_1k.hdr --out "$out/forest_sh.json"
+step env-sh $frf env-sh assets/envmaps/forest_slope_1k.hdr --yaw 90 --out "$out/forest_sh.json"
+step player node player/screenshot.mjs --glb "$out/walker.glb" --pose 0 --camera 0.5,1.45,2.9 \
+  --look-at 0,0.9,0 --fov 36 --size 256x192 --sh "$out/forest_sh.json" --out "$out/player.png" \
+  --time-frames 3
 
 {
   echo "frf demo: $scene, $(nproc) cores, $(date -u +%Y-%m-%dT%H:%MZ)"
@@ -68,6 +72,9 @@ step env-sh $frf env-sh assets/envmaps/forest_slope_1k.hdr --out "$out/forest_sh
   echo
   echo "export (the walker as glTF, docs/export.md):"
   sed 's/^/  /' "$out/export.log"
+  echo
+  echo "the web player (player/, headless Chromium on software GL):"
+  sed 's/^/  /' "$out/player.log"
 } > "$out/report.txt"
 cat "$out/report.txt"
-echo "demo: the shot in $out/shot/ (frames, preview.png animated, contact.png), the walker as $out/walker.glb, report $out/report.txt"
+echo "demo: the shot in $out/shot/ (frames, preview.png animated, contact.png), the walker as $out/walker.glb and drawn by the web player in $out/player.png, report $out/report.txt"

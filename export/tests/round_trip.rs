@@ -87,7 +87,24 @@ fn relights_as_frf(tier: Tier, floor_db: f64) {
     for key in required(&schema) {
         assert!(!glb.field()[&key].is_null(), "the extension lacks {key}");
     }
-    for view in glb.field()["poses"][0]["views"].as_array().unwrap() {
+    let pose = &glb.field()["poses"][0];
+    for key in required(&schema["properties"]["poses"]["items"]) {
+        assert!(!pose[&key].is_null(), "a pose lacks {key}");
+    }
+    // Every camera of the grid, with what a camera requires.
+    let grid = &glb.field()["grid"];
+    let cameras = pose["cameras"].as_array().unwrap();
+    assert_eq!(
+        cameras.len() as u64,
+        grid["columns"].as_u64().unwrap() * grid["rows"].as_u64().unwrap()
+    );
+    for key in required(&schema["$defs"]["camera"]) {
+        assert!(
+            cameras.iter().all(|c| !c[&key].is_null()),
+            "a camera lacks {key}"
+        );
+    }
+    for view in pose["views"].as_array().unwrap() {
         for key in required(&schema["$defs"]["view"]) {
             assert!(!view[&key].is_null(), "a view lacks {key}");
         }
@@ -216,4 +233,48 @@ fn a_field_without_normals_exports_without_them_and_says_so() {
     assert!(glb.view(0, 3, 1).unwrap()["normals"].is_null());
     // Relighting by the transfer does not need them.
     assert!(glb.relight(0, 3, 1, &light()).is_ok());
+}
+
+#[test]
+fn flows_are_the_fields_within_a_code_and_extended_beyond_the_subject() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let options = ExportOptions {
+        views: ViewSelection::List(vec![(5, 1)]),
+        ..ExportOptions::default()
+    };
+    export(&f.field, &out, &options).unwrap();
+    let glb = Export::open(&out).unwrap();
+    let field = FieldFile::open(&f.field).unwrap();
+    let view = glb.view(0, 5, 1).unwrap();
+    let index = view["flows"]["right"].as_u64().unwrap() as usize;
+    let png = image::load_from_memory(glb.image_bytes(index).unwrap())
+        .unwrap()
+        .into_luma_alpha16();
+    let want = field
+        .flow(0, 5, 1, frf_core::grid::Neighbour::Right)
+        .unwrap()
+        .unwrap();
+    let (mut known, mut unknown) = (0, 0);
+    for (p, w) in png.pixels().zip(want.pixels()) {
+        let got = [p[0], p[1]].map(|q| q as f32 / 256.0 - 128.0);
+        if w[0].abs() < frf_core::flo::UNKNOWN_THRESHOLD {
+            known += 1;
+            for c in 0..2 {
+                assert!(
+                    (got[c] - w[c]).abs() <= 0.5 / 256.0 + 1e-4,
+                    "{got:?} vs {w:?}"
+                );
+            }
+        } else {
+            // Beyond the subject: a flow the field holds near it, not the unknown code.
+            unknown += 1;
+            assert!(got.iter().all(|g| g.abs() < 64.0), "{got:?}");
+        }
+    }
+    assert!(
+        known > 500 && unknown > 500,
+        "{known} known, {unknown} extended"
+    );
 }

@@ -196,3 +196,87 @@ export function frameTexels(frames) {
 export function sunDirection(azimuth, elevation) {
   return [Math.sin(azimuth) * Math.cos(elevation), Math.sin(elevation), Math.cos(azimuth) * Math.cos(elevation)];
 }
+
+/**
+ * Which column spans of quads a ray's line can reach, seen from above (twin of frf's
+ * `render/src/cylinder/column_index.rs`): each span's quads lie within a range of
+ * azimuths about the mean of the camera centres, and all of them in an annulus about
+ * it; a ray tests only the spans whose ranges meet the azimuths its line sweeps across
+ * the annulus. Null where the grid does not allow it (every quad is tested then).
+ */
+export function columnIndex(quads, quadsPerSpan, cameras, rows) {
+  const xz = (p) => [p[0], p[2]];
+  const sub2 = (a, b) => [a[0] - b[0], a[1] - b[1]];
+  const len2 = (a) => Math.hypot(a[0], a[1]);
+  const turn = (s, e) => Math.atan2(s[0] * e[1] - s[1] * e[0], s[0] * e[0] + s[1] * e[1]);
+  const mean = (ps) => ps.reduce((s, p) => [s[0] + p[0] / ps.length, s[1] + p[1] / ps.length], [0, 0]);
+  const centres = cameras.map((c) => xz(c.centre));
+  if (!quads.length || centres.length < rows) return null;
+  const axis = mean(centres);
+  const segment = (a, b) => {
+    const ab = sub2(b, a);
+    const l = ab[0] * ab[0] + ab[1] * ab[1];
+    const k = l > 0 ? Math.min(Math.max(-(a[0] * ab[0] + a[1] * ab[1]) / l, 0), 1) : 0;
+    return len2([a[0] + ab[0] * k, a[1] + ab[1] * k]);
+  };
+  const footprints = [];
+  for (let s = 0; s < quads.length; s += quadsPerSpan) {
+    const f = { corners: [], reach: 0, near: Infinity, far: 0 };
+    for (const q of quads.slice(s, s + quadsPerSpan)) {
+      if (len2([q.normal[0], q.normal[2]]) === 0 && q.normal[1] === 0) continue;
+      const p10 = add(q.p00, q.e1);
+      const p01 = add(q.p00, q.e2);
+      const c = [q.p00, p10, p01, add(p10, add(q.e2, q.e3))].map((p) => sub2(xz(p), axis));
+      const longest = Math.max(...[[1, 0], [3, 2], [2, 0], [3, 1]].map(([i, j]) => len2(sub2(c[i], c[j]))));
+      const twist = len2([c[0][0] - c[1][0] - c[2][0] + c[3][0], c[0][1] - c[1][1] - c[2][1] + c[3][1]]);
+      f.reach = Math.max(f.reach, 2 * 1e-4 * (longest + twist));
+      for (let i = 0; i < 4; i++) {
+        f.far = Math.max(f.far, len2(c[i]));
+        for (let j = i + 1; j < 4; j++) f.near = Math.min(f.near, segment(c[i], c[j]));
+      }
+      f.corners.push(...c);
+    }
+    if (!f.corners.length) return null;
+    footprints.push(f);
+  }
+  const norm = (v) => { const l = len2(v); return l > 0 ? [v[0] / l, v[1] / l] : null; };
+  const reference = norm(sub2(mean(centres.slice(0, rows)), axis));
+  if (!reference) return null;
+  const centreOf = (f) => mean(f.corners);
+  const first = turn(reference, centreOf(footprints[0]));
+  if (first === 0) return null;
+  const orientation = Math.sign(first);
+  const reach = Math.max(...footprints.map((f) => f.reach));
+  const far = Math.max(...footprints.map((f) => f.far));
+  const near = Math.min(...footprints.map((f) => f.near));
+  const rMax = far + reach + 1e-3 * far;
+  const rMin = near - reach - 1e-3 * far;
+  if (!(rMin > 1e-2 * rMax && Number.isFinite(rMax))) return null;
+  const ranges = [];
+  let previous = [0, reference];
+  for (const f of footprints) {
+    const centre = centreOf(f);
+    const s = previous[0] + orientation * turn(previous[1], centre);
+    previous = [s, centre];
+    let lo = 0;
+    let hi = 0;
+    for (const c of f.corners) {
+      const a = orientation * turn(centre, c);
+      lo = Math.min(lo, a);
+      hi = Math.max(hi, a);
+    }
+    if (f.reach >= 0.5 * f.near) return null;
+    // frf's margin, and 0.01 rad more: the corners here are not carried into each
+    // quad's plane (the grid's quads are planar to a fraction of a millimetre).
+    const margin = 1e-3 + 0.01 + (2 * f.reach) / f.near;
+    const range = [s + lo - margin, s + hi + margin];
+    if (!(range[1] - range[0] < Math.PI)) return null;
+    ranges.push(range);
+  }
+  for (let i = 1; i < ranges.length; i++) {
+    if (!(ranges[i - 1][0] < ranges[i][0] && ranges[i - 1][1] < ranges[i][1])) return null;
+  }
+  const TAU = 2 * Math.PI;
+  if (!(ranges.at(-1)[1] - ranges[0][1] < TAU && ranges.at(-1)[1] - ranges[0][0] < 3 * Math.PI)) return null;
+  return { axis, reference, orientation, rMin, rMax, ranges, quadsPerSpan };
+}

@@ -7,7 +7,9 @@
 import * as THREE from 'three';
 import { parseGlb, poseMesh, BadFile } from './glb.js';
 import { png, greyJpeg, expect } from './images.js';
-import { poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt } from './geometry.js';
+import {
+  poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
+} from './geometry.js';
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
   SUN_MAP_VERTEX, SUN_MAP_FRAGMENT,
@@ -87,7 +89,10 @@ export class FrfPlayer {
         uHeight: { value: 0 }, uQuads: { value: null }, uQuadCount: { value: 0 }, uFrames: { value: null },
         uViews: { value: null }, uColumns: { value: 0 }, uRows: { value: 0 }, uFrameRows: { value: 0 },
         uPrelit: { value: null }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
-        uAxis: { value: new THREE.Vector2() },
+        uAxis: { value: new THREE.Vector2() }, uRanges: { value: null }, uIndexed: { value: 0 },
+        uColAxis: { value: new THREE.Vector2() }, uColReference: { value: new THREE.Vector2() },
+        uColOrientation: { value: 1 }, uRMin: { value: 0 }, uRMax: { value: 0 }, uSpans: { value: 0 },
+        uQuadsPerSpan: { value: 0 },
       },
       depthTest: false, depthWrite: false, transparent: false, blending: THREE.NoBlending,
     });
@@ -220,6 +225,7 @@ export class FrfPlayer {
       views: dataTexture(viewTable, 2, columns * rows),
       quads: dataTexture(quadTexels(geometry.quads), 5, geometry.quads.length),
       frames: dataTexture(frameTexels(geometry.frames), FRAME_TEXELS, geometry.frames.length),
+      index: columnIndex(geometry.quads, rows + 1, geometry.cameras, rows),
       prelit: new THREE.WebGLArrayRenderTarget(w, h, n, {
         type: THREE.HalfFloatType, format: THREE.RGBAFormat, depthBuffer: false,
         minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
@@ -235,11 +241,17 @@ export class FrfPlayer {
       hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
       dispose() {
         for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t.dispose();
+        this.ranges?.dispose();
         this.prelit.dispose();
         this.viewHull.dispose();
         this.hull.geometry.dispose();
       },
     };
+    if (pose.index) {
+      const r = new Float32Array(pose.index.ranges.length * 4);
+      pose.index.ranges.forEach(([lo, hi], i) => r.set([lo, hi, 0, 0], 4 * i));
+      pose.ranges = dataTexture(r, pose.index.ranges.length, 1);
+    }
     // Each view texel's distance to the hull along its ray (the sun's shadow rays start there).
     views.forEach((v, i) => {
       const camera = geometry.cameras[v.u * rows + v.v];
@@ -325,6 +337,18 @@ export class FrfPlayer {
     u.uHullT.value = hullTarget.texture;
     u.uHasHull.value = pose.geometry.hasHull ? 1 : 0;
     u.uAxis.value.set(...pose.geometry.axis);
+    const c = pose.index;
+    u.uIndexed.value = c ? 1 : 0;
+    if (c) {
+      u.uRanges.value = pose.ranges;
+      u.uColAxis.value.set(...c.axis);
+      u.uColReference.value.set(...c.reference);
+      u.uColOrientation.value = c.orientation;
+      u.uRMin.value = c.rMin;
+      u.uRMax.value = c.rMax;
+      u.uSpans.value = c.ranges.length;
+      u.uQuadsPerSpan.value = c.quadsPerSpan;
+    }
     this.renderer.setRenderTarget(target);
     this.renderer.render(this.frameScene, this.camera);
     this.renderer.setRenderTarget(saved);

@@ -225,25 +225,100 @@ struct Hit { int u; int v; float beta; float gamma; vec3 point; float t; int cla
 
 vec4 quadTexel(int i, int k) { return texelFetch(uQuads, ivec2(k, i), 0); }
 
+// The column index (geometry.js columnIndex): spans' azimuth ranges (uRanges, .xy per
+// texel), the annulus about the axis point, and whether it is used.
+uniform sampler2D uRanges;
+uniform int uIndexed;
+uniform vec2 uColAxis;
+uniform vec2 uColReference;
+uniform float uColOrientation;
+uniform float uRMin;
+uniform float uRMax;
+uniform int uSpans;
+uniform int uQuadsPerSpan;
+const float TAU = 6.2831855;
+
+// Offers the hit of the ray on quad i: the smallest t is kept (of equal ones the
+// first quad's), and whether any lies ahead.
+void offer(int i, vec3 origin, vec3 dir, inout Hit best, inout int bestIndex, inout bool anyAhead) {
+  vec4 t0 = quadTexel(i, 0), t1 = quadTexel(i, 1), t2 = quadTexel(i, 2), t3 = quadTexel(i, 3), t4 = quadTexel(i, 4);
+  vec3 normal = t4.xyz;
+  float denom = dot(normal, dir);
+  if (abs(denom) < 1e-9) return;
+  float t = dot(normal, t0.xyz - origin) / denom;
+  vec3 p = origin + dir * t;
+  vec3 r = inverseBilinear(p, t0.xyz, t1.xyz, t2.xyz, t3.xyz, normal);
+  if (r.z == 0.0 || outside(r.xy) > 1e-4) return;
+  if (t >= 0.0) anyAhead = true;
+  if (t < best.t || (t == best.t && i < bestIndex)) {
+    int wall = int(t2.w);
+    float gamma = wall != 0 ? t3.w : clamp(r.y, 0.0, 1.0);
+    best = Hit(int(t0.w), int(t1.w), clamp(r.x, 0.0, 1.0), gamma, p, t, wall);
+    bestIndex = i;
+  }
+}
+
+float turn(vec2 s, vec2 e) { return atan(cross2(s, e), dot(s, e)); }
+float columnAzimuth(vec2 v) {
+  float s = uColOrientation * turn(uColReference, v);
+  return s < 0.0 ? s + TAU : s;
+}
+vec2 spanRange(int u) { return texelFetch(uRanges, ivec2(u, 0), 0).xy; }
+
+// Offers the quads of every span whose range meets the azimuths swept from start to end.
+void walkSpans(vec2 start, vec2 end, vec3 origin, vec3 dir, inout Hit best, inout int bestIndex, inout bool anyAhead) {
+  float sweep = uColOrientation * turn(start, end);
+  float a = columnAzimuth(start);
+  float len = sweep;
+  if (sweep < 0.0) { a = columnAzimuth(end); len = -sweep; }
+  float last = spanRange(uSpans - 1).y;
+  a -= TAU * ceil((a - last) / TAU);
+  if (a > last) a -= TAU;
+  if (a <= last - TAU) a += TAU;
+  float b = a + len;
+  int lo = 0, hi = uSpans;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (spanRange(mid).y < a) lo = mid + 1; else hi = mid;
+  }
+  for (int u = lo; u < uSpans && spanRange(u).x <= b; u++) {
+    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, best, bestIndex, anyAhead);
+  }
+  for (int u = 0; u < uSpans && spanRange(u).x + TAU <= b; u++) {
+    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, best, bestIndex, anyAhead);
+  }
+}
+
 // Where the ray enters the cylinder: the smallest t of all hits, unless none lies ahead
-// (clamped = 3). Every quad is tested (frf prunes them by a column index: same hit).
+// (clamped = 3). Only the spans the ray's line can reach are tested (every quad without
+// the index), as frf does.
 Hit intersect(vec3 origin, vec3 dir) {
   Hit best = Hit(0, 0, 0.0, 0.0, vec3(0.0), BIG, 3);
+  int bestIndex = 1 << 30;
   bool anyAhead = false;
-  for (int i = 0; i < uQuadCount; i++) {
-    vec4 t0 = quadTexel(i, 0), t1 = quadTexel(i, 1), t2 = quadTexel(i, 2), t3 = quadTexel(i, 3), t4 = quadTexel(i, 4);
-    vec3 normal = t4.xyz;
-    float denom = dot(normal, dir);
-    if (abs(denom) < 1e-9) continue;
-    float t = dot(normal, t0.xyz - origin) / denom;
-    vec3 p = origin + dir * t;
-    vec3 r = inverseBilinear(p, t0.xyz, t1.xyz, t2.xyz, t3.xyz, normal);
-    if (r.z == 0.0 || outside(r.xy) > 1e-4) continue;
-    if (t >= 0.0) anyAhead = true;
-    if (t < best.t) {
-      int wall = int(t2.w);
-      float gamma = wall != 0 ? t3.w : clamp(r.y, 0.0, 1.0);
-      best = Hit(int(t0.w), int(t1.w), clamp(r.x, 0.0, 1.0), gamma, p, t, wall);
+  if (uIndexed == 0) {
+    for (int i = 0; i < uQuadCount; i++) offer(i, origin, dir, best, bestIndex, anyAhead);
+  } else {
+    vec2 o = origin.xz - uColAxis;
+    float m = max(abs(dir.x), abs(dir.z));
+    if (m == 0.0) {
+      float r = length(o);
+      if (r >= uRMin && r <= uRMax) walkSpans(o, o, origin, dir, best, bestIndex, anyAhead);
+    } else {
+      vec2 d = normalize(dir.xz / m);
+      vec2 across = vec2(-d.y, d.x);
+      float h = dot(o, across);
+      if (abs(h) <= uRMax) {
+        vec2 foot = across * h;
+        float outer = sqrt(uRMax * uRMax - h * h);
+        if (abs(h) >= uRMin) {
+          walkSpans(foot - d * outer, foot + d * outer, origin, dir, best, bestIndex, anyAhead);
+        } else {
+          float inner = sqrt(uRMin * uRMin - h * h);
+          walkSpans(foot - d * outer, foot - d * inner, origin, dir, best, bestIndex, anyAhead);
+          walkSpans(foot + d * inner, foot + d * outer, origin, dir, best, bestIndex, anyAhead);
+        }
+      }
     }
   }
   if (!anyAhead) best.clamped = 3;

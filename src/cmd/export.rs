@@ -1,5 +1,6 @@
 //! `frf export FIELD --out walker.glb`: the walker as binary glTF for engines and the
-//! web player (frf-export, docs/export.md), with what it wrote and how long it took.
+//! web player (frf-export, docs/export.md), with what it wrote and how long it took; and
+//! `frf export FIELD --sprites --out sheet.png`: a relit sprite sheet of the walk cycle.
 
 use std::path::PathBuf;
 
@@ -7,7 +8,10 @@ use clap::Args;
 use frf_export::{ExportOptions, Tier, ViewSelection};
 
 use crate::CliResult;
-use crate::cmd::args::parse_poses;
+use crate::cmd::args::{
+    SunSpec, parse_env, parse_fov, parse_point, parse_poses, parse_size, parse_sun,
+};
+use frf_core::env::EnvSource;
 
 /// Arguments of `frf export`.
 #[derive(Args)]
@@ -36,6 +40,73 @@ pub struct ExportArgs {
     /// Also print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Write a relit sprite sheet instead (`--out` the PNG; its JSON beside it): the
+    /// walk cycle's poses in columns, one row per heading.
+    #[arg(long)]
+    sprites: bool,
+    /// Sprites: the light, an environment (.hdr/.exr), `sky`, `uniform` or an L2 file
+    /// of `frf env-sh`.
+    #[arg(long, value_parser = parse_env, default_value = "sky")]
+    env: EnvSource,
+    /// Sprites: a sun added to the light, `AZ,EL[,DIAM[,E]]` as `frf render --sun`.
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]")]
+    sun: Option<SunSpec>,
+    /// Sprites: `N` headings evenly round the walker from azimuth 0, or a list of camera
+    /// azimuths in degrees (`0,90,180,270`; 0 on +z, 90 on +x: the stage's walker walks
+    /// toward +x, so 0 sees its left side and 90 its front).
+    #[arg(long, default_value = "8", value_parser = parse_headings)]
+    headings: Headings,
+    /// Sprites: a frame's size `WxH`.
+    #[arg(long, default_value = "128x180", value_parser = parse_size)]
+    sprite_size: (u32, u32),
+    /// Sprites: the cameras' `RADIUS,HEIGHT` about the walker, metres.
+    #[arg(long, default_value = "3.2,1.1", value_parser = parse_radius_height)]
+    sprite_orbit: (f32, f32),
+    /// Sprites: the point looked at, `x,y,z` metres.
+    #[arg(long, default_value = "0,0.9,0", value_parser = parse_point, allow_hyphen_values = true)]
+    look_at: [f32; 3],
+    /// Sprites: vertical field of view, degrees.
+    #[arg(long, default_value_t = 35.0, value_parser = parse_fov)]
+    fov: f32,
+    /// Sprites: exposure of the sheet, stops.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    exposure: f32,
+    /// Sprites: render with the CPU reference instead of the GPU.
+    #[arg(long)]
+    cpu: bool,
+}
+
+/// `--headings`: camera azimuths, degrees.
+#[derive(Clone, Debug)]
+pub struct Headings(Vec<f32>);
+
+fn parse_headings(s: &str) -> Result<Headings, String> {
+    if let Ok(n) = s.trim().parse::<usize>() {
+        if !(1..=64).contains(&n) {
+            return Err(format!("{n} headings: 1 to 64"));
+        }
+        return Ok(Headings(
+            (0..n).map(|i| i as f32 * 360.0 / n as f32).collect(),
+        ));
+    }
+    s.split(',')
+        .map(|a| {
+            a.trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|a| a.is_finite())
+                .ok_or_else(|| format!("{s:?}: a count of headings or a list of degrees"))
+        })
+        .collect::<Result<_, _>>()
+        .map(Headings)
+}
+
+fn parse_radius_height(s: &str) -> Result<(f32, f32), String> {
+    let v: Vec<f32> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+    match v[..] {
+        [r, h] if r.is_finite() && h.is_finite() => Ok((r, h)),
+        _ => Err(format!("{s:?}: expected RADIUS,HEIGHT in metres")),
+    }
 }
 
 fn parse_tier(s: &str) -> Result<Tier, String> {
@@ -84,6 +155,9 @@ pub fn run(args: ExportArgs) -> CliResult {
         .map_err(|e| {
             frf_core::BadArgument::new("--poses", args.poses.as_deref().unwrap_or(""), e)
         })?;
+    if args.sprites {
+        return sprites(&args, poses);
+    }
     let options = ExportOptions {
         tier: args.tier,
         poses,
@@ -112,6 +186,40 @@ pub fn run(args: ExportArgs) -> CliResult {
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
+
+/// `frf export --sprites`.
+fn sprites(args: &ExportArgs, poses: Option<Vec<u32>>) -> CliResult {
+    let options = frf_export::sprites::SpriteOptions {
+        env: args.env.clone(),
+        sun: args.sun.as_ref().map(SunSpec::sun).transpose()?,
+        headings_deg: args.headings.0.clone(),
+        poses,
+        frame_size: args.sprite_size,
+        radius_m: args.sprite_orbit.0,
+        height_m: args.sprite_orbit.1,
+        look_at: glam::Vec3::from_array(args.look_at),
+        fov_deg: args.fov,
+        exposure_stops: args.exposure,
+        cpu: args.cpu,
+    };
+    let r = frf_export::sprites::sprite_sheet(&args.field, &args.out, &options)?;
+    println!(
+        "{} written ({}x{} pixels: {} heading(s) x {} pose(s) of {}x{}) and {}, in {:.1} s",
+        r.image.display(),
+        r.width,
+        r.height,
+        r.rows,
+        r.columns,
+        args.sprite_size.0,
+        args.sprite_size.1,
+        r.json.display(),
+        r.seconds
+    );
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
     }
     Ok(())
 }

@@ -99,3 +99,96 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
     assert!(stderr(&o).contains("junk.frf"), "{}", stderr(&o));
     assert!(!out.exists());
 }
+
+#[test]
+fn export_sprites_writes_a_sheet_whose_frames_are_frf_renders() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let sheet = dir.path().join("sheet.png");
+    let mut args = vec![
+        "export",
+        f.field.to_str().unwrap(),
+        "--sprites",
+        "--out",
+        sheet.to_str().unwrap(),
+        "--headings",
+        "0,90,200",
+        "--sprite-size",
+        "40x56",
+    ];
+    args.extend(frf_testkit::cpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = image::open(&sheet).unwrap().to_rgba8();
+    // The tiny field holds one pose: three rows of one column.
+    assert_eq!(png.dimensions(), (40, 3 * 56));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("sheet.json")).unwrap()).unwrap();
+    assert_eq!(json["format"], "frf-sprites");
+    let frames = json["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 3);
+    assert_eq!(
+        (frames[1]["y"].as_u64(), frames[1]["heading_deg"].as_f64()),
+        (Some(56), Some(90.0))
+    );
+
+    // Row 1 is what `frf render` draws from the camera on the orbit at azimuth 90.
+    let out = dir.path().join("render");
+    let mut args = vec![
+        "render",
+        f.field.to_str().unwrap(),
+        "--env",
+        "sky",
+        "--orbit",
+        "3.2,1.1",
+        "--start",
+        "90",
+        "--frames",
+        "1",
+        "--size",
+        "40x56",
+        "--detail",
+        "0",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(frf_testkit::cpu_flag());
+    let o = frf(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let frame = image::open(out.join("frame_0000.png")).unwrap().to_rgba8();
+    let mut worst = 0i32;
+    let mut covered = 0;
+    for (x, y, p) in frame.enumerate_pixels() {
+        let q = png.get_pixel(x, y + 56);
+        covered += usize::from(p[3] > 128);
+        for c in 0..4 {
+            worst = worst.max((p[c] as i32 - q[c] as i32).abs());
+        }
+    }
+    assert!(covered > 200, "{covered} pixels of the walker");
+    assert!(
+        worst <= 2,
+        "the sheet's frame differs from frf render's by {worst} codes"
+    );
+
+    // Absurd options are refused by name, nothing written.
+    for (flag, value, want) in [
+        ("--headings", "0", "0 headings"),
+        ("--sprite-size", "0x10", "0x10"),
+        ("--sprite-orbit", "0,1", "radius"),
+    ] {
+        let bad = dir.path().join("bad.png");
+        let o = frf(&[
+            "export",
+            f.field.to_str().unwrap(),
+            "--sprites",
+            "--out",
+            bad.to_str().unwrap(),
+            flag,
+            value,
+        ]);
+        assert!(!o.status.success(), "{flag} {value}");
+        assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
+        assert!(!bad.exists() && !dir.path().join("bad.json").exists());
+    }
+}
