@@ -241,7 +241,7 @@ fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
     let mut doc: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
     edit(&mut doc);
     let mut json = serde_json::to_vec(&doc).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let bin = &bytes[20 + json_len..];
