@@ -160,6 +160,8 @@ pub fn sprite_sheet(
     let (columns, rows) = (poses.len(), options.headings_deg.len());
     let mut sheet = Image::new(fw as usize * columns, fh as usize * rows, [0.0f32; 4]);
     let mut frames = Vec::new();
+    let progress = frf_core::bars::bar("sprites");
+    progress.set_length((rows * columns) as u64);
     for (row, &heading) in options.headings_deg.iter().enumerate() {
         let camera = heading_camera(options, heading)?;
         // Where the walker's foot point (the origin) lands: the sprite's pivot.
@@ -169,6 +171,7 @@ pub fn sprite_sheet(
             let frame = shot.render_at(time, &camera, false).map_err(scene_error)?;
             let (x0, y0) = (column * fw as usize, row * fh as usize);
             paste(&mut sheet, &frame.frame.composite, x0, y0);
+            progress.inc(1);
             frames.push(json!({
                 "x": x0, "y": y0, "w": fw, "h": fh,
                 "row": row, "column": column, "heading_deg": heading,
@@ -176,6 +179,7 @@ pub fn sprite_sheet(
             }));
         }
     }
+    progress.finish_and_clear();
     frf_core::io::write_png8_srgba(png, &sheet, options.exposure_stops.exp2())?;
     let period = header.cycle_seconds / f64::from(header.poses_per_cycle.max(1));
     let document = json!({

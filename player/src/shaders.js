@@ -408,38 +408,33 @@ Output solvedOutput(Hit hit, vec3 origin, vec3 dir) {
   return Output(plane.xy, r.xy, inverseDepth, true);
 }
 
-// Bilinear sample of a view's flow toward neighbour dir (0 right, 1 left, 2 up, 3 down)
-// at pixel s (centres at integers, the edge repeated); absent flows are zero.
-vec2 sampleFlow(int view, int dir, vec2 s) {
-  int layer = int(viewTexel(view, 1)[dir]);
-  if (layer < 0) return vec2(0.0);
-  ivec2 size = textureSize(uFlows, 0).xy;
+// A bilinear sample of a layer at pixel s (centres at integers, the edge
+// repeated): frf's crop_position and its four texels.
+vec4 bilinearLayer(sampler2DArray tex, int layer, vec2 s) {
+  ivec2 size = textureSize(tex, 0).xy;
   vec2 p = clamp(s, vec2(-1.0), vec2(size));
   vec2 p0 = floor(p);
   vec2 fr = p - p0;
   ivec2 a = clamp(ivec2(p0), ivec2(0), size - 1);
   ivec2 b = clamp(ivec2(p0) + 1, ivec2(0), size - 1);
-  vec2 f00 = texelFetch(uFlows, ivec3(a, layer), 0).rg;
-  vec2 f10 = texelFetch(uFlows, ivec3(b.x, a.y, layer), 0).rg;
-  vec2 f01 = texelFetch(uFlows, ivec3(a.x, b.y, layer), 0).rg;
-  vec2 f11 = texelFetch(uFlows, ivec3(b, layer), 0).rg;
-  return mix(mix(f00, f10, fr.x), mix(f01, f11, fr.x), fr.y);
+  vec4 c00 = texelFetch(tex, ivec3(a, layer), 0);
+  vec4 c10 = texelFetch(tex, ivec3(b.x, a.y, layer), 0);
+  vec4 c01 = texelFetch(tex, ivec3(a.x, b.y, layer), 0);
+  vec4 c11 = texelFetch(tex, ivec3(b, layer), 0);
+  return mix(mix(c00, c10, fr.x), mix(c01, c11, fr.x), fr.y);
 }
 
+// A view's flow toward neighbour dir (0 right, 1 left, 2 up, 3 down) at pixel s, in
+// pixels; absent flows are zero.
+vec2 sampleFlow(int view, int dir, vec2 s) {
+  int layer = int(viewTexel(view, 1)[dir]);
+  return layer < 0 ? vec2(0.0) : bilinearLayer(uFlows, layer, s).rg;
+}
+
+// A view's pre-lit premultiplied colour at pixel s; views not held are transparent.
 vec4 samplePrelit(int view, vec2 s) {
   int layer = int(viewTexel(view, 0).w);
-  if (layer < 0) return vec4(0.0);
-  ivec2 size = textureSize(uPrelit, 0).xy;
-  vec2 p = clamp(s, vec2(-1.0), vec2(size));
-  vec2 p0 = floor(p);
-  vec2 fr = p - p0;
-  ivec2 a = clamp(ivec2(p0), ivec2(0), size - 1);
-  ivec2 b = clamp(ivec2(p0) + 1, ivec2(0), size - 1);
-  vec4 c00 = texelFetch(uPrelit, ivec3(a, layer), 0);
-  vec4 c10 = texelFetch(uPrelit, ivec3(b.x, a.y, layer), 0);
-  vec4 c01 = texelFetch(uPrelit, ivec3(a.x, b.y, layer), 0);
-  vec4 c11 = texelFetch(uPrelit, ivec3(b, layer), 0);
-  return mix(mix(c00, c10, fr.x), mix(c01, c11, fr.x), fr.y);
+  return layer < 0 ? vec4(0.0) : bilinearLayer(uPrelit, layer, s);
 }
 
 vec2 solveFractions(int f, int k, bool vertical, vec2 to) {
