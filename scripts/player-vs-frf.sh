@@ -7,7 +7,9 @@ set -euo pipefail
 field=$1; out=$2; shift 2
 frf=${FRF:-target/release/frf}
 mkdir -p "$out"
-"$frf" export "$field" --poses 0 --out "$out/walker.glb" >/dev/null
+# EXPORT_ARGS: more options of the export (e.g. --mesh-voxel 0.01).
+# shellcheck disable=SC2086
+"$frf" export "$field" --poses 0 ${EXPORT_ARGS:-} --out "$out/walker.glb" >/dev/null
 "$frf" env-sh sky --out "$out/sky.json" >/dev/null
 for case in "$@"; do
   IFS=, read -r u v az el e <<< "$case"

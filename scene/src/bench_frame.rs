@@ -332,11 +332,14 @@ pub fn run_frame_bench<R: ReadAt>(
                 let t = Instant::now();
                 let made = shot.render(f, false)?.made_resident.len();
                 let w = t.elapsed().as_secs_f64() * 1e3;
-                // Read after the frame's time is taken (reading waits on the device).
+                // The frame's waits, counted before the pass times are read: reading them
+                // waits on the device again, outside the frame's wall time (counting
+                // that wait made the host's share negative on a loaded machine).
+                let frame_waited = (waited_on(shot.render_device()) - before) * 1e3;
                 let times = pass_times(shot.render_device())?;
                 if k > 0 {
                     wall.push(w);
-                    waited.push((waited_on(shot.render_device()) - before) * 1e3);
+                    waited.push(frame_waited);
                     relights += made;
                     passes.push(times);
                 }
