@@ -299,6 +299,81 @@ mod tests {
         }
     }
 
+    /// An overcast sky (its zenith three times its horizon, a grey ground) whose zenith
+    /// glows, a Gaussian lobe of `glow_deg` carrying `glow` of the light, with a hot spot
+    /// of `spot_deg` carrying `spot` of it, both toward `toward`. 512x256 texels.
+    fn overcast(toward: Vec3, glow_deg: f32, glow: f32, spot_deg: f32, spot: f32) -> EnvMap {
+        let grid = EnvMap::uniform([0.0; 3], 256);
+        let (w, h) = grid.image().size();
+        let dirs: Vec<Vec3> = (0..w * h)
+            .map(|i| grid.direction_of((i % w) as f32, (i / w) as f32))
+            .collect();
+        let lobe = |deg: f32| -> Vec<f32> {
+            let s = deg.to_radians();
+            dirs.iter()
+                .map(|d| (-0.5 * (d.dot(toward).clamp(-1.0, 1.0).acos() / s).powi(2)).exp())
+                .collect()
+        };
+        let sky: Vec<f32> = dirs
+            .iter()
+            .map(|d| {
+                if d.y > 0.0 {
+                    (1.0 + 2.0 * d.y) / 3.0
+                } else {
+                    0.2
+                }
+            })
+            .collect();
+        let light = |v: &[f32]| -> f32 {
+            v.iter()
+                .enumerate()
+                .map(|(i, x)| x * grid.texel_solid_angle(i / w))
+                .sum()
+        };
+        let (g, hot) = (lobe(glow_deg), lobe(spot_deg));
+        let total = light(&sky) / (1.0 - glow - spot);
+        let (kg, kh) = (glow * total / light(&g), spot * total / light(&hot));
+        let pixels = (0..w * h)
+            .map(|i| [sky[i] + kg * g[i] + kh * hot[i]; 3])
+            .collect();
+        EnvMap::from_image(crate::image::Image::from_vec(w, h, pixels).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn a_broad_bright_zenith_is_not_taken_for_a_sun_and_a_hot_spot_in_it_is() {
+        // Overhead and a little off it: lobes 12° to 20° wide carrying 40-60 % of the
+        // light are a bright overcast, relit by the basis, not a point light.
+        for (toward, glow_deg, glow) in [
+            (Vec3::Y, 15.0, 0.6),
+            (
+                crate::light::direction_from_azimuth_elevation(0.7, 1.3),
+                12.0,
+                0.4,
+            ),
+            (
+                crate::light::direction_from_azimuth_elevation(3.0, 1.2),
+                20.0,
+                0.5,
+            ),
+        ] {
+            let map = overcast(toward, glow_deg, glow, 1.0, 0.0);
+            assert!(
+                Sun::extract(&map).unwrap().is_none(),
+                "a {glow_deg}° glow taken for a sun"
+            );
+            // A small bright spot where the clouds thin is a sun, found where it is.
+            let map = overcast(toward, glow_deg, glow, 1.5, 0.06);
+            let (sun, _) = Sun::extract(&map).unwrap().expect("the hot spot is a sun");
+            let off = sun
+                .direction()
+                .dot(toward)
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees();
+            assert!(off < 1.0, "{glow_deg}°: the sun found {off}° from the spot");
+        }
+    }
+
     #[test]
     fn the_built_in_sky_s_sun_is_found_and_taken_out_of_it() {
         let sky = EnvMap::sky().rotated(0.4);
