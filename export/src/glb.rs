@@ -113,21 +113,27 @@ impl Glb {
         if !self.images.is_empty() {
             document["images"] = Value::Array(self.images);
         }
-        let mut text = serde_json::to_vec(&document).expect("a JSON value serializes");
-        while !text.len().is_multiple_of(4) {
-            text.push(b' ');
-        }
-        let total = 12 + 8 + text.len() + 8 + self.bin.len();
-        let mut out = Vec::with_capacity(total);
-        out.extend_from_slice(b"glTF");
-        out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"JSON");
-        out.extend_from_slice(&text);
-        out.extend_from_slice(&(self.bin.len() as u32).to_le_bytes());
-        out.extend_from_slice(b"BIN\0");
-        out.extend_from_slice(&self.bin);
-        out
+        pack(&document, &self.bin)
     }
+}
+
+/// A GLB container of `document` and the binary chunk `bin` (whose length is a multiple of
+/// four): the header, the JSON chunk padded with spaces, the binary chunk.
+pub fn pack(document: &Value, bin: &[u8]) -> Vec<u8> {
+    let mut text = serde_json::to_vec(document).expect("a JSON value serializes");
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(bin);
+    out
 }

@@ -118,7 +118,7 @@ pub fn sprite_sheet(
     let started = Instant::now();
     check(options)?;
     let field = FieldFile::open(field_path)?;
-    frf_render::resident::check_renderable(&field).map_err(scene_error)?;
+    frf_render::resident::check_renderable(&field)?;
     let header = field.header().clone();
     let poses: Vec<u32> = match &options.poses {
         Some(p) => p
@@ -148,14 +148,14 @@ pub fn sprite_sheet(
     let mut scene = Scene::of_field(field_path, &header, first, look);
     scene.size = Some(options.frame_size);
     let first_time = header.pose(first)?.time_s;
-    let device = Device::open(options.cpu).map_err(scene_error)?;
+    let device = Device::open(options.cpu)?;
     let shot_options = ShotOptions {
         memory_budget: 4 << 30,
         planned: false,
         traced_lights: 256,
         detail: Some(0),
     };
-    let mut shot = Shot::live(scene, &field, device, shot_options).map_err(scene_error)?;
+    let mut shot = Shot::live(scene, &field, device, shot_options)?;
     let (fw, fh) = options.frame_size;
     let (columns, rows) = (poses.len(), options.headings_deg.len());
     let mut sheet = Image::new(fw as usize * columns, fh as usize * rows, [0.0f32; 4]);
@@ -167,15 +167,16 @@ pub fn sprite_sheet(
         // Where the walker's foot point (the origin) lands: the sprite's pivot.
         let pivot = camera.project(Vec3::ZERO).map(|p| [p.x, p.y]);
         for (column, &pose) in poses.iter().enumerate() {
-            let time = header.pose(pose)?.time_s - first_time;
-            let frame = shot.render_at(time, &camera, false).map_err(scene_error)?;
+            let pose_time = header.pose(pose)?.time_s;
+            let time = pose_time - first_time;
+            let frame = shot.render_at(time, &camera, false)?;
             let (x0, y0) = (column * fw as usize, row * fh as usize);
             paste(&mut sheet, &frame.frame.composite, x0, y0);
             progress.inc(1);
             frames.push(json!({
                 "x": x0, "y": y0, "w": fw, "h": fh,
                 "row": row, "column": column, "heading_deg": heading,
-                "pose": pose, "time_s": header.pose(pose)?.time_s, "pivot": pivot,
+                "pose": pose, "time_s": pose_time, "pivot": pivot,
             }));
         }
     }
@@ -241,8 +242,4 @@ fn paste(sheet: &mut Image<Rgba>, frame: &Image<Rgba>, x0: usize, y0: usize) {
         let at = (y0 + y) * sw + x0;
         dst[at..at + w].copy_from_slice(row);
     }
-}
-
-fn scene_error(e: impl std::fmt::Display) -> ExportError {
-    ExportError::Field(e.to_string())
 }

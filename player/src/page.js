@@ -4,7 +4,7 @@
 // pose by pose at the capture's rate.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { FrfPlayer } from './player.js';
+import { FrfPlayer, fullscreen } from './player.js';
 import { parseShLight } from './sh.js';
 import { sunDirection } from './geometry.js';
 import { FULLSCREEN_VERTEX, PRESENT_FRAGMENT } from './shaders.js';
@@ -33,14 +33,7 @@ const present = new THREE.RawShaderMaterial({
     uBottom: { value: new THREE.Vector3(0.03, 0.03, 0.035) }, uSize: { value: new THREE.Vector2() },
   },
 });
-const presentScene = new THREE.Scene();
-{
-  const g = new THREE.BufferGeometry();
-  g.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
-  const m = new THREE.Mesh(g, present);
-  m.frustumCulled = false;
-  presentScene.add(m);
-}
+const presentScene = fullscreen(present);
 
 function showError(e) {
   $('error').textContent = String(e.message ?? e);

@@ -45,7 +45,8 @@ function dataTexture(data, width, height) {
   return t;
 }
 
-function fullscreen(material) {
+/** A scene of one triangle covering the viewport, drawn with `material`. */
+export function fullscreen(material) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
   const mesh = new THREE.Mesh(geometry, material);
@@ -244,7 +245,7 @@ export class FrfPlayer {
         this.ranges?.dispose();
         this.prelit.dispose();
         this.viewHull.dispose();
-        this.hull.geometry.dispose();
+        this.hull.mesh.geometry.dispose();
       },
     };
     if (pose.index) {
@@ -266,7 +267,9 @@ export class FrfPlayer {
     g.setIndex(new THREE.BufferAttribute(mesh.indices, 1));
     const m = new THREE.Mesh(g, this.hullMaterial);
     m.frustumCulled = false;
-    return m;
+    const scene = new THREE.Scene();
+    scene.add(m);
+    return { mesh: m, scene };
   }
 
   #relight(pose) {
@@ -367,9 +370,7 @@ export class FrfPlayer {
     this.renderer.setRenderTarget(target, layer);
     this.renderer.setClearColor(0x000000, 0);
     this.renderer.clear(true, true, false);
-    const scene = new THREE.Scene();
-    scene.add(pose.hull);
-    this.renderer.render(scene, this.camera);
+    this.renderer.render(pose.hull.scene, this.camera);
     this.renderer.setRenderTarget(saved);
   }
 
@@ -407,7 +408,7 @@ export class FrfPlayer {
     this.renderer.setRenderTarget(this.sunTarget);
     this.renderer.setClearColor(0x000000, 0);
     this.renderer.clear(true, true, false);
-    const mesh = new THREE.Mesh(pose.hull.geometry, this.sunMapMaterial);
+    const mesh = new THREE.Mesh(pose.hull.mesh.geometry, this.sunMapMaterial);
     mesh.frustumCulled = false;
     const scene = new THREE.Scene();
     scene.add(mesh);

@@ -352,6 +352,14 @@ pub struct OrbitSpec {
     pub sweep_deg: f32,
 }
 
+/// Parses `RADIUS,HEIGHT`, metres (a camera circling the walker at one height).
+pub fn parse_radius_height(s: &str) -> Result<(f32, f32), String> {
+    match numbers(s, "radius and height")?[..] {
+        [r, h] => Ok((r, h)),
+        _ => Err(format!("`{s}`: expected RADIUS,HEIGHT in metres")),
+    }
+}
+
 /// Parses `RADIUS,HEIGHT[,SWEEP_DEG]`.
 pub fn parse_orbit(s: &str) -> Result<OrbitSpec, String> {
     let v = numbers(s, "orbit")?;

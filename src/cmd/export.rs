@@ -9,7 +9,8 @@ use frf_export::{ExportOptions, Tier, ViewSelection};
 
 use crate::CliResult;
 use crate::cmd::args::{
-    SunSpec, parse_env, parse_fov, parse_point, parse_poses, parse_size, parse_sun,
+    SunSpec, parse_env, parse_fov, parse_point, parse_poses, parse_radius_height, parse_size,
+    parse_sun,
 };
 use frf_core::env::EnvSource;
 
@@ -99,14 +100,6 @@ fn parse_headings(s: &str) -> Result<Headings, String> {
         })
         .collect::<Result<_, _>>()
         .map(Headings)
-}
-
-fn parse_radius_height(s: &str) -> Result<(f32, f32), String> {
-    let v: Vec<f32> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
-    match v[..] {
-        [r, h] if r.is_finite() && h.is_finite() => Ok((r, h)),
-        _ => Err(format!("{s:?}: expected RADIUS,HEIGHT in metres")),
-    }
 }
 
 fn parse_tier(s: &str) -> Result<Tier, String> {

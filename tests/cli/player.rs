@@ -234,27 +234,15 @@ fn the_player_in_chromium_draws_what_frf_renders() {
     }
 }
 
-/// The GLB `bytes` with its JSON chunk changed by `edit` (chunks re-padded).
+/// The GLB `bytes` with its JSON chunk changed by `edit`, packed again as the exporter
+/// packs it.
 fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
     let json_len = word(12);
     let mut doc: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
     edit(&mut doc);
-    let mut json = serde_json::to_vec(&doc).unwrap();
-    while !json.len().is_multiple_of(4) {
-        json.push(b' ');
-    }
-    let bin = &bytes[20 + json_len..];
-    let total = 12 + 8 + json.len() + bin.len();
-    let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
-    out.extend_from_slice(&(total as u32).to_le_bytes());
-    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
-    out.extend_from_slice(&json);
-    out.extend_from_slice(bin);
-    out
+    // The binary chunk after its 8-byte header.
+    frf_export::glb::pack(&doc, &bytes[20 + json_len + 8..])
 }
 
 #[test]
