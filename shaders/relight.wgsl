@@ -48,8 +48,9 @@ struct Job {
 // view's alpha code.
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
 // Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
-// w = 0 when the condition is not used; per tile, where its condition's lights are
-// (x: the first, y: how many, as f32); then `sun_slots` slots of a sun, those in use
+// w = 0 when the condition is not used (by the light or its suns); per tile, where its
+// condition's lights are (x: the first, y: how many, as f32); per tile, the suns'
+// coefficient x tile scale (what the basis adds for them); then `sun_slots` slots of a sun, those in use
 // first: per tile, the sun per unit of the condition's light x tile scale (rgb); the
 // sun's direction (xyz, the view's dome frame; w = 0 for an unused slot), the nearest
 // conditions (xyz, as f32; w: how many) and their weights (xyz; w: the ratio's floor),
@@ -57,7 +58,9 @@ struct Job {
 // ray starts, 0 for no shadow); its map of the hull (`SunDepth`,
 // `reflectance/src/sun_depth.rs`): its x axis (xyz) and corner's x (w), its y axis and
 // corner's y, and (texel side, texels along x, along y, where its values start in
-// `sun_depths`, as f32). After every view's: the conditions' lights, each its direction
+// `sun_depths`, as f32); the conditions that predict each of the two nearest left out
+// (xy: the first's, zw: the second's, as f32) and their weights; (its compactness, its
+// luminance, the trust's error bounds). After every view's: the conditions' lights, each its direction
 // (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
@@ -115,9 +118,68 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     return s;
 }
 
-// Where sun slot `s` of `job` starts (its per-tile units; its seven follow them).
+// Where sun slot `s` of `job` starts (its per-tile units; its ten follow them).
 fn sun_slot(job: Job, s: u32) -> u32 {
-    return job.coefficient_offset + 2u * job.tiles + s * (job.tiles + 7u);
+    return job.coefficient_offset + 3u * job.tiles + s * (job.tiles + 10u);
+}
+
+// Tile k's linear value at texel i of `job` times the sun of `slot` per unit of k's light.
+fn sunned(job: Job, slot: u32, k: u32, i: u32) -> vec3<f32> {
+    return coefficients[slot + k].rgb * tile_value(job, k, i);
+}
+
+fn lum(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// How far the normals' sun of `slot` is trusted at texel i of `job`, normal n (zero:
+// none fitted, no trust). Twin of `SunLight::trust` (`reflectance/src/sun_light.rs`).
+fn trust(job: Job, slot: u32, i: u32, n: vec3<f32>) -> f32 {
+    let head = slot + job.tiles;
+    let bounds = coefficients[head + 9u];
+    if (all(n == vec3<f32>(0.0)) || bounds.x <= 0.0) {
+        return 0.0;
+    }
+    let directions = job.coefficient_offset + job.tiles;
+    let nearest = coefficients[head + 1u];
+    let weights = coefficients[head + 2u];
+    let held = coefficients[head + 7u];
+    let held_weights = coefficients[head + 8u];
+    var error = 0.0;
+    var plain = 0.0;
+    for (var j = 0u; j < min(u32(nearest.w), 2u); j++) {
+        let k = u32(nearest[j]);
+        let actual = lum(sunned(job, slot, k, i));
+        let wanted = shading(coefficients[directions + k], n);
+        var shaded = 0.0;
+        var interpolated = 0.0;
+        for (var m = 0u; m < 2u; m++) {
+            let w = held_weights[2u * j + m];
+            if (w == 0.0) {
+                continue;
+            }
+            let o = u32(held[2u * j + m]);
+            shaded += w * shading(coefficients[directions + o], n);
+            interpolated += w * lum(sunned(job, slot, o, i));
+        }
+        // As the sun is relit: dark where the normal faces away.
+        var predicted = interpolated;
+        if (wanted <= 0.0) {
+            predicted = 0.0;
+        } else if (shaded >= weights.w * wanted) {
+            predicted = interpolated * wanted / shaded;
+        }
+        error += weights[j] * abs(predicted - actual);
+        plain += weights[j] * abs(interpolated - actual);
+    }
+    // The model's error against the plain interpolation's (what the basis does).
+    var e = 0.0;
+    if (plain > 0.0) {
+        e = error / plain;
+    } else if (error > 0.0) {
+        return 0.0;
+    }
+    return bounds.x * (1.0 - smoothstep(bounds.z, bounds.w, e));
 }
 
 // Where texel i of `job`'s camera ray meets the visual hull (xyz, w = 1), or w = 2 where it
@@ -164,8 +226,7 @@ fn sunlit(job: Job, slot: u32, surface: vec3<f32>) -> bool {
 // text).
 fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     let directions = job.coefficient_offset + job.tiles;
-    let units = slot;
-    let head = units + job.tiles;
+    let head = slot + job.tiles;
     let sun = coefficients[head];
     let nearest = coefficients[head + 1u];
     let weights = coefficients[head + 2u];
@@ -178,7 +239,7 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     var shaded = 0.0;
     for (var j = 0u; j < u32(nearest.w); j++) {
         let k = u32(nearest[j]);
-        interpolated += weights[j] * coefficients[units + k].rgb * tile_value(job, k, i);
+        interpolated += weights[j] * sunned(job, slot, k, i);
         shaded += weights[j] * shading(coefficients[directions + k], n);
     }
     if (none) {
@@ -192,7 +253,7 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     for (var k = 0u; k < job.tiles; k++) {
         let m = shading(coefficients[directions + k], n);
         if (m > 0.0) {
-            num += coefficients[units + k].rgb * tile_value(job, k, i) * m;
+            num += sunned(job, slot, k, i) * m;
             den += m * m;
         }
     }
@@ -215,40 +276,68 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         relit[job.relit_offset + i] = vec4<f32>(0.0);
         return;
     }
+    // A view with suns holds its suns' coefficients, and its normals where it has them:
+    // their codes are the alpha bytes of tiles 1 and 2.
+    let suns = params.sun_slots > 0u && coefficients[sun_slot(job, 0u) + job.tiles].w != 0.0;
     var out = vec3<f32>(0.0);
+    var basis_sun = vec3<f32>(0.0);
     for (var k = 0u; k < job.tiles; k++) {
         let c = coefficients[job.coefficient_offset + k];
         if (c.w == 0.0) {
             continue;
         }
         let code = basis[job.basis_offset + k * params.texels + i];
-        out.x += c.x * gamma_value(code & 255u);
-        out.y += c.y * gamma_value((code >> 8u) & 255u);
-        out.z += c.z * gamma_value((code >> 16u) & 255u);
+        let v = vec3<f32>(
+            gamma_value(code & 255u),
+            gamma_value((code >> 8u) & 255u),
+            gamma_value((code >> 16u) & 255u),
+        );
+        out += c.rgb * v;
+        if (suns) {
+            basis_sun += coefficients[job.coefficient_offset + 2u * job.tiles + k].rgb * v;
+        }
     }
-    // A view with a sun holds normals: their codes are the alpha bytes of tiles 1 and 2.
-    if (params.sun_slots > 0u && coefficients[sun_slot(job, 0u) + job.tiles].w != 0.0) {
+    if (suns) {
         let n = normal_of(
             basis[job.basis_offset + params.texels + i] >> 24u,
             basis[job.basis_offset + 2u * params.texels + i] >> 24u,
         );
-        var surface = vec4<f32>(0.0);
+        var trusted = 0.0;
+        var total = 0.0;
         for (var s = 0u; s < params.sun_slots; s++) {
             let slot = sun_slot(job, s);
             if (coefficients[slot + job.tiles].w == 0.0) {
                 break;
             }
-            // The texel's point on the hull is found once, where a sun would light.
-            let sun = sun_light(job, slot, i, n);
-            if (any(sun != vec3<f32>(0.0))) {
-                if (surface.w == 0.0) {
-                    surface = texel_surface(job, i);
+            let weight = coefficients[slot + job.tiles + 9u].y;
+            trusted += weight * trust(job, slot, i, n);
+            total += weight;
+        }
+        var t = 0.0;
+        if (total > 0.0) {
+            t = trusted / total;
+        }
+        var lit = vec3<f32>(0.0);
+        if (t > 0.0) {
+            var surface = vec4<f32>(0.0);
+            for (var s = 0u; s < params.sun_slots; s++) {
+                let slot = sun_slot(job, s);
+                if (coefficients[slot + job.tiles].w == 0.0) {
+                    break;
                 }
-                if (surface.w == 2.0 || sunlit(job, slot, surface.xyz)) {
-                    out += sun;
+                // The texel's point on the hull is found once, where a sun would light.
+                let sun = sun_light(job, slot, i, n);
+                if (any(sun != vec3<f32>(0.0))) {
+                    if (surface.w == 0.0) {
+                        surface = texel_surface(job, i);
+                    }
+                    if (surface.w == 2.0 || sunlit(job, slot, surface.xyz)) {
+                        lit += sun;
+                    }
                 }
             }
         }
+        out += basis_sun + t * (lit - basis_sun);
     }
     relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     // The bits of a non-negative float order as the float does; a negative texel (a

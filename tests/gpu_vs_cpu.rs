@@ -403,22 +403,33 @@ fn the_light_fit_relights_on_the_gpu_as_on_the_cpu() {
     let images: Vec<_> = dirs.iter().map(|&l| photo(l)).collect();
     let refs: Vec<_> = images.iter().collect();
     let mask = vec![true; SIDE * SIDE];
-    let fit = LightFit::fit(&refs, &dirs, &mask);
-    let resident = gpu.upload_light_fit(&fit, &refs, &dirs).unwrap();
-    for (k, &l) in all.iter().enumerate().filter(|(k, _)| !kept.contains(k)) {
-        let cpu = fit.relight(&refs, &dirs, l, 3);
-        let on_gpu = gpu.relight_fit(&resident, l, 3).unwrap();
-        let worst = cpu
-            .pixels()
-            .iter()
-            .zip(on_gpu.pixels())
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / a[c].abs().max(1.0)))
-            .fold(0.0f32, f32::max);
-        assert!(
-            worst < 1e-4,
-            "light {k}: GPU differs from the CPU by {worst}"
-        );
+    // The diffuse fit alone, and with its glossy lobe (the highlight above is one).
+    let diffuse = LightFit::fit(&refs, &dirs, &mask);
+    let glossy = LightFit::fit_glossy(&refs, &dirs, &mask, Vec3::Z);
+    assert!(diffuse.gloss().is_none());
+    assert!(
+        glossy
+            .gloss()
+            .is_some_and(|g| g.strength.iter().any(|&k| k > 0.0))
+    );
+    for (name, fit) in [("diffuse", &diffuse), ("glossy", &glossy)] {
+        let resident = gpu.upload_light_fit(fit, &refs, &dirs).unwrap();
+        for (k, &l) in all.iter().enumerate().filter(|(k, _)| !kept.contains(k)) {
+            let cpu = fit.relight(&refs, &dirs, l, 3);
+            let on_gpu = gpu.relight_fit(&resident, l, 3).unwrap();
+            let worst = cpu
+                .pixels()
+                .iter()
+                .zip(on_gpu.pixels())
+                .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / a[c].abs().max(1.0)))
+                .fold(0.0f32, f32::max);
+            assert!(
+                worst < 1e-4,
+                "{name}, light {k}: GPU differs from the CPU by {worst}"
+            );
+        }
     }
+    let fit = diffuse;
     // A photograph of another size is refused, not drawn wrong.
     let small = Image::from_vec(2, 2, vec![[0.0; 3]; 4]).unwrap();
     let mut wrong = refs.clone();

@@ -87,6 +87,9 @@ pub struct OlatReport {
     pub baselines: Baselines,
     /// Per held-out light.
     pub lights: Vec<LightScore>,
+    /// The glossy lobe's roughness (Beckmann RMS slope) the fit chose, `None` where
+    /// none explains what the diffuse fit leaves, or for a field (its normals alone).
+    pub gloss_roughness: Option<f32>,
     /// Seconds fitting the kept lights (0 for a field: its normals are stored).
     pub seconds_fit: f64,
     /// Seconds relighting the held-out lights by the fit.
@@ -121,7 +124,9 @@ pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Resul
     let directions: Vec<Vec3> = numbers.iter().map(|&k| set.directions[k]).collect();
     let photos: Vec<RgbImage> = numbers.iter().map(|&k| set.images[k].clone()).collect();
     let t = Instant::now();
-    let fit = LightFit::fit(&photos.iter().collect::<Vec<_>>(), &directions, &set.mask);
+    // The camera looks down −z of its frame, the frame of the lights.
+    let refs: Vec<&RgbImage> = photos.iter().collect();
+    let fit = LightFit::fit_glossy(&refs, &directions, &set.mask, Vec3::Z);
     let kept = Kept {
         numbers,
         photos,
@@ -329,6 +334,7 @@ fn score_held_out(
             interpolated: mean(&|s| s.interpolated),
         },
         lights,
+        gloss_roughness: kept.fit.gloss().map(|g| g.roughness),
         seconds_fit: kept.seconds_fit,
         seconds_relight,
     })
@@ -366,6 +372,10 @@ pub fn olat_table(r: &OlatReport) -> String {
         r.baselines.interpolated.mean_psnr,
         r.baselines.interpolated.mean_ssim
     ));
+    out.push_str(&match r.gloss_roughness {
+        Some(m) => format!("glossy lobe: roughness {m}\n"),
+        None => "glossy lobe: none\n".into(),
+    });
     out.push_str(&format!(
         "fit {:.2} s, relighting {:.3} s a light",
         r.seconds_fit,

@@ -24,6 +24,7 @@ pub mod decoded;
 pub mod error;
 pub mod field;
 pub mod flowcodec;
+pub mod gloss;
 pub mod hull;
 pub mod imagecodec;
 pub mod light_fit;

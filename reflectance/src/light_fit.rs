@@ -27,6 +27,7 @@ use rayon::prelude::*;
 use frf_core::image::{GrayImage, Image, Rgb, RgbImage, luminance};
 
 use crate::field::ConditionRecord;
+use crate::gloss::Gloss;
 
 /// Below this share of its brightest light a texel counts as dark under a light.
 const DARK: f32 = 0.03;
@@ -49,6 +50,8 @@ pub struct LightFit {
     /// Per texel, its unit normal (camera frame) and RGB albedo; `None` where too few
     /// lights reach it to fit one.
     texels: Vec<Option<(Vec3, [f32; 3])>>,
+    /// A glossy lobe beside the diffuse fit ([`LightFit::fit_glossy`]).
+    gloss: Option<Gloss>,
 }
 
 impl LightFit {
@@ -79,7 +82,26 @@ impl LightFit {
             width,
             height,
             texels,
+            gloss: None,
         }
+    }
+
+    /// [`LightFit::fit`], and beside it a glossy lobe seen from `view` (unit, toward the
+    /// camera) where one explains what the diffuse fit leaves ([`Gloss::fit`]).
+    pub fn fit_glossy(
+        images: &[&RgbImage],
+        directions: &[Vec3],
+        mask: &[bool],
+        view: Vec3,
+    ) -> Self {
+        let mut fit = Self::fit(images, directions, mask);
+        fit.gloss = Gloss::fit(images, directions, &fit.texels, (fit.width, view));
+        fit
+    }
+
+    /// Its glossy lobe, where it has one.
+    pub fn gloss(&self) -> Option<&Gloss> {
+        self.gloss.as_ref()
     }
 
     /// Width and height, texels.
@@ -110,7 +132,14 @@ impl LightFit {
                 let normal = self.texels[i].map(|t| t.0);
                 let shading = |k: usize, n: Vec3| n.dot(directions[k]).max(0.0);
                 let photo = |k: usize| images[k].pixels()[i];
-                relight_texel(normal, photo, (shading, directions.len()), l, &weights)
+                let (Some(gloss), Some(n)) = (&self.gloss, normal) else {
+                    return relight_texel(normal, photo, (shading, directions.len()), l, &weights);
+                };
+                // The photographs' highlights out, the new light's in.
+                let matte = |k: usize| gloss.without(photo(k), i, n, directions[k]);
+                let diffuse =
+                    relight_texel(normal, matte, (shading, directions.len()), l, &weights);
+                diffuse.map(|c| c + gloss.highlight(i, n, l))
             })
             .collect();
         Image::from_vec(self.width, self.height, pixels).expect("sized by the fit")
@@ -139,6 +168,7 @@ impl LightFit {
             width,
             height,
             texels: normals.iter().map(|n| n.map(|n| (n, [1.0; 3]))).collect(),
+            gloss: None,
         }
     }
 

@@ -11,8 +11,17 @@
 //! directions' cast shadows, not the sun's: a texel the pose's visual hull hides from the
 //! sun gets none of it ([`SunLight::sunlit`], by the hull's map seen from the sun,
 //! [`SunDepth`]). The CPU reference of the GPU's sun term (`shaders/relight.wgsl`).
+//!
+//! **Trust.** The normals' sun replaces the basis' only where the field's own evidence
+//! says the model holds ([`SunLight::trust`]), and fades to the basis' elsewhere:
+//! per view, by how compact the sun is against the cell of the condition it falls in
+//! (a source twice as broad as a cell is what the basis already resolves), and per texel, by
+//! how well the same relighting, one condition left out, predicts that condition's
+//! own image from the others' (leave one out, for each of the sun's nearest
+//! conditions). Where it predicts them badly (gloss, light bounced between surfaces, a
+//! normal the Lambertian fit got wrong) the texel keeps the basis' sun exactly.
 
-use frf_core::image::Rgb;
+use frf_core::image::{Rgb, luminance};
 use frf_core::sun::Sun;
 use std::sync::Arc;
 
@@ -21,8 +30,8 @@ use glam::{Mat3, Vec3};
 use crate::field::ConditionRecord;
 use crate::hull::VoxelHull;
 use crate::light_fit::{
-    condition_light_shares, condition_lights, group_shading, nearest_weights_by, per_unit,
-    relight_texel,
+    RATIO_FLOOR, condition_light_shares, condition_lights, group_shading, nearest_weights_by,
+    per_unit, relight_texel,
 };
 use crate::sun_depth::SunDepth;
 
@@ -35,6 +44,17 @@ use crate::sun_depth::SunDepth;
 pub const NEAREST: usize = 2;
 /// See [`NEAREST`].
 pub const WEIGHT_POWER: f32 = 2.0;
+/// A texel's leave-one-out error ([`SunLight::trust`]: the error of its nearest
+/// conditions' images predicted by the normals from the others', over the plain
+/// interpolation's of them) at which it starts to fall back to the basis' sun, and at
+/// which it has wholly, smoothly between. Chosen at the captured views of the small
+/// oracle field of pose 0 on eight maps (`lobe_zenith_s4`, `overcast_hot_a`, `sun_2_30`,
+/// `sun_5_50`, `window_20`, `bright_ground_a`, `forest_slope_1k`,
+/// `st_fagans_interior_1k`; summed gain over the basis, subject PSNR): no trust test
+/// 14.12 dB, these bounds 1-2 13.93, 1.5-3 14.20, 2-5 14.40; bounds on the error itself
+/// (over the photographs', not the interpolation's) 0.25-0.75 12.93, 0.5-1.5 13.97.
+/// Reported on the other maps in docs/results/hard_light.md.
+pub const TRUST_ERROR: [f32; 2] = [2.0, 5.0];
 /// Suns a relighting takes out of an environment and relights by the normals, brightest
 /// first ([`Sun::extract`] again on what the last left): a map may hold several sharp
 /// lights (a cathedral's windows). Measured at the captured views of the small oracle
@@ -69,6 +89,12 @@ pub struct SunView {
     pub direction: Vec3,
     /// `(condition, weight)`, [`NEAREST`] of them, weights summing to 1.
     pub nearest: Vec<(usize, f32)>,
+    /// Per condition of `nearest`: the conditions that predict its image when it is left
+    /// out, weighted as `nearest` is (the [`NEAREST`] others nearest to its direction).
+    pub held_out: Vec<Vec<(usize, f32)>>,
+    /// How compact the sun is against the cell of its nearest condition, 1 (a point) to
+    /// 0 (twice as broad as the cell: the basis resolves it, [`compactness`]).
+    pub compactness: f32,
 }
 
 /// A sun relit by a pose's normals (see the module text).
@@ -90,6 +116,10 @@ pub struct SunLight {
     pub depth: Option<SunDepth>,
     /// How far from a texel's point its shadow ray starts, metres ([`shadow_offset_m`]).
     pub shadow_offset_m: f32,
+    /// The sun's illuminance, luminance: its weight among the suns' trusts ([`suns_texel`]).
+    pub luminance: f32,
+    /// [`TRUST_ERROR`].
+    pub trust_error: [f32; 2],
 }
 
 /// [`SHADOW_OFFSET_PER_HEIGHT`] of the height of `hull`'s grid, metres.
@@ -119,9 +149,16 @@ impl SunLight {
             .iter()
             .map(|&theta| {
                 let direction = (Mat3::from_rotation_y(theta) * sun.direction()).normalize();
+                let nearest = nearest_weights_by(&directions, direction, NEAREST, WEIGHT_POWER);
+                let held_out = nearest
+                    .iter()
+                    .map(|&(k, _)| held_out_weights(&directions, k))
+                    .collect();
                 SunView {
                     direction,
-                    nearest: nearest_weights_by(&directions, direction, NEAREST, WEIGHT_POWER),
+                    compactness: compactness(sun, &directions, nearest[0].0),
+                    nearest,
+                    held_out,
                 }
             })
             .collect();
@@ -133,6 +170,8 @@ impl SunLight {
             subject: sun.direction(),
             depth: hull.map(|h| SunDepth::new(h, sun.direction())),
             shadow_offset_m: hull.map_or(0.0, |h| shadow_offset_m(h)),
+            luminance: luminance(e),
+            trust_error: TRUST_ERROR,
         }
     }
 
@@ -157,15 +196,136 @@ impl SunLight {
         let v = &self.views[view];
         relight_texel(
             normal,
-            |k| {
-                let (p, u) = (photo(k), self.unit[k]);
-                [p[0] * u[0], p[1] * u[1], p[2] * u[2]]
-            },
+            |k| self.sunned(k, &photo),
             (|k: usize, n: Vec3| self.shading(k, n), self.lights.len()),
             v.direction,
             &v.nearest,
         )
     }
+
+    /// Image `k` per unit of its condition's light, times the sun's light.
+    fn sunned(&self, k: usize, photo: impl Fn(usize) -> Rgb) -> Rgb {
+        let (p, u) = (photo(k), self.unit[k]);
+        [p[0] * u[0], p[1] * u[1], p[2] * u[2]]
+    }
+
+    /// How far the normals' sun is trusted at a texel of view `view` (see the module
+    /// text), 0 (the basis' sun) to 1: the view's [`SunView::compactness`] times a
+    /// smooth step down from 1 to 0 as the texel's leave-one-out error goes from
+    /// [`TRUST_ERROR`]'s first to its second. The error: each nearest condition's image
+    /// (luminance) predicted, as the sun is, from the others' ([`SunView::held_out`]),
+    /// its absolute error weighted as the sun weighs them, over the same of the plain
+    /// interpolation of the others' images (what the basis does without the normals).
+    /// A texel with no normal has no model: 0.
+    pub fn trust(&self, view: usize, normal: Option<Vec3>, photo: impl Fn(usize) -> Rgb) -> f32 {
+        let v = &self.views[view];
+        let Some(n) = normal else {
+            return 0.0;
+        };
+        if v.compactness <= 0.0 {
+            return 0.0;
+        }
+        let lum = |k: usize| luminance(self.sunned(k, &photo));
+        let (mut error, mut plain) = (0.0f32, 0.0f32);
+        for (&(k, w), held) in v.nearest.iter().zip(&v.held_out) {
+            let actual = lum(k);
+            let wanted = self.shading(k, n);
+            let (mut shaded, mut interpolated) = (0.0f32, 0.0f32);
+            for &(m, wm) in held {
+                shaded += wm * self.shading(m, n);
+                interpolated += wm * lum(m);
+            }
+            // As the sun is relit: dark where the normal faces away.
+            let predicted = if wanted <= 0.0 {
+                0.0
+            } else if shaded >= RATIO_FLOOR * wanted {
+                interpolated * wanted / shaded
+            } else {
+                interpolated
+            };
+            error += w * (predicted - actual).abs();
+            plain += w * (interpolated - actual).abs();
+        }
+        // The model's error against the plain interpolation's (what the basis does).
+        let e = if plain > 0.0 {
+            error / plain
+        } else if error > 0.0 {
+            f32::INFINITY
+        } else {
+            0.0
+        };
+        v.compactness * (1.0 - smoothstep(self.trust_error[0], self.trust_error[1], e))
+    }
+}
+
+/// What `suns` add at a texel of view `view` (normal `normal`, basis images `photo(k)`)
+/// to the relighting of the light less them: their light by the normals where they are
+/// trusted, the basis' `basis` (the suns' coefficients' sum of the images) where not,
+/// `basis + t (Σ_s sun_s − basis)` with `t` the suns' [`SunLight::trust`] weighted by
+/// their luminance. A sun counts where `sunlit(s)` says it reaches the texel (asked only
+/// where it would light it). At `t = 0` the texel is the basis' exactly.
+pub fn suns_texel(
+    suns: &[SunLight],
+    (view, normal): (usize, Option<Vec3>),
+    photo: impl Fn(usize) -> Rgb,
+    basis: Rgb,
+    mut sunlit: impl FnMut(&SunLight) -> bool,
+) -> Rgb {
+    let (mut trusted, mut total) = (0.0f32, 0.0f32);
+    for sun in suns {
+        trusted += sun.luminance * sun.trust(view, normal, &photo);
+        total += sun.luminance;
+    }
+    let t = if total > 0.0 { trusted / total } else { 0.0 };
+    if t <= 0.0 {
+        return basis;
+    }
+    let mut lit = [0.0f32; 3];
+    for sun in suns {
+        let s = sun.texel(view, normal, &photo);
+        if s != [0.0; 3] && sunlit(sun) {
+            for c in 0..3 {
+                lit[c] += s[c];
+            }
+        }
+    }
+    std::array::from_fn(|c| basis[c] + t * (lit[c] - basis[c]))
+}
+
+/// The [`NEAREST`] of `directions` other than `k` nearest to `directions[k]`, weighted
+/// as a sun's nearest are.
+fn held_out_weights(directions: &[Vec3], k: usize) -> Vec<(usize, f32)> {
+    let others: Vec<usize> = (0..directions.len()).filter(|&j| j != k).collect();
+    if others.is_empty() {
+        return Vec::new();
+    }
+    let towards: Vec<Vec3> = others.iter().map(|&j| directions[j]).collect();
+    nearest_weights_by(&towards, directions[k], NEAREST, WEIGHT_POWER)
+        .into_iter()
+        .map(|(j, w)| (others[j], w))
+        .collect()
+}
+
+/// How compact `sun` is against the cell of condition `k` of `directions`: 1 while its
+/// diameter is at most the angle from `k` to its nearest other condition (the cell's
+/// width), falling smoothly to 0 at twice that. Falling from half the cell's width to
+/// the whole cost `lobe_70_s5` (a Gaussian lobe of σ 5°, taken for a sun of about 17°
+/// in cells of about 30°) 0.96 dB at the small oracle field's captured views, and moved
+/// the dev maps by at most 0.06 dB: a source the size of a cell is still relit better
+/// by the normals than by the basis.
+pub fn compactness(sun: &Sun, directions: &[Vec3], k: usize) -> f32 {
+    let cell = (directions.iter().enumerate())
+        .filter(|&(j, d)| j != k && *d != Vec3::ZERO)
+        .map(|(_, d)| d.dot(directions[k]).clamp(-1.0, 1.0).acos())
+        .fold(std::f32::consts::PI, f32::min);
+    1.0 - smoothstep(cell, 2.0 * cell, 2.0 * sun.radius())
+}
+
+/// 0 below `a`, 1 above `b`, `3x² − 2x³` of `x = (v − a) / (b − a)` between (WGSL's
+/// `smoothstep`).
+pub fn smoothstep(a: f32, b: f32, v: f32) -> f32 {
+    let x = ((v - a) / (b - a)).clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
 }
 
 #[cfg(test)]
@@ -233,5 +393,94 @@ mod tests {
         // A texel facing away is dark; one without a normal takes the interpolation.
         assert_eq!(light.texel(0, Some(-Vec3::X), photo), [0.0; 3]);
         assert_eq!(light.texel(0, None, photo), [4.0, 1.0, 0.0]);
+    }
+
+    /// Seven single-light conditions (the zenith and a ring at `elevation` degrees) of
+    /// 2 units each.
+    fn dome(elevation: f32) -> Vec<ConditionRecord> {
+        let ring = (0..6).map(move |j| {
+            let a = j as f32 * std::f32::consts::FRAC_PI_3;
+            Vec3::new(a.cos(), elevation.to_radians().tan(), a.sin())
+        });
+        std::iter::once(Vec3::Y)
+            .chain(ring)
+            .map(|d| condition(d, 2.0))
+            .collect()
+    }
+
+    #[test]
+    fn a_lambertian_texel_is_trusted_and_one_the_fit_misses_keeps_the_basis_sun_exactly() {
+        let conditions = dome(40.0);
+        let sun = Sun::new(Vec3::new(0.5, 1.0, 0.2).normalize(), 0.53, [3.0; 3]).unwrap();
+        let light = SunLight::new(&sun, &conditions, &[0.0], None);
+        let n = Vec3::new(0.6, 0.7, 0.1).normalize();
+        let dirs = condition_lights(&conditions);
+        // Its images under unit light, Lambertian of albedo 0.4 with normal n.
+        let lambert = |k: usize| [0.4 * 2.0 * n.dot(dirs[k].0).max(0.0); 3];
+        let basis = [0.123, 0.456, 0.789];
+        let lit = |_: &SunLight| true;
+        let trusted = suns_texel(
+            std::slice::from_ref(&light),
+            (0, Some(n)),
+            lambert,
+            basis,
+            lit,
+        );
+        assert!((light.trust(0, Some(n), lambert) - 1.0).abs() < 1e-4);
+        let want = 0.4 * 3.0 * n.dot(sun.direction());
+        assert!(
+            trusted.iter().all(|&c| (c - want).abs() < 1e-4),
+            "{trusted:?}"
+        );
+        // A texel whose images follow its normal less and less (lit alike by every
+        // condition, as by light bounced from all around): the normals predict them
+        // from each other ever worse than their plain interpolation does, and the trust
+        // falls from 1 to 0.
+        let mixed = |a: f32| move |k: usize| lambert(k).map(|x| a * x + (1.0 - a) * 0.5);
+        let trusts: Vec<f32> = [1.0f32, 0.4, 0.35, 0.3, 0.25, 0.2, 0.1, 0.0]
+            .map(|a| light.trust(0, Some(n), mixed(a)))
+            .to_vec();
+        assert!((trusts[0] - 1.0).abs() < 1e-4, "{trusts:?}");
+        assert_eq!(*trusts.last().unwrap(), 0.0, "{trusts:?}");
+        assert!(trusts.windows(2).all(|w| w[1] <= w[0] + 1e-6), "{trusts:?}");
+        assert!(trusts.iter().any(|&t| t > 0.05 && t < 0.95), "{trusts:?}");
+        // Where it is not trusted at all, the basis' sun exactly.
+        assert_eq!(
+            suns_texel(
+                std::slice::from_ref(&light),
+                (0, Some(n)),
+                mixed(0.0),
+                basis,
+                lit
+            ),
+            basis
+        );
+        // No normal, no model: the basis' sun.
+        assert_eq!(suns_texel(&[light], (0, None), lambert, basis, lit), basis);
+    }
+
+    #[test]
+    fn a_sun_as_broad_as_its_cell_is_left_to_the_basis() {
+        let conditions = dome(82.0);
+        let cell = Vec3::Y
+            .angle_between(condition_lights(&conditions)[1].0)
+            .to_degrees();
+        let light = |diameter: f32| {
+            let sun = Sun::new(Vec3::Y, diameter, [3.0; 3]).unwrap();
+            SunLight::new(&sun, &conditions, &[0.0], None).views[0].compactness
+        };
+        assert_eq!(light(0.53), 1.0);
+        assert_eq!(light(cell), 1.0);
+        let between = light(1.5 * cell);
+        assert!(between > 0.2 && between < 0.8, "{between}");
+        assert_eq!(light(2.0 * cell), 0.0);
+        let n = Vec3::Y;
+        let photo = |_: usize| [1.0; 3];
+        let sun = Sun::new(Vec3::Y, 2.0 * cell, [3.0; 3]).unwrap();
+        let broad = SunLight::new(&sun, &conditions, &[0.0], None);
+        assert_eq!(
+            suns_texel(&[broad], (0, Some(n)), photo, [0.5; 3], |_| true),
+            [0.5; 3]
+        );
     }
 }

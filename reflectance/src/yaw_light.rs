@@ -42,6 +42,10 @@ pub struct ViewLighting {
     pub coefficients: Vec<Vec<Rgb>>,
     /// The suns relit by the normals (scene frame of the light, brightest first).
     pub suns: Vec<Sun>,
+    /// Per turntable angle asked: what the suns add to the coefficients when the basis
+    /// relights them (the whole light's less `coefficients`; empty without suns), where
+    /// the normals' sun is not trusted ([`crate::sun_light::SunLight::trust`]).
+    pub sun_coefficients: Vec<Vec<Rgb>>,
     /// The coefficients at turntable angle 0 of the whole light (the ground's frame).
     pub ground: Vec<Rgb>,
 }
@@ -111,10 +115,22 @@ impl YawLight {
         }
         let mut coefficients = vec![vec![[0.0f32; 3]; conditions]; turntables.len()];
         let mut ground = vec![[0.0f32; 3]; conditions];
+        let mut sun_coefficients = if taken.is_empty() {
+            Vec::new()
+        } else {
+            vec![vec![[0.0f32; 3]; conditions]; turntables.len()]
+        };
         for (t, part) in self.terms.iter().zip(&parts) {
             let c = t.table.coefficients(*part, t.yaw, turntables)?;
             for (sum, c) in coefficients.iter_mut().zip(&c) {
                 add_weighted(sum, c, t.weight);
+            }
+            if *part == Part::LessSuns {
+                let whole = t.table.coefficients(Part::Whole, t.yaw, turntables)?;
+                for ((sum, whole), less) in sun_coefficients.iter_mut().zip(&whole).zip(&c) {
+                    add_weighted(sum, whole, t.weight);
+                    add_weighted(sum, less, -t.weight);
+                }
             }
             let own = t.table.coefficients(Part::Whole, t.yaw, &[0.0])?;
             add_weighted(&mut ground, &own[0], t.weight);
@@ -122,6 +138,7 @@ impl YawLight {
         Ok(ViewLighting {
             coefficients,
             suns: taken,
+            sun_coefficients,
             ground,
         })
     }

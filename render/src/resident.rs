@@ -29,7 +29,7 @@ use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
-use frf_reflectance::sun_light::SunLight;
+use frf_reflectance::sun_light::{SunLight, suns_texel};
 use frf_reflectance::yaw_light::YawLight;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -146,6 +146,10 @@ pub struct PoseSource {
     /// The environment's suns, relit by the views' normals rather than by the basis
     /// (none: no sun, or views without normals), brightest first.
     pub suns: Arc<[SunLight]>,
+    /// Per view and condition: what the suns add to `coefficients` when the basis
+    /// relights them, where the normals' sun is not trusted ([`SunLight::trust`]; empty
+    /// without suns).
+    pub sun_coefficients: Vec<Vec<Rgb>>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
     /// relight the shadow maps; `None` without an environment.
     pub ground_coefficients: Option<Vec<Rgb>>,
@@ -183,6 +187,7 @@ impl PoseSource {
             ground_coefficients: relit.ground,
             plan: relit.plan,
             suns: relit.suns,
+            sun_coefficients: relit.sun_coefficients,
             ..self.clone()
         })
     }
@@ -312,6 +317,7 @@ impl PoseSource {
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
             suns: relit.suns,
+            sun_coefficients: relit.sun_coefficients,
             plan: relit.plan,
         })
     }
@@ -396,6 +402,7 @@ struct Relighting {
     coefficients: Vec<Vec<Rgb>>,
     ground: Option<Vec<Rgb>>,
     suns: Arc<[SunLight]>,
+    sun_coefficients: Vec<Vec<Rgb>>,
     plan: LightingPlan,
 }
 
@@ -468,10 +475,14 @@ fn relighting<R: ReadAt>(
                 .iter()
                 .map(|s| SunLight::new(s, &h.conditions, angles, hull)),
         );
-        Ok::<_, RenderError>((lit.coefficients, Some(lit.ground)))
+        Ok::<_, RenderError>((lit.coefficients, Some(lit.ground), lit.sun_coefficients))
     };
-    let (mut coefficients, ground) = match lighting {
-        Lighting::Unlit => (vec![vec![[1.0; 3]; h.conditions.len()]; views], None),
+    let (mut coefficients, ground, mut sun_coefficients) = match lighting {
+        Lighting::Unlit => (
+            vec![vec![[1.0; 3]; h.conditions.len()]; views],
+            None,
+            Vec::new(),
+        ),
         Lighting::Environment { env, floor } => {
             let light = YawLight::of_env(field.projector_shared()?.clone(), env, *floor);
             by_table(&light, &angles, normals, &mut suns)?
@@ -480,7 +491,7 @@ fn relighting<R: ReadAt>(
     };
     if let Some(p) = plan {
         // Conditions the plan leaves out have zero weight at every frame.
-        for c in &mut coefficients {
+        for c in coefficients.iter_mut().chain(&mut sun_coefficients) {
             for (k, used) in p.conditions.iter().enumerate() {
                 if !used {
                     c[k] = [0.0; 3];
@@ -489,7 +500,9 @@ fn relighting<R: ReadAt>(
         }
     }
     let used: Vec<bool> = (0..h.conditions.len())
-        .map(|k| coefficients.iter().any(|c| c[k].iter().any(|&x| x != 0.0)))
+        .map(|k| {
+            (coefficients.iter().chain(&sun_coefficients)).any(|c| c[k].iter().any(|&x| x != 0.0))
+        })
         .collect();
     let plan = LightingPlan {
         skipped_conditions: h
@@ -506,6 +519,7 @@ fn relighting<R: ReadAt>(
         coefficients,
         ground,
         suns: suns.into(),
+        sun_coefficients,
         plan,
     })
 }
@@ -750,21 +764,11 @@ pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i
     out
 }
 
-/// The sun's light at pixel `i` of view `view` ([`SunLight::texel`]) from the view's
-/// basis codes and the pixel's normal (`None`: none fitted).
+/// Basis image `k`'s linear value at pixel `i` of a view's codes.
 #[inline]
-pub fn sun_pixel(
-    sun: &SunLight,
-    view: usize,
-    basis: &BasisCodes,
-    normal: Option<glam::Vec3>,
-    lut: &[f32; 256],
-    i: usize,
-) -> Rgb {
-    sun.texel(view, normal, |k| {
-        let (p, s) = (basis.tiles[k][i], basis.scales[k]);
-        [p[0], p[1], p[2]].map(|c| s * lut[c as usize])
-    })
+pub fn basis_value(basis: &BasisCodes, lut: &[f32; 256], k: usize, i: usize) -> Rgb {
+    let (p, s) = (basis.tiles[k][i], basis.scales[k]);
+    [p[0], p[1], p[2]].map(|c| s * lut[c as usize])
 }
 
 /// Views already lit, for [`ResidentPose::from_views`]: per view its camera, its RGBA8
@@ -848,11 +852,8 @@ impl ResidentPose {
                 // is not relit.
                 let alpha = &source.alpha[i];
                 let normals = &source.normals[i];
-                let suns: &[SunLight] = if normals.is_empty() {
-                    &[]
-                } else {
-                    &source.suns
-                };
+                let suns = &source.suns;
+                let sun_coefficients = source.sun_coefficients.get(i);
                 let (camera, crop) = (&source.geometry.cameras[i], source.geometry.crop);
                 // The texel's point on the visual hull (`None`: its ray misses it, or
                 // there is none), which the suns' shadows are judged from.
@@ -868,24 +869,25 @@ impl ResidentPose {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
+                        let Some(sc) = sun_coefficients.filter(|_| !suns.is_empty()) else {
+                            return c;
+                        };
+                        let basis = relit_pixel(b, sc, &lut, p);
+                        let normal = normals.get(p).and_then(|&n| normal_of(n));
                         // Found once, and only where a sun would light.
                         let mut at = None;
-                        let normal = if suns.is_empty() {
-                            None
-                        } else {
-                            normal_of(normals[p])
-                        };
-                        for sun in suns {
-                            let s = sun_pixel(sun, i, b, normal, &lut, p);
-                            if s == [0.0; 3] {
-                                continue;
-                            }
-                            if (*at.get_or_insert_with(|| surface(p))).is_none_or(|x| sun.sunlit(x))
-                            {
-                                for k in 0..3 {
-                                    c[k] += s[k];
-                                }
-                            }
+                        let s = suns_texel(
+                            suns,
+                            (i, normal),
+                            |k| basis_value(b, &lut, k, p),
+                            basis,
+                            |sun| {
+                                (*at.get_or_insert_with(|| surface(p)))
+                                    .is_none_or(|x| sun.sunlit(x))
+                            },
+                        );
+                        for k in 0..3 {
+                            c[k] += s[k];
                         }
                         c
                     })

@@ -128,6 +128,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         condition_lights: Arc::new(Vec::new()),
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
         suns: Arc::from([]),
+        sun_coefficients: Vec::new(),
         ground_coefficients: None,
         plan: LightingPlan {
             skipped_conditions: Vec::new(),

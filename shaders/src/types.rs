@@ -201,6 +201,9 @@ pub struct GpuLightFitParams {
     pub indices: [u32; 4],
     /// Their weights.
     pub weights: [f32; 4],
+    /// The view (xyz, unit, toward the camera) and the glossy lobe's roughness (w; 0:
+    /// no lobe).
+    pub view: [f32; 4],
 }
 
 /// `Job` of `relight.wgsl`: one view of a relighting batch.

@@ -26,6 +26,7 @@ pub mod gait;
 pub mod geometry;
 pub mod ground;
 pub mod material;
+pub mod olat_sphere;
 pub mod optics;
 pub mod render;
 pub mod rig;

@@ -24,6 +24,8 @@ pub struct GpuLightFit {
     relit: wgpu::Buffer,
     size: (usize, usize),
     directions: Vec<Vec3>,
+    /// Toward the camera and the glossy lobe's roughness (0: none).
+    view: [f32; 4],
 }
 
 impl Gpu {
@@ -56,11 +58,13 @@ impl Gpu {
                 .collect();
             let (mut normals, mut albedo) =
                 (Vec::with_capacity(texels), Vec::with_capacity(texels));
+            // The glossy lobe's strength in the albedo's fourth.
+            let strength = |i: usize| fit.gloss().map_or(0.0, |g| g.strength[i]);
             for i in 0..texels {
                 match fit.texel(i) {
                     Some((n, a)) => {
                         normals.push(n.extend(1.0).to_array());
-                        albedo.push([a[0], a[1], a[2], 0.0]);
+                        albedo.push([a[0], a[1], a[2], strength(i)]);
                     }
                     None => {
                         normals.push([0.0; 4]);
@@ -139,6 +143,9 @@ impl Gpu {
                 relit,
                 size,
                 directions: directions.to_vec(),
+                view: fit
+                    .gloss()
+                    .map_or([0.0; 4], |g| g.view.extend(g.roughness).to_array()),
             })
         })
     }
@@ -162,6 +169,7 @@ impl Gpu {
             light: l.normalize_or_zero().extend(RATIO_FLOOR).to_array(),
             indices,
             weights: w,
+            view: fit.view,
         };
         self.scoped("relighting by a light fit", || {
             self.queue

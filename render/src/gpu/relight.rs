@@ -12,11 +12,12 @@
 
 use std::sync::Arc;
 
+use frf_core::image::Rgb;
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
 use frf_reflectance::sun_depth::SunDepth;
-use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
+use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -142,12 +143,17 @@ impl PoseRelight {
     }
 }
 
-/// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its coefficient
-/// and where its condition's lights are, then [`MAX_SUNS`] slots of a sun: per image the
-/// sun per unit of its light, then the sun's seven.
+/// Coefficients (`vec4`) a job of `tiles` basis images reads: per image its coefficient,
+/// where its condition's lights are and the suns' coefficient, then [`MAX_SUNS`] slots of
+/// a sun: per image the sun per unit of its light, then the sun's [`SUN_HEAD`].
 fn job_coefficients(tiles: usize) -> usize {
-    2 * tiles + MAX_SUNS * (tiles + 7)
+    3 * tiles + MAX_SUNS * (tiles + SUN_HEAD)
 }
+
+/// The coefficients (`vec4`) of a sun's slot after its per-image ones.
+const SUN_HEAD: usize = 10;
+// A slot holds two conditions left out, each predicted from two others.
+const _: () = assert!(NEAREST <= 2);
 
 /// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
 /// where the pose's views hold normals (only they are shaded by them).
@@ -184,26 +190,36 @@ fn packed_coefficients(
     }
     for &i in &batch.views {
         let scales = &source.basis[i].scales;
+        let sun_coefficients = source.sun_coefficients.get(i);
+        let of = |c: Option<&Vec<Rgb>>, k: usize| c.and_then(|c| c.get(k)).copied();
         for (k, &s) in scales.iter().enumerate() {
-            let c = source.coefficients[i].get(k).copied().unwrap_or([0.0; 3]);
-            let used = if c.iter().all(|&x| x == 0.0) {
+            let c = of(source.coefficients.get(i), k).unwrap_or([0.0; 3]);
+            let d = of(sun_coefficients, k).unwrap_or([0.0; 3]);
+            let used = if c.iter().chain(&d).all(|&x| x == 0.0) {
                 0.0
             } else {
                 1.0
             };
             out.push([c[0] * s, c[1] * s, c[2] * s, used]);
         }
-        let suns: &[SunLight] = if source.normals[i].is_empty() {
+        out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
+        for (k, &s) in scales.iter().enumerate() {
+            let d = of(sun_coefficients, k).unwrap_or([0.0; 3]);
+            out.push([d[0] * s, d[1] * s, d[2] * s, 0.0]);
+        }
+        let suns: &[SunLight] = if sun_coefficients.is_none() {
             &[]
         } else {
             &source.suns[..source.suns.len().min(MAX_SUNS)]
         };
-        out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
         for (s, sun) in suns.iter().enumerate() {
             pack_sun(&mut out, sun, (i, scales), maps.map(|m| m.slot_start(s)));
         }
         let empty = MAX_SUNS - suns.len();
-        out.extend(std::iter::repeat_n([0.0; 4], empty * (scales.len() + 7)));
+        out.extend(std::iter::repeat_n(
+            [0.0; 4],
+            empty * (scales.len() + SUN_HEAD),
+        ));
     }
     // Every batch holds the conditions' lights after its jobs, where the views hold
     // normals ([`light_coefficients`]).
@@ -244,16 +260,32 @@ fn pack_sun(
     out.push(view.direction.extend(1.0).to_array());
     out.push(nearest);
     out.push(weights);
-    let (Some(m), Some(depth_at)) = (&sun.depth, depth_at) else {
+    if let (Some(m), Some(depth_at)) = (&sun.depth, depth_at) {
+        out.push(sun.subject.extend(sun.shadow_offset_m).to_array());
+        out.push(m.axes[0].extend(m.corner.x).to_array());
+        out.push(m.axes[1].extend(m.corner.y).to_array());
+        let [w, h] = m.size;
+        out.push([m.texel, w as f32, h as f32, depth_at as f32]);
+    } else {
         out.push(sun.subject.extend(0.0).to_array());
         out.extend([[0.0; 4]; 3]);
-        return;
-    };
-    out.push(sun.subject.extend(sun.shadow_offset_m).to_array());
-    out.push(m.axes[0].extend(m.corner.x).to_array());
-    out.push(m.axes[1].extend(m.corner.y).to_array());
-    let [w, h] = m.size;
-    out.push([m.texel, w as f32, h as f32, depth_at as f32]);
+    }
+    // Each nearest condition left out: the two that predict it, and their weights.
+    let (mut held, mut held_weights) = ([0.0f32; 4], [0.0f32; 4]);
+    for (j, others) in view.held_out.iter().take(2).enumerate() {
+        for (m, &(k, w)) in others.iter().take(2).enumerate() {
+            held[2 * j + m] = k as f32;
+            held_weights[2 * j + m] = w;
+        }
+    }
+    out.push(held);
+    out.push(held_weights);
+    out.push([
+        view.compactness,
+        sun.luminance,
+        sun.trust_error[0],
+        sun.trust_error[1],
+    ]);
 }
 
 impl Gpu {
