@@ -106,9 +106,16 @@ struct Kept {
     seconds_fit: f64,
 }
 
-/// Scores `set` with `keep` of its lights kept (see the module text); writes each
-/// held-out light's photograph and predictions as PNGs into `images` when given.
-pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Result<OlatReport> {
+/// Scores `set` with `keep` of its lights kept (see the module text), the fit with its
+/// glossy lobe where `gloss` (else the diffuse fit alone, as a field's stored normals
+/// relight); writes each held-out light's photograph and predictions as PNGs into
+/// `images` when given.
+pub fn evaluate_olat(
+    set: &OlatSet,
+    keep: usize,
+    images: Option<&Path>,
+    gloss: bool,
+) -> Result<OlatReport> {
     let n = set.directions.len();
     if keep < 3 || keep >= n {
         return Err(EvalError::Argument(frf_core::BadArgument::new(
@@ -126,7 +133,11 @@ pub fn evaluate_olat(set: &OlatSet, keep: usize, images: Option<&Path>) -> Resul
     let t = Instant::now();
     // The camera looks down −z of its frame, the frame of the lights.
     let refs: Vec<&RgbImage> = photos.iter().collect();
-    let fit = LightFit::fit_glossy(&refs, &directions, &set.mask, Vec3::Z);
+    let fit = if gloss {
+        LightFit::fit_glossy(&refs, &directions, &set.mask, Vec3::Z)
+    } else {
+        LightFit::fit(&refs, &directions, &set.mask)
+    };
     let kept = Kept {
         numbers,
         photos,

@@ -111,7 +111,7 @@ fn the_sphere_written_as_a_set_reads_back_and_scores_as_in_memory() {
             .zip(&lights)
             .all(|(a, b)| a.distance(*b) < 1e-5)
     );
-    let report = evaluate_olat(&set, 6, None).unwrap();
+    let report = evaluate_olat(&set, 6, None, true).unwrap();
     assert!(report.gloss_roughness.is_some());
     assert!(
         report.mean_psnr >= report.baselines.interpolated.mean_psnr + 1.5,

@@ -1,6 +1,6 @@
 //! A glossy lobe beside a Lambertian light fit, so that a light between the captured
 //! ones places its highlight where the surface's normal puts it (docs/design.md section
-//! 4.3): the diffuse fit carries how shading moves, the photographs what it does not
+//! 4.1): the diffuse fit carries how shading moves, the photographs what it does not
 //! model, and neither can move a highlight to a light no photograph was taken under.
 //!
 //! **The lobe** is Torrance–Sparrow's, as the stage renders skin and cloth ([`lobe`]):

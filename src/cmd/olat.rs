@@ -1,6 +1,6 @@
 //! `frf ingest-olat DIR --out F.frf [--use K]`: a calibrated one-light-at-a-time set as a
 //! one-view field whose basis is its lights ([`frf_ingest::olat_field`]); and
-//! `frf eval-olat DIR|F.frf [--photos DIR] [--use K] [--images OUT] [--json]`: relighting
+//! `frf eval-olat DIR|F.frf [--photos DIR] [--use K] [--images OUT] [--json] [--diffuse]`: relighting
 //! scored on the set's photographs ([`frf_eval::olat`]), from the set's own kept lights
 //! or from such a field.
 
@@ -74,6 +74,10 @@ pub struct EvalOlatArgs {
     /// Print the report as JSON on standard output.
     #[arg(long)]
     pub json: bool,
+    /// With a directory: fit the diffuse model alone, without the glossy lobe (what a
+    /// field's stored normals relight by).
+    #[arg(long)]
+    pub diffuse: bool,
 }
 
 /// Runs `frf eval-olat`.
@@ -101,7 +105,7 @@ pub fn run(args: EvalOlatArgs) -> CliResult {
             .into());
         }
         let keep = args.keep.unwrap_or((n / 2).max(3));
-        evaluate_olat(&set, keep, images)?
+        evaluate_olat(&set, keep, images, !args.diffuse)?
     } else {
         let Some(photos) = &args.photos else {
             return Err(format!(
