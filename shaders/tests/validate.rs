@@ -277,7 +277,7 @@ fn pod_structs_match_naga_layouts() {
         &light_fit,
         "LightFitParams",
         GpuLightFitParams,
-        [texels, lights, nearest, pad0, light, indices, weights]
+        [texels, lights, nearest, pad0, light, indices, weights, view]
     );
     let shadow = module(&shaders::composed(shaders::SHADOW), "shadow");
     check_layout!(
