@@ -81,3 +81,18 @@ for name, share_below, az, el in [("bright_ground_a", 0.47, 60, 35), ("bright_gr
         f.write(f"{OUT}/{name}.exr")
     below = float((img * dom)[D[..., 1] <= 0].sum() / (img * dom).sum())
     print(name, "share of the light from below", round(below, 3))
+# Light from below alone: a soft sky over a bright ground (no sun), the ground brighter
+# toward one side, and a ground with a small sunlit patch (a bright slab beside the walker).
+for name, share_below, patch in [("ground_soft", 0.47, None), ("ground_patch", 0.45, (100, -40, 15))]:
+    sky = np.where(D[..., 1] > 0, 1.0, 0.0)
+    side = np.clip(D @ direction(30, 0) * 0.5 + 1.0, 0.5, 1.5)
+    ground = np.where(D[..., 1] <= 0, side, 0.0)
+    if patch is not None:
+        ground = ground + 8.0 * np.where(D[..., 1] <= 0, lobe(*patch), 0.0)
+    lu = (sky * dom).sum(); lg = (ground * dom).sum()
+    img = sky + ground * (share_below / (1 - share_below) * lu / lg)
+    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
+        f.write(f"{OUT}/{name}.exr")
+    below = float((img * dom)[D[..., 1] <= 0].sum() / (img * dom).sum())
+    print(name, "share of the light from below", round(below, 3))
