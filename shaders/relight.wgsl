@@ -49,7 +49,9 @@ struct Job {
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
 // Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
 // w = 0 when the condition is not used (by the light or its suns); per tile, where its
-// condition's lights are (x: the first, y: how many, as f32); per tile, the suns'
+// condition's lights are (x: the first, y: how many, as f32; for a floor condition relit
+// by the ground's shape, z: where its lights' reweighted shares are, one a vec4 in x,
+// and w: the ratio's floor, else 0); per tile, the suns'
 // coefficient x tile scale (what the basis adds for them); then `sun_slots` slots of a sun, those in use
 // first: per tile, the sun per unit of the condition's light x tile scale (rgb); the
 // sun's direction (xyz, the view's dome frame; w = 0 for an unused slot), the nearest
@@ -116,6 +118,29 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
         s += l.w * max(dot(n, l.xyz), 0.0);
     }
     return s;
+}
+
+// The ratio a floor condition's image is relit by at a texel of normal n (zero: none):
+// its shading under its lights reweighted by the ground's shape over its own. Twin of
+// `floor_ratio` (`reflectance/src/floor_light.rs`).
+fn floor_ratio(range: vec4<f32>, n: vec3<f32>) -> f32 {
+    if (all(n == vec3<f32>(0.0))) {
+        return 1.0;
+    }
+    let first = u32(range.x);
+    let shares = u32(range.z);
+    var own = 0.0;
+    var env = 0.0;
+    for (var j = 0u; j < u32(range.y); j++) {
+        let l = coefficients[first + j];
+        let d = max(dot(n, l.xyz), 0.0);
+        own += l.w * d;
+        env += coefficients[shares + j].x * d;
+    }
+    if (own > 0.0 && own >= range.w * env) {
+        return env / own;
+    }
+    return 1.0;
 }
 
 // Where sun slot `s` of `job` starts (its per-tile units; its ten follow them).
@@ -279,6 +304,14 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
     // A view with suns holds its suns' coefficients, and its normals where it has them:
     // their codes are the alpha bytes of tiles 1 and 2.
     let suns = params.sun_slots > 0u && coefficients[sun_slot(job, 0u) + job.tiles].w != 0.0;
+    // The texel's normal, where its view holds them (zero: none).
+    var normal = vec3<f32>(0.0);
+    if (job.tiles >= 3u) {
+        normal = normal_of(
+            basis[job.basis_offset + params.texels + i] >> 24u,
+            basis[job.basis_offset + 2u * params.texels + i] >> 24u,
+        );
+    }
     var out = vec3<f32>(0.0);
     var basis_sun = vec3<f32>(0.0);
     for (var k = 0u; k < job.tiles; k++) {
@@ -292,16 +325,19 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
             gamma_value((code >> 8u) & 255u),
             gamma_value((code >> 16u) & 255u),
         );
-        out += c.rgb * v;
+        // A floor condition relit by the ground's shape.
+        let range = coefficients[job.coefficient_offset + job.tiles + k];
+        if (range.w > 0.0) {
+            out += c.rgb * v * floor_ratio(range, normal);
+        } else {
+            out += c.rgb * v;
+        }
         if (suns) {
             basis_sun += coefficients[job.coefficient_offset + 2u * job.tiles + k].rgb * v;
         }
     }
     if (suns) {
-        let n = normal_of(
-            basis[job.basis_offset + params.texels + i] >> 24u,
-            basis[job.basis_offset + 2u * params.texels + i] >> 24u,
-        );
+        let n = normal;
         var trusted = 0.0;
         var total = 0.0;
         for (var s = 0u; s < params.sun_slots; s++) {

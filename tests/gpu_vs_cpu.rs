@@ -66,7 +66,11 @@ fn assert_relit_as_the_cpu(
 }
 
 fn tiny_source() -> PoseSource {
-    frf_testkit::tiny_field().source(&EnvMap::sky())
+    tiny_field_source(&EnvMap::sky())
+}
+
+fn tiny_field_source(env: &EnvMap) -> PoseSource {
+    frf_testkit::tiny_field().source(env)
 }
 
 #[test]
@@ -117,6 +121,40 @@ fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
             }
         }
     }
+}
+
+/// A ground of its own shape (bright toward one side) relights the floor conditions by
+/// the normals (`frf_reflectance::floor_light`) on both, and changes what they show.
+#[test]
+fn a_ground_of_its_own_shape_relights_the_floor_conditions_as_on_the_cpu() {
+    let Some(gpu) = gpu() else { return };
+    let img = Image::from_fn(64, 32, |x, y| {
+        if y < 16 {
+            [1.0; 3]
+        } else {
+            let b = 0.2 + 3.0 * x as f32 / 64.0;
+            [b, 0.8 * b, 0.6 * b]
+        }
+    });
+    let source = tiny_field_source(&EnvMap::from_image(img).unwrap());
+    assert!(
+        source
+            .floor_shares
+            .iter()
+            .any(|v| v.iter().any(|e| !e.is_empty()))
+    );
+    let cpu = ResidentPose::relight_cpu(&source);
+    let pose = gpu.upload_pose(&source).unwrap();
+    assert_relit_as_the_cpu(&gpu, &pose, &cpu, "a ground of its own shape");
+    let flat = ResidentPose::relight_cpu(&PoseSource {
+        floor_shares: Vec::new(),
+        ..source.clone()
+    });
+    let changed = (cpu.prelit.iter().flatten())
+        .zip(flat.prelit.iter().flatten())
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(changed > 100, "{changed} texels changed");
 }
 
 #[test]

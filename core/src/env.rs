@@ -305,6 +305,39 @@ impl EnvMap {
         self.radiance.sample_bilinear(x, t.y, Border::Clamp)
     }
 
+    /// The same light averaged over coarser texels, `width x height` (each the
+    /// solid-angle-weighted mean of the texels whose centres fall in it), its yaw kept:
+    /// what a light standing for a patch of the sphere sees, not the texel its centre
+    /// falls on.
+    pub fn coarse(&self, width: usize, height: usize) -> Self {
+        let (w, h) = self.radiance.size();
+        let (width, height) = (width.clamp(1, w), height.clamp(1, h));
+        let mut sum = vec![[0.0f64; 4]; width * height];
+        for y in 0..h {
+            let (omega, ty) = (self.texel_solid_angle(y) as f64, y * height / h);
+            for x in 0..w {
+                let cell = &mut sum[ty * width + x * width / w];
+                let p = self.radiance.get(x, y);
+                for c in 0..3 {
+                    cell[c] += p[c] as f64 * omega;
+                }
+                cell[3] += omega;
+            }
+        }
+        let pixels = sum
+            .iter()
+            .map(|s| {
+                let o = s[3].max(f64::MIN_POSITIVE);
+                [0, 1, 2].map(|c| (s[c] / o) as f32)
+            })
+            .collect();
+        Self {
+            radiance: Image::from_vec(width, height, pixels).expect("sized above"),
+            yaw: self.yaw,
+            clamped_texels: self.clamped_texels,
+        }
+    }
+
     /// Solid angle of one texel of row `row`, steradians.
     pub fn texel_solid_angle(&self, row: usize) -> f32 {
         let (w, h) = self.radiance.size();

@@ -23,6 +23,7 @@ pub mod container;
 pub mod decoded;
 pub mod error;
 pub mod field;
+pub mod floor_light;
 pub mod flowcodec;
 pub mod gloss;
 pub mod hull;

@@ -11,6 +11,7 @@ use std::sync::Arc;
 use frf_core::env::EnvMap;
 use frf_core::image::{Rgb, luminance};
 use frf_core::sun::Sun;
+use glam::{Mat3, Vec3};
 
 use crate::error::Result;
 use crate::project::{FloorModel, Projector};
@@ -63,6 +64,47 @@ impl YawLight {
             weight: 1.0,
             yaw: env.yaw(),
         }])
+    }
+
+    /// The luminance of its radiance arriving from `direction` (subject frame) below the
+    /// horizon as its maps hold it, or `None` when a map's floor conditions are lit by a
+    /// modelled ground rather than the map's own lower hemisphere (a uniform ground,
+    /// which a floor condition already is).
+    pub fn ground_radiance(&self) -> Option<impl Fn(Vec3) -> f32 + '_> {
+        (self.terms.iter())
+            .all(|t| t.table.floor() == FloorModel::Environment)
+            .then_some(move |d: Vec3| {
+                (self.terms.iter())
+                    .map(|t| {
+                        let turned = Mat3::from_rotation_y(-t.yaw) * d;
+                        t.weight * luminance(t.table.coarse_map().radiance(turned))
+                    })
+                    .sum()
+            })
+    }
+
+    /// The share of its luminance that arrives from below the horizon.
+    pub fn ground_share(&self) -> f32 {
+        let (mut below, mut total) = (0.0f64, 0.0f64);
+        for t in &self.terms {
+            let map = t.table.coarse_map();
+            let (w, h) = map.image().size();
+            for y in 0..h {
+                let omega = map.texel_solid_angle(y) as f64 * t.weight as f64;
+                let row: f64 = (0..w)
+                    .map(|x| luminance(map.image().get(x, y)) as f64)
+                    .sum();
+                total += row * omega;
+                if map.direction_of(0.0, y as f32).y < 0.0 {
+                    below += row * omega;
+                }
+            }
+        }
+        if total > 0.0 {
+            (below / total) as f32
+        } else {
+            0.0
+        }
     }
 
     /// Its maps.

@@ -112,6 +112,8 @@ pub struct YawTable {
     /// The suns (map frame, unturned) and the samples of what they leave; `None` inside
     /// when the map has no sun.
     less_suns: OnceLock<Option<(Vec<Sun>, Samples)>>,
+    /// [`YawTable::coarse_map`], made when first needed.
+    coarse: OnceLock<EnvMap>,
 }
 
 impl YawTable {
@@ -125,6 +127,7 @@ impl YawTable {
             map,
             floor,
             less_suns: OnceLock::new(),
+            coarse: OnceLock::new(),
         }
     }
 
@@ -136,6 +139,17 @@ impl YawTable {
     /// The map, unturned.
     pub fn map(&self) -> &EnvMap {
         &self.map
+    }
+
+    /// The map averaged over 10° texels ([`EnvMap::coarse`]), unturned: the ground's shape
+    /// as the floor conditions' lights sample it ([`crate::floor_light`]).
+    pub fn coarse_map(&self) -> &EnvMap {
+        self.coarse.get_or_init(|| self.map.coarse(36, 18))
+    }
+
+    /// What lights its floor conditions.
+    pub fn floor(&self) -> FloorModel {
+        self.floor
     }
 
     /// The map's suns (map frame, unturned, brightest first, at most [`MAX_SUNS`]), each

@@ -23,6 +23,7 @@ use frf_core::image::{GrayImage, Rgb};
 use frf_core::io::{linear_to_srgb, srgb_to_linear};
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::{ChunkKey, ChunkKind, ReadAt};
+use frf_reflectance::floor_light::{floor_ratio, floor_shares, ground_weight};
 use frf_reflectance::flowcodec::quant::{LogQuantizer, UNKNOWN_CODE};
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
@@ -150,6 +151,10 @@ pub struct PoseSource {
     /// relights them, where the normals' sun is not trusted ([`SunLight::trust`]; empty
     /// without suns).
     pub sun_coefficients: Vec<Vec<Rgb>>,
+    /// Per view and condition: a floor condition's lights' shares reweighted by the
+    /// light's ground ([`floor_shares`]), which relight its image by the normals; empty
+    /// where the basis relights it alone (no normals, a modelled ground, not the floor).
+    pub floor_shares: Vec<Vec<Vec<f32>>>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
     /// relight the shadow maps; `None` without an environment.
     pub ground_coefficients: Option<Vec<Rgb>>,
@@ -188,6 +193,7 @@ impl PoseSource {
             plan: relit.plan,
             suns: relit.suns,
             sun_coefficients: relit.sun_coefficients,
+            floor_shares: relit.floor_shares,
             ..self.clone()
         })
     }
@@ -318,6 +324,7 @@ impl PoseSource {
             ground_coefficients: relit.ground,
             suns: relit.suns,
             sun_coefficients: relit.sun_coefficients,
+            floor_shares: relit.floor_shares,
             plan: relit.plan,
         })
     }
@@ -403,6 +410,7 @@ struct Relighting {
     ground: Option<Vec<Rgb>>,
     suns: Arc<[SunLight]>,
     sun_coefficients: Vec<Vec<Rgb>>,
+    floor_shares: Vec<Vec<Vec<f32>>>,
     plan: LightingPlan,
 }
 
@@ -468,15 +476,24 @@ fn relighting<R: ReadAt>(
         .collect();
     // The views' coefficients and the ground's under a light read from its yaw tables;
     // where the views hold their normals, its suns apart, relit by them.
-    let by_table = |light: &YawLight, angles: &[f32], normals: bool, suns: &mut Vec<SunLight>| {
-        let lit = light.lighting(angles, normals)?;
-        suns.extend(
-            lit.suns
-                .iter()
-                .map(|s| SunLight::new(s, &h.conditions, angles, hull)),
-        );
-        Ok::<_, RenderError>((lit.coefficients, Some(lit.ground), lit.sun_coefficients))
-    };
+    let mut floor = Vec::new();
+    let mut by_table =
+        |light: &YawLight, angles: &[f32], normals: bool, suns: &mut Vec<SunLight>| {
+            let lit = light.lighting(angles, normals)?;
+            // The ground's own shape, where the views hold normals to relight it by.
+            if let Some(radiance) = light.ground_radiance().filter(|_| normals) {
+                let is_floor: Vec<bool> = h.conditions.iter().map(|c| c.floor).collect();
+                let lights = condition_light_shares(&h.conditions);
+                let weight = ground_weight(light.ground_share());
+                floor = floor_shares(&lights, &is_floor, (angles, weight), radiance);
+            }
+            suns.extend(
+                lit.suns
+                    .iter()
+                    .map(|s| SunLight::new(s, &h.conditions, angles, hull)),
+            );
+            Ok::<_, RenderError>((lit.coefficients, Some(lit.ground), lit.sun_coefficients))
+        };
     let (mut coefficients, ground, mut sun_coefficients) = match lighting {
         Lighting::Unlit => (
             vec![vec![[1.0; 3]; h.conditions.len()]; views],
@@ -520,6 +537,7 @@ fn relighting<R: ReadAt>(
         ground,
         suns: suns.into(),
         sun_coefficients,
+        floor_shares: floor,
         plan,
     })
 }
@@ -854,6 +872,7 @@ impl ResidentPose {
                 let normals = &source.normals[i];
                 let suns = &source.suns;
                 let sun_coefficients = source.sun_coefficients.get(i);
+                let floor_shares = source.floor_shares.get(i).filter(|_| !normals.is_empty());
                 let (camera, crop) = (&source.geometry.cameras[i], source.geometry.crop);
                 // The texel's point on the visual hull (`None`: its ray misses it, or
                 // there is none), which the suns' shadows are judged from.
@@ -869,11 +888,22 @@ impl ResidentPose {
                             return [0.0; 3];
                         }
                         let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
+                        let normal = normals.get(p).and_then(|&n| normal_of(n));
+                        // The floor conditions' images relit by the ground's shape.
+                        if let Some(shares) = floor_shares {
+                            for (k, e) in shares.iter().enumerate().filter(|(_, e)| !e.is_empty()) {
+                                let r = floor_ratio(normal, &source.condition_lights[k], e);
+                                let (v, w) =
+                                    (basis_value(b, &lut, k, p), source.coefficients[i][k]);
+                                for ch in 0..3 {
+                                    c[ch] += w[ch] * v[ch] * (r - 1.0);
+                                }
+                            }
+                        }
                         let Some(sc) = sun_coefficients.filter(|_| !suns.is_empty()) else {
                             return c;
                         };
                         let basis = relit_pixel(b, sc, &lut, p);
-                        let normal = normals.get(p).and_then(|&n| normal_of(n));
                         // Found once, and only where a sun would light.
                         let mut at = None;
                         let s = suns_texel(

@@ -129,6 +129,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         coefficients: vec![vec![[1.0, 1.0, 1.0]]; views],
         suns: Arc::from([]),
         sun_coefficients: Vec::new(),
+        floor_shares: Vec::new(),
         ground_coefficients: None,
         plan: LightingPlan {
             skipped_conditions: Vec::new(),

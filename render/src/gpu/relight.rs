@@ -150,6 +150,21 @@ fn job_coefficients(tiles: usize) -> usize {
     3 * tiles + MAX_SUNS * (tiles + SUN_HEAD)
 }
 
+/// Coefficients (`vec4`) view `i`'s job reads: [`job_coefficients`], then one a light of
+/// each floor condition relit by the ground's shape (its reweighted share).
+fn job_len(source: &PoseSource, i: usize) -> usize {
+    job_coefficients(source.basis[i].scales.len())
+        + floor_shares(source, i).map_or(0, |f| f.iter().map(Vec::len).sum())
+}
+
+/// View `i`'s floor conditions' reweighted shares, where it holds normals to relight them.
+fn floor_shares(source: &PoseSource, i: usize) -> Option<&Vec<Vec<f32>>> {
+    source
+        .floor_shares
+        .get(i)
+        .filter(|_| source.normals.get(i).is_some_and(|n| !n.is_empty()))
+}
+
 /// The coefficients (`vec4`) of a sun's slot after its per-image ones.
 const SUN_HEAD: usize = 10;
 // A slot holds two conditions left out, each predicted from two others.
@@ -177,11 +192,7 @@ fn packed_coefficients(
 ) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
     // The conditions' lights follow the jobs: where each condition's start.
-    let jobs: usize = batch
-        .views
-        .iter()
-        .map(|&i| job_coefficients(source.basis[i].scales.len()))
-        .sum();
+    let jobs: usize = batch.views.iter().map(|&i| job_len(source, i)).sum();
     let mut ranges = Vec::with_capacity(source.condition_lights.len());
     let mut start = jobs;
     for lights in source.condition_lights.iter() {
@@ -202,7 +213,19 @@ fn packed_coefficients(
             };
             out.push([c[0] * s, c[1] * s, c[2] * s, used]);
         }
-        out.extend((0..scales.len()).map(|k| ranges.get(k).copied().unwrap_or([0.0; 4])));
+        // Where each floor condition's reweighted shares are (after the sun slots), and
+        // the ratio's floor.
+        let floor = floor_shares(source, i);
+        let mut share_at = out.len() - scales.len() + job_coefficients(scales.len());
+        for k in 0..scales.len() {
+            let mut range = ranges.get(k).copied().unwrap_or([0.0; 4]);
+            if let Some(e) = floor.and_then(|f| f.get(k)).filter(|e| !e.is_empty()) {
+                range[2] = share_at as f32;
+                range[3] = RATIO_FLOOR;
+                share_at += e.len();
+            }
+            out.push(range);
+        }
         for (k, &s) in scales.iter().enumerate() {
             let d = of(sun_coefficients, k).unwrap_or([0.0; 3]);
             out.push([d[0] * s, d[1] * s, d[2] * s, 0.0]);
@@ -220,6 +243,9 @@ fn packed_coefficients(
             [0.0; 4],
             empty * (scales.len() + SUN_HEAD),
         ));
+        for e in floor.into_iter().flatten() {
+            out.extend(e.iter().map(|&x| [x, 0.0, 0.0, 0.0]));
+        }
     }
     // Every batch holds the conditions' lights after its jobs, where the views hold
     // normals ([`light_coefficients`]).
@@ -346,7 +372,7 @@ impl Gpu {
                 surface: u32::from(!source.surfaces[i].is_empty()),
                 pad1: 0,
             });
-            coefficients += job_coefficients(basis.scales.len());
+            coefficients += job_len(source, i);
             if j + 1 == views.len() {
                 coefficients += light_coefficients(source);
             }
