@@ -155,6 +155,9 @@ pub struct PoseSource {
     /// light's ground ([`floor_shares`]), which relight its image by the normals; empty
     /// where the basis relights it alone (no normals, a modelled ground, not the floor).
     pub floor_shares: Vec<Vec<Vec<f32>>>,
+    /// Per condition: whether it is a floor condition (those `floor_shares` may relight;
+    /// the GPU keeps room for them whatever the light, so that a new light fits).
+    pub floor_conditions: Arc<Vec<bool>>,
     /// Per condition: the coefficients of the ground's frame (turntable angle 0), which
     /// relight the shadow maps; `None` without an environment.
     pub ground_coefficients: Option<Vec<Rgb>>,
@@ -320,6 +323,7 @@ impl PoseSource {
             alpha: Arc::new(alpha),
             normals: Arc::new(normals),
             condition_lights: Arc::new(condition_light_shares(&h.conditions)),
+            floor_conditions: Arc::new(h.conditions.iter().map(|c| c.floor).collect()),
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
             suns: relit.suns,

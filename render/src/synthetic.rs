@@ -130,6 +130,7 @@ pub fn synthetic_pose() -> Result<PoseSource> {
         suns: Arc::from([]),
         sun_coefficients: Vec::new(),
         floor_shares: Vec::new(),
+        floor_conditions: Arc::new(Vec::new()),
         ground_coefficients: None,
         plan: LightingPlan {
             skipped_conditions: Vec::new(),

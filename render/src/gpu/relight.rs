@@ -150,11 +150,26 @@ fn job_coefficients(tiles: usize) -> usize {
     3 * tiles + MAX_SUNS * (tiles + SUN_HEAD)
 }
 
-/// Coefficients (`vec4`) view `i`'s job reads: [`job_coefficients`], then one a light of
-/// each floor condition relit by the ground's shape (its reweighted share).
+/// Coefficients (`vec4`) view `i`'s job reads: [`job_coefficients`], then, where it holds
+/// normals, one a light of each floor condition (its share reweighted by the ground's
+/// shape; zero when the light does not reweight it): the same whatever the light, so that
+/// a pose relit in place keeps its buffers.
 fn job_len(source: &PoseSource, i: usize) -> usize {
-    job_coefficients(source.basis[i].scales.len())
-        + floor_shares(source, i).map_or(0, |f| f.iter().map(Vec::len).sum())
+    job_coefficients(source.basis[i].scales.len()) + floor_len(source, i)
+}
+
+/// The floor conditions' lights of view `i`'s job ([`job_len`]).
+fn floor_len(source: &PoseSource, i: usize) -> usize {
+    if source.normals.get(i).is_none_or(|n| n.is_empty()) {
+        return 0;
+    }
+    let tiles = source.basis[i].scales.len();
+    let lights = source.condition_lights.iter().take(tiles);
+    lights
+        .zip(source.floor_conditions.iter())
+        .filter(|(_, f)| **f)
+        .map(|(l, _)| l.len())
+        .sum()
 }
 
 /// View `i`'s floor conditions' reweighted shares, where it holds normals to relight them.
@@ -217,12 +232,22 @@ fn packed_coefficients(
         // the ratio's floor.
         let floor = floor_shares(source, i);
         let mut share_at = out.len() - scales.len() + job_coefficients(scales.len());
+        // Each floor condition's room, in order, and what fills it (zeros: not reweighted).
+        let mut room: Vec<[f32; 4]> = Vec::with_capacity(floor_len(source, i));
+        let with_room = floor_len(source, i) > 0;
         for k in 0..scales.len() {
             let mut range = ranges.get(k).copied().unwrap_or([0.0; 4]);
-            if let Some(e) = floor.and_then(|f| f.get(k)).filter(|e| !e.is_empty()) {
-                range[2] = share_at as f32;
-                range[3] = RATIO_FLOOR;
-                share_at += e.len();
+            let lights = source.condition_lights.get(k).map_or(0, Vec::len);
+            if with_room && source.floor_conditions.get(k).copied().unwrap_or(false) {
+                match floor.and_then(|f| f.get(k)).filter(|e| e.len() == lights) {
+                    Some(e) => {
+                        range[2] = share_at as f32;
+                        range[3] = RATIO_FLOOR;
+                        room.extend(e.iter().map(|&x| [x, 0.0, 0.0, 0.0]));
+                    }
+                    None => room.extend(std::iter::repeat_n([0.0; 4], lights)),
+                }
+                share_at += lights;
             }
             out.push(range);
         }
@@ -243,9 +268,7 @@ fn packed_coefficients(
             [0.0; 4],
             empty * (scales.len() + SUN_HEAD),
         ));
-        for e in floor.into_iter().flatten() {
-            out.extend(e.iter().map(|&x| [x, 0.0, 0.0, 0.0]));
-        }
+        out.extend(room);
     }
     // Every batch holds the conditions' lights after its jobs, where the views hold
     // normals ([`light_coefficients`]).
