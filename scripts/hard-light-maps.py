@@ -17,14 +17,16 @@ def direction(az, el):
     return np.array([math.sin(az) * math.cos(el), math.sin(el), math.cos(az) * math.cos(el)])
 def base():
     return np.where(D[..., 1] > 0, 1.0, 0.3)
+def write(name, img):
+    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
+    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
+        f.write(f"{OUT}/{name}.exr")
 def finish(name, bg, src, share):
     # scale the source to carry `share` of the total light
     lb = (bg * dom).sum(); ls = (src * dom).sum()
     k = share / (1 - share) * lb / ls
     img = bg + k * src
-    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
-    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
-        f.write(f"{OUT}/{name}.exr")
+    write(name, img)
     print(name, "peak/mean", float(img.max() / ((img * dom).sum() / (4 * math.pi))))
 def lobe(az, el, sigma):
     a = np.degrees(np.arccos(np.clip(D @ direction(az, el), -1, 1)))
@@ -61,9 +63,7 @@ for name, bsig, bshare, hsig, hshare, az, el in [
     # shares of the total: glow bshare, hot hshare
     total = lb / (1 - bshare - hshare)
     img = bg + glow * (bshare * total / (glow * dom).sum()) + hot * (hshare * total / (hot * dom).sum())
-    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
-    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
-        f.write(f"{OUT}/{name}.exr")
+    write(name, img)
     thr = img.max() * 0.1
     print(name, "peak/mean", float(img.max() / ((img * dom).sum() / (4 * math.pi))), "area >=10% peak (sr)", float(dom[img >= thr].sum()))
 # Bright ground: a sun and a sky over a ground sending up a large share of the light (a
@@ -76,9 +76,7 @@ for name, share_below, az, el in [("bright_ground_a", 0.47, 60, 35), ("bright_gr
     upper = sky + sun * (0.5 * (sky * dom).sum() / (sun * dom).sum() * 2.0)
     lu = (upper * dom).sum(); lg = (ground * dom).sum()
     img = upper + ground * (share_below / (1 - share_below) * lu / lg)
-    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
-    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
-        f.write(f"{OUT}/{name}.exr")
+    write(name, img)
     below = float((img * dom)[D[..., 1] <= 0].sum() / (img * dom).sum())
     print(name, "share of the light from below", round(below, 3))
 # Light from below alone: a soft sky over a bright ground (no sun), the ground brighter
@@ -91,8 +89,6 @@ for name, share_below, patch in [("ground_soft", 0.47, None), ("ground_patch", 0
         ground = ground + 8.0 * np.where(D[..., 1] <= 0, lobe(*patch), 0.0)
     lu = (sky * dom).sum(); lg = (ground * dom).sum()
     img = sky + ground * (share_below / (1 - share_below) * lu / lg)
-    rgb = np.repeat(img[..., None], 3, -1).astype(np.float32)
-    with OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}, {"RGB": rgb}) as f:
-        f.write(f"{OUT}/{name}.exr")
+    write(name, img)
     below = float((img * dom)[D[..., 1] <= 0].sum() / (img * dom).sum())
     print(name, "share of the light from below", round(below, 3))

@@ -118,8 +118,6 @@ pub struct SunLight {
     pub shadow_offset_m: f32,
     /// The sun's illuminance, luminance: its weight among the suns' trusts ([`suns_texel`]).
     pub luminance: f32,
-    /// [`TRUST_ERROR`].
-    pub trust_error: [f32; 2],
 }
 
 /// [`SHADOW_OFFSET_PER_HEIGHT`] of the height of `hull`'s grid, metres.
@@ -171,7 +169,6 @@ impl SunLight {
             depth: hull.map(|h| SunDepth::new(h, sun.direction())),
             shadow_offset_m: hull.map_or(0.0, |h| shadow_offset_m(h)),
             luminance: luminance(e),
-            trust_error: TRUST_ERROR,
         }
     }
 
@@ -254,7 +251,7 @@ impl SunLight {
         } else {
             0.0
         };
-        v.compactness * (1.0 - smoothstep(self.trust_error[0], self.trust_error[1], e))
+        v.compactness * (1.0 - smoothstep(TRUST_ERROR[0], TRUST_ERROR[1], e))
     }
 }
 

@@ -17,7 +17,7 @@ use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::RATIO_FLOOR;
 use frf_reflectance::sun_depth::SunDepth;
-use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight};
+use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight, TRUST_ERROR};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
 
@@ -332,8 +332,8 @@ fn pack_sun(
     out.push([
         view.compactness,
         sun.luminance,
-        sun.trust_error[0],
-        sun.trust_error[1],
+        TRUST_ERROR[0],
+        TRUST_ERROR[1],
     ]);
 }
 
