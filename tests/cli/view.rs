@@ -48,15 +48,27 @@ fn can_view() -> bool {
     true
 }
 
-/// Runs `sh -c script` under a fresh Xvfb display, `$FRF` the binary.
+/// Runs `sh -c script` under a fresh Xvfb display, `$FRF` the binary. The script starts
+/// once the display answers; a display that never did (a server that lost a race for
+/// its number on a shared machine, seen once in CI) is tried again on a new one.
 fn under_xvfb(script: &str) -> Output {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 800x600x24", "sh", "-c", script])
-        .env("FRF", env!("CARGO_BIN_EXE_frf"))
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .unwrap()
+    let ready = "for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; \
+                 sleep 0.2; done\n";
+    let run = || {
+        Command::new("xvfb-run")
+            .args(["-a", "-s", "-screen 0 800x600x24", "sh", "-c"])
+            .arg(format!("{ready}{script}"))
+            .env("FRF", env!("CARGO_BIN_EXE_frf"))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .unwrap()
+    };
+    let first = run();
+    if stderr(&first).contains("no display to open a window on") {
+        return run();
+    }
+    first
 }
 
 /// `frf view INPUT --script FILE` (of `script`) with `args`, under Xvfb.
