@@ -107,6 +107,49 @@ fn relight(c: &mut Criterion, field: &FieldFile, by_normals: &PoseSource, lighti
         });
     }
     group.finish();
+    // The ratio itself, the two ways measured in turn so that a slow spell of this shared
+    // machine falls on both: the median of the rounds' ratios.
+    let mut pose = [by_normals, &by_basis].map(|s| gpu.upload_pose(s).unwrap());
+    let gpu_ratio = in_turn(|k| {
+        let source = [by_normals, &by_basis][k];
+        gpu.relight_pose(&mut pose[k], source).unwrap();
+        gpu.read_scales(&pose[k]).unwrap();
+    });
+    let cpu_ratio = in_turn(|k| {
+        ResidentPose::relight_cpu([by_normals, &by_basis][k]);
+    });
+    eprintln!(
+        "relight, sun by the normals over by the basis (median of {ROUNDS} rounds of one \
+         each in turn): GPU {gpu_ratio}, CPU reference {cpu_ratio}"
+    );
+}
+
+/// Rounds of [`in_turn`].
+const ROUNDS: usize = 25;
+
+/// `run(0)`'s time over `run(1)`'s, the median of [`ROUNDS`] rounds of one each in turn,
+/// and each one's median time.
+fn in_turn(mut run: impl FnMut(usize)) -> String {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut times = [Vec::new(), Vec::new()];
+    for _ in 0..ROUNDS {
+        for (k, times) in times.iter_mut().enumerate() {
+            let t = std::time::Instant::now();
+            run(k);
+            times.push(t.elapsed().as_secs_f64());
+        }
+    }
+    let ratios = times[0].iter().zip(&times[1]).map(|(a, b)| a / b).collect();
+    let [a, b] = times.map(median);
+    format!(
+        "{:.2}x ({:.1} / {:.1} ms)",
+        median(ratios),
+        a * 1e3,
+        b * 1e3
+    )
 }
 
 criterion_group!(benches, bench);

@@ -49,7 +49,7 @@ struct Job {
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
 // Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
 // w = 0 when the condition is not used (by the light or its suns); per tile, where its
-// condition's lights are (x: the first, y: how many, as f32; for a floor condition relit
+// condition's lights are (x: its cone, its lights after it, y: how many, as f32; for a floor condition relit
 // by the ground's shape, z: where its lights' reweighted shares are, one a vec4 in x,
 // and w: the ratio's floor, else 0); per tile, the suns'
 // coefficient x tile scale (what the basis adds for them); then `sun_slots` slots of a sun, those in use
@@ -62,8 +62,10 @@ struct Job {
 // corner's y, and (texel side, texels along x, along y, where its values start in
 // `sun_depths`, as f32); the conditions that predict each of the two nearest left out
 // (xy: the first's, zw: the second's, as f32) and their weights; (its compactness, its
-// luminance, the trust's error bounds). After every view's: the conditions' lights, each its direction
-// (xyz, dome frame) and share of its condition's light (w).
+// luminance, the trust's error bounds). After every view's, per condition: its lights'
+// cone (`group_cone`: the sum of their directions by share, xyz, and the bound on a
+// normal's dot product with it beyond which it sees all or none of them, w), then its
+// lights, each its direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
 @group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
@@ -108,12 +110,21 @@ fn normal_of(cx: u32, cy: u32) -> vec3<f32> {
     return normalize(vec3<f32>(select(x + t, x - t, x >= 0.0), select(y + t, y - t, y >= 0.0), z));
 }
 
-// Condition k's shading of normal n per unit of its light (`group_shading`,
-// `reflectance/src/light_fit.rs`): its lights' max(n . l, 0) weighted by their shares.
+// Condition k's shading of normal n per unit of its light (`cone_shading`,
+// `reflectance/src/light_fit.rs`): its lights' max(n . l, 0) weighted by their shares;
+// n . m where n sees every light of its cone, 0 where it sees none.
 fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
-    var s = 0.0;
     let first = u32(lights.x);
-    for (var j = first; j < first + u32(lights.y); j++) {
+    let cone = coefficients[first];
+    let d = dot(n, cone.xyz);
+    if (d >= cone.w) {
+        return d;
+    }
+    if (d <= -cone.w) {
+        return 0.0;
+    }
+    var s = 0.0;
+    for (var j = first + 1u; j <= first + u32(lights.y); j++) {
         let l = coefficients[j];
         s += l.w * max(dot(n, l.xyz), 0.0);
     }
@@ -127,7 +138,7 @@ fn floor_ratio(range: vec4<f32>, n: vec3<f32>) -> f32 {
     if (all(n == vec3<f32>(0.0))) {
         return 1.0;
     }
-    let first = u32(range.x);
+    let first = u32(range.x) + 1u;
     let shares = u32(range.z);
     var own = 0.0;
     var env = 0.0;

@@ -230,11 +230,51 @@ pub fn condition_light_shares(conditions: &[ConditionRecord]) -> Vec<Vec<(Vec3, 
 }
 
 /// A group of lights' shading of a normal `n`: `Σ share · max(n · l, 0)`.
+#[inline]
 pub fn group_shading(lights: &[(Vec3, f32)], n: Vec3) -> f32 {
     lights
         .iter()
         .map(|&(l, share)| share * n.dot(l).max(0.0))
         .sum()
+}
+
+/// The cone a group of lights lies in, which lets [`cone_shading`] skip the lights one
+/// by one: their shares' sum of directions `m = Σ share · l`, and the bound `b` on
+/// `n · m` above which a unit normal sees every light and below whose negative it sees
+/// none. With `δ` the widest angle of a light from `m`'s direction, a normal within
+/// `90° − δ` of it sees them all (`n · m ≥ |m| sin δ`), and one beyond `90° + δ` none; a
+/// group spread over more than a hemisphere gets an infinite bound (always one by one).
+pub fn group_cone(lights: &[(Vec3, f32)]) -> (Vec3, f32) {
+    let m: Vec3 = lights.iter().map(|&(l, share)| l * share).sum();
+    let Some(axis) = m.try_normalize() else {
+        return (m, f32::INFINITY);
+    };
+    let widest = (lights
+        .iter()
+        .filter(|&&(l, share)| share != 0.0 && l != Vec3::ZERO))
+    .map(|&(l, _)| l.normalize().dot(axis))
+    .fold(1.0f32, f32::min);
+    if widest <= 0.0 {
+        return (m, f32::INFINITY);
+    }
+    // sin δ, and a margin for the rounding of unit normals.
+    let sin = (1.0 - widest * widest).max(0.0).sqrt();
+    (m, m.length() * (sin + 1e-4))
+}
+
+/// [`group_shading`] of `lights` whose cone is `cone` ([`group_cone`]): `n · m` where `n`
+/// sees every light, 0 where it sees none, the lights one by one between. The same
+/// shading but for rounding; the GPU's `shading` (`shaders/relight.wgsl`) is its twin.
+#[inline]
+pub fn cone_shading(lights: &[(Vec3, f32)], (m, bound): (Vec3, f32), n: Vec3) -> f32 {
+    let d = n.dot(m);
+    if d >= bound {
+        d
+    } else if d <= -bound {
+        0.0
+    } else {
+        group_shading(lights, n)
+    }
 }
 
 /// `p` per unit of the light `e` (0 in a channel `e` leaves dark).
@@ -249,6 +289,7 @@ pub fn per_unit(p: Rgb, e: Rgb) -> Rgb {
 /// lights, their sum weighted by their share of its light). The fit's albedo cancels from
 /// both of its ratios, so the normal alone is needed: the CPU reference of the GPU's sun
 /// term (`shaders/relight.wgsl`).
+#[inline]
 pub fn relight_texel(
     normal: Option<Vec3>,
     photo: impl Fn(usize) -> Rgb,
@@ -356,6 +397,7 @@ pub fn blend(images: &[&RgbImage], weights: &[(usize, f32)]) -> RgbImage {
 }
 
 /// `Σ w_k f(k)` over `weights`.
+#[inline]
 fn weighted(weights: &[(usize, f32)], f: impl Fn(usize) -> [f32; 3]) -> [f32; 3] {
     let mut out = [0.0f32; 3];
     for &(k, w) in weights {
@@ -469,5 +511,47 @@ mod tests {
         assert_eq!(w[0].0, 0);
         assert!(w[0].1 > w[1].1);
         assert_eq!(nearest_weights(&dirs, Vec3::Y, 3), vec![(1, 1.0)]);
+    }
+
+    /// A cell of lights about `axis` spread `spread` radians, uneven shares.
+    fn cell(axis: Vec3, spread: f32) -> Vec<(Vec3, f32)> {
+        let (u, v) = axis.any_orthonormal_pair();
+        (0..16)
+            .map(|j| {
+                let (a, r) = (j as f32 * 2.4, spread * ((j % 4) as f32 + 1.0) / 4.0);
+                let d = axis * r.cos() + (u * a.cos() + v * a.sin()) * r.sin();
+                (d, (1 + j % 3) as f32 / 32.0)
+            })
+            .collect()
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn the_cone_shades_as_the_lights_one_by_one(
+            ax in -1.0f32..1.0, ay in -1.0f32..1.0, az in -1.0f32..1.0,
+            nx in -1.0f32..1.0, ny in -1.0f32..1.0, nz in -1.0f32..1.0,
+            spread in 0.0f32..2.0,
+        ) {
+            let (Some(axis), Some(n)) = (Vec3::new(ax, ay, az).try_normalize(),
+                Vec3::new(nx, ny, nz).try_normalize()) else { return Ok(()) };
+            let lights = cell(axis, spread);
+            let cone = group_cone(&lights);
+            let (one_by_one, by_cone) = (group_shading(&lights, n), cone_shading(&lights, cone, n));
+            proptest::prop_assert!((one_by_one - by_cone).abs() <= 1e-5, "{one_by_one} {by_cone}");
+        }
+    }
+
+    #[test]
+    fn the_cone_skips_the_lights_only_where_a_normal_sees_all_or_none() {
+        let lights = cell(Vec3::Y, 0.3);
+        let (m, bound) = group_cone(&lights);
+        assert!(Vec3::Y.dot(m) >= bound && (-Vec3::Y).dot(m) <= -bound);
+        // At the terminator some lights are seen and some not: one by one.
+        assert!(Vec3::X.dot(m).abs() < bound);
+        // A group over more than a hemisphere is never skipped.
+        let wide = [(Vec3::Y, 0.5), (Vec3::new(0.0, -0.2, 1.0).normalize(), 0.5)];
+        assert!(group_cone(&wide).1.is_finite());
+        let opposed = [(Vec3::Y, 0.5), (-Vec3::Y, 0.5)];
+        assert_eq!(group_cone(&opposed).1, f32::INFINITY);
     }
 }

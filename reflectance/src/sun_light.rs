@@ -23,6 +23,7 @@
 
 use frf_core::image::{Rgb, luminance};
 use frf_core::sun::Sun;
+use std::cell::Cell;
 use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
@@ -30,8 +31,8 @@ use glam::{Mat3, Vec3};
 use crate::field::ConditionRecord;
 use crate::hull::VoxelHull;
 use crate::light_fit::{
-    RATIO_FLOOR, condition_light_shares, condition_lights, group_shading, nearest_weights_by,
-    per_unit, relight_texel,
+    RATIO_FLOOR, condition_light_shares, condition_lights, cone_shading, group_cone,
+    nearest_weights_by, per_unit, relight_texel,
 };
 use crate::sun_depth::SunDepth;
 
@@ -104,6 +105,8 @@ pub struct SunLight {
     pub directions: Vec<Vec3>,
     /// Per condition: its lights' directions and shares of its light (luminance).
     pub lights: Vec<Vec<(Vec3, f32)>>,
+    /// Per condition: the cone its lights lie in ([`group_cone`]).
+    pub cones: Vec<(Vec3, f32)>,
     /// Per condition: the sun's illuminance per unit of the condition's, per channel
     /// (0 where the condition delivers none).
     pub unit: Vec<Rgb>,
@@ -143,6 +146,7 @@ impl SunLight {
             .map(|(_, delivered)| per_unit(e, *delivered))
             .collect();
         let lights = condition_light_shares(conditions);
+        let cones = lights.iter().map(|l| group_cone(l)).collect();
         let views = turntables
             .iter()
             .map(|&theta| {
@@ -163,6 +167,7 @@ impl SunLight {
         Self {
             directions,
             lights,
+            cones,
             unit,
             views,
             subject: sun.direction(),
@@ -173,9 +178,10 @@ impl SunLight {
     }
 
     /// Condition `k`'s shading of a normal `n`, per unit of its light: its lights'
-    /// `max(n · l, 0)` weighted by their shares.
+    /// `max(n · l, 0)` weighted by their shares ([`cone_shading`]).
+    #[inline]
     pub fn shading(&self, k: usize, n: Vec3) -> f32 {
-        group_shading(&self.lights[k], n)
+        cone_shading(&self.lights[k], self.cones[k], n)
     }
 
     /// Whether the sun reaches `surface`, a texel's point on the visual hull (subject
@@ -190,11 +196,24 @@ impl SunLight {
     /// The sun's light at a texel of view `view` whose normal is `normal` (`None`: none
     /// fitted), its basis images' linear values being `photo(k)`.
     pub fn texel(&self, view: usize, normal: Option<Vec3>, photo: impl Fn(usize) -> Rgb) -> Rgb {
+        self.texel_by(view, normal, photo, |k, n| self.shading(k, n))
+    }
+
+    /// [`SunLight::texel`], condition `k`'s shading of a normal `n` being `shade(k, n)`
+    /// (the same as [`SunLight::shading`], found once per texel: [`TexelCache`]).
+    #[inline]
+    fn texel_by(
+        &self,
+        view: usize,
+        normal: Option<Vec3>,
+        photo: impl Fn(usize) -> Rgb,
+        shade: impl Fn(usize, Vec3) -> f32,
+    ) -> Rgb {
         let v = &self.views[view];
         relight_texel(
             normal,
             |k| self.sunned(k, &photo),
-            (|k: usize, n: Vec3| self.shading(k, n), self.lights.len()),
+            (shade, self.lights.len()),
             v.direction,
             &v.nearest,
         )
@@ -215,6 +234,18 @@ impl SunLight {
     /// interpolation of the others' images (what the basis does without the normals).
     /// A texel with no normal has no model: 0.
     pub fn trust(&self, view: usize, normal: Option<Vec3>, photo: impl Fn(usize) -> Rgb) -> f32 {
+        self.trust_by(view, normal, photo, |k, n| self.shading(k, n))
+    }
+
+    /// [`SunLight::trust`], shading as [`SunLight::texel_by`] does.
+    #[inline]
+    fn trust_by(
+        &self,
+        view: usize,
+        normal: Option<Vec3>,
+        photo: impl Fn(usize) -> Rgb,
+        shade: impl Fn(usize, Vec3) -> f32,
+    ) -> f32 {
         let v = &self.views[view];
         let Some(n) = normal else {
             return 0.0;
@@ -226,10 +257,10 @@ impl SunLight {
         let (mut error, mut plain) = (0.0f32, 0.0f32);
         for (&(k, w), held) in v.nearest.iter().zip(&v.held_out) {
             let actual = lum(k);
-            let wanted = self.shading(k, n);
+            let wanted = shade(k, n);
             let (mut shaded, mut interpolated) = (0.0f32, 0.0f32);
             for &(m, wm) in held {
-                shaded += wm * self.shading(m, n);
+                shaded += wm * shade(m, n);
                 interpolated += wm * lum(m);
             }
             // As the sun is relit: dark where the normal faces away.
@@ -260,17 +291,26 @@ impl SunLight {
 /// trusted, the basis' `basis` (the suns' coefficients' sum of the images) where not,
 /// `basis + t (Σ_s sun_s − basis)` with `t` the suns' [`SunLight::trust`] weighted by
 /// their luminance. A sun counts where `sunlit(s)` says it reaches the texel (asked only
-/// where it would light it). At `t = 0` the texel is the basis' exactly.
+/// where it would light it). At `t = 0` the texel is the basis' exactly. `cache` holds
+/// what the suns share at the texel (a scratch kept between texels).
 pub fn suns_texel(
     suns: &[SunLight],
     (view, normal): (usize, Option<Vec3>),
-    photo: impl Fn(usize) -> Rgb,
+    (photo, cache): (impl Fn(usize) -> Rgb, &mut TexelCache),
     basis: Rgb,
     mut sunlit: impl FnMut(&SunLight) -> bool,
 ) -> Rgb {
+    let Some(first) = suns.first() else {
+        return basis;
+    };
+    cache.start(first.lights.len());
+    let cache = &*cache;
+    let photo = |k: usize| cache.photo(k, &photo);
+    // Every sun's conditions are the same: their shadings are the first's.
+    let shade = |k: usize, n: Vec3| cache.shading(k, || first.shading(k, n));
     let (mut trusted, mut total) = (0.0f32, 0.0f32);
     for sun in suns {
-        trusted += sun.luminance * sun.trust(view, normal, &photo);
+        trusted += sun.luminance * sun.trust_by(view, normal, photo, shade);
         total += sun.luminance;
     }
     let t = if total > 0.0 { trusted / total } else { 0.0 };
@@ -279,7 +319,7 @@ pub fn suns_texel(
     }
     let mut lit = [0.0f32; 3];
     for sun in suns {
-        let s = sun.texel(view, normal, &photo);
+        let s = sun.texel_by(view, normal, photo, shade);
         if s != [0.0; 3] && sunlit(sun) {
             for c in 0..3 {
                 lit[c] += s[c];
@@ -287,6 +327,62 @@ pub fn suns_texel(
         }
     }
     std::array::from_fn(|c| basis[c] + t * (lit[c] - basis[c]))
+}
+
+/// A texel's values that its suns ask for again and again, each found once: per
+/// condition, its basis image and the shading of the texel's normal ([`suns_texel`]).
+/// Kept between texels, so that nothing is allocated or cleared per texel: a value
+/// holds for the texel whose count it was stored under.
+#[derive(Debug, Default)]
+pub struct TexelCache {
+    /// Texels begun.
+    texel: u32,
+    /// Per condition: the texel its image is of, and the image.
+    photos: Vec<Cell<(u32, Rgb)>>,
+    /// Per condition: the texel its shading is of, and the shading.
+    shadings: Vec<Cell<(u32, f32)>>,
+}
+
+impl TexelCache {
+    /// Begins a texel of `conditions` conditions (the last one's values forgotten).
+    fn start(&mut self, conditions: usize) {
+        if self.photos.len() != conditions || self.texel == u32::MAX {
+            self.texel = 0;
+            self.photos = vec![Cell::new((0, [0.0; 3])); conditions];
+            self.shadings = vec![Cell::new((0, 0.0)); conditions];
+        }
+        self.texel += 1;
+    }
+
+    /// Condition `k`'s image, `photo(k)` the first time.
+    #[inline]
+    fn photo(&self, k: usize, photo: impl Fn(usize) -> Rgb) -> Rgb {
+        match self.photos.get(k).map(Cell::get) {
+            Some((t, p)) if t == self.texel => p,
+            _ => {
+                let p = photo(k);
+                if let Some(cell) = self.photos.get(k) {
+                    cell.set((self.texel, p));
+                }
+                p
+            }
+        }
+    }
+
+    /// Condition `k`'s shading of the texel's normal, `shade()` the first time.
+    #[inline]
+    fn shading(&self, k: usize, shade: impl FnOnce() -> f32) -> f32 {
+        match self.shadings.get(k).map(Cell::get) {
+            Some((t, s)) if t == self.texel => s,
+            _ => {
+                let s = shade();
+                if let Some(cell) = self.shadings.get(k) {
+                    cell.set((self.texel, s));
+                }
+                s
+            }
+        }
+    }
 }
 
 /// The [`NEAREST`] of `directions` other than `k` nearest to `directions[k]`, weighted
@@ -320,6 +416,7 @@ pub fn compactness(sun: &Sun, directions: &[Vec3], k: usize) -> f32 {
 
 /// 0 below `a`, 1 above `b`, `3x² − 2x³` of `x = (v − a) / (b − a)` between (WGSL's
 /// `smoothstep`).
+#[inline]
 pub fn smoothstep(a: f32, b: f32, v: f32) -> f32 {
     let x = ((v - a) / (b - a)).clamp(0.0, 1.0);
     x * x * (3.0 - 2.0 * x)
@@ -416,10 +513,12 @@ mod tests {
         let lambert = |k: usize| [0.4 * 2.0 * n.dot(dirs[k].0).max(0.0); 3];
         let basis = [0.123, 0.456, 0.789];
         let lit = |_: &SunLight| true;
+        // One cache for every texel below, as a view's texels share one.
+        let mut cache = TexelCache::default();
         let trusted = suns_texel(
             std::slice::from_ref(&light),
             (0, Some(n)),
-            lambert,
+            (lambert, &mut cache),
             basis,
             lit,
         );
@@ -441,19 +540,21 @@ mod tests {
         assert_eq!(*trusts.last().unwrap(), 0.0, "{trusts:?}");
         assert!(trusts.windows(2).all(|w| w[1] <= w[0] + 1e-6), "{trusts:?}");
         assert!(trusts.iter().any(|&t| t > 0.05 && t < 0.95), "{trusts:?}");
-        // Where it is not trusted at all, the basis' sun exactly.
+        // Where it is not trusted at all, the basis' sun exactly (the last texel's
+        // values forgotten).
         assert_eq!(
             suns_texel(
                 std::slice::from_ref(&light),
                 (0, Some(n)),
-                mixed(0.0),
+                (mixed(0.0), &mut cache),
                 basis,
                 lit
             ),
             basis
         );
         // No normal, no model: the basis' sun.
-        assert_eq!(suns_texel(&[light], (0, None), lambert, basis, lit), basis);
+        let none = suns_texel(&[light], (0, None), (lambert, &mut cache), basis, lit);
+        assert_eq!(none, basis);
     }
 
     #[test]
@@ -476,7 +577,13 @@ mod tests {
         let sun = Sun::new(Vec3::Y, 2.0 * cell, [3.0; 3]).unwrap();
         let broad = SunLight::new(&sun, &conditions, &[0.0], None);
         assert_eq!(
-            suns_texel(&[broad], (0, Some(n)), photo, [0.5; 3], |_| true),
+            suns_texel(
+                &[broad],
+                (0, Some(n)),
+                (photo, &mut TexelCache::default()),
+                [0.5; 3],
+                |_| true
+            ),
             [0.5; 3]
         );
     }

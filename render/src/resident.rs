@@ -30,7 +30,7 @@ use frf_reflectance::imagecodec::{BasisCodes, gamma_lut};
 use frf_reflectance::light_fit::condition_light_shares;
 use frf_reflectance::normalcodec::normal_of;
 use frf_reflectance::project::FloorModel;
-use frf_reflectance::sun_light::{SunLight, suns_texel};
+use frf_reflectance::sun_light::{SunLight, TexelCache, suns_texel};
 use frf_reflectance::yaw_light::YawLight;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -786,6 +786,32 @@ pub fn relit_pixel(basis: &BasisCodes, coefficients: &[Rgb], lut: &[f32; 256], i
     out
 }
 
+/// [`relit_pixel`] of two sets of coefficients (the light's, and its suns': what the
+/// basis adds for them), each image decoded once for both, as `shaders/relight.wgsl`
+/// does.
+#[inline]
+pub fn relit_pixel_pair(
+    basis: &BasisCodes,
+    (coefficients, suns): (&[Rgb], &[Rgb]),
+    lut: &[f32; 256],
+    i: usize,
+) -> [Rgb; 2] {
+    let mut out = [[0.0f32; 3]; 2];
+    let images = basis.tiles.iter().zip(&basis.scales);
+    for ((tile, scale), (c, d)) in images.zip(coefficients.iter().zip(suns)) {
+        if c.iter().chain(d).all(|&x| x == 0.0) {
+            continue;
+        }
+        let p = tile[i];
+        for ch in 0..3 {
+            let v = scale * lut[p[ch] as usize];
+            out[0][ch] += c[ch] * v;
+            out[1][ch] += d[ch] * v;
+        }
+    }
+    out
+}
+
 /// Basis image `k`'s linear value at pixel `i` of a view's codes.
 #[inline]
 pub fn basis_value(basis: &BasisCodes, lut: &[f32; 256], k: usize, i: usize) -> Rgb {
@@ -886,12 +912,17 @@ impl ResidentPose {
                     let (o, d) = (camera.centre(), camera.ray_direction(texel_pixel(crop, p)));
                     (t >= 0.0).then(|| o + d * t)
                 };
+                let mut cache = TexelCache::default();
                 let relit: Vec<Rgb> = (0..n)
                     .map(|p| {
                         if alpha[p] == 0 {
                             return [0.0; 3];
                         }
-                        let mut c = relit_pixel(b, &source.coefficients[i], &lut, p);
+                        let suns_basis = sun_coefficients.filter(|_| !suns.is_empty());
+                        let [mut c, basis] = match suns_basis {
+                            Some(d) => relit_pixel_pair(b, (&source.coefficients[i], d), &lut, p),
+                            None => [relit_pixel(b, &source.coefficients[i], &lut, p), [0.0; 3]],
+                        };
                         let normal = normals.get(p).and_then(|&n| normal_of(n));
                         // The floor conditions' images relit by the ground's shape.
                         if let Some(shares) = floor_shares {
@@ -904,16 +935,15 @@ impl ResidentPose {
                                 }
                             }
                         }
-                        let Some(sc) = sun_coefficients.filter(|_| !suns.is_empty()) else {
+                        if suns_basis.is_none() {
                             return c;
-                        };
-                        let basis = relit_pixel(b, sc, &lut, p);
+                        }
                         // Found once, and only where a sun would light.
                         let mut at = None;
                         let s = suns_texel(
                             suns,
                             (i, normal),
-                            |k| basis_value(b, &lut, k, p),
+                            (|k| basis_value(b, &lut, k, p), &mut cache),
                             basis,
                             |sun| {
                                 (*at.get_or_insert_with(|| surface(p)))

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use frf_core::image::Rgb;
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
-use frf_reflectance::light_fit::RATIO_FLOOR;
+use frf_reflectance::light_fit::{RATIO_FLOOR, group_cone};
 use frf_reflectance::sun_depth::SunDepth;
 use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight, TRUST_ERROR};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
@@ -185,11 +185,12 @@ const SUN_HEAD: usize = 10;
 // A slot holds two conditions left out, each predicted from two others.
 const _: () = assert!(NEAREST <= 2);
 
-/// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: one a light,
-/// where the pose's views hold normals (only they are shaded by them).
+/// Coefficients (`vec4`) the conditions' lights take after a batch's jobs: per condition
+/// its cone ([`group_cone`]) and one a light, where the pose's views hold normals (only
+/// they are shaded by them).
 fn light_coefficients(source: &PoseSource) -> usize {
     if source.normals.iter().any(|n| !n.is_empty()) {
-        source.condition_lights.iter().map(Vec::len).sum()
+        source.condition_lights.iter().map(|l| l.len() + 1).sum()
     } else {
         0
     }
@@ -206,13 +207,13 @@ fn packed_coefficients(
     maps: Option<&PoseSunMaps>,
 ) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
-    // The conditions' lights follow the jobs: where each condition's start.
+    // The conditions' cones and lights follow the jobs: where each condition's start.
     let jobs: usize = batch.views.iter().map(|&i| job_len(source, i)).sum();
     let mut ranges = Vec::with_capacity(source.condition_lights.len());
     let mut start = jobs;
     for lights in source.condition_lights.iter() {
         ranges.push([start as f32, lights.len() as f32, 0.0, 0.0]);
-        start += lights.len();
+        start += lights.len() + 1;
     }
     for &i in &batch.views {
         let scales = &source.basis[i].scales;
@@ -274,6 +275,9 @@ fn packed_coefficients(
     // normals ([`light_coefficients`]).
     if light_coefficients(source) > 0 {
         for lights in source.condition_lights.iter() {
+            // An infinite bound as the largest float (the lights one by one, always).
+            let (m, bound) = group_cone(lights);
+            out.push(m.extend(bound.min(f32::MAX)).to_array());
             out.extend(lights.iter().map(|(d, share)| d.extend(*share).to_array()));
         }
     }
