@@ -45,6 +45,9 @@ use crate::sun_depth::SunDepth;
 pub const NEAREST: usize = 2;
 /// See [`NEAREST`].
 pub const WEIGHT_POWER: f32 = 2.0;
+/// The most conditions a sun's trust reads at a view ([`SunView::involved`]): its
+/// [`NEAREST`], and the [`NEAREST`] that predict each.
+const INVOLVED: usize = NEAREST * (1 + NEAREST);
 /// A texel's leave-one-out error ([`SunLight::trust`]: the error of its nearest
 /// conditions' images predicted by the normals from the others', over the plain
 /// interpolation's of them) at which it starts to fall back to the basis' sun, and at
@@ -93,6 +96,11 @@ pub struct SunView {
     /// Per condition of `nearest`: the conditions that predict its image when it is left
     /// out, weighted as `nearest` is (the [`NEAREST`] others nearest to its direction).
     pub held_out: Vec<Vec<(usize, f32)>>,
+    /// The conditions the trust reads, each once: `nearest`'s first, in order, then those
+    /// of `held_out` not among them.
+    pub involved: Vec<usize>,
+    /// `held_out` with each condition as its place in `involved`.
+    pub held_at: Vec<Vec<(usize, f32)>>,
     /// How compact the sun is against the cell of its nearest condition, 1 (a point) to
     /// 0 (twice as broad as the cell: the basis resolves it, [`compactness`]).
     pub compactness: f32,
@@ -152,15 +160,27 @@ impl SunLight {
             .map(|&theta| {
                 let direction = (Mat3::from_rotation_y(theta) * sun.direction()).normalize();
                 let nearest = nearest_weights_by(&directions, direction, NEAREST, WEIGHT_POWER);
-                let held_out = nearest
+                let held_out: Vec<Vec<(usize, f32)>> = nearest
                     .iter()
                     .map(|&(k, _)| held_out_weights(&directions, k))
+                    .collect();
+                let mut involved: Vec<usize> = nearest.iter().map(|&(k, _)| k).collect();
+                for &(k, _) in held_out.iter().flatten() {
+                    if !involved.contains(&k) {
+                        involved.push(k);
+                    }
+                }
+                let place = |k: usize| involved.iter().position(|&j| j == k).unwrap_or(0);
+                let held_at = (held_out.iter())
+                    .map(|held| held.iter().map(|&(k, w)| (place(k), w)).collect())
                     .collect();
                 SunView {
                     direction,
                     compactness: compactness(sun, &directions, nearest[0].0),
                     nearest,
                     held_out,
+                    involved,
+                    held_at,
                 }
             })
             .collect();
@@ -253,15 +273,19 @@ impl SunLight {
         if v.compactness <= 0.0 {
             return 0.0;
         }
-        let lum = |k: usize| luminance(self.sunned(k, &photo));
+        // Each condition's luminance and shading once, the nearest first.
+        let (mut lum, mut shading) = ([0.0f32; INVOLVED], [0.0f32; INVOLVED]);
+        for (j, &k) in v.involved.iter().enumerate().take(INVOLVED) {
+            lum[j] = luminance(self.sunned(k, &photo));
+            shading[j] = shade(k, n);
+        }
         let (mut error, mut plain) = (0.0f32, 0.0f32);
-        for (&(k, w), held) in v.nearest.iter().zip(&v.held_out) {
-            let actual = lum(k);
-            let wanted = shade(k, n);
+        for (j, (&(_, w), held)) in v.nearest.iter().zip(&v.held_at).enumerate() {
+            let (actual, wanted) = (lum[j], shading[j]);
             let (mut shaded, mut interpolated) = (0.0f32, 0.0f32);
             for &(m, wm) in held {
-                shaded += wm * shade(m, n);
-                interpolated += wm * lum(m);
+                shaded += wm * shading[m];
+                interpolated += wm * lum[m];
             }
             // As the sun is relit: dark where the normal faces away.
             let predicted = if wanted <= 0.0 {
