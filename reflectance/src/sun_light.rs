@@ -381,30 +381,27 @@ impl TexelCache {
     /// Condition `k`'s image, `photo(k)` the first time.
     #[inline]
     fn photo(&self, k: usize, photo: impl Fn(usize) -> Rgb) -> Rgb {
-        match self.photos.get(k).map(Cell::get) {
-            Some((t, p)) if t == self.texel => p,
-            _ => {
-                let p = photo(k);
-                if let Some(cell) = self.photos.get(k) {
-                    cell.set((self.texel, p));
-                }
-                p
-            }
-        }
+        once(&self.photos, self.texel, k, || photo(k))
     }
 
     /// Condition `k`'s shading of the texel's normal, `shade()` the first time.
     #[inline]
     fn shading(&self, k: usize, shade: impl FnOnce() -> f32) -> f32 {
-        match self.shadings.get(k).map(Cell::get) {
-            Some((t, s)) if t == self.texel => s,
-            _ => {
-                let s = shade();
-                if let Some(cell) = self.shadings.get(k) {
-                    cell.set((self.texel, s));
-                }
-                s
+        once(&self.shadings, self.texel, k, shade)
+    }
+}
+
+/// `cells[k]`'s value where it was stored for `texel`, else `find()`, stored for it.
+#[inline]
+fn once<T: Copy>(cells: &[Cell<(u32, T)>], texel: u32, k: usize, find: impl FnOnce() -> T) -> T {
+    match cells.get(k).map(Cell::get) {
+        Some((t, v)) if t == texel => v,
+        _ => {
+            let v = find();
+            if let Some(cell) = cells.get(k) {
+                cell.set((texel, v));
             }
+            v
         }
     }
 }
