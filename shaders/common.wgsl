@@ -72,7 +72,8 @@ struct Frame {
     crop_size: vec2<u32>,
     // Its refinements: 1 rays beyond the rows through the proxy, 2 occlusion-aware morphs.
     flags: u32,
-    pad: u32,
+    // 1: the compute frame pass also writes the walker's depth (`subject_depth`).
+    depth: u32,
     // The pixels shaded, [x0, y0, x1, y1] (ends exclusive): the walker is transparent
     // outside them (`render/src/footprint.rs`).
     bounds: vec4<u32>,

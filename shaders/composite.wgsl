@@ -35,7 +35,8 @@ struct Composite {
     // Tiles in a row of `tiles`, and their side in pixels.
     tile_columns: u32,
     tile_side: u32,
-    pad: u32,
+    // 1: walkers that overlap at a pixel go over each other by their depths there.
+    by_depth: u32,
 }
 
 // A walker's subject frame: `subject_from_world`, as columns and translation; the
@@ -75,6 +76,12 @@ struct Instance {
 @group(1) @binding(2) var plate: texture_2d<f32>;
 // The walkers' relit shadows (rgb), rows along +z, one layer each.
 @group(1) @binding(3) var shadows: texture_2d_array<f32>;
+// Each walker's depth at its pixels, beside its render in `subjects` (metres along the
+// pixel's ray, `subject_depth` of the frame pass); read when `params.by_depth` is 1.
+@group(1) @binding(4) var depths: texture_2d_array<f32>;
+
+// The most walkers a pixel orders by depth: twin of `composite::MAX_OVERLAP`.
+const MAX_OVERLAP: u32 = 16u;
 
 struct Layers {
     composite: vec4<f32>,
@@ -215,8 +222,13 @@ fn composite_pixel(pixel: vec2<i32>) -> Layers {
     if (params.backdrop == 0u) {
         under = vec4<f32>(0.0, 0.0, 0.0, clamp(1.0 - luminance(s), 0.0, 1.0));
     }
-    // The walkers, each over the ones behind it.
+    // The walkers, each over the ones behind it: in the listed order (back to front by
+    // their positions), or by their depths at this pixel (twin of `stack_by_depth`).
     var front = vec4<f32>(0.0);
+    // The walkers covering the pixel beyond the last MAX_OVERLAP go under, in order;
+    // those are sorted farthest first (an insertion sort, ties in the listed order).
+    var near: array<vec2<f32>, MAX_OVERLAP>;
+    var count = 0u;
     for (var j = 0u; j < listed; j++) {
         let i = tiles[first + j];
         let b = instances[i].bounds;
@@ -224,6 +236,41 @@ fn composite_pixel(pixel: vec2<i32>) -> Layers {
             continue;
         }
         let place = instances[i].place;
+        let at = vec2<i32>(pixel) + place.xy;
+        let layer = textureLoad(subjects, at, place.z, 0);
+        if (params.by_depth == 0u) {
+            front = layer + (1.0 - clamp(layer.w, 0.0, 1.0)) * front;
+            continue;
+        }
+        if (layer.w <= 0.0) {
+            continue;
+        }
+        if (count == MAX_OVERLAP) {
+            // The oldest kept goes under now.
+            let k = u32(near[0].y);
+            let under = textureLoad(subjects, vec2<i32>(pixel) + instances[k].place.xy, instances[k].place.z, 0);
+            front = under + (1.0 - clamp(under.w, 0.0, 1.0)) * front;
+            for (var m = 1u; m < MAX_OVERLAP; m++) {
+                near[m - 1u] = near[m];
+            }
+            count -= 1u;
+        }
+        near[count] = vec2<f32>(textureLoad(depths, at, place.z, 0).x, f32(i));
+        count += 1u;
+    }
+    // Farthest first; a stable insertion sort keeps the listed order among equals.
+    for (var m = 1u; m < count; m++) {
+        let e = near[m];
+        var n = m;
+        while (n > 0u && near[n - 1u].x < e.x) {
+            near[n] = near[n - 1u];
+            n -= 1u;
+        }
+        near[n] = e;
+    }
+    for (var m = 0u; m < count; m++) {
+        let k = u32(near[m].y);
+        let place = instances[k].place;
         let layer = textureLoad(subjects, vec2<i32>(pixel) + place.xy, place.z, 0);
         front = layer + (1.0 - clamp(layer.w, 0.0, 1.0)) * front;
     }

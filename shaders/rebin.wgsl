@@ -27,6 +27,9 @@
 // The compute pass's target (`cs_main` only): pixel p of the frame goes to texel
 // p + frame.place.xy of layer frame.place.z.
 @group(0) @binding(2) var target_image: texture_storage_2d_array<rgba32float, write>;
+// Beside it when `frame.depth` is 1 (`cs_main` only): the walker's depth at the pixel
+// (`subject_depth`), which orders walkers that overlap in the composite.
+@group(0) @binding(3) var depth_image: texture_storage_2d_array<r32float, write>;
 
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
@@ -185,7 +188,12 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         let c = classify(vec2<f32>(p) + 0.5);
-        textureStore(target_image, vec2<i32>(p) + frame.place.xy, frame.place.z, shade_classified(c));
+        let at = vec2<i32>(p) + frame.place.xy;
+        textureStore(target_image, at, frame.place.z, shade_classified(c));
+        if (frame.depth == 1u) {
+            let dir = pixel_ray(frame, vec4<f32>(vec2<f32>(p) + 0.5, 0.0, 1.0));
+            textureStore(depth_image, at, frame.place.z, vec4<f32>(subject_depth(frame.centre.xyz, dir)));
+        }
         count_class(c.kind);
     }
 }

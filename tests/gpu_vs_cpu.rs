@@ -520,3 +520,89 @@ fn a_reduced_pose_relights_its_suns_by_its_normals_on_both() {
         assert!(differ * 1000 <= hits, "{differ} of {hits} texels differ");
     }
 }
+
+/// Two walkers that overlap in the frame, one a little behind and beside the other, each
+/// turned its own way: the GPU puts them over each other by their depths at each pixel
+/// as the CPU twin does (`stack_by_depth`), and differs from the two stacked whole in the
+/// order of their positions where the one behind by position is nearer by depth (4 pixels
+/// here: a hand).
+#[test]
+fn overlapping_walkers_are_ordered_by_depth_as_on_the_cpu() {
+    use frf_core::camera::Rigid;
+    use frf_render::renderer::{Device, Walker};
+    let Some(gpu) = gpu() else { return };
+    let source = tiny_source();
+    let cam = Camera::look_at(
+        Vec3::new(0.3, 1.3, 3.4),
+        Vec3::new(0.1, 0.8, 0.0),
+        Vec3::Y,
+        0.7,
+        96,
+        72,
+    )
+    .unwrap();
+    let place = |x: f32, z: f32, heading: f32| Rigid {
+        rotation: Rigid::rotation_y(heading).rotation,
+        translation: Vec3::new(x, 0.0, z),
+    };
+    let placements = [place(0.0, 0.0, 0.0), place(0.25, -0.3, 2.6)];
+    let frames: Vec<_> = [Device::Gpu(Box::new(gpu)), Device::Cpu]
+        .into_iter()
+        .map(|device| {
+            let residents = [
+                device.make_resident(&source).unwrap(),
+                device.make_resident(&source).unwrap(),
+            ];
+            let walkers: Vec<Walker> = residents
+                .iter()
+                .zip(placements)
+                .map(|(resident, world_from_subject)| Walker {
+                    resident,
+                    world_from_subject,
+                    between: None,
+                    within: None,
+                })
+                .collect();
+            let backdrop = device.backdrop(Backdrop::None).unwrap();
+            device
+                .render_frame(&walkers, &backdrop, &cam, Variant::FourWay, true)
+                .unwrap()
+        })
+        .collect();
+    let (g, c) = (&frames[0], &frames[1]);
+    let worst = g
+        .composite
+        .pixels()
+        .iter()
+        .zip(c.composite.pixels())
+        .flat_map(|(x, y)| (0..4).map(move |k| (x[k] - y[k]).abs()))
+        .fold(0.0f32, f32::max);
+    eprintln!("two walkers by depth: GPU vs CPU {worst:e}");
+    assert!(worst <= 2e-3, "GPU and CPU differ by {worst}");
+    // Both walkers show, and overlap.
+    let covered = c.composite.pixels().iter().filter(|p| p[3] > 0.5).count();
+    assert!(covered > 200, "{covered} pixels covered");
+    // Stacked whole in the order of their positions instead, some pixels differ.
+    let device = Device::Cpu;
+    let resident = device.make_resident(&source).unwrap();
+    let order = frf_render::composite::back_to_front(&cam, &placements.map(|p| p.translation));
+    let layers = order
+        .iter()
+        .map(|&k| {
+            let seen = cam.transformed(&placements[k].inverse());
+            device
+                .render_subject(&resident, &seen, Variant::FourWay)
+                .unwrap()
+                .0
+        })
+        .collect();
+    let whole = frf_render::composite::stack(layers).unwrap();
+    let crossed = whole
+        .pixels()
+        .iter()
+        .zip(c.layers.as_ref().unwrap().subject.pixels())
+        .filter(|(a, b)| (0..4).any(|k| (a[k] - b[k]).abs() > 0.05))
+        .count();
+    eprintln!("pixels where depth reorders the walkers: {crossed}");
+    assert!(crossed > 0, "ordered by depth as by position everywhere");
+}

@@ -100,9 +100,9 @@ fn score_frame_walkers<R: ReadAt>(
             scene.instances.len()
         )));
     }
-    let instance = scene.instances[0];
+    let placement = scene.placement(0, frame.time);
     let cycle = stage.config().gait.cycle_seconds();
-    let instant = scene.phase_at(0, frame.time, cycle) * cycle;
+    let instant = scene.phase_at(0, frame.time, &shot.plan().gait) * cycle;
     let world = shot.lighting_at(frame.time)?.ok_or_else(|| {
         EvalError::NoTruth("an unlit scene has no true lighting to compare with".into())
     })?;
@@ -119,8 +119,8 @@ fn score_frame_walkers<R: ReadAt>(
 
     // The truth, in the walker's frame: its camera and its lighting.
     let t = Instant::now();
-    let subject_camera = instance.camera_in_subject_frame(&frame.camera);
-    let lights = world.rotated(-instance.heading).median_cut(lights);
+    let subject_camera = placement.camera_in_subject_frame(&frame.camera);
+    let lights = world.rotated(-placement.heading).median_cut(lights);
     let pose_time = stage.pose_time_s(pose);
     let truth_time_s = match truth_at {
         TruthAt::Pose => pose_time,
@@ -135,7 +135,7 @@ fn score_frame_walkers<R: ReadAt>(
     let truth = stage.truth_image_at(truth_time_s, &subject_camera, &lights);
     let subject = rgba_from(&truth.color, &truth.alpha)?;
     let actor = stage.true_actor_at(truth_time_s);
-    let subject_from_world = instance.world_from_subject().inverse();
+    let subject_from_world = placement.world_from_subject().inverse();
     let shadow =
         |p: glam::Vec3| relative_irradiance(&actor, &lights, subject_from_world.transform_point(p));
     let (truth, _) = compose(subject.clone(), &frame.camera, &backdrop, &shadow)?;

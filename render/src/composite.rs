@@ -168,6 +168,54 @@ pub fn stack(layers: Vec<Image<Rgba>>) -> Result<Image<Rgba>> {
     Ok(out)
 }
 
+/// The most walkers a pixel orders by depth ([`stack_by_depth`]; `MAX_OVERLAP` in
+/// `shaders/composite.wgsl`): a pixel where more overlap puts the farthest in the
+/// frame's back-to-front order first, under the rest. A crowd of 400 at 640x360 met at
+/// most 9 at a pixel.
+pub const MAX_OVERLAP: usize = 16;
+
+/// Walkers rendered one by one, each with its depth at every pixel, listed back to front
+/// by their positions ([`back_to_front`]): at each pixel, those that cover it
+/// (alpha above 0) put over each other farthest first by their depth there, ties in the
+/// listed order, so that walkers that pass each other cross where their bodies do. At
+/// most [`MAX_OVERLAP`] are ordered at a pixel; those listed before them go under, in
+/// the listed order.
+pub fn stack_by_depth(layers: Vec<(Image<Rgba>, Image<f32>)>) -> Result<Image<Rgba>> {
+    let Some((first, _)) = layers.first() else {
+        return Err(RenderError::Misuse("no walker to stack".into()));
+    };
+    let size = first.size();
+    if layers
+        .iter()
+        .any(|(c, d)| c.size() != size || d.size() != size)
+    {
+        return Err(RenderError::Misuse(
+            "walker layers of different sizes".into(),
+        ));
+    }
+    let (w, h) = size;
+    let pixels: Vec<Rgba> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let covering: Vec<(f32, usize)> = layers
+                .iter()
+                .enumerate()
+                .filter(|(_, (c, _))| c.get(x, y)[3] > 0.0)
+                .map(|(k, (_, d))| (d.get(x, y), k))
+                .collect();
+            let cut = covering.len().saturating_sub(MAX_OVERLAP);
+            let (under, sorted) = covering.split_at(cut);
+            let mut sorted = sorted.to_vec();
+            sorted.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            under.iter().chain(&sorted).fold([0.0; 4], |acc, &(_, k)| {
+                over(layers[k].0.get(x, y), acc, [1.0; 3], false)
+            })
+        })
+        .collect();
+    Ok(Image::from_vec(w, h, pixels)?)
+}
+
 /// Composites `subject` (rendered by `camera`) over `backdrop`, its ground darkened by
 /// `shadow(ground point)` (see the module docs): the composite and its layers.
 pub fn compose(
@@ -297,6 +345,26 @@ mod tests {
             "{:?}",
             ground[0]
         );
+    }
+
+    #[test]
+    fn walkers_cross_where_their_depths_do() {
+        // Two opaque walkers over the same 2x1 pixels: red nearer at the left pixel, blue
+        // nearer at the right one (two bodies passing each other).
+        let red = Image::from_vec(2, 1, vec![[1.0, 0.0, 0.0, 1.0]; 2]).unwrap();
+        let blue = Image::from_vec(2, 1, vec![[0.0, 0.0, 1.0, 1.0]; 2]).unwrap();
+        let red_depth = Image::from_vec(2, 1, vec![2.0f32, 4.0]).unwrap();
+        let blue_depth = Image::from_vec(2, 1, vec![3.0f32, 3.0]).unwrap();
+        let out = stack_by_depth(vec![(red, red_depth), (blue, blue_depth)]).unwrap();
+        assert_eq!(out.get(0, 0), [1.0, 0.0, 0.0, 1.0]);
+        assert_eq!(out.get(1, 0), [0.0, 0.0, 1.0, 1.0]);
+        // Half-covering layers keep Porter–Duff over in depth order.
+        let a = Image::from_vec(1, 1, vec![[0.5, 0.0, 0.0, 0.5]]).unwrap();
+        let b = Image::from_vec(1, 1, vec![[0.0, 0.5, 0.0, 0.5]]).unwrap();
+        let near = Image::from_vec(1, 1, vec![1.0f32]).unwrap();
+        let far = Image::from_vec(1, 1, vec![5.0f32]).unwrap();
+        let out = stack_by_depth(vec![(a, near), (b, far)]).unwrap();
+        assert_eq!(out.get(0, 0), [0.5, 0.25, 0.0, 0.75]);
     }
 
     #[test]

@@ -119,3 +119,32 @@ pub fn render_cpu_within(
         stats,
     )
 }
+
+/// The depth of the subject of `pose` at each pixel of `camera` (subject frame) within
+/// `within` ([`crate::proxy::Proxy::depth`]: metres along the pixel's ray); infinite
+/// outside it. What orders overlapping walkers pixel by pixel
+/// ([`crate::composite::stack_by_depth`]); twin of the frame pass's depth.
+pub fn depth_cpu_within(
+    pose: &ResidentPose,
+    camera: &Camera,
+    within: Option<PixelBox>,
+) -> Image<f32> {
+    let (w, h) = (camera.width as usize, camera.height as usize);
+    let within = within.unwrap_or(PixelBox::whole(camera.width, camera.height));
+    let proxy = &pose.geometry.proxy;
+    let rows: Vec<Vec<f32>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            (0..w)
+                .map(|x| {
+                    if !within.contains(x as u32, y as u32) {
+                        return f32::INFINITY;
+                    }
+                    let dir = camera.ray_direction(Vec2::new(x as f32, y as f32));
+                    proxy.depth(camera.centre(), dir)
+                })
+                .collect()
+        })
+        .collect();
+    Image::from_vec(w, h, rows.into_iter().flatten().collect()).expect("w*h pixels by construction")
+}

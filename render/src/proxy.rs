@@ -24,6 +24,13 @@
 //!   depth does worse than none (measured on dinoRing, one row: 20.2 against 23.9 dB).
 //!
 //! `proxy_point` in `shaders/rebin.wgsl` is the GPU twin.
+//!
+//! **Depth.** Where walkers overlap in a frame, each pixel puts them over each other by
+//! their depth there ([`Proxy::depth`]): the distance along the pixel's ray to the proxy's
+//! point, and without a hull (or for a vertical ray beside it) to the ray's point nearest
+//! the subject's vertical axis. Distances are kept by the rigid move from the world into
+//! a walker's subject frame, so every walker's are comparable. `subject_depth` in
+//! `shaders/rebin/proxy.wgsl` is its twin.
 
 use std::sync::Arc;
 
@@ -131,10 +138,44 @@ impl Proxy {
     }
 }
 
+impl Proxy {
+    /// The depth of the subject along the ray from `origin` in direction `dir` (any
+    /// length), metres: see the module docs.
+    pub fn depth(&self, origin: Vec3, dir: Vec3) -> f32 {
+        let dir = dir.normalize_or_zero();
+        if let Some(p) = self.point(origin, dir) {
+            return (p - origin).length();
+        }
+        let o = Vec2::new(origin.x, origin.z) - self.axis;
+        let d = Vec2::new(dir.x, dir.z);
+        let dd = d.length_squared();
+        if dd < VERTICAL_EPS {
+            return o.length();
+        }
+        (-o.dot(d) / dd).max(0.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use frf_core::volume::VoxelGrid;
+
+    #[test]
+    fn depth_is_the_distance_to_the_proxy_or_to_the_axis() {
+        let grid =
+            VoxelGrid::covering(Vec3::new(-0.2, 0.0, -0.2), Vec3::new(0.2, 2.0, 0.2), 0.1).unwrap();
+        let p = Proxy::new(Some(VoxelHull::full(grid)));
+        // Straight at the box from 3 m: its face at 0.2 m from the axis.
+        let d = p.depth(Vec3::new(0.0, 1.0, 3.0), Vec3::new(0.0, 0.0, -2.0));
+        assert!((d - 2.8).abs() < 1e-4, "{d}");
+        // No hull: the nearest point to the axis, along a unit ray.
+        let none = Proxy::new(None);
+        let d = none.depth(Vec3::new(0.0, 1.0, 3.0), Vec3::new(1.0, 0.0, -1.0));
+        assert!((d - 3.0 / 2f32.sqrt()).abs() < 1e-4, "{d}");
+        // A vertical ray: its horizontal distance to the axis.
+        assert!((none.depth(Vec3::new(3.0, 5.0, 4.0), Vec3::NEG_Y) - 5.0).abs() < 1e-5);
+    }
 
     #[test]
     fn without_a_hull_there_is_no_point() {

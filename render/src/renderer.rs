@@ -12,8 +12,8 @@
 use frf_core::camera::{Camera, Rigid};
 use frf_core::image::{Image, Rgb, Rgba};
 
-use crate::composite::{Backdrop, Layers, back_to_front, compose, stack};
-use crate::cpu::{FrameStats, render_cpu, render_cpu_within};
+use crate::composite::{Backdrop, Layers, back_to_front, compose, stack, stack_by_depth};
+use crate::cpu::{FrameStats, depth_cpu_within, render_cpu, render_cpu_within};
 use crate::error::Result;
 use crate::footprint::PixelBox;
 use crate::gpu::composite::{GpuBackdrop, GpuInstanceRef};
@@ -494,8 +494,8 @@ impl Device {
         }
     }
 
-    /// The CPU reference of [`Device::render_frame`]: each walker alone, stacked back to
-    /// front, then composited.
+    /// The CPU reference of [`Device::render_frame`]: each walker alone, put over each
+    /// other by depth at every pixel ([`stack_by_depth`]), then composited.
     fn render_frame_cpu(
         &self,
         walkers: &[Walker],
@@ -509,6 +509,7 @@ impl Device {
             .map(|w| w.world_from_subject.translation)
             .collect();
         let mut drawn = Vec::with_capacity(walkers.len());
+        let mut depths = Vec::with_capacity(walkers.len());
         let mut stats = FrameStats::default();
         let mut shadows = Vec::new();
         for k in back_to_front(camera, &positions) {
@@ -518,6 +519,13 @@ impl Device {
             let render = |pose, seen: &Camera| render_cpu_within(pose, seen, variant, w.within);
             let (img, s) = render(cpu_pose(&w.resident.kind)?, &seen);
             stats = stats.merge(s);
+            if walkers.len() > 1 {
+                depths.push(depth_cpu_within(
+                    cpu_pose(&w.resident.kind)?,
+                    &seen,
+                    w.within,
+                ));
+            }
             drawn.push(match w.between {
                 None => img,
                 Some((after, s)) => {
@@ -559,7 +567,13 @@ impl Device {
             }
             s
         };
-        let (composite, l) = compose(stack(drawn)?, camera, &backdrop.cpu, &shadow)?;
+        // One walker is itself; several are put over each other by depth, pixel by pixel.
+        let subjects = if depths.is_empty() {
+            stack(drawn)?
+        } else {
+            stack_by_depth(drawn.into_iter().zip(depths).collect())?
+        };
+        let (composite, l) = compose(subjects, camera, &backdrop.cpu, &shadow)?;
         Ok(Frame {
             composite,
             layers: layers.then_some(l),

@@ -240,19 +240,21 @@ pub fn bench_scene(
     (frames, spacing): (usize, Spacing),
 ) -> Scene {
     let mut s = scene.clone();
-    let first = scene.instances[0];
+    let first = &scene.instances[0];
     let side = (n as f32).sqrt().ceil() as usize;
     let centre = (side as f32 - 1.0) * 0.5;
     s.instances = (0..n)
-        .map(|k| Instance {
-            position: first.position
-                + Vec3::new(
-                    ((k % side) as f32 - centre) * SPACING_M,
-                    0.0,
-                    ((k / side) as f32 - centre) * SPACING_M,
-                ),
-            heading: first.heading + k as f32 * 137.507_77_f32.to_radians(),
-            time_offset: first.time_offset,
+        .map(|k| {
+            Instance::standing(
+                first.position
+                    + Vec3::new(
+                        ((k % side) as f32 - centre) * SPACING_M,
+                        0.0,
+                        ((k / side) as f32 - centre) * SPACING_M,
+                    ),
+                first.heading + k as f32 * 137.507_77_f32.to_radians(),
+                first.time_offset,
+            )
         })
         .collect();
     let key = scene.lighting[0].clone();

@@ -7,13 +7,17 @@ use frf_core::sun::Sun;
 use frf_reflectance::project::FloorModel;
 use glam::Vec3;
 
-use super::file::{At, CameraToml, CompositeToml, LightingToml, OutputToml, Reporter, SceneToml};
+use super::file::{
+    At, CameraToml, CompositeToml, LightingToml, OutputToml, Reporter, SceneToml, WalkKeyToml,
+};
 use super::{
     BackdropSpec, Instance, LightKey, MAX_DISTANCE_M, MAX_FRAMES, MAX_INTENSITY, MAX_SIDE_PX,
-    MAX_TIME_S, Preview, ShadowSpec, TimeInterpolation,
+    MAX_TIME_S, Preview, Probe, Probes, ShadowSpec, TimeInterpolation,
 };
 use crate::error::Result;
 use crate::path::{CameraPath, Orbit, Trajectory};
+use crate::probes::ProbeLayout;
+use crate::walk::{WalkKey, WalkPath};
 use frf_render::composite::GroundLook;
 use frf_render::morph::Variant;
 
@@ -262,6 +266,66 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
     Ok((lighting, floor))
 }
 
+/// `lighting.probe`: the light probes, when given; a refusal names the probe: no map
+/// (`none`), a position or yaw that is not finite, an intensity outside 0 to 10^6, two
+/// probes at one place, too many.
+pub fn probes(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Probes>> {
+    let raw = &l.get_ref().probe;
+    if raw.is_empty() {
+        return Ok(None);
+    }
+    let none = |e: &Option<At<String>>| e.as_ref().is_some_and(|e| e.get_ref() == "none");
+    if none(&l.get_ref().env) || l.get_ref().key.iter().any(|k| none(&k.get_ref().env)) {
+        return Err(r.error(
+            "lighting.probe",
+            raw[0].span(),
+            "probes relight the walkers: the scene's env (its backdrop) cannot be \"none\"",
+        ));
+    }
+    let mut probes = Vec::with_capacity(raw.len());
+    for (i, p) in raw.iter().enumerate() {
+        let field = |name: &str| format!("lighting.probe[{i}].{name}");
+        let v = p.get_ref();
+        let source = env(r, &field("env"), &At::new(p.span(), v.env.clone()))?;
+        if source == EnvSource::None {
+            return Err(r.error(
+                &field("env"),
+                p.span(),
+                "a probe needs a map: a .hdr/.exr file, an frf env-sh file, \"sky\" or \"uniform\"",
+            ));
+        }
+        let position = Vec3::from(v.position);
+        if !position.is_finite() || position.abs().max_element() > MAX_DISTANCE_M {
+            return Err(r.error(&field("position"), p.span(), "finite metres within 10 km"));
+        }
+        if !v.yaw_deg.is_finite() {
+            return Err(r.error(&field("yaw_deg"), p.span(), "a finite angle"));
+        }
+        if !(v.intensity >= 0.0 && v.intensity <= MAX_INTENSITY) {
+            return Err(r.error(
+                &field("intensity"),
+                p.span(),
+                format!("{}: expected 0 to 10^6", v.intensity),
+            ));
+        }
+        probes.push(Probe {
+            position,
+            env: source,
+            yaw: radians(v.yaw_deg),
+            intensity: v.intensity,
+        });
+    }
+    let points = probes
+        .iter()
+        .map(|p| glam::Vec2::new(p.position.x, p.position.z))
+        .collect();
+    let layout = ProbeLayout::new(points).map_err(|(i, problem)| {
+        let span = raw.get(i).map_or(0..0, |p| p.span());
+        r.error(&format!("lighting.probe[{i}]"), span, problem)
+    })?;
+    Ok(Some(Probes { probes, layout }))
+}
+
 /// `camera`: an orbit or keys.
 pub fn camera(r: &Reporter, camera: &At<CameraToml>) -> Result<Trajectory> {
     let c = camera.get_ref();
@@ -356,7 +420,8 @@ pub fn composite(
     Ok((backdrop, shadow))
 }
 
-/// `instance`: the walkers (one at the origin when none is given).
+/// `instance`: the walkers (one at the origin when none is given), standing or walking a
+/// path; a refusal names the walker, the field (the key of a path) and the line.
 pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
     let mut instances = Vec::new();
     for (i, inst) in raw.instance.iter().enumerate() {
@@ -365,20 +430,6 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
         let bad = |name: &str, value: String, range: &str| {
             Err(r.error(&key(name), inst.span(), format!("{value}: {range}")))
         };
-        if !v
-            .position
-            .iter()
-            .all(|c| c.is_finite() && c.abs() <= MAX_DISTANCE_M)
-        {
-            return bad(
-                "position",
-                format!("{:?}", v.position),
-                "finite metres within 10 km",
-            );
-        }
-        if !v.heading_deg.is_finite() {
-            return bad("heading_deg", v.heading_deg.to_string(), "a finite angle");
-        }
         if !(v.time_offset.is_finite() && v.time_offset.abs() <= 1e6) {
             return bad(
                 "time_offset",
@@ -386,27 +437,81 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
                 "finite seconds within 10^6",
             );
         }
-        if v.position[1] != 0.0 {
+        if !v.key.is_empty() {
+            if v.position.is_some() || v.heading_deg.is_some() {
+                return Err(r.error(
+                    &key("key"),
+                    inst.span(),
+                    "a walker on a path gives keys, not position or heading_deg (give \
+                     heading_deg at its keys)",
+                ));
+            }
+            instances.push(walker_on_path(r, i, &v.key, v.time_offset)?);
+            continue;
+        }
+        let position = v.position.unwrap_or([0.0; 3]);
+        let heading_deg = v.heading_deg.unwrap_or(0.0);
+        if !position
+            .iter()
+            .all(|c| c.is_finite() && c.abs() <= MAX_DISTANCE_M)
+        {
+            return bad(
+                "position",
+                format!("{position:?}"),
+                "finite metres within 10 km",
+            );
+        }
+        if !heading_deg.is_finite() {
+            return bad("heading_deg", heading_deg.to_string(), "a finite angle");
+        }
+        if position[1] != 0.0 {
             return Err(r.error(
                 &format!("instance[{i}].position"),
                 inst.span(),
                 "walkers stand on the ground: y must be 0",
             ));
         }
-        instances.push(Instance {
-            position: Vec3::from(v.position),
-            heading: v.heading_deg.to_radians(),
-            time_offset: v.time_offset,
-        });
+        instances.push(Instance::standing(
+            Vec3::from(position),
+            radians(heading_deg),
+            v.time_offset,
+        ));
     }
     if instances.is_empty() {
-        instances.push(Instance {
-            position: Vec3::ZERO,
-            heading: 0.0,
-            time_offset: 0.0,
-        });
+        instances.push(Instance::standing(Vec3::ZERO, 0.0, 0.0));
     }
     Ok(instances)
+}
+
+/// An angle in degrees as radians, reduced to a turn in double precision first (so that
+/// 10^9 degrees is the same heading as its remainder).
+fn radians(deg: f64) -> f32 {
+    deg.rem_euclid(360.0).to_radians() as f32
+}
+
+/// Walker `i` on the path of `keys`, its walk `time_offset` seconds ahead.
+fn walker_on_path(
+    r: &Reporter,
+    i: usize,
+    keys: &[At<WalkKeyToml>],
+    time_offset: f64,
+) -> Result<Instance> {
+    let walk_keys = keys
+        .iter()
+        .map(|k| {
+            let k = k.get_ref();
+            WalkKey {
+                time: k.time,
+                position: Vec3::from(k.position),
+                heading: k.heading_deg.map(|h| radians(h) as f64),
+            }
+        })
+        .collect();
+    let path = WalkPath::new(walk_keys).map_err(|(j, problem)| {
+        let span = keys.get(j).map_or(0..0, |k| k.span());
+        r.error(&format!("instance[{i}].key[{j}]"), span, problem)
+    })?;
+    Ok(Instance::walking(path, time_offset))
 }
 
 /// `lighting.sun`, when given: refused naming the field for a direction that is not one

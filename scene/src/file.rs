@@ -32,6 +32,10 @@
 //! #         illuminance = 12.0 }       # or direction = [x, y, z]; or radiance = L;
 //! #                                   # colour = [r, g, b]. Added to env (turned by yaw,
 //! #                                   # scaled by intensity); alone with env = "none"
+//! # [[lighting.probe]]                # light probes (frf_scene::probes): each walker is
+//! # position = [-4.0, 1.2, 0.0]       # lit by them interpolated where it stands, the
+//! # env = "shade.hdr"                 # key's intensity and the sun added; the backdrop
+//! # yaw_deg = 0.0                     # still shows env
 //!
 //! [camera]                            # an orbit over the time range, or keys
 //! orbit = { radius = 3.2, height = 1.4, start_deg = -30.0, sweep_deg = 120.0,
@@ -52,6 +56,15 @@
 //! position = [0.0, 0.0, 0.0]          # metres, on the ground y = 0
 //! heading_deg = 0.0                   # about +y; 0 walks toward +x
 //! time_offset = 0.0                   # seconds added to the scene's time for its walk
+//!
+//! [[instance]]                        # a walker walking a path (frf_scene::walk): keys
+//! time_offset = 0.25                  # instead of position; it faces where it walks
+//! [[instance.key]]                    # (or heading_deg at every key) and its walk
+//! time = 0.0                          # advances with the distance walked
+//! position = [-3.0, 0.0, 0.0]
+//! [[instance.key]]
+//! time = 4.0
+//! position = [2.0, 0.0, -2.0]
 //! ```
 
 use std::ops::Range;
@@ -174,6 +187,31 @@ pub struct LightingToml {
     /// A sun added to the environment (or lighting alone, with `env = "none"`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sun: Option<At<SunToml>>,
+    /// Light probes: each walker is lit by them interpolated where it stands
+    /// ([`crate::probes`]) instead of by `env`, which the backdrop still shows.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub probe: Vec<At<ProbeToml>>,
+}
+
+/// `[[lighting.probe]]`: the light at a place of the scene.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeToml {
+    /// Where it was taken, metres (its height is not used).
+    pub position: [f32; 3],
+    /// Its map: a `.hdr`/`.exr` file, an `frf env-sh` file (`.json`), `"sky"` or
+    /// `"uniform"`.
+    pub env: String,
+    /// Its turn about `+y`, degrees.
+    #[serde(default)]
+    pub yaw_deg: f64,
+    /// Multiplier of its radiance.
+    #[serde(default = "one_f32")]
+    pub intensity: f32,
+}
+
+fn one_f32() -> f32 {
+    1.0
 }
 
 /// `lighting.sun`: a direction (by azimuth and elevation, or a vector), an angular
@@ -321,19 +359,61 @@ fn maps_word() -> At<String> {
     At::new(0..0, "maps".into())
 }
 
-/// `[[instance]]`.
-#[derive(Debug, Deserialize, Serialize)]
+/// `[[instance]]`: a walker standing (`position`, `heading_deg`) or walking a path
+/// (`key`s, [`crate::walk`]).
+#[derive(Debug, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct InstanceToml {
-    /// Metres.
-    #[serde(default)]
-    pub position: [f32; 3],
-    /// Degrees.
-    #[serde(default)]
-    pub heading_deg: f32,
+    /// Metres (a walker standing; default the origin).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub position: Option<[f32; 3]>,
+    /// Degrees (a walker standing; default 0).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heading_deg: Option<f64>,
     /// Seconds.
     #[serde(default)]
     pub time_offset: f64,
+    /// The path's keys (a walker walking).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub key: Vec<At<WalkKeyToml>>,
+}
+
+impl InstanceToml {
+    /// How `instance` is written (the viewer's recorder).
+    pub fn of(instance: &crate::walk::Instance) -> Self {
+        let keys = instance.path.as_ref().map_or(Vec::new(), |p| {
+            p.keys()
+                .iter()
+                .map(|k| {
+                    written(WalkKeyToml {
+                        time: k.time,
+                        position: k.position.to_array(),
+                        heading_deg: k.heading.map(f64::to_degrees),
+                    })
+                })
+                .collect()
+        });
+        let standing = keys.is_empty();
+        Self {
+            position: standing.then(|| instance.position.to_array()),
+            heading_deg: standing.then(|| f64::from(instance.heading).to_degrees()),
+            time_offset: instance.time_offset,
+            key: keys,
+        }
+    }
+}
+
+/// `[[instance.key]]`: where a walker is at a time, and optionally its heading.
+#[derive(Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct WalkKeyToml {
+    /// Seconds, scene clock.
+    pub time: f64,
+    /// Metres, on the ground.
+    pub position: [f32; 3],
+    /// Degrees about `+y` (at every key or none: else the walker faces where it walks).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heading_deg: Option<f64>,
 }
 
 /// Errors about one scene file, pointing at lines.

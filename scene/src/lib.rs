@@ -16,9 +16,11 @@
 //!
 //! **Frames.** The scene frame is the world of the shot (metres, `+y` up, the ground
 //! `y = 0`). Each walker (an *instance*) stands at its position, turned by its heading
-//! about `+y`, its walk `time_offset` seconds ahead of the scene's clock; its subject
-//! frame is `world_from_subject = T(position) · R_y(heading)`. With one instance at the
-//! origin the scene frame is the subject frame of the field.
+//! about `+y`, or walks along a path ([`walk`]: its position and heading at each
+//! instant, its walk's phase advanced by the distance walked), its walk `time_offset`
+//! seconds ahead; its subject frame at an instant is `world_from_subject = T(position) ·
+//! R_y(heading)` ([`Placement`]). With one instance at the origin the scene frame is the
+//! subject frame of the field.
 
 pub mod bench_frame;
 mod check;
@@ -30,17 +32,19 @@ pub mod output;
 pub mod path;
 pub mod plan;
 pub mod plan_report;
+pub mod probes;
 pub mod render_shot;
 pub mod settings;
 pub mod shot;
 pub mod shot_report;
+pub mod spline;
+pub mod walk;
 
 use std::path::{Path, PathBuf};
 
-use frf_core::camera::{Camera, Rigid};
+use frf_core::camera::Camera;
 use frf_core::env::EnvSource;
 use frf_reflectance::project::FloorModel;
-use glam::Vec3;
 
 pub use crate::error::{Result, SceneError};
 use crate::path::Trajectory;
@@ -61,9 +65,7 @@ pub const MAX_TIME_S: f64 = 1e9;
 /// The brightest an environment may be scaled (`lighting.intensity`, the viewer's
 /// `intensity`): far above any exposure a frame can show, far below f32's overflow.
 pub const MAX_INTENSITY: f32 = 1e6;
-/// How far from the origin a position may lie, metres (walkers, the viewer's camera):
-/// f32 still resolves a millimetre there.
-pub const MAX_DISTANCE_M: f32 = 1e4;
+pub use walk::{Gait, Instance, MAX_DISTANCE_M, Placement};
 
 /// The animated preview of a render.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -136,31 +138,26 @@ pub struct LightingAt {
     pub sun: Option<frf_core::sun::Sun>,
 }
 
-/// One walker of the scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Instance {
-    /// Where it stands (scene frame, metres).
-    pub position: Vec3,
-    /// Its heading about `+y`, radians.
-    pub heading: f32,
-    /// Seconds its walk is ahead of the scene's clock.
-    pub time_offset: f64,
+/// A light probe: the light at a place of the scene ([`probes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Probe {
+    /// Where it was taken (scene frame, metres).
+    pub position: glam::Vec3,
+    /// Its map.
+    pub env: EnvSource,
+    /// Its turn about `+y`, radians.
+    pub yaw: f32,
+    /// Multiplier of its radiance.
+    pub intensity: f32,
 }
 
-impl Instance {
-    /// `world_from_subject`.
-    pub fn world_from_subject(&self) -> Rigid {
-        let r = Rigid::rotation_y(self.heading);
-        Rigid {
-            rotation: r.rotation,
-            translation: self.position,
-        }
-    }
-
-    /// A scene camera as this walker's subject frame sees it.
-    pub fn camera_in_subject_frame(&self, camera: &Camera) -> Camera {
-        camera.transformed(&self.world_from_subject().inverse())
-    }
+/// The scene's light probes and how they interpolate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Probes {
+    /// The probes.
+    pub probes: Vec<Probe>,
+    /// Their layout on the ground.
+    pub layout: probes::ProbeLayout,
 }
 
 /// What a frame between two captured poses shows.
@@ -213,6 +210,8 @@ pub struct Scene {
     pub lighting: Vec<LightKey>,
     /// A sun added to the lighting (`lighting.sun`; [`frf_core::sun`]).
     pub sun: Option<frf_core::sun::Sun>,
+    /// Light probes that light the walkers where they stand (`lighting.probe`).
+    pub probes: Option<Probes>,
     /// What lights the subject from below.
     pub floor: FloorModel,
     /// The camera.
@@ -297,6 +296,7 @@ impl Scene {
         let (size, exposure, preview, variant) = check::output(&r, &raw.output)?;
         let (lighting, floor) = check::lighting(&r, &raw.lighting)?;
         let sun = check::sun(&r, &raw.lighting)?;
+        let probes = check::probes(&r, &raw.lighting)?;
         let camera = check::camera(&r, &raw.camera)?;
         let (backdrop, shadow) =
             check::composite(&r, &raw.composite, (&camera, &raw.camera), &lighting)?;
@@ -316,6 +316,7 @@ impl Scene {
             variant,
             lighting,
             sun,
+            probes,
             floor,
             camera,
             backdrop,
@@ -395,29 +396,56 @@ impl Scene {
         }
     }
 
-    /// The pose of the walk cycle (`poses_per_cycle` poses over `cycle_seconds`) that
-    /// instance `i` shows at time `t`: the nearest pose to its phase, looping.
-    pub fn pose_at(&self, i: usize, t: f64, cycle_seconds: f64, poses_per_cycle: u32) -> u32 {
+    /// Where instance `i` stands at time `t`, and which way it faces.
+    pub fn placement(&self, i: usize, t: f64) -> Placement {
+        self.instances[i].at(t)
+    }
+
+    /// The pose of the walk cycle (`poses_per_cycle` poses of `gait`) that instance `i`
+    /// shows at time `t`: the nearest pose to its phase, looping.
+    pub fn pose_at(&self, i: usize, t: f64, gait: &Gait, poses_per_cycle: u32) -> u32 {
         let n = poses_per_cycle.max(1) as f64;
-        let phase = self.phase_at(i, t, cycle_seconds);
+        let phase = self.phase_at(i, t, gait);
         ((phase * n).round() as u32) % poses_per_cycle.max(1)
     }
 
-    /// Where in its walk cycle (of `cycle_seconds`) instance `i` is at time `t`, in cycles,
-    /// `[0, 1)`: pose `k` of `n` per cycle is at phase `k / n`.
-    pub fn phase_at(&self, i: usize, t: f64, cycle_seconds: f64) -> f64 {
-        ((t + self.instances[i].time_offset) / cycle_seconds).rem_euclid(1.0)
+    /// Where in its walk cycle instance `i` is at time `t`, in cycles, `[0, 1)`: pose `k`
+    /// of `n` per cycle is at phase `k / n` ([`Instance::phase`]: by the distance walked
+    /// on a path, by time on the spot).
+    pub fn phase_at(&self, i: usize, t: f64, gait: &Gait) -> f64 {
+        self.instances[i].phase(t, gait)
     }
 
-    /// Every environment the scene names.
+    /// The probes' weights where walker `i` stands at time `t` (`(probe, weight)`,
+    /// [`probes::ProbeLayout::weights`]); empty without probes.
+    pub fn probe_weights(&self, i: usize, t: f64) -> Vec<(usize, f32)> {
+        self.probes.as_ref().map_or(Vec::new(), |p| {
+            let at = self.placement(i, t).position;
+            p.layout.weights(glam::Vec2::new(at.x, at.z))
+        })
+    }
+
+    /// Every environment the scene names (its lighting keys', then its probes').
     pub fn environments(&self) -> Vec<EnvSource> {
         let mut out: Vec<EnvSource> = Vec::new();
-        for k in &self.lighting {
-            if !out.contains(&k.env) {
-                out.push(k.env.clone());
+        let probes = self
+            .probes
+            .iter()
+            .flat_map(|p| p.probes.iter().map(|p| &p.env));
+        for env in self.lighting.iter().map(|k| &k.env).chain(probes) {
+            if !out.contains(env) {
+                out.push(env.clone());
             }
         }
         out
+    }
+
+    /// Whether walker `i`'s own light changes during the shot: it turns, or it moves
+    /// between probes.
+    pub fn walker_light_changes(&self, i: usize) -> bool {
+        let inst = &self.instances[i];
+        let between_probes = self.probes.as_ref().is_some_and(|p| p.probes.len() > 1);
+        inst.turns() || (between_probes && inst.moves())
     }
 }
 

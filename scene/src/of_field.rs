@@ -94,15 +94,16 @@ impl Scene {
                 intensity: 1.0,
             }],
             sun: look.sun,
+            probes: None,
             floor: look.floor,
             camera: look.camera,
             backdrop: look.backdrop,
             shadow: look.shadow,
-            instances: vec![Instance {
-                position: Vec3::ZERO,
-                heading: 0.0,
-                time_offset: f64::from(pose) / cycle * header.cycle_seconds,
-            }],
+            instances: vec![Instance::standing(
+                Vec3::ZERO,
+                0.0,
+                f64::from(pose) / cycle * header.cycle_seconds,
+            )],
         }
     }
 
@@ -122,4 +123,13 @@ impl Scene {
             .collect();
         Ok(frames)
     }
+}
+
+/// The walk of `field`: its cycle, and its gait's speed as the field records it
+/// (`None` for a field that does not: its walkers walk on the spot).
+pub fn field_gait<R: frf_reflectance::container::ReadAt>(
+    field: &frf_reflectance::FieldFile<R>,
+) -> crate::Result<crate::Gait> {
+    let h = field.header();
+    Ok(crate::Gait::new(h.cycle_seconds, None))
 }

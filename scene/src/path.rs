@@ -169,31 +169,11 @@ impl CameraPath {
         if k.len() == 1 {
             return k[0];
         }
-        let i = k.partition_point(|key| key.time <= t).clamp(1, k.len() - 1) - 1;
-        let (a, b) = (&k[i], &k[i + 1]);
-        let h = b.time - a.time;
-        // The fraction of the segment in 64 bits, then 32 for the positions.
-        let s = ((t - a.time) / h) as f32;
-        // Tangents from the neighbouring keys (one-sided at the ends), scaled to this
-        // segment: the change over the neighbours times `h` over their time span. The
-        // ratio of spans first, so that keys a subnormal time apart do not divide by it
-        // (an infinite tangent times a tiny `h`).
-        let tangent = |j: usize, f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
-            let (l, r) = (j.saturating_sub(1), (j + 1).min(k.len() - 1));
-            (f(&k[r]) - f(&k[l])) * (h / (k[r].time - k[l].time)) as f32
-        };
-        let hermite = |f: &dyn Fn(&Key) -> Vec3| -> Vec3 {
-            let (p0, p1) = (f(a), f(b));
-            let (m0, m1) = (tangent(i, f), tangent(i + 1, f));
-            let (s2, s3) = (s * s, s * s * s);
-            p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
-                + m0 * (s3 - 2.0 * s2 + s)
-                + p1 * (-2.0 * s3 + 3.0 * s2)
-                + m1 * (s3 - s2)
-        };
-        let position = hermite(&|key| Vec3::from(key.position));
-        let look_at = hermite(&|key| Vec3::from(key.look_at));
-        let fov = hermite(&|key| Vec3::splat(key.fov_deg)).x;
+        let times: Vec<f64> = k.iter().map(|key| key.time).collect();
+        let along = |f: &dyn Fn(&Key) -> Vec3| crate::spline::catmull_rom(&times, &|j| f(&k[j]), t);
+        let position = along(&|key| Vec3::from(key.position));
+        let look_at = along(&|key| Vec3::from(key.look_at));
+        let fov = along(&|key| Vec3::splat(key.fov_deg)).x;
         Key {
             time: t,
             position: position.to_array(),

@@ -41,7 +41,7 @@ use serde::Serialize;
 
 pub use frf_render::pose_plan::PosePlan;
 
-use super::{Scene, ShadowSpec, TimeInterpolation};
+use super::{Gait, Scene, ShadowSpec, TimeInterpolation};
 use crate::error::{Result, SceneError};
 use frf_render::cylinder::Cylinder;
 use frf_render::detail::detail_level;
@@ -80,24 +80,23 @@ pub struct FramePlan {
 
 impl FramePlan {
     /// Frame `index` at `time` of `scene` on a field of header `h` holding `field_poses`
-    /// (sorted): each walker's pose, the nearest held, or, morphing in time, the held
-    /// poses around its instant ([`poses_around`]).
+    /// (sorted) whose walk is `gait`: each walker's pose, the nearest held, or, morphing
+    /// in time, the held poses around its instant ([`poses_around`]).
     pub fn at(
         scene: &Scene,
         h: &FieldHeader,
         field_poses: &[u32],
-        interpolate: TimeInterpolation,
+        (interpolate, gait): (TimeInterpolation, &Gait),
         (index, time): (usize, f64),
     ) -> Self {
         let (poses, between) = (0..scene.instances.len())
             .map(|i| match interpolate {
                 TimeInterpolation::Nearest => {
-                    let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                    let wanted = scene.pose_at(i, time, gait, h.poses_per_cycle);
                     (nearest_pose(wanted, field_poses, h.poses_per_cycle), None)
                 }
                 TimeInterpolation::Flow => {
-                    let at =
-                        scene.phase_at(i, time, h.cycle_seconds) * h.poses_per_cycle.max(1) as f64;
+                    let at = scene.phase_at(i, time, gait) * h.poses_per_cycle.max(1) as f64;
                     poses_around(at, field_poses, h.poses_per_cycle)
                 }
             })
@@ -198,6 +197,8 @@ pub struct Plan {
     pub ground_seen: bool,
     /// What frames between captured poses show.
     pub interpolate: TimeInterpolation,
+    /// The field's walk: how walkers on paths advance their phase.
+    pub gait: Gait,
 }
 
 /// The plan of `pose` in `plans`, added (needing nothing yet) when absent.
@@ -530,7 +531,10 @@ impl Plan {
         let frames = scene.shot_frames(0..scene.frame_times().len(), size)?;
         let interpolate = scene.interpolate.unwrap_or(TimeInterpolation::Nearest);
         // No hull yet: the design's bounds.
-        let mut plan = Self::from_header(scene, header, &frames, interpolate, &mut |_| Ok(None))?;
+        let gait = Gait::new(header.cycle_seconds, None);
+        let mut plan = Self::from_header(scene, header, &frames, (interpolate, gait), &mut |_| {
+            Ok(None)
+        })?;
         if plan.ground_seen && scene.shadow != ShadowSpec::None {
             let (columns, rows) = (header.columns, header.rows);
             for p in &mut plan.poses {
@@ -633,8 +637,14 @@ impl Plan {
                     ),
                 })?;
         }
-        let mut plan =
-            Self::from_header(scene, field.header(), frames, interpolate, &mut hull_box)?;
+        let gait = crate::of_field::field_gait(field)?;
+        let mut plan = Self::from_header(
+            scene,
+            field.header(),
+            frames,
+            (interpolate, gait),
+            &mut hull_box,
+        )?;
         let rows = field.header().rows;
         let counts = &mut plan.counts;
         (counts.views_used, counts.views_total, counts.flows_used) = (0, 0, 0);
@@ -756,7 +766,8 @@ impl Plan {
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
-    /// poses, for `frames`, frames between poses drawn as `interpolate` says, each pose's
+    /// poses and the walk `gait`, for `frames`, frames between poses drawn as
+    /// `interpolate` says, each pose's
     /// subject within the bounds of the hull box `hull_box` gives
     /// ([`SubjectBounds::of_pose`]); the counts of views and flows are those the plan asks
     /// for (no chunk is known, so no byte either).
@@ -764,13 +775,13 @@ impl Plan {
         scene: &Scene,
         h: &FieldHeader,
         frames: &[ShotFrame],
-        interpolate: TimeInterpolation,
+        (interpolate, gait): (TimeInterpolation, Gait),
         hull_box: &mut dyn FnMut(u32) -> Result<Option<(Vec3, Vec3)>>,
     ) -> Result<Self> {
         if frames.is_empty() {
             return Err(SceneError::Misuse("a shot of no frame"));
         }
-        let (frame_plans, substituted) = frame_plans(scene, h, frames, interpolate);
+        let (frame_plans, substituted) = frame_plans(scene, h, frames, (interpolate, &gait));
         let views = h.columns * h.rows;
         let projector = Projector::new(&h.conditions)?;
         let lit = lit_conditions(scene, &projector, &h.conditions)?;
@@ -809,6 +820,7 @@ impl Plan {
             floor_conditions_left_out: left_out.iter().filter(|&&k| h.conditions[k].floor).count(),
             ground_seen,
             interpolate,
+            gait,
         })
     }
 
@@ -829,7 +841,7 @@ fn frame_plans(
     scene: &Scene,
     h: &FieldHeader,
     frames: &[ShotFrame],
-    interpolate: TimeInterpolation,
+    (interpolate, gait): (TimeInterpolation, &Gait),
 ) -> (Vec<FramePlan>, BTreeSet<(u32, u32)>) {
     let mut field_poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
     field_poses.sort_unstable();
@@ -838,9 +850,9 @@ fn frame_plans(
         .iter()
         .map(|f| {
             let (index, time) = (f.index, f.time);
-            let fp = FramePlan::at(scene, h, &field_poses, interpolate, (index, time));
+            let fp = FramePlan::at(scene, h, &field_poses, (interpolate, gait), (index, time));
             for (i, &held) in fp.poses.iter().enumerate() {
-                let wanted = scene.pose_at(i, time, h.cycle_seconds, h.poses_per_cycle);
+                let wanted = scene.pose_at(i, time, gait, h.poses_per_cycle);
                 // Morphing in time, a frame stands a pose in only where it has no
                 // other to morph toward (a one-pose field): said as nearest's are.
                 let morphed = interpolate == TimeInterpolation::Flow && fp.between[i].is_some();
@@ -890,7 +902,10 @@ impl Traced<'_> {
                     Entry::Occupied(b) => *b.get(),
                     Entry::Vacant(b) => *b.insert(SubjectBounds::of_pose(record, hull_box(pose)?)?),
                 };
-                let subject_camera = self.scene.instances[i].camera_in_subject_frame(&frame.camera);
+                let subject_camera = self
+                    .scene
+                    .placement(i, frame.time)
+                    .camera_in_subject_frame(&frame.camera);
                 let plan = entry(
                     &mut walkers[i],
                     pose,

@@ -136,11 +136,49 @@ impl LightingKey {
 struct World {
     env: EnvMap,
     light: YawLight,
+    /// With probes: each probe's map (turned and scaled) and its term, and the sun's term,
+    /// which light the walkers where they stand instead of `light`.
+    probes: Option<ProbeLights>,
+}
+
+/// The scene's probes under a frame's lighting (see [`World`]).
+struct ProbeLights {
+    maps: Vec<EnvMap>,
+    terms: Vec<YawTerm>,
+    sun: Option<YawTerm>,
+}
+
+/// A walker's own light at a frame: its heading and the probes' weights where it stands,
+/// and that as bits, which tell two apart (see [`Cached::walker_key`]).
+#[derive(Debug, Clone, PartialEq)]
+struct WalkerLight {
+    heading: f32,
+    weights: Vec<(usize, f32)>,
+    key: Vec<u32>,
+}
+
+impl WalkerLight {
+    fn new(heading: f32, weights: Vec<(usize, f32)>) -> Self {
+        let mut key = vec![heading.to_bits()];
+        for &(k, w) in &weights {
+            key.extend([k as u32, w.to_bits()]);
+        }
+        Self {
+            heading,
+            weights,
+            key,
+        }
+    }
 }
 
 struct Cached {
     pose: u32,
-    heading: u32,
+    /// The walker's light it is relit for ([`WalkerLight::key`]: its heading, and the
+    /// probes' weights where it stood).
+    walker_key: Vec<u32>,
+    /// The walker it serves alone, when that walker turns (a walker on a path: relit in
+    /// place as it turns); `None`: any walker of its heading.
+    owner: Option<usize>,
     /// What it was made from (`None`: every view, flow and condition).
     plan: Option<PosePlan>,
     lighting: LightingKey,
@@ -246,10 +284,14 @@ pub struct Shot<'a, R: ReadAt> {
     /// Per walker, the cache slots its poses took last frame: looked at first, so that
     /// a frame's search of the cache grows with its walkers, not with their square.
     last_slots: Vec<Vec<usize>>,
-    /// Whether every frame of the planned shot has one lighting: its poses then let go
-    /// of their basis codes once lit ([`Device::release_basis`]), and hold what a
-    /// pre-lit pose holds.
+    /// Whether every frame of the planned shot has one lighting and every walker one
+    /// heading: its poses then let go of their basis codes once lit
+    /// ([`Device::release_basis`]), and hold what a pre-lit pose holds.
     held_light: bool,
+    /// Per walker: whether its own light changes during the shot (it turns, or moves
+    /// between probes, [`Scene::walker_light_changes`]): its residents are its own, relit
+    /// in place.
+    own_light: Vec<bool>,
 }
 
 impl<'a, R: ReadAt> Shot<'a, R> {
@@ -306,7 +348,12 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .iter()
             .map(|f| LightingKey::of(&scene.lighting_at(f.time)))
             .collect();
-        let held_light = options.planned && keys.windows(2).all(|w| w[0] == w[1]);
+        let own_light: Vec<bool> = (0..scene.instances.len())
+            .map(|i| scene.walker_light_changes(i))
+            .collect();
+        let held_light = options.planned
+            && keys.windows(2).all(|w| w[0] == w[1])
+            && !own_light.iter().any(|&t| t);
         // Views read again (by another walker's heading, or a new light) are not decoded
         // again: a quarter of the budget keeps them decoded.
         field.keep_decoded(options.memory_budget / DECODED_SHARE);
@@ -331,6 +378,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             live_frames: 0,
             last_slots: Vec::new(),
             held_light,
+            own_light,
         })
     }
 
@@ -464,6 +512,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         } else {
             EnvMap::mix(&maps.iter().map(|(e, w)| (e, *w)).collect::<Vec<_>>())?
         };
+        let mut sun_term = None;
         if let Some(sun) = &l.sun {
             // The sun stays put in the scene frame while the maps turn: a map of its own,
             // black but for it, of the world map's texels.
@@ -473,16 +522,43 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 let black = EnvMap::from_image(RgbImage::new(w, h, [0.0; 3]))?;
                 Ok(sun.lit(&black)?)
             })?;
-            terms.push(YawTerm {
+            let term = YawTerm {
                 table,
                 weight: 1.0,
                 yaw: 0.0,
-            });
+            };
+            terms.push(term.clone());
+            sun_term = Some(term);
             env = sun.lit(&env)?;
         }
+        let probes = match self.scene.probes.clone() {
+            None => None,
+            Some(p) => {
+                let (mut maps, mut terms) = (Vec::new(), Vec::new());
+                for probe in &p.probes {
+                    let e = self.env(&probe.env)?.ok_or(SceneError::Misuse(
+                        "a probe without a map (refused when the scene is read)",
+                    ))?;
+                    let table = self.table(probe.env.to_string(), || Ok(e.clone()))?;
+                    let weight = probe.intensity * l.intensity;
+                    maps.push(e.rotated(probe.yaw).scaled(weight));
+                    terms.push(YawTerm {
+                        table,
+                        weight,
+                        yaw: probe.yaw,
+                    });
+                }
+                Some(ProbeLights {
+                    maps,
+                    terms,
+                    sun: sun_term,
+                })
+            }
+        };
         let world = Arc::new(World {
             env,
             light: YawLight::new(terms),
+            probes,
         });
         self.world = Some((key, Some(world.clone())));
         Ok(Some(world))
@@ -518,6 +594,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             self.scene.backdrop.clone(),
         );
         f(self.scene.to_mut());
+        self.own_light = (0..self.scene.instances.len())
+            .map(|i| self.scene.walker_light_changes(i))
+            .collect();
         let scene = &self.scene;
         if (scene.floor, scene.shadow) != (before.0, before.1) {
             self.cache.clear();
@@ -549,7 +628,13 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let h = self.field.header();
         let mut held: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
         held.sort_unstable();
-        FramePlan::at(&self.scene, h, &held, self.plan.interpolate, (index, time))
+        FramePlan::at(
+            &self.scene,
+            h,
+            &held,
+            (self.plan.interpolate, &self.plan.gait),
+            (index, time),
+        )
     }
 
     /// Draws the frame of `camera` at `time` into the kept targets of its size (on the
@@ -574,7 +659,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             // Relights recorded for this frame go ahead of the caller's encoder.
             gpu.flush();
         }
-        let walkers = self.walkers(&slots, camera);
+        let walkers = self.walkers(&slots, camera, fp.time);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
         let Device::Gpu(gpu) = &self.device else {
             unreachable!("checked above")
@@ -688,7 +773,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         layers: bool,
     ) -> Result<ShotInFlight> {
         let (slots, made_resident) = self.prepare(fp)?;
-        let walkers = self.walkers(&slots, camera);
+        let walkers = self.walkers(&slots, camera, fp.time);
         let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
         let frame =
             self.device
@@ -701,15 +786,16 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         })
     }
 
-    /// The walkers of a frame of `camera` whose poses are the cache's `slots`; a planned
+    /// The walkers of a frame of `camera` at `time` whose poses are the cache's `slots`
+    /// (each where it stands then); a planned
     /// shot shades each within the pixels where its pose (both, between two) may show
     /// ([`frf_render::footprint::SubjectBounds::pixel_box`]).
-    fn walkers(&self, slots: &[Slot], camera: &Camera) -> Vec<Walker<'_>> {
+    fn walkers(&self, slots: &[Slot], camera: &Camera, time: f64) -> Vec<Walker<'_>> {
         slots
             .iter()
-            .zip(&self.scene.instances)
-            .map(|(&(k, between), inst)| {
-                let world_from_subject = inst.world_from_subject();
+            .enumerate()
+            .map(|(i, &(k, between))| {
+                let world_from_subject = self.scene.placement(i, time).world_from_subject();
                 let resident = &self.cache[k].resident;
                 let within = self.options.planned.then(|| {
                     let mut bounds = resident.bounds();
@@ -747,14 +833,26 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .into_iter()
                 .chain(fp.between[i].map(|(after, _)| (i, after)))
         });
+        let lights: Vec<WalkerLight> = (0..self.scene.instances.len())
+            .map(|i| {
+                let heading = self.scene.placement(i, fp.time).heading;
+                WalkerLight::new(heading, self.scene.probe_weights(i, fp.time))
+            })
+            .collect();
         for (i, pose) in drawn {
-            let heading = self.scene.instances[i].heading;
+            let light = &lights[i];
+            // A walker whose own light changes (it turns, or moves between probes) has
+            // residents of its own, relit in place as its light changes.
+            let owner = self.own_light[i].then_some(i);
             // The walker's own needs of the pose: a resident that covers them serves it
-            // (walkers of one heading seeing the same quads share one); the one it had
+            // (walkers of one light seeing the same quads share one); the one it had
             // last frame, when it still does.
             let wanted = self.walker_plan(i, pose);
             let serves = |c: &Cached| {
-                c.pose == pose && c.heading == heading.to_bits() && covers(&c.plan, wanted)
+                c.pose == pose
+                    && c.owner == owner
+                    && (owner.is_some() || c.walker_key == light.key)
+                    && covers(&c.plan, wanted)
             };
             let found = self
                 .last_slots
@@ -766,11 +864,17 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 })
                 .or_else(|| self.cache.iter().position(serves));
             let slot = match found {
-                Some(k) if self.cache[k].lighting == key => k,
+                Some(k)
+                    if self.cache[k].lighting == key && self.cache[k].walker_key == light.key =>
+                {
+                    k
+                }
                 Some(k) => {
-                    // The same views under a new light: relit where they are.
+                    // The same views under a new light, turned or moved: relit where they
+                    // are.
+                    self.cache[k].walker_key = light.key.clone();
                     let t = Instant::now();
-                    self.relight_cached(k, world)?;
+                    self.relight_cached(k, world, light)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     self.counters.poses_made_resident += 1;
                     self.counters.relights += 1;
@@ -790,8 +894,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         .cache
                         .iter()
                         .position(|c| c.pose == pose && covers(&c.plan, wanted.as_ref()));
-                    let resident =
-                        self.make_resident(pose, heading, world, wanted.as_ref(), like)?;
+                    let resident = self.make_resident(pose, light, world, wanted.as_ref(), like)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     (
                         self.counters.basis_views_reused,
@@ -803,7 +906,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     made_resident.push(pose);
                     self.cache.push(Cached {
                         pose,
-                        heading: heading.to_bits(),
+                        walker_key: light.key.clone(),
+                        owner,
                         plan: wanted,
                         lighting: key.clone(),
                         bytes: resident.bytes(),
@@ -859,19 +963,39 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         }
     }
 
-    /// The lighting of a walker of `heading` under the scene frame's lighting `world`.
-    fn walker_lighting(&self, heading: f32, world: Option<&World>) -> Lighting {
-        match world {
-            Some(w) => Lighting::Tabled(w.light.turned(-heading)),
-            None => Lighting::Unlit,
-        }
+    /// The lighting of a walker whose own light is `light` under the scene frame's
+    /// lighting `world`: the scene's light, or with probes theirs weighted where it
+    /// stands and the sun, turned by minus its heading.
+    fn walker_lighting(&self, light: &WalkerLight, world: Option<&World>) -> Lighting {
+        let Some(w) = world else {
+            return Lighting::Unlit;
+        };
+        let scene_frame = match &w.probes {
+            None => w.light.clone(),
+            Some(p) => YawLight::new(
+                light
+                    .weights
+                    .iter()
+                    .map(|&(k, weight)| YawTerm {
+                        weight: weight * p.terms[k].weight,
+                        ..p.terms[k].clone()
+                    })
+                    .chain(p.sun.clone())
+                    .collect(),
+            ),
+        };
+        Lighting::Tabled(scene_frame.turned(-light.heading))
     }
 
-    /// Relights cache entry `k` for its walker's heading under `world`: its views' new
-    /// coefficients, relit where they are resident, with its shadow.
-    fn relight_cached(&mut self, k: usize, world: Option<&World>) -> Result<()> {
-        let heading = f32::from_bits(self.cache[k].heading);
-        let lighting = self.walker_lighting(heading, world);
+    /// Relights cache entry `k` for its walker's light `light` under `world`: its views'
+    /// new coefficients, relit where they are resident, with its shadow.
+    fn relight_cached(
+        &mut self,
+        k: usize,
+        world: Option<&World>,
+        light: &WalkerLight,
+    ) -> Result<()> {
+        let lighting = self.walker_lighting(light, world);
         let entry = &self.cache[k];
         let source = entry
             .resident
@@ -879,7 +1003,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .relit(self.field, &lighting, entry.plan.as_ref())?;
         let traced = match self.scene.shadow {
             ShadowSpec::Traced if entry.resident.has_shadow() => {
-                self.traced_shadow(entry.pose, world, heading)?
+                self.traced_shadow(entry.pose, world, light)?
             }
             _ => None,
         };
@@ -892,18 +1016,29 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(())
     }
 
-    /// The shadow of pose `pose`'s hull under `world` seen by a walker of `heading`
-    /// (traced), when it has a hull and there is an environment.
+    /// The shadow of pose `pose`'s hull under `world` seen by a walker whose own light
+    /// is `light` (traced), when it has a hull and there is an environment: the scene's
+    /// map, or with probes theirs mixed where it stands.
     fn traced_shadow(
         &self,
         pose: u32,
         world: Option<&World>,
-        heading: f32,
+        light: &WalkerLight,
     ) -> Result<Option<frf_render::shadow::RelitShadow>> {
         let (Some(hull), Some(world)) = (self.field.hull(pose)?, world) else {
             return Ok(None);
         };
-        let env = world.env.rotated(-heading);
+        let env = match &world.probes {
+            None => world.env.rotated(-light.heading),
+            Some(p) => {
+                let mixed: Vec<(&EnvMap, f32)> = light
+                    .weights
+                    .iter()
+                    .map(|&(k, w)| (&p.maps[k], w))
+                    .collect();
+                EnvMap::mix(&mixed)?.rotated(-light.heading)
+            }
+        };
         let ground = self
             .field
             .header()
@@ -921,12 +1056,12 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     fn make_resident(
         &self,
         pose: u32,
-        heading: f32,
+        light: &WalkerLight,
         world: Option<&World>,
         plan: Option<&PosePlan>,
         like: Option<usize>,
     ) -> Result<Resident> {
-        let lighting = self.walker_lighting(heading, world);
+        let lighting = self.walker_lighting(light, world);
         let level = self
             .options
             .detail
@@ -982,7 +1117,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 }
             }
             ShadowSpec::Traced if wants(plan.is_some_and(|p| p.hull)) => {
-                if let Some(shadow) = self.traced_shadow(pose, world, heading)? {
+                if let Some(shadow) = self.traced_shadow(pose, world, light)? {
                     self.device
                         .set_shadow(&mut resident, SceneShadow::Relit(shadow))?;
                 }

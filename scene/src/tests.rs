@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use super::*;
+use glam::Vec3;
 
 const MINIMAL: &str = r#"
 field = "walker.frf"
@@ -77,7 +78,7 @@ fn times_far_from_zero_keep_their_frames_apart_and_the_walk_moving() {
     let poses: Vec<u32> = s
         .frame_times()
         .iter()
-        .map(|&t| s.pose_at(0, t, 1.0, 300))
+        .map(|&t| s.pose_at(0, t, &Gait::new(1.0, None), 300))
         .collect();
     // 300 poses a second at 60 fps: five poses a frame, every frame another.
     assert!(poses.windows(2).all(|w| w[0] != w[1]), "{poses:?}");
@@ -222,12 +223,12 @@ fn poses_follow_the_walk_cycle_with_each_walker_s_offset() {
     );
     let s = scene(&text).unwrap();
     // A 1 s cycle of 30 poses.
-    assert_eq!(s.pose_at(0, 0.0, 1.0, 30), 0);
-    assert_eq!(s.pose_at(0, 0.1, 1.0, 30), 3);
-    assert_eq!(s.pose_at(1, 0.0, 1.0, 30), 15);
+    assert_eq!(s.pose_at(0, 0.0, &Gait::new(1.0, None), 30), 0);
+    assert_eq!(s.pose_at(0, 0.1, &Gait::new(1.0, None), 30), 3);
+    assert_eq!(s.pose_at(1, 0.0, &Gait::new(1.0, None), 30), 15);
     // Looping, and nearest: 0.99 s rounds to pose 30, which is pose 0.
-    assert_eq!(s.pose_at(0, 0.99, 1.0, 30), 0);
-    assert_eq!(s.pose_at(0, 2.1, 1.0, 30), 3);
+    assert_eq!(s.pose_at(0, 0.99, &Gait::new(1.0, None), 30), 0);
+    assert_eq!(s.pose_at(0, 2.1, &Gait::new(1.0, None), 30), 3);
     // The second walker's frame: a camera at its position sees it from its origin.
     let cam = Camera::look_at(
         Vec3::new(1.0, 1.5, 4.0),
@@ -238,7 +239,7 @@ fn poses_follow_the_walk_cycle_with_each_walker_s_offset() {
         8,
     )
     .unwrap();
-    let seen = s.instances[1].camera_in_subject_frame(&cam);
+    let seen = s.placement(1, 0.0).camera_in_subject_frame(&cam);
     assert!((seen.centre() - Vec3::new(0.0, 1.5, 4.0)).length() < 1e-5);
 }
 

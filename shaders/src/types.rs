@@ -112,8 +112,9 @@ pub struct GpuFrame {
     pub crop_size: [u32; 2],
     /// `frf_render::morph::Variant::flags`: as `variant` (the override `FLAGS`).
     pub flags: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// 1: the compute frame pass also writes the walker's depth at each pixel
+    /// (`frf_render::proxy::Proxy::depth`), which orders walkers that overlap.
+    pub depth: u32,
     /// The pixels shaded, `[x0, y0, x1, y1]` (ends exclusive; `frf_render::footprint`):
     /// the walker is transparent outside them.
     pub bounds: [u32; 4],
@@ -267,8 +268,9 @@ pub struct GpuComposite {
     pub tile_columns: u32,
     /// Their side, pixels (`frf_render::footprint::TILE`).
     pub tile_side: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// 1: walkers that overlap at a pixel are put over each other by their depths
+    /// there (`frf_render::composite::stack_by_depth`); 0: in the listed order.
+    pub by_depth: u32,
 }
 
 /// `Instance` of `composite.wgsl`: `subject_from_world` of a walker.

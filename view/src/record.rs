@@ -14,8 +14,8 @@ use frf_core::env::EnvSource;
 use frf_reflectance::project::FloorModel;
 use frf_render::composite::GroundLook;
 use frf_scene::file::{
-    CameraToml, CompositeToml, InstanceToml, LightKeyToml, LightingToml, OutputToml, SceneToml,
-    SunToml, TimeToml, written,
+    CameraToml, CompositeToml, InstanceToml, LightKeyToml, LightingToml, OutputToml, ProbeToml,
+    SceneToml, SunToml, TimeToml, written,
 };
 use frf_scene::path::Key;
 use frf_scene::{BackdropSpec, Scene, ShadowSpec};
@@ -153,6 +153,19 @@ pub fn scene_toml(
                     colour: (strength > 0.0).then(|| e.map(|c| c / strength)),
                 })
             }),
+            probe: scene
+                .probes
+                .iter()
+                .flat_map(|p| &p.probes)
+                .map(|p| {
+                    written(ProbeToml {
+                        position: p.position.to_array(),
+                        env: env_text(&p.env),
+                        yaw_deg: f64::from(p.yaw).to_degrees(),
+                        intensity: p.intensity,
+                    })
+                })
+                .collect(),
         }),
         camera: written(CameraToml {
             orbit: None,
@@ -174,13 +187,7 @@ pub fn scene_toml(
         instance: scene
             .instances
             .iter()
-            .map(|i| {
-                written(InstanceToml {
-                    position: i.position.to_array(),
-                    heading_deg: i.heading.to_degrees(),
-                    time_offset: i.time_offset,
-                })
-            })
+            .map(|i| written(InstanceToml::of(i)))
             .collect(),
     };
     let text = toml::to_string(&out).map_err(|e| ViewError::Record(e.to_string()))?;

@@ -183,7 +183,11 @@ impl<'a> Viewer<'a> {
         let Some(record) = h.poses.iter().find(|p| p.pose == pose) else {
             return Vec::new();
         };
-        let world = self.shot.scene().instances[0].world_from_subject();
+        let world = self
+            .shot
+            .scene()
+            .placement(0, self.time)
+            .world_from_subject();
         let mut out = Vec::new();
         for u in 0..h.columns {
             for v in 0..h.rows {
@@ -198,9 +202,9 @@ impl<'a> Viewer<'a> {
         out
     }
 
-    /// The axis of the first walker (its position).
+    /// The axis of the first walker (where it stands now).
     fn axis_at(&self) -> Vec3 {
-        self.shot.scene().instances[0].position
+        self.shot.scene().placement(0, self.time).position
     }
 
     /// Puts the camera at captured view `(column, row)`.

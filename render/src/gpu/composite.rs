@@ -120,7 +120,7 @@ impl Gpu {
                 instances: 0,
                 tile_columns: 0,
                 tile_side: TILE,
-                pad: 0,
+                by_depth: 0,
             };
             let (env, plate, plate_size) = match backdrop {
                 Backdrop::None => (one("no environment"), one("no plate"), None),
@@ -168,7 +168,8 @@ impl Gpu {
     }
 
     /// Renders a frame of `camera` (world frame): every walker's pose drawn by the
-    /// camera as its subject frame sees it (back to front, [`back_to_front`]), composited
+    /// camera as its subject frame sees it (back to front, [`back_to_front`]; where
+    /// walkers overlap, by their depths at each pixel), composited
     /// over `backdrop` with the product of their relit shadows; with `layers`, the
     /// walkers alone, the relative irradiance and the backdrop too.
     pub fn render_composite(
@@ -311,7 +312,10 @@ impl Gpu {
                     (i.pose, seen, i.within.unwrap_or(whole))
                 })
                 .collect();
-            let subjects = self.draw_subjects(encoder, &drawn, size, variant, timestamps);
+            // Walkers that may overlap are put over each other by depth, pixel by pixel.
+            let by_depth = drawn.len() > 1;
+            let subjects =
+                self.draw_subjects(encoder, &drawn, size, (variant, by_depth), timestamps);
             let between: Vec<BetweenDraw> = order
                 .iter()
                 .enumerate()
@@ -344,6 +348,7 @@ impl Gpu {
                 params.shadow_extent = info.extent_m;
             }
             params.instances = order.len() as u32;
+            params.by_depth = by_depth as u32;
             let tiles = TileLists::new(size.0, size.1, &touched);
             params.tile_columns = tiles.columns;
             params.tile_side = TILE;
@@ -390,6 +395,7 @@ impl Gpu {
                 view(&backdrop.env),
                 view(&backdrop.plate),
                 array_view(&t.shadows),
+                array_view(subjects.depth_texture()),
             ];
             bind_group(
                 &self.device,

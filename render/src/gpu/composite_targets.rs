@@ -48,6 +48,7 @@ impl CompositePass {
                 texture_2d(1, FLOAT),
                 texture_2d(2, FLOAT),
                 texture_array(3, FLOAT),
+                texture_array(4, FLOAT),
             ],
         });
         let pipeline = compute_pipeline(

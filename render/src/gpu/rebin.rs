@@ -93,6 +93,7 @@ impl RebinPass {
                 uniform::<GpuFrame>(0, both),
                 storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
                 storage_texture_array(2, wgpu::TextureFormat::Rgba32Float),
+                storage_texture_array(3, wgpu::TextureFormat::R32Float),
             ],
         );
         let classes_layout = layout(
@@ -209,6 +210,11 @@ impl Subjects {
         self.targets.texture()
     }
 
+    /// Beside it, the walkers' depths (written by renders drawn with depth).
+    pub fn depth_texture(&self) -> &wgpu::Texture {
+        &self.targets.depth
+    }
+
     /// The id of the targets they are drawn into ([`SubjectTargets::id`]).
     pub fn id(&self) -> u64 {
         self.targets.id
@@ -240,7 +246,7 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         crop_origin: [0, 0],
         crop_size: [1, 1],
         flags: variant.flags(),
-        pad: 0,
+        depth: 0,
         bounds: PixelBox::whole(camera.width, camera.height).to_array(),
         place: [0; 4],
     };
@@ -318,6 +324,8 @@ pub(super) struct SubjectTargets {
     /// Names these targets in the keys of bind groups made of them ([`super::kept`]).
     pub(super) id: u64,
     texture: wgpu::Texture,
+    /// The renders' depths, texel for texel beside `texture` (R32Float).
+    depth: wgpu::Texture,
     pages: Vec<wgpu::TextureView>,
     slots: Vec<SlotTargets>,
     /// Every slot's frame uniform, each at its multiple of `stride`: a frame writes them
@@ -362,10 +370,28 @@ impl SubjectTargets {
                 | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        let all = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
+        let array_view = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let all = array_view(&texture);
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("subject depths"),
+            size: wgpu::Extent3d {
+                width: size.0,
+                height: size.1,
+                depth_or_array_layers: pages,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
         });
+        let all_depth = array_view(&depth);
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stats"),
             size: 16,
@@ -420,6 +446,10 @@ impl SubjectTargets {
                                 binding: 2,
                                 resource: wgpu::BindingResource::TextureView(&all),
                             },
+                            wgpu::BindGroupEntry {
+                                binding: 3,
+                                resource: wgpu::BindingResource::TextureView(&all_depth),
+                            },
                         ],
                     ),
                     classes: group("frame (classes)", &pass.classes_layout, &[frame, stats]),
@@ -429,6 +459,7 @@ impl SubjectTargets {
         Self {
             id: super::kept::unique_id(),
             texture,
+            depth,
             pages,
             slots,
             uniforms,
@@ -598,7 +629,7 @@ impl Gpu {
         encoder: &mut wgpu::CommandEncoder,
         instances: &[(&GpuPose, Camera, PixelBox)],
         size: (u32, u32),
-        variant: Variant,
+        (variant, depth): (Variant, bool),
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> Subjects {
         let boxes: Vec<PixelBox> = instances.iter().map(|i| i.2).collect();
@@ -624,7 +655,14 @@ impl Gpu {
                 (pose, drawn)
             })
             .collect();
-        self.draw_renders(encoder, &targets, &renders, variant, timestamps, true);
+        self.draw_renders(
+            encoder,
+            &targets,
+            &renders,
+            (variant, depth),
+            timestamps,
+            true,
+        );
         Subjects {
             targets,
             outside,
@@ -642,7 +680,7 @@ impl Gpu {
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
         renders: &[(&GpuPose, DrawnRender)],
-        variant: Variant,
+        (variant, depth): (Variant, bool),
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
@@ -652,6 +690,7 @@ impl Gpu {
                 let mut frame = frame_uniform(Some(pose), &d.camera, variant);
                 frame.bounds = d.within.to_array();
                 frame.place = d.place.to_array();
+                frame.depth = depth as u32;
                 frame
             })
             .collect();
@@ -731,8 +770,13 @@ impl Gpu {
                     label: Some("frame"),
                 });
             let whole = PixelBox::whole(size.0, size.1);
-            let subject =
-                self.draw_subjects(&mut encoder, &[(pose, *camera, whole)], size, variant, None);
+            let subject = self.draw_subjects(
+                &mut encoder,
+                &[(pose, *camera, whole)],
+                size,
+                (variant, false),
+                None,
+            );
             let t = &subject.targets;
             t.readback.copy(&mut encoder, &t.texture);
             self.copy_stats(&mut encoder, &subject, &t.stats_readback);

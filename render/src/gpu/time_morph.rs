@@ -137,7 +137,7 @@ impl Gpu {
         });
         // Every walker's three renders, in one go, then their morphs in one pass.
         let drawn = between_renders(walkers, &renders);
-        self.draw_renders(encoder, &scratch, &drawn, variant, None, false);
+        self.draw_renders(encoder, &scratch, &drawn, (variant, false), None, false);
         let groups = self.morph_groups(&scratch, subjects, walkers, &renders, &morphs);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

@@ -1,0 +1,156 @@
+//! Walkers that walk through a scene and are lit where they are, drawn by the shot on the
+//! tiny oracle field (one pose: what changes from frame to frame is where a walker stands,
+//! which way it faces and its light): a walker on a path draws at each frame what a
+//! walker standing there draws; a path of no length is a standing walker frame for
+//! frame; one probe is the scene's map, and a walker between two probes is lit by the
+//! map that mixes them.
+//!
+//! Renders on the GPU (lavapipe on machines without one), or on the CPU reference where
+//! `FRF_SKIP_GPU=1` says there is no adapter.
+
+#![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
+
+use std::path::Path;
+
+use frf_core::image::{Image, Rgba};
+use frf_reflectance::FieldFile;
+use frf_render::renderer::Device;
+use frf_scene::Scene;
+use frf_scene::shot::{Shot, ShotOptions};
+
+fn device() -> Device {
+    Device::open(frf_testkit::cpu_flag().is_some()).unwrap()
+}
+
+/// A scene of the tiny field seen from a fixed camera, 48x64, at 10 fps from 0 to `end`
+/// seconds, lit as `lighting` says, with `walkers`.
+fn scene(lighting: &str, walkers: &str, end: f64) -> Scene {
+    let text = format!(
+        r#"
+[time]
+end = {end}
+fps = 10
+
+[output]
+size = [64, 48]
+
+{lighting}
+
+[camera]
+[[camera.key]]
+time = 0.0
+position = [0.5, 1.6, 4.5]
+look_at = [0.5, 0.8, 0.0]
+fov_deg = 40.0
+
+[composite]
+backdrop = "env"
+shadow = "maps"
+
+{walkers}
+"#
+    );
+    Scene::parse(Path::new("/walkers/scene.toml"), &text).unwrap()
+}
+
+/// The frames of `scene` on the tiny field: composites and walker layers.
+fn frames(scene: &Scene) -> Vec<(Image<Rgba>, Image<Rgba>)> {
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let all = scene
+        .shot_frames(0..scene.frame_times().len(), (64, 48))
+        .unwrap();
+    let options = ShotOptions {
+        memory_budget: 1 << 30,
+        planned: true,
+        traced_lights: 64,
+        detail: None,
+    };
+    let mut shot = Shot::new(scene, &field, device(), &all, options).unwrap();
+    all.iter()
+        .map(|f| {
+            let r = shot.render(f, true).unwrap();
+            (r.frame.composite, r.frame.layers.unwrap().subject)
+        })
+        .collect()
+}
+
+fn largest_difference(a: &Image<Rgba>, b: &Image<Rgba>) -> f32 {
+    a.pixels()
+        .iter()
+        .zip(b.pixels())
+        .flat_map(|(x, y)| (0..4).map(move |k| (x[k] - y[k]).abs()))
+        .fold(0.0, f32::max)
+}
+
+const SKY: &str = "[lighting]\nenv = \"sky\"";
+
+#[test]
+fn a_walker_on_a_path_draws_what_a_walker_standing_there_draws() {
+    // A bend: from (-0.6, 0, 0.4) round to (1.2, 0, -0.4) in 0.4 s.
+    let path = "[[instance]]\n\
+        [[instance.key]]\ntime = 0.0\nposition = [-0.6, 0.0, 0.4]\n\
+        [[instance.key]]\ntime = 0.2\nposition = [0.3, 0.0, 0.3]\n\
+        [[instance.key]]\ntime = 0.4\nposition = [1.2, 0.0, -0.4]\n";
+    let walking = scene(SKY, path, 0.4);
+    assert!(walking.instances[0].turns());
+    let drawn = frames(&walking);
+    for (k, t) in walking.frame_times().into_iter().enumerate() {
+        let at = walking.placement(0, t);
+        let standing = format!(
+            "[[instance]]\nposition = [{}, 0.0, {}]\nheading_deg = {}\n",
+            at.position.x,
+            at.position.z,
+            f64::from(at.heading).to_degrees()
+        );
+        let still = frames(&scene(SKY, &standing, 0.0));
+        let d = largest_difference(&drawn[k].0, &still[0].0);
+        // The heading goes through degrees in the file: a few 1e-6 radians of turn.
+        assert!(d < 2e-3, "frame {k} at {t} s: {d}");
+    }
+    // It moved: the first and last frames differ.
+    assert!(largest_difference(&drawn[0].1, &drawn[3].1) > 0.1);
+}
+
+#[test]
+fn a_path_of_no_length_is_a_standing_walker_frame_for_frame() {
+    let still_path = "[[instance]]\ntime_offset = 0.3\n\
+        [[instance.key]]\ntime = 0.0\nposition = [0.4, 0.0, 0.2]\nheading_deg = 30.0\n\
+        [[instance.key]]\ntime = 1.0\nposition = [0.4, 0.0, 0.2]\nheading_deg = 30.0\n";
+    let standing =
+        "[[instance]]\ntime_offset = 0.3\nposition = [0.4, 0.0, 0.2]\nheading_deg = 30.0\n";
+    let a = frames(&scene(SKY, still_path, 0.3));
+    let b = frames(&scene(SKY, standing, 0.3));
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        assert!(x.0.pixels() == y.0.pixels(), "frame {k} differs");
+    }
+}
+
+#[test]
+fn one_probe_is_the_scenes_map_and_two_mix_linearly() {
+    let walker = "[[instance]]\nposition = [0.5, 0.0, 0.0]\nheading_deg = 20.0\n";
+    let plain = frames(&scene(SKY, walker, 0.0));
+    let one = "[lighting]\nenv = \"sky\"\n[[lighting.probe]]\nposition = [7.0, 1.2, -3.0]\nenv = \"sky\"\n";
+    let probed = frames(&scene(one, walker, 0.0));
+    assert!(
+        plain[0].0.pixels() == probed[0].0.pixels(),
+        "one probe differs from the map"
+    );
+
+    // Two probes 4 m apart, the walker a quarter of the way from the uniform one to the
+    // sky's: lit by 0.75 uniform + 0.25 sky. A cross-fade of the two maps a quarter of the
+    // way (0.1 s of 0.4) lights the walker so too (its backdrop differs: compare the
+    // walkers).
+    let two = "[lighting]\nenv = \"sky\"\n\
+        [[lighting.probe]]\nposition = [-0.5, 1.2, 0.0]\nenv = \"uniform\"\n\
+        [[lighting.probe]]\nposition = [3.5, 1.2, 0.0]\nenv = \"sky\"\n";
+    let mixed = frames(&scene(two, walker, 0.0));
+    let fade = "[lighting]\nenv = \"uniform\"\n\
+        [[lighting.key]]\ntime = 0.0\n\
+        [[lighting.key]]\ntime = 0.4\nenv = \"sky\"\n";
+    let faded = frames(&scene(fade, walker, 0.2));
+    let d = largest_difference(&mixed[0].1, &faded[1].1);
+    assert!(d < 1e-4, "the probes' mix differs from the maps' by {d}");
+    // And it is not the sky's light alone.
+    assert!(largest_difference(&mixed[0].1, &plain[0].1) > 0.01);
+}
