@@ -124,12 +124,3 @@ impl Scene {
         Ok(frames)
     }
 }
-
-/// The walk of `field`: its cycle, and its gait's speed as the field records it
-/// (`None` for a field that does not: its walkers walk on the spot).
-pub fn field_gait<R: frf_reflectance::container::ReadAt>(
-    field: &frf_reflectance::FieldFile<R>,
-) -> crate::Result<crate::Gait> {
-    let h = field.header();
-    Ok(crate::Gait::new(h.cycle_seconds, None))
-}

@@ -637,7 +637,7 @@ impl Plan {
                     ),
                 })?;
         }
-        let gait = crate::of_field::field_gait(field)?;
+        let gait = Gait::of_field(field);
         let mut plan = Self::from_header(
             scene,
             field.header(),

@@ -98,6 +98,15 @@ impl Gait {
         }
     }
 
+    /// The walk of `field`: its cycle, and its gait's speed as the field records it
+    /// (`None` for a field that does not: its walkers walk on the spot).
+    pub fn of_field<R: frf_reflectance::container::ReadAt>(
+        field: &frf_reflectance::FieldFile<R>,
+    ) -> Self {
+        let h = field.header();
+        Self::new(h.cycle_seconds, None)
+    }
+
     /// The captured speed, metres per second.
     pub fn speed_mps(&self) -> Option<f64> {
         self.stride_m.map(|s| s / self.cycle_seconds)
