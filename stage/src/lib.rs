@@ -11,6 +11,8 @@
 //!   textures, and Lambert + Torrance–Sparrow reflectance.
 //! - [`render`], [`studio`], [`sensor`]: the ray tracer (supersampled, shadowed), the
 //!   retro-reflective floor and backdrop, and the sensor's noise and 12-bit quantization.
+//! - [`crowd`]: the true image of several walkers in one world, each at its own instant
+//!   and under its own lights, occluding and shadowing one another.
 //! - [`truth`]: true alpha, true optical flow between any two views or instants, and the
 //!   true image of any virtual camera under any basis combination or HDR environment.
 //! - [`writer`]: writes a capture directory described by a manifest
@@ -23,6 +25,7 @@ pub mod body;
 pub mod brdf;
 pub mod config;
 pub mod contact;
+pub mod crowd;
 pub mod error;
 pub mod gait;
 pub mod geometry;
