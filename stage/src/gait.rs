@@ -51,7 +51,7 @@ impl Gait {
     /// The treadmill belt's speed, metres per second: how fast a planted foot moves
     /// backward (`-x`) in the subject frame.
     pub fn speed_mps(self) -> f64 {
-        f64::from(self.shape().speed_mps)
+        self.shape().speed_mps
     }
 
     /// Metres of belt per cycle (speed x cycle): the stride, twice the spacing of
@@ -79,7 +79,7 @@ struct GaitShape {
     /// Fraction of the cycle a foot is down.
     duty: f32,
     /// Belt speed, m/s.
-    speed_mps: f32,
+    speed_mps: f64,
     /// Height of the early-swing lift of the ankle (the heel kicking up), metres, and
     /// the exponent `n` of its shape `s² (1 - s)ⁿ` (peak at `s = 2 / (2 + n)`).
     kick: (f32, i32),
@@ -283,7 +283,7 @@ fn lift_shape(s: f32, a: i32, b: i32) -> f32 {
 fn foot(gait: Gait, leg_phase: f32) -> FootPose {
     let shape = gait.shape();
     let cycle = gait.cycle_seconds() as f32;
-    let v = shape.speed_mps;
+    let v = shape.speed_mps as f32;
     let psi = leg_phase.rem_euclid(1.0);
     // The belt carries a planted foot this far during a stance.
     let step = v * shape.duty * cycle;

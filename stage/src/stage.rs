@@ -328,6 +328,7 @@ impl Stage {
                 frame_rate_hz: rig::FRAME_RATE_HZ,
                 poses: self.config.poses.clone(),
                 reference_track: 1,
+                gait_speed_mps: Some(self.config.gait.speed_mps()),
             },
             turntable: Turntable {
                 azimuth_deg: (0..self.cycles())
