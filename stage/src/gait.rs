@@ -101,7 +101,9 @@ struct GaitShape {
 /// knee peaking at 60° (the clinical curves: ~60°). The pelvis was fitted (a random
 /// search minimising the largest stance knee flexion while every knee stays bent at
 /// least 9°, at both feet's extremes of reach, pelvis yaw included): it bobs 6.7 cm,
-/// highest in single support, and the stance knee stays within 15°-37°.
+/// highest in single support; the stance knee stays within 15°-37°, the swing knee
+/// within 9°-60°. (Level feet cost reach: spacing the footfalls as far apart as the
+/// former ankles reached, 1.26 m/s, would bend the stance knee to 46°, a crouch.)
 const WALK: GaitShape = GaitShape {
     duty: 0.6,
     speed_mps: 1.05,
@@ -118,7 +120,8 @@ const WALK: GaitShape = GaitShape {
 /// the heel up 20 cm and reaches forward 8 cm above the belt, pitching -37° to +3°,
 /// for a swing knee peaking near 97° (the clinical curves: ~100°). The pelvis rides 2 cm
 /// higher in flight than in mid-stance, as high as the extended legs allow at touch-down
-/// and lift-off: the stance knee flexes 16°-51° (runners: ~45° at mid-stance).
+/// and lift-off: the stance knee flexes 16°-51° (runners: ~45° at mid-stance), the swing
+/// knee 10°-97°.
 const RUN: GaitShape = GaitShape {
     duty: 0.35,
     speed_mps: 2.57,
@@ -129,8 +132,10 @@ const RUN: GaitShape = GaitShape {
 };
 
 /// Exponent `p` of the swing's forward velocity profile `-v + U (1 - |1 - 2s|ᵖ)`: large
-/// enough that the foot turns forward within a few centimetres of lift-off (1.7 cm
-/// walking, 3.8 cm running) instead of the 8 cm of a sine profile.
+/// enough that the lifted foot, still moving back with the belt, turns forward within
+/// 0.9 cm (walking) and 4.5 cm (running) of where it left the belt (1.7 and 7.7 cm with a
+/// sine profile, which left the running legs short of reach), and overshoots its
+/// touch-down point as little.
 const SWING_PROFILE_EXPONENT: i32 = 4;
 
 /// The pose of one foot, subject frame.
