@@ -4,7 +4,9 @@
 //! point-spread function ([`crate::optics`]), direct lighting with shadow
 //! rays (self-shadowing, and the actor's shadow on floor and backdrop), and, per pixel,
 //! the subject's coverage (the true alpha) and the surface point seen through the pixel
-//! centre (from which true optical flow is computed).
+//! centre (from which true optical flow is computed). [`render_crowd`] does the same for
+//! several actors without the studio, each under its own light, the nearest seen and
+//! each shadowing the others, with each one's coverage.
 
 use frf_core::camera::Camera;
 use frf_core::image::{GrayImage, Image, Rgb, RgbImage};
