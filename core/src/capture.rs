@@ -436,6 +436,15 @@ fn check_timing(c: &Check, m: &Manifest) -> Result<()> {
     c.positive("timing.cycle_seconds", t.cycle_seconds)?;
     c.positive("timing.set_rate_hz", t.set_rate_hz)?;
     c.positive("timing.frame_rate_hz", t.frame_rate_hz)?;
+    if let Some(v) = t.gait_speed_mps {
+        c.finite("timing.gait_speed_mps", v)?;
+        if v < 0.0 {
+            return Err(c.fail(
+                "timing.gait_speed_mps",
+                format!("a belt speed cannot be negative, got {v}"),
+            ));
+        }
+    }
     if t.poses_per_cycle == 0 || t.poses_per_cycle > MAX_POSES_PER_CYCLE {
         return Err(c.fail(
             "timing.poses_per_cycle",

@@ -12,7 +12,7 @@
 //! ```toml
 //! format = "frf-capture"
 //! version = 1
-//! [timing]          # cycle_seconds, poses_per_cycle, set_rate_hz, frame_rate_hz, poses, reference_track
+//! [timing]          # cycle_seconds, poses_per_cycle, set_rate_hz, frame_rate_hz, poses, reference_track, gait_speed_mps (optional)
 //! [turntable]       # azimuth_deg = [one per cycle], degrees_per_cycle
 //! [[cameras]]       # name, width, height, fx, fy, cx, cy, world_from_camera = 3x4 rows
 //! [[conditions]]    # name, floor, lights = [{ direction, intensity, solid_angle_sr }]
@@ -86,6 +86,11 @@ pub struct Timing {
     /// Index `k` of the reference track frame `T_k` that the set is registered to
     /// (`1`, the middle one, in the original).
     pub reference_track: u32,
+    /// Speed of the treadmill's belt, metres per second: how fast a planted foot moves
+    /// backward in the subject frame, so that a walker moved along a path advances its
+    /// gait by the distance walked. Absent when not known (older and real captures).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gait_speed_mps: Option<f64>,
 }
 
 /// The turntable under the treadmill.
@@ -280,5 +285,20 @@ mod tests {
         );
         let e = pattern_placeholders("a}").unwrap_err().to_string();
         assert!(e.contains("unmatched '}'") && e.contains(r#""a}""#), "{e}");
+    }
+
+    #[test]
+    fn the_belt_speed_is_optional_in_the_timing() {
+        let older = "cycle_seconds = 1.0\nposes_per_cycle = 30\nset_rate_hz = 30.0\n\
+                     frame_rate_hz = 990.0\nposes = [0]\nreference_track = 1\n";
+        let t: Timing = toml::from_str(older).expect("an older timing reads");
+        assert_eq!(t.gait_speed_mps, None);
+        assert!(
+            !toml::to_string(&t)
+                .expect("writes")
+                .contains("gait_speed_mps")
+        );
+        let t: Timing = toml::from_str(&format!("{older}gait_speed_mps = 1.05\n")).expect("reads");
+        assert_eq!(t.gait_speed_mps, Some(1.05));
     }
 }

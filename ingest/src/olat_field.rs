@@ -107,6 +107,7 @@ pub fn ingest_olat(
         jpeg_quality,
         shadows: None,
         hulls: None,
+        gait_speed_mps: None,
     };
     let basis: Vec<_> = kept.iter().map(|&k| set.images[k].clone()).collect();
     let alpha = Image::from_vec(

@@ -438,6 +438,7 @@ pub fn ingest_ring(
         jpeg_quality,
         shadows: None,
         hulls: None,
+        gait_speed_mps: None,
     };
     let mut writer = FieldWriter::create(out, header.clone())?;
     for u in 0..columns {

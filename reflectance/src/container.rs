@@ -514,6 +514,11 @@ fn differences(a: &FieldHeader, b: &FieldHeader) -> String {
         format!("{} s, {} poses", a.cycle_seconds, a.poses_per_cycle),
         format!("{} s, {} poses", b.cycle_seconds, b.poses_per_cycle),
     );
+    let speed = |h: &FieldHeader| match h.gait_speed_mps {
+        Some(v) => format!("{v} m/s"),
+        None => "not recorded".into(),
+    };
+    differ("the belt's speed", speed(a), speed(b));
     let basis = |h: &FieldHeader| match h.conditions == a.conditions {
         true => format!("{} conditions", h.conditions.len()),
         false => format!("{} other conditions", h.conditions.len()),

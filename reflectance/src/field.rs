@@ -205,6 +205,13 @@ pub struct FieldHeader {
     /// How the visual hulls were carved, if the field has them.
     #[serde(default)]
     pub hulls: Option<HullSpec>,
+    /// Speed of the treadmill's belt during the capture, metres per second (how fast a
+    /// planted foot moves backward in the subject frame; a walker placed on a path
+    /// advances its gait by the distance walked over it), when the capture said so.
+    /// Fields without it (older fields, real captures) can measure it from their hulls
+    /// ([`crate::gait_speed::measure`], [`crate::gait_speed::gait_speed_mps`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gait_speed_mps: Option<f64>,
 }
 
 impl FieldHeader {
@@ -279,6 +286,7 @@ impl FieldHeader {
             jpeg_quality,
             shadows: None,
             hulls: None,
+            gait_speed_mps: m.timing.gait_speed_mps,
         })
     }
 
@@ -422,6 +430,13 @@ impl FieldHeader {
                     return Err(format!("pose {} view {i}: size or turntable angle", p.pose));
                 }
             }
+        }
+        if let Some(v) = self.gait_speed_mps
+            && !(v.is_finite() && v >= 0.0)
+        {
+            return Err(format!(
+                "gait_speed_mps {v}: a belt speed is a finite number of metres per second, at least 0"
+            ));
         }
         if let Some(s) = &self.shadows {
             s.ground

@@ -12,6 +12,7 @@
 //! - [`project`], [`relight`]: HDR environments projected onto the basis (spherical
 //!   Voronoi regions of the lights, turntable rotation, two floor models) and CPU
 //!   relighting.
+//! - [`gait_speed`]: the treadmill's speed, recorded or measured from the hulls.
 //! - [`container`], [`store`]: the field file, an indexed and checksummed container that
 //!   reads one view without the rest; [`decoded`]: views' basis images kept decoded
 //!   between reads; [`stats`]: its contents and compression ratios.
@@ -25,6 +26,7 @@ pub mod error;
 pub mod field;
 pub mod floor_light;
 pub mod flowcodec;
+pub mod gait_speed;
 pub mod gloss;
 pub mod hull;
 pub mod imagecodec;

@@ -438,6 +438,39 @@ fn poses_written_apart_merge_into_one_field() {
         .to_string();
     assert!(e.contains("the visual hulls") && e.contains("0.005"), "{e}");
     assert!(!e.contains("grid") && !e.contains("codec"), "{e}");
+    // Parts must agree on the belt's speed: one that records another is refused naming
+    // it; a merged field keeps the parts' speed.
+    let faster = dir.path().join("faster.frf");
+    let mut hs = FieldFile::open(&parts[1]).unwrap().header().clone();
+    assert_eq!(hs.gait_speed_mps, None);
+    hs.gait_speed_mps = Some(9.0);
+    FieldWriter::create(&faster, hs.clone())
+        .unwrap()
+        .finish()
+        .unwrap();
+    let e = frf_reflectance::container::merge_fields(&[parts[0].clone(), faster.clone()], &merged)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("the belt's speed") && e.contains("9 m/s") && e.contains("not recorded"),
+        "{e}"
+    );
+    let slower = dir.path().join("slower.frf");
+    let mut h0 = FieldFile::open(&parts[0]).unwrap().header().clone();
+    h0.gait_speed_mps = Some(9.0);
+    FieldWriter::create(&slower, h0).unwrap().finish().unwrap();
+    frf_reflectance::container::merge_fields(&[slower, faster], &merged).unwrap();
+    assert_eq!(
+        FieldFile::open(&merged).unwrap().header().gait_speed_mps,
+        Some(9.0)
+    );
+    // A negative speed is no speed.
+    hs.gait_speed_mps = Some(-1.0);
+    let e = FieldWriter::create(&dir.path().join("backward.frf"), hs)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("gait_speed_mps"), "{e}");
 }
 
 /// The fuzz targets start from small valid inputs (`fuzz/seeds/{container,huffman,images}`)

@@ -1,7 +1,8 @@
 //! The truth behind the visual hull and the shadows: which points of space the walker
 //! fills, and how much of the light reaching the ground `y = 0` it blocks. Both are of
 //! the unperturbed walker at a pose's reference instant, in the subject frame, as
-//! [`crate::Stage::truth_image`] shows it.
+//! [`crate::Stage::truth_image`] shows it; [`relative_irradiance_among`] takes several
+//! actors (a crowd, [`crate::crowd`]).
 //!
 //! **Relative irradiance** at a ground point `x` under distant lights `l` (direction
 //! `d_l`, irradiance at normal incidence `E_l`, RGB): the irradiance with the walker over
@@ -27,6 +28,13 @@ const GROUND_OFFSET_M: f32 = 1e-4;
 /// The relative irradiance at ground point `point` under `lights`, with `actor` in the
 /// way (see the module docs).
 pub fn relative_irradiance(actor: &Actor, lights: &[DirLight], point: Vec3) -> Rgb {
+    relative_irradiance_among(std::slice::from_ref(actor), lights, point)
+}
+
+/// The relative irradiance at ground point `point` under `lights`, with every actor of
+/// `actors` in the way: a light counts only where no actor blocks it (see the module
+/// docs; `V_l(x)` is 1 when the ray misses them all).
+pub fn relative_irradiance_among(actors: &[Actor], lights: &[DirLight], point: Vec3) -> Rgb {
     let origin = Vec3::new(point.x, point.y + GROUND_OFFSET_M, point.z);
     let (mut lit, mut all) = ([0.0f64; 3], [0.0f64; 3]);
     for l in lights {
@@ -38,7 +46,7 @@ pub fn relative_irradiance(actor: &Actor, lights: &[DirLight], point: Vec3) -> R
             origin,
             dir: l.direction,
         };
-        let visible = !actor.occludes(&ray, 0.0, f32::INFINITY);
+        let visible = !actors.iter().any(|a| a.occludes(&ray, 0.0, f32::INFINITY));
         for c in 0..3 {
             let e = (l.irradiance[c] * cos) as f64;
             all[c] += e;

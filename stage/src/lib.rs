@@ -5,11 +5,14 @@
 //!
 //! - [`rig`]: the dome's 26 basis conditions, track and matte lighting, the 3 cameras,
 //!   the turntable and the 33-slot schedule of a lighting set.
-//! - [`actor`], [`gait`], [`material`], [`brdf`]: the walker (16 capsules and ellipsoids),
-//!   its cyclic gait with seeded cycle-to-cycle perturbations, procedural textures, and
-//!   Lambert + Torrance–Sparrow reflectance.
+//! - [`actor`], [`gait`], [`leg`], [`body`], [`material`], [`brdf`]: the walker (16
+//!   capsules and ellipsoids), its treadmill gait (planted feet moving with the belt, legs
+//!   by inverse kinematics) with seeded cycle-to-cycle perturbations, procedural
+//!   textures, and Lambert + Torrance–Sparrow reflectance.
 //! - [`render`], [`studio`], [`sensor`]: the ray tracer (supersampled, shadowed), the
 //!   retro-reflective floor and backdrop, and the sensor's noise and 12-bit quantization.
+//! - [`crowd`]: the true image of several walkers in one world, each at its own instant
+//!   and under its own lights, occluding and shadowing one another.
 //! - [`truth`]: true alpha, true optical flow between any two views or instants, and the
 //!   true image of any virtual camera under any basis combination or HDR environment.
 //! - [`writer`]: writes a capture directory described by a manifest
@@ -18,13 +21,16 @@
 //! Frames, axes and units: [`frf_core::conventions`].
 
 pub mod actor;
+pub mod body;
 pub mod brdf;
 pub mod config;
 pub mod contact;
+pub mod crowd;
 pub mod error;
 pub mod gait;
 pub mod geometry;
 pub mod ground;
+pub mod leg;
 pub mod material;
 pub mod olat_sphere;
 pub mod optics;

@@ -4,7 +4,9 @@
 //! point-spread function ([`crate::optics`]), direct lighting with shadow
 //! rays (self-shadowing, and the actor's shadow on floor and backdrop), and, per pixel,
 //! the subject's coverage (the true alpha) and the surface point seen through the pixel
-//! centre (from which true optical flow is computed).
+//! centre (from which true optical flow is computed). [`render_crowd`] does the same for
+//! several actors without the studio, each under its own light, the nearest seen and
+//! each shadowing the others, with each one's coverage.
 
 use frf_core::camera::Camera;
 use frf_core::image::{GrayImage, Image, Rgb, RgbImage};
@@ -49,6 +51,53 @@ pub struct Scene<'a> {
     pub illumination: &'a Illumination,
 }
 
+/// One actor of a crowd, placed in the world frame, and the light that shades it
+/// ([`render_crowd`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Lit<'a> {
+    /// The actor, world frame.
+    pub actor: &'a Actor,
+    /// The lights that shade this actor (every actor shadows every other).
+    pub illumination: &'a Illumination,
+}
+
+/// What [`render_crowd`] produces.
+#[derive(Debug, Clone)]
+pub struct CrowdRendered {
+    /// Linear radiance, premultiplied on black, averaged over the pixel.
+    pub color: RgbImage,
+    /// Fraction of the pixel covered by any actor.
+    pub alpha: GrayImage,
+    /// Per actor, in the order given, the fraction of the pixel's sub-samples whose
+    /// nearest hit is that actor; they sum to `alpha` (to rounding; each went through the
+    /// same lens blur).
+    pub coverage: Vec<GrayImage>,
+}
+
+/// The actors and studio one image shows, and how each is lit.
+struct World<'a> {
+    /// Each actor (world frame) with the light that shades it.
+    actors: Vec<Lit<'a>>,
+    /// The light of floor and backdrop, when they are present.
+    studio: Option<&'a Illumination>,
+}
+
+impl<'a> World<'a> {
+    fn of_scene(scene: &Scene<'a>) -> Self {
+        Self {
+            actors: scene
+                .actor
+                .map(|actor| Lit {
+                    actor,
+                    illumination: scene.illumination,
+                })
+                .into_iter()
+                .collect(),
+            studio: scene.studio.then_some(scene.illumination),
+        }
+    }
+}
+
 /// Offset of shadow-ray origins along the normal, metres: far above f32 rounding at
 /// stage scale (~1e-7 m), far below any feature (~1 cm).
 const SHADOW_BIAS_M: f32 = 2e-4;
@@ -59,13 +108,19 @@ fn add_scaled(acc: &mut Rgb, c: Rgb, k: f32) {
     }
 }
 
-fn lit(actor: Option<&Actor>, point: Vec3, normal: Vec3, light: &DirLight) -> bool {
-    let Some(actor) = actor else { return true };
+/// Whether `light` reaches `point` past every actor of `world`.
+fn lit(world: &World, point: Vec3, normal: Vec3, light: &DirLight) -> bool {
+    if world.actors.is_empty() {
+        return true;
+    }
     let ray = Ray {
         origin: point + normal * SHADOW_BIAS_M,
         dir: light.direction,
     };
-    !actor.occludes(&ray, 0.0, f32::INFINITY)
+    !world
+        .actors
+        .iter()
+        .any(|a| a.actor.occludes(&ray, 0.0, f32::INFINITY))
 }
 
 /// The albedo-independent part of the actor's shading at a hit: radiance toward the eye
@@ -89,8 +144,8 @@ fn actor_albedo(hit: &ActorHit, pixel_angle: f32) -> Rgb {
 }
 
 fn shade_actor(
-    scene: &Scene,
-    actor: &Actor,
+    world: &World,
+    which: usize,
     ray: &Ray,
     hit: &ActorHit,
     pixel_angle: f32,
@@ -117,10 +172,10 @@ fn shade_actor(
         add_scaled(&mut out.diffuse, light.irradiance, d);
         add_scaled(&mut out.specular, light.irradiance, s);
     };
-    match scene.illumination {
+    match world.actors[which].illumination {
         Illumination::Lights(lights) => {
             for light in lights {
-                if n.dot(light.direction) > 0.0 && lit(Some(actor), p, n, light) {
+                if n.dot(light.direction) > 0.0 && lit(world, p, n, light) {
                     add(light, light.direction);
                 }
             }
@@ -136,9 +191,12 @@ fn combine(albedo: Rgb, shading: &ActorShading) -> Rgb {
     [0, 1, 2].map(|c| albedo[c] * shading.diffuse[c] + shading.specular[c])
 }
 
-fn shade_studio(scene: &Scene, ray: &Ray, hit: &StudioHit) -> Rgb {
+fn shade_studio(world: &World, ray: &Ray, hit: &StudioHit) -> Rgb {
     let view = -ray.dir;
-    match scene.illumination {
+    let Some(illumination) = world.studio else {
+        return [0.0; 3];
+    };
+    match illumination {
         Illumination::Lights(lights) => {
             let mut out = [0.0; 3];
             let normal = match hit {
@@ -146,9 +204,7 @@ fn shade_studio(scene: &Scene, ray: &Ray, hit: &StudioHit) -> Rgb {
                 StudioHit::Backdrop(_) => Vec3::Z,
             };
             for light in lights {
-                if normal.dot(light.direction) <= 0.0
-                    || !lit(scene.actor, hit.point(), normal, light)
-                {
+                if normal.dot(light.direction) <= 0.0 || !lit(world, hit.point(), normal, light) {
                     continue;
                 }
                 add_scaled(&mut out, studio::reflect(hit, light, view), 1.0);
@@ -163,17 +219,18 @@ fn shade_studio(scene: &Scene, ray: &Ray, hit: &StudioHit) -> Rgb {
 /// What a primary ray sees first.
 #[derive(Debug, Clone, Copy)]
 enum Visible {
-    Actor(ActorHit),
+    /// Actor `.0` of the world.
+    Actor(usize, ActorHit),
     Studio(StudioHit),
     Nothing,
 }
 
 impl Visible {
-    /// Whether two rays see the same smooth surface (one body part, the floor, the
-    /// backdrop or nothing), so that shading one stands for both.
+    /// Whether two rays see the same smooth surface (one body part of one actor, the
+    /// floor, the backdrop or nothing), so that shading one stands for both.
     fn same_surface(&self, other: &Visible) -> bool {
         match (self, other) {
-            (Visible::Actor(a), Visible::Actor(b)) => a.part == b.part,
+            (Visible::Actor(i, a), Visible::Actor(j, b)) => i == j && a.part == b.part,
             (Visible::Studio(StudioHit::Floor(_)), Visible::Studio(StudioHit::Floor(_)))
             | (Visible::Studio(StudioHit::Backdrop(_)), Visible::Studio(StudioHit::Backdrop(_)))
             | (Visible::Nothing, Visible::Nothing) => true,
@@ -183,7 +240,7 @@ impl Visible {
 
     fn surface_point(&self) -> Option<SurfacePoint> {
         match self {
-            Visible::Actor(hit) => Some(SurfacePoint {
+            Visible::Actor(_, hit) => Some(SurfacePoint {
                 part: hit.part,
                 local: hit.local,
             }),
@@ -192,14 +249,19 @@ impl Visible {
     }
 }
 
-fn visibility(scene: &Scene, ray: &Ray) -> Visible {
-    if let Some(hit) = scene
-        .actor
-        .and_then(|a| a.intersect(ray, 0.0, f32::INFINITY))
-    {
-        return Visible::Actor(hit);
+/// The nearest actor hit along `ray`, else the studio, else nothing.
+fn visibility(world: &World, ray: &Ray) -> Visible {
+    let mut nearest: Option<(usize, ActorHit)> = None;
+    for (i, a) in world.actors.iter().enumerate() {
+        let limit = nearest.map_or(f32::INFINITY, |(_, h)| h.t);
+        if let Some(hit) = a.actor.intersect(ray, 0.0, limit) {
+            nearest = Some((i, hit));
+        }
     }
-    if scene.studio
+    if let Some((i, hit)) = nearest {
+        return Visible::Actor(i, hit);
+    }
+    if world.studio.is_some()
         && let Some((_, hit)) = studio::intersect(ray)
     {
         return Visible::Studio(hit);
@@ -207,14 +269,14 @@ fn visibility(scene: &Scene, ray: &Ray) -> Visible {
     Visible::Nothing
 }
 
-fn shade(scene: &Scene, ray: &Ray, visible: &Visible, pixel_angle: f32) -> Rgb {
-    match (visible, scene.actor) {
-        (Visible::Actor(hit), Some(actor)) => combine(
+fn shade(world: &World, ray: &Ray, visible: &Visible, pixel_angle: f32) -> Rgb {
+    match visible {
+        Visible::Actor(which, hit) => combine(
             actor_albedo(hit, pixel_angle),
-            &shade_actor(scene, actor, ray, hit, pixel_angle),
+            &shade_actor(world, *which, ray, hit, pixel_angle),
         ),
-        (Visible::Studio(hit), _) => shade_studio(scene, ray, hit),
-        _ => [0.0; 3],
+        Visible::Studio(hit) => shade_studio(world, ray, hit),
+        Visible::Nothing => [0.0; 3],
     }
 }
 
@@ -227,7 +289,54 @@ fn shade(scene: &Scene, ray: &Ray, visible: &Visible, pixel_angle: f32) -> Rgb {
 /// sub-sample is lit on its own. Lighting varies slowly within one surface; texture
 /// does not, hence its full sampling.
 pub fn render(camera: &Camera, scene: &Scene, samples_per_axis: u32) -> Rendered {
+    let traced = trace(camera, &World::of_scene(scene), samples_per_axis);
+    let sigma = crate::optics::PSF_SIGMA_PX;
+    Rendered {
+        color: crate::optics::blur(&traced.color, sigma),
+        alpha: crate::optics::blur(&traced.alpha, sigma),
+        surface: traced.surface,
+    }
+}
+
+/// Renders several actors (world frame) through `camera`, without studio, each shaded
+/// by its own illumination, with the nearest hit among them seen and every actor
+/// shadowing every other; sampled and blurred as [`render`] does. A crowd of one is
+/// exactly [`render`] of that actor without studio.
+pub fn render_crowd(camera: &Camera, actors: &[Lit], samples_per_axis: u32) -> CrowdRendered {
+    let world = World {
+        actors: actors.to_vec(),
+        studio: None,
+    };
+    let traced = trace(camera, &world, samples_per_axis);
+    let sigma = crate::optics::PSF_SIGMA_PX;
+    CrowdRendered {
+        color: crate::optics::blur(&traced.color, sigma),
+        alpha: crate::optics::blur(&traced.alpha, sigma),
+        coverage: traced
+            .coverage
+            .iter()
+            .map(|c| crate::optics::blur(c, sigma))
+            .collect(),
+    }
+}
+
+/// What [`trace`] produces, before the lens's blur.
+struct Traced {
+    color: RgbImage,
+    alpha: GrayImage,
+    /// Per actor, the fraction of sub-samples that see it.
+    coverage: Vec<GrayImage>,
+    surface: Image<Option<SurfacePoint>>,
+}
+
+/// One traced row: colour, per pixel and actor the sub-samples that see it (pixel-major),
+/// and the surface points.
+type Row = (Vec<Rgb>, Vec<u32>, Vec<Option<SurfacePoint>>);
+
+/// The ray tracing of [`render`] and [`render_crowd`] (see [`render`]).
+fn trace(camera: &Camera, world: &World, samples_per_axis: u32) -> Traced {
     let (w, h) = (camera.width as usize, camera.height as usize);
+    let k = world.actors.len();
     let n = samples_per_axis.max(1);
     let inv = 1.0 / (n * n) as f32;
     let pixel_angle = 1.0 / camera.intrinsics.fx.min(camera.intrinsics.fy);
@@ -235,86 +344,95 @@ pub fn render(camera: &Camera, scene: &Scene, samples_per_axis: u32) -> Rendered
         origin: camera.centre(),
         dir: camera.ray_direction(pixel),
     };
-    let rows: Vec<Vec<(Rgb, f32, Option<SurfacePoint>)>> = (0..h)
+    let rows: Vec<Row> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut samples = Vec::with_capacity((n * n) as usize);
-            (0..w)
-                .map(|x| {
-                    let centre = Vec2::new(x as f32, y as f32);
-                    let centre_ray = ray_through(centre);
-                    let centre_visible = visibility(scene, &centre_ray);
-                    samples.clear();
-                    for sy in 0..n {
-                        for sx in 0..n {
-                            let offset = Vec2::new(
-                                (sx as f32 + 0.5) / n as f32 - 0.5,
-                                (sy as f32 + 0.5) / n as f32 - 0.5,
-                            );
-                            let ray = ray_through(centre + offset);
-                            samples.push((offset, ray, visibility(scene, &ray)));
-                        }
+            let mut colors = Vec::with_capacity(w);
+            let mut counts = vec![0u32; w * k];
+            let mut surfaces = Vec::with_capacity(w);
+            for x in 0..w {
+                let centre = Vec2::new(x as f32, y as f32);
+                let centre_ray = ray_through(centre);
+                let centre_visible = visibility(world, &centre_ray);
+                samples.clear();
+                for sy in 0..n {
+                    for sx in 0..n {
+                        let offset = Vec2::new(
+                            (sx as f32 + 0.5) / n as f32 - 0.5,
+                            (sy as f32 + 0.5) / n as f32 - 0.5,
+                        );
+                        let ray = ray_through(centre + offset);
+                        samples.push((offset, ray, visibility(world, &ray)));
                     }
-                    let covered = samples
-                        .iter()
-                        .filter(|s| matches!(s.2, Visible::Actor(_)))
-                        .count();
-                    let uniform = samples.iter().all(|s| s.2.same_surface(&centre_visible));
-                    let color = if uniform {
-                        match (&centre_visible, scene.actor) {
-                            (Visible::Actor(hit), Some(actor)) => {
-                                let mut albedo = [0.0; 3];
-                                for (_, _, v) in &samples {
-                                    if let Visible::Actor(h) = v {
-                                        add_scaled(&mut albedo, actor_albedo(h, pixel_angle), inv);
-                                    }
+                }
+                for s in &samples {
+                    if let Visible::Actor(i, _) = s.2 {
+                        counts[x * k + i] += 1;
+                    }
+                }
+                let uniform = samples.iter().all(|s| s.2.same_surface(&centre_visible));
+                let color = if uniform {
+                    match &centre_visible {
+                        Visible::Actor(which, hit) => {
+                            let mut albedo = [0.0; 3];
+                            for (_, _, v) in &samples {
+                                if let Visible::Actor(_, h) = v {
+                                    add_scaled(&mut albedo, actor_albedo(h, pixel_angle), inv);
                                 }
-                                combine(
-                                    albedo,
-                                    &shade_actor(scene, actor, &centre_ray, hit, pixel_angle),
-                                )
                             }
-                            _ => shade(scene, &centre_ray, &centre_visible, pixel_angle),
+                            combine(
+                                albedo,
+                                &shade_actor(world, *which, &centre_ray, hit, pixel_angle),
+                            )
                         }
-                    } else {
-                        let mut color = [0.0; 3];
-                        for (_, ray, visible) in &samples {
-                            add_scaled(&mut color, shade(scene, ray, visible, pixel_angle), inv);
-                        }
-                        color
-                    };
-                    // The surface point through the centre, or at the silhouette the
-                    // covered sub-sample nearest to it.
-                    let surface = centre_visible.surface_point().or_else(|| {
-                        samples
-                            .iter()
-                            .filter(|s| matches!(s.2, Visible::Actor(_)))
-                            .min_by(|a, b| a.0.length_squared().total_cmp(&b.0.length_squared()))
-                            .and_then(|s| s.2.surface_point())
-                    });
-                    (color, covered as f32 * inv, surface)
-                })
-                .collect()
+                        _ => shade(world, &centre_ray, &centre_visible, pixel_angle),
+                    }
+                } else {
+                    let mut color = [0.0; 3];
+                    for (_, ray, visible) in &samples {
+                        add_scaled(&mut color, shade(world, ray, visible, pixel_angle), inv);
+                    }
+                    color
+                };
+                // The surface point through the centre, or at the silhouette the
+                // covered sub-sample nearest to it.
+                let surface = centre_visible.surface_point().or_else(|| {
+                    samples
+                        .iter()
+                        .filter(|s| matches!(s.2, Visible::Actor(..)))
+                        .min_by(|a, b| a.0.length_squared().total_cmp(&b.0.length_squared()))
+                        .and_then(|s| s.2.surface_point())
+                });
+                colors.push(color);
+                surfaces.push(surface);
+            }
+            (colors, counts, surfaces)
         })
         .collect();
     let mut color = Vec::with_capacity(w * h);
     let mut alpha = Vec::with_capacity(w * h);
+    let mut coverage = vec![Vec::with_capacity(w * h); k];
     let mut surface = Vec::with_capacity(w * h);
-    for (c, a, s) in rows.into_iter().flatten() {
-        color.push(c);
-        alpha.push(a);
-        surface.push(s);
+    for (colors, counts, surfaces) in rows {
+        color.extend(colors);
+        surface.extend(surfaces);
+        for x in 0..w {
+            let pixel = &counts[x * k..(x + 1) * k];
+            alpha.push(pixel.iter().sum::<u32>() as f32 * inv);
+            for (c, &m) in coverage.iter_mut().zip(pixel) {
+                c.push(m as f32 * inv);
+            }
+        }
     }
-    let sigma = crate::optics::PSF_SIGMA_PX;
-    Rendered {
-        color: crate::optics::blur(
-            &Image::from_vec(w, h, color).expect("w*h pixels by construction"),
-            sigma,
-        ),
-        alpha: crate::optics::blur(
-            &Image::from_vec(w, h, alpha).expect("w*h pixels by construction"),
-            sigma,
-        ),
-        surface: Image::from_vec(w, h, surface).expect("w*h pixels by construction"),
+    Traced {
+        color: image(w, h, color),
+        alpha: image(w, h, alpha),
+        coverage: coverage.into_iter().map(|c| image(w, h, c)).collect(),
+        surface: image(w, h, surface),
     }
+}
+
+fn image<P: Copy>(w: usize, h: usize, pixels: Vec<P>) -> Image<P> {
+    Image::from_vec(w, h, pixels).expect("w*h pixels by construction")
 }

@@ -13,7 +13,7 @@ use frf_core::manifest::{
 use crate::actor::Actor;
 use crate::config::StageConfig;
 use crate::error::{Result, StageError};
-use crate::gait::Perturbation;
+use crate::gait::{self, FootContact, Perturbation};
 use crate::render::{Rendered, Scene, render};
 use crate::rig::{self, BasisCondition, StageSlot};
 use crate::rng::hash;
@@ -108,6 +108,15 @@ impl Stage {
             .unwrap_or_default();
         let phase = (time_s / self.config.gait.cycle_seconds()) as f32;
         Actor::walker(self.config.gait, phase, &perturbation)
+    }
+
+    /// The feet of the unperturbed walker `time_s` seconds into its cycle, left then
+    /// right (subject frame): each foot's sole point [`crate::body::SOLE_POINT`] and
+    /// whether it is on the belt. A foot on the belt lies on `y = 0` and moves at exactly
+    /// `-`[`crate::Gait::speed_mps`] along `x`.
+    pub fn feet_at(&self, time_s: f64) -> [FootContact; 2] {
+        let phase = (time_s / self.config.gait.cycle_seconds()) as f32;
+        gait::contacts(self.config.gait, phase)
     }
 
     /// Camera `camera` and the actor of cycle `cycle`, pose `pose`, `offset_s` after the
@@ -319,6 +328,7 @@ impl Stage {
                 frame_rate_hz: rig::FRAME_RATE_HZ,
                 poses: self.config.poses.clone(),
                 reference_track: 1,
+                gait_speed_mps: Some(self.config.gait.speed_mps()),
             },
             turntable: Turntable {
                 azimuth_deg: (0..self.cycles())

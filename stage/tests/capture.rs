@@ -13,7 +13,7 @@ use frf_core::manifest::Manifest;
 use frf_stage::render::{Scene, render};
 use frf_stage::rig::{REFERENCE_SLOT, StageSlot, slot_time_offset_s};
 use frf_stage::studio::Illumination;
-use frf_stage::{Preset, SetFlowTruth, Stage, StageConfig, write_capture};
+use frf_stage::{Gait, Preset, SetFlowTruth, Stage, StageConfig, write_capture};
 
 /// A small capture: tiny images, 3 cycles, one pose.
 fn small_config() -> StageConfig {
@@ -310,6 +310,23 @@ fn broken_captures_are_refused_naming_the_problem() {
         err.contains("capture.toml") && err.contains("schedule[4].kind") && err.contains("flash"),
         "{err}"
     );
+
+    // The belt's speed: the stage writes it; a manifest without it reads (older and real
+    // captures); a negative or NaN one is refused naming the field.
+    assert_eq!(good.timing.gait_speed_mps, Some(Gait::Walk.speed_mps()));
+    let mut m = good.clone();
+    m.timing.gait_speed_mps = None;
+    save(dir.path(), &m);
+    let text = std::fs::read_to_string(dir.path().join("capture.toml")).unwrap();
+    assert!(!text.contains("gait_speed_mps"), "{text}");
+    let read = Capture::open(dir.path()).unwrap();
+    assert_eq!(read.manifest().timing.gait_speed_mps, None);
+    for bad in [-1.0, f64::NAN] {
+        m.timing.gait_speed_mps = Some(bad);
+        save(dir.path(), &m);
+        let err = Capture::open(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("timing.gait_speed_mps"), "{err}");
+    }
 
     // NaN in a camera matrix.
     let mut m = good.clone();
