@@ -3,7 +3,9 @@
 //! where it stands), each copy turned by the golden angle from the last so that every
 //! walker is relit for a heading of its own (the costly case: walkers of one heading
 //! share one relit pose). The lighting is held (`constant`) or turned 15° a frame
-//! (`turning`). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
+//! (`turning`). The walkers stand (`standing`) or walk (`walking`: each from its place
+//! along a bend of [`BEND_RADIUS_M`] at [`WALK_SPEED_MPS`], turning as it goes, so every
+//! walker's own light changes every frame). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
 //! apart (`held`: every walker keeps its pose, only the lighting differs) or as the
 //! scene's own frames are (`shot`: poses stream in and out as in a render). The shot's
 //! plan is made once before the frames, as `frf render` makes it, and is not timed. One
@@ -45,6 +47,32 @@ const TURN_DEG_PER_FRAME: f32 = 15.0;
 /// Metres between walkers on the grid.
 const SPACING_M: f32 = 1.2;
 
+/// Radius of the bend a walking walker follows, metres: a turn of 90° over 6 m.
+pub const BEND_RADIUS_M: f32 = 6.0 / std::f32::consts::FRAC_PI_2;
+
+/// A walking walker's speed, metres per second (a brisk walk).
+pub const WALK_SPEED_MPS: f32 = 1.4;
+
+/// Whether the benchmark's walkers stand or walk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Motion {
+    /// Each on its place of the grid.
+    Standing,
+    /// Each along a bend from its place ([`BEND_RADIUS_M`], [`WALK_SPEED_MPS`]).
+    Walking,
+}
+
+impl Motion {
+    /// Its name in tables and JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Motion::Standing => "standing",
+            Motion::Walking => "walking",
+        }
+    }
+}
+
 /// A frame's lighting in the benchmark.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -84,6 +112,8 @@ pub struct FrameBenchOptions {
     pub walkers: Vec<usize>,
     /// Lightings.
     pub lights: Vec<LightMode>,
+    /// Standing, walking, or both.
+    pub motions: Vec<Motion>,
     /// Frames counted per row (after one not counted).
     pub frames: usize,
     /// Frame size.
@@ -117,6 +147,8 @@ pub struct FrameBenchRow {
     pub walkers: usize,
     /// `constant` or `turning`.
     pub light: LightMode,
+    /// `standing` or `walking`.
+    pub motion: Motion,
     /// Median host work per frame (wall less waits on the device), ms.
     pub host_ms_per_frame: f64,
     /// Median wait on the device per frame (fenced), ms.
@@ -166,12 +198,13 @@ impl FrameBenchReport {
              device)\n",
             self.device, self.size.0, self.size.1, self.frames
         );
-        out += "walkers  light     host ms  gpu ms  wall ms  relit/frame  peak MB\n";
+        out += "walkers  light     motion     host ms  gpu ms  wall ms  relit/frame  peak MB\n";
         for r in &self.rows {
             out += &format!(
-                "{:>7}  {:<8} {:>8.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
+                "{:>7}  {:<8} {:<9} {:>8.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
                 r.walkers,
                 r.light.name(),
+                r.motion.name(),
                 r.host_ms_per_frame,
                 r.gpu_ms_per_frame,
                 r.wall_ms_per_frame,
@@ -189,23 +222,37 @@ impl FrameBenchReport {
                     .map(|p| format!("{} {:.1} ({})", p.pass, p.ms, p.passes))
                     .collect();
                 out += &format!(
-                    "{:>7}  {:<8} {}; all {:.1}\n",
+                    "{:>7}  {:<8} {:<9} {}; all {:.1}\n",
                     r.walkers,
                     r.light.name(),
+                    r.motion.name(),
                     passes.join(", "),
                     r.gpu_timestamps_ms_per_frame.unwrap_or(f64::NAN)
                 );
             }
         }
-        let find =
-            |w: usize, l: LightMode| self.rows.iter().find(|r| r.walkers == w && r.light == l);
+        let row = |w: usize, l: LightMode, m: Motion| {
+            (self.rows.iter()).find(|r| r.walkers == w && r.light == l && r.motion == m)
+        };
+        let find = |w: usize, l: LightMode| row(w, l, Motion::Standing);
         for r in &self.rows {
             if r.light == LightMode::Turning
+                && r.motion == Motion::Standing
                 && let Some(c) = find(r.walkers, LightMode::Constant)
             {
                 out += &format!(
                     "{} walkers: turning / constant light, wall per frame: {:.2}x\n",
                     r.walkers,
+                    r.wall_ms_per_frame / c.wall_ms_per_frame
+                );
+            }
+            if r.motion == Motion::Walking
+                && let Some(c) = row(r.walkers, r.light, Motion::Standing)
+            {
+                out += &format!(
+                    "{} walkers, {} light: walking / standing, wall per frame: {:.2}x\n",
+                    r.walkers,
+                    r.light.name(),
                     r.wall_ms_per_frame / c.wall_ms_per_frame
                 );
             }
@@ -231,38 +278,41 @@ impl FrameBenchReport {
     }
 }
 
-/// `scene` with its first walker copied `n` times on a grid, lit as `light` says for
-/// `frames` frames from its start.
+/// `scene` with its first walker copied `n` times on a grid, standing or walking as
+/// `motion` says, lit as `light` says for `frames` frames from its start.
 pub fn bench_scene(
     scene: &Scene,
     n: usize,
-    light: LightMode,
+    (light, motion): (LightMode, Motion),
     (frames, spacing): (usize, Spacing),
 ) -> Scene {
     let mut s = scene.clone();
     let first = &scene.instances[0];
     let side = (n as f32).sqrt().ceil() as usize;
     let centre = (side as f32 - 1.0) * 0.5;
-    s.instances = (0..n)
-        .map(|k| {
-            Instance::standing(
-                first.position
-                    + Vec3::new(
-                        ((k % side) as f32 - centre) * SPACING_M,
-                        0.0,
-                        ((k / side) as f32 - centre) * SPACING_M,
-                    ),
-                first.heading + k as f32 * 137.507_77_f32.to_radians(),
-                first.time_offset,
-            )
-        })
-        .collect();
-    let key = scene.lighting[0].clone();
     let step = match spacing {
         Spacing::Held => FRAME_STEP_S,
         Spacing::Shot => 1.0 / scene.fps,
     };
     let span = (frames + 1) as f64 * step;
+    s.instances = (0..n)
+        .map(|k| {
+            let position = first.position
+                + Vec3::new(
+                    ((k % side) as f32 - centre) * SPACING_M,
+                    0.0,
+                    ((k / side) as f32 - centre) * SPACING_M,
+                );
+            let heading = first.heading + k as f32 * 137.507_77_f32.to_radians();
+            match motion {
+                Motion::Standing => Instance::standing(position, heading, first.time_offset),
+                Motion::Walking => {
+                    walking(position, heading, (scene.start, span), first.time_offset)
+                }
+            }
+        })
+        .collect();
+    let key = scene.lighting[0].clone();
     s.start = scene.start;
     s.fps = 1.0 / step;
     s.end = scene.start + span;
@@ -308,14 +358,17 @@ pub fn run_frame_bench<R: ReadAt>(
         .into());
     }
     drop(device);
-    let rows_wanted = options.walkers.len() * options.lights.len();
+    let rows_wanted = options.walkers.len() * options.lights.len() * options.motions.len();
     progress.phase("frames", rows_wanted * (options.frames + 1));
     let mut rows = Vec::with_capacity(rows_wanted);
     let mut device_name = String::new();
     let mut pass_clock = "none";
+    let modes: Vec<(LightMode, Motion)> = (options.lights.iter())
+        .flat_map(|&l| options.motions.iter().map(move |&m| (l, m)))
+        .collect();
     for &n in &options.walkers {
-        for &light in &options.lights {
-            let s = bench_scene(scene, n, light, (options.frames, options.spacing));
+        for &(light, motion) in &modes {
+            let s = bench_scene(scene, n, (light, motion), (options.frames, options.spacing));
             let frames = s.shot_frames(0..options.frames + 1, options.size)?;
             let device = Device::open(options.cpu)?;
             device_name = device.name();
@@ -351,6 +404,7 @@ pub fn run_frame_bench<R: ReadAt>(
             rows.push(FrameBenchRow {
                 walkers: n,
                 light,
+                motion,
                 host_ms_per_frame: median(&host),
                 gpu_ms_per_frame: median(&waited),
                 wall_ms_per_frame: median(&wall),
@@ -376,6 +430,33 @@ pub fn run_frame_bench<R: ReadAt>(
         frames: options.frames,
         rows,
     })
+}
+
+/// A walker starting at `position` facing `heading`, walking a bend of [`BEND_RADIUS_M`]
+/// to its left at [`WALK_SPEED_MPS`] over `span` seconds from `start`, its walk
+/// `time_offset` ahead.
+fn walking(position: Vec3, heading: f32, (start, span): (f64, f64), time_offset: f64) -> Instance {
+    let turn = glam::Quat::from_rotation_y(heading);
+    let keys = (0..=4)
+        .map(|j| {
+            let t = span * j as f64 / 4.0;
+            let angle = WALK_SPEED_MPS * t as f32 / BEND_RADIUS_M;
+            // Along +x, bending toward -z (its left), in the walker's own frame.
+            let local = Vec3::new(angle.sin(), 0.0, angle.cos() - 1.0) * BEND_RADIUS_M;
+            let mut p = position + turn * local;
+            p.y = 0.0;
+            crate::walk::WalkKey {
+                time: start + t,
+                position: p,
+                heading: None,
+            }
+        })
+        .collect();
+    match crate::walk::WalkPath::new(keys) {
+        Ok(path) => Instance::walking(path, time_offset),
+        // A span too short to move: standing.
+        Err(_) => Instance::standing(position, heading, time_offset),
+    }
 }
 
 /// Seconds the host has waited on `device` so far (none on the CPU).

@@ -531,7 +531,7 @@ impl Plan {
         let frames = scene.shot_frames(0..scene.frame_times().len(), size)?;
         let interpolate = scene.interpolate.unwrap_or(TimeInterpolation::Nearest);
         // No hull yet: the design's bounds.
-        let gait = Gait::new(header.cycle_seconds, None);
+        let gait = Gait::new(header.cycle_seconds, header.gait_speed_mps);
         let mut plan = Self::from_header(scene, header, &frames, (interpolate, gait), &mut |_| {
             Ok(None)
         })?;
@@ -637,7 +637,7 @@ impl Plan {
                     ),
                 })?;
         }
-        let gait = Gait::of_field(field);
+        let gait = Gait::of_field(field)?;
         let mut plan = Self::from_header(
             scene,
             field.header(),

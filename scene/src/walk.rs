@@ -98,13 +98,14 @@ impl Gait {
         }
     }
 
-    /// The walk of `field`: its cycle, and its gait's speed as the field records it
-    /// (`None` for a field that does not: its walkers walk on the spot).
+    /// The walk of `field`: its cycle, and its gait's speed as the field records it, or
+    /// as its visual hulls tell it ([`frf_reflectance::gait_speed`]); `None` when neither
+    /// does (its walkers walk on the spot).
     pub fn of_field<R: frf_reflectance::container::ReadAt>(
         field: &frf_reflectance::FieldFile<R>,
-    ) -> Self {
-        let h = field.header();
-        Self::new(h.cycle_seconds, None)
+    ) -> crate::Result<Self> {
+        let speed = frf_reflectance::gait_speed::gait_speed_mps(field)?;
+        Ok(Self::new(field.header().cycle_seconds, speed))
     }
 
     /// The captured speed, metres per second.

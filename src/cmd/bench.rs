@@ -18,7 +18,7 @@ use super::args::{LightingArgs, parse_size};
 use crate::CliResult;
 use frf_core::bars::{Bars, bar};
 use frf_scene::Scene;
-use frf_scene::bench_frame::{FrameBenchOptions, LightMode, Spacing, run_frame_bench};
+use frf_scene::bench_frame::{FrameBenchOptions, LightMode, Motion, Spacing, run_frame_bench};
 use frf_scene::shot::ShotOptions;
 
 /// `frf bench ...`.
@@ -63,6 +63,9 @@ struct FrameArgs {
     /// Lightings timed.
     #[arg(long, value_enum, default_value = "both")]
     light: LightArg,
+    /// Walkers standing, walking a bend (their own light changes every frame), or both.
+    #[arg(long, value_enum, default_value = "standing")]
+    motion: MotionArg,
     /// Frames counted per row (one more is drawn first, not counted).
     #[arg(long, default_value_t = 6)]
     frames: usize,
@@ -82,6 +85,17 @@ struct FrameArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
+}
+
+/// `--motion`.
+#[derive(Clone, Copy, ValueEnum)]
+enum MotionArg {
+    /// On their places of the grid.
+    Standing,
+    /// Along a bend from there.
+    Walking,
+    /// Both.
+    Both,
 }
 
 /// `--spacing`.
@@ -171,6 +185,11 @@ fn frame(args: FrameArgs) -> CliResult {
             LightArg::Constant => vec![LightMode::Constant],
             LightArg::Turning => vec![LightMode::Turning],
             LightArg::Both => vec![LightMode::Constant, LightMode::Turning],
+        },
+        motions: match args.motion {
+            MotionArg::Standing => vec![Motion::Standing],
+            MotionArg::Walking => vec![Motion::Walking],
+            MotionArg::Both => vec![Motion::Standing, Motion::Walking],
         },
         frames: args.frames,
         spacing: match args.spacing {
