@@ -1,20 +1,31 @@
 //! A scene's shot judged frame by frame against the virtual stage's truth: the frame the
-//! renderer draws (walker, shadow and backdrop) against the true composite of the same
+//! renderer draws (walkers, shadows and backdrop) against the true composite of the same
 //! camera, time and lighting.
 //!
-//! The truth of a frame: the stage's true walker at the frame's instant of its walk
-//! ([`TruthAt::Instant`], the default: between two captured poses the walker is in
-//! between, which a render of the nearest pose is not) or at the instant of the pose the
-//! plan draws ([`TruthAt::Pose`]: the renderer's view error alone), seen by the frame's
-//! camera (moved into the walker's frame), lit by the frame's environment reduced to
-//! median-cut lights; its true shadow traced against the true body; both composited over
-//! the frame's own backdrop by the product's compositing
-//! ([`frf_render::composite::compose`]), so that only the walker and its shadow differ.
-//! Scenes of one walker only: the stage films one person.
+//! The truth of a frame: the stage's true walkers ([`frf_stage::crowd`]), each where the
+//! scene places it at the frame (its position and heading on its path), at the frame's
+//! instant of its walk ([`TruthAt::Instant`], the default: its phase as the scene
+//! advances it, by time or by the distance walked; between two captured poses the walker
+//! is in between, which a render of the nearest pose is not) or at the instant of the
+//! pose the plan draws ([`TruthAt::Pose`]: the renderer's view error alone), each lit by
+//! the light at it (the scene's environment, or its probes mixed where it stands, with
+//! the sun) reduced to median-cut lights, with true occlusion between walkers and their
+//! true shadows on each other; the ground's true relative irradiance among all of them
+//! under the scene's lighting; both composited over the frame's own backdrop by the
+//! product's compositing ([`frf_render::composite::compose`]), so that only the walkers
+//! and their shadows differ.
+//!
+//! Per frame: PSNR of the frame and of the walkers' layer where either covers a pixel,
+//! SSIM, and the walkers' alpha against the true coverage as a soft intersection over
+//! union, `Σ min(a, â) / Σ max(a, â)`; the same per walker over the pixels where it is the
+//! nearest true walker (grown by [`WALKER_MARGIN_PX`], so that a rendered edge beside the
+//! true one counts). Over the shot, how far a stance foot slides on the ground
+//! ([`foot_slide_cm`]).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
+use frf_core::light::DirLight;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 use frf_render::composite::compose;
@@ -23,14 +34,22 @@ use frf_scene::Scene;
 use frf_scene::plan::ShotFrame;
 use frf_scene::shot::{Shot, ShotOptions};
 use frf_stage::Stage;
-use frf_stage::ground::relative_irradiance;
+use frf_stage::crowd::Walker as TrueWalker;
+use frf_stage::ground::relative_irradiance_among;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{EvalError, Result};
 use crate::metrics::{psnr, ssim, subject_mask};
-use frf_core::image::{Image, Rgba};
+use frf_core::image::{GrayImage, Image, Rgba};
 use frf_core::io::rgba_from;
 use frf_core::progress::Progress;
+
+/// Pixels a walker's own pixels are grown by for its scores (see the module docs).
+pub const WALKER_MARGIN_PX: usize = 2;
+
+/// A pixel belongs to the walker whose true coverage is at least this share of the
+/// pixel's true alpha, where that alpha is at least [`crate::metrics::SUBJECT_ALPHA`].
+const OWN_SHARE: f32 = 0.5;
 
 /// Which instant of the walk a frame's truth shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -42,6 +61,23 @@ pub enum TruthAt {
     Pose,
 }
 
+/// One walker of one frame against its truth.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WalkerFrameScore {
+    /// The pose drawn (the earlier, between two).
+    pub pose: u32,
+    /// Between two poses: the later and the fraction of the way to it.
+    pub between: Option<(u32, f32)>,
+    /// The instant of its walk the truth shows, seconds into its cycle.
+    pub truth_time_s: f64,
+    /// Its pixels (where it is the nearest true walker, grown by [`WALKER_MARGIN_PX`]).
+    pub pixels: usize,
+    /// PSNR of the walkers' layer over its pixels, dB (`None` without pixels).
+    pub psnr_subject: Option<f64>,
+    /// Soft alpha IoU over its pixels (`None` without pixels).
+    pub alpha_iou: Option<f64>,
+}
+
 /// One frame of a shot against its truth.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ShotFrameScore {
@@ -49,43 +85,82 @@ pub struct ShotFrameScore {
     pub index: usize,
     /// Seconds into the shot.
     pub time: f64,
-    /// The pose drawn (the earlier, between two).
+    /// The pose the first walker draws (the earlier, between two).
     pub pose: u32,
-    /// Between two poses: the later and the fraction of the way to it.
+    /// Between two poses: the later and the fraction of the way to it (first walker).
     pub between: Option<(u32, f32)>,
-    /// The instant of the walk the truth shows, seconds into its cycle.
+    /// The instant of the first walker's walk the truth shows, seconds into its cycle.
     pub truth_time_s: f64,
-    /// How far the frame's instant is from the drawn pose's, seconds (wrapped to the
-    /// nearest cycle; 0 when the truth is at the pose).
+    /// How far that instant is from the drawn pose's, seconds (wrapped to the nearest
+    /// cycle; 0 when the truth is at the pose).
     pub time_from_pose_s: f64,
-    /// PSNR of the whole frame (walker, shadow, backdrop) against the true composite, dB.
+    /// PSNR of the whole frame (walkers, shadows, backdrop) against the true composite, dB.
     pub psnr_frame: f64,
-    /// PSNR of the walker layer where it or the truth covers the pixel, dB.
+    /// PSNR of the walkers' layer where it or the truth covers the pixel, dB.
     pub psnr_subject: f64,
-    /// SSIM of the walker layer over the same pixels.
+    /// SSIM of the walkers' layer over the same pixels.
     pub ssim_subject: f64,
-    /// Seconds the renderer took for the frame (including making its pose resident).
+    /// Soft intersection over union of the walkers' alpha with the true coverage.
+    pub alpha_iou: f64,
+    /// Whether two walkers' true pixels overlap in the frame (one hides part of another).
+    pub walkers_overlap: bool,
+    /// Per walker.
+    pub walkers: Vec<WalkerFrameScore>,
+    /// Seconds the renderer took for the frame (including making its poses resident).
     pub seconds_render: f64,
     /// Seconds the stage took for the true frame (CPU).
     pub seconds_truth: f64,
 }
 
-/// Scores `frame` of `shot` against the truth of `stage` under `lights` median-cut
-/// lights of the frame's environment.
-pub fn score_frame<R: ReadAt>(
-    stage: &Stage,
-    shot: &mut Shot<'_, R>,
-    frame: &ShotFrame,
-    lights: usize,
-    truth_at: TruthAt,
-) -> Result<ShotFrameScore> {
-    Ok(score_frame_walkers(stage, shot, frame, lights, truth_at)?.0)
-}
-
-/// The rendered and the true walker of a frame (premultiplied RGBA).
+/// The rendered and the true walkers of a frame (premultiplied RGBA).
 type Walkers = (Image<Rgba>, Image<Rgba>);
 
-/// [`score_frame`], with the frame's rendered and true walker.
+/// `Σ min / Σ max` of two alphas over the pixels `mask` keeps (all without one); 1 where
+/// both are empty.
+pub fn soft_iou(a: &[f32], b: &[f32], mask: Option<&[bool]>) -> f64 {
+    let (mut inter, mut union) = (0.0f64, 0.0f64);
+    for (i, (&x, &y)) in a.iter().zip(b).enumerate() {
+        if mask.is_some_and(|m| !m[i]) {
+            continue;
+        }
+        let (x, y) = (x.clamp(0.0, 1.0) as f64, y.clamp(0.0, 1.0) as f64);
+        inter += x.min(y);
+        union += x.max(y);
+    }
+    if union > 0.0 { inter / union } else { 1.0 }
+}
+
+/// The pixels where walker `k` is the nearest true walker (see the module docs), grown by
+/// [`WALKER_MARGIN_PX`].
+fn own_pixels(coverage: &[GrayImage], alpha: &GrayImage, k: usize) -> Vec<bool> {
+    let (w, h) = alpha.size();
+    let own: Vec<bool> = (0..w * h)
+        .map(|i| {
+            let a = alpha.pixels()[i];
+            a >= crate::metrics::SUBJECT_ALPHA && coverage[k].pixels()[i] >= OWN_SHARE * a
+        })
+        .collect();
+    let m = WALKER_MARGIN_PX as isize;
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as isize, (i / w) as isize);
+            (-m..=m).any(|dy| {
+                (-m..=m).any(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    u >= 0
+                        && v >= 0
+                        && (u as usize) < w
+                        && (v as usize) < h
+                        && own[v as usize * w + u as usize]
+                })
+            })
+        })
+        .collect()
+}
+
+/// Scores `frame` of `shot` against the truth of `stage` under `lights` median-cut
+/// lights of each walker's environment (see the module docs), with the frame's rendered
+/// and true walkers.
 fn score_frame_walkers<R: ReadAt>(
     stage: &Stage,
     shot: &mut Shot<'_, R>,
@@ -93,16 +168,9 @@ fn score_frame_walkers<R: ReadAt>(
     lights: usize,
     truth_at: TruthAt,
 ) -> Result<(ShotFrameScore, Walkers)> {
-    let scene = shot.scene();
-    if scene.instances.len() != 1 {
-        return Err(EvalError::NoTruth(format!(
-            "a scene of {} walkers: the stage's truth has one",
-            scene.instances.len()
-        )));
-    }
-    let placement = scene.placement(0, frame.time);
+    let scene = shot.scene().clone();
+    let gait = shot.plan().gait;
     let cycle = stage.config().gait.cycle_seconds();
-    let instant = scene.phase_at(0, frame.time, &shot.plan().gait) * cycle;
     let world = shot.lighting_at(frame.time)?.ok_or_else(|| {
         EvalError::NoTruth("an unlit scene has no true lighting to compare with".into())
     })?;
@@ -111,52 +179,128 @@ fn score_frame_walkers<R: ReadAt>(
     let t = Instant::now();
     let rendered = shot.render(frame, true)?;
     let seconds_render = t.elapsed().as_secs_f64();
-    let pose = rendered.poses[0];
     let layers = rendered
         .frame
         .layers
         .ok_or_else(|| EvalError::Misuse("the renderer returned no layers".into()))?;
 
-    // The truth, in the walker's frame: its camera and its lighting.
+    // The truth: every walker where the scene places it, at its instant, lit where it is.
     let t = Instant::now();
-    let subject_camera = placement.camera_in_subject_frame(&frame.camera);
-    let lights = world.rotated(-placement.heading).median_cut(lights);
-    let pose_time = stage.pose_time_s(pose);
-    let truth_time_s = match truth_at {
-        TruthAt::Pose => pose_time,
-        TruthAt::Instant => instant,
-    };
+    let mut walkers = Vec::with_capacity(scene.instances.len());
+    let mut times = Vec::with_capacity(scene.instances.len());
+    for i in 0..scene.instances.len() {
+        let placement = scene.placement(i, frame.time);
+        let env = shot.walker_environment(i, frame.time)?.ok_or_else(|| {
+            EvalError::NoTruth("an unlit scene has no true lighting to compare with".into())
+        })?;
+        let time_s = match truth_at {
+            TruthAt::Pose => stage.pose_time_s(rendered.poses[i]),
+            TruthAt::Instant => scene.phase_at(i, frame.time, &gait) * cycle,
+        };
+        times.push(time_s);
+        walkers.push(TrueWalker {
+            world_from_subject: placement.world_from_subject(),
+            time_s,
+            lights: env.median_cut(lights),
+        });
+    }
+    let truth = stage.crowd_truth(&frame.camera, &walkers);
+    let subject = rgba_from(&truth.color, &truth.alpha)?;
+    let actors = stage.crowd_actors(&walkers);
+    let ground_lights: Vec<DirLight> = world.median_cut(lights);
+    let shadow = |p: glam::Vec3| relative_irradiance_among(&actors, &ground_lights, p);
+    let (truth_frame, _) = compose(subject.clone(), &frame.camera, &backdrop, &shadow)?;
+    let seconds_truth = t.elapsed().as_secs_f64();
+
+    let mask = subject_mask(&subject, &layers.subject);
+    let rendered_alpha: Vec<f32> = layers.subject.pixels().iter().map(|p| p[3]).collect();
+    let true_alpha: Vec<f32> = subject.pixels().iter().map(|p| p[3]).collect();
+    let own: Vec<Vec<bool>> = (0..walkers.len())
+        .map(|k| own_pixels(&truth.coverage, &truth.alpha, k))
+        .collect();
+    let walkers_overlap = (0..walkers.len()).any(|a| {
+        (a + 1..walkers.len()).any(|b| {
+            truth.coverage[a]
+                .pixels()
+                .iter()
+                .zip(truth.coverage[b].pixels())
+                .any(|(x, y)| *x > 0.01 && *y > 0.01)
+        })
+    });
+    let per_walker = (0..walkers.len())
+        .map(|k| {
+            let pixels = own[k].iter().filter(|&&m| m).count();
+            WalkerFrameScore {
+                pose: rendered.poses[k],
+                between: rendered.between[k],
+                truth_time_s: times[k],
+                pixels,
+                psnr_subject: (pixels > 0).then(|| psnr(&subject, &layers.subject, Some(&own[k]))),
+                alpha_iou: (pixels > 0)
+                    .then(|| soft_iou(&rendered_alpha, &true_alpha, Some(&own[k]))),
+            }
+        })
+        .collect();
+    let pose_time = stage.pose_time_s(rendered.poses[0]);
     let time_from_pose_s = {
-        let d = (truth_time_s - pose_time).rem_euclid(cycle);
+        let d = (times[0] - pose_time).rem_euclid(cycle);
         let d = if d > 0.5 * cycle { d - cycle } else { d };
         // Rounding at a pose's own instant is no time at all (not -0.0 ms).
         if d.abs() < 1e-9 { 0.0 } else { d }
     };
-    let truth = stage.truth_image_at(truth_time_s, &subject_camera, &lights);
-    let subject = rgba_from(&truth.color, &truth.alpha)?;
-    let actor = stage.true_actor_at(truth_time_s);
-    let subject_from_world = placement.world_from_subject().inverse();
-    let shadow =
-        |p: glam::Vec3| relative_irradiance(&actor, &lights, subject_from_world.transform_point(p));
-    let (truth, _) = compose(subject.clone(), &frame.camera, &backdrop, &shadow)?;
-    let seconds_truth = t.elapsed().as_secs_f64();
-
-    let mask = subject_mask(&subject, &layers.subject);
     let score = ShotFrameScore {
         index: frame.index,
         time: frame.time,
-        pose,
+        pose: rendered.poses[0],
         between: rendered.between[0],
-        truth_time_s,
+        truth_time_s: times[0],
         time_from_pose_s,
-        psnr_frame: psnr(&truth, &rendered.frame.composite, None),
+        psnr_frame: psnr(&truth_frame, &rendered.frame.composite, None),
         psnr_subject: psnr(&subject, &layers.subject, Some(&mask)),
         ssim_subject: ssim(&subject, &layers.subject, Some(&mask)),
+        alpha_iou: soft_iou(&rendered_alpha, &true_alpha, None),
+        walkers_overlap,
+        walkers: per_walker,
         seconds_render,
         seconds_truth,
     };
     Ok((score, (layers.subject, subject)))
 }
+
+/// The most a stance foot slides on the ground over the time range of `scene` (the
+/// largest distance, in centimetres, that the stage's own sole point of a foot that is
+/// down moves from where it touched down), sampled `rate_hz` times a second, for every
+/// walker: each placed where the scene places it and at the instant of its walk the
+/// scene's phase gives ([`Scene::phase_at`] with `gait`). A walker on the spot slides by
+/// its treadmill's travel over a stance; on a path at the captured speed, by nothing.
+pub fn foot_slide_cm(stage: &Stage, scene: &Scene, gait: &frf_scene::Gait, rate_hz: f64) -> f64 {
+    let cycle = stage.config().gait.cycle_seconds();
+    let steps = (((scene.end - scene.start) * rate_hz).ceil() as usize).max(1);
+    let mut worst = 0.0f64;
+    for i in 0..scene.instances.len() {
+        // Per foot: where it touched down, while it is down.
+        let mut planted: [Option<glam::Vec3>; 2] = [None, None];
+        for k in 0..=steps {
+            let t = scene.start + (scene.end - scene.start) * k as f64 / steps as f64;
+            let place = scene.placement(i, t).world_from_subject();
+            let feet = stage.feet_at(scene.phase_at(i, t, gait) * cycle);
+            for (f, foot) in feet.iter().enumerate() {
+                if !foot.down {
+                    planted[f] = None;
+                    continue;
+                }
+                let at = place.transform_point(foot.point);
+                let first = *planted[f].get_or_insert(at);
+                worst = worst.max(at.distance(first) as f64);
+            }
+        }
+    }
+    100.0 * worst
+}
+
+/// Samples a second of [`foot_slide_cm`] in reports: a 240 Hz clock resolves a foot's
+/// slide to under half a centimetre at walking speeds.
+pub const FOOT_SLIDE_RATE_HZ: f64 = 240.0;
 
 /// How the walker changes from frame to frame, against how the true walker does: over
 /// the pairs of consecutive frames scored, the mean absolute change of its premultiplied
@@ -211,6 +355,25 @@ fn steadiness(frames: &[(ShotFrameScore, Walkers)]) -> Option<Steadiness> {
     })
 }
 
+/// One walker over the frames scored.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct WalkerSummary {
+    /// Mean PSNR over its pixels, dB (`None`: never seen).
+    pub psnr_subject_mean: Option<f64>,
+    /// Mean soft alpha IoU over its pixels.
+    pub alpha_iou_mean: Option<f64>,
+    /// The same over the frames where walkers overlap (`None`: none do).
+    pub psnr_subject_overlap: Option<f64>,
+    /// (See `psnr_subject_overlap`.)
+    pub alpha_iou_overlap: Option<f64>,
+}
+
+/// The mean of the values given, if any.
+fn mean_some(v: impl Iterator<Item = Option<f64>>) -> Option<f64> {
+    let v: Vec<f64> = v.flatten().collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
 /// Memory budget of the poses kept resident while scoring a shot, bytes (a few frames
 /// only).
 const BUDGET_BYTES: u64 = 4_000_000_000;
@@ -240,6 +403,13 @@ pub struct ShotReport {
     pub psnr_subject_mean: f64,
     /// Mean SSIM of the walker.
     pub ssim_subject_mean: f64,
+    /// Mean soft alpha IoU of the walkers against the true coverage.
+    pub alpha_iou_mean: f64,
+    /// Per walker: its mean PSNR and alpha IoU over its own pixels (frames where it has
+    /// some), and over the frames where walkers overlap.
+    pub walkers: Vec<WalkerSummary>,
+    /// The most a stance foot slides on the ground over the shot, cm ([`foot_slide_cm`]).
+    pub foot_slide_cm: f64,
     /// Mean seconds to render a frame.
     pub seconds_render_mean: f64,
     /// Mean seconds for a true frame.
@@ -300,6 +470,24 @@ pub fn evaluate_shot<R: ReadAt>(
     let scores: Vec<ShotFrameScore> = scored.into_iter().map(|(s, _)| s).collect();
     let mean =
         |g: fn(&ShotFrameScore) -> f64| scores.iter().map(g).sum::<f64>() / scores.len() as f64;
+    let walkers = (0..scene.instances.len())
+        .map(|k| {
+            let of = |overlap: bool, g: fn(&WalkerFrameScore) -> Option<f64>| {
+                mean_some(
+                    (scores.iter())
+                        .filter(|s| !overlap || s.walkers_overlap)
+                        .map(|s| g(&s.walkers[k])),
+                )
+            };
+            WalkerSummary {
+                psnr_subject_mean: of(false, |w| w.psnr_subject),
+                alpha_iou_mean: of(false, |w| w.alpha_iou),
+                psnr_subject_overlap: of(true, |w| w.psnr_subject),
+                alpha_iou_overlap: of(true, |w| w.alpha_iou),
+            }
+        })
+        .collect();
+    let foot_slide_cm = foot_slide_cm(stage, scene, &shot.plan().gait, FOOT_SLIDE_RATE_HZ);
     let (scene_path, field_path, capture) = paths;
     Ok(ShotReport {
         scene: scene_path,
@@ -312,6 +500,9 @@ pub fn evaluate_shot<R: ReadAt>(
         psnr_frame_mean: mean(|s| s.psnr_frame),
         psnr_subject_mean: mean(|s| s.psnr_subject),
         ssim_subject_mean: mean(|s| s.ssim_subject),
+        alpha_iou_mean: mean(|s| s.alpha_iou),
+        walkers,
+        foot_slide_cm,
         seconds_render_mean: mean(|s| s.seconds_render),
         seconds_truth_mean: mean(|s| s.seconds_truth),
         frames: scores,
@@ -351,7 +542,7 @@ impl ShotReport {
             },
             self.device
         ));
-        lines.push("frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  render s  truth s".to_string());
+        lines.push("frame   time  pose  from pose  PSNR frame  PSNR walker  SSIM walker  alpha IoU  render s  truth s".to_string());
         for s in &self.frames {
             // Between two poses: both, the earlier first.
             let pose = match s.between {
@@ -359,7 +550,7 @@ impl ShotReport {
                 None => s.pose.to_string(),
             };
             lines.push(format!(
-                "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>9.3} {:>8.2}",
+                "{:>5} {:>6.2} {:>5} {:>7.1} ms {:>8.2} dB {:>9.2} dB {:>12.4} {:>10.4} {:>9.3} {:>8.2}",
                 s.index,
                 s.time,
                 pose,
@@ -367,6 +558,7 @@ impl ShotReport {
                 s.psnr_frame,
                 s.psnr_subject,
                 s.ssim_subject,
+                s.alpha_iou,
                 s.seconds_render,
                 s.seconds_truth
             ));
@@ -379,6 +571,24 @@ impl ShotReport {
             self.seconds_render_mean,
             self.seconds_truth_mean
         ));
+        lines.push(format!(
+            "alpha IoU of the walkers against the true coverage: {:.4} (mean); a stance foot slides \
+             {:.2} cm at most on the ground",
+            self.alpha_iou_mean, self.foot_slide_cm
+        ));
+        if self.walkers.len() > 1 {
+            for (k, w) in self.walkers.iter().enumerate() {
+                let db = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2} dB"));
+                let iou = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
+                lines.push(format!(
+                    "walker {k}: {} (alpha IoU {}) over its pixels; where walkers overlap {} ({})",
+                    db(w.psnr_subject_mean),
+                    iou(w.alpha_iou_mean),
+                    db(w.psnr_subject_overlap),
+                    iou(w.alpha_iou_overlap)
+                ));
+            }
+        }
         if let Some(m) = &self.steadiness {
             lines.push(format!(
                 "motion: the walker's largest change between consecutive frames {:.5} (mean |ΔRGBA| a pixel), \

@@ -313,6 +313,7 @@ pub fn probes(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Probes>> {
             env: source,
             yaw: radians(v.yaw_deg),
             intensity: v.intensity,
+            suns: v.suns,
         });
     }
     let points = probes

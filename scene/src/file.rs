@@ -35,7 +35,8 @@
 //! # [[lighting.probe]]                # light probes (frf_scene::probes): each walker is
 //! # position = [-4.0, 1.2, 0.0]       # lit by them interpolated where it stands, the
 //! # env = "shade.hdr"                 # key's intensity and the sun added; the backdrop
-//! # yaw_deg = 0.0                     # still shows env
+//! # yaw_deg = 0.0                     # still shows env; suns = false: the map's
+//! #                                   # suns taken out (in shade)
 //!
 //! [camera]                            # an orbit over the time range, or keys
 //! orbit = { radius = 3.2, height = 1.4, start_deg = -30.0, sweep_deg = 120.0,
@@ -208,6 +209,14 @@ pub struct ProbeToml {
     /// Multiplier of its radiance.
     #[serde(default = "one_f32")]
     pub intensity: f32,
+    /// `false`: the map with its suns taken out, as in the shade of something between
+    /// the probe and the sun (default `true`).
+    #[serde(default = "yes")]
+    pub suns: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn one_f32() -> f32 {

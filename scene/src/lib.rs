@@ -149,6 +149,8 @@ pub struct Probe {
     pub yaw: f32,
     /// Multiplier of its radiance.
     pub intensity: f32,
+    /// Whether its map keeps its suns (`false`: taken out, the probe in shade).
+    pub suns: bool,
 }
 
 /// The scene's light probes and how they interpolate.

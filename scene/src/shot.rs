@@ -146,6 +146,8 @@ struct ProbeLights {
     maps: Vec<EnvMap>,
     terms: Vec<YawTerm>,
     sun: Option<YawTerm>,
+    /// The scene's sun, as turned and scaled at the frame.
+    sun_light: Option<frf_core::sun::Sun>,
 }
 
 /// A walker's own light at a frame: its heading and the probes' weights where it stands,
@@ -169,6 +171,20 @@ impl WalkerLight {
             key,
         }
     }
+}
+
+/// The map that lights a walker under `world` (scene frame): the scene's, or with probes
+/// theirs mixed by `weights` with the scene's sun in it.
+fn walker_map(world: &World, weights: &[(usize, f32)]) -> Result<EnvMap> {
+    let Some(p) = &world.probes else {
+        return Ok(world.env.clone());
+    };
+    let mixed: Vec<(&EnvMap, f32)> = weights.iter().map(|&(k, w)| (&p.maps[k], w)).collect();
+    let mixed = EnvMap::mix(&mixed)?;
+    Ok(match &p.sun_light {
+        Some(s) => s.lit(&mixed)?,
+        None => mixed,
+    })
 }
 
 struct Cached {
@@ -463,6 +479,30 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok(Some(e))
     }
 
+    /// The map of `probe`: its environment, or that less its suns ([`frf_core::sun::Sun::extract`], as
+    /// many as a relighting takes out) when it stands in shade; made once.
+    fn probe_map(&mut self, probe: &crate::Probe) -> Result<EnvMap> {
+        let e = self.env(&probe.env)?.ok_or(SceneError::Misuse(
+            "a probe without a map (refused when the scene is read)",
+        ))?;
+        if probe.suns {
+            return Ok(e);
+        }
+        let key = format!("{} (shade)", probe.env);
+        if let Some(shade) = self.envs.get(&key) {
+            return Ok(shade.clone());
+        }
+        let mut shade = e;
+        for _ in 0..frf_reflectance::sun_light::MAX_SUNS {
+            match frf_core::sun::Sun::extract(&shade)? {
+                Some((_, less)) => shade = less,
+                None => break,
+            }
+        }
+        self.envs.insert(key, shade.clone());
+        Ok(shade)
+    }
+
     /// The yaw table of the map `key` (made by `map` the first time).
     fn table(
         &mut self,
@@ -536,10 +576,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             Some(p) => {
                 let (mut maps, mut terms) = (Vec::new(), Vec::new());
                 for probe in &p.probes {
-                    let e = self.env(&probe.env)?.ok_or(SceneError::Misuse(
-                        "a probe without a map (refused when the scene is read)",
-                    ))?;
-                    let table = self.table(probe.env.to_string(), || Ok(e.clone()))?;
+                    let e = self.probe_map(probe)?;
+                    let shade = if probe.suns { "" } else { " (shade)" };
+                    let table = self.table(format!("{}{shade}", probe.env), || Ok(e.clone()))?;
                     let weight = probe.intensity * l.intensity;
                     maps.push(e.rotated(probe.yaw).scaled(weight));
                     terms.push(YawTerm {
@@ -552,6 +591,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     maps,
                     terms,
                     sun: sun_term,
+                    sun_light: l.sun,
                 })
             }
         };
@@ -693,6 +733,19 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         self.live_frames += 1;
         let fp = self.frame_at(self.live_frames, time);
         self.render_plan(&fp, camera, layers)
+    }
+
+    /// The environment that lights walker `walker` at `t` seconds (scene frame): the
+    /// scene's ([`Shot::lighting_at`]), or with probes theirs mixed where it stands with
+    /// the scene's sun; `None` when the scene shows the field unlit. What its truth is lit
+    /// by.
+    pub fn walker_environment(&mut self, walker: usize, t: f64) -> Result<Option<EnvMap>> {
+        let l = self.scene.lighting_at(t);
+        let Some(world) = self.world_lighting(&l)? else {
+            return Ok(None);
+        };
+        let weights = self.scene.probe_weights(walker, t);
+        Ok(Some(walker_map(&world, &weights)?))
     }
 
     /// The environment lighting the scene (scene frame) at `t` seconds: `None` when the
@@ -1028,17 +1081,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let (Some(hull), Some(world)) = (self.field.hull(pose)?, world) else {
             return Ok(None);
         };
-        let env = match &world.probes {
-            None => world.env.rotated(-light.heading),
-            Some(p) => {
-                let mixed: Vec<(&EnvMap, f32)> = light
-                    .weights
-                    .iter()
-                    .map(|&(k, w)| (&p.maps[k], w))
-                    .collect();
-                EnvMap::mix(&mixed)?.rotated(-light.heading)
-            }
-        };
+        let env = walker_map(world, &light.weights)?.rotated(-light.heading);
         let ground = self
             .field
             .header()

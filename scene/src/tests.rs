@@ -336,3 +336,91 @@ fn only_rays_near_the_subject_may_see_it() {
     assert!(!may_see_subject(eye, Vec3::Z));
     assert!(may_see_subject(Vec3::new(0.2, 1.0, 0.0), Vec3::Z));
 }
+
+/// Walkers on paths and light probes in scene files: what they accept, and what they
+/// refuse naming the walker's key or the probe and the line.
+#[test]
+fn paths_and_probes_are_read_and_bad_ones_refused_by_name() {
+    let path = format!(
+        "{MINIMAL}\n[[instance]]\ntime_offset = 0.2\n\
+         [[instance.key]]\ntime = 0.0\nposition = [-1.0, 0.0, 0.0]\n\
+         [[instance.key]]\ntime = 1.0\nposition = [0.0, 0.0, 1.0]\n"
+    );
+    let s = scene(&path).unwrap();
+    // Two keys: a straight line, walked without turning.
+    assert!(s.instances[0].moves() && !s.instances[0].turns());
+    let at = s.placement(0, 1.0).position;
+    assert!((at - Vec3::new(0.0, 0.0, 1.0)).length() < 1e-5, "{at}");
+    // Phase from the distance walked: 1.2 m a cycle.
+    let gait = Gait::new(1.0, Some(1.2));
+    let walked = s.instances[0].path.as_ref().unwrap().distance(1.0);
+    let want = (0.2 + walked / 1.2).rem_euclid(1.0);
+    assert!((s.phase_at(0, 1.0, &gait) - want).abs() < 1e-9);
+
+    let one_key = format!(
+        "{MINIMAL}\n[[instance]]\n[[instance.key]]\ntime = 0.0\nposition = [0.0, 0.0, 0.0]\n"
+    );
+    let e = error(&one_key);
+    assert!(
+        e.contains("instance[0].key[0]") && e.contains("at least two keys"),
+        "{e}"
+    );
+    let out_of_order = path.replace(
+        "time = 1.0\nposition = [0.0",
+        "time = -1.0\nposition = [0.0",
+    );
+    let e = error(&out_of_order);
+    assert!(
+        e.contains("instance[0].key[1]") && e.contains("does not follow"),
+        "{e}"
+    );
+    assert!(e.contains("line"), "{e}");
+    let nan = path.replace("[-1.0, 0.0, 0.0]", "[nan, 0.0, 0.0]");
+    let e = error(&nan);
+    assert!(
+        e.contains("instance[0].key[0]") && e.contains("not finite"),
+        "{e}"
+    );
+    let fast = path.replace(
+        "time = 1.0\nposition = [0.0, 0.0, 1.0]",
+        "time = 1.0\nposition = [900.0, 0.0, 1.0]",
+    );
+    let e = error(&fast);
+    assert!(e.contains("m/s") && e.contains("instance[0].key[1]"), "{e}");
+    let both = path.replace(
+        "time_offset = 0.2\n",
+        "time_offset = 0.2\nposition = [1.0, 0.0, 0.0]\n",
+    );
+    let e = error(&both);
+    assert!(
+        e.contains("instance[0].key") && e.contains("not position"),
+        "{e}"
+    );
+
+    let probes = format!(
+        "{MINIMAL}\n[[lighting.probe]]\nposition = [1.0, 1.2, 0.0]\nenv = \"sky\"\n\
+         [[lighting.probe]]\nposition = [-1.0, 1.2, 0.0]\nenv = \"uniform\"\nsuns = false\n"
+    );
+    let s = scene(&probes).unwrap();
+    let p = s.probes.as_ref().unwrap();
+    assert_eq!(p.probes.len(), 2);
+    assert!(!p.probes[1].suns);
+    // The walker at the origin: half of each.
+    let w = s.probe_weights(0, 0.0);
+    assert!(w.iter().all(|&(_, x)| (x - 0.5).abs() < 1e-6), "{w:?}");
+    let no_map = probes.replace("env = \"uniform\"", "env = \"none\"");
+    let e = error(&no_map);
+    assert!(
+        e.contains("lighting.probe[1].env") && e.contains("needs a map"),
+        "{e}"
+    );
+    let missing = probes.replace("env = \"uniform\"\n", "");
+    let e = error(&missing);
+    assert!(e.contains("env"), "{e}");
+    let same = probes.replace("[-1.0, 1.2, 0.0]", "[1.0, 0.5, 0.0]");
+    let e = error(&same);
+    assert!(
+        e.contains("lighting.probe[1]") && e.contains("probe 0"),
+        "{e}"
+    );
+}

@@ -163,6 +163,7 @@ pub fn scene_toml(
                         env: env_text(&p.env),
                         yaw_deg: f64::from(p.yaw).to_degrees(),
                         intensity: p.intensity,
+                        suns: p.suns,
                     })
                 })
                 .collect(),
