@@ -65,6 +65,7 @@ fn frames(scene: &Scene) -> Vec<(Image<Rgba>, Image<Rgba>)> {
         planned: true,
         traced_lights: 64,
         detail: None,
+        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
     };
     let mut shot = Shot::new(scene, &field, device(), &all, options).unwrap();
     all.iter()

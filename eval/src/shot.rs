@@ -110,6 +110,9 @@ pub struct ShotFrameScore {
     pub seconds_render: f64,
     /// Seconds the stage took for the true frame (CPU).
     pub seconds_truth: f64,
+    /// With `--standing`: the PSNR of the same walker standing at the origin, seen and
+    /// lit alike in its own frame ([`standing_twin`]), against the same truth, dB.
+    pub psnr_subject_standing: Option<f64>,
 }
 
 /// The rendered and the true walkers of a frame (premultiplied RGBA).
@@ -160,14 +163,14 @@ fn own_pixels(coverage: &[GrayImage], alpha: &GrayImage, k: usize) -> Vec<bool> 
 
 /// Scores `frame` of `shot` against the truth of `stage` under `lights` median-cut
 /// lights of each walker's environment (see the module docs), with the frame's rendered
-/// and true walkers.
+/// and true walkers, and its rendered and true composites.
 fn score_frame_walkers<R: ReadAt>(
     stage: &Stage,
     shot: &mut Shot<'_, R>,
     frame: &ShotFrame,
     lights: usize,
     truth_at: TruthAt,
-) -> Result<(ShotFrameScore, Walkers)> {
+) -> Result<(ShotFrameScore, Walkers, Walkers)> {
     let scene = shot.scene().clone();
     let gait = shot.plan().gait;
     let cycle = stage.config().gait.cycle_seconds();
@@ -263,8 +266,79 @@ fn score_frame_walkers<R: ReadAt>(
         walkers: per_walker,
         seconds_render,
         seconds_truth,
+        psnr_subject_standing: None,
     };
-    Ok((score, (layers.subject, subject)))
+    Ok((
+        score,
+        (layers.subject, subject),
+        (rendered.frame.composite, truth_frame),
+    ))
+}
+
+/// The twin of `scene`'s one walker at `frame` standing still: at the origin facing `+x`,
+/// at the same instant of its walk (its phase under `gait`), seen by the frame's camera
+/// carried into the walker's frame, lit by the same light turned with it (the lighting
+/// keys' yaw, the probes' places and turns), so that it sees the same relative views under
+/// the same relative light; one frame at time 0.
+pub fn standing_twin(
+    scene: &Scene,
+    frame: &ShotFrame,
+    gait: &frf_scene::Gait,
+    stage: &Stage,
+) -> Result<(Scene, ShotFrame)> {
+    let t = frame.time;
+    let placement = scene.placement(0, t);
+    let subject_from_world = placement.world_from_subject().inverse();
+    let heading = placement.heading;
+    let cycle = stage.config().gait.cycle_seconds();
+    let mut twin = scene.clone();
+    twin.start = 0.0;
+    twin.end = 0.0;
+    twin.instances = vec![frf_scene::Instance::standing(
+        glam::Vec3::ZERO,
+        0.0,
+        scene.phase_at(0, t, gait) * cycle,
+    )];
+    // The lighting at t, turned against the heading: one key, or two cross-fading at t's
+    // share.
+    let l = scene.lighting_at(t);
+    let key = |time: f64, env: &frf_core::env::EnvSource| frf_scene::LightKey {
+        time,
+        env: env.clone(),
+        yaw: l.yaw - heading,
+        intensity: l.intensity,
+    };
+    twin.lighting = match l.maps.as_slice() {
+        [(env, _)] => vec![key(f64::NEG_INFINITY, env)],
+        [(a, _), (b, s)] => vec![
+            key(f64::NEG_INFINITY, a),
+            key(-f64::from(*s), a),
+            key(1.0 - f64::from(*s), b),
+        ],
+        _ => return Err(EvalError::Misuse("a lighting of no map".into())),
+    };
+    if let Some(p) = &mut twin.probes {
+        for probe in &mut p.probes {
+            probe.position = subject_from_world.transform_point(probe.position);
+            probe.yaw -= heading;
+        }
+        let points = p
+            .probes
+            .iter()
+            .map(|q| glam::Vec2::new(q.position.x, q.position.z))
+            .collect();
+        p.layout = frf_scene::probes::ProbeLayout::new(points)
+            .map_err(|(_, e)| EvalError::Misuse(format!("the twin's probes: {e}")))?;
+    }
+    let camera = placement.camera_in_subject_frame(&frame.camera);
+    Ok((
+        twin,
+        ShotFrame {
+            index: 0,
+            time: 0.0,
+            camera,
+        },
+    ))
 }
 
 /// The most a stance foot slides on the ground over the time range of `scene` (the
@@ -410,6 +484,9 @@ pub struct ShotReport {
     pub walkers: Vec<WalkerSummary>,
     /// The most a stance foot slides on the ground over the shot, cm ([`foot_slide_cm`]).
     pub foot_slide_cm: f64,
+    /// With `--standing`: the mean PSNR of the walker's standing twin ([`standing_twin`])
+    /// over the same frames, dB.
+    pub psnr_subject_standing_mean: Option<f64>,
     /// Mean seconds to render a frame.
     pub seconds_render_mean: f64,
     /// Mean seconds for a true frame.
@@ -421,20 +498,48 @@ pub struct ShotReport {
     pub seconds: f64,
 }
 
-/// Scores `count` frames spread over the shot of `scene` (rendered from `field`, which
-/// `paths.1` names, on `device`) against the truth of `stage` under `lights` median-cut
-/// lights; `paths` = (scene file, field, capture) for the report.
-#[allow(clippy::too_many_arguments)]
+/// How a shot is scored ([`evaluate_shot`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ShotEval {
+    /// Frames scored, spread evenly over the shot.
+    pub frames: usize,
+    /// Median-cut lights of the truth.
+    pub lights: usize,
+    /// Which instant the truth shows.
+    pub truth_at: TruthAt,
+    /// How far a walker's own light may move before its poses are relit.
+    pub light_tolerance: frf_scene::shot::LightTolerance,
+    /// Also score, at each frame, the same walker standing at the origin seen by the same
+    /// camera and lit by the same light in its own frame ([`standing_twin`]): what a
+    /// walker on a path loses against one on the spot (one walker only).
+    pub standing: bool,
+    /// Render on the CPU reference.
+    pub cpu: bool,
+}
+
+/// Where `evaluate_shot` writes each scored frame's render and truth, as PNGs
+/// (`frame_NNNN.png`, `frame_NNNN_truth.png`), when given.
+pub type ShotImages<'a> = Option<&'a std::path::Path>;
+
+/// Scores frames of the shot of `scene` (rendered from `field`, which `paths.1` names)
+/// against the truth of `stage` as `how` says; `paths` = (scene file, field, capture)
+/// for the report.
 pub fn evaluate_shot<R: ReadAt>(
     scene: &Scene,
     field: &FieldFile<R>,
-    device: Device,
     stage: &Stage,
-    count: usize,
-    (lights, truth_at): (usize, TruthAt),
+    (how, images): (&ShotEval, ShotImages),
     paths: (PathBuf, PathBuf, PathBuf),
     progress: &dyn Progress,
 ) -> Result<ShotReport> {
+    let (count, lights, truth_at) = (how.frames, how.lights, how.truth_at);
+    if how.standing && scene.instances.len() != 1 {
+        return Err(EvalError::Misuse(format!(
+            "--standing compares one walker with itself standing, and the scene has {}",
+            scene.instances.len()
+        )));
+    }
+    let device = Device::open(how.cpu)?;
     let start = Instant::now();
     let h = field.header();
     let size = scene.size.unwrap_or((h.width, h.height));
@@ -448,6 +553,7 @@ pub fn evaluate_shot<R: ReadAt>(
         planned: true,
         traced_lights: lights,
         detail: None,
+        light_tolerance: how.light_tolerance,
     };
     let mut shot = Shot::new(scene, field, device, &frames, options)?;
     for f in &shot.plan().frames {
@@ -462,7 +568,27 @@ pub fn evaluate_shot<R: ReadAt>(
     progress.phase("frames scored", frames.len());
     let mut scored = Vec::new();
     for f in &frames {
-        scored.push(score_frame_walkers(stage, &mut shot, f, lights, truth_at)?);
+        let (mut score, walkers, composites) =
+            score_frame_walkers(stage, &mut shot, f, lights, truth_at)?;
+        if let Some(dir) = images {
+            let name = |suffix: &str| dir.join(format!("frame_{:04}{suffix}.png", f.index));
+            frf_core::io::write_png8_srgba(&name(""), &composites.0, 1.0)?;
+            frf_core::io::write_png8_srgba(&name("_truth"), &composites.1, 1.0)?;
+        }
+        if how.standing {
+            let (twin, twin_frame) = standing_twin(scene, f, &shot.plan().gait, stage)?;
+            let mut twin_shot =
+                Shot::new(&twin, field, Device::open(how.cpu)?, &[twin_frame], options)?;
+            let r = twin_shot.render(&twin_frame, true)?;
+            let layer = r
+                .frame
+                .layers
+                .ok_or_else(|| EvalError::Misuse("the renderer returned no layers".into()))?
+                .subject;
+            let mask = subject_mask(&walkers.1, &layer);
+            score.psnr_subject_standing = Some(psnr(&walkers.1, &layer, Some(&mask)));
+        }
+        scored.push((score, walkers));
         progress.step();
     }
     progress.finish();
@@ -503,6 +629,7 @@ pub fn evaluate_shot<R: ReadAt>(
         alpha_iou_mean: mean(|s| s.alpha_iou),
         walkers,
         foot_slide_cm,
+        psnr_subject_standing_mean: mean_some(scores.iter().map(|s| s.psnr_subject_standing)),
         seconds_render_mean: mean(|s| s.seconds_render),
         seconds_truth_mean: mean(|s| s.seconds_truth),
         frames: scores,
@@ -576,6 +703,14 @@ impl ShotReport {
              {:.2} cm at most on the ground",
             self.alpha_iou_mean, self.foot_slide_cm
         ));
+        if let Some(standing) = self.psnr_subject_standing_mean {
+            lines.push(format!(
+                "the same walker standing, seen and lit alike in its own frame: {standing:.2} dB \
+                 (walking {:.2} dB: {:+.2} dB)",
+                self.psnr_subject_mean,
+                self.psnr_subject_mean - standing
+            ));
+        }
         if self.walkers.len() > 1 {
             for (k, w) in self.walkers.iter().enumerate() {
                 let db = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2} dB"));

@@ -154,6 +154,7 @@ pub fn sprite_sheet(
         planned: false,
         traced_lights: 256,
         detail: Some(0),
+        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
     };
     let mut shot = Shot::live(scene, &field, device, shot_options)?;
     let (fw, fh) = options.frame_size;

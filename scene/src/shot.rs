@@ -61,6 +61,48 @@ pub struct ShotOptions {
     /// Every walker at this level of detail ([`frf_render::detail`]); `None`: the plan's
     /// choice per walker (full detail without a plan).
     pub detail: Option<u8>,
+    /// How far a walker's own light may move from the one its poses were relit for
+    /// before they are relit again ([`LightTolerance`]).
+    pub light_tolerance: LightTolerance,
+}
+
+/// How far a walker's own light (its heading, the probes' weights where it stands) may
+/// move from the one its resident poses were relit for before they are relit: a walker
+/// that turns or walks between probes is then relit every few frames rather than every
+/// frame. Zero relights at every change (exact).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct LightTolerance {
+    /// Radians of heading.
+    pub heading: f32,
+    /// Of any probe's weight.
+    pub weight: f32,
+}
+
+impl LightTolerance {
+    /// Exact: every change relights.
+    pub const EXACT: Self = Self {
+        heading: 0.0,
+        weight: 0.0,
+    };
+
+    /// What shots use unless told otherwise.
+    pub const DEFAULT: Self = Self::EXACT;
+
+    /// Whether poses relit for `lit` still serve a walker whose light is `now`.
+    fn holds(&self, lit: &WalkerLight, now: &WalkerLight) -> bool {
+        if lit.key == now.key {
+            return true;
+        }
+        let turn = (now.heading - lit.heading + std::f32::consts::PI)
+            .rem_euclid(std::f32::consts::TAU)
+            - std::f32::consts::PI;
+        let weight =
+            |w: &[(usize, f32)], k: usize| w.iter().find(|p| p.0 == k).map_or(0.0, |p| p.1);
+        let moved = (lit.weights.iter().chain(&now.weights))
+            .map(|&(k, _)| (weight(&lit.weights, k) - weight(&now.weights, k)).abs())
+            .fold(0.0f32, f32::max);
+        turn.abs() <= self.heading && moved <= self.weight
+    }
 }
 
 /// Whether a resident made from `have` serves a walker that needs `want` (`None`:
@@ -151,7 +193,7 @@ struct ProbeLights {
 }
 
 /// A walker's own light at a frame: its heading and the probes' weights where it stands,
-/// and that as bits, which tell two apart (see [`Cached::walker_key`]).
+/// and that as bits, which tell two apart (see [`Cached::lit`]).
 #[derive(Debug, Clone, PartialEq)]
 struct WalkerLight {
     heading: f32,
@@ -189,9 +231,9 @@ fn walker_map(world: &World, weights: &[(usize, f32)]) -> Result<EnvMap> {
 
 struct Cached {
     pose: u32,
-    /// The walker's light it is relit for ([`WalkerLight::key`]: its heading, and the
-    /// probes' weights where it stood).
-    walker_key: Vec<u32>,
+    /// The walker's light it is relit for (its heading, and the probes' weights where it
+    /// stood).
+    lit: WalkerLight,
     /// The walker it serves alone, when that walker turns (a walker on a path: relit in
     /// place as it turns); `None`: any walker of its heading.
     owner: Option<usize>,
@@ -904,7 +946,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             let serves = |c: &Cached| {
                 c.pose == pose
                     && c.owner == owner
-                    && (owner.is_some() || c.walker_key == light.key)
+                    && (owner.is_some() || c.lit.key == light.key)
                     && covers(&c.plan, wanted)
             };
             let found = self
@@ -918,14 +960,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .or_else(|| self.cache.iter().position(serves));
             let slot = match found {
                 Some(k)
-                    if self.cache[k].lighting == key && self.cache[k].walker_key == light.key =>
+                    if self.cache[k].lighting == key
+                        && self
+                            .options
+                            .light_tolerance
+                            .holds(&self.cache[k].lit, light) =>
                 {
                     k
                 }
                 Some(k) => {
                     // The same views under a new light, turned or moved: relit where they
                     // are.
-                    self.cache[k].walker_key = light.key.clone();
+                    self.cache[k].lit = light.clone();
                     let t = Instant::now();
                     self.relight_cached(k, world, light)?;
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
@@ -959,7 +1005,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     made_resident.push(pose);
                     self.cache.push(Cached {
                         pose,
-                        walker_key: light.key.clone(),
+                        lit: light.clone(),
                         owner,
                         plan: wanted,
                         lighting: key.clone(),

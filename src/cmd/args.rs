@@ -159,6 +159,29 @@ pub fn opt_path_text<S: serde::Serializer>(p: &Option<PathBuf>, s: S) -> Result<
     }
 }
 
+/// Parses a light tolerance: `DEG` (a walker's heading) or `DEG,WEIGHT` (and a probe's
+/// weight).
+pub fn parse_light_tolerance(s: &str) -> Result<frf_scene::shot::LightTolerance, String> {
+    let bad = || {
+        format!(
+            "light tolerance `{s}`: expected DEG or DEG,WEIGHT (a heading within 0 to 180 \
+             degrees, a probe's weight within 0 to 1)"
+        )
+    };
+    let mut parts = s
+        .split(',')
+        .map(|p| p.trim().parse::<f32>().map_err(|_| bad()));
+    let deg = parts.next().ok_or_else(bad)??;
+    let weight = parts.next().transpose()?.unwrap_or(0.0);
+    if parts.next().is_some() || !(0.0..=180.0).contains(&deg) || !(0.0..=1.0).contains(&weight) {
+        return Err(bad());
+    }
+    Ok(frf_scene::shot::LightTolerance {
+        heading: deg.to_radians(),
+        weight,
+    })
+}
+
 /// Parses `WxH`, each side 1 to [`MAX_SIDE_PX`].
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -202,6 +202,7 @@ fn frame(args: FrameArgs) -> CliResult {
             planned: true,
             traced_lights: 256,
             detail: None,
+            light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
         },
         cpu: args.cpu,
     };

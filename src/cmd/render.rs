@@ -114,6 +114,12 @@ pub struct RenderArgs {
     /// leave first).
     #[arg(long, default_value_t = DEFAULT_BUDGET_MB, value_parser = clap::value_parser!(u64).range(1..))]
     pub memory_budget: u64,
+    /// How far a walker's own light (its heading, degrees; the probes' weights where it
+    /// stands) may move before its poses are relit: `DEG` or `DEG,WEIGHT` (default: the
+    /// renderer's, `frf_scene::shot::LightTolerance::DEFAULT`; `0` relights every change).
+    #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
+    #[serde(skip)]
+    pub light_tolerance: Option<frf_scene::shot::LightTolerance>,
 }
 
 /// The scene a field render's flags describe: one walker frozen in `pose`.
@@ -290,6 +296,9 @@ pub fn run(args: RenderArgs) -> CliResult {
         planned: !args.no_plan,
         traced_lights: args.scene.shadow_lights,
         detail: args.detail,
+        light_tolerance: args
+            .light_tolerance
+            .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
     };
     let summary = render_to_dir(&job, args.cpu, options, &Bars::default(), &mut |line| {
         eprintln!("{line}")

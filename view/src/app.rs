@@ -291,6 +291,7 @@ impl<'a> App<'a> {
                 planned: false,
                 traced_lights: TRACED_LIGHTS,
                 detail: None,
+                light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
             },
         )?;
         let mut viewer = Viewer::new(shot, options.field.clone(), options.envs);

@@ -84,6 +84,15 @@ pub struct EvalArgs {
     /// drawn pose's (`pose`: the error of the view alone).
     #[arg(long, value_enum, default_value = "instant")]
     pub truth_at: TruthAtArg,
+    /// With a scene: how far a walker's own light may move before its poses are relit
+    /// (as `frf render --light-tolerance`).
+    #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
+    pub light_tolerance: Option<frf_scene::shot::LightTolerance>,
+    /// With a scene of one walker: also score the same walker standing at the origin,
+    /// seen by the same camera and lit by the same light in its own frame, at each frame
+    /// (what walking a path costs against walking on the spot).
+    #[arg(long)]
+    pub standing: bool,
     #[command(flatten)]
     pub compare: CompareArgs,
     /// Write each camera's truth and renders as PNGs here (with `--budget`, the first

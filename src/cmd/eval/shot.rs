@@ -2,9 +2,8 @@
 //! rendered as `frf render SCENE.toml` renders them and scored against their true
 //! composites from the virtual stage ([`frf_eval::shot`]).
 
-use frf_eval::shot::evaluate_shot;
+use frf_eval::shot::{ShotEval, evaluate_shot};
 use frf_reflectance::FieldFile;
-use frf_render::renderer::Device;
 use frf_scene::Scene;
 
 use super::args::EvalArgs;
@@ -23,13 +22,21 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let field = FieldFile::open(&field_path)?;
     frf_render::resident::check_renderable(&field)?;
     let stage = frf_stage::open_stage(&args.capture)?;
+    let how = ShotEval {
+        frames: args.frames.unwrap_or(DEFAULT_FRAMES),
+        lights: args.lights,
+        truth_at: args.truth_at.into(),
+        light_tolerance: args
+            .light_tolerance
+            .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
+        standing: args.standing,
+        cpu: args.compare.cpu,
+    };
     let report = evaluate_shot(
         &scene,
         &field,
-        Device::open(args.compare.cpu)?,
         &stage,
-        args.frames.unwrap_or(DEFAULT_FRAMES),
-        (args.lights, args.truth_at.into()),
+        (&how, args.images.as_deref()),
         (args.field.clone(), field_path, args.capture.clone()),
         &Bars::default(),
     )?;
