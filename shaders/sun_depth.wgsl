@@ -29,6 +29,20 @@ struct SunDepthJob {
 // f32's lowest finite value: a line that misses the hull.
 const MISSES: f32 = -3.4028235e38;
 
+// Another walker's hull walked along a walker's map (`SunDepth::with_occluders`): the
+// map's job (its `far` beyond both hulls) and `there_from_here`, the walker's frame into
+// the occluder's (rotation columns, translation). The occluder's hull is bound as
+// `proxy` and `hull_bits`.
+struct SunOccluderJob {
+    map: SunDepthJob,
+    there_x: vec4<f32>,
+    there_y: vec4<f32>,
+    there_z: vec4<f32>,
+    there_t: vec4<f32>,
+}
+
+@group(0) @binding(4) var<storage, read> occluder_jobs: array<SunOccluderJob>;
+
 // One texel (x) of the map of sun slot y.
 @compute @workgroup_size(64)
 fn sun_depth(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -44,4 +58,26 @@ fn sun_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = job.axis_x.xyz * q.x + job.axis_y.xyz * q.y + d * far;
     let t = hull_first_hit(origin, -d);
     reach[job.size.z + i] = select(MISSES, far - t, t >= 0.0);
+}
+
+// One texel (x) of the map of occluder job y: the reach there raised to the occluder's
+// where it lies farther toward the sun. Runs after `sun_depth` made the map.
+@compute @workgroup_size(64)
+fn sun_occluder(@builtin(global_invocation_id) id: vec3<u32>) {
+    let o = occluder_jobs[id.y];
+    let job = o.map;
+    let i = id.x;
+    if (job.size.w == 0u || i >= job.size.x * job.size.y) {
+        return;
+    }
+    let q = vec2<f32>(job.axis_x.w, job.axis_y.w)
+        + (vec2<f32>(f32(i % job.size.x), f32(i / job.size.x)) + 0.5) * job.texel.x;
+    let d = job.toward.xyz;
+    let far = job.toward.w;
+    let origin = job.axis_x.xyz * q.x + job.axis_y.xyz * q.y + d * far;
+    let there = mat3x3<f32>(o.there_x.xyz, o.there_y.xyz, o.there_z.xyz);
+    let t = hull_first_hit(there * origin + o.there_t.xyz, there * -d);
+    if (t >= 0.0) {
+        reach[job.size.z + i] = max(reach[job.size.z + i], far - t);
+    }
 }

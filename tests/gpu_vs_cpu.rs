@@ -606,3 +606,75 @@ fn overlapping_walkers_are_ordered_by_depth_as_on_the_cpu() {
     eprintln!("pixels where depth reorders the walkers: {crossed}");
     assert!(crossed > 0, "ordered by depth as by position everywhere");
 }
+
+/// A walker standing between the sun and the tiny field's walker: the suns' maps with its
+/// hull in the way are made on the GPU as the CPU twin traces them, the pose relit by
+/// them is the CPU's code for code, and the walker it shades is darker than without it.
+#[test]
+fn another_walker_in_the_way_of_the_sun_shades_on_both() {
+    use frf_core::camera::Rigid;
+    use frf_reflectance::project::FloorModel;
+    use frf_reflectance::sun_depth::Occluder;
+    use frf_reflectance::yaw_light::YawLight;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    // A low sun in the sky's place of the sun, and the same walker 1.2 m toward it.
+    let toward =
+        frf_core::light::direction_from_azimuth_elevation(90f32.to_radians(), 20f32.to_radians());
+    let env = frf_core::sun::Sun::new(toward, 1.0, [8.0, 7.0, 6.0])
+        .unwrap()
+        .lit(&EnvMap::uniform([0.2; 3], 64))
+        .unwrap();
+    let hull = std::sync::Arc::new(field.hull(0).unwrap().unwrap());
+    let mut beside = Vec3::new(toward.x, 0.0, toward.z).normalize() * 1.2;
+    beside.y = 0.0;
+    let occluder = Occluder {
+        hull,
+        here_from_there: Rigid {
+            rotation: glam::Mat3::IDENTITY,
+            translation: beside,
+        },
+    };
+    let light = |occluders: Vec<Occluder>| {
+        Lighting::Tabled(
+            YawLight::of_env(
+                field.projector_shared().unwrap().clone(),
+                &env,
+                FloorModel::Environment,
+            )
+            .with_occluders(occluders),
+        )
+    };
+    let alone = PoseSource::load(&field, 0, &light(Vec::new())).unwrap();
+    let shaded = PoseSource::load(&field, 0, &light(vec![occluder])).unwrap();
+    assert!(!shaded.suns.is_empty() && shaded.holds_normals());
+    assert_eq!(shaded.suns[0].depth.as_ref().unwrap().occluders.len(), 1);
+    let cpu = ResidentPose::relight_cpu(&shaded);
+    let pose = gpu.upload_pose(&shaded).unwrap();
+    assert_relit_as_the_cpu(&gpu, &pose, &cpu, "shaded by another walker");
+    let maps = gpu.read_sun_maps(&pose, &shaded.suns).unwrap();
+    let cpu_map = shaded.suns[0].depth.as_ref().unwrap().reach();
+    let differ = cpu_map
+        .iter()
+        .zip(&maps[0])
+        .filter(|(a, b)| (*a - *b).abs() > 1e-4)
+        .count();
+    assert!(differ * 1000 <= cpu_map.len(), "{differ} texels differ");
+    // The sunlit side of the walker goes dark where the other stands in the way.
+    let lum = |p: &ResidentPose| -> f64 {
+        p.prelit
+            .iter()
+            .zip(&p.scales)
+            .map(|(view, s)| view.iter().map(|c| c[1] as f64 * *s as f64).sum::<f64>())
+            .sum()
+    };
+    let (a, b) = (lum(&ResidentPose::relight_cpu(&alone)), lum(&cpu));
+    eprintln!("pre-lit light: alone {a:.3e}, with the other in the way {b:.3e}");
+    assert!(
+        b < 0.9 * a,
+        "the other walker took {:.1} % of the light",
+        100.0 * (1.0 - b / a)
+    );
+}

@@ -66,6 +66,7 @@ fn frames(scene: &Scene) -> Vec<(Image<Rgba>, Image<Rgba>)> {
         traced_lights: 64,
         detail: None,
         light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+        walker_shadows: true,
     };
     let mut shot = Shot::new(scene, &field, device(), &all, options).unwrap();
     all.iter()

@@ -515,6 +515,8 @@ pub struct ShotEval {
     pub standing: bool,
     /// Render on the CPU reference.
     pub cpu: bool,
+    /// Whether walkers shade one another under a sun (`false`: the ablation).
+    pub walker_shadows: bool,
 }
 
 /// Where `evaluate_shot` writes each scored frame's render and truth, as PNGs
@@ -554,6 +556,7 @@ pub fn evaluate_shot<R: ReadAt>(
         traced_lights: lights,
         detail: None,
         light_tolerance: how.light_tolerance,
+        walker_shadows: how.walker_shadows,
     };
     let mut shot = Shot::new(scene, field, device, &frames, options)?;
     for f in &shot.plan().frames {

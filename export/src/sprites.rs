@@ -155,6 +155,7 @@ pub fn sprite_sheet(
         traced_lights: 256,
         detail: Some(0),
         light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+        walker_shadows: true,
     };
     let mut shot = Shot::live(scene, &field, device, shot_options)?;
     let (fw, fh) = options.frame_size;

@@ -12,13 +12,30 @@
 //! ([`SunDepth::reach`]), and on the GPU by `shaders/sun_depth.wgsl`, the same walk through
 //! the hull (`shaders/rebin/proxy.wgsl`), where the relight pass reads them: a turning
 //! sun costs the host no walk.
+//!
+//! **Other walkers in the way** ([`Occluder`]): a walker near another may stand between it
+//! and the sun. Its hull, placed where it stands in this walker's frame, is walked along
+//! the same lines and raises their reach where it lies farther toward the sun
+//! ([`SunDepth::with_occluders`]): the map's texels stay this walker's (only its own points
+//! are looked up), and their lines start beyond both hulls.
 
 use std::sync::{Arc, OnceLock};
 
+use frf_core::camera::Rigid;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::hull::VoxelHull;
+
+/// Another walker's hull in the way of a walker's suns: the hull, and where it stands in
+/// the walker's frame.
+#[derive(Debug, Clone)]
+pub struct Occluder {
+    /// Its visual hull (in its own subject frame).
+    pub hull: Arc<VoxelHull>,
+    /// Its subject frame into the walker's.
+    pub here_from_there: Rigid,
+}
 
 /// The map's texel side in voxels of the hull. Measured at the captured views of the
 /// small oracle field (5 mm voxels; subject PSNR under the built-in sky / `grace`, and the
@@ -42,10 +59,12 @@ pub struct SunDepth {
     pub texel: f32,
     /// Texels along x and y.
     pub size: [u32; 2],
-    /// `toward · p` where each texel's ray starts, a texel beyond the hull's box on the
-    /// sun's side.
+    /// `toward · p` where each texel's ray starts, a texel beyond the hull's box (and its
+    /// occluders') on the sun's side.
     pub far: f32,
     hull: Arc<VoxelHull>,
+    /// Other walkers' hulls in the way ([`SunDepth::with_occluders`]).
+    pub occluders: Vec<Occluder>,
     reach: OnceLock<Vec<f32>>,
 }
 
@@ -56,7 +75,7 @@ impl SunDepth {
         let (x, y) = d.any_orthonormal_pair();
         let g = hull.grid();
         let texel = g.voxel_m * TEXEL_PER_VOXEL;
-        let (min, max, far) = projected_box(hull, [x, y, d]);
+        let (min, max, far, _) = projected_box(hull, [x, y, d], &Rigid::IDENTITY);
         // Rays start a texel beyond the box on the sun's side.
         let far = far + texel;
         let size = ((max - min) / texel).ceil().max(Vec2::ONE);
@@ -68,8 +87,32 @@ impl SunDepth {
             size: [size.x as u32, size.y as u32],
             far,
             hull: hull.clone(),
+            occluders: Vec::new(),
             reach: OnceLock::new(),
         }
+    }
+
+    /// The same map with `occluders` in the way too: those whose hull's box, seen along
+    /// the sun, overlaps the map and reaches farther toward the sun than this hull's
+    /// lowest point (the others cannot shade it) are kept, and the lines start beyond
+    /// them.
+    pub fn with_occluders(mut self, occluders: &[Occluder]) -> Self {
+        let [x, y] = self.axes;
+        let d = self.toward;
+        let (map_lo, map_hi) = (
+            self.corner,
+            self.corner + Vec2::new(self.size[0] as f32, self.size[1] as f32) * self.texel,
+        );
+        let own_low = projected_box(&self.hull, [x, y, d], &Rigid::IDENTITY).3;
+        for o in occluders {
+            let (lo, hi, far, _) = projected_box(&o.hull, [x, y, d], &o.here_from_there);
+            let overlaps = lo.x < map_hi.x && hi.x > map_lo.x && lo.y < map_hi.y && hi.y > map_lo.y;
+            if overlaps && far > own_low {
+                self.far = self.far.max(far + self.texel);
+                self.occluders.push(o.clone());
+            }
+        }
+        self
     }
 
     /// The most texels a map of `hull` can have, whatever the sun's direction: the box's
@@ -98,9 +141,18 @@ impl SunDepth {
                     let q = self.corner
                         + (Vec2::new((i % w) as f32, (i / w) as f32) + 0.5) * self.texel;
                     let origin = x * q.x + y * q.y + self.toward * self.far;
-                    self.hull
+                    let own = self
+                        .hull
                         .first_hit(origin, -self.toward)
-                        .map_or(f32::MIN, |t| self.far - t)
+                        .map_or(f32::MIN, |t| self.far - t);
+                    self.occluders.iter().fold(own, |reach, o| {
+                        let there = o.here_from_there.inverse();
+                        let dir = there.rotation * -self.toward;
+                        match o.hull.first_hit(there.transform_point(origin), dir) {
+                            Some(t) => reach.max(self.far - t),
+                            None => reach,
+                        }
+                    })
                 })
                 .collect()
         })
@@ -118,30 +170,55 @@ impl SunDepth {
     }
 }
 
-/// The hull's box seen along `axes` (`[x, y, toward]`): the least and most of its corners'
-/// `(x · p, y · p)`, and the most of their `toward · p`.
-fn projected_box(hull: &VoxelHull, [x, y, d]: [Vec3; 3]) -> (Vec2, Vec2, f32) {
+/// The hull's box, moved by `place`, seen along `axes` (`[x, y, toward]`): the least and
+/// most of its corners' `(x · p, y · p)`, and the most and least of their `toward · p`.
+fn projected_box(hull: &VoxelHull, [x, y, d]: [Vec3; 3], place: &Rigid) -> (Vec2, Vec2, f32, f32) {
     let g = hull.grid();
     let (lo, hi) = (Vec3::from(g.origin), g.max_corner());
-    let (mut min, mut max, mut far) = (Vec2::INFINITY, Vec2::NEG_INFINITY, f32::NEG_INFINITY);
+    let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
+    let (mut far, mut near) = (f32::NEG_INFINITY, f32::INFINITY);
     for c in 0..8 {
-        let p = Vec3::new(
+        let p = place.transform_point(Vec3::new(
             if c & 1 == 0 { lo.x } else { hi.x },
             if c & 2 == 0 { lo.y } else { hi.y },
             if c & 4 == 0 { lo.z } else { hi.z },
-        );
+        ));
         let q = Vec2::new(x.dot(p), y.dot(p));
         min = min.min(q);
         max = max.max(q);
         far = far.max(d.dot(p));
+        near = near.min(d.dot(p));
     }
-    (min, max, far)
+    (min, max, far, near)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use frf_core::volume::VoxelGrid;
+
+    #[test]
+    fn another_hull_toward_the_sun_shades_and_one_away_does_not() {
+        let own = ball(Vec3::new(0.0, 1.0, 0.0), 0.3, 0.02);
+        let other = ball(Vec3::new(0.0, 1.0, 0.0), 0.3, 0.02);
+        // A sun low in +x; the other walker 1.5 m toward it, and another 1.5 m away.
+        let toward = Vec3::new(1.0, 0.1, 0.0);
+        let at = |x: f32| Occluder {
+            hull: other.clone(),
+            here_from_there: Rigid {
+                rotation: glam::Mat3::from_rotation_y(0.7),
+                translation: Vec3::new(x, 0.0, 0.0),
+            },
+        };
+        let map = SunDepth::new(&own, toward).with_occluders(&[at(1.5), at(-1.5)]);
+        assert_eq!(map.occluders.len(), 1, "the one behind cannot shade");
+        // The ball's side facing the sun is now in the other's shadow; without it, lit.
+        let facing = Vec3::new(0.0, 1.0, 0.0) + toward.normalize() * 0.32;
+        assert!(map.shades(facing));
+        assert!(!SunDepth::new(&own, toward).shades(facing));
+        // Its top sees over the other: still lit.
+        assert!(!map.shades(Vec3::new(0.0, 1.31, 0.0)));
+    }
 
     /// A ball of radius `r` about `c`, voxels of side `s`.
     fn ball(c: Vec3, r: f32, s: f32) -> Arc<VoxelHull> {

@@ -197,6 +197,15 @@ impl SunLight {
         }
     }
 
+    /// The same sun with other walkers' hulls in the way of its shadows too
+    /// ([`SunDepth::with_occluders`]; nothing changes without a hull of its own).
+    pub fn with_occluders(mut self, occluders: &[crate::sun_depth::Occluder]) -> Self {
+        if !occluders.is_empty() {
+            self.depth = self.depth.map(|d| d.with_occluders(occluders));
+        }
+        self
+    }
+
     /// Condition `k`'s shading of a normal `n`, per unit of its light: its lights'
     /// `max(n · l, 0)` weighted by their shares ([`cone_shading`]).
     #[inline]

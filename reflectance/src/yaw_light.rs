@@ -15,6 +15,7 @@ use glam::{Mat3, Vec3};
 
 use crate::error::Result;
 use crate::project::{FloorModel, Projector};
+use crate::sun_depth::Occluder;
 use crate::sun_light::MAX_SUNS;
 use crate::yaw_table::{Part, YawTable};
 
@@ -29,10 +30,12 @@ pub struct YawTerm {
     pub yaw: f32,
 }
 
-/// A light as a sum of turned, weighted maps (see the module text).
+/// A light as a sum of turned, weighted maps (see the module text), and the other
+/// walkers that stand in the way of its suns ([`YawLight::with_occluders`]).
 #[derive(Debug, Clone)]
 pub struct YawLight {
     terms: Vec<YawTerm>,
+    occluders: Vec<Occluder>,
 }
 
 /// What relights a pose under a light: per view its coefficients (with the suns taken out
@@ -54,7 +57,23 @@ pub struct ViewLighting {
 impl YawLight {
     /// A light of `terms`.
     pub fn new(terms: Vec<YawTerm>) -> Self {
-        Self { terms }
+        Self {
+            terms,
+            occluders: Vec::new(),
+        }
+    }
+
+    /// The same light with `occluders` (in the frame of the walker it lights) in the way of
+    /// its suns: they shade the walker where they stand between it and a sun
+    /// ([`crate::sun_depth::Occluder`]).
+    pub fn with_occluders(mut self, occluders: Vec<Occluder>) -> Self {
+        self.occluders = occluders;
+        self
+    }
+
+    /// The other walkers in the way of its suns.
+    pub fn occluders(&self) -> &[Occluder] {
+        &self.occluders
     }
 
     /// `env` (turned by its own yaw) as a light of one map, through a table of its own.
@@ -124,6 +143,7 @@ impl YawLight {
                 })
                 .collect(),
         )
+        .with_occluders(self.occluders.clone())
     }
 
     /// Its coefficients at each of `turntables` (radians). With `suns`, the maps' suns

@@ -491,11 +491,9 @@ fn relighting<R: ReadAt>(
                 let weight = ground_weight(light.ground_share());
                 floor = floor_shares(&lights, &is_floor, (angles, weight), radiance);
             }
-            suns.extend(
-                lit.suns
-                    .iter()
-                    .map(|s| SunLight::new(s, &h.conditions, angles, hull)),
-            );
+            suns.extend(lit.suns.iter().map(|s| {
+                SunLight::new(s, &h.conditions, angles, hull).with_occluders(light.occluders())
+            }));
             Ok::<_, RenderError>((lit.coefficients, Some(lit.ground), lit.sun_coefficients))
         };
     let (mut coefficients, ground, mut sun_coefficients) = match lighting {

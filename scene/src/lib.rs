@@ -442,12 +442,13 @@ impl Scene {
         out
     }
 
-    /// Whether walker `i`'s own light changes during the shot: it turns, or it moves
-    /// between probes.
+    /// Whether walker `i`'s own light changes during the shot: it turns, it moves
+    /// between probes, or another walker moves (and may come between it and a sun).
     pub fn walker_light_changes(&self, i: usize) -> bool {
         let inst = &self.instances[i];
         let between_probes = self.probes.as_ref().is_some_and(|p| p.probes.len() > 1);
-        inst.turns() || (between_probes && inst.moves())
+        let others_move = (self.instances.iter().enumerate()).any(|(j, w)| j != i && w.moves());
+        inst.turns() || (between_probes && inst.moves()) || others_move
     }
 }
 

@@ -160,6 +160,24 @@ pub struct GpuSunDepthJob {
     pub texel: [f32; 4],
 }
 
+/// `SunOccluderJob` of `sun_depth.wgsl`: another walker's hull walked along one sun's
+/// map of a walker (`frf_reflectance::sun_depth::Occluder`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuSunOccluderJob {
+    /// The map's frame and slot, as its own job (`toward.w`: `far`, beyond both hulls).
+    pub map: GpuSunDepthJob,
+    /// `there_from_here` (the walker's frame into the occluder's): its rotation's columns
+    /// and its translation (w unused).
+    pub there_x: [f32; 4],
+    /// (See `there_x`.)
+    pub there_y: [f32; 4],
+    /// (See `there_x`.)
+    pub there_z: [f32; 4],
+    /// (See `there_x`.)
+    pub there_t: [f32; 4],
+}
+
 /// `RelightParams` of `relight.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]

@@ -11,7 +11,7 @@ use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuLightFitParams, GpuPresent, GpuProxy,
     GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuSunDepthJob,
-    GpuTimeMorph, GpuView,
+    GpuSunOccluderJob, GpuTimeMorph, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -155,6 +155,12 @@ fn pod_structs_match_naga_layouts() {
         "SunDepthJob",
         GpuSunDepthJob,
         [toward, axis_x, axis_y, size, texel]
+    );
+    check_layout!(
+        &sun_depth,
+        "SunOccluderJob",
+        GpuSunOccluderJob,
+        [map, there_x, there_y, there_z, there_t]
     );
     let rebin = module(
         &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES, (4, 1)),

@@ -203,6 +203,7 @@ fn frame(args: FrameArgs) -> CliResult {
             traced_lights: 256,
             detail: None,
             light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+            walker_shadows: true,
         },
         cpu: args.cpu,
     };

@@ -120,6 +120,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
     #[serde(skip)]
     pub light_tolerance: Option<frf_scene::shot::LightTolerance>,
+    /// Walkers standing between another and a sun do not shade it (an ablation).
+    #[arg(long)]
+    pub no_walker_shadows: bool,
 }
 
 /// The scene a field render's flags describe: one walker frozen in `pose`.
@@ -299,6 +302,7 @@ pub fn run(args: RenderArgs) -> CliResult {
         light_tolerance: args
             .light_tolerance
             .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
+        walker_shadows: !args.no_walker_shadows,
     };
     let summary = render_to_dir(&job, args.cpu, options, &Bars::default(), &mut |line| {
         eprintln!("{line}")

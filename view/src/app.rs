@@ -292,6 +292,7 @@ impl<'a> App<'a> {
                 traced_lights: TRACED_LIGHTS,
                 detail: None,
                 light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+                walker_shadows: true,
             },
         )?;
         let mut viewer = Viewer::new(shot, options.field.clone(), options.envs);

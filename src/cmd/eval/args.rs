@@ -93,6 +93,10 @@ pub struct EvalArgs {
     /// (what walking a path costs against walking on the spot).
     #[arg(long)]
     pub standing: bool,
+    /// With a scene: walkers standing between another and a sun do not shade it (the
+    /// ablation of walker-on-walker shadows).
+    #[arg(long)]
+    pub no_walker_shadows: bool,
     #[command(flatten)]
     pub compare: CompareArgs,
     /// Write each camera's truth and renders as PNGs here (with `--budget`, the first

@@ -30,6 +30,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
             .light_tolerance
             .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
         standing: args.standing,
+        walker_shadows: !args.no_walker_shadows,
         cpu: args.compare.cpu,
     };
     let report = evaluate_shot(
