@@ -4,8 +4,9 @@
 //! walker is relit for a heading of its own (the costly case: walkers of one heading
 //! share one relit pose). The lighting is held (`constant`) or turned 15° a frame
 //! (`turning`). The walkers stand (`standing`) or walk (`walking`: each from its place
-//! along a bend of [`BEND_RADIUS_M`] at [`WALK_SPEED_MPS`], turning as it goes, so every
-//! walker's own light changes every frame). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
+//! along a bend of [`BEND_RADIUS_M`] at the field's gait speed (else
+//! [`WALK_SPEED_MPS`]), turning as it goes, so every walker's own light changes every
+//! frame; its walk plays as fast as a standing walker's). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
 //! apart (`held`: every walker keeps its pose, only the lighting differs) or as the
 //! scene's own frames are (`shot`: poses stream in and out as in a render). The shot's
 //! plan is made once before the frames, as `frf render` makes it, and is not timed. One
@@ -50,7 +51,8 @@ const SPACING_M: f32 = 1.2;
 /// Radius of the bend a walking walker follows, metres: a turn of 90° over 6 m.
 pub const BEND_RADIUS_M: f32 = 6.0 / std::f32::consts::FRAC_PI_2;
 
-/// A walking walker's speed, metres per second (a brisk walk).
+/// A walking walker's speed where the field does not know its gait's, metres per second
+/// (a brisk walk).
 pub const WALK_SPEED_MPS: f32 = 1.4;
 
 /// Whether the benchmark's walkers stand or walk.
@@ -283,7 +285,7 @@ impl FrameBenchReport {
 pub fn bench_scene(
     scene: &Scene,
     n: usize,
-    (light, motion): (LightMode, Motion),
+    (light, motion, speed): (LightMode, Motion, f32),
     (frames, spacing): (usize, Spacing),
 ) -> Scene {
     let mut s = scene.clone();
@@ -306,9 +308,12 @@ pub fn bench_scene(
             let heading = first.heading + k as f32 * 137.507_77_f32.to_radians();
             match motion {
                 Motion::Standing => Instance::standing(position, heading, first.time_offset),
-                Motion::Walking => {
-                    walking(position, heading, (scene.start, span), first.time_offset)
-                }
+                Motion::Walking => walking(
+                    position,
+                    (heading, speed),
+                    (scene.start, span),
+                    first.time_offset,
+                ),
             }
         })
         .collect();
@@ -366,9 +371,17 @@ pub fn run_frame_bench<R: ReadAt>(
     let modes: Vec<(LightMode, Motion)> = (options.lights.iter())
         .flat_map(|&l| options.motions.iter().map(move |&m| (l, m)))
         .collect();
+    let speed = crate::Gait::of_field(field)?
+        .speed_mps()
+        .map_or(WALK_SPEED_MPS, |v| v as f32);
     for &n in &options.walkers {
         for &(light, motion) in &modes {
-            let s = bench_scene(scene, n, (light, motion), (options.frames, options.spacing));
+            let s = bench_scene(
+                scene,
+                n,
+                (light, motion, speed),
+                (options.frames, options.spacing),
+            );
             let frames = s.shot_frames(0..options.frames + 1, options.size)?;
             let device = Device::open(options.cpu)?;
             device_name = device.name();
@@ -433,14 +446,19 @@ pub fn run_frame_bench<R: ReadAt>(
 }
 
 /// A walker starting at `position` facing `heading`, walking a bend of [`BEND_RADIUS_M`]
-/// to its left at [`WALK_SPEED_MPS`] over `span` seconds from `start`, its walk
+/// to its left at `speed` (metres per second) over `span` seconds from `start`, its walk
 /// `time_offset` ahead.
-fn walking(position: Vec3, heading: f32, (start, span): (f64, f64), time_offset: f64) -> Instance {
+fn walking(
+    position: Vec3,
+    (heading, speed): (f32, f32),
+    (start, span): (f64, f64),
+    time_offset: f64,
+) -> Instance {
     let turn = glam::Quat::from_rotation_y(heading);
     let keys = (0..=4)
         .map(|j| {
             let t = span * j as f64 / 4.0;
-            let angle = WALK_SPEED_MPS * t as f32 / BEND_RADIUS_M;
+            let angle = speed * t as f32 / BEND_RADIUS_M;
             // Along +x, bending toward -z (its left), in the walker's own frame.
             let local = Vec3::new(angle.sin(), 0.0, angle.cos() - 1.0) * BEND_RADIUS_M;
             let mut p = position + turn * local;

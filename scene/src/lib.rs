@@ -443,12 +443,13 @@ impl Scene {
     }
 
     /// Whether walker `i`'s own light changes during the shot: it turns, it moves
-    /// between probes, or another walker moves (and may come between it and a sun).
-    pub fn walker_light_changes(&self, i: usize) -> bool {
+    /// between probes, or (`walker_shadows`) another walker may stand between it and a
+    /// sun, whose shadow on it changes as that walker walks.
+    pub fn walker_light_changes(&self, i: usize, walker_shadows: bool) -> bool {
         let inst = &self.instances[i];
         let between_probes = self.probes.as_ref().is_some_and(|p| p.probes.len() > 1);
-        let others_move = (self.instances.iter().enumerate()).any(|(j, w)| j != i && w.moves());
-        inst.turns() || (between_probes && inst.moves()) || others_move
+        let others = walker_shadows && self.instances.len() > 1;
+        inst.turns() || (between_probes && inst.moves()) || others
     }
 }
 

@@ -496,7 +496,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .map(|f| LightingKey::of(&scene.lighting_at(f.time)))
             .collect();
         let own_light: Vec<bool> = (0..scene.instances.len())
-            .map(|i| scene.walker_light_changes(i))
+            .map(|i| scene.walker_light_changes(i, options.walker_shadows))
             .collect();
         let held_light = options.planned
             && keys.windows(2).all(|w| w[0] == w[1])
@@ -779,7 +779,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         );
         f(self.scene.to_mut());
         self.own_light = (0..self.scene.instances.len())
-            .map(|i| self.scene.walker_light_changes(i))
+            .map(|i| {
+                self.scene
+                    .walker_light_changes(i, self.options.walker_shadows)
+            })
             .collect();
         let scene = &self.scene;
         if (scene.floor, scene.shadow) != (before.0, before.1) {
