@@ -5,10 +5,11 @@
 # the visual hull, 96x136 pixels), ingest turns the capture into a flowed reflectance
 # field with the flow between consecutive poses (each step's error against the stage's
 # truth), `frf render scenes/demo.toml` draws the shot at 30 fps, three frames a pose,
-# morphed in time between them (the walker walking, the camera moving around it, relit
-# by the forest shipped in assets/envmaps, its shadow on the ground, composited over the
-# environment), and `frf eval` scores frames of the shot against their true composites,
-# each against the walker at its own instant. Output in demo-out/
+# morphed in time between them (the walker crossing the forest on a path, its walk
+# advancing with the distance it covers, the camera following it, relit by the forest
+# shipped in assets/envmaps, its shadow on the ground, composited over the environment),
+# and `frf eval` scores frames of the shot against their true composites, each against
+# the walker where and when the scene places it. Output in demo-out/
 # (every step resumes: a rerun continues an interrupted one); demo-out/report.txt holds
 # the error and the time of each step.
 set -euo pipefail
@@ -48,8 +49,8 @@ step eval $frf eval "$scene" --field "$out/walker.frf" --capture "$out/capture" 
 # turns it), drawn by the web player in headless Chromium from the shot's camera at 1 s.
 step export $frf export "$out/walker.frf" --out "$out/walker.glb"
 step env-sh $frf env-sh assets/envmaps/forest_slope_1k.hdr --yaw 90 --out "$out/forest_sh.json"
-step player node player/screenshot.mjs --glb "$out/walker.glb" --pose 0 --camera 0.5,1.45,2.9 \
-  --look-at 0,0.9,0 --fov 36 --size 256x192 --sh "$out/forest_sh.json" --out "$out/player.png" \
+step player node player/screenshot.mjs --glb "$out/walker.glb" --pose 0 --camera 0.4,1.5,3.5 \
+  --look-at 0.1,0.9,0 --fov 40 --size 256x192 --sh "$out/forest_sh.json" --out "$out/player.png" \
   --time-frames 3
 
 {

@@ -197,6 +197,13 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                               "views": view_json}));
     }
     let animation = pose_animation(&mut glb, &poses, &header, &pose_json);
+    // The walk's speed as the field records it or its hulls tell it: what an engine moves
+    // the walker by so that its feet stay planted (docs/export.md, "Root motion").
+    let walk = frf_reflectance::gait_speed::gait_speed_mps(&field)?.map(|speed| {
+        json!({"speed_mps": speed, "stride_m": speed * header.cycle_seconds,
+               "forward": [1.0, 0.0, 0.0],
+               "measured": header.gait_speed_mps.is_none()})
+    });
     let document = json!({
         "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
         "extensionsUsed": [EXTENSION],
@@ -214,6 +221,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                      "width": header.width, "height": header.height},
             "cycle_seconds": header.cycle_seconds,
             "poses_per_cycle": header.poses_per_cycle,
+            "walk": walk,
             "source": field_path.file_name().map(|n| n.to_string_lossy().into_owned()),
             "poses": pose_json,
         }},

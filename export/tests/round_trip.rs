@@ -115,6 +115,19 @@ fn relights_as_frf(tier: Tier, floor_db: f64) {
         );
         assert_eq!(view["transfer"]["colour"].is_null(), tier == Tier::Full);
     }
+    // The walk's speed and stride, as the field records them.
+    let walk = &glb.field()["walk"];
+    let field = frf_reflectance::FieldFile::open(&frf_testkit::tiny_field().field).unwrap();
+    let h = field.header();
+    let speed = h
+        .gait_speed_mps
+        .expect("the tiny stage records its belt's speed");
+    assert!(
+        (walk["speed_mps"].as_f64().unwrap() - speed).abs() < 1e-9,
+        "{walk}"
+    );
+    assert!((walk["stride_m"].as_f64().unwrap() - speed * h.cycle_seconds).abs() < 1e-9);
+    assert_eq!(walk["measured"], false);
     // The walk: a node per pose under the walker, an animation switching them.
     let d = &glb.document;
     assert_eq!(d["nodes"][0]["children"].as_array().unwrap().len(), 1);

@@ -18,6 +18,8 @@
 //!   sphere stays in its band of elevations; so it is left out when every environment of
 //!   the scene is black over that band (e.g. the floor conditions under a black lower
 //!   hemisphere), or when the scene's intensity is zero throughout.
+//! - **Probes**: a light probe no walker stands near at any frame (weight 0 wherever they
+//!   are, [`crate::probes`]) is not loaded; the others are.
 //! - **Shadows**: the maps only when the scene asks for a shadow and some ray meets the
 //!   ground patch. The visual hull (a few kilobytes) is always read when the field holds
 //!   it: it is the renderer's proxy for rays beyond the grid's rows, and traced shadows'.
@@ -195,6 +197,9 @@ pub struct Plan {
     pub floor_conditions_left_out: usize,
     /// Whether some frame sees the ground patch (a shadow is drawn).
     pub ground_seen: bool,
+    /// Per light probe of the scene: whether some walker is lit by it at some frame
+    /// (the others are not loaded).
+    pub probes_used: Vec<bool>,
     /// What frames between captured poses show.
     pub interpolate: TimeInterpolation,
     /// The field's walk: how walkers on paths advance their phase.
@@ -357,6 +362,22 @@ fn reached(
         }
     }
     (quads, ground)
+}
+
+/// Per probe of `scene`, whether some walker stands where it weighs at one of `frames`.
+fn probes_used(scene: &Scene, frames: &[ShotFrame]) -> Vec<bool> {
+    let Some(p) = &scene.probes else {
+        return Vec::new();
+    };
+    let mut used = vec![false; p.probes.len()];
+    for f in frames {
+        for i in 0..scene.instances.len() {
+            for (k, w) in scene.probe_weights(i, f.time) {
+                used[k] |= w > 0.0;
+            }
+        }
+    }
+    used
 }
 
 /// Which conditions the scene can light (see the module docs).
@@ -819,6 +840,7 @@ impl Plan {
                 .collect(),
             floor_conditions_left_out: left_out.iter().filter(|&&k| h.conditions[k].floor).count(),
             ground_seen,
+            probes_used: probes_used(scene, frames),
             interpolate,
             gait,
         })

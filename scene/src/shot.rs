@@ -707,7 +707,22 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             None => None,
             Some(p) => {
                 let (mut maps, mut terms) = (Vec::new(), Vec::new());
-                for probe in &p.probes {
+                for (k, probe) in p.probes.iter().enumerate() {
+                    let used = self.plan.probes_used.get(k).copied().unwrap_or(true);
+                    if self.options.planned && !used {
+                        // No walker stands where it weighs: a black map of the scene's
+                        // texels holds its place, never read with a weight.
+                        let (w, h) = env.image().size();
+                        let black = EnvMap::from_image(RgbImage::new(w, h, [0.0; 3]))?;
+                        let table = self.table(format!("unused {w}x{h}"), || Ok(black.clone()))?;
+                        maps.push(black);
+                        terms.push(YawTerm {
+                            table,
+                            weight: 0.0,
+                            yaw: 0.0,
+                        });
+                        continue;
+                    }
                     let e = self.probe_map(probe)?;
                     let shade = if probe.suns { "" } else { " (shade)" };
                     let table = self.table(format!("{}{shade}", probe.env), || Ok(e.clone()))?;

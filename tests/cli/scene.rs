@@ -871,3 +871,152 @@ fn a_sun_flag_on_a_scene_is_used_and_said() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--yaw"), "{}", stderr(&o));
 }
+
+/// Two walkers side by side walking toward the camera under a low sun from their left,
+/// on the tiny field: `frf eval` scores each against the stage's truth of both (their
+/// placements, instants and light), their feet stay planted on straight paths at the
+/// captured speed, the one in the other's shadow scores better with walker-on-walker
+/// shadows than without (`--no-walker-shadows`), and `--standing` finds the walking walker
+/// as good as the same walker standing. A scene whose path has one key is refused by name,
+/// and nothing is written.
+#[test]
+fn eval_scores_walkers_on_paths_that_shade_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let capture = frf_testkit::tiny_field()
+        .capture()
+        .to_str()
+        .unwrap()
+        .to_string();
+    let scene = dir.path().join("side.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"field = "{field}"
+[time]
+end = 1.0
+fps = 10.0
+[output]
+size = [96, 72]
+[lighting]
+env = "uniform"
+intensity = 0.35
+[lighting.sun]
+azimuth_deg = -90.0
+elevation_deg = 25.0
+illuminance = 12.0
+[camera]
+[[camera.key]]
+time = 0.0
+position = [-3.0, 1.6, 4.0]
+look_at = [0.3, 0.8, -1.0]
+fov_deg = 40.0
+[composite]
+backdrop = "env"
+ground = 0.3
+[[instance]]
+[[instance.key]]
+time = 0.0
+position = [-0.55, 0.0, -2.0]
+[[instance.key]]
+time = 1.0
+position = [-0.55, 0.0, -0.95]
+[[instance]]
+[[instance.key]]
+time = 0.0
+position = [0.55, 0.0, -2.0]
+[[instance.key]]
+time = 1.0
+position = [0.55, 0.0, -0.95]
+"#,
+            field = field().display()
+        ),
+    )
+    .unwrap();
+    let eval = |extra: &[&str]| -> frf_eval::shot::ShotReport {
+        let mut args = vec![
+            "eval",
+            scene.to_str().unwrap(),
+            "--capture",
+            &capture,
+            "--frames",
+            "3",
+            "--lights",
+            "32",
+            "--truth-at",
+            "pose",
+            "--json",
+        ];
+        args.extend(extra);
+        args.extend(gpu_flag());
+        serde_json::from_slice(&ok(&args).stdout).unwrap()
+    };
+    let with = eval(&[]);
+    let without = eval(&["--no-walker-shadows"]);
+    assert_eq!(with.frames.len(), 3);
+    assert!(with.frames.iter().all(|f| f.walkers.len() == 2));
+    // 1.05 m in 1 s along straight lines: the captured speed, feet planted.
+    assert!(with.foot_slide_cm < 0.1, "{}", with.foot_slide_cm);
+    assert!(with.alpha_iou_mean > 0.7, "{}", with.alpha_iou_mean);
+    let shaded = |r: &frf_eval::shot::ShotReport| r.walkers[1].psnr_subject_mean.unwrap();
+    eprintln!(
+        "walker in the other's shadow: {:.2} dB with walker shadows, {:.2} without",
+        shaded(&with),
+        shaded(&without)
+    );
+    assert!(shaded(&with) > shaded(&without) + 1.0);
+    // The walker on the left does not change: nothing stands between it and the sun.
+    let left = |r: &frf_eval::shot::ShotReport| r.walkers[0].psnr_subject_mean.unwrap();
+    assert!((left(&with) - left(&without)).abs() < 0.05);
+
+    // One walker's path, against itself standing: what walking costs.
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let cut = text
+        .find("[[instance]]\n[[instance.key]]\ntime = 0.0\nposition = [0.55")
+        .unwrap();
+    let one = dir.path().join("one.toml");
+    std::fs::write(&one, &text[..cut]).unwrap();
+    let mut args = vec![
+        "eval",
+        one.to_str().unwrap(),
+        "--capture",
+        &capture,
+        "--frames",
+        "2",
+        "--lights",
+        "32",
+        "--standing",
+        "--json",
+    ];
+    args.extend(gpu_flag());
+    let r: frf_eval::shot::ShotReport = serde_json::from_slice(&ok(&args).stdout).unwrap();
+    let standing = r.psnr_subject_standing_mean.unwrap();
+    assert!(
+        (r.psnr_subject_mean - standing).abs() < 0.5,
+        "{} vs {standing}",
+        r.psnr_subject_mean
+    );
+
+    // A path of one key: refused naming the walker's key, and no frame written.
+    let bad = dir.path().join("bad.toml");
+    let cut = text
+        .find("[[instance.key]]\ntime = 1.0\nposition = [-0.55")
+        .unwrap();
+    let end = text
+        .find("[[instance]]\n[[instance.key]]\ntime = 0.0\nposition = [0.55")
+        .unwrap();
+    std::fs::write(&bad, format!("{}{}", &text[..cut], &text[end..])).unwrap();
+    let out = dir.path().join("bad_out");
+    let o = frf(&[
+        "render",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(
+        e.contains("instance[0].key[0]") && e.contains("two keys"),
+        "{e}"
+    );
+    assert!(!out.exists(), "a refused scene wrote {}", out.display());
+}

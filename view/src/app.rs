@@ -58,6 +58,30 @@ struct Live<'a> {
     adapter: String,
 }
 
+/// The walkers' paths over the frame ([`crate::paths`]), behind the panel: each a line,
+/// its walker now a dot.
+fn draw_paths(ui: &egui::Ui, viewer: &crate::viewer::Viewer, window: (u32, u32)) {
+    let Ok(size) = viewer.frame_size(window) else {
+        return;
+    };
+    let Ok(camera) = viewer.camera.camera(size.0, size.1) else {
+        return;
+    };
+    let painter = ui.ctx().layer_painter(egui::LayerId::background());
+    let per_point = ui.ctx().pixels_per_point();
+    let point = |p: glam::Vec2| egui::pos2(p.x / per_point, p.y / per_point);
+    let colour = egui::Color32::from_rgb(255, 200, 40);
+    for o in crate::paths::overlays(viewer.shot.scene(), &camera, window, viewer.time) {
+        for run in &o.runs {
+            let line: Vec<egui::Pos2> = run.iter().map(|&p| point(p)).collect();
+            painter.add(egui::Shape::line(line, egui::Stroke::new(1.5, colour)));
+        }
+        if let Some(now) = o.now {
+            painter.circle_filled(point(now), 4.0, colour);
+        }
+    }
+}
+
 impl Live<'_> {
     fn gpu(&self) -> &Gpu {
         match self.viewer.shot.render_device() {
@@ -89,6 +113,9 @@ impl Live<'_> {
         let mut actions = panel::Actions::default();
         let viewer = &mut self.viewer;
         let mut output = self.egui.egui_ctx().clone().run_ui(input, |ui| {
+            if viewer.show_paths {
+                draw_paths(ui, viewer, window_size);
+            }
             if let Some(figures) = figures {
                 actions = panel::show(ui, viewer, figures, message);
             }

@@ -6,6 +6,7 @@
 //!   go through it);
 //! - [`script`]: the commands a script runs without a person (tests, figures);
 //! - [`record`]: keys set while moving, written as a scene file `frf render` renders;
+//! - [`paths`]: the walkers' paths drawn over the frame;
 //! - [`timer`]: the GPU time of a frame from timestamp queries;
 //! - `app` and `panel`: the window, its event loop and the panel.
 //!
@@ -17,6 +18,7 @@ mod app;
 pub mod camera;
 mod outcome;
 mod panel;
+pub mod paths;
 pub mod record;
 pub mod script;
 pub mod timer;

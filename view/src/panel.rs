@@ -134,6 +134,12 @@ fn controls(
     {
         v.set_time(t);
     }
+    if v.shot.scene().instances.iter().any(|w| w.moves()) {
+        ui.checkbox(
+            &mut v.show_paths,
+            "walkers' paths (the time slider scrubs along them)",
+        );
+    }
     ui.separator();
     let names: Vec<String> = v.envs.iter().map(|e| e.name()).collect();
     let shown = v.env.or(v.env_index());

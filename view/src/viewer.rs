@@ -77,6 +77,8 @@ pub struct Viewer<'a> {
     pub recording: Recording,
     /// Where the clock loops: `[start, end)`.
     pub span: (f64, f64),
+    /// Whether the walkers' paths are drawn over the frame ([`crate::paths`]).
+    pub show_paths: bool,
 }
 
 impl<'a> Viewer<'a> {
@@ -139,6 +141,7 @@ impl<'a> Viewer<'a> {
             recording: Recording::default(),
             span: (start, end),
             shot,
+            show_paths: true,
         }
     }
 
