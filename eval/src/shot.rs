@@ -104,6 +104,9 @@ pub struct ShotFrameScore {
     pub alpha_iou: f64,
     /// Whether two walkers' true pixels overlap in the frame (one hides part of another).
     pub walkers_overlap: bool,
+    /// Where walkers cross: the pixels whose ray meets two true bodies, and the share of
+    /// them where the renderer puts the truly nearest in front ([`Occlusion`]).
+    pub occlusion: Option<Occlusion>,
     /// Per walker.
     pub walkers: Vec<WalkerFrameScore>,
     /// Seconds the renderer took for the frame (including making its poses resident).
@@ -113,6 +116,71 @@ pub struct ShotFrameScore {
     /// With `--standing`: the PSNR of the same walker standing at the origin, seen and
     /// lit alike in its own frame ([`standing_twin`]), against the same truth, dB.
     pub psnr_subject_standing: Option<f64>,
+}
+
+/// How walkers that cross are ordered at the pixels where they do (see
+/// [`ShotFrameScore::occlusion`]).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct Occlusion {
+    /// Pixels whose ray (through the pixel's centre) meets two or more true bodies.
+    pub pixels: usize,
+    /// Share of them where the walker the renderer puts in front (of those the ray
+    /// meets, the nearest by its depth there, [`frf_render::proxy::Proxy::depth`]) is the
+    /// truly nearest body.
+    pub by_depth: f64,
+    /// The same for whole walkers put over each other back to front by position (the
+    /// order before depth).
+    pub by_position: f64,
+}
+
+/// Where walkers cross in a frame of `camera` (scene frame): at every pixel whose ray
+/// meets two or more of the true bodies `actors` (world frame), whether the renderer's
+/// order (by the depth of each walker's hull, `hulls`: its proxy and placement) and the
+/// order by position put the truly nearest body in front. `None` where no ray meets two.
+fn occlusion(
+    camera: &frf_core::camera::Camera,
+    actors: &[frf_stage::actor::Actor],
+    hulls: &[(frf_render::proxy::Proxy, frf_scene::Placement)],
+) -> Option<Occlusion> {
+    let positions: Vec<glam::Vec3> = hulls.iter().map(|h| h.1.position).collect();
+    let by_position = frf_render::composite::back_to_front(camera, &positions);
+    let (mut pixels, mut depth_right, mut position_right) = (0usize, 0usize, 0usize);
+    for y in 0..camera.height {
+        for x in 0..camera.width {
+            let dir = camera.ray_direction(glam::Vec2::new(x as f32, y as f32)).normalize();
+            let ray = frf_stage::geometry::Ray {
+                origin: camera.centre(),
+                dir,
+            };
+            let bodies: Vec<(usize, f32)> = (actors.iter().enumerate())
+                .filter_map(|(k, a)| a.intersect(&ray, 0.0, f32::INFINITY).map(|h| (k, h.t)))
+                .collect();
+            if bodies.len() < 2 {
+                continue;
+            }
+            let nearest = |v: &[(usize, f32)]| v.iter().min_by(|a, b| a.1.total_cmp(&b.1)).map(|m| m.0);
+            let truth = nearest(&bodies);
+            // The renderer orders the walkers that show at the pixel by their depth there.
+            let depths: Vec<(usize, f32)> = (bodies.iter())
+                .map(|&(k, _)| {
+                    let (proxy, placed) = &hulls[k];
+                    let there = placed.world_from_subject().inverse();
+                    let (o, d) = (there.transform_point(camera.centre()), there.rotation * dir);
+                    (k, proxy.depth(o, d))
+                })
+                .collect();
+            pixels += 1;
+            depth_right += usize::from(nearest(&depths) == truth);
+            // Back to front: the last of the walkers the ray meets goes in front.
+            let front = by_position.iter().rev().find(|k| bodies.iter().any(|b| b.0 == **k));
+            position_right += usize::from(front.copied() == truth);
+        }
+    }
+    (pixels > 0).then(|| Occlusion {
+        pixels,
+        by_depth: depth_right as f64 / pixels as f64,
+        by_position: position_right as f64 / pixels as f64,
+    })
 }
 
 /// The rendered and the true walkers of a frame (premultiplied RGBA).
@@ -230,6 +298,17 @@ fn score_frame_walkers<R: ReadAt>(
                 .any(|(x, y)| *x > 0.01 && *y > 0.01)
         })
     });
+    let hulls = (0..walkers.len())
+        .map(|i| {
+            let hull = shot.field().hull(rendered.poses[i])?;
+            Ok((frf_render::proxy::Proxy::new(hull), scene.placement(i, frame.time)))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let occlusion = if walkers.len() > 1 {
+        occlusion(&frame.camera, &actors, &hulls)
+    } else {
+        None
+    };
     let per_walker = (0..walkers.len())
         .map(|k| {
             let pixels = own[k].iter().filter(|&&m| m).count();
@@ -263,6 +342,7 @@ fn score_frame_walkers<R: ReadAt>(
         ssim_subject: ssim(&subject, &layers.subject, Some(&mask)),
         alpha_iou: soft_iou(&rendered_alpha, &true_alpha, None),
         walkers_overlap,
+        occlusion,
         walkers: per_walker,
         seconds_render,
         seconds_truth,
@@ -487,6 +567,9 @@ pub struct ShotReport {
     /// With `--standing`: the mean PSNR of the walker's standing twin ([`standing_twin`])
     /// over the same frames, dB.
     pub psnr_subject_standing_mean: Option<f64>,
+    /// Over the frames where walkers cross, every crossing pixel counted once
+    /// ([`Occlusion`]); `None` where none cross.
+    pub occlusion: Option<Occlusion>,
     /// Mean seconds to render a frame.
     pub seconds_render_mean: f64,
     /// Mean seconds for a true frame.
@@ -633,6 +716,18 @@ pub fn evaluate_shot<R: ReadAt>(
         walkers,
         foot_slide_cm,
         psnr_subject_standing_mean: mean_some(scores.iter().map(|s| s.psnr_subject_standing)),
+        occlusion: {
+            let all: Vec<Occlusion> = scores.iter().filter_map(|s| s.occlusion).collect();
+            let pixels: usize = all.iter().map(|o| o.pixels).sum();
+            let share = |g: fn(&Occlusion) -> f64| {
+                all.iter().map(|o| g(o) * o.pixels as f64).sum::<f64>() / pixels as f64
+            };
+            (pixels > 0).then(|| Occlusion {
+                pixels,
+                by_depth: share(|o| o.by_depth),
+                by_position: share(|o| o.by_position),
+            })
+        },
         seconds_render_mean: mean(|s| s.seconds_render),
         seconds_truth_mean: mean(|s| s.seconds_truth),
         frames: scores,
@@ -706,6 +801,15 @@ impl ShotReport {
              {:.2} cm at most on the ground",
             self.alpha_iou_mean, self.foot_slide_cm
         ));
+        if let Some(o) = &self.occlusion {
+            lines.push(format!(
+                "where walkers cross ({} pixels): the nearer by depth is the true nearest at \
+                 {:.2} %, the nearer by position at {:.2} %",
+                o.pixels,
+                100.0 * o.by_depth,
+                100.0 * o.by_position
+            ));
+        }
         if let Some(standing) = self.psnr_subject_standing_mean {
             lines.push(format!(
                 "the same walker standing, seen and lit alike in its own frame: {standing:.2} dB \

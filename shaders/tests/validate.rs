@@ -206,7 +206,7 @@ fn pod_structs_match_naga_layouts() {
             crop_origin,
             crop_size,
             flags,
-            pad,
+            depth,
             bounds,
             place
         ]
@@ -316,7 +316,7 @@ fn pod_structs_match_naga_layouts() {
             instances,
             tile_columns,
             tile_side,
-            pad
+            by_depth
         ]
     );
     check_layout!(
