@@ -17,7 +17,8 @@ struct TimeMorph {
     at_motions: vec4<i32>,
     at_morph: vec4<i32>,
     s: f32,
-    pad0: f32,
+    // 1: the morph's depth is the nearer of the two poses' renders' depths.
+    by_depth: u32,
     pad1: f32,
     pad2: f32,
 }
@@ -28,6 +29,11 @@ struct TimeMorph {
 @group(0) @binding(3) var before_motion: texture_2d<f32>;
 @group(0) @binding(4) var after_motion: texture_2d<f32>;
 @group(0) @binding(5) var morphed: texture_storage_2d<rgba32float, write>;
+// With `by_depth`: the two poses' renders' depths (as `before` and `after`), and the
+// morph's (as `morphed`): the nearer (`render/src/proxy.rs`).
+@group(0) @binding(6) var before_depth: texture_2d<f32>;
+@group(0) @binding(7) var after_depth: texture_2d<f32>;
+@group(0) @binding(8) var morphed_depth: texture_storage_2d<r32float, write>;
 
 fn motion_at(t: texture_2d<f32>, p: vec2<i32>, at: vec2<i32>) -> vec2<f32> {
     let m = textureLoad(t, p + at, 0);
@@ -72,4 +78,8 @@ fn morph_in_time(@builtin(global_invocation_id) id: vec3<u32>) {
     let a = bilinear_zero(before, tm.at_poses.xy, at + tm.s * motion_at(after_motion, p, tm.at_motions.zw));
     let b = bilinear_zero(after, tm.at_poses.zw, at + (1.0 - tm.s) * motion_at(before_motion, p, tm.at_motions.xy));
     textureStore(morphed, p + tm.at_morph.xy, (1.0 - tm.s) * a + tm.s * b);
+    if (tm.by_depth == 1u) {
+        let d = min(textureLoad(before_depth, p + tm.at_poses.xy, 0).x, textureLoad(after_depth, p + tm.at_poses.zw, 0).x);
+        textureStore(morphed_depth, p + tm.at_morph.xy, vec4<f32>(d));
+    }
 }

@@ -135,19 +135,22 @@ pub struct Occlusion {
 
 /// Where walkers cross in a frame of `camera` (scene frame): at every pixel whose ray
 /// meets two or more of the true bodies `actors` (world frame), whether the renderer's
-/// order (by the depth of each walker's hull, `hulls`: its proxy and placement) and the
-/// order by position put the truly nearest body in front. `None` where no ray meets two.
+/// order (by each walker's depth: the nearer of its poses' proxies', `hulls` with its
+/// placement) and the order by position put the truly nearest body in front. `None`
+/// where no ray meets two.
 fn occlusion(
     camera: &frf_core::camera::Camera,
     actors: &[frf_stage::actor::Actor],
-    hulls: &[(frf_render::proxy::Proxy, frf_scene::Placement)],
+    hulls: &[(Vec<frf_render::proxy::Proxy>, frf_scene::Placement)],
 ) -> Option<Occlusion> {
     let positions: Vec<glam::Vec3> = hulls.iter().map(|h| h.1.position).collect();
     let by_position = frf_render::composite::back_to_front(camera, &positions);
     let (mut pixels, mut depth_right, mut position_right) = (0usize, 0usize, 0usize);
     for y in 0..camera.height {
         for x in 0..camera.width {
-            let dir = camera.ray_direction(glam::Vec2::new(x as f32, y as f32)).normalize();
+            let dir = camera
+                .ray_direction(glam::Vec2::new(x as f32, y as f32))
+                .normalize();
             let ray = frf_stage::geometry::Ray {
                 origin: camera.centre(),
                 dir,
@@ -158,21 +161,29 @@ fn occlusion(
             if bodies.len() < 2 {
                 continue;
             }
-            let nearest = |v: &[(usize, f32)]| v.iter().min_by(|a, b| a.1.total_cmp(&b.1)).map(|m| m.0);
+            let nearest =
+                |v: &[(usize, f32)]| v.iter().min_by(|a, b| a.1.total_cmp(&b.1)).map(|m| m.0);
             let truth = nearest(&bodies);
             // The renderer orders the walkers that show at the pixel by their depth there.
             let depths: Vec<(usize, f32)> = (bodies.iter())
                 .map(|&(k, _)| {
-                    let (proxy, placed) = &hulls[k];
+                    let (proxies, placed) = &hulls[k];
                     let there = placed.world_from_subject().inverse();
                     let (o, d) = (there.transform_point(camera.centre()), there.rotation * dir);
-                    (k, proxy.depth(o, d))
+                    let depth = proxies
+                        .iter()
+                        .map(|p| p.depth(o, d))
+                        .fold(f32::INFINITY, f32::min);
+                    (k, depth)
                 })
                 .collect();
             pixels += 1;
             depth_right += usize::from(nearest(&depths) == truth);
             // Back to front: the last of the walkers the ray meets goes in front.
-            let front = by_position.iter().rev().find(|k| bodies.iter().any(|b| b.0 == **k));
+            let front = by_position
+                .iter()
+                .rev()
+                .find(|k| bodies.iter().any(|b| b.0 == **k));
             position_right += usize::from(front.copied() == truth);
         }
     }
@@ -298,10 +309,17 @@ fn score_frame_walkers<R: ReadAt>(
                 .any(|(x, y)| *x > 0.01 && *y > 0.01)
         })
     });
+    // Each walker's proxies: of the pose drawn, and of the later between two.
     let hulls = (0..walkers.len())
         .map(|i| {
-            let hull = shot.field().hull(rendered.poses[i])?;
-            Ok((frf_render::proxy::Proxy::new(hull), scene.placement(i, frame.time)))
+            let proxy = |pose| Ok(frf_render::proxy::Proxy::new(shot.field().hull(pose)?));
+            let poses = [Some(rendered.poses[i]), rendered.between[i].map(|b| b.0)];
+            let proxies = poses
+                .into_iter()
+                .flatten()
+                .map(proxy)
+                .collect::<Result<_>>()?;
+            Ok((proxies, scene.placement(i, frame.time)))
         })
         .collect::<Result<Vec<_>>>()?;
     let occlusion = if walkers.len() > 1 {

@@ -159,7 +159,7 @@ fn damaged_exports_and_bad_options_are_refused_by_name() {
         ([bytes.as_slice(), b"tail"].concat(), "appended"),
         (b"PK\x03\x04 not a glb".to_vec(), "no glTF magic"),
         (
-            replaced(&bytes, b"\"version\":1}", b"\"version\":9}"),
+            replaced(&bytes, b"\"version\":1,\"walk\"", b"\"version\":9,\"walk\""),
             "version 9",
         ),
     ];

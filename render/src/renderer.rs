@@ -520,11 +520,15 @@ impl Device {
             let (img, s) = render(cpu_pose(&w.resident.kind)?, &seen);
             stats = stats.merge(s);
             if walkers.len() > 1 {
-                depths.push(depth_cpu_within(
-                    cpu_pose(&w.resident.kind)?,
-                    &seen,
-                    w.within,
-                ));
+                // Between two poses, the nearer of their depths ([`crate::proxy`]).
+                let mut depth = depth_cpu_within(cpu_pose(&w.resident.kind)?, &seen, w.within);
+                if let Some((after, _)) = w.between {
+                    let other = depth_cpu_within(cpu_pose(&after.kind)?, &seen, w.within);
+                    for (d, o) in depth.pixels_mut().iter_mut().zip(other.pixels()) {
+                        *d = d.min(*o);
+                    }
+                }
+                depths.push(depth);
             }
             drawn.push(match w.between {
                 None => img,

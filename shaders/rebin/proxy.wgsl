@@ -114,22 +114,25 @@ fn hull_first_hit(origin: vec3<f32>, dir: vec3<f32>) -> f32 {
     return -1.0;
 }
 
-// The depth of the subject along the ray, metres: to the proxy's point, else to the
-// ray's point nearest the subject's vertical axis (a vertical ray: its horizontal
-// distance to the axis). Twin of `Proxy::depth`.
+// What a ray that misses the hull adds to the depth: twin of `proxy::MISS_DEPTH_M`.
+const MISS_DEPTH_M: f32 = 1e4;
+
+// The depth of the subject along the ray, metres: to the hull's first voxel, else
+// MISS_DEPTH_M plus the distance to the ray's point nearest the subject's vertical axis (a
+// vertical ray: its horizontal distance to the axis). Twin of `Proxy::depth`.
 fn subject_depth(origin: vec3<f32>, dir_in: vec3<f32>) -> f32 {
     let dir = normalize_or_zero(dir_in);
-    let p = proxy_point(origin, dir);
-    if (p.w > 0.0) {
-        return length(p.xyz - origin);
+    let t = hull_first_hit(origin, dir);
+    if (t >= 0.0) {
+        return t;
     }
     let o = origin.xz - proxy.axis;
     let d = dir.xz;
     let dd = dot(d, d);
     if (dd < 1e-8) {
-        return length(o);
+        return MISS_DEPTH_M + length(o);
     }
-    return max(-dot(o, d) / dd, 0.0);
+    return MISS_DEPTH_M + max(-dot(o, d) / dd, 0.0);
 }
 
 // Where the ray meets the subject as far as the proxy knows (w = 1), or w = 0 without a

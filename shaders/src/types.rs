@@ -370,8 +370,9 @@ pub struct GpuTimeMorph {
     pub at_morph: [i32; 4],
     /// The fraction of the way from `k` to `k'`.
     pub s: f32,
-    /// Padding.
-    pub pad0: f32,
+    /// 1: the walker's depth is the nearer of its two poses' (the morph's depth written
+    /// beside it); 0: no depth is read or written.
+    pub by_depth: u32,
     /// Padding.
     pub pad1: f32,
     /// Padding.

@@ -56,8 +56,8 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         } else if name == "sun_depth.wgsl" {
             assert_eq!(text, shaders::SUN_DEPTH, "{name} as compiled");
             let m = module(&shaders::sun_depth_pass(), &name);
-            // vs_main (of every pass), sun_depth.
-            assert_eq!(m.entry_points.len(), 2, "{name}");
+            // vs_main (of every pass), sun_depth, sun_occluder.
+            assert_eq!(m.entry_points.len(), 3, "{name}");
         } else {
             let m = module(&shaders::composed(&text), &name);
             assert!(!m.entry_points.is_empty(), "{name} has no entry point");
@@ -331,7 +331,7 @@ fn pod_structs_match_naga_layouts() {
         "TimeMorph",
         GpuTimeMorph,
         [
-            to_image, bounds, at_poses, at_motions, at_morph, s, pad0, pad1, pad2
+            to_image, bounds, at_poses, at_motions, at_morph, s, by_depth, pad1, pad2
         ]
     );
 }

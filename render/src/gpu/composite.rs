@@ -329,7 +329,7 @@ impl Gpu {
                     })
                 })
                 .collect();
-            self.morph_in_time(encoder, &subjects, &between, size, variant);
+            self.morph_in_time(encoder, &subjects, &between, size, (variant, by_depth));
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let (gpu_instances, touched) = place_walkers(

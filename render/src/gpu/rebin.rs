@@ -215,6 +215,11 @@ impl Subjects {
         &self.targets.depth
     }
 
+    /// The view of `page` of the depths.
+    pub(super) fn depth_page_view(&self, page: u32) -> &wgpu::TextureView {
+        self.targets.depth_page_view(page)
+    }
+
     /// The id of the targets they are drawn into ([`SubjectTargets::id`]).
     pub fn id(&self) -> u64 {
         self.targets.id
@@ -324,8 +329,9 @@ pub(super) struct SubjectTargets {
     /// Names these targets in the keys of bind groups made of them ([`super::kept`]).
     pub(super) id: u64,
     texture: wgpu::Texture,
-    /// The renders' depths, texel for texel beside `texture` (R32Float).
+    /// The renders' depths, texel for texel beside `texture` (R32Float), and its pages.
     depth: wgpu::Texture,
+    depth_pages: Vec<wgpu::TextureView>,
     pages: Vec<wgpu::TextureView>,
     slots: Vec<SlotTargets>,
     /// Every slot's frame uniform, each at its multiple of `stride`: a frame writes them
@@ -388,10 +394,23 @@ impl SubjectTargets {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
         let all_depth = array_view(&depth);
+        let depth_pages = (0..pages)
+            .map(|page| {
+                depth.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: page,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stats"),
             size: 16,
@@ -460,6 +479,7 @@ impl SubjectTargets {
             id: super::kept::unique_id(),
             texture,
             depth,
+            depth_pages,
             pages,
             slots,
             uniforms,
@@ -490,6 +510,16 @@ impl SubjectTargets {
     /// The view of `page`.
     pub(super) fn page_view(&self, page: u32) -> &wgpu::TextureView {
         &self.pages[page as usize]
+    }
+
+    /// The depths' texture array.
+    pub(super) fn depth_texture(&self) -> &wgpu::Texture {
+        &self.depth
+    }
+
+    /// The view of `page` of the depths.
+    pub(super) fn depth_page_view(&self, page: u32) -> &wgpu::TextureView {
+        &self.depth_pages[page as usize]
     }
 
     /// The fragment pass's frame bind group of `slot`.

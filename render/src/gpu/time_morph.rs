@@ -43,6 +43,16 @@ impl TimeMorphPass {
     /// Compiles the pass on `device`.
     pub fn new(device: &wgpu::Device) -> Self {
         let module = shaders::module(device, "time morph", shaders::TIME_MORPH);
+        let storage = |binding, format| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
         let texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -70,16 +80,10 @@ impl TimeMorphPass {
                 texture(2),
                 texture(3),
                 texture(4),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                storage(5, wgpu::TextureFormat::Rgba32Float),
+                texture(6),
+                texture(7),
+                storage(8, wgpu::TextureFormat::R32Float),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -118,7 +122,7 @@ impl Gpu {
         subjects: &Subjects,
         walkers: &[BetweenDraw],
         size: (u32, u32),
-        variant: Variant,
+        (variant, by_depth): (Variant, bool),
     ) {
         if walkers.is_empty() {
             return;
@@ -137,8 +141,8 @@ impl Gpu {
         });
         // Every walker's three renders, in one go, then their morphs in one pass.
         let drawn = between_renders(walkers, &renders);
-        self.draw_renders(encoder, &scratch, &drawn, (variant, false), None, false);
-        let groups = self.morph_groups(&scratch, subjects, walkers, &renders, &morphs);
+        self.draw_renders(encoder, &scratch, &drawn, (variant, by_depth), None, false);
+        let groups = self.morph_groups(&scratch, subjects, walkers, (&renders, &morphs), by_depth);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("time morph"),
@@ -153,7 +157,7 @@ impl Gpu {
                 }
             }
         }
-        copy_morphs(encoder, &scratch, subjects, walkers, &morphs);
+        copy_morphs(encoder, &scratch, subjects, walkers, (&morphs, by_depth));
     }
 
     /// Each walker's morph bind group (`renders`: three places a walker, `morphs`: one):
@@ -163,8 +167,8 @@ impl Gpu {
         scratch: &SubjectTargets,
         subjects: &Subjects,
         walkers: &[BetweenDraw],
-        renders: &[Place],
-        morphs: &[Place],
+        (renders, morphs): (&[Place], &[Place]),
+        by_depth: bool,
     ) -> Vec<wgpu::BindGroup> {
         let size_of_uniform = std::mem::size_of::<GpuTimeMorph>();
         let stride = uniform_stride(&self.device, size_of_uniform);
@@ -181,7 +185,7 @@ impl Gpu {
                 at_motions: pair(before_motion, after_motion),
                 at_morph: pair(morphs[j], morphs[j]),
                 s: w.between.s,
-                pad0: 0.0,
+                by_depth: by_depth as u32,
                 pad1: 0.0,
                 pad2: 0.0,
             };
@@ -201,11 +205,12 @@ impl Gpu {
             }
         }
         let page = |p: Place| scratch.page_view(p.page);
+        let depth_page = |p: Place| scratch.depth_page_view(p.page);
         walkers
             .iter()
             .enumerate()
             .map(|(j, w)| {
-                let (_, before_view) = subjects.place(w.layer);
+                let (before, before_view) = subjects.place(w.layer);
                 let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
                 self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("time morph"),
@@ -224,6 +229,9 @@ impl Gpu {
                         view(page(before_motion), 3),
                         view(page(after_motion), 4),
                         view(page(morphs[j]), 5),
+                        view(subjects.depth_page_view(before.page), 6),
+                        view(depth_page(after), 7),
+                        view(depth_page(morphs[j]), 8),
                     ],
                 })
             })
@@ -265,7 +273,7 @@ fn copy_morphs(
     scratch: &SubjectTargets,
     subjects: &Subjects,
     walkers: &[BetweenDraw],
-    morphs: &[Place],
+    (morphs, by_depth): (&[Place], bool),
 ) {
     for (w, &morph) in walkers.iter().zip(morphs) {
         let (before, _) = subjects.place(w.layer);
@@ -286,14 +294,22 @@ fn copy_morphs(
                 aspect: wgpu::TextureAspect::All,
             }
         };
+        let extent = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
         encoder.copy_texture_to_texture(
             at(scratch.texture(), morph),
             at(subjects.texture(), before),
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
+            extent,
         );
+        if by_depth {
+            encoder.copy_texture_to_texture(
+                at(scratch.depth_texture(), morph),
+                at(subjects.depth_texture(), before),
+                extent,
+            );
+        }
     }
 }
