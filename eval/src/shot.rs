@@ -680,7 +680,7 @@ pub fn evaluate_shot<R: ReadAt>(
             frf_core::io::write_png8_srgba(&name("_truth"), &composites.1, 1.0)?;
         }
         if how.standing {
-            let (twin, twin_frame) = standing_twin(scene, f, &shot.plan().gait, stage)?;
+            let (twin, twin_frame) = standing_twin(shot.scene(), f, &shot.plan().gait, stage)?;
             let mut twin_shot =
                 Shot::new(&twin, field, Device::open(how.cpu)?, &[twin_frame], options)?;
             let r = twin_shot.render(&twin_frame, true)?;
@@ -717,7 +717,7 @@ pub fn evaluate_shot<R: ReadAt>(
             }
         })
         .collect();
-    let foot_slide_cm = foot_slide_cm(stage, scene, &shot.plan().gait, FOOT_SLIDE_RATE_HZ);
+    let foot_slide_cm = foot_slide_cm(stage, shot.scene(), &shot.plan().gait, FOOT_SLIDE_RATE_HZ);
     let (scene_path, field_path, capture) = paths;
     Ok(ShotReport {
         scene: scene_path,

@@ -14,7 +14,7 @@
 //! pairs. It refuses to guess (`None`) with fewer than [`MIN_POSES`] poses with hulls, or
 //! no pair with a foot down in both, or a median that is not a positive speed.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::container::{FieldFile, ReadAt};
 use crate::error::Result;
@@ -89,10 +89,16 @@ pub fn from_hulls(poses: &[(f64, &VoxelHull)], cycle_seconds: f64) -> Option<f64
 /// The mean `x` of the hull's voxels on the belt on each side (left `z < 0`, right
 /// `z ≥ 0`), where that side has a foot down.
 fn planted_feet(hull: &VoxelHull) -> [Option<f64>; 2] {
+    feet_on_belt(hull).map(|f| f.map(|p| f64::from(p.x)))
+}
+
+/// The mean `(x, z)` of the hull's voxels on the belt on each side (left `z < 0`, right
+/// `z ≥ 0`), where that side has a foot down (at least [`MIN_FOOT_VOXELS`] of them).
+pub fn feet_on_belt(hull: &VoxelHull) -> [Option<Vec2>; 2] {
     let grid = hull.grid();
     let band = BELT_BAND_M.max(grid.voxel_m);
     let [nx, ny, nz] = grid.dims;
-    let mut sums = [(0.0f64, 0usize); 2];
+    let mut sums = [(0.0f64, 0.0f64, 0usize); 2];
     for j in 0..ny {
         if grid.centre(0, j, 0).y > band {
             break;
@@ -103,12 +109,134 @@ fn planted_feet(hull: &VoxelHull) -> [Option<f64>; 2] {
                     let c: Vec3 = grid.centre(i, j, k);
                     let side = usize::from(c.z >= 0.0);
                     sums[side].0 += f64::from(c.x);
-                    sums[side].1 += 1;
+                    sums[side].1 += f64::from(c.z);
+                    sums[side].2 += 1;
                 }
             }
         }
     }
-    sums.map(|(sum, count)| (count >= MIN_FOOT_VOXELS).then(|| sum / count as f64))
+    sums.map(|(x, z, count)| {
+        (count >= MIN_FOOT_VOXELS)
+            .then(|| Vec2::new((x / count as f64) as f32, (z / count as f64) as f32))
+    })
+}
+
+/// Where a field's walker has its feet on the belt through its cycle, as its visual
+/// hulls tell it ([`feet_on_belt`] of every pose's hull): what keeps a walker's planted
+/// foot in place when it turns on a path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FootTrack {
+    /// Seconds a cycle.
+    pub cycle_seconds: f64,
+    /// The belt's speed, metres per second ([`gait_speed_mps`]).
+    pub speed_mps: f64,
+    /// `(seconds into the cycle, per side the foot's point on the belt when down)`,
+    /// in time order.
+    pub samples: Vec<(f64, [Option<Vec2>; 2])>,
+    /// Per side, when each of its feet lands and lifts (seconds into the cycle; a step
+    /// may wrap round the cycle's end): half way between the poses that see it change.
+    contacts: [Vec<(f64, f64)>; 2],
+}
+
+impl FootTrack {
+    /// The track of `field`'s hulls; `None` with fewer than [`MIN_POSES`] poses with
+    /// hulls, or without the belt's speed.
+    pub fn of<R: ReadAt>(field: &FieldFile<R>) -> Result<Option<Self>> {
+        let Some(speed_mps) = gait_speed_mps(field)? else {
+            return Ok(None);
+        };
+        let mut samples = Vec::new();
+        for p in &field.header().poses {
+            if let Some(hull) = field.hull(p.pose)? {
+                samples.push((p.time_s, feet_on_belt(&hull)));
+            }
+        }
+        Ok(Self::new(samples, field.header().cycle_seconds, speed_mps))
+    }
+
+    /// The track of `samples` (any order) of a cycle of `cycle_seconds` on a belt of
+    /// `speed_mps`; `None` with fewer than [`MIN_POSES`].
+    pub fn new(
+        mut samples: Vec<(f64, [Option<Vec2>; 2])>,
+        cycle_seconds: f64,
+        speed_mps: f64,
+    ) -> Option<Self> {
+        if samples.len() < MIN_POSES || !(cycle_seconds > 0.0) || !speed_mps.is_finite() {
+            return None;
+        }
+        samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let n = samples.len();
+        let contacts = [0, 1].map(|side| {
+            let down = |k: usize| samples[k % n].1[side].is_some();
+            let between = |k: usize| {
+                let (a, b) = (samples[k % n].0, samples[(k + 1) % n].0);
+                (a + 0.5 * (b - a).rem_euclid(cycle_seconds)).rem_euclid(cycle_seconds)
+            };
+            if (0..n).all(down) {
+                return vec![(0.0, cycle_seconds)];
+            }
+            let mut steps = Vec::new();
+            for k in 0..n {
+                // A step lands between sample k (up) and k + 1 (down).
+                if !down(k) && down(k + 1) {
+                    let mut j = k + 1;
+                    while down(j + 1) {
+                        j += 1;
+                    }
+                    steps.push((between(k), between(j)));
+                }
+            }
+            steps
+        });
+        Some(Self {
+            cycle_seconds,
+            speed_mps,
+            samples,
+            contacts,
+        })
+    }
+
+    /// Seconds from `a` forward to `b` round the cycle.
+    fn ahead(&self, a: f64, b: f64) -> f64 {
+        (b - a).rem_euclid(self.cycle_seconds)
+    }
+
+    /// Side `side`'s foot on the belt `t` seconds into the cycle, when it is down: its
+    /// step (when it landed and when it lifts) and its point, from the pose nearest in
+    /// time that sees it down, carried by the belt from there.
+    fn foot(&self, side: usize, t: f64) -> Option<((f64, f64), Vec2)> {
+        let &(land, lift) = self.contacts[side]
+            .iter()
+            .find(|&&(land, lift)| self.ahead(land, t) <= self.ahead(land, lift))?;
+        let nearest = (self.samples.iter())
+            .filter(|s| s.1[side].is_some())
+            .min_by(|a, b| {
+                let d = |s: f64| self.ahead(s, t).min(self.ahead(t, s));
+                d(a.0).total_cmp(&d(b.0))
+            })?;
+        let p = nearest.1[side]?;
+        // Seconds from the sample to t, the short way round the cycle.
+        let mut dt = self.ahead(nearest.0, t);
+        if dt > 0.5 * self.cycle_seconds {
+            dt -= self.cycle_seconds;
+        }
+        Some((
+            (land, lift),
+            p - Vec2::new((self.speed_mps * dt) as f32, 0.0),
+        ))
+    }
+
+    /// The point on the belt the walker stands on `t` seconds into its cycle (subject
+    /// frame, `(x, z)`), and whether both feet are down: its foot that is down; while both
+    /// are, the mean of the two; `None` in the air.
+    pub fn stance(&self, t: f64) -> Option<(Vec2, bool)> {
+        let t = t.rem_euclid(self.cycle_seconds);
+        match [self.foot(0, t), self.foot(1, t)] {
+            [Some((_, p)), None] | [None, Some((_, p))] => Some((p, false)),
+            [Some(a), Some(b)] => Some((0.5 * (a.1 + b.1), true)),
+            [None, None] => None,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -146,6 +274,21 @@ mod tests {
         let poses: Vec<(f64, &VoxelHull)> = hulls.iter().map(|(t, h)| (*t, h)).collect();
         let measured = from_hulls(&poses, 1.0).expect("a measure");
         assert!((measured - v).abs() < 0.05 * v, "{measured}");
+        // The track: the foot down at each instant, carried by the belt between poses;
+        // both down where the steps overlap (0.4 to 0.5 s, seen at 0.4 and 0.5).
+        let samples = hulls.iter().map(|(t, h)| (*t, feet_on_belt(h))).collect();
+        let track = FootTrack::new(samples, 1.0, v).expect("a track");
+        let (p, both) = track.stance(0.12).expect("the left foot is down");
+        assert!(
+            !both && (p.x - (0.3 - v * 0.12) as f32).abs() < 0.02 && p.y < 0.0,
+            "{p}"
+        );
+        let (p, both) = track.stance(0.72).expect("the right foot is down");
+        assert!(
+            !both && (p.x - (0.3 - v * 0.32) as f32).abs() < 0.02 && p.y > 0.0,
+            "{p}"
+        );
+        assert!(track.stance(0.47).expect("both").1);
         // Too few poses, or no foot ever down: no guess.
         assert_eq!(from_hulls(&poses[..2], 1.0), None);
         let up = feet(None, None);

@@ -474,12 +474,26 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     }
 
     fn with_scene(
-        scene: Cow<'a, Scene>,
+        mut scene: Cow<'a, Scene>,
         field: &'a FieldFile<R>,
         device: Device,
         frames: &[ShotFrame],
         options: ShotOptions,
     ) -> Result<Self> {
+        // Walkers on paths turn on their planted foot where the hulls tell the feet.
+        if scene.instances.iter().any(|i| i.moves())
+            && let Some(track) = frf_reflectance::gait_speed::FootTrack::of(field)?
+        {
+            let gait = crate::Gait::of_field(field)?;
+            let stance = |t| {
+                track
+                    .stance(t)
+                    .map(|(point, both)| crate::walk::Stance { point, both })
+            };
+            for instance in &mut scene.to_mut().instances {
+                instance.plant(&gait, &stance);
+            }
+        }
         if let Some(most) = device.max_walkers()
             && scene.instances.len() > most
         {
