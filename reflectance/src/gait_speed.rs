@@ -161,7 +161,11 @@ impl FootTrack {
         cycle_seconds: f64,
         speed_mps: f64,
     ) -> Option<Self> {
-        if samples.len() < MIN_POSES || !(cycle_seconds > 0.0) || !speed_mps.is_finite() {
+        if samples.len() < MIN_POSES
+            || cycle_seconds.is_nan()
+            || cycle_seconds <= 0.0
+            || !speed_mps.is_finite()
+        {
             return None;
         }
         samples.sort_by(|a, b| a.0.total_cmp(&b.0));
