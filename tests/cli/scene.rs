@@ -200,6 +200,37 @@ fn a_camera_on_one_side_reads_only_that_side() {
 }
 
 #[test]
+fn a_walker_turning_on_its_path_reads_the_views_of_every_heading_it_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let camera = "[0.0, 1.3, 3.0]";
+    let standing = |heading: f32| format!("[[instance]]\nheading_deg = {heading}\n");
+    let turning = "[[instance]]\n\
+                   [[instance.key]]\ntime = 0.0\nposition = [0.0, 0.0, 0.0]\nheading_deg = 0.0\n\
+                   [[instance.key]]\ntime = 0.4\nposition = [0.4, 0.0, 0.0]\nheading_deg = 90.0\n";
+    let plans: Vec<serde_json::Value> = [standing(0.0), standing(90.0), turning.to_string()]
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            plan_json(
+                &write_scene(dir.path(), &format!("w{k}.toml"), w, camera, camera),
+                &[],
+            )
+        })
+        .collect();
+    let n = |p: &serde_json::Value, k: &str| p[k].as_u64().unwrap();
+    let (start, end, walking) = (&plans[0], &plans[1], &plans[2]);
+    // The two ends see different sides of the walker; walking between them reads both
+    // and what lies between, and still not the whole grid.
+    for k in ["views_used", "bytes_read"] {
+        assert!(n(walking, k) > n(start, k).max(n(end, k)), "{k}: {plans:?}");
+    }
+    assert!(
+        n(walking, "views_used") < n(walking, "views_total"),
+        "{walking}"
+    );
+}
+
+#[test]
 fn frame_ranges_split_a_shot_and_a_rerun_resumes() {
     let dir = tempfile::tempdir().unwrap();
     let scene = write_scene(
