@@ -132,7 +132,13 @@ impl SunDepth {
     /// Per texel (x fastest): the largest `toward · p` of the hull along its centre's
     /// line, `f32::MIN` where the line misses the hull; made on the first call.
     pub fn reach(&self) -> &[f32] {
-        self.reach.get_or_init(|| {
+        if let Some(made) = self.reach.get() {
+            return made;
+        }
+        // Made outside the lock's initialisation: a parallel loop inside `get_or_init` can
+        // deadlock, when a thread waiting in it steals work that asks for the same map.
+        // Two threads that both make it make the same values.
+        let made = {
             let [x, y] = self.axes;
             let w = self.size[0] as usize;
             (0..self.texels())
@@ -155,7 +161,8 @@ impl SunDepth {
                     })
                 })
                 .collect()
-        })
+        };
+        self.reach.get_or_init(|| made)
     }
 
     /// Whether the hull lies between `p` and the sun: it reaches past `p` along the line

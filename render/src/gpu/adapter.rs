@@ -13,6 +13,13 @@
 //! on a machine that has both, the default adapter used to be GL and every render failed
 //! ("Format Rgba32Float is not renderable"); a machine with GL alone is told so, and to
 //! render with `--cpu`.
+//!
+//! A process opens one wgpu instance and enumerates its adapters once ([`shared`]); every
+//! [`super::Gpu`] it opens after that is a device of one of those adapters. Opening an
+//! instance per device, as each GPU test did, brings every backend up and down again
+//! (the GL backend's EGL display is initialised and terminated with each instance): on a
+//! real GPU, tests opening devices on four threads at once then waited forever with the
+//! GPU idle, where each alone passed. One instance, made once, takes that away.
 
 use std::sync::OnceLock;
 
@@ -144,32 +151,49 @@ fn wanted() -> Option<String> {
         .filter(|s| !s.trim().is_empty())
 }
 
+/// [`shared`]'s instance and adapters, once made.
+static SHARED: OnceLock<(wgpu::Instance, Vec<wgpu::Adapter>)> = OnceLock::new();
+
+/// The process's wgpu instance (backends from `WGPU_BACKEND`, else all) and its
+/// adapters, made on the first call and shared by every later one (see the module text).
+pub fn shared() -> &'static (wgpu::Instance, Vec<wgpu::Adapter>) {
+    SHARED.get_or_init(|| {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        (instance, adapters)
+    })
+}
+
 /// Every adapter of `instance` with what it lacks, preferred first.
 pub fn candidates(instance: &wgpu::Instance) -> Vec<(wgpu::Adapter, Candidate)> {
     candidates_for(instance, None)
 }
 
 /// Every adapter of `instance` with what it lacks (with `surface`, presenting to it too),
-/// preferred first.
+/// preferred first; the process's [`shared`] instance answers from the adapters it found.
 fn candidates_for(
     instance: &wgpu::Instance,
     surface: Option<&wgpu::Surface>,
 ) -> Vec<(wgpu::Adapter, Candidate)> {
-    let mut all: Vec<(wgpu::Adapter, Candidate)> =
-        pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
-            .into_iter()
-            .map(|a| {
-                let mut lacks = lacks(&a);
-                if surface.is_some_and(|s| !a.is_surface_supported(s)) {
-                    lacks.push("presenting to the window".into());
-                }
-                let c = Candidate {
-                    adapter: describe(&a.get_info()),
-                    lacks,
-                };
-                (a, c)
-            })
-            .collect();
+    let adapters = match SHARED.get() {
+        Some((own, found)) if own == instance => found.clone(),
+        _ => pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all())),
+    };
+    let mut all: Vec<(wgpu::Adapter, Candidate)> = adapters
+        .into_iter()
+        .map(|a| {
+            let mut lacks = lacks(&a);
+            if surface.is_some_and(|s| !a.is_surface_supported(s)) {
+                lacks.push("presenting to the window".into());
+            }
+            let c = Candidate {
+                adapter: describe(&a.get_info()),
+                lacks,
+            };
+            (a, c)
+        })
+        .collect();
     all.sort_by_key(|(a, c)| (!c.lacks.is_empty(), rank(&a.get_info())));
     all
 }
@@ -274,10 +298,9 @@ pub fn choose_for(
 /// Every adapter found (preferred first, with what it lacks) and the choice
 /// [`choose`] makes among them, for a report (`frf info --gpu`).
 pub fn survey() -> (Vec<Candidate>, Result<AdapterReport>) {
-    let instance =
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let found = candidates(&instance).into_iter().map(|(_, c)| c).collect();
-    (found, choose(&instance).map(|(_, report)| report))
+    let instance = &shared().0;
+    let found = candidates(instance).into_iter().map(|(_, c)| c).collect();
+    (found, choose(instance).map(|(_, report)| report))
 }
 
 /// Keeps Mesa's Vulkan device-selection layer from probing for a display server: loaded

@@ -116,9 +116,7 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the adapter [`adapter::choose`] takes and builds the pipelines.
     pub fn new() -> Result<Self> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Self::on(&instance, None)
+        Self::on(&adapter::shared().0, None)
     }
 
     /// Opens the adapter of `instance` [`adapter::choose_for`] takes (one that can present
