@@ -68,6 +68,11 @@ pub struct Proxy {
 impl Proxy {
     /// The proxy of a pose with `hull` (none: no proxy).
     pub fn new(hull: Option<VoxelHull>) -> Self {
+        Self::shared(hull.map(Arc::new))
+    }
+
+    /// [`Proxy::new`] of a hull held elsewhere too.
+    pub fn shared(hull: Option<Arc<VoxelHull>>) -> Self {
         let axis = hull
             .as_ref()
             .and_then(|h| h.bounds())
@@ -75,10 +80,7 @@ impl Proxy {
                 let c = 0.5 * (lo + hi);
                 Vec2::new(c.x, c.z)
             });
-        Self {
-            hull: hull.map(Arc::new),
-            axis,
-        }
+        Self { hull, axis }
     }
 
     /// The visual hull, if there is one.

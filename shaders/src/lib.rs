@@ -34,6 +34,9 @@ pub const FLOOR: &str = include_str!("../floor.wgsl");
 pub const CYLINDER: &str = include_str!("../rebin/cylinder.wgsl");
 /// `rebin/proxy.wgsl`: the geometric proxy, composed after the frame pass.
 pub const PROXY: &str = include_str!("../rebin/proxy.wgsl");
+/// `rebin/hull.wgsl`: a ray's walk through a visual hull's voxels, composed after the
+/// frame pass and after the suns' maps.
+pub const HULL: &str = include_str!("../rebin/hull.wgsl");
 /// `morph/e06.wgsl`: E06's morphs, composed after the frame pass.
 pub const E06: &str = include_str!("../morph/e06.wgsl");
 /// `morph/solved.wgsl`: the solved four-way morph, composed after the frame pass.
@@ -85,13 +88,13 @@ pub fn composed(pass: &str) -> String {
 pub fn frame_pass(prelit: &str, flow: &str, (kind, flags): (u32, u32)) -> String {
     let morph = format!("const KIND: u32 = {kind}u;\nconst FLAGS: u32 = {flags}u;");
     [
-        COMMON, &morph, prelit, flow, REBIN, CYLINDER, PROXY, E06, SOLVED,
+        COMMON, &morph, prelit, flow, REBIN, CYLINDER, PROXY, HULL, E06, SOLVED,
     ]
     .join("\n")
 }
 
 /// The sun-depth pass's full source: the shared definitions, the pass, and the walk
-/// through the hull it shares with the frame pass ([`PROXY`]).
+/// through a hull it shares with the frame pass ([`HULL`]).
 pub fn sun_depth_pass() -> String {
-    [COMMON, SUN_DEPTH, PROXY].join("\n")
+    [COMMON, SUN_DEPTH, HULL].join("\n")
 }

@@ -160,13 +160,34 @@ pub struct GpuSunDepthJob {
     pub texel: [f32; 4],
 }
 
-/// `SunOccluderJob` of `sun_depth.wgsl`: another walker's hull walked along one sun's
-/// map of a walker (`frf_reflectance::sun_depth::Occluder`).
+/// `SunMap` of `sun_depth.wgsl`: a map to make, its walker's hull and its occluders.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
-pub struct GpuSunOccluderJob {
-    /// The map's frame and slot, as its own job (`toward.w`: `far`, beyond both hulls).
+pub struct GpuSunMap {
+    /// The map's frame and where its values go.
     pub map: GpuSunDepthJob,
+    /// The walker's own hull (its entry in the table of hulls), the first of its
+    /// occluders (in the occluders' table) and how many; the fourth unused.
+    pub hulls: [u32; 4],
+}
+
+/// `HullAt` of `sun_depth.wgsl`: a hull of the table of hulls, and where its words start.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuHullAt {
+    /// Its grid.
+    pub proxy: GpuProxy,
+    /// The first of its words in the array of every hull's words (the rest unused).
+    pub at: [u32; 4],
+}
+
+/// `SunOccluder` of `sun_depth.wgsl`: another walker's hull walked along one sun's map of
+/// a walker (`frf_reflectance::sun_depth::Occluder`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuSunOccluder {
+    /// Its hull's entry in the table of hulls (the rest unused).
+    pub hull: [u32; 4],
     /// `there_from_here` (the walker's frame into the occluder's): its rotation's columns
     /// and its translation (w unused).
     pub there_x: [f32; 4],

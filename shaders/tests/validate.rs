@@ -9,9 +9,9 @@ use std::mem::{offset_of, size_of};
 
 use frf_shaders as shaders;
 use frf_shaders::types::{
-    GpuColumnIndex, GpuComposite, GpuFrame, GpuInstance, GpuLightFitParams, GpuPresent, GpuProxy,
-    GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams, GpuSunDepthJob,
-    GpuSunOccluderJob, GpuTimeMorph, GpuView,
+    GpuColumnIndex, GpuComposite, GpuFrame, GpuHullAt, GpuInstance, GpuLightFitParams, GpuPresent,
+    GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams,
+    GpuSunDepthJob, GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -56,8 +56,8 @@ fn every_wgsl_file_parses_and_validates_as_compiled() {
         } else if name == "sun_depth.wgsl" {
             assert_eq!(text, shaders::SUN_DEPTH, "{name} as compiled");
             let m = module(&shaders::sun_depth_pass(), &name);
-            // vs_main (of every pass), sun_depth, sun_occluder.
-            assert_eq!(m.entry_points.len(), 3, "{name}");
+            // vs_main (of every pass), sun_depth.
+            assert_eq!(m.entry_points.len(), 2, "{name}");
         } else {
             let m = module(&shaders::composed(&text), &name);
             assert!(!m.entry_points.is_empty(), "{name} has no entry point");
@@ -156,11 +156,13 @@ fn pod_structs_match_naga_layouts() {
         GpuSunDepthJob,
         [toward, axis_x, axis_y, size, texel]
     );
+    check_layout!(&sun_depth, "SunMap", GpuSunMap, [map, hulls]);
+    check_layout!(&sun_depth, "HullAt", GpuHullAt, [proxy, at]);
     check_layout!(
         &sun_depth,
-        "SunOccluderJob",
-        GpuSunOccluderJob,
-        [map, there_x, there_y, there_z, there_t]
+        "SunOccluder",
+        GpuSunOccluder,
+        [hull, there_x, there_y, there_z, there_t]
     );
     let rebin = module(
         &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES, (4, 1)),

@@ -7,7 +7,6 @@
 use std::sync::Arc;
 
 use frf_core::volume::GroundGrid;
-use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
 use glam::Quat;
 use wgpu::util::DeviceExt;
@@ -37,10 +36,6 @@ pub struct GpuPose {
     prelit: wgpu::Texture,
     /// The view table (whose scales the relighting pass sets).
     pub(super) views: wgpu::Buffer,
-    /// The hull's grid and its words, as the frame pass binds them (the suns' maps walk
-    /// it too, [`super::sun_depth`]).
-    pub(super) proxy: wgpu::Buffer,
-    pub(super) hull: wgpu::Buffer,
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
     pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
@@ -72,13 +67,6 @@ pub struct RelitShadowInfo {
 }
 
 impl GpuPose {
-    /// Its hull, and the hull's grid and words as the frame pass binds them (none without
-    /// a hull).
-    pub(super) fn hull(&self) -> Option<(&VoxelHull, &wgpu::Buffer, &wgpu::Buffer)> {
-        let hull = self.geometry.proxy.hull()?;
-        Some((hull, &self.proxy, &self.hull))
-    }
-
     /// A view of the pre-lit texture array.
     pub(super) fn prelit_codes_view(&self) -> wgpu::TextureView {
         self.prelit.create_view(&wgpu::TextureViewDescriptor {
@@ -201,8 +189,13 @@ impl Gpu {
             &flows,
             source.flows.table,
         );
-        let relight = self.pose_relight(basis, geometry.views(), pose.hull());
-        self.record_relight(&relight, source, (&pose.prelit_codes_view(), &pose.views));
+        let hull = pose.geometry.proxy.hull_shared().cloned();
+        let mut relight = self.pose_relight(basis, geometry.views(), hull);
+        self.record_relight(
+            &mut relight,
+            source,
+            (&pose.prelit_codes_view(), &pose.views),
+        );
         pose.relight = Some(relight);
         Ok(pose)
     }
@@ -214,11 +207,13 @@ impl Gpu {
         if pose.relight.is_none() {
             // Let go of ([`GpuPose::release_basis`]): uploaded again.
             let basis = self.upload_basis(source)?;
-            let relight = self.pose_relight(basis, source.geometry.views(), pose.hull());
+            let hull = pose.geometry.proxy.hull_shared().cloned();
+            let relight = self.pose_relight(basis, source.geometry.views(), hull);
             pose.relight = Some(relight);
         }
         self.scoped("relighting a resident pose", || {
-            let relight = pose.relight.as_ref().ok_or_else(|| {
+            let target = pose.prelit_codes_view();
+            let relight = pose.relight.as_mut().ok_or_else(|| {
                 crate::RenderError::Misuse("relighting a pose of no basis".into())
             })?;
             if !relight.basis().holds(&source.basis) {
@@ -226,7 +221,7 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(relight, source, (&pose.prelit_codes_view(), &pose.views));
+            self.record_relight(relight, source, (&target, &pose.views));
             Ok(())
         })
     }
@@ -464,8 +459,6 @@ impl Gpu {
             bind_group,
             prelit,
             views: view_buffer,
-            proxy: proxy_buffer,
-            hull: hull_buffer,
             relight: None,
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,
@@ -525,7 +518,8 @@ impl Gpu {
 
 impl Gpu {
     /// The suns' maps of `pose` as the GPU made them at its last relight (per sun of
-    /// `suns`, its map's values; for tests and inspection): none without a hull.
+    /// `suns`, its map's values; for tests and inspection, before other poses are
+    /// relit): none without a hull.
     pub fn read_sun_maps(&self, pose: &GpuPose, suns: &[SunLight]) -> Result<Vec<Vec<f32>>> {
         let Some(maps) = pose.relight.as_ref().and_then(|r| r.sun_maps()) else {
             return Ok(Vec::new());
@@ -539,7 +533,7 @@ impl Gpu {
                 .enumerate()
                 .filter_map(|(s, sun)| {
                     let n = sun.depth.as_ref()?.texels();
-                    let start = maps.slot_start(s);
+                    let start = maps.starts.get(s).copied().flatten()?;
                     Some(all[start..start + n].to_vec())
                 })
                 .collect())

@@ -16,7 +16,6 @@ use frf_core::image::Rgb;
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::{RATIO_FLOOR, group_cone};
-use frf_reflectance::sun_depth::SunDepth;
 use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight, TRUST_ERROR};
 use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
 use wgpu::util::DeviceExt;
@@ -25,7 +24,7 @@ use super::bind::{
     bind_group, buffer_with, compute_pipeline, empty_buffer, storage, storage_texture_array,
     table_bytes, uniform,
 };
-use super::sun_depth::PoseSunMaps;
+use super::sun_depth::SunMapsAt;
 use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::Result;
@@ -127,8 +126,11 @@ pub struct PoseRelight {
     basis: Arc<GpuBasis>,
     coefficients: Vec<wgpu::Buffer>,
     peaks: wgpu::Buffer,
-    /// Its suns' maps of the hull, made on the GPU (none without a hull).
-    sun_maps: Option<PoseSunMaps>,
+    /// Its hull, whose maps toward the suns the GPU makes at each relight (none without
+    /// a hull: its suns cast no shadow).
+    hull: Option<Arc<VoxelHull>>,
+    /// Where its suns' maps were made at its last relight (read back by tests).
+    pub(super) sun_maps: Option<SunMapsAt>,
 }
 
 impl PoseRelight {
@@ -137,8 +139,8 @@ impl PoseRelight {
         &self.basis
     }
 
-    /// Its suns' maps (none without a hull).
-    pub(super) fn sun_maps(&self) -> Option<&PoseSunMaps> {
+    /// Where its suns' maps were made at its last relight (none without a hull).
+    pub(super) fn sun_maps(&self) -> Option<&SunMapsAt> {
         self.sun_maps.as_ref()
     }
 }
@@ -204,7 +206,7 @@ fn light_coefficients(source: &PoseSource) -> usize {
 fn packed_coefficients(
     batch: &BasisBatch,
     source: &PoseSource,
-    maps: Option<&PoseSunMaps>,
+    maps: Option<&SunMapsAt>,
 ) -> Vec<[f32; 4]> {
     let mut out = Vec::with_capacity(batch.coefficients.max(1));
     // The conditions' cones and lights follow the jobs: where each condition's start.
@@ -262,7 +264,8 @@ fn packed_coefficients(
             &source.suns[..source.suns.len().min(MAX_SUNS)]
         };
         for (s, sun) in suns.iter().enumerate() {
-            pack_sun(&mut out, sun, (i, scales), maps.map(|m| m.slot_start(s)));
+            let depth_at = maps.and_then(|m| m.starts.get(s).copied().flatten());
+            pack_sun(&mut out, sun, (i, scales), depth_at);
         }
         let empty = MAX_SUNS - suns.len();
         out.extend(std::iter::repeat_n(
@@ -288,8 +291,8 @@ fn packed_coefficients(
 }
 
 /// One slot of view `i`'s job for `sun` (`shaders/relight.wgsl` says what each holds),
-/// its map of the hull, if any, from `depth_at` on in the pose's maps
-/// ([`PoseSunMaps::reach`]; `None`: no maps, no cast shadows).
+/// its map of the hull, if any, from `depth_at` on in the batch's maps
+/// ([`SunMapsAt::reach`]; `None`: no map, no cast shadows).
 fn pack_sun(
     out: &mut Vec<[f32; 4]>,
     sun: &SunLight,
@@ -447,17 +450,14 @@ impl Gpu {
         }
     }
 
-    /// A pose's own relighting buffers over the shared `basis`, for `views` views, and the
-    /// slots of its suns' maps where it has a hull (`hull`: the hull, and its grid and
-    /// words as the frame pass binds them).
+    /// A pose's own relighting buffers over the shared `basis`, for `views` views, with
+    /// its hull (`None`: none), whose suns' maps each relight makes.
     pub(super) fn pose_relight(
         &self,
         basis: Arc<GpuBasis>,
         views: usize,
-        hull: Option<(&VoxelHull, &wgpu::Buffer, &wgpu::Buffer)>,
+        hull: Option<Arc<VoxelHull>>,
     ) -> PoseRelight {
-        let sun_maps = hull
-            .map(|(h, proxy, words)| self.pose_sun_maps(proxy, words, SunDepth::most_texels(h)));
         let buffer =
             |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
         let dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
@@ -469,20 +469,26 @@ impl Gpu {
                 .collect(),
             peaks: buffer("peaks", views.max(1) * 4, dst),
             basis,
-            sun_maps,
+            hull,
+            sun_maps: None,
         }
     }
 
-    /// Writes `source`'s coefficients into `relight`'s buffers and records the passes
-    /// that make its suns' maps ([`super::sun_depth`]) and relight its views into the
+    /// Asks for its suns' maps ([`super::sun_depth`], made with every other walker's in
+    /// one dispatch ahead of the relights), writes `source`'s coefficients into
+    /// `relight`'s buffers and records the passes that relight its views into the
     /// pre-lit array `target`, their scales into the pose's view table `views`
-    /// ([`Gpu::relight_pose`]).
+    /// ([`Gpu::relight_pose`]); keeps where the maps are.
     pub(super) fn record_relight(
         &self,
-        relight: &PoseRelight,
+        relight: &mut PoseRelight,
         source: &PoseSource,
         (target, views): (&wgpu::TextureView, &wgpu::Buffer),
     ) {
+        relight.sun_maps = relight
+            .hull
+            .as_ref()
+            .map(|hull| self.ask_sun_maps(hull, &source.suns));
         let maps = relight.sun_maps.as_ref();
         let basis = &relight.basis;
         for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
@@ -499,9 +505,6 @@ impl Gpu {
         let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
         let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
         self.with_pending(|encoder| {
-            if let Some(maps) = maps {
-                self.record_sun_maps(encoder, maps, &source.suns);
-            }
             encoder.clear_buffer(&relight.peaks, 0, None);
             for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
                 let bind = bind_group(
@@ -585,6 +588,8 @@ impl Gpu {
             .take()
             .map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
+        // The suns' maps the pending relights read, made first.
+        self.submit_sun_maps();
         if let Some(p) = pending {
             self.queue.submit([p]);
         }

@@ -1,48 +1,49 @@
-//! The suns' maps of a pose's visual hull made on the GPU (`shaders/sun_depth.wgsl`), twin
+//! The suns' maps of the walkers' hulls made on the GPU (`shaders/sun_depth.wgsl`), twin
 //! of [`SunDepth::reach`]: the host sets each map's frame ([`SunDepth::new`], a few
-//! products), and one invocation a texel walks the hull the frame pass already holds, into
-//! the pose's slots that the relight pass reads. A light that turns moves its suns, so
-//! their maps are made again for every relight: on the GPU that is one dispatch, where the
-//! host walked a ray per texel of every map of every walker's pose.
+//! products), and one invocation a texel walks the walker's hull and those of the other
+//! walkers in the way of its sun ([`frf_reflectance::sun_depth::Occluder`]); the relight
+//! pass then reads the map. A light that turns moves the suns, so the maps are made again
+//! for every relight.
 //!
-//! Other walkers in the way of a sun ([`frf_reflectance::sun_depth::Occluder`]) are walked
-//! after it, one dispatch each, their hulls uploaded once and kept ([`OCCLUDER_HULLS`]).
+//! Every map asked for between two submissions is made by **one dispatch**, whatever the
+//! number of walkers and occluders: the maps' frames and their occluders go into one list
+//! each ([`SunBatch`]), their values into one scratch buffer that the relights recorded
+//! with them read at their offsets, and every hull walked into one table of hulls over
+//! one array of words ([`HullTable`]), each hull uploaded once while it is kept. The
+//! dispatch is submitted ahead of the pending relights ([`Gpu::submit`]); a map is needed
+//! only until its relight has run, so the scratch is reused by the next batch.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::sun_depth::SunDepth;
 use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
-use frf_shaders::types::{GpuSunDepthJob, GpuSunOccluderJob};
-use wgpu::util::DeviceExt;
+use frf_shaders::types::{GpuHullAt, GpuSunDepthJob, GpuSunMap, GpuSunOccluder};
 
 use super::Gpu;
-use super::bind::{bind_group, compute_pipeline, empty_buffer, storage};
-use super::kept::Kept;
+use super::bind::{bind_group, buffer_with, compute_pipeline, empty_buffer, storage};
 use super::timing::compute_pass_writes;
-
-/// Other walkers' hulls kept on the GPU, the most recently used (a crowd's neighbours).
-pub const OCCLUDER_HULLS: usize = 64;
-
-/// An occluder's hull as the pass binds it: its grid and its words (and the hull, so that
-/// the address keying it stays its own).
-struct OccluderHull {
-    _hull: Arc<VoxelHull>,
-    proxy: wgpu::Buffer,
-    words: wgpu::Buffer,
-}
 
 /// Workgroup size of the pass (`@workgroup_size(64)`).
 const WORKGROUP: u32 = 64;
 
-/// The pass's layout and pipeline.
+/// Hulls the table holds at first (it grows when a batch needs more).
+const FIRST_HULLS: usize = 64;
+
+/// Words of the hulls' array at first (4 MiB; it grows when a batch needs more).
+const FIRST_WORDS: usize = 1 << 20;
+
+/// Values of the maps' scratch at first (4 MiB; it grows when a batch needs more).
+const FIRST_VALUES: usize = 1 << 20;
+
+/// Most maps in one dispatch (rows of workgroups).
+const MOST_MAPS: usize = 65_535;
+
+/// The pass's layout and pipeline, and the hulls and maps it holds.
 pub struct SunDepthPass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
-    occluder_layout: wgpu::BindGroupLayout,
-    occluder_pipeline: wgpu::ComputePipeline,
-    /// Occluders' hulls, by address.
-    hulls: Kept<usize, OccluderHull>,
+    state: Mutex<(HullTable, SunBatch)>,
 }
 
 impl SunDepthPass {
@@ -56,218 +57,305 @@ impl SunDepthPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sun depth"),
             entries: &[
-                storage::<frf_shaders::types::GpuProxy>(0, true, c),
+                storage::<GpuHullAt>(0, true, c),
                 storage::<u32>(1, true, c),
-                storage::<GpuSunDepthJob>(2, true, c),
+                storage::<GpuSunMap>(2, true, c),
                 storage::<f32>(3, false, c),
+                storage::<GpuSunOccluder>(4, true, c),
             ],
         });
         let pipeline = compute_pipeline(device, "sun depth", &[&layout], &module, "sun_depth");
-        let occluder_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("sun occluder"),
-            entries: &[
-                storage::<frf_shaders::types::GpuProxy>(0, true, c),
-                storage::<u32>(1, true, c),
-                storage::<f32>(3, false, c),
-                storage::<GpuSunOccluderJob>(4, true, c),
-            ],
-        });
-        let occluder_pipeline = compute_pipeline(
-            device,
-            "sun occluder",
-            &[&occluder_layout],
-            &module,
-            "sun_occluder",
-        );
+        let state = Mutex::new((
+            HullTable::new(device, FIRST_HULLS, FIRST_WORDS),
+            SunBatch::new(device, FIRST_VALUES),
+        ));
         Self {
             layout,
             pipeline,
-            occluder_layout,
-            occluder_pipeline,
-            hulls: Kept::new(OCCLUDER_HULLS),
+            state,
         }
     }
 }
 
-/// A pose's [`MAX_SUNS`] slots of a sun's map, each of the most texels a map of its hull
-/// can have ([`SunDepth::most_texels`]), and what the pass binds to fill them.
-pub struct PoseSunMaps {
-    jobs: wgpu::Buffer,
-    /// The maps' values, slot after slot: what the relight pass reads.
-    pub(super) reach: wgpu::Buffer,
-    slot_texels: usize,
-    bind: wgpu::BindGroup,
+/// Every hull the maps walk: a table of their grids and one array of their words, each
+/// hull uploaded once while kept (keyed by its address, held so that the address stays
+/// its own). When a batch needs a hull that does not fit, the table is emptied once the
+/// work that reads it is submitted, and grown to hold it.
+struct HullTable {
+    held: Vec<Arc<VoxelHull>>,
+    words_used: usize,
+    table: wgpu::Buffer,
+    words: wgpu::Buffer,
+    capacity: (usize, usize),
 }
 
-impl PoseSunMaps {
-    /// Where slot `s`'s values start in [`PoseSunMaps::reach`].
-    pub(super) fn slot_start(&self, s: usize) -> usize {
-        s * self.slot_texels
+impl HullTable {
+    fn new(device: &wgpu::Device, hulls: usize, words: usize) -> Self {
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        Self {
+            held: Vec::new(),
+            words_used: 0,
+            table: empty_buffer(device, "hull table", hulls * size_of::<GpuHullAt>(), usage),
+            words: empty_buffer(device, "hull words", words * 4, usage),
+            capacity: (hulls, words),
+        }
+    }
+
+    /// The entry of `hull`, when held.
+    fn entry(&self, hull: &Arc<VoxelHull>) -> Option<u32> {
+        let at = self.held.iter().position(|h| Arc::ptr_eq(h, hull))?;
+        Some(at as u32)
+    }
+
+    /// Adds `hull` (its grid and words written into the buffers), when it fits.
+    fn add(&mut self, queue: &wgpu::Queue, hull: &Arc<VoxelHull>) -> Option<u32> {
+        let (proxy, words) = crate::proxy::Proxy::shared(Some(hull.clone())).gpu();
+        let (hulls, most_words) = self.capacity;
+        if self.held.len() >= hulls || self.words_used + words.len() > most_words {
+            return None;
+        }
+        let entry = GpuHullAt {
+            proxy,
+            at: [self.words_used as u32, 0, 0, 0],
+        };
+        let k = self.held.len();
+        queue.write_buffer(
+            &self.table,
+            (k * size_of::<GpuHullAt>()) as u64,
+            bytemuck::bytes_of(&entry),
+        );
+        queue.write_buffer(
+            &self.words,
+            (self.words_used * 4) as u64,
+            bytemuck::cast_slice(&words),
+        );
+        self.words_used += words.len();
+        self.held.push(hull.clone());
+        Some(k as u32)
     }
 }
 
-/// The job of `map` in slot `s` of slots of `slot_texels` (unused, no shadow, when it
-/// would not fit: a map never has more texels than [`SunDepth::most_texels`]).
-fn job(map: &SunDepth, s: usize, slot_texels: usize) -> GpuSunDepthJob {
-    let fits = map.texels() <= slot_texels;
+/// The maps asked for since the last submission: their jobs, their occluders, and the
+/// scratch their values go into (one after the other).
+struct SunBatch {
+    maps: Vec<GpuSunMap>,
+    occluders: Vec<GpuSunOccluder>,
+    used: usize,
+    most_texels: usize,
+    reach: wgpu::Buffer,
+    capacity: usize,
+}
+
+impl SunBatch {
+    fn new(device: &wgpu::Device, values: usize) -> Self {
+        Self {
+            maps: Vec::new(),
+            occluders: Vec::new(),
+            used: 0,
+            most_texels: 0,
+            reach: empty_buffer(
+                device,
+                "sun depths",
+                values * 4,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            capacity: values,
+        }
+    }
+}
+
+/// The job of `map` whose values start at `start`.
+fn job(map: &SunDepth, start: usize) -> GpuSunDepthJob {
     GpuSunDepthJob {
         toward: map.toward.extend(map.far).to_array(),
         axis_x: map.axes[0].extend(map.corner.x).to_array(),
         axis_y: map.axes[1].extend(map.corner.y).to_array(),
-        size: [
-            map.size[0],
-            map.size[1],
-            (s * slot_texels) as u32,
-            u32::from(fits),
-        ],
+        size: [map.size[0], map.size[1], start as u32, 1],
         texel: [map.texel, 0.0, 0.0, 0.0],
     }
 }
 
+/// Where each sun's map of a relight lies in the scratch ([`Gpu::ask_sun_maps`]).
+pub(super) struct SunMapsAt {
+    /// Per sun slot (of the first [`MAX_SUNS`]), where its values start; `None` for a
+    /// sun without a map.
+    pub starts: Vec<Option<usize>>,
+    /// The scratch buffer they are in.
+    pub reach: wgpu::Buffer,
+}
+
+/// Why a request had to wait for the work before it to be submitted.
+enum Full {
+    /// The batch's scratch or list of maps.
+    Batch,
+    /// The table of hulls.
+    Hulls,
+}
+
 impl Gpu {
-    /// Slots for the suns' maps of a pose whose hull the frame pass binds as `proxy` and
-    /// `hull` (its words), of `slot_texels` each.
-    pub(super) fn pose_sun_maps(
+    /// Asks for the maps of `suns` (those with one, of the first [`MAX_SUNS`]) of the
+    /// walker whose hull is `own`: added to the batch that the next submission makes in
+    /// one dispatch ahead of the relights recorded after this call. When the batch or
+    /// the table of hulls is full, the work pending is submitted first (and the table
+    /// grown or the scratch grown as the request needs).
+    pub(super) fn ask_sun_maps(&self, own: &Arc<VoxelHull>, suns: &[SunLight]) -> SunMapsAt {
+        let suns = &suns[..suns.len().min(MAX_SUNS)];
+        loop {
+            match self.try_sun_maps(own, suns) {
+                Ok(at) => return at,
+                Err(_) => self.flush(),
+            }
+        }
+    }
+
+    /// One try of [`Gpu::ask_sun_maps`]: `Err` when the work pending must be submitted
+    /// first (then the table or the scratch is ready for the next try).
+    fn try_sun_maps(
         &self,
-        proxy: &wgpu::Buffer,
-        hull: &wgpu::Buffer,
-        slot_texels: usize,
-    ) -> PoseSunMaps {
-        let buffer =
-            |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
+        own: &Arc<VoxelHull>,
+        suns: &[SunLight],
+    ) -> std::result::Result<SunMapsAt, Full> {
+        let mut state = self
+            .sun_depth
+            .state
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let (hulls, batch) = &mut *state;
+        let maps: Vec<(usize, &SunDepth)> = suns
+            .iter()
+            .enumerate()
+            .filter_map(|(s, sun)| Some((s, sun.depth.as_ref()?)))
+            .collect();
+        let values: usize = maps.iter().map(|(_, m)| m.texels()).sum();
+        let busy = !batch.maps.is_empty();
+        if batch.used + values > batch.capacity || batch.maps.len() + maps.len() > MOST_MAPS {
+            if busy {
+                return Err(Full::Batch);
+            }
+            let capacity = values.next_power_of_two().max(batch.capacity);
+            *batch = SunBatch::new(&self.device, capacity);
+        }
+        // Every hull the request walks, in the table.
+        let wanted: Vec<&Arc<VoxelHull>> = std::iter::once(own)
+            .chain(
+                maps.iter()
+                    .flat_map(|(_, m)| m.occluders.iter().map(|o| &o.hull)),
+            )
+            .collect();
+        let mut entries = Vec::with_capacity(wanted.len());
+        for hull in &wanted {
+            match hulls.entry(hull).or_else(|| hulls.add(&self.queue, hull)) {
+                Some(e) => entries.push(e),
+                None if busy => return Err(Full::Hulls),
+                None => {
+                    // Nothing in flight reads the table: start it again, large enough.
+                    let words: usize = wanted.iter().map(|h| h.word_count() + 1).sum();
+                    let (n, w) = hulls.capacity;
+                    *hulls = HullTable::new(
+                        &self.device,
+                        (2 * n).max(wanted.len().next_power_of_two()),
+                        (2 * w).max(words.next_power_of_two()),
+                    );
+                    return Err(Full::Hulls);
+                }
+            }
+        }
+        let mut starts = vec![None; suns.len()];
+        let mut occluder_entries = entries[1..].iter();
+        for (s, map) in maps {
+            let first = batch.occluders.len();
+            for o in &map.occluders {
+                let there = o.here_from_there.inverse();
+                let r = there.rotation;
+                let hull = *occluder_entries.next().expect("an entry per occluder");
+                batch.occluders.push(GpuSunOccluder {
+                    hull: [hull, 0, 0, 0],
+                    there_x: r.x_axis.extend(0.0).to_array(),
+                    there_y: r.y_axis.extend(0.0).to_array(),
+                    there_z: r.z_axis.extend(0.0).to_array(),
+                    there_t: there.translation.extend(0.0).to_array(),
+                });
+            }
+            batch.maps.push(GpuSunMap {
+                map: job(map, batch.used),
+                hulls: [entries[0], first as u32, map.occluders.len() as u32, 0],
+            });
+            starts[s] = Some(batch.used);
+            batch.used += map.texels();
+            batch.most_texels = batch.most_texels.max(map.texels());
+        }
+        Ok(SunMapsAt {
+            starts,
+            reach: batch.reach.clone(),
+        })
+    }
+
+    /// Submits the dispatch that makes every map asked for since the last call (none:
+    /// nothing), and empties the batch; [`Gpu::submit`] calls it ahead of the relights
+    /// that read the maps.
+    pub(super) fn submit_sun_maps(&self) {
+        let mut state = self
+            .sun_depth
+            .state
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let (hulls, batch) = &mut *state;
+        if batch.maps.is_empty() {
+            return;
+        }
         let storage = wgpu::BufferUsages::STORAGE;
-        let jobs = buffer(
-            "sun depth jobs",
-            MAX_SUNS * size_of::<GpuSunDepthJob>(),
-            storage | wgpu::BufferUsages::COPY_DST,
+        let maps = buffer_with(
+            &self.device,
+            "sun maps",
+            bytemuck::cast_slice(&batch.maps),
+            storage,
         );
-        let reach = buffer(
-            "sun depths",
-            MAX_SUNS * slot_texels.max(1) * 4,
-            storage | wgpu::BufferUsages::COPY_SRC,
-        );
+        let occluders = if batch.occluders.is_empty() {
+            buffer_with(
+                &self.device,
+                "sun occluders",
+                bytemuck::bytes_of(&<GpuSunOccluder as bytemuck::Zeroable>::zeroed()),
+                storage,
+            )
+        } else {
+            buffer_with(
+                &self.device,
+                "sun occluders",
+                bytemuck::cast_slice(&batch.occluders),
+                storage,
+            )
+        };
         let bind = bind_group(
             &self.device,
             "sun depth",
             &self.sun_depth.layout,
             vec![
-                proxy.as_entire_binding(),
-                hull.as_entire_binding(),
-                jobs.as_entire_binding(),
-                reach.as_entire_binding(),
+                hulls.table.as_entire_binding(),
+                hulls.words.as_entire_binding(),
+                maps.as_entire_binding(),
+                batch.reach.as_entire_binding(),
+                occluders.as_entire_binding(),
             ],
         );
-        PoseSunMaps {
-            jobs,
-            reach,
-            slot_texels,
-            bind,
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("sun depth"),
+            });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("sun depth"),
+                timestamp_writes: compute_pass_writes(self.pass_timestamps("sun depth", None)),
+            });
+            pass.set_pipeline(&self.sun_depth.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            let groups = (batch.most_texels as u32).div_ceil(WORKGROUP);
+            pass.dispatch_workgroups(groups, batch.maps.len() as u32, 1);
         }
-    }
-
-    /// Writes the maps' frames of `suns` (those with a map, in slots in their order) and
-    /// records the pass that fills their slots into `encoder`.
-    pub(super) fn record_sun_maps(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        maps: &PoseSunMaps,
-        suns: &[SunLight],
-    ) {
-        let jobs: Vec<GpuSunDepthJob> = suns
-            .iter()
-            .take(MAX_SUNS)
-            .enumerate()
-            .filter_map(|(s, sun)| Some(job(sun.depth.as_ref()?, s, maps.slot_texels)))
-            .collect();
-        if jobs.is_empty() {
-            return;
-        }
-        let mut all = jobs.clone();
-        all.resize(MAX_SUNS, bytemuck::Zeroable::zeroed());
-        self.queue
-            .write_buffer(&maps.jobs, 0, bytemuck::cast_slice(&all));
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("sun depth"),
-            timestamp_writes: compute_pass_writes(self.pass_timestamps("sun depth", None)),
-        });
-        pass.set_pipeline(&self.sun_depth.pipeline);
-        pass.set_bind_group(0, &maps.bind, &[]);
-        let groups = (maps.slot_texels as u32).div_ceil(WORKGROUP);
-        pass.dispatch_workgroups(groups, MAX_SUNS as u32, 1);
-        drop(pass);
-        self.record_occluders(encoder, maps, suns);
-    }
-
-    /// Records, after the suns' own maps, a dispatch per other walker in the way of each
-    /// sun ([`SunDepth::with_occluders`]): its hull walked along the map's lines.
-    fn record_occluders(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        maps: &PoseSunMaps,
-        suns: &[SunLight],
-    ) {
-        for (s, sun) in suns.iter().take(MAX_SUNS).enumerate() {
-            let Some(map) = sun.depth.as_ref() else {
-                continue;
-            };
-            for o in &map.occluders {
-                let hull = self.sun_depth.hulls.get(Arc::as_ptr(&o.hull) as usize, || {
-                    let (proxy, words) = crate::proxy::Proxy::new(Some((*o.hull).clone())).gpu();
-                    let upload = |label, bytes: &[u8]| {
-                        self.device
-                            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                                label: Some(label),
-                                contents: bytes,
-                                usage: wgpu::BufferUsages::STORAGE,
-                            })
-                    };
-                    OccluderHull {
-                        _hull: o.hull.clone(),
-                        proxy: upload("occluder hull", bytemuck::bytes_of(&proxy)),
-                        words: upload("occluder hull words", bytemuck::cast_slice(&words)),
-                    }
-                });
-                let there = o.here_from_there.inverse();
-                let r = there.rotation;
-                let job = GpuSunOccluderJob {
-                    map: job(map, s, maps.slot_texels),
-                    there_x: r.x_axis.extend(0.0).to_array(),
-                    there_y: r.y_axis.extend(0.0).to_array(),
-                    there_z: r.z_axis.extend(0.0).to_array(),
-                    there_t: there.translation.extend(0.0).to_array(),
-                };
-                let jobs = self
-                    .device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some("sun occluder job"),
-                        contents: bytemuck::bytes_of(&job),
-                        usage: wgpu::BufferUsages::STORAGE,
-                    });
-                // Bindings 0, 1, 3 and 4 (2 holds the suns' own jobs, which it does not read).
-                let entries: Vec<wgpu::BindGroupEntry> = [
-                    (0, hull.proxy.as_entire_binding()),
-                    (1, hull.words.as_entire_binding()),
-                    (3, maps.reach.as_entire_binding()),
-                    (4, jobs.as_entire_binding()),
-                ]
-                .into_iter()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-                .collect();
-                let bind = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("sun occluder"),
-                    layout: &self.sun_depth.occluder_layout,
-                    entries: &entries,
-                });
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("sun occluder"),
-                    timestamp_writes: compute_pass_writes(
-                        self.pass_timestamps("sun occluder", None),
-                    ),
-                });
-                pass.set_pipeline(&self.sun_depth.occluder_pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups((map.texels() as u32).div_ceil(WORKGROUP), 1, 1);
-            }
-        }
+        self.queue.submit([encoder.finish()]);
+        batch.maps.clear();
+        batch.occluders.clear();
+        batch.used = 0;
+        batch.most_texels = 0;
     }
 }
