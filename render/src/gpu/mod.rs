@@ -28,6 +28,7 @@ pub mod bench;
 pub mod bind;
 pub mod composite;
 mod composite_targets;
+mod deferred;
 pub mod formats;
 pub mod kept;
 pub mod light_fit;
@@ -85,6 +86,7 @@ pub struct Gpu {
     relight: relight::RelightPass,
     /// Work recorded between frames, sent ahead of the next ([`Gpu::submit`]).
     pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
+    deferred: std::sync::Mutex<deferred::Deferred>,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
@@ -159,6 +161,7 @@ impl Gpu {
         Self {
             relight: relight::RelightPass::new(&device),
             pending: std::sync::Mutex::new(None),
+            deferred: std::sync::Mutex::default(),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited_ns: std::sync::atomic::AtomicU64::new(0),

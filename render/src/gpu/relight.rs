@@ -7,8 +7,9 @@
 //! the pose's own buffer, the weighted sum of the basis images, and its encoding into the
 //! pose's pre-lit layers with each view's peak as its scale, written by the GPU into the
 //! pose's view table. Nothing is uploaded again, nothing is read back and nothing waits:
-//! the dispatches of every pose relit between two frames are recorded into the GPU's one
-//! pending encoder, which [`Gpu::submit`] sends just ahead of the next frame.
+//! the dispatches of every pose relit between two frames go into one relight pass
+//! ([`super::deferred`]), after the one dispatch that made all their suns' maps
+//! ([`super::sun_depth`]), which [`Gpu::submit`] sends just ahead of the next frame.
 
 use std::sync::Arc;
 
@@ -24,8 +25,8 @@ use super::bind::{
     bind_group, buffer_with, compute_pipeline, empty_buffer, storage, storage_texture_array,
     table_bytes, uniform,
 };
+use super::deferred::{Dispatch, Kind};
 use super::sun_depth::SunMapsAt;
-use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::resident::PoseSource;
@@ -504,40 +505,35 @@ impl Gpu {
             .unwrap_or(0);
         let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
         let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
-        self.with_pending(|encoder| {
-            encoder.clear_buffer(&relight.peaks, 0, None);
-            for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
-                let bind = bind_group(
-                    &self.device,
-                    "relight",
-                    &self.relight.layout,
-                    vec![
-                        batch.params.as_entire_binding(),
-                        batch.codes.as_entire_binding(),
-                        coefficients.as_entire_binding(),
-                        self.relight.gamma.as_entire_binding(),
-                        relit.as_entire_binding(),
-                        relight.peaks.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(target),
-                        batch.jobs.as_entire_binding(),
-                        views.as_entire_binding(),
-                        depths.as_entire_binding(),
-                    ],
-                );
-                let groups = (basis.texels as u32).div_ceil(WORKGROUP);
-                // One pass: the encoding's dispatch sees the sums' (wgpu orders the
-                // two dispatches' use of the scratch and the peaks).
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("relight"),
-                    timestamp_writes: compute_pass_writes(self.pass_timestamps("relight", None)),
-                });
-                pass.set_bind_group(0, &bind, &[]);
-                for pipeline in [&self.relight.relight, &self.relight.encode] {
-                    pass.set_pipeline(pipeline);
-                    pass.dispatch_workgroups(groups, batch.views.len() as u32, 1);
-                }
-            }
-        });
+        self.with_pending(|encoder| encoder.clear_buffer(&relight.peaks, 0, None));
+        let groups = (basis.texels as u32).div_ceil(WORKGROUP);
+        for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
+            let bind = bind_group(
+                &self.device,
+                "relight",
+                &self.relight.layout,
+                vec![
+                    batch.params.as_entire_binding(),
+                    batch.codes.as_entire_binding(),
+                    coefficients.as_entire_binding(),
+                    self.relight.gamma.as_entire_binding(),
+                    relit.as_entire_binding(),
+                    relight.peaks.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(target),
+                    batch.jobs.as_entire_binding(),
+                    views.as_entire_binding(),
+                    depths.as_entire_binding(),
+                ],
+            );
+            // The sums, then their encoding (wgpu orders the two dispatches' use of the
+            // scratch and the peaks), in the pass every relight of the frame shares.
+            let pair = [&self.relight.relight, &self.relight.encode].map(|pipeline| Dispatch {
+                pipeline: pipeline.clone(),
+                bind: bind.clone(),
+                groups: [groups, batch.views.len() as u32, 1],
+            });
+            self.defer(Kind::Relight, pair);
+        }
     }
 
     /// The scratch buffer relit colours go through between the two passes, at least
@@ -585,8 +581,9 @@ impl Gpu {
             .pending
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .take()
-            .map(|p| p.finish());
+            .take();
+        // The relights and shadows gathered, a pass each, after the pending clears.
+        let pending = self.record_deferred(pending).map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
         // The suns' maps the pending relights read, made first.
         self.submit_sun_maps();

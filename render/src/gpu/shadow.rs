@@ -9,8 +9,8 @@ use wgpu::util::DeviceExt;
 use super::bind::{
     bind_group, buffer_with, compute_pipeline, rgba32f, storage, storage_texture, uniform,
 };
+use super::deferred::{Dispatch, Kind};
 use super::pose::{GpuPose, MapRelight, RelitShadowInfo};
-use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::shadow::{RelitShadow, ShadowMaps};
@@ -85,16 +85,15 @@ impl Gpu {
             };
             self.queue
                 .write_buffer(&relight.weights, 0, bytemuck::cast_slice(&weights));
-            self.with_pending(|encoder| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("shadow"),
-                    timestamp_writes: compute_pass_writes(self.pass_timestamps("shadow", None)),
-                });
-                pass.set_pipeline(&self.shadow.pipeline);
-                pass.set_bind_group(0, &relight.bind, &[]);
-                let groups = n.div_ceil(WORKGROUP);
-                pass.dispatch_workgroups(groups, groups, 1);
-            });
+            let groups = n.div_ceil(WORKGROUP);
+            self.defer(
+                Kind::Shadow,
+                [Dispatch {
+                    pipeline: self.shadow.pipeline.clone(),
+                    bind: relight.bind.clone(),
+                    groups: [groups, groups, 1],
+                }],
+            );
             pose.shadow_maps = Some(relight);
             Ok(())
         })

@@ -144,6 +144,8 @@ struct SunBatch {
     most_texels: usize,
     reach: wgpu::Buffer,
     capacity: usize,
+    /// Whether a request did not fit: the next batch's scratch is twice as large.
+    outgrown: bool,
 }
 
 impl SunBatch {
@@ -160,6 +162,7 @@ impl SunBatch {
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             ),
             capacity: values,
+            outgrown: false,
         }
     }
 }
@@ -230,6 +233,7 @@ impl Gpu {
         let busy = !batch.maps.is_empty();
         if batch.used + values > batch.capacity || batch.maps.len() + maps.len() > MOST_MAPS {
             if busy {
+                batch.outgrown = true;
                 return Err(Full::Batch);
             }
             let capacity = values.next_power_of_two().max(batch.capacity);
@@ -353,9 +357,15 @@ impl Gpu {
             pass.dispatch_workgroups(groups, batch.maps.len() as u32, 1);
         }
         self.queue.submit([encoder.finish()]);
-        batch.maps.clear();
-        batch.occluders.clear();
-        batch.used = 0;
-        batch.most_texels = 0;
+        if batch.outgrown {
+            // The next frame's maps fit in one batch (the buffer in flight is kept by
+            // the submission that reads it).
+            *batch = SunBatch::new(&self.device, 2 * batch.capacity);
+        } else {
+            batch.maps.clear();
+            batch.occluders.clear();
+            batch.used = 0;
+            batch.most_texels = 0;
+        }
     }
 }
