@@ -155,7 +155,10 @@ impl SunLight {
             .collect();
         let lights = condition_light_shares(conditions);
         let cones = lights.iter().map(|l| group_cone(l)).collect();
-        let views = turntables
+        // Views of one turntable angle (a column's cameras, the views not read) see the
+        // sun alike: each angle is worked out once.
+        let (angles, at) = distinct(turntables);
+        let distinct_views: Vec<SunView> = angles
             .iter()
             .map(|&theta| {
                 let direction = (Mat3::from_rotation_y(theta) * sun.direction()).normalize();
@@ -184,6 +187,7 @@ impl SunLight {
                 }
             })
             .collect();
+        let views = at.iter().map(|&k| distinct_views[k].clone()).collect();
         Self {
             directions,
             lights,
@@ -452,6 +456,25 @@ pub fn smoothstep(a: f32, b: f32, v: f32) -> f32 {
     x * x * (3.0 - 2.0 * x)
 }
 
+/// The distinct values of `angles` (bit for bit, in first-seen order) and, per angle, the
+/// index of its value among them.
+pub(crate) fn distinct(angles: &[f32]) -> (Vec<f32>, Vec<usize>) {
+    let mut values: Vec<f32> = Vec::new();
+    let at = angles
+        .iter()
+        .map(
+            |a| match values.iter().position(|v| v.to_bits() == a.to_bits()) {
+                Some(k) => k,
+                None => {
+                    values.push(*a);
+                    values.len() - 1
+                }
+            },
+        )
+        .collect();
+    (values, at)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -466,6 +489,25 @@ mod tests {
                 intensity: [e; 3],
                 solid_angle_sr: 0.5,
             }],
+        }
+    }
+
+    #[test]
+    fn views_of_one_angle_see_the_sun_as_that_angle_alone() {
+        let (values, at) = distinct(&[0.5, 0.0, 0.5, -0.0, 1.0, 0.0]);
+        // Bit for bit: -0 and 0 are two angles (each worked out as itself).
+        assert_eq!(values, vec![0.5, 0.0, -0.0, 1.0]);
+        assert_eq!(at, vec![0, 1, 0, 2, 3, 1]);
+        let conditions: Vec<ConditionRecord> = [Vec3::X, Vec3::Z, Vec3::NEG_X, Vec3::Y]
+            .into_iter()
+            .map(|d| condition(d + 0.3 * Vec3::Y, 1.0))
+            .collect();
+        let sun = Sun::new(Vec3::new(1.0, 1.0, 0.2), 0.53, [1.0; 3]).unwrap();
+        let angles = [0.3, 1.2, 0.3, 2.0, 1.2];
+        let together = SunLight::new(&sun, &conditions, &angles, None);
+        for (i, &a) in angles.iter().enumerate() {
+            let alone = SunLight::new(&sun, &conditions, &[a], None);
+            assert_eq!(together.views[i], alone.views[0], "view {i}");
         }
     }
 

@@ -151,6 +151,23 @@ impl YawLight {
     /// brightest suns first) are returned apart and taken out of the coefficients of the
     /// upper conditions ([`Part::LessSuns`]).
     pub fn lighting(&self, turntables: &[f32], suns: bool) -> Result<ViewLighting> {
+        // Views of one turntable angle (a column's cameras, the views not read) are lit
+        // alike: each angle is read from the tables once.
+        let (angles, at) = crate::sun_light::distinct(turntables);
+        if angles.len() < turntables.len() {
+            let lit = self.lighting(&angles, suns)?;
+            let spread = |per: Vec<Vec<Rgb>>| -> Vec<Vec<Rgb>> {
+                if per.is_empty() {
+                    return per;
+                }
+                at.iter().map(|&k| per[k].clone()).collect()
+            };
+            return Ok(ViewLighting {
+                coefficients: spread(lit.coefficients),
+                sun_coefficients: spread(lit.sun_coefficients),
+                ..lit
+            });
+        }
         let conditions = self
             .terms
             .first()
