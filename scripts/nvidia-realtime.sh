@@ -7,6 +7,9 @@
 # repository root with two ignored folders prepared on a machine that has them:
 #   .dev/frf        this build (cargo build --release, then strip)
 #   .dev/frf-base   optional: the build it is compared with
+#   .dev/gpu_vs_cpu optional: the GPU-against-CPU test binary (cargo test --release --test
+#                   gpu_vs_cpu --no-run, then strip), run with 4 test threads (issue 58:
+#                   it waited forever on a real GPU with several threads)
 #   .gl/*.deb       the Vulkan loader and GL dispatch libraries (apt-get download
 #                   libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
 # The field is made there: the small stage preset, poses 0 and 1, no perturbation,
@@ -26,6 +29,13 @@ start=$(date +%s)
 .dev/frf stage --preset small --poses 0,1 --perturbation 0 --out "$W/capture" > "$OUT/stage.log" 2>&1
 .dev/frf ingest "$W/capture" --out "$W/small.frf" --pose-flow > "$OUT/ingest.log" 2>&1
 echo "field made in $(( $(date +%s) - start )) s"
+if [ -x .dev/gpu_vs_cpu ]; then
+  # The tests find the tiny stage's field themselves; 4 threads, bounded.
+  start=$(date +%s)
+  timeout 240 .dev/gpu_vs_cpu --test-threads 4 > "$OUT/gpu_vs_cpu.log" 2>&1
+  echo "gpu_vs_cpu, 4 threads: exit $? in $(( $(date +%s) - start )) s"
+  grep -E "^test result|FAILED|panicked" "$OUT/gpu_vs_cpu.log"
+fi
 # The crowd of scenes/crowd.toml with its lighting held (the bench turns it itself).
 awk '/^\[\[lighting.key\]\]/{skip=1} /^\[camera\]/{skip=0} !skip' scenes/crowd.toml > "$W/crowd.toml"
 for build in base new; do
@@ -40,7 +50,7 @@ for build in base new; do
     --stages compute --warmup 3 --repeats 10 --cpu-repeats 1 --json \
     > "$OUT/interp_$build.json" 2> "$OUT/interp_$build.log"
   $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 1920x1080 \
-    --walkers 1,40,100 --light both --frames 6 --json \
+    --walkers 1,40,100,400 --light both --frames 6 --json \
     > "$OUT/frame_$build.json" 2> "$OUT/frame_$build.log"
 done
 for build in base new; do
