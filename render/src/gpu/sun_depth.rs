@@ -77,6 +77,13 @@ impl SunDepthPass {
     }
 }
 
+impl SunDepthPass {
+    /// The hulls and the maps asked for, locked.
+    fn state(&self) -> std::sync::MutexGuard<'_, (HullTable, SunBatch)> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
 /// Every hull the maps walk: a table of their grids and one array of their words, each
 /// hull uploaded once while kept (keyed by its address, held so that the address stays
 /// its own). When a batch needs a hull that does not fit, the table is emptied once the
@@ -218,11 +225,7 @@ impl Gpu {
         own: &Arc<VoxelHull>,
         suns: &[SunLight],
     ) -> std::result::Result<SunMapsAt, Full> {
-        let mut state = self
-            .sun_depth
-            .state
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let mut state = self.sun_depth.state();
         let (hulls, batch) = &mut *state;
         let maps: Vec<(usize, &SunDepth)> = suns
             .iter()
@@ -298,11 +301,7 @@ impl Gpu {
     /// nothing), and empties the batch; [`Gpu::submit`] calls it ahead of the relights
     /// that read the maps.
     pub(super) fn submit_sun_maps(&self) {
-        let mut state = self
-            .sun_depth
-            .state
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
+        let mut state = self.sun_depth.state();
         let (hulls, batch) = &mut *state;
         if batch.maps.is_empty() {
             return;
@@ -314,21 +313,16 @@ impl Gpu {
             bytemuck::cast_slice(&batch.maps),
             storage,
         );
-        let occluders = if batch.occluders.is_empty() {
-            buffer_with(
-                &self.device,
-                "sun occluders",
-                bytemuck::bytes_of(&<GpuSunOccluder as bytemuck::Zeroable>::zeroed()),
-                storage,
-            )
-        } else {
-            buffer_with(
-                &self.device,
-                "sun occluders",
-                bytemuck::cast_slice(&batch.occluders),
-                storage,
-            )
-        };
+        // A binding is never empty.
+        if batch.occluders.is_empty() {
+            batch.occluders.push(bytemuck::Zeroable::zeroed());
+        }
+        let occluders = buffer_with(
+            &self.device,
+            "sun occluders",
+            bytemuck::cast_slice(&batch.occluders),
+            storage,
+        );
         let bind = bind_group(
             &self.device,
             "sun depth",
