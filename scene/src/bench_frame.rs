@@ -21,6 +21,9 @@
 //!   resident, projecting the light, recording and submitting the passes, converting the
 //!   pixels read back); on a software adapter a submission may run earlier work before
 //!   it returns, which then counts here (docs/results/realtime.md measures how much);
+//! - `residency_ms_per_frame`: of the host's work, reading and relighting poses (the
+//!   light's coefficients for every walker relit, recording its relight): what a turning
+//!   light or a walker on a curve costs the host, apart from the frame's own;
 //! - `gpu_timestamps_ms_per_frame`: the device's time in the frame's passes by GPU
 //!   timestamp queries, where the adapter has them (`passes` gives each pass's).
 
@@ -155,6 +158,9 @@ pub struct FrameBenchRow {
     pub host_ms_per_frame: f64,
     /// Median wait on the device per frame (fenced), ms.
     pub gpu_ms_per_frame: f64,
+    /// Median host work per frame reading and relighting poses (part of
+    /// `host_ms_per_frame`), ms.
+    pub residency_ms_per_frame: f64,
     /// Median frame, ms.
     pub wall_ms_per_frame: f64,
     /// Median device time in the frame's passes by GPU timestamps, ms (`None` where the
@@ -200,14 +206,16 @@ impl FrameBenchReport {
              device)\n",
             self.device, self.size.0, self.size.1, self.frames
         );
-        out += "walkers  light     motion     host ms  gpu ms  wall ms  relit/frame  peak MB\n";
+        out += "walkers  light     motion     host ms (relighting)  gpu ms  wall ms  relit/frame  \
+                peak MB\n";
         for r in &self.rows {
             out += &format!(
-                "{:>7}  {:<8} {:<9} {:>8.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
+                "{:>7}  {:<8} {:<9} {:>8.1} {:>12.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
                 r.walkers,
                 r.light.name(),
                 r.motion.name(),
                 r.host_ms_per_frame,
+                r.residency_ms_per_frame,
                 r.gpu_ms_per_frame,
                 r.wall_ms_per_frame,
                 r.relights_per_frame,
@@ -393,10 +401,12 @@ pub fn run_frame_bench<R: ReadAt>(
             let mut shot = Shot::new(&s, field, device, &frames, options.shot)?;
             let mut wall = Vec::new();
             let mut waited = Vec::new();
+            let mut residency = Vec::new();
             let mut passes: Vec<Vec<PassTime>> = Vec::new();
             let mut relights = 0;
             for (k, f) in frames.iter().enumerate() {
                 let before = waited_on(shot.render_device());
+                let resident_before = shot.counters().residency_seconds;
                 let t = Instant::now();
                 let made = shot.render(f, false)?.made_resident.len();
                 let w = t.elapsed().as_secs_f64() * 1e3;
@@ -408,6 +418,7 @@ pub fn run_frame_bench<R: ReadAt>(
                 if k > 0 {
                     wall.push(w);
                     waited.push(frame_waited);
+                    residency.push((shot.counters().residency_seconds - resident_before) * 1e3);
                     relights += made;
                     passes.push(times);
                 }
@@ -420,6 +431,7 @@ pub fn run_frame_bench<R: ReadAt>(
                 motion,
                 host_ms_per_frame: median(&host),
                 gpu_ms_per_frame: median(&waited),
+                residency_ms_per_frame: median(&residency),
                 wall_ms_per_frame: median(&wall),
                 gpu_timestamps_ms_per_frame: (pass_clock == "gpu-timestamps").then(|| {
                     let sums: Vec<f64> = passes

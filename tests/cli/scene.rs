@@ -793,6 +793,12 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         );
         assert!(host > 0.0 && host <= wall, "{r}");
         assert!(gpu >= 0.0 && gpu <= wall, "{r}");
+        // Reading and relighting poses: only under the turning light, within the frame.
+        let relighting = ms("residency_ms_per_frame");
+        match r["light"].as_str().unwrap() {
+            "turning" => assert!(relighting > 0.0 && relighting <= wall, "{r}"),
+            _ => assert_eq!(relighting, 0.0, "{r}"),
+        }
         let passes = r["passes"].as_array().unwrap();
         let pass = |name: &str| passes.iter().find(|p| p["pass"] == name);
         if report["pass_clock"] == "gpu-timestamps" {
