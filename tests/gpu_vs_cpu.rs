@@ -678,3 +678,71 @@ fn another_walker_in_the_way_of_the_sun_shades_on_both() {
         100.0 * (1.0 - b / a)
     );
 }
+
+#[test]
+fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
+    use frf_core::camera::Rigid;
+    use frf_reflectance::project::FloorModel;
+    use frf_reflectance::sun_depth::Occluder;
+    use frf_reflectance::yaw_light::YawLight;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let toward =
+        frf_core::light::direction_from_azimuth_elevation(60f32.to_radians(), 25f32.to_radians());
+    let env = frf_core::sun::Sun::new(toward, 1.0, [8.0, 7.0, 6.0])
+        .unwrap()
+        .lit(&EnvMap::uniform([0.2; 3], 64))
+        .unwrap();
+    // Occluders with hulls of their own (each its own entry in the table of hulls), one
+    // and two metres toward the sun.
+    let flat = Vec3::new(toward.x, 0.0, toward.z).normalize();
+    let occluder = |metres: f32| Occluder {
+        hull: std::sync::Arc::new(field.hull(0).unwrap().unwrap()),
+        here_from_there: Rigid {
+            rotation: glam::Mat3::from_rotation_y(metres),
+            translation: flat * metres,
+        },
+    };
+    let light = |occluders: Vec<Occluder>| {
+        Lighting::Tabled(
+            YawLight::of_env(
+                field.projector_shared().unwrap().clone(),
+                &env,
+                FloorModel::Environment,
+            )
+            .with_occluders(occluders),
+        )
+    };
+    let sources: Vec<PoseSource> = [
+        vec![],
+        vec![occluder(1.0)],
+        vec![occluder(1.0), occluder(2.0)],
+    ]
+    .into_iter()
+    .map(|o| PoseSource::load(&field, 0, &light(o)).unwrap())
+    .collect();
+    // Buffers far too small for one walker's maps and hulls: every request outgrows
+    // them, while the maps asked for before it wait in the batch.
+    gpu.restart_sun_maps(16, 1, 16);
+    let poses: Vec<_> = sources
+        .iter()
+        .map(|s| gpu.upload_pose(s).unwrap())
+        .collect();
+    for (k, (pose, source)) in poses.iter().zip(&sources).enumerate() {
+        let cpu = ResidentPose::relight_cpu(source);
+        assert_relit_as_the_cpu(&gpu, pose, &cpu, &format!("walker {k}"));
+    }
+    // The last walker's maps, as made (its batch was the last).
+    let last = sources.last().unwrap();
+    let maps = gpu
+        .read_sun_maps(poses.last().unwrap(), &last.suns)
+        .unwrap();
+    let cpu_map = last.suns[0].depth.as_ref().unwrap().reach();
+    assert_eq!(last.suns[0].depth.as_ref().unwrap().occluders.len(), 2);
+    let differ = (cpu_map.iter().zip(&maps[0]))
+        .filter(|(a, b)| (*a - *b).abs() > 1e-4)
+        .count();
+    assert!(differ * 1000 <= cpu_map.len(), "{differ} texels differ");
+}

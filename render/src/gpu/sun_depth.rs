@@ -84,6 +84,20 @@ impl SunDepthPass {
     }
 }
 
+impl Gpu {
+    /// Starts the suns' maps' buffers again at `values` values of maps and `hulls` hulls
+    /// of `words` words in all (for tests: buffers small enough that a few walkers
+    /// outgrow them, which the next requests then grow).
+    pub fn restart_sun_maps(&self, values: usize, hulls: usize, words: usize) {
+        self.flush();
+        let mut state = self.sun_depth.state();
+        *state = (
+            HullTable::new(&self.device, hulls.max(1), words.max(1)),
+            SunBatch::new(&self.device, values.max(1)),
+        );
+    }
+}
+
 /// Every hull the maps walk: a table of their grids and one array of their words, each
 /// hull uploaded once while kept (keyed by its address, held so that the address stays
 /// its own). When a batch needs a hull that does not fit, the table is emptied once the
