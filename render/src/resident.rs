@@ -190,14 +190,23 @@ impl PoseSource {
             (&read, self.holds_normals()),
             self.geometry.proxy.hull_shared(),
         )?;
+        // The views, flows and geometry are shared; only the light's parts are new (a
+        // clone of the whole would copy the old light's, to throw them away).
         Ok(Self {
+            geometry: self.geometry.clone(),
+            flows: self.flows.clone(),
+            basis: self.basis.clone(),
+            alpha: self.alpha.clone(),
+            normals: self.normals.clone(),
+            surfaces: self.surfaces.clone(),
+            condition_lights: self.condition_lights.clone(),
+            floor_conditions: self.floor_conditions.clone(),
             coefficients: relit.coefficients,
             ground_coefficients: relit.ground,
             plan: relit.plan,
             suns: relit.suns,
             sun_coefficients: relit.sun_coefficients,
             floor_shares: relit.floor_shares,
-            ..self.clone()
         })
     }
 
