@@ -607,48 +607,67 @@ fn overlapping_walkers_are_ordered_by_depth_as_on_the_cpu() {
     assert!(crossed > 0, "ordered by depth as by position everywhere");
 }
 
+/// A low sun (`[8, 7, 6]`, its direction at `azimuth_deg`, `elevation_deg`) over a dim
+/// uniform sky, and its direction.
+fn low_sun(azimuth_deg: f32, elevation_deg: f32) -> (EnvMap, Vec3) {
+    let toward = frf_core::light::direction_from_azimuth_elevation(
+        azimuth_deg.to_radians(),
+        elevation_deg.to_radians(),
+    );
+    let env = frf_core::sun::Sun::new(toward, 1.0, [8.0, 7.0, 6.0])
+        .unwrap()
+        .lit(&EnvMap::uniform([0.2; 3], 64))
+        .unwrap();
+    (env, toward)
+}
+
+/// Pose 0 of `field` under `env` read from its yaw tables, with `occluders` in the way of
+/// its suns.
+fn with_occluders(
+    field: &FieldFile,
+    env: &EnvMap,
+    occluders: Vec<frf_reflectance::sun_depth::Occluder>,
+) -> PoseSource {
+    let light = frf_render::resident::Lighting::Tabled(
+        frf_reflectance::yaw_light::YawLight::of_env(
+            field.projector_shared().unwrap().clone(),
+            env,
+            frf_reflectance::project::FloorModel::Environment,
+        )
+        .with_occluders(occluders),
+    );
+    PoseSource::load(field, 0, &light).unwrap()
+}
+
+/// Pose 0's hull of `field` standing at `translation`, turned by `turn` (radians), in
+/// the way of the walker at the origin.
+fn occluder_at(
+    field: &FieldFile,
+    translation: Vec3,
+    turn: f32,
+) -> frf_reflectance::sun_depth::Occluder {
+    frf_reflectance::sun_depth::Occluder {
+        hull: std::sync::Arc::new(field.hull(0).unwrap().unwrap()),
+        here_from_there: frf_core::camera::Rigid {
+            rotation: glam::Mat3::from_rotation_y(turn),
+            translation,
+        },
+    }
+}
+
 /// A walker standing between the sun and the tiny field's walker: the suns' maps with its
 /// hull in the way are made on the GPU as the CPU twin traces them, the pose relit by
 /// them is the CPU's code for code, and the walker it shades is darker than without it.
 #[test]
 fn another_walker_in_the_way_of_the_sun_shades_on_both() {
-    use frf_core::camera::Rigid;
-    use frf_reflectance::project::FloorModel;
-    use frf_reflectance::sun_depth::Occluder;
-    use frf_reflectance::yaw_light::YawLight;
-    use frf_render::resident::Lighting;
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
     // A low sun in the sky's place of the sun, and the same walker 1.2 m toward it.
-    let toward =
-        frf_core::light::direction_from_azimuth_elevation(90f32.to_radians(), 20f32.to_radians());
-    let env = frf_core::sun::Sun::new(toward, 1.0, [8.0, 7.0, 6.0])
-        .unwrap()
-        .lit(&EnvMap::uniform([0.2; 3], 64))
-        .unwrap();
-    let hull = std::sync::Arc::new(field.hull(0).unwrap().unwrap());
-    let mut beside = Vec3::new(toward.x, 0.0, toward.z).normalize() * 1.2;
-    beside.y = 0.0;
-    let occluder = Occluder {
-        hull,
-        here_from_there: Rigid {
-            rotation: glam::Mat3::IDENTITY,
-            translation: beside,
-        },
-    };
-    let light = |occluders: Vec<Occluder>| {
-        Lighting::Tabled(
-            YawLight::of_env(
-                field.projector_shared().unwrap().clone(),
-                &env,
-                FloorModel::Environment,
-            )
-            .with_occluders(occluders),
-        )
-    };
-    let alone = PoseSource::load(&field, 0, &light(Vec::new())).unwrap();
-    let shaded = PoseSource::load(&field, 0, &light(vec![occluder])).unwrap();
+    let (env, toward) = low_sun(90.0, 20.0);
+    let beside = Vec3::new(toward.x, 0.0, toward.z).normalize() * 1.2;
+    let alone = with_occluders(&field, &env, Vec::new());
+    let shaded = with_occluders(&field, &env, vec![occluder_at(&field, beside, 0.0)]);
     assert!(!shaded.suns.is_empty() && shaded.holds_normals());
     assert_eq!(shaded.suns[0].depth.as_ref().unwrap().occluders.len(), 1);
     let cpu = ResidentPose::relight_cpu(&shaded);
@@ -679,6 +698,10 @@ fn another_walker_in_the_way_of_the_sun_shades_on_both() {
     );
 }
 
+/// Walkers relit between two frames whose suns' maps and hulls outgrow the buffers they
+/// share (the batch's scratch, the table of hulls), grown while the maps asked for before
+/// wait in the batch: every walker relit as the CPU twin relights it, and the last one's
+/// maps (two occluders in the way) as the CPU traces them.
 #[test]
 fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
     use frf_core::camera::Rigid;
