@@ -309,20 +309,21 @@ fn score_frame_walkers<R: ReadAt>(
                 .any(|(x, y)| *x > 0.01 && *y > 0.01)
         })
     });
-    // Each walker's proxies: of the pose drawn, and of the later between two.
-    let hulls = (0..walkers.len())
-        .map(|i| {
-            let proxy = |pose| Ok(frf_render::proxy::Proxy::new(shot.field().hull(pose)?));
-            let poses = [Some(rendered.poses[i]), rendered.between[i].map(|b| b.0)];
-            let proxies = poses
-                .into_iter()
-                .flatten()
-                .map(proxy)
-                .collect::<Result<_>>()?;
-            Ok((proxies, scene.placement(i, frame.time)))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    // Where two or more walkers are drawn, each one's proxies (of the pose drawn, and of
+    // the later between two) order them as the renderer does.
     let occlusion = if walkers.len() > 1 {
+        let hulls = (0..walkers.len())
+            .map(|i| {
+                let proxy = |pose| Ok(frf_render::proxy::Proxy::new(shot.field().hull(pose)?));
+                let poses = [Some(rendered.poses[i]), rendered.between[i].map(|b| b.0)];
+                let proxies = poses
+                    .into_iter()
+                    .flatten()
+                    .map(proxy)
+                    .collect::<Result<_>>()?;
+                Ok((proxies, scene.placement(i, frame.time)))
+            })
+            .collect::<Result<Vec<_>>>()?;
         occlusion(&frame.camera, &actors, &hulls)
     } else {
         None

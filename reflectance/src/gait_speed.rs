@@ -142,16 +142,23 @@ impl FootTrack {
     /// The track of `field`'s hulls; `None` with fewer than [`MIN_POSES`] poses with
     /// hulls, or without the belt's speed.
     pub fn of<R: ReadAt>(field: &FieldFile<R>) -> Result<Option<Self>> {
-        let Some(speed_mps) = gait_speed_mps(field)? else {
-            return Ok(None);
-        };
-        let mut samples = Vec::new();
-        for p in &field.header().poses {
+        let h = field.header();
+        let mut hulls = Vec::new();
+        for p in &h.poses {
             if let Some(hull) = field.hull(p.pose)? {
-                samples.push((p.time_s, feet_on_belt(&hull)));
+                hulls.push((p.time_s, hull));
             }
         }
-        Ok(Self::new(samples, field.header().cycle_seconds, speed_mps))
+        // The belt's speed as [`gait_speed_mps`] gives it, from the hulls read once.
+        let poses: Vec<(f64, &VoxelHull)> = hulls.iter().map(|(t, h)| (*t, h)).collect();
+        let Some(speed_mps) = h
+            .gait_speed_mps
+            .or_else(|| from_hulls(&poses, h.cycle_seconds))
+        else {
+            return Ok(None);
+        };
+        let samples = poses.iter().map(|&(t, h)| (t, feet_on_belt(h))).collect();
+        Ok(Self::new(samples, h.cycle_seconds, speed_mps))
     }
 
     /// The track of `samples` (any order) of a cycle of `cycle_seconds` on a belt of

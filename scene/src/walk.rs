@@ -500,12 +500,10 @@ impl Instance {
             // The walker goes where it faces: what the path covers this step, along the
             // walker's heading rather than the path's (no difference without a lag).
             let step = (path.distance(t + PIVOT_STEP_S) - path.distance(t)) as f32;
-            let (hw, hp) = ((0.5 * (h0 + h1) + lag) as f32, (0.5 * (h0 + h1)) as f32);
-            c += step
-                * (glam::Vec2::new(hw.cos(), -hw.sin()) - glam::Vec2::new(hp.cos(), -hp.sin()));
+            let (h, hp) = ((hp + lag) as f32, hp as f32);
+            c += step * (glam::Vec2::new(h.cos(), -h.sin()) - glam::Vec2::new(hp.cos(), -hp.sin()));
             if let Some(Stance { point: f, .. }) = on {
                 // The foot in the scene frame, from the root: R_y(h) (x, 0, z).
-                let h = (0.5 * (h0 + h1) + lag) as f32;
                 let r = glam::Vec2::new(
                     f.x * h.cos() + f.y * h.sin(),
                     -f.x * h.sin() + f.y * h.cos(),

@@ -382,6 +382,19 @@ impl SubjectTargets {
                 ..Default::default()
             })
         };
+        // One 2D view a page (layer) of `t`.
+        let page_views = |t: &wgpu::Texture| -> Vec<wgpu::TextureView> {
+            (0..pages)
+                .map(|page| {
+                    t.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2),
+                        base_array_layer: page,
+                        array_layer_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect()
+        };
         let all = array_view(&texture);
         let depth = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("subject depths"),
@@ -401,16 +414,7 @@ impl SubjectTargets {
             view_formats: &[],
         });
         let all_depth = array_view(&depth);
-        let depth_pages = (0..pages)
-            .map(|page| {
-                depth.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: page,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let depth_pages = page_views(&depth);
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stats"),
             size: 16,
@@ -426,16 +430,7 @@ impl SubjectTargets {
                 entries,
             })
         };
-        let pages = (0..pages)
-            .map(|page| {
-                texture.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: page,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
+        let pages = page_views(&texture);
         let size_of_frame = std::mem::size_of::<GpuFrame>();
         let stride = super::bind::uniform_stride(device, size_of_frame);
         let uniforms = uniform_buffer(device, "frames", stride * slots as usize);
