@@ -768,4 +768,19 @@ fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
         .filter(|(a, b)| (*a - *b).abs() > 1e-4)
         .count();
     assert!(differ * 1000 <= cpu_map.len(), "{differ} texels differ");
+    // The control: the same walker's map without the occluders differs from it (a GPU
+    // that dropped them would fail above).
+    let alone = sources[0].suns[0].depth.as_ref().unwrap().reach();
+    assert_eq!(
+        alone.len(),
+        cpu_map.len(),
+        "one frame of map with and without them"
+    );
+    let raised = (alone.iter().zip(&maps[0]))
+        .filter(|(a, b)| (*a - *b).abs() > 1e-4)
+        .count();
+    assert!(
+        raised * 100 > cpu_map.len(),
+        "occluders raise {raised} texels"
+    );
 }
