@@ -389,7 +389,12 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
     relit[job.relit_offset + i] = vec4<f32>(out, f32(alpha));
     // The bits of a non-negative float order as the float does; a negative texel (a
     // light with negative lobes, as an L2 light has) would read as the largest.
-    atomicMax(&peaks[job.view], bitcast<u32>(max(max(out.x, max(out.y, out.z)), 0.0)));
+    // Most texels are below the peak already found: read before writing, so that the
+    // view's one counter is written (and contended) only while its peak still grows.
+    let peak = bitcast<u32>(max(max(out.x, max(out.y, out.z)), 0.0));
+    if (peak > atomicLoad(&peaks[job.view])) {
+        atomicMax(&peaks[job.view], peak);
+    }
 }
 
 fn srgb_encode(v: f32) -> f32 {

@@ -369,7 +369,15 @@ impl VoxelHull {
     /// The box of the occupied voxels (their outer faces), or `None` when empty.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for index in (0..self.grid.len()).filter(|&i| self.occupied(i)) {
+        // The occupied voxels, a word of bits at a time (most words are empty).
+        let occupied = self.bits.iter().enumerate().flat_map(|(w, &word)| {
+            std::iter::successors((word != 0).then_some(word), |&b| {
+                let rest = b & (b - 1);
+                (rest != 0).then_some(rest)
+            })
+            .map(move |b| w * 64 + b.trailing_zeros() as usize)
+        });
+        for index in occupied.take_while(|&i| i < self.grid.len()) {
             let [i, j, k] = self.grid.cell(index);
             let c = self.grid.centre(i, j, k);
             lo = lo.min(c);

@@ -7,7 +7,9 @@
 //! rendering, made by one ray per texel of the map from the sun's side).
 //!
 //! The map's texel is [`TEXEL_PER_VOXEL`] of the hull's voxel (1 cm at 5 mm voxels), so a
-//! point's line is within half a texel of the one traced for it. The map's frame is set
+//! point's line is within half a texel of the one traced for it; for views read at a level
+//! of detail it is as much wider as their texels are (twice a level), which leaves a map
+//! texel about a view's texel and takes a quarter of the walks a level. The map's frame is set
 //! on the host; its values are traced on the host when the CPU reference first reads them
 //! ([`SunDepth::reach`]), and on the GPU by `shaders/sun_depth.wgsl`, the same walk through
 //! the hull (`shaders/rebin/proxy.wgsl`), where the relight pass reads them: a turning
@@ -69,12 +71,15 @@ pub struct SunDepth {
 }
 
 impl SunDepth {
-    /// The map of `hull` seen from the direction `toward` (any length but zero).
-    pub fn new(hull: &Arc<VoxelHull>, toward: Vec3) -> Self {
+    /// The map of `hull` seen from the direction `toward` (any length but zero), for
+    /// views read at level of detail `level`: its texel [`TEXEL_PER_VOXEL`] voxels at
+    /// full detail, twice as wide a level (a texel of the map about a texel of the views,
+    /// whose points it is looked up for: a quarter of the walks a level).
+    pub fn new(hull: &Arc<VoxelHull>, toward: Vec3, level: u8) -> Self {
         let d = toward.normalize_or(Vec3::Y);
         let (x, y) = d.any_orthonormal_pair();
         let g = hull.grid();
-        let texel = g.voxel_m * TEXEL_PER_VOXEL;
+        let texel = g.voxel_m * TEXEL_PER_VOXEL * (1u32 << level.min(8)) as f32;
         let (min, max, far, _) = projected_box(hull, [x, y, d], &Rigid::IDENTITY);
         // Rays start a texel beyond the box on the sun's side.
         let far = far + texel;
@@ -217,12 +222,12 @@ mod tests {
                 translation: Vec3::new(x, 0.0, 0.0),
             },
         };
-        let map = SunDepth::new(&own, toward).with_occluders(&[at(1.5), at(-1.5)]);
+        let map = SunDepth::new(&own, toward, 0).with_occluders(&[at(1.5), at(-1.5)]);
         assert_eq!(map.occluders.len(), 1, "the one behind cannot shade");
         // The ball's side facing the sun is now in the other's shadow; without it, lit.
         let facing = Vec3::new(0.0, 1.0, 0.0) + toward.normalize() * 0.32;
         assert!(map.shades(facing));
-        assert!(!SunDepth::new(&own, toward).shades(facing));
+        assert!(!SunDepth::new(&own, toward, 0).shades(facing));
         // Its top sees over the other: still lit.
         assert!(!map.shades(Vec3::new(0.0, 1.31, 0.0)));
     }
@@ -241,7 +246,7 @@ mod tests {
             Vec3::new(1.0, 1.0, 0.3),
             Vec3::new(-0.2, 0.4, -1.0),
         ] {
-            let map = SunDepth::new(&hull, toward);
+            let map = SunDepth::new(&hull, toward, 0);
             let d = toward.normalize();
             let (mut agree, mut total) = (0, 0);
             // Points on a grid through and around the ball.

@@ -139,12 +139,14 @@ pub fn shadow_offset_m(hull: &VoxelHull) -> f32 {
 
 impl SunLight {
     /// `sun` (subject frame) over a basis of `conditions`, for views at turntable angles
-    /// `turntables` (radians), its shadows cast by `hull` where there is one.
+    /// `turntables` (radians) read at level of detail `level`, its shadows cast by `hull`
+    /// where there is one (its map's texel as wide as theirs, [`SunDepth::new`]).
     pub fn new(
         sun: &Sun,
         conditions: &[ConditionRecord],
         turntables: &[f32],
         hull: Option<&Arc<VoxelHull>>,
+        level: u8,
     ) -> Self {
         let lights = condition_lights(conditions);
         let directions: Vec<Vec3> = lights.iter().map(|l| l.0).collect();
@@ -195,7 +197,7 @@ impl SunLight {
             unit,
             views,
             subject: sun.direction(),
-            depth: hull.map(|h| SunDepth::new(h, sun.direction())),
+            depth: hull.map(|h| SunDepth::new(h, sun.direction(), level)),
             shadow_offset_m: hull.map_or(0.0, |h| shadow_offset_m(h)),
             luminance: luminance(e),
         }
@@ -504,9 +506,9 @@ mod tests {
             .collect();
         let sun = Sun::new(Vec3::new(1.0, 1.0, 0.2), 0.53, [1.0; 3]).unwrap();
         let angles = [0.3, 1.2, 0.3, 2.0, 1.2];
-        let together = SunLight::new(&sun, &conditions, &angles, None);
+        let together = SunLight::new(&sun, &conditions, &angles, None, 0);
         for (i, &a) in angles.iter().enumerate() {
-            let alone = SunLight::new(&sun, &conditions, &[a], None);
+            let alone = SunLight::new(&sun, &conditions, &[a], None, 0);
             assert_eq!(together.views[i], alone.views[0], "view {i}");
         }
     }
@@ -524,7 +526,7 @@ mod tests {
         let sun = Sun::new(Vec3::Y, 0.53, [1.0; 3]).unwrap();
         let conditions = vec![condition(Vec3::Y, 1.0)];
         let offset =
-            |h: f32| SunLight::new(&sun, &conditions, &[0.0], Some(&hull(h))).shadow_offset_m;
+            |h: f32| SunLight::new(&sun, &conditions, &[0.0], Some(&hull(h)), 0).shadow_offset_m;
         let (walker, child) = (offset(1.9), offset(0.95));
         assert!(
             (walker - SHADOW_OFFSET_PER_HEIGHT * 1.9).abs() < 0.03,
@@ -533,7 +535,7 @@ mod tests {
         assert!((child / walker - 0.5).abs() < 0.03, "{child} {walker}");
         // Without a hull nothing is cast, and nothing is offset.
         assert_eq!(
-            SunLight::new(&sun, &conditions, &[0.0], None).shadow_offset_m,
+            SunLight::new(&sun, &conditions, &[0.0], None, 0).shadow_offset_m,
             0.0
         );
     }
@@ -546,7 +548,13 @@ mod tests {
             .collect();
         // The sun at +X of the subject frame: +X in the dome at θ = 0, −Z at θ = 90°.
         let sun = Sun::new(Vec3::X, 0.53, [4.0, 4.0, 4.0]).unwrap();
-        let light = SunLight::new(&sun, &conditions, &[0.0, std::f32::consts::FRAC_PI_2], None);
+        let light = SunLight::new(
+            &sun,
+            &conditions,
+            &[0.0, std::f32::consts::FRAC_PI_2],
+            None,
+            0,
+        );
         assert_eq!(light.views[0].nearest, vec![(1, 1.0)]);
         assert!(light.views[1].direction.distance(-Vec3::Z) < 1e-5);
         let photo = |k: usize| [k as f32 + 1.0, 0.5, 0.0];
@@ -578,7 +586,7 @@ mod tests {
     fn a_lambertian_texel_is_trusted_and_one_the_fit_misses_keeps_the_basis_sun_exactly() {
         let conditions = dome(40.0);
         let sun = Sun::new(Vec3::new(0.5, 1.0, 0.2).normalize(), 0.53, [3.0; 3]).unwrap();
-        let light = SunLight::new(&sun, &conditions, &[0.0], None);
+        let light = SunLight::new(&sun, &conditions, &[0.0], None, 0);
         let n = Vec3::new(0.6, 0.7, 0.1).normalize();
         let dirs = condition_lights(&conditions);
         // Its images under unit light, Lambertian of albedo 0.4 with normal n.
@@ -637,7 +645,7 @@ mod tests {
             .to_degrees();
         let light = |diameter: f32| {
             let sun = Sun::new(Vec3::Y, diameter, [3.0; 3]).unwrap();
-            SunLight::new(&sun, &conditions, &[0.0], None).views[0].compactness
+            SunLight::new(&sun, &conditions, &[0.0], None, 0).views[0].compactness
         };
         assert_eq!(light(0.53), 1.0);
         assert_eq!(light(cell), 1.0);
@@ -647,7 +655,7 @@ mod tests {
         let n = Vec3::Y;
         let photo = |_: usize| [1.0; 3];
         let sun = Sun::new(Vec3::Y, 2.0 * cell, [3.0; 3]).unwrap();
-        let broad = SunLight::new(&sun, &conditions, &[0.0], None);
+        let broad = SunLight::new(&sun, &conditions, &[0.0], None, 0);
         assert_eq!(
             suns_texel(
                 &[broad],

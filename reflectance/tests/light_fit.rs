@@ -196,7 +196,7 @@ fn a_field_basis_relights_a_sun_by_its_fitted_normals_near_the_analytic_image() 
     let direction = Vec3::new(0.45, 0.35, 0.82).normalize();
     let sun = Sun::new(direction, 0.53, [3.0; 3]).unwrap();
     let truth = photograph(direction).map(|p| p.map(|x| 3.0 * x));
-    let light = SunLight::new(&sun, &conditions, &[0.0], None);
+    let light = SunLight::new(&sun, &conditions, &[0.0], None, 0);
     let normals = fit.normals();
     let ours = Image::from_fn(SIDE, SIDE, |x, y| {
         let i = y * SIDE + x;

@@ -160,6 +160,8 @@ pub struct PoseGeometry {
     pub proxy: Proxy,
     /// Where the subject can show: a ray that misses these bounds shows nothing of it.
     pub bounds: SubjectBounds,
+    /// The level of detail its views were read at ([`crate::detail`]; 0: as captured).
+    pub level: u8,
 }
 
 impl PoseGeometry {
@@ -218,7 +220,15 @@ impl PoseGeometry {
             prelit_layer_count: cameras_len,
             proxy: Proxy::default(),
             bounds: SubjectBounds::DESIGN,
+            level: 0,
         }
+    }
+
+    /// The same geometry of views read at level of detail `level` (its `image_size`,
+    /// `crop` and `cameras` already those of the reduced views).
+    pub fn at_level(mut self, level: u8) -> Self {
+        self.level = level;
+        self
     }
 
     /// The same geometry holding only the views for which `held(view)` holds (the

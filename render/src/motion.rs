@@ -104,6 +104,9 @@ pub fn pose_motion<R: ReadAt>(
     let h = field.header();
     let g = &source.geometry;
     let (pose, rows, crop) = (g.pose, g.rows, g.crop);
+    // Motion is in metres, the same at every level: a texel of a pose read at a level
+    // of detail ([`crate::detail`]) takes its block's middle pixel's.
+    let level = g.level;
     let mut poses: Vec<u32> = h.poses.iter().map(|p| p.pose).collect();
     poses.sort_unstable();
     let read: Vec<bool> = source
@@ -124,20 +127,25 @@ pub fn pose_motion<R: ReadAt>(
             let Some(flow) = field.pose_flow(pose, u, v, step)? else {
                 return Ok(None);
             };
-            let camera = &g.cameras[i];
-            let later = h.pose(to_pose)?.views[to_u * rows + v]
-                .camera
-                .to_camera()
-                .map_err(RenderError::BadCamera)?;
-            let to_metres = motion_to_image(camera).inverse();
+            // The flow is in the captured image's pixels: read it through the captured
+            // cameras, whatever the level the pose was read at.
+            let captured = |pose: u32, i: usize| -> Result<Camera> {
+                h.pose(pose)?.views[i]
+                    .camera
+                    .to_camera()
+                    .map_err(RenderError::BadCamera)
+            };
+            let camera = captured(pose, i)?;
+            let later = captured(to_pose, to_u * rows + v)?;
+            let to_metres = motion_to_image(&camera).inverse();
             if !to_metres.is_finite() {
                 return Ok(None);
             }
             let mut metres: Vec<Option<Vec2>> = (0..crop.texels())
                 .map(|k| {
-                    let (x, y) = crop.pixel(k);
+                    let (x, y) = block_pixel(crop.pixel(k), level, (flow.width(), flow.height()));
                     let at = Vec2::new(x as f32, y as f32);
-                    subject_motion(camera, &later, at, flow.get(x, y)).map(|m| to_metres * m)
+                    subject_motion(&camera, &later, at, flow.get(x, y)).map(|m| to_metres * m)
                 })
                 .collect();
             // Beyond the stored flow, the nearest edge's motion (as the inter-view flows
@@ -166,6 +174,15 @@ pub fn pose_motion<R: ReadAt>(
         })
         .unzip();
     Ok(Some(ResidentPose::with_views(source, scales, prelit)))
+}
+
+/// The captured image's pixel a texel `(x, y)` of the image reduced to `level` takes its
+/// motion from: its block's middle one (the one right of and below the middle of an
+/// even block), within the captured image of `size`.
+fn block_pixel((x, y): (usize, usize), level: u8, size: (usize, usize)) -> (usize, usize) {
+    let middle = (1usize << level) / 2;
+    let at = |t: usize, n: usize| ((t << level) + middle).min(n.saturating_sub(1));
+    (at(x, size.0), at(y, size.1))
 }
 
 /// One view's motion (metres) as pre-lit texels and their scale (see the module docs).

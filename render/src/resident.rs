@@ -188,7 +188,7 @@ impl PoseSource {
             lighting,
             plan,
             (&read, self.holds_normals()),
-            self.geometry.proxy.hull_shared(),
+            (self.geometry.proxy.hull_shared(), self.geometry.level),
         )?;
         // The views, flows and geometry are shared; only the light's parts are new (a
         // clone of the whole would copy the old light's, to throw them away).
@@ -310,14 +310,15 @@ impl PoseSource {
             })
             .with_bounds(bounds)
             .with_proxy(Proxy::new(hull))
-            .with_held(|i| read[i]);
+            .with_held(|i| read[i])
+            .at_level(level);
         let relit = relighting(
             field,
             pose,
             lighting,
             plan,
             (&read, held),
-            geometry.proxy.hull_shared(),
+            (geometry.proxy.hull_shared(), level),
         )?;
         let surfaces = hull_surfaces(&geometry, &normals);
         Ok(Self {
@@ -468,7 +469,7 @@ fn relighting<R: ReadAt>(
     lighting: &Lighting,
     plan: Option<&PosePlan>,
     (read, normals): (&[bool], bool),
-    hull: Option<&Arc<VoxelHull>>,
+    (hull, level): (Option<&Arc<VoxelHull>>, u8),
 ) -> Result<Relighting> {
     let h = field.header();
     let record = h.pose(pose)?;
@@ -501,7 +502,8 @@ fn relighting<R: ReadAt>(
                 floor = floor_shares(&lights, &is_floor, (angles, weight), radiance);
             }
             suns.extend(lit.suns.iter().map(|s| {
-                SunLight::new(s, &h.conditions, angles, hull).with_occluders(light.occluders())
+                SunLight::new(s, &h.conditions, angles, hull, level)
+                    .with_occluders(light.occluders())
             }));
             Ok::<_, RenderError>((lit.coefficients, Some(lit.ground), lit.sun_coefficients))
         };

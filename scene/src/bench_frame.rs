@@ -21,6 +21,7 @@
 //!   resident, projecting the light, recording and submitting the passes, converting the
 //!   pixels read back); on a software adapter a submission may run earlier work before
 //!   it returns, which then counts here (docs/results/realtime.md measures how much);
+//! - `first_frame_ms`: the first frame, not counted (every walker's poses made resident);
 //! - `residency_ms_per_frame`: of the host's work, reading and relighting poses (the
 //!   light's coefficients for every walker relit, recording its relight): what a turning
 //!   light or a walker on a curve costs the host, apart from the frame's own;
@@ -163,6 +164,10 @@ pub struct FrameBenchRow {
     pub residency_ms_per_frame: f64,
     /// Median frame, ms.
     pub wall_ms_per_frame: f64,
+    /// The first frame (not counted in the medians), ms: every walker's poses read,
+    /// decoded, uploaded and lit before it is drawn (what a shot or the viewer waits
+    /// for before its first picture).
+    pub first_frame_ms: f64,
     /// Median device time in the frame's passes by GPU timestamps, ms (`None` where the
     /// adapter has no timestamp queries, and on the CPU).
     pub gpu_timestamps_ms_per_frame: Option<f64>,
@@ -207,10 +212,10 @@ impl FrameBenchReport {
             self.device, self.size.0, self.size.1, self.frames
         );
         out += "walkers  light     motion     host ms (relighting)  gpu ms  wall ms  relit/frame  \
-                peak MB\n";
+                peak MB  first ms\n";
         for r in &self.rows {
             out += &format!(
-                "{:>7}  {:<8} {:<9} {:>8.1} {:>12.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1}\n",
+                "{:>7}  {:<8} {:<9} {:>8.1} {:>12.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1} {:>9.1}\n",
                 r.walkers,
                 r.light.name(),
                 r.motion.name(),
@@ -219,7 +224,8 @@ impl FrameBenchReport {
                 r.gpu_ms_per_frame,
                 r.wall_ms_per_frame,
                 r.relights_per_frame,
-                r.peak_resident_mb
+                r.peak_resident_mb,
+                r.first_frame_ms
             );
         }
         if self.rows.iter().any(|r| !r.passes.is_empty()) {
@@ -404,6 +410,7 @@ pub fn run_frame_bench<R: ReadAt>(
             let mut residency = Vec::new();
             let mut passes: Vec<Vec<PassTime>> = Vec::new();
             let mut relights = 0;
+            let mut first = 0.0;
             for (k, f) in frames.iter().enumerate() {
                 let before = waited_on(shot.render_device());
                 let resident_before = shot.counters().residency_seconds;
@@ -415,7 +422,9 @@ pub fn run_frame_bench<R: ReadAt>(
                 // that wait made the host's share negative on a loaded machine).
                 let frame_waited = (waited_on(shot.render_device()) - before) * 1e3;
                 let times = pass_times(shot.render_device())?;
-                if k > 0 {
+                if k == 0 {
+                    first = w;
+                } else {
                     wall.push(w);
                     waited.push(frame_waited);
                     residency.push((shot.counters().residency_seconds - resident_before) * 1e3);
@@ -433,6 +442,7 @@ pub fn run_frame_bench<R: ReadAt>(
                 gpu_ms_per_frame: median(&waited),
                 residency_ms_per_frame: median(&residency),
                 wall_ms_per_frame: median(&wall),
+                first_frame_ms: first,
                 gpu_timestamps_ms_per_frame: (pass_clock == "gpu-timestamps").then(|| {
                     let sums: Vec<f64> = passes
                         .iter()

@@ -809,7 +809,6 @@ impl Plan {
         let traced = Traced {
             scene,
             h,
-            interpolate,
             lit: &lit,
         };
         let (mut walkers, ground_seen) = traced.walkers(&frame_plans, frames, hull_box)?;
@@ -888,12 +887,11 @@ fn frame_plans(
     (frame_plans, substituted)
 }
 
-/// What the walkers' rays are traced against: the scene, the field's header, how frames
-/// between poses are drawn and which conditions are lit.
+/// What the walkers' rays are traced against: the scene, the field's header and which
+/// conditions are lit.
 struct Traced<'a> {
     scene: &'a Scene,
     h: &'a FieldHeader,
-    interpolate: TimeInterpolation,
     lit: &'a [bool],
 }
 
@@ -966,12 +964,7 @@ impl Traced<'_> {
             .collect::<Result<_>>()?;
         let cylinder = Cylinder::new(&centres, columns, rows, h.wraps);
         let (quads, ground) = reached(&cylinder, camera, &bounds, half);
-        let level = if self.interpolate == TimeInterpolation::Flow {
-            // Motion views are made at the captured resolution.
-            0
-        } else {
-            detail_level(captured_ppm(record)?, pixels_per_metre(camera))
-        };
+        let level = detail_level(captured_ppm(record)?, pixels_per_metre(camera));
         let shadow_level = h.shadows.as_ref().map_or(0, |s| {
             let ground = s.ground.texels as f32 / s.ground.extent_m;
             detail_level(ground, pixels_per_metre(camera))

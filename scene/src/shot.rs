@@ -1327,15 +1327,6 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             .options
             .detail
             .unwrap_or_else(|| plan.map_or(0, |p| p.level));
-        if level > 0 && self.plan.interpolate == TimeInterpolation::Flow {
-            return Err(BadArgument::new(
-                "--detail",
-                level,
-                "0 in a shot morphed between poses, whose motion views are made at full \
-                 detail (or time.interpolate = \"nearest\")",
-            )
-            .into());
-        }
         let like = like.map(|k| &self.cache[k].resident);
         let source = match like {
             Some(r) => r.source().relit(self.field, &lighting, plan)?,
