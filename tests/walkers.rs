@@ -235,3 +235,29 @@ fn motion_at_reduced_detail_is_full_detail_s_at_each_block() {
         "{wrong} m at the wrong pixel, {right} m at the right"
     );
 }
+
+/// The walkers of a crowd drawing one pose share its visual hull (one decode, one upload
+/// to the GPU, which keys uploads by the copy): every reader gets the copy that is held,
+/// equal to the hull decoded afresh; once none is held, the next reader decodes anew.
+#[test]
+fn readers_of_one_pose_share_its_hull_while_it_is_held() {
+    use std::sync::Arc;
+
+    use frf_render::resident::{Lighting, PoseSource};
+
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let load = || PoseSource::load(&field, 0, &Lighting::Unlit).unwrap();
+    let hull_of = |s: &PoseSource| s.geometry.proxy.hull_shared().unwrap().clone();
+    let (a, b) = (load(), load());
+    let held = hull_of(&a);
+    assert!(Arc::ptr_eq(&held, &hull_of(&b)));
+    assert!(Arc::ptr_eq(&held, &field.hull_shared(0).unwrap().unwrap()));
+    assert_eq!(*held, field.hull(0).unwrap().unwrap());
+    // Dropped by every holder, it is decoded again: a copy of its own.
+    let weak = Arc::downgrade(&held);
+    drop((a, b, held));
+    assert!(weak.upgrade().is_none());
+    let again = field.hull_shared(0).unwrap().unwrap();
+    assert_eq!(Arc::strong_count(&again), 1);
+}

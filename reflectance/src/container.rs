@@ -243,6 +243,8 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     /// The projector of the field's conditions, made on first use
     /// ([`FieldFile::projector`]).
     pub(crate) projector: std::sync::OnceLock<std::sync::Arc<crate::project::Projector>>,
+    /// Poses' visual hulls decoded and still held somewhere ([`FieldFile::hull_shared`]).
+    pub(crate) hulls: crate::store::SharedHulls,
 }
 
 impl FieldFile<FileSource> {
@@ -369,6 +371,7 @@ impl<R: ReadAt> FieldFile<R> {
             bytes_read: std::sync::atomic::AtomicU64::new(0),
             decoded: Default::default(),
             projector: Default::default(),
+            hulls: Default::default(),
         })
     }
 

@@ -27,7 +27,7 @@ use std::path::Path;
 use frf_core::camera::Camera;
 use frf_core::image::{Border, GrayImage};
 use frf_core::volume::VoxelGrid;
-use glam::Vec3;
+use glam::{UVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{ReflectanceError, Result};
@@ -81,6 +81,8 @@ pub struct VoxelHull {
     /// A bit per block of [`BLOCK`]³ voxels: whether any is occupied ([`VoxelHull::first_hit`]
     /// steps over empty blocks whole).
     blocks: Vec<u64>,
+    /// [`VoxelHull::bounds`], found with the blocks.
+    bounds: Option<(Vec3, Vec3)>,
 }
 
 /// Whether view `s` puts the point `p` outside the subject: behind the camera, outside
@@ -179,22 +181,35 @@ impl VoxelHull {
     }
 
     /// The hull of `grid` whose occupancy is `bits` (voxel `index` at bit `index % 64` of
-    /// word `index / 64`), with its blocks.
+    /// word `index / 64`), with its blocks and its bounds.
     fn of_bits(grid: VoxelGrid, bits: Vec<u64>) -> Self {
         let dims = block_dims(&grid);
         let b = BLOCK as u32;
         let mut blocks = vec![0u64; (dims.iter().product::<i64>() as usize).div_ceil(64)];
+        let (mut lo, mut hi) = (UVec3::MAX, UVec3::ZERO);
         for (w, &word) in bits.iter().enumerate() {
             let mut rest = word;
             while rest != 0 {
                 let index = w * 64 + rest.trailing_zeros() as usize;
                 rest &= rest - 1;
-                let [i, j, k] = grid.cell(index).map(|c| (c / b) as i64);
+                let cell = grid.cell(index);
+                (lo, hi) = (lo.min(cell.into()), hi.max(cell.into()));
+                let [i, j, k] = cell.map(|c| (c / b) as i64);
                 let block = ((k * dims[1] + j) * dims[0] + i) as usize;
                 blocks[block / 64] |= 1 << (block % 64);
             }
         }
-        Self { grid, bits, blocks }
+        // The occupied cells' box, from the lowest one's lowest corner to the highest
+        // one's highest.
+        let half = Vec3::splat(0.5 * grid.voxel_m);
+        let centre = |c: UVec3| grid.centre(c.x, c.y, c.z);
+        let bounds = (lo.x <= hi.x).then(|| (centre(lo) - half, centre(hi) + half));
+        Self {
+            grid,
+            bits,
+            blocks,
+            bounds,
+        }
     }
 
     /// A hull with every voxel of `grid` occupied.
@@ -368,23 +383,7 @@ impl VoxelHull {
 
     /// The box of the occupied voxels (their outer faces), or `None` when empty.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        // The occupied voxels, a word of bits at a time (most words are empty).
-        let occupied = self.bits.iter().enumerate().flat_map(|(w, &word)| {
-            std::iter::successors((word != 0).then_some(word), |&b| {
-                let rest = b & (b - 1);
-                (rest != 0).then_some(rest)
-            })
-            .map(move |b| w * 64 + b.trailing_zeros() as usize)
-        });
-        for index in occupied.take_while(|&i| i < self.grid.len()) {
-            let [i, j, k] = self.grid.cell(index);
-            let c = self.grid.centre(i, j, k);
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
-        let half = Vec3::splat(0.5 * self.grid.voxel_m);
-        (lo.x <= hi.x).then(|| (lo - half, hi + half))
+        self.bounds
     }
 
     /// Intersection over union with a reference occupancy of the same grid

@@ -3,6 +3,9 @@
 //! encoded in parallel and written in order), and reading one view back from only its
 //! own chunks.
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, Weak};
+
 use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 
@@ -417,4 +420,30 @@ impl<R: ReadAt> FieldFile<R> {
         }
         self.decode_chunk(&k, VoxelHull::decode).map(Some)
     }
+
+    /// [`FieldFile::hull`], shared: while one copy of a pose's hull is held (by a walker
+    /// drawing the pose, say), every other reader gets that copy instead of decoding its
+    /// own (the walkers of a crowd read one pose's hull once, and the GPU, which keys its
+    /// uploads by the copy, uploads it once).
+    pub fn hull_shared(&self, pose: u32) -> Result<Option<Arc<VoxelHull>>> {
+        let held = |hulls: &SharedHulls| hulls.lock().ok()?.get(&pose)?.upgrade();
+        if let Some(h) = held(&self.hulls) {
+            return Ok(Some(h));
+        }
+        let Some(made) = self.hull(pose)?.map(Arc::new) else {
+            return Ok(None);
+        };
+        let mut hulls = self.hulls.lock().unwrap_or_else(|e| e.into_inner());
+        hulls.retain(|_, h| h.strong_count() > 0);
+        // Another reader may have decoded it meanwhile: keep theirs.
+        let kept = hulls.get(&pose).and_then(Weak::upgrade);
+        let h = kept.unwrap_or_else(|| {
+            hulls.insert(pose, Arc::downgrade(&made));
+            made
+        });
+        Ok(Some(h))
+    }
 }
+
+/// Poses' hulls decoded and held somewhere, by pose ([`FieldFile::hull_shared`]).
+pub(crate) type SharedHulls = Mutex<HashMap<u32, Weak<VoxelHull>>>;

@@ -269,7 +269,7 @@ impl PoseSource {
             .collect::<Result<Vec<_>>>()?;
         // The hull is the renderer's proxy for rays beyond the grid's rows.
         let hull = if plan.is_none_or(|p| p.hull) {
-            field.hull(pose)?
+            field.hull_shared(pose)?
         } else {
             None
         };
@@ -309,7 +309,7 @@ impl PoseSource {
                 flows[i][n.index()].is_some()
             })
             .with_bounds(bounds)
-            .with_proxy(Proxy::new(hull))
+            .with_proxy(Proxy::shared(hull))
             .with_held(|i| read[i])
             .at_level(level);
         let relit = relighting(

@@ -553,9 +553,14 @@ impl Plan {
         let interpolate = scene.interpolate.unwrap_or(TimeInterpolation::Nearest);
         // No hull yet: the design's bounds.
         let gait = Gait::new(header.cycle_seconds, header.gait_speed_mps);
-        let mut plan = Self::from_header(scene, header, &frames, (interpolate, gait), &mut |_| {
-            Ok(None)
-        })?;
+        let projector = Projector::new(&header.conditions)?;
+        let mut plan = Self::from_header(
+            scene,
+            (header, &projector),
+            &frames,
+            (interpolate, gait),
+            &mut |_| Ok(None),
+        )?;
         if plan.ground_seen && scene.shadow != ShadowSpec::None {
             let (columns, rows) = (header.columns, header.rows);
             for p in &mut plan.poses {
@@ -643,7 +648,7 @@ impl Plan {
         };
         let mut hull_box = |pose| {
             Ok(match field.header().hulls {
-                Some(_) => field.hull(pose)?.and_then(|h| h.bounds()),
+                Some(_) => field.hull_shared(pose)?.and_then(|h| h.bounds()),
                 None => None,
             })
         };
@@ -661,7 +666,7 @@ impl Plan {
         let gait = Gait::of_field(field)?;
         let mut plan = Self::from_header(
             scene,
-            field.header(),
+            (field.header(), field.projector()?),
             frames,
             (interpolate, gait),
             &mut hull_box,
@@ -787,14 +792,14 @@ impl Plan {
     }
 
     /// The plan of `scene` on a field (or a capture) with `h`'s grid, cameras, basis and
-    /// poses and the walk `gait`, for `frames`, frames between poses drawn as
+    /// poses (and `projector`, its basis's) and the walk `gait`, for `frames`, frames between poses drawn as
     /// `interpolate` says, each pose's
     /// subject within the bounds of the hull box `hull_box` gives
     /// ([`SubjectBounds::of_pose`]); the counts of views and flows are those the plan asks
     /// for (no chunk is known, so no byte either).
     pub fn from_header(
         scene: &Scene,
-        h: &FieldHeader,
+        (h, projector): (&FieldHeader, &Projector),
         frames: &[ShotFrame],
         (interpolate, gait): (TimeInterpolation, Gait),
         hull_box: &mut dyn FnMut(u32) -> Result<Option<(Vec3, Vec3)>>,
@@ -804,8 +809,7 @@ impl Plan {
         }
         let (frame_plans, substituted) = frame_plans(scene, h, frames, (interpolate, &gait));
         let views = h.columns * h.rows;
-        let projector = Projector::new(&h.conditions)?;
-        let lit = lit_conditions(scene, &projector, &h.conditions)?;
+        let lit = lit_conditions(scene, projector, &h.conditions)?;
         let traced = Traced {
             scene,
             h,

@@ -573,7 +573,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             return Ok(None);
         };
         let hull = match self.plan.poses.first() {
-            Some(p) => self.field.hull(p.pose)?,
+            Some(p) => self.field.hull_shared(p.pose)?,
             None => None,
         };
         let subject = hull
@@ -1218,7 +1218,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         if let Some(h) = self.hulls.get(&pose) {
             return Ok(h.clone());
         }
-        let h = self.field.hull(pose)?.map(Arc::new);
+        let h = self.field.hull_shared(pose)?;
         self.hulls.insert(pose, h.clone());
         Ok(h)
     }
@@ -1296,7 +1296,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         world: Option<&World>,
         light: &WalkerLight,
     ) -> Result<Option<frf_render::shadow::RelitShadow>> {
-        let (Some(hull), Some(world)) = (self.field.hull(pose)?, world) else {
+        let (Some(hull), Some(world)) = (self.field.hull_shared(pose)?, world) else {
             return Ok(None);
         };
         let env = walker_map(world, &light.weights)?.rotated(-light.heading);
