@@ -475,6 +475,28 @@ impl Device {
         )?))
     }
 
+    /// Draws a frame as [`Device::submit_frame`] does and waits until it is drawn,
+    /// reading nothing back (what a viewer presenting it waits for); the CPU reference
+    /// renders it and lets it go.
+    pub fn draw_frame_unread(
+        &self,
+        walkers: &[Walker],
+        backdrop: &DeviceBackdrop,
+        camera: &Camera,
+        variant: Variant,
+    ) -> Result<()> {
+        backdrop.cpu.check(camera)?;
+        if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
+            let instances = walkers
+                .iter()
+                .map(Walker::gpu_instance)
+                .collect::<Result<Vec<_>>>()?;
+            return gpu.draw_composite_unread(&instances, b, camera, variant);
+        }
+        self.render_frame_cpu(walkers, backdrop, camera, variant, false)
+            .map(drop)
+    }
+
     /// The frame `drawn` ([`Device::submit_frame`]), read back once its submission is
     /// done.
     pub fn finish_frame(&self, drawn: FrameInFlight) -> Result<Frame> {

@@ -13,7 +13,8 @@
 //! frame is drawn first to make the poses resident and is not counted; the medians of
 //! the counted frames are reported:
 //!
-//! - `wall_ms_per_frame`: the frame from start to its pixels read back;
+//! - `wall_ms_per_frame`: the frame from start to its pixels read back (with
+//!   `--no-readback`, to the device's having drawn it: nothing is copied back);
 //! - `gpu_ms_per_frame`: how long the host waited on the device within it (fenced: the
 //!   device's work that the host did not overlap; on a software adapter the device is
 //!   the host's own cores);
@@ -126,6 +127,8 @@ pub struct FrameBenchOptions {
     pub size: (u32, u32),
     /// How shots are rendered (memory budget, plan).
     pub shot: ShotOptions,
+    /// Read each frame's pixels back (else only wait until it is drawn).
+    pub readback: bool,
     /// Render on the CPU reference.
     pub cpu: bool,
 }
@@ -191,6 +194,9 @@ pub struct FrameBenchReport {
     pub pass_clock: &'static str,
     /// How far apart the counted frames were.
     pub spacing: Spacing,
+    /// Whether each frame's pixels were read back (else each frame was waited for
+    /// where it was drawn).
+    pub readback: bool,
     /// Frame size.
     pub size: (u32, u32),
     /// Frames counted per row.
@@ -206,9 +212,14 @@ impl FrameBenchReport {
             Spacing::Held => "1 ms apart, poses held",
             Spacing::Shot => "spaced as the shot's",
         };
+        let readback = if self.readback {
+            "read back"
+        } else {
+            "not read back"
+        };
         let mut out = format!(
-            "{} at {}x{}, {} frames a row, {spacing} (medians; gpu = fenced wait on the \
-             device)\n",
+            "{} at {}x{}, {} frames a row, {spacing}, {readback} (medians; gpu = fenced \
+             wait on the device)\n",
             self.device, self.size.0, self.size.1, self.frames
         );
         out += "walkers  light     motion     host ms (relighting)  gpu ms  wall ms  relit/frame  \
@@ -415,7 +426,11 @@ pub fn run_frame_bench<R: ReadAt>(
                 let before = waited_on(shot.render_device());
                 let resident_before = shot.counters().residency_seconds;
                 let t = Instant::now();
-                let made = shot.render(f, false)?.made_resident.len();
+                let made = if options.readback {
+                    shot.render(f, false)?.made_resident.len()
+                } else {
+                    shot.draw_unread(f)?.len()
+                };
                 let w = t.elapsed().as_secs_f64() * 1e3;
                 // The frame's waits, counted before the pass times are read: reading them
                 // waits on the device again, outside the frame's wall time (counting
@@ -461,6 +476,7 @@ pub fn run_frame_bench<R: ReadAt>(
         gpu_clock: "fenced-wall",
         pass_clock,
         spacing: options.spacing,
+        readback: options.readback,
         size: options.size,
         frames: options.frames,
         rows,

@@ -961,16 +961,29 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// it ([`Device::submit_frame`]): a sequence submits the next frame before it
     /// [`Shot::finish`]es this one, so that the GPU draws one while the other is read back.
     pub fn submit(&mut self, frame: &ShotFrame, layers: bool) -> Result<ShotInFlight> {
-        let fp: FramePlan = self
-            .plan
-            .frames
-            .iter()
+        let fp = self.frame_plan(frame)?;
+        self.submit_plan(&fp, &frame.camera, layers)
+    }
+
+    /// The plan of `frame` (one of the frames the shot was planned for).
+    fn frame_plan(&self, frame: &ShotFrame) -> Result<FramePlan> {
+        (self.plan.frames.iter())
             .find(|f| f.index == frame.index)
             .cloned()
-            .ok_or_else(|| {
-                SceneError::Internal(format!("frame {} was not planned", frame.index))
-            })?;
-        self.submit_plan(&fp, &frame.camera, layers)
+            .ok_or_else(|| SceneError::Internal(format!("frame {} was not planned", frame.index)))
+    }
+
+    /// Draws frame `frame` as [`Shot::render`] does and waits until the device has drawn
+    /// it, reading nothing back ([`Device::draw_frame_unread`]); the poses made resident
+    /// for it.
+    pub fn draw_unread(&mut self, frame: &ShotFrame) -> Result<Vec<u32>> {
+        let fp = self.frame_plan(frame)?;
+        let (slots, made_resident) = self.prepare(&fp)?;
+        let walkers = self.walkers(&slots, &frame.camera, fp.time);
+        let backdrop = &self.backdrop.as_ref().expect("made by prepare").1;
+        self.device
+            .draw_frame_unread(&walkers, backdrop, &frame.camera, self.scene.variant)?;
+        Ok(made_resident)
     }
 
     /// Reads back a frame [`Shot::submit`] drew.

@@ -79,6 +79,11 @@ struct FrameArgs {
     /// Most memory the resident poses may hold together, MB.
     #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u64).range(1..))]
     memory_budget: u64,
+    /// Draw each frame and wait for it without reading its pixels back (a frame shown
+    /// where it is drawn, as a viewer shows it): the wall time is then the frame's
+    /// without the copy to the host and its conversion.
+    #[arg(long)]
+    no_readback: bool,
     /// Render on the CPU reference.
     #[arg(long)]
     cpu: bool,
@@ -205,6 +210,7 @@ fn frame(args: FrameArgs) -> CliResult {
             light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
             walker_shadows: true,
         },
+        readback: !args.no_readback,
         cpu: args.cpu,
     };
     let report = run_frame_bench(&scene, &field, &options, &Bars::default())?;

@@ -824,7 +824,7 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     assert_eq!(report["spacing"], "held", "{report}");
     // Frames spaced as the shot's (10 fps; the tiny field holds one pose, so none streams
     // in here).
-    let shot = ok(&[
+    let unread = ok(&[
         "bench",
         "frame",
         scene.to_str().unwrap(),
@@ -836,10 +836,22 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         "3",
         "--spacing",
         "shot",
+        "--no-readback",
         "--json",
     ]);
-    let shot: serde_json::Value = serde_json::from_slice(&shot.stdout).unwrap();
+    let shot: serde_json::Value = serde_json::from_slice(&unread.stdout).unwrap();
     assert_eq!(shot["spacing"], "shot", "{shot}");
+    // Drawn and waited for, not read back (as a viewer shows a frame); read back by
+    // default.
+    assert_eq!(
+        (report["readback"].clone(), shot["readback"].clone()),
+        (true.into(), false.into())
+    );
+    assert!(
+        stderr(&unread).contains("not read back"),
+        "{}",
+        stderr(&unread)
+    );
     assert!(
         shot["rows"][0]["wall_ms_per_frame"].as_f64().unwrap() > 0.0,
         "{shot}"

@@ -205,6 +205,33 @@ impl Gpu {
         self.submit_drawn(encoder, &drawn, layers)
     }
 
+    /// Draws a frame as [`Gpu::submit_composite`] does, submits it without copying
+    /// anything back (a frame shown where it is drawn: what a viewer presenting it
+    /// waits for) and waits until the device has drawn it.
+    pub fn draw_composite_unread(
+        &self,
+        instances: &[GpuInstanceRef],
+        backdrop: &GpuBackdrop,
+        camera: &Camera,
+        variant: Variant,
+    ) -> Result<()> {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("composite (unread)"),
+            });
+        self.encode_composite(&mut encoder, instances, backdrop, camera, variant, None)?;
+        let submission = self.submit([encoder.finish()]);
+        self.waiting(|| {
+            self.device.poll(wgpu::PollType::Wait {
+                submission_index: Some(submission),
+                timeout: None,
+            })
+        })
+        .map_err(super::wgpu_err("waiting on a frame"))?;
+        Ok(())
+    }
+
     /// Reads back the frame `encoder` draws (`drawn`, [`Gpu::encode_composite`]): submits
     /// it with the copies, and returns the composite, the layers when `layers`, and what
     /// happened to the walkers' pixels.
