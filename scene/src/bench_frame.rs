@@ -26,6 +26,9 @@
 //! - `residency_ms_per_frame`: of the host's work, reading and relighting poses (the
 //!   light's coefficients for every walker relit, recording its relight): what a turning
 //!   light or a walker on a curve costs the host, apart from the frame's own;
+//! - `submit_ms_per_frame`: of the host's work, the time inside `queue.submit` (on
+//!   lavapipe, which runs the work submitted on the calling thread, the device's work:
+//!   the host's own is then `host_ms_per_frame` less this);
 //! - `gpu_timestamps_ms_per_frame`: the device's time in the frame's passes by GPU
 //!   timestamp queries, where the adapter has them (`passes` gives each pass's).
 
@@ -165,6 +168,10 @@ pub struct FrameBenchRow {
     /// Median host work per frame reading and relighting poses (part of
     /// `host_ms_per_frame`), ms.
     pub residency_ms_per_frame: f64,
+    /// Median time per frame inside `queue.submit` (part of `host_ms_per_frame`), ms:
+    /// on a software adapter that runs the work submitted on the calling thread
+    /// (lavapipe), the device's work too.
+    pub submit_ms_per_frame: f64,
     /// Median frame, ms.
     pub wall_ms_per_frame: f64,
     /// The first frame (not counted in the medians), ms: every walker's poses read,
@@ -222,16 +229,18 @@ impl FrameBenchReport {
              wait on the device)\n",
             self.device, self.size.0, self.size.1, self.frames
         );
-        out += "walkers  light     motion     host ms (relighting)  gpu ms  wall ms  relit/frame  \
-                peak MB  first ms\n";
+        out += "walkers  light     motion     host ms (relighting, submit)  gpu ms  wall ms  \
+                relit/frame  peak MB  first ms\n";
         for r in &self.rows {
             out += &format!(
-                "{:>7}  {:<8} {:<9} {:>8.1} {:>12.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1} {:>9.1}\n",
+                "{:>7}  {:<8} {:<9} {:>8.1} {:>10.1} {:>9.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1} \
+                 {:>9.1}\n",
                 r.walkers,
                 r.light.name(),
                 r.motion.name(),
                 r.host_ms_per_frame,
                 r.residency_ms_per_frame,
+                r.submit_ms_per_frame,
                 r.gpu_ms_per_frame,
                 r.wall_ms_per_frame,
                 r.relights_per_frame,
@@ -291,11 +300,14 @@ impl FrameBenchReport {
         {
             for light in [LightMode::Constant, LightMode::Turning] {
                 if let (Some(a), Some(b)) = (find(lo.walkers, light), find(hi.walkers, light)) {
+                    let own = |r: &FrameBenchRow| r.host_ms_per_frame - r.submit_ms_per_frame;
                     out += &format!(
-                        "{light} light: host per frame at {} walkers / at {}: {:.2}x\n",
+                        "{light} light: host per frame at {} walkers / at {}: {:.2}x \
+                         (less its submissions: {:.2}x)\n",
                         b.walkers,
                         a.walkers,
                         b.host_ms_per_frame / a.host_ms_per_frame,
+                        own(b) / own(a),
                         light = light.name()
                     );
                 }
@@ -419,11 +431,13 @@ pub fn run_frame_bench<R: ReadAt>(
             let mut wall = Vec::new();
             let mut waited = Vec::new();
             let mut residency = Vec::new();
+            let mut submitting = Vec::new();
             let mut passes: Vec<Vec<PassTime>> = Vec::new();
             let mut relights = 0;
             let mut first = 0.0;
             for (k, f) in frames.iter().enumerate() {
                 let before = waited_on(shot.render_device());
+                let submitted_before = submitted_on(shot.render_device());
                 let resident_before = shot.counters().residency_seconds;
                 let t = Instant::now();
                 let made = if options.readback {
@@ -443,6 +457,7 @@ pub fn run_frame_bench<R: ReadAt>(
                     wall.push(w);
                     waited.push(frame_waited);
                     residency.push((shot.counters().residency_seconds - resident_before) * 1e3);
+                    submitting.push((submitted_on(shot.render_device()) - submitted_before) * 1e3);
                     relights += made;
                     passes.push(times);
                 }
@@ -456,6 +471,7 @@ pub fn run_frame_bench<R: ReadAt>(
                 host_ms_per_frame: median(&host),
                 gpu_ms_per_frame: median(&waited),
                 residency_ms_per_frame: median(&residency),
+                submit_ms_per_frame: median(&submitting),
                 wall_ms_per_frame: median(&wall),
                 first_frame_ms: first,
                 gpu_timestamps_ms_per_frame: (pass_clock == "gpu-timestamps").then(|| {
@@ -519,6 +535,14 @@ fn walking(
 fn waited_on(device: &Device) -> f64 {
     match device {
         Device::Gpu(gpu) => gpu.waited().as_secs_f64(),
+        Device::Cpu => 0.0,
+    }
+}
+
+/// Seconds `device` has spent submitting so far (none on the CPU).
+fn submitted_on(device: &Device) -> f64 {
+    match device {
+        Device::Gpu(gpu) => gpu.submitted().as_secs_f64(),
         Device::Cpu => 0.0,
     }
 }

@@ -793,6 +793,9 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         );
         assert!(host > 0.0 && host <= wall, "{r}");
         assert!(gpu >= 0.0 && gpu <= wall, "{r}");
+        // Submitting is part of the host's work.
+        let submit = ms("submit_ms_per_frame");
+        assert!(submit > 0.0 && submit <= host, "{r}");
         // The first frame makes the walkers' poses resident: slower than the frames
         // after it.
         assert!(ms("first_frame_ms") > wall, "{r}");

@@ -93,6 +93,8 @@ pub struct Gpu {
     staging: std::sync::Mutex<Vec<readback::FrameStaging>>,
     /// Nanoseconds the host has waited on the device ([`Gpu::waited`]).
     waited_ns: std::sync::atomic::AtomicU64,
+    /// Nanoseconds the host has spent in `queue.submit` ([`Gpu::submitted`]).
+    submitted_ns: std::sync::atomic::AtomicU64,
     rebin: rebin::RebinPass,
     /// How the frame pass runs.
     stage: rebin::PassKind,
@@ -165,6 +167,7 @@ impl Gpu {
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited_ns: std::sync::atomic::AtomicU64::new(0),
+            submitted_ns: std::sync::atomic::AtomicU64::new(0),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,
             targets: kept::Kept::new(KEPT_TARGETS),
@@ -243,13 +246,24 @@ impl Gpu {
 
     /// Runs `f`, a call that may block on the device, counting its time as waiting.
     fn waiting<T>(&self, f: impl FnOnce() -> T) -> T {
-        let start = std::time::Instant::now();
-        let out = f();
-        self.waited_ns.fetch_add(
-            start.elapsed().as_nanos() as u64,
-            std::sync::atomic::Ordering::Relaxed,
-        );
-        out
+        counted(&self.waited_ns, f)
+    }
+
+    /// Submits `buffers` to the queue, counting the time it takes ([`Gpu::submitted`]).
+    fn submit_counted(
+        &self,
+        buffers: impl IntoIterator<Item = wgpu::CommandBuffer>,
+    ) -> wgpu::SubmissionIndex {
+        counted(&self.submitted_ns, || self.queue.submit(buffers))
+    }
+
+    /// How long the host has spent submitting so far (inside `queue.submit`): part of
+    /// its own work, but where the adapter is software that runs the work submitted on
+    /// the calling thread (lavapipe), the device's work too.
+    pub fn submitted(&self) -> std::time::Duration {
+        std::time::Duration::from_nanos(
+            self.submitted_ns.load(std::sync::atomic::Ordering::Relaxed),
+        )
     }
 
     /// How long the host has waited on the device so far (every fence and readback; not
@@ -289,4 +303,15 @@ impl Gpu {
         buffer.unmap();
         Ok(bytes)
     }
+}
+
+/// Runs `f`, adding the nanoseconds it takes to `total`.
+fn counted<T>(total: &std::sync::atomic::AtomicU64, f: impl FnOnce() -> T) -> T {
+    let start = std::time::Instant::now();
+    let out = f();
+    total.fetch_add(
+        start.elapsed().as_nanos() as u64,
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    out
 }

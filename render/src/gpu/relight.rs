@@ -588,9 +588,9 @@ impl Gpu {
         // The suns' maps the pending relights read, made first.
         self.submit_sun_maps();
         if let Some(p) = pending {
-            self.queue.submit([p]);
+            self.submit_counted([p]);
         }
-        self.queue.submit(buffers)
+        self.submit_counted(buffers)
     }
 
     /// Submits the pending work (before a caller submits its own encoder).

@@ -364,7 +364,7 @@ impl Gpu {
             let groups = (batch.most_texels as u32).div_ceil(WORKGROUP);
             pass.dispatch_workgroups(groups, batch.maps.len() as u32, 1);
         }
-        self.queue.submit([encoder.finish()]);
+        self.submit_counted([encoder.finish()]);
         if batch.outgrown {
             // The next frame's maps fit in one batch (the buffer in flight is kept by
             // the submission that reads it).
