@@ -314,7 +314,11 @@ fn score_frame_walkers<R: ReadAt>(
     let occlusion = if walkers.len() > 1 {
         let hulls = (0..walkers.len())
             .map(|i| {
-                let proxy = |pose| Ok(frf_render::proxy::Proxy::new(shot.field().hull(pose)?));
+                let proxy = |pose| {
+                    Ok(frf_render::proxy::Proxy::shared(
+                        shot.field().hull_shared(pose)?,
+                    ))
+                };
                 let poses = [Some(rendered.poses[i]), rendered.between[i].map(|b| b.0)];
                 let proxies = poses
                     .into_iter()
