@@ -2,8 +2,9 @@
 # Issue 47's figures on a machine with an NVIDIA GPU, no Rust and no network
 # (docs/results/realtime.md): the interpolation bench at 320x448 and 1920x1080 (the frame
 # pass against its floor pass, every storage format), and `frf bench frame` on a crowd at
-# 1920x1080 (1, 40 and 100 walkers, a constant and a turning light, per-pass GPU
-# timestamps), this build against a previous one in the same run. Run from the
+# 1920x1080 (1, 40, 100 and 400 walkers, a constant and a turning light, per-pass GPU
+# timestamps), this build against a previous one in the same run; then this build's
+# frames not read back (as a viewer shows them) and the 40-walker scene at 640x360. Run from the
 # repository root with two ignored folders prepared on a machine that has them:
 #   .dev/frf        this build (cargo build --release, then strip)
 #   .dev/frf-base   optional: the build it is compared with
@@ -52,6 +53,17 @@ for build in base new; do
   $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 1920x1080 \
     --walkers 1,40,100,400 --light both --frames 6 --json \
     > "$OUT/frame_$build.json" 2> "$OUT/frame_$build.log"
+  # As a viewer shows frames (issue 58's fps targets): nothing read back; this build
+  # only (older builds lack the flag).
+  if [ $build = new ]; then
+    $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 1920x1080 \
+      --walkers 1,100,400 --light both --frames 6 --no-readback --json \
+      > "$OUT/frame_unread.json" 2> "$OUT/frame_unread.log"
+    # The 40-walker scene at 640x360 (turning over constant, first frame).
+    $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 640x360 \
+      --walkers 40 --light both --frames 6 --spacing shot --json \
+      > "$OUT/frame_640.json" 2> "$OUT/frame_640.log"
+  fi
 done
 for build in base new; do
   [ -e "$OUT/interp_$build.log" ] || continue
@@ -60,4 +72,9 @@ for build in base new; do
   grep -E "^fourway " "$OUT/interp_$build.log" | grep -v "codes +codes8" | sort -k6 -n | head -3
   grep -E "^CPU reference .*fourway " "$OUT/interp_$build.log"
   sed -n '/^walkers/,$p' "$OUT/frame_$build.log"
+done
+for run in unread 640; do
+  [ -e "$OUT/frame_$run.log" ] || continue
+  echo "== frame bench, $run"
+  sed -n '/^walkers/,$p' "$OUT/frame_$run.log"
 done
