@@ -228,6 +228,11 @@ fn io(path: &Path, source: std::io::Error) -> ReflectanceError {
     }
 }
 
+/// Poses' visual hulls decoded and still held somewhere, by pose
+/// ([`FieldFile::hull_shared`]).
+pub(crate) type SharedHulls =
+    std::sync::Mutex<std::collections::HashMap<u32, std::sync::Weak<crate::hull::VoxelHull>>>;
+
 /// A field file opened for reading: its header and index are read; chunks on demand.
 pub struct FieldFile<R: ReadAt = FileSource> {
     path: PathBuf,
@@ -244,7 +249,7 @@ pub struct FieldFile<R: ReadAt = FileSource> {
     /// ([`FieldFile::projector`]).
     pub(crate) projector: std::sync::OnceLock<std::sync::Arc<crate::project::Projector>>,
     /// Poses' visual hulls decoded and still held somewhere ([`FieldFile::hull_shared`]).
-    pub(crate) hulls: crate::store::SharedHulls,
+    pub(crate) hulls: SharedHulls,
 }
 
 impl FieldFile<FileSource> {

@@ -3,13 +3,12 @@
 //! encoded in parallel and written in order), and reading one view back from only its
 //! own chunks.
 
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex, Weak};
+use std::sync::{Arc, Weak};
 
 use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{FlowImage, GrayImage, RgbImage};
 
-use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt};
+use crate::container::{ChunkKey, ChunkKind, FieldFile, FieldWriter, ReadAt, SharedHulls};
 use crate::error::{ReflectanceError, Result};
 use crate::field::{FieldHeader, ViewData};
 use crate::flowcodec;
@@ -444,6 +443,3 @@ impl<R: ReadAt> FieldFile<R> {
         Ok(Some(h))
     }
 }
-
-/// Poses' hulls decoded and held somewhere, by pose ([`FieldFile::hull_shared`]).
-pub(crate) type SharedHulls = Mutex<HashMap<u32, Weak<VoxelHull>>>;
