@@ -46,10 +46,20 @@ fn assert_relit_as_the_cpu(
     cpu: &ResidentPose,
     what: &str,
 ) {
+    assert_relit_within(gpu, pose, cpu, (what, 1e-5));
+}
+
+/// [`assert_relit_as_the_cpu`] with the scales within `tolerance` (relative).
+fn assert_relit_within(
+    gpu: &Gpu,
+    pose: &frf_render::gpu::GpuPose,
+    cpu: &ResidentPose,
+    (what, tolerance): (&str, f32),
+) {
     let scales = gpu.read_scales(pose).unwrap();
     for (i, (a, b)) in cpu.scales.iter().zip(&scales).enumerate() {
         assert!(
-            (a - b).abs() <= 1e-5 * a.abs().max(1e-6),
+            (a - b).abs() <= tolerance * a.abs().max(1e-6),
             "{what}, view {i}: scale {a} vs {b}"
         );
     }
@@ -782,5 +792,135 @@ fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
     assert!(
         raised * 100 > cpu_map.len(),
         "occluders raise {raised} texels"
+    );
+}
+
+/// A light looked up on the device by each view's turn (`Gpu::relight_turned`) writes the
+/// coefficients the host works out for it (`PoseSource::relit`) and relights the pose as
+/// the CPU twin does: the sky turned (its sun relit by the normals, the floor conditions
+/// by the ground's shape), two maps cross-faded (a sun from each), a walker in the way
+/// of the sun, and a plan that leaves conditions out. Coefficients within 1e-3 (relative;
+/// measured 3.8e-4 at most, the suns' nearest weights through the GPU's `acos`), scales
+/// within 5e-4 and codes within 1 of the CPU twin. Control: the coefficients of the light
+/// the pose was made under differ.
+#[test]
+fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
+    use frf_reflectance::project::FloorModel;
+    use frf_reflectance::yaw_light::{YawLight, YawTerm};
+    use frf_render::gpu::turn_light::TurnedLight;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let h = field.header();
+    let turntables: Vec<f32> = (h.pose(0).unwrap().views.iter())
+        .map(|v| v.turntable_deg.to_radians())
+        .collect();
+    let projector = field.projector_shared().unwrap().clone();
+    let sky = YawLight::of_env(projector.clone(), &EnvMap::sky(), FloorModel::Environment);
+    let (low, _) = low_sun(130.0, 25.0);
+    let low = YawLight::of_env(projector, &low, FloorModel::Environment);
+    let faded = YawLight::new(vec![
+        YawTerm {
+            weight: 0.6,
+            yaw: 0.7,
+            ..sky.terms()[0].clone()
+        },
+        YawTerm {
+            weight: 0.4,
+            yaw: -1.1,
+            ..low.terms()[0].clone()
+        },
+    ]);
+    let shaded =
+        low.turned(0.3)
+            .with_occluders(vec![occluder_at(&field, Vec3::new(0.9, 0.0, 0.4), 0.5)]);
+    let first = fixture.source(&EnvMap::sky());
+    let mut unused = vec![true; h.conditions.len()];
+    for k in (0..unused.len()).step_by(3) {
+        unused[k] = false;
+    }
+    let cases: Vec<(&str, YawLight, Option<&[bool]>)> = vec![
+        ("sky turned", sky.turned(2.3), None),
+        ("sky turned back", sky.turned(-0.05), None),
+        ("two maps", faded, None),
+        ("a walker in the way", shaded, None),
+        ("a plan", sky.turned(4.0), Some(&unused)),
+    ];
+    let plan_of = |used: Option<&[bool]>| {
+        used.map(|u| frf_render::pose_plan::PosePlan {
+            pose: 0,
+            views: vec![true; turntables.len()],
+            flows: vec![[true; 4]; turntables.len()],
+            conditions: u.to_vec(),
+            shadow_maps: false,
+            hull: true,
+            pose_flows: [false; 2],
+            level: 0,
+            shadow_level: 0,
+            bounds: frf_render::footprint::SubjectBounds::DESIGN,
+        })
+    };
+    for (what, light, used) in &cases {
+        let plan = plan_of(*used);
+        let turned = TurnedLight {
+            light,
+            conditions: &h.conditions,
+            turntables: &turntables,
+            used: *used,
+        };
+        let mut device = gpu.upload_pose(&first).unwrap();
+        gpu.flush();
+        assert!(gpu.relight_turned(&mut device, &first, &turned).unwrap());
+        let looked_up = gpu.read_coefficients(&device).unwrap();
+        let source = first
+            .relit(&field, &Lighting::Tabled(light.clone()), plan.as_ref())
+            .unwrap();
+        // Every case relights suns by the normals; the cross-fade one from each map.
+        let suns = if *what == "two maps" { 2 } else { 1 };
+        assert_eq!(source.suns.len(), suns, "{what}");
+        let mut host = gpu.upload_pose(&first).unwrap();
+        gpu.flush();
+        gpu.relight_pose(&mut host, &source).unwrap();
+        let worked_out = gpu.read_coefficients(&host).unwrap();
+        assert_eq!(looked_up.len(), worked_out.len(), "{what}: batches");
+        let mut most = 0.0f32;
+        for (a, b) in looked_up.iter().flatten().zip(worked_out.iter().flatten()) {
+            for (x, y) in a.iter().zip(b) {
+                let d = (x - y).abs() / y.abs().max(1e-3);
+                most = most.max(d);
+                assert!(
+                    d < 1e-3,
+                    "{what}: coefficient {a:?} looked up, {b:?} worked out"
+                );
+            }
+        }
+        eprintln!("{what}: largest relative difference {most:.2e}");
+        let cpu = ResidentPose::relight_cpu(&source);
+        assert_relit_within(&gpu, &device, &cpu, (what, 5e-4));
+    }
+    // Control: the pose as made (the sky unturned) is not what the last light relights.
+    let made = gpu.upload_pose(&first).unwrap();
+    let as_made = gpu.read_coefficients(&made).unwrap();
+    let turned = TurnedLight {
+        light: &cases[0].1,
+        conditions: &h.conditions,
+        turntables: &turntables,
+        used: None,
+    };
+    let mut device = gpu.upload_pose(&first).unwrap();
+    gpu.relight_turned(&mut device, &first, &turned).unwrap();
+    let looked_up = gpu.read_coefficients(&device).unwrap();
+    let differ = (looked_up.iter().flatten())
+        .zip(as_made.iter().flatten())
+        .filter(|(a, b)| {
+            a.iter()
+                .zip(b.iter())
+                .any(|(x, y)| (x - y).abs() > 1e-3 * y.abs().max(1e-3))
+        })
+        .count();
+    assert!(
+        differ > 100,
+        "the turned sky looks up {differ} coefficients unlike the unturned"
     );
 }

@@ -423,7 +423,7 @@ fn once<T: Copy>(cells: &[Cell<(u32, T)>], texel: u32, k: usize, find: impl FnOn
 
 /// The [`NEAREST`] of `directions` other than `k` nearest to `directions[k]`, weighted
 /// as a sun's nearest are.
-fn held_out_weights(directions: &[Vec3], k: usize) -> Vec<(usize, f32)> {
+pub fn held_out_weights(directions: &[Vec3], k: usize) -> Vec<(usize, f32)> {
     let others: Vec<usize> = (0..directions.len()).filter(|&j| j != k).collect();
     if others.is_empty() {
         return Vec::new();
@@ -443,11 +443,17 @@ fn held_out_weights(directions: &[Vec3], k: usize) -> Vec<(usize, f32)> {
 /// the dev maps by at most 0.06 dB: a source the size of a cell is still relit better
 /// by the normals than by the basis.
 pub fn compactness(sun: &Sun, directions: &[Vec3], k: usize) -> f32 {
-    let cell = (directions.iter().enumerate())
+    let cell = cell_width(directions, k);
+    1.0 - smoothstep(cell, 2.0 * cell, 2.0 * sun.radius())
+}
+
+/// The width of condition `k`'s cell among `directions`: the angle to its nearest other
+/// (radians, at most π), what [`compactness`] holds a sun against.
+pub fn cell_width(directions: &[Vec3], k: usize) -> f32 {
+    (directions.iter().enumerate())
         .filter(|&(j, d)| j != k && *d != Vec3::ZERO)
         .map(|(_, d)| d.dot(directions[k]).clamp(-1.0, 1.0).acos())
-        .fold(std::f32::consts::PI, f32::min);
-    1.0 - smoothstep(cell, 2.0 * cell, 2.0 * sun.radius())
+        .fold(std::f32::consts::PI, f32::min)
 }
 
 /// 0 below `a`, 1 above `b`, `3x² − 2x³` of `x = (v − a) / (b − a)` between (WGSL's

@@ -172,28 +172,9 @@ impl YawLight {
             .terms
             .first()
             .map_or(0, |t| t.table.projector().conditions());
-        let mut parts = vec![Part::Whole; self.terms.len()];
-        let mut taken: Vec<Sun> = Vec::new();
-        if suns {
-            let mut by_sun: Vec<(usize, f32)> = Vec::new();
-            for (i, t) in self.terms.iter().enumerate() {
-                if let Some(first) = t.table.suns()?.first() {
-                    by_sun.push((i, t.weight * luminance(first.illuminance())));
-                }
-            }
-            // Brightest first; of equals, the first map's.
-            by_sun.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-            for (i, _) in by_sun {
-                let t = &self.terms[i];
-                let found = t.table.suns()?;
-                if t.weight > 0.0 && taken.len() + found.len() <= MAX_SUNS {
-                    parts[i] = Part::LessSuns;
-                    taken.extend(found.iter().map(|s| turned_sun(s, t)));
-                }
-            }
-        }
+        let (parts, taken) = self.suns_taken(suns)?;
+        let taken: Vec<Sun> = taken.into_iter().map(|(_, _, s)| s).collect();
         let mut coefficients = vec![vec![[0.0f32; 3]; conditions]; turntables.len()];
-        let mut ground = vec![[0.0f32; 3]; conditions];
         let mut sun_coefficients = if taken.is_empty() {
             Vec::new()
         } else {
@@ -211,15 +192,56 @@ impl YawLight {
                     add_weighted(sum, less, -t.weight);
                 }
             }
-            let own = t.table.coefficients(Part::Whole, t.yaw, &[0.0])?;
-            add_weighted(&mut ground, &own[0], t.weight);
         }
+        let ground = self.ground(conditions)?;
         Ok(ViewLighting {
             coefficients,
             suns: taken,
             sun_coefficients,
             ground,
         })
+    }
+}
+
+impl YawLight {
+    /// The coefficients at turntable angle 0 of the whole light (the ground's frame), of
+    /// `conditions` conditions.
+    pub fn ground(&self, conditions: usize) -> Result<Vec<Rgb>> {
+        let mut ground = vec![[0.0f32; 3]; conditions];
+        for t in &self.terms {
+            let own = t.table.coefficients(Part::Whole, t.yaw, &[0.0])?;
+            add_weighted(&mut ground, &own[0], t.weight);
+        }
+        Ok(ground)
+    }
+
+    /// Which part of each term's map its coefficients are of, and the suns relit by the
+    /// normals apart (with `suns`; none without): up to [`MAX_SUNS`] in all, a map's suns
+    /// taken whole or not at all, the maps of brightest suns first. Each sun taken with
+    /// its term and its place among the map's suns, turned and weighted as the term is.
+    pub fn suns_taken(&self, suns: bool) -> Result<(Vec<Part>, Vec<(usize, usize, Sun)>)> {
+        let mut parts = vec![Part::Whole; self.terms.len()];
+        let mut taken = Vec::new();
+        if !suns {
+            return Ok((parts, taken));
+        }
+        let mut by_sun: Vec<(usize, f32)> = Vec::new();
+        for (i, t) in self.terms.iter().enumerate() {
+            if let Some(first) = t.table.suns()?.first() {
+                by_sun.push((i, t.weight * luminance(first.illuminance())));
+            }
+        }
+        // Brightest first; of equals, the first map's.
+        by_sun.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        for (i, _) in by_sun {
+            let t = &self.terms[i];
+            let found = t.table.suns()?;
+            if t.weight > 0.0 && taken.len() + found.len() <= MAX_SUNS {
+                parts[i] = Part::LessSuns;
+                taken.extend((found.iter().enumerate()).map(|(j, s)| (i, j, turned_sun(s, t))));
+            }
+        }
+        Ok((parts, taken))
     }
 }
 

@@ -215,6 +215,26 @@ impl YawTable {
             .collect())
     }
 
+    /// Every sample of `part` (made first, in parallel), sample after sample, each a
+    /// value per condition: what the device holds to look a view's coefficients up by its
+    /// turn (`frf-render`'s light on the device). `None` for [`Part::LessSuns`] of a map
+    /// without suns. Unlike [`YawTable::coefficients`], the floor conditions of
+    /// [`Part::LessSuns`] are what the suns leave: the reader takes the whole map's there.
+    pub fn samples(&self, part: Part) -> Result<Option<Vec<Rgb>>> {
+        let samples = match part {
+            Part::Whole => &self.whole,
+            Part::LessSuns => match self.less_suns()? {
+                Some((_, s)) => s,
+                None => return Ok(None),
+            },
+        };
+        let all: Vec<usize> = (0..SAMPLES_PER_TURN).collect();
+        samples.make(&self.projector, &all);
+        Ok(Some(
+            all.iter().flat_map(|&i| samples.get(i).to_vec()).collect(),
+        ))
+    }
+
     /// Samples made so far (of the whole map), of [`SAMPLES_PER_TURN`].
     pub fn samples_made(&self) -> usize {
         self.whole

@@ -18,12 +18,17 @@ use crate::error::Result;
 use crate::footprint::PixelBox;
 use crate::gpu::composite::{GpuBackdrop, GpuInstanceRef};
 use crate::gpu::time_morph::GpuBetween;
+use crate::gpu::turn_light::TurnedLight;
 use crate::gpu::{Gpu, GpuPose};
 use crate::morph::Variant;
 use crate::motion::{TimePair, motion_to_image, time_morph};
+use crate::pose_plan::PosePlan;
 use crate::resident::{PoseSource, ResidentPose};
 use crate::shadow::{RelitShadow, ShadowMaps};
 use frf_core::grid::PoseStep;
+use frf_reflectance::FieldFile;
+use frf_reflectance::container::ReadAt;
+use frf_reflectance::yaw_light::YawLight;
 
 /// Where rendering happens.
 pub enum Device {
@@ -325,6 +330,45 @@ impl Device {
             self.set_shadow(resident, SceneShadow::Maps(&maps))?;
         }
         Ok(())
+    }
+
+    /// Relights `resident` under `light` (in its walker's frame; `plan`, what its pose's
+    /// reading left out), as [`Device::relight`] does with [`PoseSource::relit`]'s
+    /// coefficients. On the GPU the views' coefficients are looked up on the device
+    /// ([`Gpu::relight_turned`]) and the host writes a record, whatever the views; the
+    /// resident's host copy of the coefficients then stays that of the light it was made
+    /// under (the GPU's are the light's). Elsewhere, and where the device cannot, the host
+    /// works them out.
+    pub fn relight_tabled<R: ReadAt>(
+        &self,
+        resident: &mut Resident,
+        field: &FieldFile<R>,
+        light: &YawLight,
+        plan: Option<&PosePlan>,
+    ) -> Result<()> {
+        if let (ResidentKind::Gpu(pose), Device::Gpu(gpu)) = (&mut resident.kind, self) {
+            let h = field.header();
+            let record = h.pose(resident.source.geometry.pose)?;
+            let turntables: Vec<f32> = (record.views.iter())
+                .map(|v| v.turntable_deg.to_radians())
+                .collect();
+            let turned = TurnedLight {
+                light,
+                conditions: &h.conditions,
+                turntables: &turntables,
+                used: plan.map(|p| p.conditions.as_slice()),
+            };
+            if gpu.relight_turned(pose, &resident.source, &turned)? {
+                resident.ground_coefficients = Some(light.ground(h.conditions.len())?);
+                if let Some(maps) = resident.shadow_maps.clone() {
+                    self.set_shadow(resident, SceneShadow::Maps(&maps))?;
+                }
+                return Ok(());
+            }
+        }
+        let lighting = crate::resident::Lighting::Tabled(light.clone());
+        let source = resident.source.relit(field, &lighting, plan)?;
+        self.relight(resident, &source)
     }
 
     /// Sets the motion `resident` carries toward its next and previous poses

@@ -25,6 +25,8 @@ pub const COMPOSITE: &str = include_str!("../composite.wgsl");
 pub const PRESENT: &str = include_str!("../present.wgsl");
 /// `time_morph.wgsl`: the morph in time of a frame between two poses.
 pub const TIME_MORPH: &str = include_str!("../time_morph.wgsl");
+/// `turn_light.wgsl`: a light's coefficients looked up on the device by each view's turn.
+pub const TURN_LIGHT: &str = include_str!("../turn_light.wgsl");
 /// `light_fit.wgsl`: photographs under single lights relit by a per-texel light fit.
 pub const LIGHT_FIT: &str = include_str!("../light_fit.wgsl");
 /// `floor.wgsl`, standalone.
@@ -58,8 +60,9 @@ pub const SUN_DEPTH: &str = include_str!("../sun_depth.wgsl");
 
 /// Every pass but the frame pass ([`frame_pass`]) and the sun's map ([`sun_depth_pass`]),
 /// named.
-pub const PASSES: [(&str, &str); 7] = [
+pub const PASSES: [(&str, &str); 8] = [
     ("relight", RELIGHT),
+    ("turn_light", TURN_LIGHT),
     ("shadow", SHADOW),
     ("composite", COMPOSITE),
     ("floor", FLOOR),

@@ -399,3 +399,55 @@ pub struct GpuTimeMorph {
     /// Padding.
     pub pad2: f32,
 }
+
+/// `TurnParams` of `turn_light.wgsl`: a batch of views whose light the device looks up.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuTurnParams {
+    /// Views in the batch.
+    pub jobs: u32,
+    /// Conditions of the field.
+    pub conditions: u32,
+    /// Samples of a yaw table per turn.
+    pub samples: u32,
+    /// Sun slots per job.
+    pub sun_slots: u32,
+    /// Where the plan's mask of conditions starts in the job data.
+    pub mask: u32,
+    /// A table's coarse map, texels across.
+    pub coarse_w: u32,
+    /// Its texels down.
+    pub coarse_h: u32,
+    /// The least share of a condition's shading a ratio is taken over.
+    pub ratio_floor: f32,
+    /// The leave-one-out error at which a sun's trust starts to fall.
+    pub trust_low: f32,
+    /// The error at which it has fallen to 0.
+    pub trust_high: f32,
+    /// Padding to 16 bytes.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
+}
+
+/// `TurnJob` of `turn_light.wgsl`: one view of a batch whose light the device looks up.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuTurnJob {
+    /// Its first coefficient in the batch's coefficients.
+    pub coefficient_offset: u32,
+    /// Its basis images.
+    pub tiles: u32,
+    /// Its turntable angle, a fraction of a turn.
+    pub turn: f32,
+    /// 1 when it holds normals (room for the floor conditions' shares), else 0.
+    pub normals: u32,
+    /// Where its images' scales start in the job data.
+    pub scales: u32,
+    /// Padding to 32 bytes.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
+    /// Padding.
+    pub pad3: u32,
+}

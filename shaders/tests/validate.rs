@@ -11,7 +11,7 @@ use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuHullAt, GpuInstance, GpuLightFitParams, GpuPresent,
     GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams,
-    GpuSunDepthJob, GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuView,
+    GpuSunDepthJob, GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -278,6 +278,30 @@ fn pod_structs_match_naga_layouts() {
             relit_offset,
             surface,
             pad1
+        ]
+    );
+    let turn = module(&shaders::composed(shaders::TURN_LIGHT), "turn_light");
+    check_layout!(
+        &turn,
+        "TurnParams",
+        GpuTurnParams,
+        [
+            jobs, conditions, samples, sun_slots, mask, coarse_w, coarse_h, pad
+        ]
+    );
+    check_layout!(
+        &turn,
+        "TurnJob",
+        GpuTurnJob,
+        [
+            coefficient_offset,
+            tiles,
+            turn,
+            normals,
+            scales,
+            pad1,
+            pad2,
+            pad3
         ]
     );
     let light_fit = module(&shaders::composed(shaders::LIGHT_FIT), "light_fit");

@@ -43,6 +43,7 @@ pub mod shadow;
 pub mod sun_depth;
 pub mod time_morph;
 pub mod timing;
+pub mod turn_light;
 
 use crate::error::{RenderError, Result};
 
@@ -115,6 +116,7 @@ pub struct Gpu {
     shadow: shadow::ShadowPass,
     composite: composite_targets::CompositePass,
     sun_depth: sun_depth::SunDepthPass,
+    turn_light: turn_light::TurnLightPass,
 }
 
 impl Gpu {
@@ -179,6 +181,7 @@ impl Gpu {
             shadow: shadow::ShadowPass::new(&device),
             composite: composite_targets::CompositePass::new(&device),
             sun_depth: sun_depth::SunDepthPass::new(&device),
+            turn_light: turn_light::TurnLightPass::new(&device),
             device,
             queue,
             adapter,

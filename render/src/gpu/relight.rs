@@ -98,6 +98,8 @@ struct BasisBatch {
     jobs: wgpu::Buffer,
     /// Coefficients (`vec4`) the batch's jobs read.
     coefficients: usize,
+    /// Per job, where its coefficients start.
+    offsets: Vec<u32>,
 }
 
 /// The basis codes of a pose's views resident on the GPU (see the module docs).
@@ -113,6 +115,14 @@ impl GpuBasis {
     /// Bytes it holds on the GPU.
     pub fn bytes(&self) -> u64 {
         self.bytes
+    }
+
+    /// Per batch of views, the views (indices into the pose's) and where each one's
+    /// coefficients start in the batch's.
+    pub(super) fn batch_jobs(&self) -> impl Iterator<Item = (&[usize], &[u32])> {
+        self.batches
+            .iter()
+            .map(|b| (b.views.as_slice(), b.offsets.as_slice()))
     }
 
     /// Whether it holds `codes` (the same host copy).
@@ -132,6 +142,8 @@ pub struct PoseRelight {
     hull: Option<Arc<VoxelHull>>,
     /// Where its suns' maps were made at its last relight (read back by tests).
     pub(super) sun_maps: Option<SunMapsAt>,
+    /// What relights it on the device ([`super::turn_light`]), made the first time.
+    pub(super) turn: Option<super::turn_light::TurnState>,
 }
 
 impl PoseRelight {
@@ -143,6 +155,11 @@ impl PoseRelight {
     /// Where its suns' maps were made at its last relight (none without a hull).
     pub(super) fn sun_maps(&self) -> Option<&SunMapsAt> {
         self.sun_maps.as_ref()
+    }
+
+    /// The coefficients of its batch `b` (none past its batches).
+    pub(super) fn coefficient_buffer(&self, b: usize) -> Option<&wgpu::Buffer> {
+        self.coefficients.get(b)
     }
 }
 
@@ -391,6 +408,7 @@ impl Gpu {
         let mut codes: Vec<u32> = Vec::new();
         let mut jobs = Vec::with_capacity(views.len());
         let mut coefficients = 0;
+        let mut offsets = Vec::with_capacity(views.len());
         for (j, &i) in views.iter().enumerate() {
             let basis = &source.basis[i];
             jobs.push(GpuRelightJob {
@@ -403,6 +421,7 @@ impl Gpu {
                 surface: u32::from(!source.surfaces[i].is_empty()),
                 pad1: 0,
             });
+            offsets.push(coefficients as u32);
             coefficients += job_len(source, i);
             if j + 1 == views.len() {
                 coefficients += light_coefficients(source);
@@ -448,6 +467,7 @@ impl Gpu {
             jobs: buffer("jobs", bytemuck::cast_slice(&jobs), storage),
             views,
             coefficients,
+            offsets,
         }
     }
 
@@ -461,7 +481,9 @@ impl Gpu {
     ) -> PoseRelight {
         let buffer =
             |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
-        let dst = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let dst = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
         PoseRelight {
             coefficients: basis
                 .batches
@@ -472,6 +494,7 @@ impl Gpu {
             basis,
             hull,
             sun_maps: None,
+            turn: None,
         }
     }
 
@@ -486,17 +509,32 @@ impl Gpu {
         source: &PoseSource,
         (target, views): (&wgpu::TextureView, &wgpu::Buffer),
     ) {
-        relight.sun_maps = relight
-            .hull
-            .as_ref()
-            .map(|hull| self.ask_sun_maps(hull, &source.suns));
+        relight.sun_maps = relight.hull.as_ref().map(|hull| {
+            let maps: Vec<_> = source.suns.iter().map(|s| s.depth.as_ref()).collect();
+            self.ask_sun_maps(hull, &maps)
+        });
         let maps = relight.sun_maps.as_ref();
-        let basis = &relight.basis;
-        for (batch, buffer) in basis.batches.iter().zip(&relight.coefficients) {
+        for (batch, buffer) in relight.basis.batches.iter().zip(&relight.coefficients) {
             let packed = packed_coefficients(batch, source, maps);
             self.queue
                 .write_buffer(buffer, 0, bytemuck::cast_slice(&packed));
         }
+        self.record_relight_passes(relight, (target, views), |_| None);
+    }
+
+    /// Records the passes that relight `relight`'s views from the coefficients in its
+    /// buffers into the pre-lit array `target`, their scales into the view table `views`:
+    /// per batch of views, the dispatch `before` gives for it (the light on the device,
+    /// [`super::turn_light`], which writes the coefficients), then the sums and their
+    /// encoding.
+    pub(super) fn record_relight_passes(
+        &self,
+        relight: &PoseRelight,
+        (target, views): (&wgpu::TextureView, &wgpu::Buffer),
+        before: impl Fn(usize) -> Option<Dispatch>,
+    ) {
+        let maps = relight.sun_maps.as_ref();
+        let basis = &relight.basis;
         let most_jobs = basis
             .batches
             .iter()
@@ -507,7 +545,10 @@ impl Gpu {
         let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
         self.with_pending(|encoder| encoder.clear_buffer(&relight.peaks, 0, None));
         let groups = (basis.texels as u32).div_ceil(WORKGROUP);
-        for (batch, coefficients) in basis.batches.iter().zip(&relight.coefficients) {
+        for (b, (batch, coefficients)) in
+            basis.batches.iter().zip(&relight.coefficients).enumerate()
+        {
+            self.defer(Kind::Relight, before(b));
             let bind = bind_group(
                 &self.device,
                 "relight",

@@ -17,7 +17,7 @@ use std::sync::{Arc, Mutex};
 
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::sun_depth::SunDepth;
-use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
+use frf_reflectance::sun_light::MAX_SUNS;
 use frf_shaders::types::{GpuHullAt, GpuSunDepthJob, GpuSunMap, GpuSunOccluder};
 
 use super::Gpu;
@@ -222,7 +222,11 @@ impl Gpu {
     /// one dispatch ahead of the relights recorded after this call. When the batch or
     /// the table of hulls is full, the work pending is submitted first (and the table
     /// grown or the scratch grown as the request needs).
-    pub(super) fn ask_sun_maps(&self, own: &Arc<VoxelHull>, suns: &[SunLight]) -> SunMapsAt {
+    pub(super) fn ask_sun_maps(
+        &self,
+        own: &Arc<VoxelHull>,
+        suns: &[Option<&SunDepth>],
+    ) -> SunMapsAt {
         let suns = &suns[..suns.len().min(MAX_SUNS)];
         loop {
             match self.try_sun_maps(own, suns) {
@@ -237,14 +241,14 @@ impl Gpu {
     fn try_sun_maps(
         &self,
         own: &Arc<VoxelHull>,
-        suns: &[SunLight],
+        suns: &[Option<&SunDepth>],
     ) -> std::result::Result<SunMapsAt, Full> {
         let mut state = self.sun_depth.state();
         let (hulls, batch) = &mut *state;
         let maps: Vec<(usize, &SunDepth)> = suns
             .iter()
             .enumerate()
-            .filter_map(|(s, sun)| Some((s, sun.depth.as_ref()?)))
+            .filter_map(|(s, map)| Some((s, (*map)?)))
             .collect();
         let values: usize = maps.iter().map(|(_, m)| m.texels()).sum();
         let busy = !batch.maps.is_empty();

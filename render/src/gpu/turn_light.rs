@@ -1,0 +1,452 @@
+//! A light on the device (`shaders/turn_light.wgsl`; docs/design.md section 4.1, *A light
+//! on the device*): the yaw tables of a light's maps held on the GPU, and a relight that
+//! writes one small record (the maps' turns and weights, the suns' maps) where the host
+//! path works out and uploads every view's coefficients ([`super::relight`]). The views'
+//! coefficients are then looked up by their turn in one dispatch per batch of views, just
+//! ahead of the relighting pass that reads them, in the same pass: a turning light and a
+//! crowd of walkers on curves cost the host a record per relight, whatever the views.
+//!
+//! Twin of the host path: the same entries as `packed_coefficients` of the lighting
+//! `PoseSource::relit` works out, to within float rounding (the turn's bracket is found in
+//! single precision here).
+
+use std::f64::consts::{PI, TAU};
+use std::sync::{Arc, Mutex};
+
+use frf_core::image::luminance;
+use frf_reflectance::field::ConditionRecord;
+use frf_reflectance::floor_light::ground_weight;
+use frf_reflectance::light_fit::{RATIO_FLOOR, condition_lights};
+use frf_reflectance::project::FloorModel;
+use frf_reflectance::sun_depth::SunDepth;
+use frf_reflectance::sun_light::{
+    MAX_SUNS, TRUST_ERROR, cell_width, held_out_weights, shadow_offset_m,
+};
+use frf_reflectance::yaw_light::YawLight;
+use frf_reflectance::yaw_table::{Part, SAMPLES_PER_TURN, YawTable};
+use frf_shaders::types::{GpuTurnJob, GpuTurnParams};
+
+use super::bind::{bind_group, buffer_with, compute_pipeline, empty_buffer, storage, uniform};
+use super::deferred::Dispatch;
+use super::pose::GpuPose;
+use super::relight::PoseRelight;
+use super::{Gpu, shaders};
+use crate::error::{RenderError, Result};
+use crate::resident::PoseSource;
+
+/// Workgroup size of the pass (`@workgroup_size(64)`).
+const WORKGROUP: u32 = 64;
+/// Record entries (`vec4`) per map of a light, and per sun.
+const TERM: usize = 2;
+const SUN: usize = 5;
+
+/// The pass and the tables it holds.
+pub struct TurnLightPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    tables: Mutex<HeldTables>,
+}
+
+/// Every table the device holds, one after the other in one buffer (made again, larger,
+/// when a map is added: a light's maps are few and added once).
+#[derive(Default)]
+struct HeldTables {
+    values: Vec<[f32; 4]>,
+    buffer: Option<wgpu::Buffer>,
+    held: Vec<(Arc<YawTable>, TableAt)>,
+    /// The coarse maps' size (the same for every table).
+    coarse: (u32, u32),
+}
+
+/// Where a table's parts lie in the buffer.
+#[derive(Debug, Clone)]
+struct TableAt {
+    whole: u32,
+    /// What its suns leave (none without suns).
+    less: Option<u32>,
+    coarse: u32,
+    /// Per sun (brightest first), its illuminance and radius.
+    suns: Vec<u32>,
+}
+
+impl TurnLightPass {
+    /// Builds the pass on `device`.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = shaders::module(device, "turn light", shaders::TURN_LIGHT);
+        let c = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("turn light"),
+            entries: &[
+                uniform::<GpuTurnParams>(0, c),
+                storage::<GpuTurnJob>(1, true, c),
+                storage::<f32>(2, true, c),
+                storage::<[f32; 4]>(3, true, c),
+                storage::<[f32; 4]>(4, true, c),
+                storage::<[f32; 4]>(5, true, c),
+                storage::<[f32; 4]>(6, false, c),
+            ],
+        });
+        let pipeline = compute_pipeline(device, "turn light", &[&layout], &module, "turn_light");
+        Self {
+            layout,
+            pipeline,
+            tables: Mutex::default(),
+        }
+    }
+}
+
+/// What a pose keeps to be relit on the device: per batch of views its jobs, scales and
+/// the plan's mask; the field's conditions; the buffer its light's record goes in.
+pub struct TurnState {
+    batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
+    conditions: wgpu::Buffer,
+    light: wgpu::Buffer,
+}
+
+/// A light to relight a pose by on the device, with what of its field it needs.
+pub struct TurnedLight<'a> {
+    /// The light, turned into the walker's frame.
+    pub light: &'a YawLight,
+    /// The field's conditions.
+    pub conditions: &'a [ConditionRecord],
+    /// Per view of the pose, its turntable angle, radians.
+    pub turntables: &'a [f32],
+    /// Per condition, whether the pose's plan uses it (`None`: all).
+    pub used: Option<&'a [bool]>,
+}
+
+/// Per condition, the four entries the pass reads (`turn_light.wgsl`'s `conditions`).
+fn condition_table(conditions: &[ConditionRecord]) -> Vec<[f32; 4]> {
+    let lights = condition_lights(conditions);
+    let directions: Vec<glam::Vec3> = lights.iter().map(|l| l.0).collect();
+    let mut out = Vec::with_capacity(4 * conditions.len().max(1));
+    for (k, ((d, delivered), c)) in lights.iter().zip(conditions).enumerate() {
+        out.push(d.extend(if c.floor { 1.0 } else { 0.0 }).to_array());
+        let cell = cell_width(&directions, k);
+        out.push([delivered[0], delivered[1], delivered[2], cell]);
+        let (mut at, mut by) = ([0.0f32; 4], [0.0f32; 4]);
+        let held = held_out_weights(&directions, k);
+        for (m, &(j, w)) in held.iter().take(2).enumerate() {
+            at[m] = j as f32;
+            by[m] = w;
+        }
+        at[2] = held.len().min(2) as f32;
+        out.push(at);
+        out.push(by);
+    }
+    if out.is_empty() {
+        out.push([0.0; 4]);
+    }
+    out
+}
+
+impl Gpu {
+    /// Where `table`'s parts lie on the device, uploading them the first time (every
+    /// sample made first) and the buffer that holds every table now.
+    fn held_table(&self, table: &Arc<YawTable>) -> Result<(TableAt, wgpu::Buffer, (u32, u32))> {
+        let mut held = self
+            .turn_light
+            .tables
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let found = held
+            .held
+            .iter()
+            .find(|(t, _)| Arc::ptr_eq(t, table))
+            .map(|(_, at)| at.clone());
+        let at = match found {
+            Some(at) => at,
+            None => {
+                let coarse = table.coarse_map().image();
+                let size = (coarse.width() as u32, coarse.height() as u32);
+                if !held.held.is_empty() && held.coarse != size {
+                    return Err(RenderError::Misuse(
+                        "maps of coarse maps of two sizes on the device".into(),
+                    ));
+                }
+                held.coarse = size;
+                let values = &mut held.values;
+                let mut push = |part: Vec<frf_core::image::Rgb>| {
+                    let at = values.len() as u32;
+                    values.extend(part.iter().map(|c| [c[0], c[1], c[2], 0.0]));
+                    at
+                };
+                let whole = push(table.samples(Part::Whole)?.unwrap_or_default());
+                let less = table.samples(Part::LessSuns)?.map(&mut push);
+                let lum: Vec<frf_core::image::Rgb> = (0..coarse.height())
+                    .flat_map(|y| (0..coarse.width()).map(move |x| (x, y)))
+                    .map(|(x, y)| [luminance(coarse.get(x, y)), 0.0, 0.0])
+                    .collect();
+                let coarse_at = push(lum);
+                let suns = table
+                    .suns()?
+                    .iter()
+                    .map(|s| {
+                        let e = s.illuminance();
+                        push(vec![e, [s.radius(), 0.0, 0.0]]) as usize
+                    })
+                    .collect::<Vec<_>>();
+                // The illuminance's luminance rides in its fourth value.
+                for (&at, s) in suns.iter().zip(table.suns()?) {
+                    held.values[at][3] = luminance(s.illuminance());
+                }
+                let at = TableAt {
+                    whole,
+                    less,
+                    coarse: coarse_at,
+                    suns: suns.into_iter().map(|s| s as u32).collect(),
+                };
+                held.buffer = Some(buffer_with(
+                    &self.device,
+                    "yaw tables",
+                    bytemuck::cast_slice(&held.values),
+                    wgpu::BufferUsages::STORAGE,
+                ));
+                held.held.push((table.clone(), at.clone()));
+                at
+            }
+        };
+        let buffer = held.buffer.clone().expect("made with the first table");
+        Ok((at, buffer, held.coarse))
+    }
+
+    /// What `relight`'s batches need to be relit on the device (see [`TurnState`]).
+    fn turn_state(
+        &self,
+        relight: &PoseRelight,
+        source: &PoseSource,
+        light: &TurnedLight,
+        coarse: (u32, u32),
+    ) -> TurnState {
+        let storage = wgpu::BufferUsages::STORAGE;
+        let batches = relight
+            .basis()
+            .batch_jobs()
+            .map(|(views, offsets)| {
+                let mut data: Vec<f32> = Vec::new();
+                let jobs: Vec<GpuTurnJob> = views
+                    .iter()
+                    .zip(offsets)
+                    .map(|(&i, &offset)| {
+                        let scales = &source.basis[i].scales;
+                        let job = GpuTurnJob {
+                            coefficient_offset: offset,
+                            tiles: scales.len() as u32,
+                            turn: (light.turntables.get(i).copied().unwrap_or(0.0) as f64 / TAU)
+                                as f32,
+                            normals: u32::from(
+                                source.normals.get(i).is_some_and(|n| !n.is_empty()),
+                            ),
+                            scales: data.len() as u32,
+                            ..bytemuck::Zeroable::zeroed()
+                        };
+                        data.extend(scales);
+                        job
+                    })
+                    .collect();
+                let mask = data.len() as u32;
+                data.extend((0..light.conditions.len()).map(|k| {
+                    let used = light.used.is_none_or(|u| u.get(k).copied().unwrap_or(true));
+                    if used { 1.0 } else { 0.0 }
+                }));
+                let params = GpuTurnParams {
+                    jobs: jobs.len() as u32,
+                    conditions: light.conditions.len() as u32,
+                    samples: SAMPLES_PER_TURN as u32,
+                    sun_slots: MAX_SUNS as u32,
+                    mask,
+                    coarse_w: coarse.0,
+                    coarse_h: coarse.1,
+                    ratio_floor: RATIO_FLOOR,
+                    trust_low: TRUST_ERROR[0],
+                    trust_high: TRUST_ERROR[1],
+                    pad1: 0,
+                    pad2: 0,
+                };
+                let n = jobs.len() as u32;
+                (
+                    buffer_with(
+                        &self.device,
+                        "turn params",
+                        bytemuck::bytes_of(&params),
+                        wgpu::BufferUsages::UNIFORM,
+                    ),
+                    buffer_with(
+                        &self.device,
+                        "turn jobs",
+                        bytemuck::cast_slice(&jobs),
+                        storage,
+                    ),
+                    buffer_with(
+                        &self.device,
+                        "turn data",
+                        bytemuck::cast_slice(&data),
+                        storage,
+                    ),
+                    n,
+                )
+            })
+            .collect();
+        TurnState {
+            batches,
+            conditions: buffer_with(
+                &self.device,
+                "turn conditions",
+                bytemuck::cast_slice(&condition_table(light.conditions)),
+                storage,
+            ),
+            light: empty_buffer(
+                &self.device,
+                "turn light",
+                (1 + TERM * 8 + SUN * MAX_SUNS) * 16,
+                storage | wgpu::BufferUsages::COPY_DST,
+            ),
+        }
+    }
+
+    /// Relights `pose` (made resident from `source`, its views) under `light` on the
+    /// device: its suns' maps asked for, its light's record written, and per batch of
+    /// views the lookup of their coefficients and their relighting recorded with the
+    /// pending work. `Ok(false)`, nothing done, where the pose holds no relighting
+    /// buffers to look them up into (its basis let go of) or the light has more maps
+    /// than a record holds: the host path relights it then.
+    pub fn relight_turned(
+        &self,
+        pose: &mut GpuPose,
+        source: &PoseSource,
+        light: &TurnedLight,
+    ) -> Result<bool> {
+        let terms = light.light.terms();
+        if pose.relight.is_none() || terms.len() > 8 {
+            return Ok(false);
+        }
+        self.scoped("relighting a pose on the device", || {
+            let mut tables = Vec::with_capacity(terms.len());
+            for t in terms {
+                tables.push(self.held_table(&t.table)?);
+            }
+            let Some((_, arena, coarse)) = tables.first().cloned() else {
+                return Ok(false);
+            };
+            // The last table added holds every one before it.
+            let arena = tables.last().map_or(arena, |t| t.1.clone());
+            let normals = source.holds_normals();
+            let (parts, taken) = light.light.suns_taken(normals)?;
+            let taken = &taken[..taken.len().min(MAX_SUNS)];
+            let environment = terms
+                .iter()
+                .all(|t| t.table.floor() == FloorModel::Environment);
+            let ground = if normals && environment {
+                ground_weight(light.light.ground_share())
+            } else {
+                0.0
+            };
+            let geometry = &pose.geometry;
+            let hull = geometry.proxy.hull_shared().cloned();
+            let occluders = light.light.occluders();
+            let depths: Vec<Option<SunDepth>> = taken
+                .iter()
+                .map(|(_, _, sun)| {
+                    let h = hull.as_ref()?;
+                    let map = SunDepth::new(h, sun.direction(), geometry.level);
+                    Some(if occluders.is_empty() {
+                        map
+                    } else {
+                        map.with_occluders(occluders)
+                    })
+                })
+                .collect();
+            let relight = pose.relight.as_mut().expect("checked above");
+            relight.sun_maps = hull.as_ref().map(|h| {
+                let maps: Vec<Option<&SunDepth>> = depths.iter().map(Option::as_ref).collect();
+                self.ask_sun_maps(h, &maps)
+            });
+            // The record: the maps' turns and weights, the suns and their maps.
+            let mut record: Vec<[f32; 4]> =
+                vec![[terms.len() as f32, taken.len() as f32, ground, 0.0]];
+            for ((t, part), (at, _, _)) in terms.iter().zip(&parts).zip(&tables) {
+                let less = match (part, at.less) {
+                    (Part::LessSuns, Some(l)) => l as f32,
+                    _ => -1.0,
+                };
+                record.push([at.whole as f32, less, at.coarse as f32, t.weight]);
+                let base = ((3.0 * PI + t.yaw as f64) / TAU).rem_euclid(1.0);
+                record.push([base as f32, t.yaw, 0.0, 0.0]);
+            }
+            for (s, ((term, j, sun), depth)) in taken.iter().zip(&depths).enumerate() {
+                let at = tables[*term].0.suns[*j];
+                record.push([at as f32, 0.0, terms[*term].weight, 0.0]);
+                let start = relight
+                    .sun_maps
+                    .as_ref()
+                    .and_then(|m| m.starts.get(s).copied().flatten());
+                let subject = sun.direction();
+                match (depth, start, hull.as_ref()) {
+                    (Some(m), Some(start), Some(h)) => {
+                        record.push(subject.extend(shadow_offset_m(h)).to_array());
+                        record.push(m.axes[0].extend(m.corner.x).to_array());
+                        record.push(m.axes[1].extend(m.corner.y).to_array());
+                        let [w, h] = m.size;
+                        record.push([m.texel, w as f32, h as f32, start as f32]);
+                    }
+                    _ => {
+                        record.push(subject.extend(0.0).to_array());
+                        record.extend([[0.0; 4]; 3]);
+                    }
+                }
+            }
+            if relight.turn.is_none() {
+                relight.turn = Some(self.turn_state(relight, source, light, coarse));
+            }
+            let state = relight.turn.as_ref().expect("made above");
+            self.queue
+                .write_buffer(&state.light, 0, bytemuck::cast_slice(&record));
+            let target = pose.prelit_codes_view();
+            let relight = pose.relight.as_ref().expect("checked above");
+            let state = relight.turn.as_ref().expect("made above");
+            let before = |b: usize| {
+                let (params, jobs, data, n) = state.batches.get(b)?;
+                let coefficients = relight.coefficient_buffer(b)?;
+                let bind = bind_group(
+                    &self.device,
+                    "turn light",
+                    &self.turn_light.layout,
+                    vec![
+                        params.as_entire_binding(),
+                        jobs.as_entire_binding(),
+                        data.as_entire_binding(),
+                        state.conditions.as_entire_binding(),
+                        arena.as_entire_binding(),
+                        state.light.as_entire_binding(),
+                        coefficients.as_entire_binding(),
+                    ],
+                );
+                Some(Dispatch {
+                    pipeline: self.turn_light.pipeline.clone(),
+                    bind,
+                    groups: [n.div_ceil(WORKGROUP).max(1), 1, 1],
+                })
+            };
+            self.record_relight_passes(relight, (&target, &pose.views), before);
+            Ok(true)
+        })
+    }
+
+    /// The coefficients `pose`'s last relight wrote, per batch of its views (for tests
+    /// and inspection: the device's lookup against the host's); none for a pose uploaded
+    /// already lit.
+    pub fn read_coefficients(&self, pose: &GpuPose) -> Result<Vec<Vec<[f32; 4]>>> {
+        let Some(relight) = pose.relight.as_ref() else {
+            return Ok(Vec::new());
+        };
+        self.scoped("reading a pose's coefficients back", || {
+            (0..)
+                .map_while(|b| relight.coefficient_buffer(b))
+                .map(|buffer| {
+                    let bytes = self.read_back(buffer, "coefficients readback")?;
+                    Ok(bytemuck::cast_slice(&bytes).to_vec())
+                })
+                .collect()
+        })
+    }
+}

@@ -1,0 +1,307 @@
+// The light at a view's turn, on the device (docs/design.md section 4.1, *A light on the
+// device*): the relighting coefficients `relight.wgsl` reads, written for every view of a
+// batch from the light's yaw tables held on the GPU, so that a light that turns and a
+// walker that turns cost the host one small record per relight instead of the views'
+// coefficients. Twin of `packed_coefficients` (`render/src/gpu/relight.rs`) over the
+// lighting of `relighting` (`render/src/resident.rs`): the tables' samples interpolated at
+// each map's turn (`YawTable::coefficients`, `reflectance/src/yaw_table.rs`), each sun's
+// slot as `SunLight::new` makes it (`reflectance/src/sun_light.rs`) and the floor
+// conditions' shares reweighted by the ground (`floor_shares`,
+// `reflectance/src/floor_light.rs`). Writes every entry of a job but where its conditions'
+// lights are (the range's first two values, and the lights after the jobs), which do
+// not change with the light. Compiled after `common.wgsl`.
+
+struct TurnParams {
+    // Views in the batch.
+    jobs: u32,
+    // Conditions of the field.
+    conditions: u32,
+    // Samples of a table per turn.
+    samples: u32,
+    // Sun slots per job.
+    sun_slots: u32,
+    // Where the pose's plan's mask of conditions starts in `job_data` (1: used).
+    mask: u32,
+    // A table's coarse map, texels across and down.
+    coarse_w: u32,
+    coarse_h: u32,
+    // `RATIO_FLOOR` (`reflectance/src/light_fit.rs`) and `TRUST_ERROR`
+    // (`reflectance/src/sun_light.rs`), which the slots carry to `relight.wgsl`.
+    ratio_floor: f32,
+    trust_low: f32,
+    trust_high: f32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// One view of the batch: where its coefficients start, its basis images, its turntable
+// angle (a fraction of a turn), whether it holds normals (room for the floor conditions'
+// shares after its sun slots) and where its images' scales are in `job_data`.
+struct TurnJob {
+    coefficient_offset: u32,
+    tiles: u32,
+    turn: f32,
+    normals: u32,
+    scales: u32,
+    pad1: u32,
+    pad2: u32,
+    pad3: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: TurnParams;
+@group(0) @binding(1) var<storage, read> jobs: array<TurnJob>;
+// The jobs' images' scales, then the plan's mask.
+@group(0) @binding(2) var<storage, read> job_data: array<f32>;
+// Per condition, four: its light's direction (xyz, dome frame; w: 1 for a floor
+// condition), the light it delivers (rgb; w: the angle to its nearest other condition,
+// its cell), the two conditions that predict it when it is left out (xy, as f32; z: how
+// many) and their weights (xy).
+@group(0) @binding(3) var<storage, read> conditions: array<vec4<f32>>;
+// Every table the device holds: per table, its samples of the whole map (`samples` x
+// `conditions`, rgb), of what its suns leave, its coarse map's luminance (one a vec4, x),
+// and per sun its illuminance (rgb; w: luminance) and its radius (x).
+@group(0) @binding(4) var<storage, read> tables: array<vec4<f32>>;
+// The light of this relight: (terms, suns, the ground's weight, 0); per term (where its
+// whole samples are, where those less its suns are or -1, where its coarse map is or -1,
+// its weight) and (its turn, a fraction of a turn on from the samples' origin; its yaw;
+// 0; 0); per sun taken, five: (where it is in `tables`, 0, its term's weight, 0), then
+// the four its slot holds of its map (`pack_sun`, `render/src/gpu/relight.rs`).
+@group(0) @binding(5) var<storage, read> light: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> coefficients: array<vec4<f32>>;
+
+const TERM: u32 = 2u;
+const SUN: u32 = 5u;
+// Coefficients (vec4) of a sun's slot after its per-image ones (`SUN_HEAD`).
+const SUN_HEAD: u32 = 10u;
+const PI: f32 = 3.14159265358979;
+
+// Term t's samples at turn `c` (a fraction of a turn): the two around it and the second's
+// weight.
+fn bracket(c: f32) -> vec3<f32> {
+    let n = f32(params.samples);
+    let f = fract(c) * n;
+    let i0 = min(floor(f), n - 1.0);
+    let i1 = select(i0 + 1.0, 0.0, i0 + 1.0 >= n);
+    return vec3<f32>(i0, i1, f - i0);
+}
+
+// Sample `s` of condition k in the samples starting at `at`.
+fn sample(at: u32, s: f32, k: u32) -> vec3<f32> {
+    return tables[at + u32(s) * params.conditions + k].xyz;
+}
+
+// Condition k's coefficients at a view of turntable turn `turn`: the light's, and what its
+// suns add where the basis relights them.
+fn condition_light(k: u32, turn: f32) -> array<vec3<f32>, 2> {
+    let terms = u32(light[0].x);
+    let is_floor = conditions[4u * k].w > 0.5;
+    var c = vec3<f32>(0.0);
+    var d = vec3<f32>(0.0);
+    for (var t = 0u; t < terms; t++) {
+        let head = light[1u + TERM * t];
+        let b = bracket(light[2u + TERM * t].x + turn);
+        let whole_at = u32(head.x);
+        let whole = mix(sample(whole_at, b.x, k), sample(whole_at, b.y, k), b.z);
+        if (head.y < 0.0 || is_floor) {
+            c += head.w * whole;
+        } else {
+            let less_at = u32(head.y);
+            let less = mix(sample(less_at, b.x, k), sample(less_at, b.y, k), b.z);
+            c += head.w * less;
+            d += head.w * whole - head.w * less;
+        }
+    }
+    return array<vec3<f32>, 2>(c, d);
+}
+
+// `v` turned by `a` radians about +y (glam's `Mat3::from_rotation_y`).
+fn turned(v: vec3<f32>, a: f32) -> vec3<f32> {
+    let c = cos(a);
+    let s = sin(a);
+    return vec3<f32>(c * v.x + s * v.z, v.y, -s * v.x + c * v.z);
+}
+
+// A coarse map's texel (x, y), clamped to the map.
+fn coarse_texel(at: u32, x: i32, y: i32) -> f32 {
+    let w = i32(params.coarse_w);
+    let h = i32(params.coarse_h);
+    return tables[at + u32(clamp(y, 0, h - 1) * w + clamp(x, 0, w - 1))].x;
+}
+
+fn coarse_bilinear(at: u32, x: f32, y: f32) -> f32 {
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let f = vec2<f32>(x - x0, y - y0);
+    let xi = i32(x0);
+    let yi = i32(y0);
+    let top = mix(coarse_texel(at, xi, yi), coarse_texel(at, xi + 1, yi), f.x);
+    let bottom = mix(coarse_texel(at, xi, yi + 1), coarse_texel(at, xi + 1, yi + 1), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// The luminance a coarse map holds toward `direction` (`EnvMap::radiance`, bilinear,
+// wrapping in azimuth).
+fn coarse_radiance(at: u32, direction: vec3<f32>) -> f32 {
+    let d = normalize(direction);
+    let w = f32(params.coarse_w);
+    let u = (1.0 + atan2(d.x, -d.z) / PI) / 2.0;
+    let v = acos(clamp(d.y, -1.0, 1.0)) / PI;
+    let tx = u * w - 0.5;
+    let ty = v * f32(params.coarse_h) - 0.5;
+    let x = tx - floor(tx / w) * w;
+    if (x > w - 1.0) {
+        let f = x - (w - 1.0);
+        return mix(coarse_bilinear(at, w - 1.0, ty), coarse_bilinear(at, 0.0, ty), f);
+    }
+    return coarse_bilinear(at, x, ty);
+}
+
+// The light's ground toward `d` (subject frame), luminance.
+fn ground_radiance(d: vec3<f32>) -> f32 {
+    var r = 0.0;
+    for (var t = 0u; t < u32(light[0].x); t++) {
+        let head = light[1u + TERM * t];
+        let yaw = light[2u + TERM * t].y;
+        r += head.w * coarse_radiance(u32(head.z), turned(d, -yaw));
+    }
+    return r;
+}
+
+// The angle between two unit vectors as `nearest_weights_by` takes it.
+fn angle(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    return acos(clamp(dot(a, b), -1.0, 1.0));
+}
+
+@compute @workgroup_size(64)
+fn turn_light(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.jobs) {
+        return;
+    }
+    let job = jobs[id.x];
+    let tiles = job.tiles;
+    let at = job.coefficient_offset;
+    let suns = u32(light[0].y);
+    let ground = light[0].z;
+    // Per image: its coefficient and whether it is used; where its condition's lights
+    // are (the floor's shares set below); what the suns add.
+    for (var k = 0u; k < tiles; k++) {
+        let s = job_data[job.scales + k];
+        let cd = condition_light(k, job.turn);
+        let used_by_plan = job_data[params.mask + k] > 0.5;
+        let c = select(vec3<f32>(0.0), cd[0], used_by_plan);
+        let d = select(vec3<f32>(0.0), cd[1], used_by_plan);
+        let used = select(0.0, 1.0, any(c != vec3<f32>(0.0)) || any(d != vec3<f32>(0.0)));
+        coefficients[at + k] = vec4<f32>(c * s, used);
+        coefficients[at + 2u * tiles + k] = vec4<f32>(d * s, 0.0);
+    }
+    // The sun slots, those of the suns taken first.
+    let slot_len = tiles + SUN_HEAD;
+    let slots = at + 3u * tiles;
+    for (var j = 0u; j < params.sun_slots; j++) {
+        let o = slots + j * slot_len;
+        if (j >= suns) {
+            for (var m = 0u; m < slot_len; m++) {
+                coefficients[o + m] = vec4<f32>(0.0);
+            }
+            continue;
+        }
+        let r = 1u + TERM * u32(light[0].x) + SUN * j;
+        let head = light[r];
+        let weight = head.z;
+        let e = tables[u32(head.x)];
+        let radius = tables[u32(head.x) + 1u].x;
+        for (var k = 0u; k < tiles; k++) {
+            let delivered = conditions[4u * k + 1u].xyz;
+            let unit = select(vec3<f32>(0.0), e.xyz * weight / delivered, delivered > vec3<f32>(0.0));
+            coefficients[o + k] = vec4<f32>(unit * job_data[job.scales + k], 0.0);
+        }
+        // The sun in the view's dome frame, and its two nearest conditions by angle.
+        let subject = light[r + 1u].xyz;
+        let direction = normalize(turned(subject, job.turn * 2.0 * PI));
+        var first = 0u;
+        var second = 0u;
+        var a0 = 1e30;
+        var a1 = 1e30;
+        for (var k = 0u; k < params.conditions; k++) {
+            let a = angle(conditions[4u * k].xyz, direction);
+            if (a < a0) {
+                second = first;
+                a1 = a0;
+                first = k;
+                a0 = a;
+            } else if (a < a1) {
+                second = k;
+                a1 = a;
+            }
+        }
+        var nearest = vec4<f32>(f32(first), 0.0, 0.0, 1.0);
+        var weights = vec4<f32>(1.0, 0.0, 0.0, params.ratio_floor);
+        if (a0 >= 1e-6 && params.conditions > 1u) {
+            let w0 = 1.0 / (a0 * a0);
+            let w1 = 1.0 / (a1 * a1);
+            nearest = vec4<f32>(f32(first), f32(second), 0.0, 2.0);
+            weights = vec4<f32>(w0 / (w0 + w1), w1 / (w0 + w1), 0.0, params.ratio_floor);
+        }
+        let h = o + tiles;
+        coefficients[h] = vec4<f32>(direction, 1.0);
+        coefficients[h + 1u] = nearest;
+        coefficients[h + 2u] = weights;
+        for (var m = 0u; m < 4u; m++) {
+            coefficients[h + 3u + m] = light[r + 1u + m];
+        }
+        // Each nearest left out: the two that predict it, and their weights.
+        var held = vec4<f32>(0.0);
+        var held_weights = vec4<f32>(0.0);
+        for (var n = 0u; n < u32(nearest.w); n++) {
+            let k = u32(nearest[n]);
+            let predict = conditions[4u * k + 2u];
+            let by = conditions[4u * k + 3u];
+            for (var m = 0u; m < u32(predict.z); m++) {
+                held[2u * n + m] = predict[m];
+                held_weights[2u * n + m] = by[m];
+            }
+        }
+        coefficients[h + 7u] = held;
+        coefficients[h + 8u] = held_weights;
+        let cell = conditions[4u * first + 1u].w;
+        let compact = 1.0 - smoothstep(cell, 2.0 * cell, 2.0 * radius);
+        coefficients[h + 9u] = vec4<f32>(compact, e.w * weight, params.trust_low, params.trust_high);
+    }
+    // Each floor condition's reweighted shares (its range's last two values say where),
+    // where the view holds normals to relight them.
+    if (job.normals == 0u) {
+        return;
+    }
+    var room = slots + params.sun_slots * slot_len;
+    for (var k = 0u; k < tiles; k++) {
+        if (conditions[4u * k].w < 0.5) {
+            continue;
+        }
+        let range = coefficients[at + tiles + k];
+        let first = u32(range.x) + 1u;
+        let count = u32(range.y);
+        var total = 0.0;
+        if (ground > 0.0) {
+            for (var j = 0u; j < count; j++) {
+                let l = coefficients[first + j];
+                total += l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
+            }
+        }
+        let reweighted = ground > 0.0 && total > 0.0 && total < 3.0e38;
+        for (var j = 0u; j < count; j++) {
+            var share = 0.0;
+            if (reweighted) {
+                let l = coefficients[first + j];
+                let w = l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
+                share = l.w + ground * (w / total - l.w);
+            }
+            coefficients[room + j] = vec4<f32>(share, 0.0, 0.0, 0.0);
+        }
+        coefficients[at + tiles + k] = vec4<f32>(
+            range.xy,
+            select(0.0, f32(room), reweighted),
+            select(0.0, params.ratio_floor, reweighted),
+        );
+        room += count;
+    }
+}
