@@ -30,8 +30,9 @@ struct TurnParams {
     ratio_floor: f32,
     trust_low: f32,
     trust_high: f32,
-    pad1: u32,
-    pad2: u32,
+    // Threads per job: its most conditions and the sun slots.
+    items: u32,
+    pad: u32,
 }
 
 // One view of the batch: where its coefficients start, its basis images, its turntable
@@ -55,7 +56,7 @@ struct TurnJob {
 // Per condition, four: its light's direction (xyz, dome frame; w: 1 for a floor
 // condition), the light it delivers (rgb; w: the angle to its nearest other condition,
 // its cell), the two conditions that predict it when it is left out (xy, as f32; z: how
-// many) and their weights (xy).
+// many; w: how many lights it has) and their weights (xy).
 @group(0) @binding(3) var<storage, read> conditions: array<vec4<f32>>;
 // Every table the device holds: per table, its samples of the whole map (`samples` x
 // `conditions`, rgb), of what its suns leave, its coarse map's luminance (one a vec4, x),
@@ -172,136 +173,156 @@ fn angle(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return acos(clamp(dot(a, b), -1.0, 1.0));
 }
 
-@compute @workgroup_size(64)
-fn turn_light(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= params.jobs) {
-        return;
+// Where floor condition k's shares go in job `at`'s coefficients: after its sun slots,
+// the floor conditions before it taking as many as they have lights.
+fn room_of(at: u32, tiles: u32, k: u32) -> u32 {
+    var room = at + 3u * tiles + params.sun_slots * (tiles + SUN_HEAD);
+    for (var j = 0u; j < k; j++) {
+        if (conditions[4u * j].w > 0.5) {
+            room += u32(conditions[4u * j + 2u].w);
+        }
     }
-    let job = jobs[id.x];
+    return room;
+}
+
+// Condition k of a job (below `tiles`): its coefficient and whether it is used, what the
+// suns add, each sun's light per unit of its own, and for a floor condition of a view
+// with normals its lights' shares reweighted by the ground (its range's last two values
+// say where).
+fn condition_item(job: TurnJob, k: u32) {
     let tiles = job.tiles;
     let at = job.coefficient_offset;
+    let s = job_data[job.scales + k];
+    let cd = condition_light(k, job.turn);
+    let used_by_plan = job_data[params.mask + k] > 0.5;
+    let c = select(vec3<f32>(0.0), cd[0], used_by_plan);
+    let d = select(vec3<f32>(0.0), cd[1], used_by_plan);
+    let used = select(0.0, 1.0, any(c != vec3<f32>(0.0)) || any(d != vec3<f32>(0.0)));
+    coefficients[at + k] = vec4<f32>(c * s, used);
+    coefficients[at + 2u * tiles + k] = vec4<f32>(d * s, 0.0);
     let suns = u32(light[0].y);
-    let ground = light[0].z;
-    // Per image: its coefficient and whether it is used; where its condition's lights
-    // are (the floor's shares set below); what the suns add.
-    for (var k = 0u; k < tiles; k++) {
-        let s = job_data[job.scales + k];
-        let cd = condition_light(k, job.turn);
-        let used_by_plan = job_data[params.mask + k] > 0.5;
-        let c = select(vec3<f32>(0.0), cd[0], used_by_plan);
-        let d = select(vec3<f32>(0.0), cd[1], used_by_plan);
-        let used = select(0.0, 1.0, any(c != vec3<f32>(0.0)) || any(d != vec3<f32>(0.0)));
-        coefficients[at + k] = vec4<f32>(c * s, used);
-        coefficients[at + 2u * tiles + k] = vec4<f32>(d * s, 0.0);
-    }
-    // The sun slots, those of the suns taken first.
-    let slot_len = tiles + SUN_HEAD;
     let slots = at + 3u * tiles;
+    let delivered = conditions[4u * k + 1u].xyz;
     for (var j = 0u; j < params.sun_slots; j++) {
-        let o = slots + j * slot_len;
-        if (j >= suns) {
-            for (var m = 0u; m < slot_len; m++) {
-                coefficients[o + m] = vec4<f32>(0.0);
-            }
-            continue;
+        var unit = vec3<f32>(0.0);
+        if (j < suns) {
+            let head = light[1u + TERM * u32(light[0].x) + SUN * j];
+            let e = tables[u32(head.x)].xyz * head.z;
+            unit = select(vec3<f32>(0.0), e / delivered, delivered > vec3<f32>(0.0));
         }
-        let r = 1u + TERM * u32(light[0].x) + SUN * j;
-        let head = light[r];
-        let weight = head.z;
-        let e = tables[u32(head.x)];
-        let radius = tables[u32(head.x) + 1u].x;
-        for (var k = 0u; k < tiles; k++) {
-            let delivered = conditions[4u * k + 1u].xyz;
-            let unit = select(vec3<f32>(0.0), e.xyz * weight / delivered, delivered > vec3<f32>(0.0));
-            coefficients[o + k] = vec4<f32>(unit * job_data[job.scales + k], 0.0);
-        }
-        // The sun in the view's dome frame, and its two nearest conditions by angle.
-        let subject = light[r + 1u].xyz;
-        let direction = normalize(turned(subject, job.turn * 2.0 * PI));
-        var first = 0u;
-        var second = 0u;
-        var a0 = 1e30;
-        var a1 = 1e30;
-        for (var k = 0u; k < params.conditions; k++) {
-            let a = angle(conditions[4u * k].xyz, direction);
-            if (a < a0) {
-                second = first;
-                a1 = a0;
-                first = k;
-                a0 = a;
-            } else if (a < a1) {
-                second = k;
-                a1 = a;
-            }
-        }
-        var nearest = vec4<f32>(f32(first), 0.0, 0.0, 1.0);
-        var weights = vec4<f32>(1.0, 0.0, 0.0, params.ratio_floor);
-        if (a0 >= 1e-6 && params.conditions > 1u) {
-            let w0 = 1.0 / (a0 * a0);
-            let w1 = 1.0 / (a1 * a1);
-            nearest = vec4<f32>(f32(first), f32(second), 0.0, 2.0);
-            weights = vec4<f32>(w0 / (w0 + w1), w1 / (w0 + w1), 0.0, params.ratio_floor);
-        }
-        let h = o + tiles;
-        coefficients[h] = vec4<f32>(direction, 1.0);
-        coefficients[h + 1u] = nearest;
-        coefficients[h + 2u] = weights;
-        for (var m = 0u; m < 4u; m++) {
-            coefficients[h + 3u + m] = light[r + 1u + m];
-        }
-        // Each nearest left out: the two that predict it, and their weights.
-        var held = vec4<f32>(0.0);
-        var held_weights = vec4<f32>(0.0);
-        for (var n = 0u; n < u32(nearest.w); n++) {
-            let k = u32(nearest[n]);
-            let predict = conditions[4u * k + 2u];
-            let by = conditions[4u * k + 3u];
-            for (var m = 0u; m < u32(predict.z); m++) {
-                held[2u * n + m] = predict[m];
-                held_weights[2u * n + m] = by[m];
-            }
-        }
-        coefficients[h + 7u] = held;
-        coefficients[h + 8u] = held_weights;
-        let cell = conditions[4u * first + 1u].w;
-        let compact = 1.0 - smoothstep(cell, 2.0 * cell, 2.0 * radius);
-        coefficients[h + 9u] = vec4<f32>(compact, e.w * weight, params.trust_low, params.trust_high);
+        coefficients[slots + j * (tiles + SUN_HEAD) + k] = vec4<f32>(unit * s, 0.0);
     }
-    // Each floor condition's reweighted shares (its range's last two values say where),
-    // where the view holds normals to relight them.
-    if (job.normals == 0u) {
+    if (job.normals == 0u || conditions[4u * k].w < 0.5) {
         return;
     }
-    var room = slots + params.sun_slots * slot_len;
-    for (var k = 0u; k < tiles; k++) {
-        if (conditions[4u * k].w < 0.5) {
-            continue;
-        }
-        let range = coefficients[at + tiles + k];
-        let first = u32(range.x) + 1u;
-        let count = u32(range.y);
-        var total = 0.0;
-        if (ground > 0.0) {
-            for (var j = 0u; j < count; j++) {
-                let l = coefficients[first + j];
-                total += l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
-            }
-        }
-        let reweighted = ground > 0.0 && total > 0.0 && total < 3.0e38;
+    let ground = light[0].z;
+    let range = coefficients[at + tiles + k];
+    let first = u32(range.x) + 1u;
+    let count = u32(range.y);
+    let room = room_of(at, tiles, k);
+    var total = 0.0;
+    if (ground > 0.0) {
         for (var j = 0u; j < count; j++) {
-            var share = 0.0;
-            if (reweighted) {
-                let l = coefficients[first + j];
-                let w = l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
-                share = l.w + ground * (w / total - l.w);
-            }
-            coefficients[room + j] = vec4<f32>(share, 0.0, 0.0, 0.0);
+            let l = coefficients[first + j];
+            total += l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
         }
-        coefficients[at + tiles + k] = vec4<f32>(
-            range.xy,
-            select(0.0, f32(room), reweighted),
-            select(0.0, params.ratio_floor, reweighted),
-        );
-        room += count;
+    }
+    let reweighted = ground > 0.0 && total > 0.0 && total < 3.0e38;
+    for (var j = 0u; j < count; j++) {
+        var share = 0.0;
+        if (reweighted) {
+            let l = coefficients[first + j];
+            let w = l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
+            share = l.w + ground * (w / total - l.w);
+        }
+        coefficients[room + j] = vec4<f32>(share, 0.0, 0.0, 0.0);
+    }
+    coefficients[at + tiles + k] = vec4<f32>(
+        range.xy,
+        select(0.0, f32(room), reweighted),
+        select(0.0, params.ratio_floor, reweighted),
+    );
+}
+
+// Sun slot j of a job: the sun in the view's dome frame, its nearest conditions and
+// their weights, its map, the conditions that predict each nearest, its compactness and
+// luminance; zero past the suns taken.
+fn sun_item(job: TurnJob, j: u32) {
+    let tiles = job.tiles;
+    let h = job.coefficient_offset + 3u * tiles + j * (tiles + SUN_HEAD) + tiles;
+    if (j >= u32(light[0].y)) {
+        for (var m = 0u; m < SUN_HEAD; m++) {
+            coefficients[h + m] = vec4<f32>(0.0);
+        }
+        return;
+    }
+    let r = 1u + TERM * u32(light[0].x) + SUN * j;
+    let weight = light[r].z;
+    let e = tables[u32(light[r].x)];
+    let radius = tables[u32(light[r].x) + 1u].x;
+    let direction = normalize(turned(light[r + 1u].xyz, job.turn * 2.0 * PI));
+    // Its two nearest conditions by angle (the first of equals first).
+    var first = 0u;
+    var second = 0u;
+    var a0 = 1e30;
+    var a1 = 1e30;
+    for (var k = 0u; k < params.conditions; k++) {
+        let a = angle(conditions[4u * k].xyz, direction);
+        if (a < a0) {
+            second = first;
+            a1 = a0;
+            first = k;
+            a0 = a;
+        } else if (a < a1) {
+            second = k;
+            a1 = a;
+        }
+    }
+    var nearest = vec4<f32>(f32(first), 0.0, 0.0, 1.0);
+    var weights = vec4<f32>(1.0, 0.0, 0.0, params.ratio_floor);
+    if (a0 >= 1e-6 && params.conditions > 1u) {
+        let w0 = 1.0 / (a0 * a0);
+        let w1 = 1.0 / (a1 * a1);
+        nearest = vec4<f32>(f32(first), f32(second), 0.0, 2.0);
+        weights = vec4<f32>(w0 / (w0 + w1), w1 / (w0 + w1), 0.0, params.ratio_floor);
+    }
+    coefficients[h] = vec4<f32>(direction, 1.0);
+    coefficients[h + 1u] = nearest;
+    coefficients[h + 2u] = weights;
+    for (var m = 0u; m < 4u; m++) {
+        coefficients[h + 3u + m] = light[r + 1u + m];
+    }
+    var held = vec4<f32>(0.0);
+    var held_weights = vec4<f32>(0.0);
+    for (var n = 0u; n < u32(nearest.w); n++) {
+        let k = u32(nearest[n]);
+        let predict = conditions[4u * k + 2u];
+        let by = conditions[4u * k + 3u];
+        for (var m = 0u; m < u32(predict.z); m++) {
+            held[2u * n + m] = predict[m];
+            held_weights[2u * n + m] = by[m];
+        }
+    }
+    coefficients[h + 7u] = held;
+    coefficients[h + 8u] = held_weights;
+    let cell = conditions[4u * first + 1u].w;
+    let compact = 1.0 - smoothstep(cell, 2.0 * cell, 2.0 * radius);
+    coefficients[h + 9u] = vec4<f32>(compact, e.w * weight, params.trust_low, params.trust_high);
+}
+
+// One item of one job a thread: `items` per job, its conditions first, then its sun
+// slots (a job of fewer conditions leaves the rest idle).
+@compute @workgroup_size(64)
+fn turn_light(@builtin(global_invocation_id) id: vec3<u32>) {
+    let job_index = id.x / params.items;
+    let item = id.x % params.items;
+    if (job_index >= params.jobs) {
+        return;
+    }
+    let job = jobs[job_index];
+    if (item < job.tiles) {
+        condition_item(job, item);
+    } else if (item - job.tiles < params.sun_slots) {
+        sun_item(job, item - job.tiles);
     }
 }

@@ -1281,18 +1281,25 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     ) -> Result<()> {
         let lighting = self.walker_lighting(light, world);
         let entry = &self.cache[k];
-        let source = entry
-            .resident
-            .source()
-            .relit(self.field, &lighting, entry.plan.as_ref())?;
         let traced = match self.scene.shadow {
             ShadowSpec::Traced if entry.resident.has_shadow() => {
                 self.traced_shadow(entry.pose, world, light)?
             }
             _ => None,
         };
-        let resident = &mut self.cache[k].resident;
-        self.device.relight(resident, &source)?;
+        let entry = &mut self.cache[k];
+        let resident = &mut entry.resident;
+        match &lighting {
+            // Looked up from the light's tables on the device, where there is one.
+            Lighting::Tabled(l) => {
+                (self.device).relight_tabled(resident, self.field, l, entry.plan.as_ref())?
+            }
+            _ => {
+                let source =
+                    (resident.source()).relit(self.field, &lighting, entry.plan.as_ref())?;
+                self.device.relight(resident, &source)?;
+            }
+        }
         if let Some(shadow) = traced {
             self.device
                 .set_shadow(resident, SceneShadow::Relit(shadow))?;

@@ -424,10 +424,10 @@ pub struct GpuTurnParams {
     pub trust_low: f32,
     /// The error at which it has fallen to 0.
     pub trust_high: f32,
+    /// Threads per job: the most conditions of a job, then the sun slots.
+    pub items: u32,
     /// Padding to 16 bytes.
-    pub pad1: u32,
-    /// Padding.
-    pub pad2: u32,
+    pub pad: u32,
 }
 
 /// `TurnJob` of `turn_light.wgsl`: one view of a batch whose light the device looks up.

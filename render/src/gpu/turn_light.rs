@@ -95,8 +95,9 @@ impl TurnLightPass {
     }
 }
 
-/// What a pose keeps to be relit on the device: per batch of views its jobs, scales and
-/// the plan's mask; the field's conditions; the buffer its light's record goes in.
+/// What a pose keeps to be relit on the device: per batch of views its parameters, jobs,
+/// scales and the plan's mask, and its threads; the field's conditions; the buffer its
+/// light's record goes in.
 pub struct TurnState {
     batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
     conditions: wgpu::Buffer,
@@ -131,6 +132,7 @@ fn condition_table(conditions: &[ConditionRecord]) -> Vec<[f32; 4]> {
             by[m] = w;
         }
         at[2] = held.len().min(2) as f32;
+        at[3] = c.lights.len() as f32;
         out.push(at);
         out.push(by);
     }
@@ -245,6 +247,7 @@ impl Gpu {
                     })
                     .collect();
                 let mask = data.len() as u32;
+                let items = jobs.iter().map(|j| j.tiles).max().unwrap_or(0) + MAX_SUNS as u32;
                 data.extend((0..light.conditions.len()).map(|k| {
                     let used = light.used.is_none_or(|u| u.get(k).copied().unwrap_or(true));
                     if used { 1.0 } else { 0.0 }
@@ -260,10 +263,10 @@ impl Gpu {
                     ratio_floor: RATIO_FLOOR,
                     trust_low: TRUST_ERROR[0],
                     trust_high: TRUST_ERROR[1],
-                    pad1: 0,
-                    pad2: 0,
+                    items,
+                    pad: 0,
                 };
-                let n = jobs.len() as u32;
+                let n = jobs.len() as u32 * items;
                 (
                     buffer_with(
                         &self.device,
