@@ -220,20 +220,24 @@ fn condition_item(job: TurnJob, k: u32) {
     let first = u32(range.x) + 1u;
     let count = u32(range.y);
     let room = room_of(at, tiles, k);
+    // Each light's share weighted by the ground it sees, kept in its room, then
+    // normalised there.
     var total = 0.0;
-    if (ground > 0.0) {
-        for (var j = 0u; j < count; j++) {
+    for (var j = 0u; j < count; j++) {
+        var w = 0.0;
+        if (ground > 0.0) {
             let l = coefficients[first + j];
-            total += l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
+            w = l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
         }
+        coefficients[room + j] = vec4<f32>(w, 0.0, 0.0, 0.0);
+        total += w;
     }
     let reweighted = ground > 0.0 && total > 0.0 && total < 3.0e38;
     for (var j = 0u; j < count; j++) {
         var share = 0.0;
         if (reweighted) {
-            let l = coefficients[first + j];
-            let w = l.w * max(ground_radiance(turned(l.xyz, -job.turn * 2.0 * PI)), 0.0);
-            share = l.w + ground * (w / total - l.w);
+            let own = coefficients[first + j].w;
+            share = own + ground * (coefficients[room + j].x / total - own);
         }
         coefficients[room + j] = vec4<f32>(share, 0.0, 0.0, 0.0);
     }

@@ -286,7 +286,18 @@ fn pod_structs_match_naga_layouts() {
         "TurnParams",
         GpuTurnParams,
         [
-            jobs, conditions, samples, sun_slots, mask, coarse_w, coarse_h, pad
+            jobs,
+            conditions,
+            samples,
+            sun_slots,
+            mask,
+            coarse_w,
+            coarse_h,
+            ratio_floor,
+            trust_low,
+            trust_high,
+            items,
+            pad
         ]
     );
     check_layout!(
