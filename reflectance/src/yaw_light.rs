@@ -106,18 +106,9 @@ impl YawLight {
     pub fn ground_share(&self) -> f32 {
         let (mut below, mut total) = (0.0f64, 0.0f64);
         for t in &self.terms {
-            let map = t.table.coarse_map();
-            let (w, h) = map.image().size();
-            for y in 0..h {
-                let omega = map.texel_solid_angle(y) as f64 * t.weight as f64;
-                let row: f64 = (0..w)
-                    .map(|x| luminance(map.image().get(x, y)) as f64)
-                    .sum();
-                total += row * omega;
-                if map.direction_of(0.0, y as f32).y < 0.0 {
-                    below += row * omega;
-                }
-            }
+            let (b, all) = t.table.ground_parts();
+            below += b * t.weight as f64;
+            total += all * t.weight as f64;
         }
         if total > 0.0 {
             (below / total) as f32

@@ -114,6 +114,8 @@ pub struct YawTable {
     less_suns: OnceLock<Option<(Vec<Sun>, Samples)>>,
     /// [`YawTable::coarse_map`], made when first needed.
     coarse: OnceLock<EnvMap>,
+    /// [`YawTable::ground_parts`], found when first needed.
+    ground: OnceLock<(f64, f64)>,
 }
 
 impl YawTable {
@@ -128,6 +130,7 @@ impl YawTable {
             floor,
             less_suns: OnceLock::new(),
             coarse: OnceLock::new(),
+            ground: OnceLock::new(),
         }
     }
 
@@ -145,6 +148,27 @@ impl YawTable {
     /// as the floor conditions' lights sample it ([`crate::floor_light`]).
     pub fn coarse_map(&self) -> &EnvMap {
         self.coarse.get_or_init(|| self.map.coarse(36, 18))
+    }
+
+    /// Its coarse map's luminance arriving from below the horizon and in all (each
+    /// `∫ L dω`), found once: what [`crate::yaw_light::YawLight::ground_share`] weighs.
+    pub fn ground_parts(&self) -> (f64, f64) {
+        *self.ground.get_or_init(|| {
+            let map = self.coarse_map();
+            let (w, h) = map.image().size();
+            let (mut below, mut total) = (0.0f64, 0.0f64);
+            for y in 0..h {
+                let omega = map.texel_solid_angle(y) as f64;
+                let row: f64 = (0..w)
+                    .map(|x| frf_core::image::luminance(map.image().get(x, y)) as f64)
+                    .sum();
+                total += row * omega;
+                if map.direction_of(0.0, y as f32).y < 0.0 {
+                    below += row * omega;
+                }
+            }
+            (below, total)
+        })
     }
 
     /// What lights its floor conditions.

@@ -144,7 +144,13 @@ pub struct PoseRelight {
     pub(super) sun_maps: Option<SunMapsAt>,
     /// What relights it on the device ([`super::turn_light`]), made the first time.
     pub(super) turn: Option<super::turn_light::TurnState>,
+    /// Its relighting pass's bind groups (one a batch) and the scratch and suns' maps'
+    /// buffers they bind, kept for the next relight.
+    binds: std::sync::Mutex<Option<BindsKept>>,
 }
+
+/// Bind groups kept, with the buffers that change between relights they bind.
+type BindsKept = ((wgpu::Buffer, wgpu::Buffer), Vec<wgpu::BindGroup>);
 
 impl PoseRelight {
     /// The shared codes.
@@ -495,6 +501,7 @@ impl Gpu {
             hull,
             sun_maps: None,
             turn: None,
+            binds: std::sync::Mutex::new(None),
         }
     }
 
@@ -519,7 +526,7 @@ impl Gpu {
             self.queue
                 .write_buffer(buffer, 0, bytemuck::cast_slice(&packed));
         }
-        self.record_relight_passes(relight, (target, views), |_| None);
+        self.record_relight_passes(relight, (|| target.clone(), views), |_| None);
     }
 
     /// Records the passes that relight `relight`'s views from the coefficients in its
@@ -530,7 +537,7 @@ impl Gpu {
     pub(super) fn record_relight_passes(
         &self,
         relight: &PoseRelight,
-        (target, views): (&wgpu::TextureView, &wgpu::Buffer),
+        (target, views): (impl Fn() -> wgpu::TextureView, &wgpu::Buffer),
         before: impl Fn(usize) -> Option<Dispatch>,
     ) {
         let maps = relight.sun_maps.as_ref();
@@ -545,27 +552,38 @@ impl Gpu {
         let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
         self.with_pending(|encoder| encoder.clear_buffer(&relight.peaks, 0, None));
         let groups = (basis.texels as u32).div_ceil(WORKGROUP);
-        for (b, (batch, coefficients)) in
-            basis.batches.iter().zip(&relight.coefficients).enumerate()
-        {
+        // The bind groups of its last relight serve while the scratch and the maps'
+        // buffer are the same.
+        let key = (relit.clone(), depths.clone());
+        let mut kept = relight.binds.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.as_ref().is_none_or(|(k, _)| *k != key) {
+            let target = target();
+            let binds = (basis.batches.iter().zip(&relight.coefficients))
+                .map(|(batch, coefficients)| {
+                    bind_group(
+                        &self.device,
+                        "relight",
+                        &self.relight.layout,
+                        vec![
+                            batch.params.as_entire_binding(),
+                            batch.codes.as_entire_binding(),
+                            coefficients.as_entire_binding(),
+                            self.relight.gamma.as_entire_binding(),
+                            relit.as_entire_binding(),
+                            relight.peaks.as_entire_binding(),
+                            wgpu::BindingResource::TextureView(&target),
+                            batch.jobs.as_entire_binding(),
+                            views.as_entire_binding(),
+                            depths.as_entire_binding(),
+                        ],
+                    )
+                })
+                .collect();
+            *kept = Some((key, binds));
+        }
+        let binds = &kept.as_ref().expect("made above").1;
+        for (b, (batch, bind)) in basis.batches.iter().zip(binds).enumerate() {
             self.defer(Kind::Relight, before(b));
-            let bind = bind_group(
-                &self.device,
-                "relight",
-                &self.relight.layout,
-                vec![
-                    batch.params.as_entire_binding(),
-                    batch.codes.as_entire_binding(),
-                    coefficients.as_entire_binding(),
-                    self.relight.gamma.as_entire_binding(),
-                    relit.as_entire_binding(),
-                    relight.peaks.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(target),
-                    batch.jobs.as_entire_binding(),
-                    views.as_entire_binding(),
-                    depths.as_entire_binding(),
-                ],
-            );
             // The sums, then their encoding (wgpu orders the two dispatches' use of the
             // scratch and the peaks), in the pass every relight of the frame shares.
             let pair = [&self.relight.relight, &self.relight.encode].map(|pipeline| Dispatch {

@@ -102,6 +102,8 @@ pub struct TurnState {
     batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
     conditions: wgpu::Buffer,
     light: wgpu::Buffer,
+    /// Its bind groups (one a batch) and the tables' buffer they bind.
+    binds: Mutex<Option<(wgpu::Buffer, Vec<wgpu::BindGroup>)>>,
 }
 
 /// A light to relight a pose by on the device, with what of its field it needs.
@@ -304,6 +306,7 @@ impl Gpu {
                 (1 + TERM * 8 + SUN * MAX_SUNS) * 16,
                 storage | wgpu::BufferUsages::COPY_DST,
             ),
+            binds: Mutex::new(None),
         }
     }
 
@@ -404,33 +407,43 @@ impl Gpu {
             let state = relight.turn.as_ref().expect("made above");
             self.queue
                 .write_buffer(&state.light, 0, bytemuck::cast_slice(&record));
-            let target = pose.prelit_codes_view();
             let relight = pose.relight.as_ref().expect("checked above");
             let state = relight.turn.as_ref().expect("made above");
+            // The bind groups of its last relight serve while the tables are the same.
+            let mut kept = state.binds.lock().unwrap_or_else(|e| e.into_inner());
+            if kept.as_ref().is_none_or(|(a, _)| *a != arena) {
+                let binds = (state.batches.iter().enumerate())
+                    .filter_map(|(b, (params, jobs, data, _))| {
+                        let coefficients = relight.coefficient_buffer(b)?;
+                        Some(bind_group(
+                            &self.device,
+                            "turn light",
+                            &self.turn_light.layout,
+                            vec![
+                                params.as_entire_binding(),
+                                jobs.as_entire_binding(),
+                                data.as_entire_binding(),
+                                state.conditions.as_entire_binding(),
+                                arena.as_entire_binding(),
+                                state.light.as_entire_binding(),
+                                coefficients.as_entire_binding(),
+                            ],
+                        ))
+                    })
+                    .collect();
+                *kept = Some((arena.clone(), binds));
+            }
+            let binds = &kept.as_ref().expect("made above").1;
             let before = |b: usize| {
-                let (params, jobs, data, n) = state.batches.get(b)?;
-                let coefficients = relight.coefficient_buffer(b)?;
-                let bind = bind_group(
-                    &self.device,
-                    "turn light",
-                    &self.turn_light.layout,
-                    vec![
-                        params.as_entire_binding(),
-                        jobs.as_entire_binding(),
-                        data.as_entire_binding(),
-                        state.conditions.as_entire_binding(),
-                        arena.as_entire_binding(),
-                        state.light.as_entire_binding(),
-                        coefficients.as_entire_binding(),
-                    ],
-                );
+                let (_, _, _, n) = state.batches.get(b)?;
                 Some(Dispatch {
                     pipeline: self.turn_light.pipeline.clone(),
-                    bind,
+                    bind: binds.get(b)?.clone(),
                     groups: [n.div_ceil(WORKGROUP).max(1), 1, 1],
                 })
             };
-            self.record_relight_passes(relight, (&target, &pose.views), before);
+            let target = || pose.prelit_codes_view();
+            self.record_relight_passes(relight, (target, &pose.views), before);
             Ok(true)
         })
     }
