@@ -924,3 +924,49 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
         "the turned sky looks up {differ} coefficients unlike the unturned"
     );
 }
+
+/// The device holds a bounded number of yaw tables: lights of more maps than it holds,
+/// one after the other, let go of those no light holds any more, and the last light
+/// still relights as the host works it out.
+#[test]
+fn the_tables_on_the_device_are_bounded_and_stay_right() {
+    use frf_reflectance::project::FloorModel;
+    use frf_reflectance::yaw_light::YawLight;
+    use frf_render::gpu::turn_light::TurnedLight;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let h = field.header();
+    let turntables: Vec<f32> = (h.pose(0).unwrap().views.iter())
+        .map(|v| v.turntable_deg.to_radians())
+        .collect();
+    let projector = field.projector_shared().unwrap().clone();
+    let first = fixture.source(&EnvMap::sky());
+    let mut pose = gpu.upload_pose(&first).unwrap();
+    let mut last = None;
+    for k in 0..20 {
+        // A map of its own each time: the sky brighter by a step.
+        let env = EnvMap::sky().scaled(1.0 + 0.05 * k as f32);
+        let light = YawLight::of_env(projector.clone(), &env, FloorModel::Environment);
+        let turned = TurnedLight {
+            light: &light,
+            conditions: &h.conditions,
+            turntables: &turntables,
+            used: None,
+        };
+        gpu.flush();
+        assert!(gpu.relight_turned(&mut pose, &first, &turned).unwrap());
+        assert!(gpu.tables_held() <= 16, "{} tables held", gpu.tables_held());
+        last = Some(light);
+    }
+    let source = first
+        .relit(&field, &Lighting::Tabled(last.unwrap()), None)
+        .unwrap();
+    assert_relit_within(
+        &gpu,
+        &pose,
+        &ResidentPose::relight_cpu(&source),
+        ("the last", 5e-4),
+    );
+}

@@ -210,7 +210,7 @@ impl YawLight {
     /// normals apart (with `suns`; none without): up to [`MAX_SUNS`] in all, a map's suns
     /// taken whole or not at all, the maps of brightest suns first. Each sun taken with
     /// its term and its place among the map's suns, turned and weighted as the term is.
-    pub fn suns_taken(&self, suns: bool) -> Result<(Vec<Part>, Vec<(usize, usize, Sun)>)> {
+    pub fn suns_taken(&self, suns: bool) -> Result<(Vec<Part>, Vec<TakenSun>)> {
         let mut parts = vec![Part::Whole; self.terms.len()];
         let mut taken = Vec::new();
         if !suns {
@@ -235,6 +235,10 @@ impl YawLight {
         Ok((parts, taken))
     }
 }
+
+/// A sun taken from a light's maps ([`YawLight::suns_taken`]): its term, its place among
+/// the map's suns, and the sun as the term turns and weighs it.
+pub type TakenSun = (usize, usize, Sun);
 
 /// A map's sun as its term turns and weighs it (itself for a term of weight 1, unturned).
 fn turned_sun(sun: &Sun, t: &YawTerm) -> Sun {

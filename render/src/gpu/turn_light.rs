@@ -65,7 +65,7 @@ struct TableAt {
     /// What its suns leave (none without suns).
     less: Option<u32>,
     coarse: u32,
-    /// Per sun (brightest first), its illuminance and radius.
+    /// Per sun (brightest first), where its illuminance and radius are.
     suns: Vec<u32>,
 }
 
@@ -144,74 +144,104 @@ fn condition_table(conditions: &[ConditionRecord]) -> Vec<[f32; 4]> {
     out
 }
 
+impl HeldTables {
+    /// Adds `table`'s parts (every sample made first) to the values; where they lie.
+    fn add(&mut self, table: &Arc<YawTable>) -> Result<TableAt> {
+        let coarse = table.coarse_map().image();
+        let size = (coarse.width() as u32, coarse.height() as u32);
+        if !self.held.is_empty() && self.coarse != size {
+            return Err(RenderError::Misuse(
+                "maps of coarse maps of two sizes on the device".into(),
+            ));
+        }
+        self.coarse = size;
+        let values = &mut self.values;
+        let mut push = |part: &[[f32; 4]]| {
+            let at = values.len() as u32;
+            values.extend_from_slice(part);
+            at
+        };
+        let rgb = |part: Vec<frf_core::image::Rgb>| -> Vec<[f32; 4]> {
+            part.iter().map(|c| [c[0], c[1], c[2], 0.0]).collect()
+        };
+        let whole = push(&rgb(table.samples(Part::Whole)?.unwrap_or_default()));
+        let less = table.samples(Part::LessSuns)?.map(|l| push(&rgb(l)));
+        let lum: Vec<[f32; 4]> = (0..coarse.height())
+            .flat_map(|y| (0..coarse.width()).map(move |x| (x, y)))
+            .map(|(x, y)| [luminance(coarse.get(x, y)), 0.0, 0.0, 0.0])
+            .collect();
+        let coarse_at = push(&lum);
+        // Per sun its illuminance (and its luminance), then its radius.
+        let suns = (table.suns()?.iter())
+            .map(|s| {
+                let e = s.illuminance();
+                push(&[
+                    [e[0], e[1], e[2], luminance(e)],
+                    [s.radius(), 0.0, 0.0, 0.0],
+                ])
+            })
+            .collect();
+        let at = TableAt {
+            whole,
+            less,
+            coarse: coarse_at,
+            suns,
+        };
+        self.held.push((table.clone(), at.clone()));
+        Ok(at)
+    }
+}
+
+/// Tables the device holds before those no light holds any more are let go of (a scene
+/// whose sun moves makes a table of it at each new place).
+const MOST_TABLES: usize = 16;
+
 impl Gpu {
-    /// Where `table`'s parts lie on the device, uploading them the first time (every
-    /// sample made first) and the buffer that holds every table now.
+    /// Where `table`'s parts lie on the device, uploading them the first time, and the
+    /// buffer that holds every table now. Past [`MOST_TABLES`], the tables nothing else
+    /// holds are let go of first (the others move: a light's relights ask again).
     fn held_table(&self, table: &Arc<YawTable>) -> Result<(TableAt, wgpu::Buffer, (u32, u32))> {
         let mut held = self
             .turn_light
             .tables
             .lock()
             .unwrap_or_else(|e| e.into_inner());
-        let found = held
-            .held
-            .iter()
+        let found = (held.held.iter())
             .find(|(t, _)| Arc::ptr_eq(t, table))
             .map(|(_, at)| at.clone());
         let at = match found {
             Some(at) => at,
             None => {
-                let coarse = table.coarse_map().image();
-                let size = (coarse.width() as u32, coarse.height() as u32);
-                if !held.held.is_empty() && held.coarse != size {
-                    return Err(RenderError::Misuse(
-                        "maps of coarse maps of two sizes on the device".into(),
-                    ));
+                if held.held.len() >= MOST_TABLES {
+                    let kept: Vec<Arc<YawTable>> = (held.held.drain(..))
+                        .map(|(t, _)| t)
+                        .filter(|t| Arc::strong_count(t) > 1)
+                        .collect();
+                    held.values.clear();
+                    for t in &kept {
+                        held.add(t)?;
+                    }
                 }
-                held.coarse = size;
-                let values = &mut held.values;
-                let mut push = |part: Vec<frf_core::image::Rgb>| {
-                    let at = values.len() as u32;
-                    values.extend(part.iter().map(|c| [c[0], c[1], c[2], 0.0]));
-                    at
-                };
-                let whole = push(table.samples(Part::Whole)?.unwrap_or_default());
-                let less = table.samples(Part::LessSuns)?.map(&mut push);
-                let lum: Vec<frf_core::image::Rgb> = (0..coarse.height())
-                    .flat_map(|y| (0..coarse.width()).map(move |x| (x, y)))
-                    .map(|(x, y)| [luminance(coarse.get(x, y)), 0.0, 0.0])
-                    .collect();
-                let coarse_at = push(lum);
-                let suns = table
-                    .suns()?
-                    .iter()
-                    .map(|s| {
-                        let e = s.illuminance();
-                        push(vec![e, [s.radius(), 0.0, 0.0]]) as usize
-                    })
-                    .collect::<Vec<_>>();
-                // The illuminance's luminance rides in its fourth value.
-                for (&at, s) in suns.iter().zip(table.suns()?) {
-                    held.values[at][3] = luminance(s.illuminance());
-                }
-                let at = TableAt {
-                    whole,
-                    less,
-                    coarse: coarse_at,
-                    suns: suns.into_iter().map(|s| s as u32).collect(),
-                };
+                let at = held.add(table)?;
                 held.buffer = Some(buffer_with(
                     &self.device,
                     "yaw tables",
                     bytemuck::cast_slice(&held.values),
                     wgpu::BufferUsages::STORAGE,
                 ));
-                held.held.push((table.clone(), at.clone()));
                 at
             }
         };
         let buffer = held.buffer.clone().expect("made with the first table");
         Ok((at, buffer, held.coarse))
+    }
+
+    /// Tables the device holds now (for tests and inspection).
+    pub fn tables_held(&self) -> usize {
+        (self.turn_light.tables.lock())
+            .unwrap_or_else(|e| e.into_inner())
+            .held
+            .len()
     }
 
     /// What `relight`'s batches need to be relit on the device (see [`TurnState`]).
@@ -327,15 +357,21 @@ impl Gpu {
             return Ok(false);
         }
         self.scoped("relighting a pose on the device", || {
+            // Every map's table where it lies, asked again when one asked last made room by
+            // moving those asked before it.
             let mut tables = Vec::with_capacity(terms.len());
-            for t in terms {
-                tables.push(self.held_table(&t.table)?);
+            for _ in 0..2 {
+                tables.clear();
+                for t in terms {
+                    tables.push(self.held_table(&t.table)?);
+                }
+                if tables.windows(2).all(|w| w[0].1 == w[1].1) {
+                    break;
+                }
             }
-            let Some((_, arena, coarse)) = tables.first().cloned() else {
+            let Some((_, arena, coarse)) = tables.last().cloned() else {
                 return Ok(false);
             };
-            // The last table added holds every one before it.
-            let arena = tables.last().map_or(arena, |t| t.1.clone());
             let normals = source.holds_normals();
             let (parts, taken) = light.light.suns_taken(normals)?;
             let taken = &taken[..taken.len().min(MAX_SUNS)];
