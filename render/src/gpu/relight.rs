@@ -143,10 +143,21 @@ pub struct PoseRelight {
     /// Where its suns' maps were made at its last relight (read back by tests).
     pub(super) sun_maps: Option<SunMapsAt>,
     /// What relights it on the device ([`super::turn_light`]), made the first time.
-    pub(super) turn: Option<super::turn_light::TurnState>,
+    pub(super) turn: Option<TurnState>,
     /// Its relighting pass's bind groups (one a batch) and the scratch and suns' maps'
     /// buffers they bind, kept for the next relight.
     binds: std::sync::Mutex<Option<BindsKept>>,
+}
+
+/// What a pose keeps to be relit on the device (`super::turn_light`): per batch of views its parameters, jobs,
+/// scales and the plan's mask, and its threads; the field's conditions; the buffer its
+/// light's record goes in.
+pub struct TurnState {
+    pub(super) batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
+    pub(super) conditions: wgpu::Buffer,
+    pub(super) light: wgpu::Buffer,
+    /// Its bind groups (one a batch) and the tables' buffer they bind.
+    pub(super) binds: std::sync::Mutex<Option<(wgpu::Buffer, Vec<wgpu::BindGroup>)>>,
 }
 
 /// Bind groups kept, with the buffers that change between relights they bind.

@@ -29,7 +29,7 @@ use frf_shaders::types::{GpuTurnJob, GpuTurnParams};
 use super::bind::{bind_group, buffer_with, compute_pipeline, empty_buffer, storage, uniform};
 use super::deferred::Dispatch;
 use super::pose::GpuPose;
-use super::relight::PoseRelight;
+use super::relight::{PoseRelight, TurnState};
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::resident::PoseSource;
@@ -93,17 +93,6 @@ impl TurnLightPass {
             tables: Mutex::default(),
         }
     }
-}
-
-/// What a pose keeps to be relit on the device: per batch of views its parameters, jobs,
-/// scales and the plan's mask, and its threads; the field's conditions; the buffer its
-/// light's record goes in.
-pub struct TurnState {
-    batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
-    conditions: wgpu::Buffer,
-    light: wgpu::Buffer,
-    /// Its bind groups (one a batch) and the tables' buffer they bind.
-    binds: Mutex<Option<(wgpu::Buffer, Vec<wgpu::BindGroup>)>>,
 }
 
 /// A light to relight a pose by on the device, with what of its field it needs.
