@@ -681,7 +681,11 @@ heading_deg = 200.0
 
 /// A light that turns every frame (issue 37): the shot relights its resident poses in
 /// place, from the basis codes they keep, and every frame equals the same frame rendered
-/// alone, its poses made resident afresh under that light.
+/// alone, its poses made resident afresh under that light: to 1e-6 where the host works
+/// the coefficients out both times (the CPU reference); on the GPU, whose relights in
+/// place look them up on the device (design §4.9), to the GPU-vs-CPU tolerance of
+/// `tests/gpu_vs_cpu.rs` (2e-3: the lookup's float rounding can move a pre-lit code by
+/// one; measured 4e-4).
 #[test]
 fn a_turning_light_relit_in_place_draws_what_a_fresh_residency_draws() {
     let dir = tempfile::tempdir().unwrap();
@@ -731,8 +735,9 @@ fn a_turning_light_relit_in_place_draws_what_a_fresh_residency_draws() {
             .zip(&b)
             .map(|(x, y)| (x - y).abs())
             .fold(0.0f32, f32::max);
+        let bound = if gpu_flag().is_none() { 2e-3 } else { 1e-6 };
         assert!(
-            worst <= 1e-6,
+            worst <= bound,
             "frame {k}: relit in place differs by {worst}"
         );
     }

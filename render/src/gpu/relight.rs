@@ -149,9 +149,9 @@ pub struct PoseRelight {
     binds: std::sync::Mutex<Option<BindsKept>>,
 }
 
-/// What a pose keeps to be relit on the device (`super::turn_light`): per batch of views its parameters, jobs,
-/// scales and the plan's mask, and its threads; the field's conditions; the buffer its
-/// light's record goes in.
+/// What a pose keeps to be relit on the device (`super::turn_light`): per batch of views
+/// its parameters, jobs, scales and the plan's mask, and its threads; the field's
+/// conditions; the buffer its light's record goes in.
 pub struct TurnState {
     pub(super) batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
     pub(super) conditions: wgpu::Buffer,
