@@ -1,8 +1,10 @@
 //! Dispatches gathered by kind between two submissions and recorded as one compute pass
 //! per kind: every pose relit between two frames (a turning light relights a crowd) adds
 //! its dispatches to the relight pass and its shadow's to the shadow pass, instead of a
-//! pass of its own each. [`Gpu::submit`] records them, relights before shadows, after
-//! what the pending encoder already holds (the clears of the relights' peaks).
+//! pass of its own each, and the lookups of its light on the device to a pass before
+//! them all (none waits for another). [`Gpu::submit`] records them, lights, relights,
+//! then shadows, after what the pending encoder already holds (the clears of the
+//! relights' peaks).
 
 use super::Gpu;
 use super::timing::compute_pass_writes;
@@ -10,6 +12,9 @@ use super::timing::compute_pass_writes;
 /// The kinds, in the order they are recorded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kind {
+    /// The lights looked up on the device ([`super::turn_light`]): every relight's
+    /// coefficients, written before any relight reads them.
+    Light,
     /// The relighting pass (its sums, then its encoding), [`super::relight`].
     Relight,
     /// The relit shadow, [`super::shadow`].
@@ -17,11 +22,12 @@ pub(super) enum Kind {
 }
 
 impl Kind {
-    const ALL: [Kind; 2] = [Kind::Relight, Kind::Shadow];
+    const ALL: [Kind; 3] = [Kind::Light, Kind::Relight, Kind::Shadow];
 
     /// The pass's name (in the timings).
     fn name(self) -> &'static str {
         match self {
+            Kind::Light => "turn light",
             Kind::Relight => "relight",
             Kind::Shadow => "shadow",
         }

@@ -543,8 +543,8 @@ impl Gpu {
     /// Records the passes that relight `relight`'s views from the coefficients in its
     /// buffers into the pre-lit array `target`, their scales into the view table `views`:
     /// per batch of views, the dispatch `before` gives for it (the light on the device,
-    /// [`super::turn_light`], which writes the coefficients), then the sums and their
-    /// encoding.
+    /// [`super::turn_light`], which writes the coefficients: in the pass ahead of the
+    /// relights), then the sums and their encoding.
     pub(super) fn record_relight_passes(
         &self,
         relight: &PoseRelight,
@@ -594,7 +594,7 @@ impl Gpu {
         }
         let binds = &kept.as_ref().expect("made above").1;
         for (b, (batch, bind)) in basis.batches.iter().zip(binds).enumerate() {
-            self.defer(Kind::Relight, before(b));
+            self.defer(Kind::Light, before(b));
             // The sums, then their encoding (wgpu orders the two dispatches' use of the
             // scratch and the peaks), in the pass every relight of the frame shares.
             let pair = [&self.relight.relight, &self.relight.encode].map(|pipeline| Dispatch {
