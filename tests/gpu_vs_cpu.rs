@@ -795,6 +795,29 @@ fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
     );
 }
 
+/// Pose 0's views' turntable angles (radians) of `field`.
+fn turntables_of(field: &FieldFile) -> Vec<f32> {
+    (field.header().pose(0).unwrap().views.iter())
+        .map(|v| v.turntable_deg.to_radians())
+        .collect()
+}
+
+/// `light` to relight pose 0 of `field` by on the device, the conditions `used` (`None`:
+/// all).
+fn on_device<'a>(
+    light: &'a frf_reflectance::yaw_light::YawLight,
+    field: &'a FieldFile,
+    turntables: &'a [f32],
+    used: Option<&'a [bool]>,
+) -> frf_render::gpu::turn_light::TurnedLight<'a> {
+    frf_render::gpu::turn_light::TurnedLight {
+        light,
+        conditions: &field.header().conditions,
+        turntables,
+        used,
+    }
+}
+
 /// A light looked up on the device by each view's turn (`Gpu::relight_turned`) writes the
 /// coefficients the host works out for it (`PoseSource::relit`) and relights the pose as
 /// the CPU twin does: the sky turned (its sun relit by the normals, the floor conditions
@@ -807,15 +830,12 @@ fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
 fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     use frf_reflectance::project::FloorModel;
     use frf_reflectance::yaw_light::{YawLight, YawTerm};
-    use frf_render::gpu::turn_light::TurnedLight;
     use frf_render::resident::Lighting;
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
     let h = field.header();
-    let turntables: Vec<f32> = (h.pose(0).unwrap().views.iter())
-        .map(|v| v.turntable_deg.to_radians())
-        .collect();
+    let turntables = turntables_of(&field);
     let projector = field.projector_shared().unwrap().clone();
     let sky = YawLight::of_env(projector.clone(), &EnvMap::sky(), FloorModel::Environment);
     let (low, _) = low_sun(130.0, 25.0);
@@ -863,12 +883,7 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     };
     for (what, light, used) in &cases {
         let plan = plan_of(*used);
-        let turned = TurnedLight {
-            light,
-            conditions: &h.conditions,
-            turntables: &turntables,
-            used: *used,
-        };
+        let turned = on_device(light, &field, &turntables, *used);
         let mut device = gpu.upload_pose(&first).unwrap();
         gpu.flush();
         assert!(gpu.relight_turned(&mut device, &first, &turned).unwrap());
@@ -902,12 +917,7 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     // Control: the pose as made (the sky unturned) is not what the last light relights.
     let made = gpu.upload_pose(&first).unwrap();
     let as_made = gpu.read_coefficients(&made).unwrap();
-    let turned = TurnedLight {
-        light: &cases[0].1,
-        conditions: &h.conditions,
-        turntables: &turntables,
-        used: None,
-    };
+    let turned = on_device(&cases[0].1, &field, &turntables, None);
     let mut device = gpu.upload_pose(&first).unwrap();
     gpu.relight_turned(&mut device, &first, &turned).unwrap();
     let looked_up = gpu.read_coefficients(&device).unwrap();
@@ -932,15 +942,11 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
 fn the_tables_on_the_device_are_bounded_and_stay_right() {
     use frf_reflectance::project::FloorModel;
     use frf_reflectance::yaw_light::YawLight;
-    use frf_render::gpu::turn_light::TurnedLight;
     use frf_render::resident::Lighting;
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
-    let h = field.header();
-    let turntables: Vec<f32> = (h.pose(0).unwrap().views.iter())
-        .map(|v| v.turntable_deg.to_radians())
-        .collect();
+    let turntables = turntables_of(&field);
     let projector = field.projector_shared().unwrap().clone();
     let first = fixture.source(&EnvMap::sky());
     let mut pose = gpu.upload_pose(&first).unwrap();
@@ -949,12 +955,7 @@ fn the_tables_on_the_device_are_bounded_and_stay_right() {
         // A map of its own each time: the sky brighter by a step.
         let env = EnvMap::sky().scaled(1.0 + 0.05 * k as f32);
         let light = YawLight::of_env(projector.clone(), &env, FloorModel::Environment);
-        let turned = TurnedLight {
-            light: &light,
-            conditions: &h.conditions,
-            turntables: &turntables,
-            used: None,
-        };
+        let turned = on_device(&light, &field, &turntables, None);
         gpu.flush();
         assert!(gpu.relight_turned(&mut pose, &first, &turned).unwrap());
         assert!(gpu.tables_held() <= 16, "{} tables held", gpu.tables_held());
