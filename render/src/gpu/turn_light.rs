@@ -2,9 +2,10 @@
 //! on the device*): the yaw tables of a light's maps held on the GPU, and a relight that
 //! writes one small record (the maps' turns and weights, the suns' maps) where the host
 //! path works out and uploads every view's coefficients ([`super::relight`]). The views'
-//! coefficients are then looked up by their turn in one dispatch per batch of views, just
-//! ahead of the relighting pass that reads them, in the same pass: a turning light and a
-//! crowd of walkers on curves cost the host a record per relight, whatever the views.
+//! coefficients are then looked up by their turn in one dispatch per batch of views, in a
+//! pass of their own ahead of the relighting pass that reads them (`super::deferred`): a
+//! turning light and a crowd of walkers on curves cost the host a record per relight,
+//! whatever the views.
 //!
 //! Twin of the host path: the same entries as `packed_coefficients` of the lighting
 //! `PoseSource::relit` works out, to within float rounding (the turn's bracket is found in
@@ -16,13 +17,14 @@ use std::sync::{Arc, Mutex};
 use frf_core::image::luminance;
 use frf_reflectance::field::ConditionRecord;
 use frf_reflectance::floor_light::ground_weight;
+use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::light_fit::{RATIO_FLOOR, condition_lights};
 use frf_reflectance::project::FloorModel;
 use frf_reflectance::sun_depth::SunDepth;
 use frf_reflectance::sun_light::{
     MAX_SUNS, TRUST_ERROR, cell_width, held_out_weights, shadow_offset_m,
 };
-use frf_reflectance::yaw_light::YawLight;
+use frf_reflectance::yaw_light::{TakenSun, YawLight, YawTerm};
 use frf_reflectance::yaw_table::{Part, SAMPLES_PER_TURN, YawTable};
 use frf_shaders::types::{GpuTurnJob, GpuTurnParams};
 
@@ -39,6 +41,8 @@ const WORKGROUP: u32 = 64;
 /// Record entries (`vec4`) per map of a light, and per sun.
 const TERM: usize = 2;
 const SUN: usize = 5;
+/// The most maps a light relit on the device has (more: the host relights it).
+const MOST_TERMS: usize = 8;
 
 /// The pass and the tables it holds.
 pub struct TurnLightPass {
@@ -57,6 +61,10 @@ struct HeldTables {
     /// The coarse maps' size (the same for every table).
     coarse: (u32, u32),
 }
+
+/// A table as the device holds it: where its parts lie, the buffer of every table, and
+/// the coarse maps' size.
+type HeldAt = (TableAt, wgpu::Buffer, (u32, u32));
 
 /// Where a table's parts lie in the buffer.
 #[derive(Debug, Clone)]
@@ -189,7 +197,7 @@ impl Gpu {
     /// Where `table`'s parts lie on the device, uploading them the first time, and the
     /// buffer that holds every table now. Past [`MOST_TABLES`], the tables nothing else
     /// holds are let go of first (the others move: a light's relights ask again).
-    fn held_table(&self, table: &Arc<YawTable>) -> Result<(TableAt, wgpu::Buffer, (u32, u32))> {
+    fn held_table(&self, table: &Arc<YawTable>) -> Result<HeldAt> {
         let mut held = self
             .turn_light
             .tables
@@ -322,7 +330,7 @@ impl Gpu {
             light: empty_buffer(
                 &self.device,
                 "turn light",
-                (1 + TERM * 8 + SUN * MAX_SUNS) * 16,
+                (1 + TERM * MOST_TERMS + SUN * MAX_SUNS) * 16,
                 storage | wgpu::BufferUsages::COPY_DST,
             ),
             binds: Mutex::new(None),
@@ -342,7 +350,7 @@ impl Gpu {
         light: &TurnedLight,
     ) -> Result<bool> {
         let terms = light.light.terms();
-        if pose.relight.is_none() || terms.len() > 8 {
+        if pose.relight.is_none() || terms.len() > MOST_TERMS {
             return Ok(false);
         }
         self.scoped("relighting a pose on the device", || {
@@ -392,40 +400,17 @@ impl Gpu {
                 let maps: Vec<Option<&SunDepth>> = depths.iter().map(Option::as_ref).collect();
                 self.ask_sun_maps(h, &maps)
             });
-            // The record: the maps' turns and weights, the suns and their maps.
-            let mut record: Vec<[f32; 4]> =
-                vec![[terms.len() as f32, taken.len() as f32, ground, 0.0]];
-            for ((t, part), (at, _, _)) in terms.iter().zip(&parts).zip(&tables) {
-                let less = match (part, at.less) {
-                    (Part::LessSuns, Some(l)) => l as f32,
-                    _ => -1.0,
-                };
-                record.push([at.whole as f32, less, at.coarse as f32, t.weight]);
-                let base = ((3.0 * PI + t.yaw as f64) / TAU).rem_euclid(1.0);
-                record.push([base as f32, t.yaw, 0.0, 0.0]);
-            }
-            for (s, ((term, j, sun), depth)) in taken.iter().zip(&depths).enumerate() {
-                let at = tables[*term].0.suns[*j];
-                record.push([at as f32, 0.0, terms[*term].weight, 0.0]);
-                let start = relight
-                    .sun_maps
-                    .as_ref()
-                    .and_then(|m| m.starts.get(s).copied().flatten());
-                let subject = sun.direction();
-                match (depth, start, hull.as_ref()) {
-                    (Some(m), Some(start), Some(h)) => {
-                        record.push(subject.extend(shadow_offset_m(h)).to_array());
-                        record.push(m.axes[0].extend(m.corner.x).to_array());
-                        record.push(m.axes[1].extend(m.corner.y).to_array());
-                        let [w, h] = m.size;
-                        record.push([m.texel, w as f32, h as f32, start as f32]);
-                    }
-                    _ => {
-                        record.push(subject.extend(0.0).to_array());
-                        record.extend([[0.0; 4]; 3]);
-                    }
-                }
-            }
+            let starts: Vec<Option<usize>> = (0..taken.len())
+                .map(|k| {
+                    (relight.sun_maps.as_ref()).and_then(|m| m.starts.get(k).copied().flatten())
+                })
+                .collect();
+            let record = light_record(
+                (terms, &parts, &tables),
+                (taken, &depths, &starts),
+                ground,
+                hull.as_deref(),
+            );
             if relight.turn.is_none() {
                 relight.turn = Some(self.turn_state(relight, source, light, coarse));
             }
@@ -490,4 +475,44 @@ impl Gpu {
                 .collect()
         })
     }
+}
+
+/// The record of a light (`turn_light.wgsl`'s `light`): per map of `terms` (its part, its
+/// table) its turn and weight; per sun taken its table's entry, its direction and, where
+/// it has a map of `hull` (at `starts` in the maps' scratch), the map.
+fn light_record(
+    (terms, parts, tables): (&[YawTerm], &[Part], &[HeldAt]),
+    (taken, depths, starts): (&[TakenSun], &[Option<SunDepth>], &[Option<usize>]),
+    ground: f32,
+    hull: Option<&VoxelHull>,
+) -> Vec<[f32; 4]> {
+    let mut record: Vec<[f32; 4]> = vec![[terms.len() as f32, taken.len() as f32, ground, 0.0]];
+    for ((t, part), (at, _, _)) in terms.iter().zip(parts).zip(tables) {
+        let less = match (part, at.less) {
+            (Part::LessSuns, Some(l)) => l as f32,
+            _ => -1.0,
+        };
+        record.push([at.whole as f32, less, at.coarse as f32, t.weight]);
+        let base = ((3.0 * PI + t.yaw as f64) / TAU).rem_euclid(1.0);
+        record.push([base as f32, t.yaw, 0.0, 0.0]);
+    }
+    for (((term, j, sun), depth), start) in taken.iter().zip(depths).zip(starts) {
+        let at = tables[*term].0.suns[*j];
+        record.push([at as f32, 0.0, terms[*term].weight, 0.0]);
+        let subject = sun.direction();
+        match (depth, start, hull) {
+            (Some(m), Some(start), Some(h)) => {
+                record.push(subject.extend(shadow_offset_m(h)).to_array());
+                record.push(m.axes[0].extend(m.corner.x).to_array());
+                record.push(m.axes[1].extend(m.corner.y).to_array());
+                let [w, h] = m.size;
+                record.push([m.texel, w as f32, h as f32, *start as f32]);
+            }
+            _ => {
+                record.push(subject.extend(0.0).to_array());
+                record.extend([[0.0; 4]; 3]);
+            }
+        }
+    }
+    record
 }
