@@ -261,3 +261,44 @@ fn readers_of_one_pose_share_its_hull_while_it_is_held() {
     let again = field.hull_shared(0).unwrap().unwrap();
     assert_eq!(Arc::strong_count(&again), 1);
 }
+
+/// A light that turns with a sun in the scene (issue 58): the sun's map is one yaw table
+/// turned by the lighting keys, as the sky's is, so a turning shot makes two tables
+/// whatever its frames (control: keyed by the turned sun, as before, it made one a frame,
+/// six here, and the GPU held every one of them), and the light does turn.
+#[test]
+fn a_turning_light_with_a_sun_reads_one_table_for_the_sun() {
+    let lighting = "[lighting]\nenv = \"uniform\"\nintensity = 0.35\n\
+        [[lighting.key]]\ntime = 0.0\nyaw_deg = 0.0\n\
+        [[lighting.key]]\ntime = 0.5\nyaw_deg = 90.0\n\
+        [lighting.sun]\nazimuth_deg = -90.0\nelevation_deg = 25.0\nilluminance = 12.0\n";
+    let walker = "[[instance]]\nposition = [0.0, 0.0, 0.0]\n";
+    let turning = scene(lighting, walker, 0.5);
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let all = turning
+        .shot_frames(0..turning.frame_times().len(), (64, 48))
+        .unwrap();
+    assert!(all.len() >= 5);
+    let options = ShotOptions {
+        memory_budget: 1 << 30,
+        planned: true,
+        traced_lights: 64,
+        detail: None,
+        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+        walker_shadows: true,
+    };
+    let mut shot = Shot::new(&turning, &field, device(), &all, options).unwrap();
+    let mut lit = Vec::new();
+    for f in &all {
+        lit.push(shot.render(f, false).unwrap().frame.composite);
+    }
+    assert!(
+        shot.counters().relights >= all.len() - 1,
+        "{:?}",
+        shot.counters()
+    );
+    assert_eq!(shot.counters().yaw_tables, 2, "{:?}", shot.counters());
+    // The light does turn: the first and last frames differ.
+    assert!(largest_difference(&lit[0], &lit[lit.len() - 1]) > 0.01);
+}

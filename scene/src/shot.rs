@@ -358,6 +358,8 @@ pub struct ShotCounters {
     pub reduced_reused: u64,
     /// (See `reduced_reused`.)
     pub reduced_made: u64,
+    /// Yaw tables made (one a map, and one for the scene's sun, whatever the turns).
+    pub yaw_tables: usize,
 }
 
 /// One rendered frame of a shot.
@@ -661,6 +663,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let projector = self.field.projector_shared()?.clone();
         let table = Arc::new(YawTable::new(projector, &map()?, self.scene.floor));
         self.tables.insert(key, table.clone());
+        self.counters.yaw_tables += 1;
         Ok(table)
     }
 
@@ -699,19 +702,20 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             EnvMap::mix(&maps.iter().map(|(e, w)| (e, *w)).collect::<Vec<_>>())?
         };
         let mut sun_term = None;
-        if let Some(sun) = &l.sun {
-            // The sun stays put in the scene frame while the maps turn: a map of its own,
-            // black but for it, of the world map's texels.
+        if let (Some(sun), Some(base)) = (&l.sun, self.scene.sun) {
+            // The scene's sun in a map of its own, black but for it, of the world map's
+            // texels: one table for the shot, turned and weighted as the lighting keys turn
+            // and scale it (`Scene::lighting_at`), so that a turning light reads one table
+            // (on the device, one held) instead of making one at each turn.
             let (w, h) = env.image().size();
-            let bits = LightingKey::of(l).sun;
-            let table = self.table(format!("sun {bits:?} {w}x{h}"), || {
+            let table = self.table(format!("sun {base:?} {w}x{h}"), || {
                 let black = EnvMap::from_image(RgbImage::new(w, h, [0.0; 3]))?;
-                Ok(sun.lit(&black)?)
+                Ok(base.lit(&black)?)
             })?;
             let term = YawTerm {
                 table,
-                weight: 1.0,
-                yaw: 0.0,
+                weight: l.intensity,
+                yaw: l.yaw,
             };
             terms.push(term.clone());
             sun_term = Some(term);
