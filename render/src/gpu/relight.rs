@@ -4,12 +4,13 @@
 //! A pose's basis codes are uploaded once ([`GpuBasis`], shared by every relit copy of
 //! the same views: walkers of other headings, the same walker under a new light). A
 //! light is then one dispatch pair per batch of views: the new coefficients written into
-//! the pose's own buffer, the weighted sum of the basis images, and its encoding into the
-//! pose's pre-lit layers with each view's peak as its scale, written by the GPU into the
-//! pose's view table. Nothing is uploaded again, nothing is read back and nothing waits:
-//! the dispatches of every pose relit between two frames go into one relight pass
-//! ([`super::deferred`]), after the one dispatch that made all their suns' maps
-//! ([`super::sun_depth`]), which [`Gpu::submit`] sends just ahead of the next frame.
+//! the pose's own buffer (by the host, or looked up by the device from the light's yaw
+//! tables, [`super::turn_light`]), the weighted sum of the basis images, and its encoding
+//! into the pose's pre-lit layers with each view's peak as its scale, written by the GPU
+//! into the pose's view table. Nothing is uploaded again, nothing is read back and
+//! nothing waits: the dispatches of every pose relit between two frames go into one
+//! relight pass ([`super::deferred`]), after the one dispatch that made all their suns'
+//! maps ([`super::sun_depth`]), which [`Gpu::submit`] sends just ahead of the next frame.
 
 use std::sync::Arc;
 
