@@ -795,25 +795,17 @@ fn walkers_whose_maps_outgrow_the_buffers_are_relit_as_on_the_cpu() {
     );
 }
 
-/// Pose 0's views' turntable angles (radians) of `field`.
-fn turntables_of(field: &FieldFile) -> Vec<f32> {
-    (field.header().pose(0).unwrap().views.iter())
-        .map(|v| v.turntable_deg.to_radians())
-        .collect()
-}
-
 /// `light` to relight pose 0 of `field` by on the device, the conditions `used` (`None`:
 /// all).
 fn on_device<'a>(
     light: &'a frf_reflectance::yaw_light::YawLight,
     field: &'a FieldFile,
-    turntables: &'a [f32],
     used: Option<&'a [bool]>,
 ) -> frf_render::gpu::turn_light::TurnedLight<'a> {
     frf_render::gpu::turn_light::TurnedLight {
         light,
         conditions: &field.header().conditions,
-        turntables,
+        pose: field.header().pose(0).unwrap(),
         used,
     }
 }
@@ -835,7 +827,7 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
     let h = field.header();
-    let turntables = turntables_of(&field);
+    let views = h.pose(0).unwrap().views.len();
     let projector = field.projector_shared().unwrap().clone();
     let sky = YawLight::of_env(projector.clone(), &EnvMap::sky(), FloorModel::Environment);
     let (low, _) = low_sun(130.0, 25.0);
@@ -870,8 +862,8 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     let plan_of = |used: Option<&[bool]>| {
         used.map(|u| frf_render::pose_plan::PosePlan {
             pose: 0,
-            views: vec![true; turntables.len()],
-            flows: vec![[true; 4]; turntables.len()],
+            views: vec![true; views],
+            flows: vec![[true; 4]; views],
             conditions: u.to_vec(),
             shadow_maps: false,
             hull: true,
@@ -883,7 +875,7 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     };
     for (what, light, used) in &cases {
         let plan = plan_of(*used);
-        let turned = on_device(light, &field, &turntables, *used);
+        let turned = on_device(light, &field, *used);
         let mut device = gpu.upload_pose(&first).unwrap();
         gpu.flush();
         assert!(gpu.relight_turned(&mut device, &first, &turned).unwrap());
@@ -917,7 +909,7 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     // Control: the pose as made (the sky unturned) is not what the last light relights.
     let made = gpu.upload_pose(&first).unwrap();
     let as_made = gpu.read_coefficients(&made).unwrap();
-    let turned = on_device(&cases[0].1, &field, &turntables, None);
+    let turned = on_device(&cases[0].1, &field, None);
     let mut device = gpu.upload_pose(&first).unwrap();
     gpu.relight_turned(&mut device, &first, &turned).unwrap();
     let looked_up = gpu.read_coefficients(&device).unwrap();
@@ -946,7 +938,6 @@ fn the_tables_on_the_device_are_bounded_and_stay_right() {
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
-    let turntables = turntables_of(&field);
     let projector = field.projector_shared().unwrap().clone();
     let first = fixture.source(&EnvMap::sky());
     let mut pose = gpu.upload_pose(&first).unwrap();
@@ -955,7 +946,7 @@ fn the_tables_on_the_device_are_bounded_and_stay_right() {
         // A map of its own each time: the sky brighter by a step.
         let env = EnvMap::sky().scaled(1.0 + 0.05 * k as f32);
         let light = YawLight::of_env(projector.clone(), &env, FloorModel::Environment);
-        let turned = on_device(&light, &field, &turntables, None);
+        let turned = on_device(&light, &field, None);
         gpu.flush();
         assert!(gpu.relight_turned(&mut pose, &first, &turned).unwrap());
         assert!(gpu.tables_held() <= 16, "{} tables held", gpu.tables_held());

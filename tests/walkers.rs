@@ -54,6 +54,18 @@ shadow = "maps"
     Scene::parse(Path::new("/walkers/scene.toml"), &text).unwrap()
 }
 
+/// A planned shot's options, a budget of 1 GiB.
+fn planned_options() -> ShotOptions {
+    ShotOptions {
+        memory_budget: 1 << 30,
+        planned: true,
+        traced_lights: 64,
+        detail: None,
+        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+        walker_shadows: true,
+    }
+}
+
 /// The frames of `scene` on the tiny field: composites and walker layers.
 fn frames(scene: &Scene) -> Vec<(Image<Rgba>, Image<Rgba>)> {
     let fixture = frf_testkit::tiny_field();
@@ -61,14 +73,7 @@ fn frames(scene: &Scene) -> Vec<(Image<Rgba>, Image<Rgba>)> {
     let all = scene
         .shot_frames(0..scene.frame_times().len(), (64, 48))
         .unwrap();
-    let options = ShotOptions {
-        memory_budget: 1 << 30,
-        planned: true,
-        traced_lights: 64,
-        detail: None,
-        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
-        walker_shadows: true,
-    };
+    let options = planned_options();
     let mut shot = Shot::new(scene, &field, device(), &all, options).unwrap();
     all.iter()
         .map(|f| {
@@ -280,14 +285,7 @@ fn a_turning_light_with_a_sun_reads_one_table_for_the_sun() {
         .shot_frames(0..turning.frame_times().len(), (64, 48))
         .unwrap();
     assert!(all.len() >= 5);
-    let options = ShotOptions {
-        memory_budget: 1 << 30,
-        planned: true,
-        traced_lights: 64,
-        detail: None,
-        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
-        walker_shadows: true,
-    };
+    let options = planned_options();
     let mut shot = Shot::new(&turning, &field, device(), &all, options).unwrap();
     let mut lit = Vec::new();
     for f in &all {

@@ -144,6 +144,15 @@ pub struct PoseRecord {
     pub pose_flows_to: Option<[Option<u32>; 2]>,
 }
 
+impl PoseRecord {
+    /// Per view, its turntable angle, radians (what turns the dome's light for it).
+    pub fn turntables(&self) -> Vec<f32> {
+        (self.views.iter())
+            .map(|v| v.turntable_deg.to_radians())
+            .collect()
+    }
+}
+
 /// The shadow maps of a field (docs/design.md section 2.4): their ground grid and the
 /// basis conditions they belong to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -348,14 +348,11 @@ impl Device {
     ) -> Result<()> {
         if let (ResidentKind::Gpu(pose), Device::Gpu(gpu)) = (&mut resident.kind, self) {
             let h = field.header();
-            let record = h.pose(resident.source.geometry.pose)?;
-            let turntables: Vec<f32> = (record.views.iter())
-                .map(|v| v.turntable_deg.to_radians())
-                .collect();
+
             let turned = TurnedLight {
                 light,
                 conditions: &h.conditions,
-                turntables: &turntables,
+                pose: h.pose(resident.source.geometry.pose)?,
                 used: plan.map(|p| p.conditions.as_slice()),
             };
             if gpu.relight_turned(pose, &resident.source, &turned)? {
@@ -507,10 +504,7 @@ impl Device {
     ) -> Result<FrameInFlight> {
         backdrop.cpu.check(camera)?;
         if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
-            let instances = walkers
-                .iter()
-                .map(Walker::gpu_instance)
-                .collect::<Result<Vec<_>>>()?;
+            let instances = gpu_instances(walkers)?;
             let pending = gpu.submit_composite(&instances, b, camera, variant, layers)?;
             return Ok(FrameInFlight::Gpu(pending));
         }
@@ -531,11 +525,7 @@ impl Device {
     ) -> Result<()> {
         backdrop.cpu.check(camera)?;
         if let (Device::Gpu(gpu), Some(b)) = (self, &backdrop.gpu) {
-            let instances = walkers
-                .iter()
-                .map(Walker::gpu_instance)
-                .collect::<Result<Vec<_>>>()?;
-            return gpu.draw_composite_unread(&instances, b, camera, variant);
+            return gpu.draw_composite_unread(&gpu_instances(walkers)?, b, camera, variant);
         }
         self.render_frame_cpu(walkers, backdrop, camera, variant, false)
             .map(drop)
@@ -653,6 +643,11 @@ impl Device {
 }
 
 /// The CPU reference's copy of a resident pose.
+/// The GPU's view of every walker of a frame ([`Walker::gpu_instance`]).
+fn gpu_instances<'a>(walkers: &[Walker<'a>]) -> Result<Vec<GpuInstanceRef<'a>>> {
+    walkers.iter().map(Walker::gpu_instance).collect()
+}
+
 fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
     match kind {
         ResidentKind::Cpu { pose, .. } => Ok(pose),

@@ -476,18 +476,10 @@ fn relighting<R: ReadAt>(
     let views = read.len();
     let mut suns = Vec::new();
     // Views not read keep angle 0 (their coefficients are never used).
-    let angles: Vec<f32> = record
-        .views
-        .iter()
-        .enumerate()
-        .map(|(i, v)| {
-            if read[i] {
-                v.turntable_deg.to_radians()
-            } else {
-                0.0
-            }
-        })
-        .collect();
+    let mut angles = record.turntables();
+    for (a, _) in angles.iter_mut().zip(read).filter(|(_, r)| !**r) {
+        *a = 0.0;
+    }
     // The views' coefficients and the ground's under a light read from its yaw tables;
     // where the views hold their normals, its suns apart, relit by them.
     let mut floor = Vec::new();

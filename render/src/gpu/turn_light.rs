@@ -15,7 +15,7 @@ use std::f64::consts::{PI, TAU};
 use std::sync::{Arc, Mutex};
 
 use frf_core::image::luminance;
-use frf_reflectance::field::ConditionRecord;
+use frf_reflectance::field::{ConditionRecord, PoseRecord};
 use frf_reflectance::floor_light::ground_weight;
 use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::light_fit::{RATIO_FLOOR, condition_lights};
@@ -109,8 +109,9 @@ pub struct TurnedLight<'a> {
     pub light: &'a YawLight,
     /// The field's conditions.
     pub conditions: &'a [ConditionRecord],
-    /// Per view of the pose, its turntable angle, radians.
-    pub turntables: &'a [f32],
+    /// The pose's record (its views' turntable angles), read when the pose is first relit
+    /// on the device.
+    pub pose: &'a PoseRecord,
     /// Per condition, whether the pose's plan uses it (`None`: all).
     pub used: Option<&'a [bool]>,
 }
@@ -250,6 +251,7 @@ impl Gpu {
         coarse: (u32, u32),
     ) -> TurnState {
         let storage = wgpu::BufferUsages::STORAGE;
+        let turntables = light.pose.turntables();
         let batches = relight
             .basis()
             .batch_jobs()
@@ -263,8 +265,7 @@ impl Gpu {
                         let job = GpuTurnJob {
                             coefficient_offset: offset,
                             tiles: scales.len() as u32,
-                            turn: (light.turntables.get(i).copied().unwrap_or(0.0) as f64 / TAU)
-                                as f32,
+                            turn: (turntables.get(i).copied().unwrap_or(0.0) as f64 / TAU) as f32,
                             normals: u32::from(
                                 source.normals.get(i).is_some_and(|n| !n.is_empty()),
                             ),
