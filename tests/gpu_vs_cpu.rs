@@ -221,9 +221,11 @@ fn a_request_the_gpu_refuses_is_returned_as_a_typed_error() {
 fn the_relit_shadow_and_the_composite_agree_with_the_cpu() {
     let Some(gpu) = gpu() else { return };
     let field = FieldFile::open(&frf_testkit::tiny_field().field).unwrap();
-    let maps = ShadowMaps::load(&field, 0)
-        .unwrap()
-        .expect("the fixture has shadow maps");
+    let maps = std::sync::Arc::new(
+        ShadowMaps::load(&field, 0)
+            .unwrap()
+            .expect("the fixture has shadow maps"),
+    );
     let source = tiny_source();
     let coefficients = source.ground_coefficients.clone().unwrap();
     let cpu_shadow = maps.relight(&coefficients);
@@ -252,10 +254,10 @@ fn the_relit_shadow_and_the_composite_agree_with_the_cpu() {
         ("none", Backdrop::None),
     ] {
         gpu_renderer
-            .set_scene(backdrop.clone(), SceneShadow::Maps(&maps))
+            .set_scene(backdrop.clone(), SceneShadow::Maps(maps.clone()))
             .unwrap();
         cpu_renderer
-            .set_scene(backdrop, SceneShadow::Maps(&maps))
+            .set_scene(backdrop, SceneShadow::Maps(maps.clone()))
             .unwrap();
         // The relit shadow: the same sums in the same order (measured: equal).
         let g = gpu_renderer.relit_shadow().unwrap().unwrap();

@@ -163,6 +163,23 @@ fn one_probe_is_the_scenes_map_and_two_mix_linearly() {
     assert!(largest_difference(&mixed[0].1, &plain[0].1) > 0.01);
 }
 
+/// The tiny stage's poses 0 and 1 with the flow between them, written into `dir`.
+fn two_pose_field(dir: &Path) -> std::path::PathBuf {
+    let mut config = frf_testkit::tiny_config();
+    config.poses = vec![0, 1];
+    let stage = frf_stage::Stage::new(config).unwrap();
+    let path = dir.join("two.frf");
+    let options = frf_eval::oracle::OracleOptions {
+        poses: vec![0, 1],
+        jpeg_quality: 95,
+        predict_flow: true,
+        shadows: None,
+        pose_flows: true,
+    };
+    frf_eval::oracle::write_oracle_field(&stage, &path, &options, &|_, _| {}).unwrap();
+    path
+}
+
 /// A walker drawn at reduced detail between two poses (issue 58): its motion views,
 /// made from the pose-to-pose flows of the captured images, hold at each reduced texel
 /// the motion full detail holds at the middle of its block, in metres; read at the
@@ -177,19 +194,7 @@ fn motion_at_reduced_detail_is_full_detail_s_at_each_block() {
     use glam::Vec2;
 
     let dir = tempfile::tempdir().unwrap();
-    let mut config = frf_testkit::tiny_config();
-    config.poses = vec![0, 1];
-    let stage = frf_stage::Stage::new(config).unwrap();
-    let path = dir.path().join("two.frf");
-    let options = frf_eval::oracle::OracleOptions {
-        poses: vec![0, 1],
-        jpeg_quality: 95,
-        predict_flow: true,
-        shadows: None,
-        pose_flows: true,
-    };
-    frf_eval::oracle::write_oracle_field(&stage, &path, &options, &|_, _| {}).unwrap();
-    let field = FieldFile::open(&path).unwrap();
+    let field = FieldFile::open(&two_pose_field(dir.path())).unwrap();
     let kept = ReducedViews::default();
     let motion = |level: u8| {
         let source =
@@ -299,4 +304,48 @@ fn a_turning_light_with_a_sun_reads_one_table_for_the_sun() {
     assert_eq!(shot.counters().yaw_tables, 2, "{:?}", shot.counters());
     // The light does turn: the first and last frames differ.
     assert!(largest_difference(&lit[0], &lit[lit.len() - 1]) > 0.01);
+}
+
+/// Walkers of one pose between two poses share its motion (issue 58, the first frame):
+/// the motion of views does not depend on their light, so a walker whose views another
+/// walker's copy holds takes that copy's motion (one made per pose and direction,
+/// whatever the walkers: control, before, one per walker); its shadow maps are read
+/// once, not once a walker.
+#[test]
+fn walkers_of_one_pose_share_its_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let field = FieldFile::open(&two_pose_field(dir.path())).unwrap();
+    // Three walkers facing three ways, whose frames after the first fall between the
+    // field's two poses.
+    let walkers = "[[instance]]\nposition = [-0.8, 0.0, 0.0]\nheading_deg = 0.0\n\
+        [[instance]]\nposition = [0.0, 0.0, 0.0]\nheading_deg = 120.0\n\
+        [[instance]]\nposition = [0.8, 0.0, 0.0]\nheading_deg = 240.0\n";
+    let scene = scene(SKY, walkers, 0.3);
+    let all = scene
+        .shot_frames(0..scene.frame_times().len(), (64, 48))
+        .unwrap();
+    let drawn = |walkers: usize| {
+        let options = ShotOptions {
+            planned: false,
+            ..planned_options()
+        };
+        let mut one = scene.clone();
+        one.instances.truncate(walkers);
+        let mut shot = Shot::new(&one, &field, device(), &all, options).unwrap();
+        let between = all
+            .iter()
+            .map(|f| shot.render(f, false).unwrap().between)
+            .filter(|b| b.iter().all(Option::is_some))
+            .count();
+        (between, shot.counters().clone())
+    };
+    let (between, one) = drawn(1);
+    let (_, three) = drawn(3);
+    assert!(between > 0, "no frame between poses");
+    assert!(one.motions_made >= 2, "{one:?}");
+    assert_eq!(three.poses_made_resident, 3 * one.poses_made_resident);
+    assert_eq!(three.motions_made, one.motions_made, "{three:?}");
+    // Their shadow maps (none in this field: looked for once a pose) read once a pose.
+    assert!(one.shadow_maps_read >= 1, "{one:?}");
+    assert_eq!(three.shadow_maps_read, one.shadow_maps_read, "{three:?}");
 }

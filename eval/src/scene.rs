@@ -132,7 +132,7 @@ pub fn score_scene<R: ReadAt>(
     progress: &dyn Progress,
 ) -> Result<SceneScore> {
     let backdrop = Backdrop::environment(env.clone(), ground);
-    let maps = ShadowMaps::load(field, pose)?;
+    let maps = ShadowMaps::load(field, pose)?.map(std::sync::Arc::new);
     // The ablation first: the environment's lights traced against the hull.
     let hull = field.hull(pose)?;
     let hull_iou = hull
@@ -153,7 +153,7 @@ pub fn score_scene<R: ReadAt>(
     let t = Instant::now();
     renderer.set_scene(
         backdrop.clone(),
-        maps.as_ref().map_or(SceneShadow::None, SceneShadow::Maps),
+        maps.clone().map_or(SceneShadow::None, SceneShadow::Maps),
     )?;
     let scene_seconds = t.elapsed().as_secs_f64();
     let relit = renderer.relit_shadow()?;

@@ -24,7 +24,7 @@ fn hull_shadow_and_composite_meet_their_bounds_against_the_truth() {
         .unwrap();
     let env = EnvMap::sky();
     let lights = env.median_cut(512);
-    let maps = ShadowMaps::load(&field, 0).unwrap().unwrap();
+    let maps = std::sync::Arc::new(ShadowMaps::load(&field, 0).unwrap().unwrap());
     let source = tiny.source(&env);
     let relit = maps.relight(source.ground_coefficients.as_ref().unwrap());
     let maps_error = shadow_error(&relit, &tiny.stage, 0, &lights);
@@ -68,7 +68,7 @@ fn hull_shadow_and_composite_meet_their_bounds_against_the_truth() {
     let mut renderer = Renderer::new(&source, None).unwrap();
     let backdrop = Backdrop::environment(env, GroundLook::Environment);
     renderer
-        .set_scene(backdrop.clone(), SceneShadow::Maps(&maps))
+        .set_scene(backdrop.clone(), SceneShadow::Maps(maps.clone()))
         .unwrap();
     let frame = renderer
         .render_frame(&camera, Variant::FourWay, false)

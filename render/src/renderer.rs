@@ -40,11 +40,12 @@ pub enum Device {
 
 /// Where a scene's shadow comes from.
 #[derive(Debug, Clone)]
-pub enum SceneShadow<'a> {
+pub enum SceneShadow {
     /// No shadow.
     None,
-    /// The pose's attenuation maps, relit with the lighting the pose was relit with.
-    Maps(&'a ShadowMaps),
+    /// The pose's attenuation maps, relit with the lighting the pose was relit with
+    /// (shared: every walker of a pose holds the same copy).
+    Maps(std::sync::Arc<ShadowMaps>),
     /// A relit shadow computed elsewhere (e.g. [`crate::shadow::traced_shadow`]).
     Relit(RelitShadow),
 }
@@ -68,8 +69,9 @@ pub struct Resident {
     /// The shadow maps it casts its shadow from, relit with it.
     shadow_maps: Option<std::sync::Arc<ShadowMaps>>,
     /// Its motion toward the next and the previous pose ([`frf_core::grid::PoseStep`]
-    /// order), when made ([`Device::set_motion`]).
-    motion: [Option<ResidentKind>; 2],
+    /// order), when made ([`Device::set_motion`]), or lent by another resident of the
+    /// same views ([`Resident::share_motion`]): it does not depend on the light.
+    motion: [Option<std::sync::Arc<ResidentKind>>; 2],
     ground_coefficients: Option<Vec<Rgb>>,
     shadow: bool,
     /// The pose.
@@ -77,24 +79,40 @@ pub struct Resident {
 }
 
 impl Resident {
-    /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy), its
-    /// shared basis codes left out ([`Resident::basis`]).
+    /// Bytes the pose holds where it is rendered (GPU memory, or the CPU's copy), what
+    /// it may share with other residents left out ([`Resident::shared`]).
     pub fn bytes(&self) -> u64 {
-        let bytes = |k: &ResidentKind| match k {
-            ResidentKind::Gpu(p) => p.geometry.resident_bytes(),
-            ResidentKind::Cpu { pose, .. } => pose.resident_bytes(),
-        };
-        bytes(&self.kind) + self.motion.iter().flatten().map(bytes).sum::<u64>()
+        kind_bytes(&self.kind)
     }
 
-    /// Its basis codes, which residents made from the same views share: an identity
-    /// (equal for those that share them) and the bytes they hold where it is rendered.
-    pub fn basis(&self) -> (usize, u64) {
+    /// What it may share with residents made from the same views, each as an identity
+    /// (equal for those that share it) and the bytes it holds where it is rendered: its
+    /// basis codes, and its motion toward each neighbouring pose that it holds.
+    pub fn shared(&self) -> Vec<(usize, u64)> {
         let id = std::sync::Arc::as_ptr(&self.source.basis) as usize;
-        match &self.kind {
+        let basis = match &self.kind {
             ResidentKind::Gpu(p) => (id, p.basis().map_or(0, |b| b.bytes())),
             ResidentKind::Cpu { .. } => (id, self.source.basis_bytes()),
+        };
+        let motion = self.motion.iter().flatten();
+        std::iter::once(basis)
+            .chain(motion.map(|m| (std::sync::Arc::as_ptr(m) as usize, kind_bytes(m))))
+            .collect()
+    }
+
+    /// Takes the motion `other` holds toward each neighbouring pose where it holds none
+    /// and `other` was made from the same views (the motion is the views' own, whatever
+    /// their light): shared, not made or uploaded again. Whether it then holds each
+    /// ([`frf_core::grid::PoseStep`] order).
+    pub fn share_motion(&mut self, other: &Resident) -> [bool; 2] {
+        if std::sync::Arc::ptr_eq(&self.source.basis, &other.source.basis) {
+            for (mine, theirs) in self.motion.iter_mut().zip(&other.motion) {
+                if mine.is_none() {
+                    mine.clone_from(theirs);
+                }
+            }
         }
+        [0, 1].map(|k| self.motion[k].is_some())
     }
 
     /// The views it was made from, with the coefficients of its current light.
@@ -185,8 +203,8 @@ impl<'a> Walker<'a> {
             };
             i.between = Some(GpuBetween {
                 after: gpu(Some(&after.kind), PoseStep::Next)?,
-                before_motion: gpu(self.resident.motion[0].as_ref(), PoseStep::Next)?,
-                after_motion: gpu(after.motion[1].as_ref(), PoseStep::Prev)?,
+                before_motion: gpu(self.resident.motion[0].as_deref(), PoseStep::Next)?,
+                after_motion: gpu(after.motion[1].as_deref(), PoseStep::Prev)?,
                 s,
             });
         }
@@ -327,7 +345,7 @@ impl Device {
         resident.source = source.clone();
         resident.ground_coefficients = source.ground_coefficients.clone();
         if let Some(maps) = resident.shadow_maps.clone() {
-            self.set_shadow(resident, SceneShadow::Maps(&maps))?;
+            self.set_shadow(resident, SceneShadow::Maps(maps))?;
         }
         Ok(())
     }
@@ -358,7 +376,7 @@ impl Device {
             if gpu.relight_turned(pose, &resident.source, &turned)? {
                 resident.ground_coefficients = Some(light.ground(h.conditions.len())?);
                 if let Some(maps) = resident.shadow_maps.clone() {
-                    self.set_shadow(resident, SceneShadow::Maps(&maps))?;
+                    self.set_shadow(resident, SceneShadow::Maps(maps))?;
                 }
                 return Ok(());
             }
@@ -369,23 +387,23 @@ impl Device {
     }
 
     /// Sets the motion `resident` carries toward its next and previous poses
-    /// ([`frf_core::grid::PoseStep`] order; [`crate::motion::pose_motion`]).
+    /// ([`frf_core::grid::PoseStep`] order; [`crate::motion::pose_motion`]); a `None`
+    /// leaves what it holds toward that pose.
     pub fn set_motion(
         &self,
         resident: &mut Resident,
         motion: [Option<ResidentPose>; 2],
     ) -> Result<()> {
         for (slot, m) in resident.motion.iter_mut().zip(motion) {
-            *slot = match (m, self) {
-                (None, _) => None,
-                (Some(m), Device::Gpu(gpu)) => {
-                    Some(ResidentKind::Gpu(Box::new(gpu.upload_motion(&m)?)))
-                }
-                (Some(m), Device::Cpu) => Some(ResidentKind::Cpu {
+            let made = match (m, self) {
+                (None, _) => continue,
+                (Some(m), Device::Gpu(gpu)) => ResidentKind::Gpu(Box::new(gpu.upload_motion(&m)?)),
+                (Some(m), Device::Cpu) => ResidentKind::Cpu {
                     pose: Box::new(m),
                     shadow: None,
-                }),
+                },
             };
+            *slot = Some(std::sync::Arc::new(made));
         }
         Ok(())
     }
@@ -404,16 +422,13 @@ impl Device {
         let coefficients = resident.ground_coefficients.clone().unwrap_or_default();
         let cast = !matches!(shadow, SceneShadow::None);
         resident.shadow_maps = match &shadow {
-            SceneShadow::Maps(m) => match &resident.shadow_maps {
-                Some(kept) if std::ptr::eq(&**kept, *m) => Some(kept.clone()),
-                _ => Some(std::sync::Arc::new((*m).clone())),
-            },
+            SceneShadow::Maps(m) => Some(m.clone()),
             _ => None,
         };
         match (&mut resident.kind, self) {
             (ResidentKind::Gpu(pose), Device::Gpu(gpu)) => match shadow {
                 // The GPU relights the maps itself (tested against the CPU's).
-                SceneShadow::Maps(m) => gpu.set_shadow(pose, m, &coefficients)?,
+                SceneShadow::Maps(m) => gpu.set_shadow(pose, &m, &coefficients)?,
                 SceneShadow::Relit(r) => gpu.upload_shadow(pose, &r)?,
                 SceneShadow::None => pose.clear_shadow(),
             },
@@ -594,7 +609,7 @@ impl Device {
                             PoseStep::Next => &w.resident.motion[0],
                             PoseStep::Prev => &after.motion[1],
                         };
-                        m.as_ref().ok_or_else(|| no_motion(step))
+                        m.as_deref().ok_or_else(|| no_motion(step))
                     });
                     let after_img = render(cpu_pose(&after.kind)?, &seen).0;
                     let before_motion = render(cpu_pose(next?)?, &seen).0;
@@ -642,12 +657,20 @@ impl Device {
     }
 }
 
-/// The CPU reference's copy of a resident pose.
 /// The GPU's view of every walker of a frame ([`Walker::gpu_instance`]).
 fn gpu_instances<'a>(walkers: &[Walker<'a>]) -> Result<Vec<GpuInstanceRef<'a>>> {
     walkers.iter().map(Walker::gpu_instance).collect()
 }
 
+/// Bytes `kind` holds where it is rendered.
+fn kind_bytes(kind: &ResidentKind) -> u64 {
+    match kind {
+        ResidentKind::Gpu(p) => p.geometry.resident_bytes(),
+        ResidentKind::Cpu { pose, .. } => pose.resident_bytes(),
+    }
+}
+
+/// The CPU reference's copy of a resident pose.
 fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
     match kind {
         ResidentKind::Cpu { pose, .. } => Ok(pose),

@@ -16,6 +16,7 @@
 use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use frf_core::env::{EnvMap, EnvSource};
@@ -142,21 +143,25 @@ fn covers(have: &Option<PosePlan>, want: Option<&PosePlan>) -> bool {
     }
 }
 
-/// Bytes the cache's residents hold: each its own, and their basis codes once for those
-/// that share them.
+/// Bytes the cache's residents hold: each its own, and what they share (basis codes,
+/// motion) once for those that share it.
 fn cache_bytes(cache: &[Cached]) -> u64 {
     let mut seen: Vec<usize> = Vec::new();
     let mut total = 0;
     for c in cache {
         total += c.bytes;
-        let (id, bytes) = c.basis;
-        if !seen.contains(&id) {
-            seen.push(id);
-            total += bytes;
+        for &(id, bytes) in &c.shared {
+            if !seen.contains(&id) {
+                seen.push(id);
+                total += bytes;
+            }
         }
     }
     total
 }
+
+/// Shadow maps by pose and level of detail (`None`: the field holds none for the pose).
+type KeptMaps = HashMap<(u32, u8), Option<Arc<ShadowMaps>>>;
 
 /// A walker's cache slot in a frame, and between two poses the later pose's slot and the
 /// fraction of the way to it.
@@ -328,10 +333,10 @@ struct Cached {
     plan: Option<PosePlan>,
     lighting: LightingKey,
     resident: Resident,
-    /// The resident's own bytes, and its basis codes' identity and bytes
-    /// ([`Resident::basis`]), measured when made or relit.
+    /// The resident's own bytes, and what it shares with residents of the same views
+    /// (identities and bytes, [`Resident::shared`]), measured when made or relit.
     bytes: u64,
-    basis: (usize, u64),
+    shared: Vec<(usize, u64)>,
     last_frame: usize,
 }
 
@@ -360,6 +365,12 @@ pub struct ShotCounters {
     pub reduced_made: u64,
     /// Yaw tables made (one a map, and one for the scene's sun, whatever the turns).
     pub yaw_tables: usize,
+    /// Poses' motion toward a neighbouring pose made ([`pose_motion`]); a walker whose
+    /// views another walker's copy holds shares that copy's instead.
+    pub motions_made: usize,
+    /// Times a pose's shadow maps were read from the field (once a pose and level of
+    /// detail: every walker of it shares the copy read).
+    pub shadow_maps_read: usize,
 }
 
 /// One rendered frame of a shot.
@@ -441,6 +452,11 @@ pub struct Shot<'a, R: ReadAt> {
     own_light: Vec<bool>,
     /// The visual hulls read so far (the walkers in the way of another's suns), by pose.
     hulls: HashMap<u32, Option<Arc<VoxelHull>>>,
+    /// The shadow maps read so far, by pose and level of detail: every walker of a pose
+    /// shares one copy.
+    shadow_maps: std::sync::Mutex<KeptMaps>,
+    /// How many times shadow maps were read from the field.
+    maps_read: AtomicUsize,
 }
 
 impl<'a, R: ReadAt> Shot<'a, R> {
@@ -543,6 +559,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             held_light,
             own_light,
             hulls: HashMap::new(),
+            shadow_maps: Default::default(),
+            maps_read: AtomicUsize::new(0),
         })
     }
 
@@ -1127,7 +1145,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     let c = &mut self.cache[k];
                     c.lighting = key.clone();
                     // Codes let go of are uploaded again to relight.
-                    (c.bytes, c.basis) = (c.resident.bytes(), c.resident.basis());
+                    (c.bytes, c.shared) = (c.resident.bytes(), c.resident.shared());
                     k
                 }
                 None => {
@@ -1139,7 +1157,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         .cache
                         .iter()
                         .position(|c| c.pose == pose && covers(&c.plan, wanted.as_ref()));
-                    let resident = self.make_resident(pose, light, world, wanted.as_ref(), like)?;
+                    let (resident, motions) =
+                        self.make_resident(pose, light, world, wanted.as_ref(), like)?;
+                    self.counters.motions_made += motions;
+                    self.counters.shadow_maps_read = self.maps_read.load(Ordering::Relaxed);
                     self.counters.residency_seconds += t.elapsed().as_secs_f64();
                     (
                         self.counters.basis_views_reused,
@@ -1156,7 +1177,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                         plan: wanted,
                         lighting: key.clone(),
                         bytes: resident.bytes(),
-                        basis: resident.basis(),
+                        shared: resident.shared(),
                         resident,
                         last_frame: fp.index,
                     });
@@ -1238,6 +1259,18 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let h = self.field.hull_shared(pose)?;
         self.hulls.insert(pose, h.clone());
         Ok(h)
+    }
+
+    /// The shadow maps of pose `pose` reduced to `level`, read once.
+    fn shadow_maps(&self, pose: u32, level: u8) -> Result<Option<Arc<ShadowMaps>>> {
+        let mut kept = self.shadow_maps.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(maps) = kept.get(&(pose, level)) {
+            return Ok(maps.clone());
+        }
+        self.maps_read.fetch_add(1, Ordering::Relaxed);
+        let maps = ShadowMaps::load(self.field, pose)?.map(|m| Arc::new(m.reduced(level)));
+        kept.insert((pose, level), maps.clone());
+        Ok(maps)
     }
 
     /// What walker `walker` needs of pose `pose` when the shot is planned (`None`:
@@ -1337,7 +1370,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
     /// Reads pose `pose` as `plan` says (everything when `None`), relights it for a walker
     /// of `heading` under the scene frame's lighting `world`, and sets its shadow. With
     /// `like` (a cache entry of the same pose whose plan covers `plan`), its views are
-    /// taken from there, basis codes shared, instead of being read again.
+    /// taken from there, basis codes and motion shared, instead of being read again. The
+    /// resident, and how many motions toward a neighbouring pose were made for it.
     fn make_resident(
         &self,
         pose: u32,
@@ -1345,7 +1379,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         world: Option<&World>,
         plan: Option<&PosePlan>,
         like: Option<usize>,
-    ) -> Result<Resident> {
+    ) -> Result<(Resident, usize)> {
         let lighting = self.walker_lighting(light, world);
         let level = self
             .options
@@ -1367,29 +1401,32 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         if self.held_light {
             self.device.release_basis(&mut resident);
         }
+        let mut made = 0;
         if self.plan.interpolate == TimeInterpolation::Flow {
+            // The motion of views another walker's copy holds is shared, not made again.
+            let held = like.map_or([false; 2], |l| resident.share_motion(l));
             let motion = PoseStep::ALL.map(|step| {
                 let wanted = match plan {
                     Some(p) => p.pose_flows[step.index()],
                     None => true,
                 };
-                wanted.then(|| pose_motion(self.field, &source, step))
+                (wanted && !held[step.index()]).then(|| pose_motion(self.field, &source, step))
             });
             let [next, prev] = motion;
             let motion = [next.transpose()?.flatten(), prev.transpose()?.flatten()];
+            made = motion.iter().flatten().count();
             self.device.set_motion(&mut resident, motion)?;
         }
         let wants = |planned: bool| if self.options.planned { planned } else { true };
         match self.scene.shadow {
             ShadowSpec::Maps if wants(plan.is_some_and(|p| p.shadow_maps)) => {
-                if let Some(maps) = ShadowMaps::load(self.field, pose)? {
-                    let level = self
-                        .options
-                        .detail
-                        .unwrap_or_else(|| plan.map_or(0, |p| p.shadow_level));
-                    let maps = maps.reduced(level);
+                let level = self
+                    .options
+                    .detail
+                    .unwrap_or_else(|| plan.map_or(0, |p| p.shadow_level));
+                if let Some(maps) = self.shadow_maps(pose, level)? {
                     self.device
-                        .set_shadow(&mut resident, SceneShadow::Maps(&maps))?;
+                        .set_shadow(&mut resident, SceneShadow::Maps(maps))?;
                 }
             }
             ShadowSpec::Traced if wants(plan.is_some_and(|p| p.hull)) => {
@@ -1400,7 +1437,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             }
             _ => {}
         }
-        Ok(resident)
+        Ok((resident, made))
     }
 
     /// Drops the least recently used poses the current frame does not draw until the
