@@ -3,7 +3,8 @@
 //! where it stands), each copy turned by the golden angle from the last so that every
 //! walker is relit for a heading of its own (the costly case: walkers of one heading
 //! share one relit pose). The lighting is held (`constant`) or turned 15° a frame
-//! (`turning`). The walkers stand (`standing`) or walk (`walking`: each from its place
+//! (`turning`; `--turn-deg` sets the turn: a light turning slower than the shot's light
+//! tolerance relights a walker every few frames, [`crate::shot::LightTolerance`]). The walkers stand (`standing`) or walk (`walking`: each from its place
 //! along a bend of [`BEND_RADIUS_M`] at the field's gait speed (else
 //! [`WALK_SPEED_MPS`]), turning as it goes, so every walker's own light changes every
 //! frame; its walk plays as fast as a standing walker's). The frames are spaced ([`Spacing`]) a millisecond of the scene's time
@@ -50,8 +51,8 @@ use frf_core::BadArgument;
 /// Seconds of the scene's time between two counted frames.
 const FRAME_STEP_S: f64 = 1e-3;
 
-/// Degrees a turning light turns a frame.
-const TURN_DEG_PER_FRAME: f32 = 15.0;
+/// Degrees a turning light turns a frame, unless told otherwise.
+pub const TURN_DEG_PER_FRAME: f32 = 15.0;
 
 /// Metres between walkers on the grid.
 const SPACING_M: f32 = 1.2;
@@ -122,6 +123,8 @@ pub struct FrameBenchOptions {
     pub walkers: Vec<usize>,
     /// Lightings.
     pub lights: Vec<LightMode>,
+    /// Degrees a turning light turns a frame.
+    pub turn_deg: f32,
     /// Standing, walking, or both.
     pub motions: Vec<Motion>,
     /// Frames counted per row (after one not counted).
@@ -144,6 +147,11 @@ impl FrameBenchOptions {
         }
         if self.walkers.is_empty() {
             return Err(BadArgument::new("--walkers", "(none)", "at least one count").into());
+        }
+        if !(self.turn_deg > 0.0 && self.turn_deg <= 180.0) {
+            return Err(
+                BadArgument::new("--turn-deg", self.turn_deg, "above 0 to 180 degrees").into(),
+            );
         }
         if self.frames == 0 || self.frames > 10_000 {
             return Err(BadArgument::new("--frames", self.frames, "1 to 10000 frames").into());
@@ -201,6 +209,11 @@ pub struct FrameBenchReport {
     pub pass_clock: &'static str,
     /// How far apart the counted frames were.
     pub spacing: Spacing,
+    /// Degrees the turning light turned a frame.
+    pub turn_deg_per_frame: f32,
+    /// Degrees a walker's light could turn before its poses were relit
+    /// ([`crate::shot::LightTolerance`]).
+    pub light_tolerance_deg: f32,
     /// Whether each frame's pixels were read back (else each frame was waited for
     /// where it was drawn).
     pub readback: bool,
@@ -225,9 +238,14 @@ impl FrameBenchReport {
             "not read back"
         };
         let mut out = format!(
-            "{} at {}x{}, {} frames a row, {spacing}, {readback} (medians; gpu = fenced \
-             wait on the device)\n",
-            self.device, self.size.0, self.size.1, self.frames
+            "{} at {}x{}, {} frames a row, {spacing}, {readback}, a turning light {}° a \
+             frame, relit past {}° (medians; gpu = fenced wait on the device)\n",
+            self.device,
+            self.size.0,
+            self.size.1,
+            self.frames,
+            self.turn_deg_per_frame,
+            self.light_tolerance_deg
         );
         out += "walkers  light     motion     host ms (relighting, submit)  gpu ms  wall ms  \
                 relit/frame  peak MB  first ms\n";
@@ -318,11 +336,12 @@ impl FrameBenchReport {
 }
 
 /// `scene` with its first walker copied `n` times on a grid, standing or walking as
-/// `motion` says, lit as `light` says for `frames` frames from its start.
+/// `motion` says, lit as `light` says (turning `turn_deg` a frame) for `frames` frames
+/// from its start.
 pub fn bench_scene(
     scene: &Scene,
     n: usize,
-    (light, motion, speed): (LightMode, Motion, f32),
+    (light, turn_deg, motion, speed): (LightMode, f32, Motion, f32),
     (frames, spacing): (usize, Spacing),
 ) -> Scene {
     let mut s = scene.clone();
@@ -370,7 +389,7 @@ pub fn bench_scene(
             },
             LightKey {
                 time: s.end,
-                yaw: key.yaw + (TURN_DEG_PER_FRAME * (frames + 1) as f32).to_radians(),
+                yaw: key.yaw + (turn_deg * (frames + 1) as f32).to_radians(),
                 ..key
             },
         ],
@@ -416,7 +435,7 @@ pub fn run_frame_bench<R: ReadAt>(
             let s = bench_scene(
                 scene,
                 n,
-                (light, motion, speed),
+                (light, options.turn_deg, motion, speed),
                 (options.frames, options.spacing),
             );
             let frames = s.shot_frames(0..options.frames + 1, options.size)?;
@@ -492,6 +511,8 @@ pub fn run_frame_bench<R: ReadAt>(
         gpu_clock: "fenced-wall",
         pass_clock,
         spacing: options.spacing,
+        turn_deg_per_frame: options.turn_deg,
+        light_tolerance_deg: options.shot.light_tolerance.heading.to_degrees(),
         readback: options.readback,
         size: options.size,
         frames: options.frames,

@@ -75,10 +75,12 @@ pub struct ShotOptions {
 /// How far a walker's own light (its heading, the probes' weights where it stands) may
 /// move from the one its resident poses were relit for before they are relit: a walker
 /// that turns or walks between probes is then relit every few frames rather than every
-/// frame. Zero relights at every change (exact).
+/// frame. A light that turns (its lighting keys' yaw) turns every walker's light alike, by
+/// the same turn relative to it as the walker's own turn the other way: the tolerance on
+/// heading holds for the two together. Zero relights at every change (exact).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct LightTolerance {
-    /// Radians of heading.
+    /// Radians of heading, the walker's relative to the light's yaw.
     pub heading: f32,
     /// Of any probe's weight.
     pub weight: f32,
@@ -106,13 +108,15 @@ impl LightTolerance {
     /// Whether poses relit for `lit` still serve a walker whose light is `now` (the
     /// walkers in the way of its suns where they were, [`OCCLUDER_STEP_M`]).
     fn holds(&self, lit: &WalkerLight, now: &WalkerLight) -> bool {
-        if lit.key == now.key {
+        if lit.key == now.key && lit.yaw == now.yaw {
             return true;
         }
         if lit.occluder_key != now.occluder_key {
             return false;
         }
-        let turn = (now.heading - lit.heading + std::f32::consts::PI)
+        // The light's turn relative to the walker, since it was relit.
+        let relative = |l: &WalkerLight| l.yaw - l.heading;
+        let turn = (relative(now) - relative(lit) + std::f32::consts::PI)
             .rem_euclid(std::f32::consts::TAU)
             - std::f32::consts::PI;
         let weight =
@@ -178,6 +182,14 @@ struct LightingKey {
 }
 
 impl LightingKey {
+    /// Whether `other` is this lighting turned (only its yaw, and so its sun's direction,
+    /// differ): what a walker's light tolerance may hold ([`LightTolerance`]).
+    fn turned_alike(&self, other: &Self) -> bool {
+        self.maps == other.maps
+            && self.intensity == other.intensity
+            && self.sun.is_some() == other.sun.is_some()
+    }
+
     fn of(l: &LightingAt) -> Self {
         Self {
             maps: l
@@ -223,6 +235,9 @@ struct ProbeLights {
 #[derive(Debug, Clone)]
 struct WalkerLight {
     heading: f32,
+    /// The lighting's yaw at the frame (radians): the walker is lit by it turned by
+    /// `yaw − heading`.
+    yaw: f32,
     weights: Vec<(usize, f32)>,
     key: Vec<u32>,
     /// The other walkers in the way of its suns, in its frame ([`Occluder`]), and where
@@ -240,13 +255,14 @@ pub const OCCLUDER_STEP_M: f32 = 0.02;
 pub const OCCLUDER_STEP_RAD: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
 impl WalkerLight {
-    fn new(heading: f32, weights: Vec<(usize, f32)>) -> Self {
+    fn new(heading: f32, yaw: f32, weights: Vec<(usize, f32)>) -> Self {
         let mut key = vec![heading.to_bits()];
         for &(k, w) in &weights {
             key.extend([k as u32, w.to_bits()]);
         }
         Self {
             heading,
+            yaw,
             weights,
             key,
             occluders: Vec::new(),
@@ -1124,7 +1140,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .or_else(|| self.cache.iter().position(serves));
             let slot = match found {
                 Some(k)
-                    if self.cache[k].lighting == key
+                    if self.cache[k].lighting.turned_alike(&key)
                         && self
                             .options
                             .light_tolerance
@@ -1226,9 +1242,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let n = self.scene.instances.len();
         let placements: Vec<Placement> = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
         let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
+        let yaw = self.scene.lighting_at(fp.time).yaw;
         let mut lights = Vec::with_capacity(n);
         for (i, here) in placements.iter().enumerate() {
-            let mut light = WalkerLight::new(here.heading, self.scene.probe_weights(i, fp.time));
+            let weights = self.scene.probe_weights(i, fp.time);
+            let mut light = WalkerLight::new(here.heading, yaw, weights);
             let subject_from_world = here.world_from_subject().inverse();
             for (j, there) in placements.iter().enumerate() {
                 let shades = self.options.walker_shadows && j != i;

@@ -43,7 +43,7 @@ enum BenchCommand {
 enum LightArg {
     /// The scene's first lighting key, held.
     Constant,
-    /// Turned 15 degrees a frame.
+    /// Turned 15 degrees a frame (`--turn-deg`).
     Turning,
     /// Both.
     Both,
@@ -63,6 +63,14 @@ struct FrameArgs {
     /// Lightings timed.
     #[arg(long, value_enum, default_value = "both")]
     light: LightArg,
+    /// Degrees a turning light turns a frame (a light turning less than the shots' light
+    /// tolerance, 2°, relights each walker every few frames).
+    #[arg(long, default_value_t = frf_scene::bench_frame::TURN_DEG_PER_FRAME)]
+    turn_deg: f32,
+    /// How far a walker's light may turn before its poses are relit, as `frf render
+    /// --light-tolerance` (default: the renderer's; `0` relights every change).
+    #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
+    light_tolerance: Option<frf_scene::shot::LightTolerance>,
     /// Walkers standing, walking a bend (their own light changes every frame), or both.
     #[arg(long, value_enum, default_value = "standing")]
     motion: MotionArg,
@@ -191,6 +199,7 @@ fn frame(args: FrameArgs) -> CliResult {
             LightArg::Turning => vec![LightMode::Turning],
             LightArg::Both => vec![LightMode::Constant, LightMode::Turning],
         },
+        turn_deg: args.turn_deg,
         motions: match args.motion {
             MotionArg::Standing => vec![Motion::Standing],
             MotionArg::Walking => vec![Motion::Walking],
@@ -207,7 +216,9 @@ fn frame(args: FrameArgs) -> CliResult {
             planned: true,
             traced_lights: 256,
             detail: None,
-            light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+            light_tolerance: args
+                .light_tolerance
+                .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
             walker_shadows: true,
         },
         readback: !args.no_readback,

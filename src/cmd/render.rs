@@ -114,9 +114,10 @@ pub struct RenderArgs {
     /// leave first).
     #[arg(long, default_value_t = DEFAULT_BUDGET_MB, value_parser = clap::value_parser!(u64).range(1..))]
     pub memory_budget: u64,
-    /// How far a walker's own light (its heading, degrees; the probes' weights where it
-    /// stands) may move before its poses are relit: `DEG` or `DEG,WEIGHT` (default: the
-    /// renderer's, `frf_scene::shot::LightTolerance::DEFAULT`; `0` relights every change).
+    /// How far a walker's own light (its heading relative to the light's yaw, degrees;
+    /// the probes' weights where it stands) may move before its poses are relit: `DEG` or
+    /// `DEG,WEIGHT` (default: the renderer's, `frf_scene::shot::LightTolerance::DEFAULT`;
+    /// `0` relights every change).
     #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
     #[serde(skip)]
     pub light_tolerance: Option<frf_scene::shot::LightTolerance>,

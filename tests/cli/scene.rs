@@ -867,6 +867,31 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
+    // A light turning 1° a frame, within the shot's light tolerance (2°): the walker is
+    // relit every third frame, not every frame (a light's turn relative to a walker is
+    // held to the tolerance a walker's own turn is).
+    let mut slow = vec![
+        "bench",
+        "frame",
+        scene.to_str().unwrap(),
+        "--walkers",
+        "1",
+        "--light",
+        "turning",
+        "--turn-deg",
+        "1",
+        "--frames",
+        "6",
+        "--json",
+    ];
+    slow.extend(gpu_flag());
+    let slow: serde_json::Value = serde_json::from_slice(&ok(&slow).stdout).unwrap();
+    assert_eq!(slow["turn_deg_per_frame"], 1.0, "{slow}");
+    let relit = slow["rows"][0]["relights_per_frame"].as_f64().unwrap();
+    assert!(relit > 0.0 && relit <= 0.5, "{slow}");
+    let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--turn-deg", "0"]);
+    assert!(!bad.status.success());
+    assert!(stderr(&bad).contains("--turn-deg 0"), "{}", stderr(&bad));
     if gpu_flag().is_none() {
         // More walkers than the device's array textures hold: refused up front, by name,
         // before any pose is read (it panicked in wgpu, issue 48).
