@@ -59,9 +59,10 @@ for build in base new; do
     $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 1920x1080 \
       --walkers 1,100,400 --light both --frames 6 --no-readback --json \
       > "$OUT/frame_unread.json" 2> "$OUT/frame_unread.log"
-    # The 40-walker scene at 640x360 (turning over constant, first frame).
+    # The 40-walker scene at 640x360 (turning over constant, first frame), its light
+    # turning as the did (180° over 3 s at 30 fps: 2° a frame).
     $F bench frame "$W/crowd.toml" --field "$W/small.frf" --size 640x360 \
-      --walkers 40 --light both --frames 6 --spacing shot --json \
+      --walkers 40 --light both --turn-deg 2 --frames 6 --spacing shot --json \
       > "$OUT/frame_640.json" 2> "$OUT/frame_640.log"
   fi
 done
