@@ -50,19 +50,36 @@ fn can_view() -> bool {
 
 /// Runs `sh -c script` under a fresh Xvfb display, `$FRF` the binary. The script starts
 /// once the display answers; a display that never did (a server that lost a race for
-/// its number on a shared machine, seen once in CI) is tried again on a new one.
+/// its number on a shared machine, seen once in CI) is tried again on a new one. The
+/// status is the script's own: xvfb-run replaces it with 5 when it fails to remove its
+/// own temporary directory afterwards (seen once on this machine), so the script says
+/// its status on its last line of stderr.
 fn under_xvfb(script: &str) -> Output {
+    use std::os::unix::process::ExitStatusExt;
+
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let ready = "for i in $(seq 50); do xdotool getdisplaygeometry >/dev/null 2>&1 && break; \
                  sleep 0.2; done\n";
+    const SAID: &str = "under-xvfb status ";
     let run = || {
-        Command::new("xvfb-run")
+        let mut o = Command::new("xvfb-run")
             .args(["-a", "-s", "-screen 0 800x600x24", "sh", "-c"])
-            .arg(format!("{ready}{script}"))
+            .arg(format!(
+                "{ready}{script}\nstatus=$?\necho \"{SAID}$status\" >&2\nexit $status"
+            ))
             .env("FRF", env!("CARGO_BIN_EXE_frf"))
             .env("XDG_RUNTIME_DIR", std::env::temp_dir())
             .output()
-            .unwrap()
+            .unwrap();
+        let said = stderr(&o);
+        let own = (said.lines())
+            .filter_map(|l| l.strip_prefix(SAID))
+            .last()
+            .and_then(|c| c.trim().parse::<i32>().ok());
+        if let Some(code) = own {
+            o.status = std::process::ExitStatus::from_raw(code << 8);
+        }
+        o
     };
     let first = run();
     if stderr(&first).contains("no display to open a window on") {
