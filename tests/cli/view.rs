@@ -73,8 +73,8 @@ fn under_xvfb(script: &str) -> Output {
             .unwrap();
         let said = stderr(&o);
         let own = (said.lines())
-            .filter_map(|l| l.strip_prefix(SAID))
-            .last()
+            .rev()
+            .find_map(|l| l.strip_prefix(SAID))
             .and_then(|c| c.trim().parse::<i32>().ok());
         if let Some(code) = own {
             o.status = std::process::ExitStatus::from_raw(code << 8);
