@@ -44,6 +44,7 @@ pub mod sun_depth;
 pub mod time_morph;
 pub mod timing;
 pub mod turn_light;
+mod uploads;
 
 use crate::error::{RenderError, Result};
 
@@ -88,6 +89,8 @@ pub struct Gpu {
     /// Work recorded between frames, sent ahead of the next ([`Gpu::submit`]).
     pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
     deferred: std::sync::Mutex<deferred::Deferred>,
+    /// Small writes gathered between submissions, sent as one ([`uploads`]).
+    uploads: std::sync::Mutex<uploads::Uploads>,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
@@ -166,6 +169,7 @@ impl Gpu {
             relight: relight::RelightPass::new(&device),
             pending: std::sync::Mutex::new(None),
             deferred: std::sync::Mutex::default(),
+            uploads: std::sync::Mutex::default(),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited_ns: std::sync::atomic::AtomicU64::new(0),

@@ -535,8 +535,7 @@ impl Gpu {
         let maps = relight.sun_maps.as_ref();
         for (batch, buffer) in relight.basis.batches.iter().zip(&relight.coefficients) {
             let packed = packed_coefficients(batch, source, maps);
-            self.queue
-                .write_buffer(buffer, 0, bytemuck::cast_slice(&packed));
+            self.upload(buffer, 0, bytemuck::cast_slice(&packed));
         }
         self.record_relight_passes(relight, (|| target.clone(), views), |_| None);
     }
@@ -656,7 +655,9 @@ impl Gpu {
         // The relights and shadows gathered, a pass each, after the pending clears.
         let pending = self.record_deferred(pending).map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
-        // The suns' maps the pending relights read, made first.
+        // The small writes every later piece reads, then the suns' maps the pending
+        // relights read.
+        self.submit_uploads();
         self.submit_sun_maps();
         if let Some(p) = pending {
             self.submit_counted([p]);

@@ -83,8 +83,7 @@ impl Gpu {
                 Some(k) => k,
                 None => self.map_relight(pose, maps, weights.len())?,
             };
-            self.queue
-                .write_buffer(&relight.weights, 0, bytemuck::cast_slice(&weights));
+            self.upload(&relight.weights, 0, bytemuck::cast_slice(&weights));
             let groups = n.div_ceil(WORKGROUP);
             self.defer(
                 Kind::Shadow,

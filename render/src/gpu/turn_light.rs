@@ -416,8 +416,7 @@ impl Gpu {
                 relight.turn = Some(self.turn_state(relight, source, light, coarse));
             }
             let state = relight.turn.as_ref().expect("made above");
-            self.queue
-                .write_buffer(&state.light, 0, bytemuck::cast_slice(&record));
+            self.upload(&state.light, 0, bytemuck::cast_slice(&record));
             let relight = pose.relight.as_ref().expect("checked above");
             let state = relight.turn.as_ref().expect("made above");
             // The bind groups of its last relight serve while the tables are the same.
