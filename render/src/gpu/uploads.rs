@@ -72,3 +72,50 @@ impl Gpu {
         self.submit_counted([encoder.finish()]);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes gathered land where they were aimed when the next submission goes, the
+    /// later of two to the same place wins, the kept buffer grows past its first size,
+    /// and what was sent is not sent again.
+    #[test]
+    fn writes_land_in_order_in_one_submission() {
+        let gpu = match Gpu::new() {
+            Ok(g) => g,
+            Err(e) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => {
+                eprintln!("skipped (FRF_SKIP_GPU=1): {e}");
+                return;
+            }
+            Err(e) => panic!("no GPU adapter ({e}); install mesa-vulkan-drivers"),
+        };
+        let usage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
+        let make = |label: &str, words: usize| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: (words * 4) as u64,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let words = |bytes: Vec<u8>| -> Vec<u32> { bytemuck::cast_slice(&bytes).to_vec() };
+        let (a, b) = (make("a", 4), make("b", 1 << 15));
+        gpu.upload(&a, 0, bytemuck::cast_slice(&[1u32, 2, 3, 4]));
+        gpu.upload(&a, 8, bytemuck::cast_slice(&[7u32]));
+        let big: Vec<u32> = (0..1 << 15).collect();
+        gpu.upload(&b, 0, bytemuck::cast_slice(&big));
+        gpu.upload(&a, 4, bytemuck::cast_slice(&[5u32, 6]));
+        assert_eq!(gpu.uploads.lock().unwrap().copies.len(), 4);
+        // `read_back` submits: the writes go first.
+        assert_eq!(words(gpu.read_back(&a, "a").unwrap()), [1, 5, 6, 4]);
+        assert_eq!(words(gpu.read_back(&b, "b").unwrap()), big);
+        assert!(gpu.uploads.lock().unwrap().copies.is_empty());
+        // Nothing gathered is sent twice: a buffer written directly keeps what it got.
+        gpu.queue
+            .write_buffer(&a, 0, bytemuck::cast_slice(&[9u32, 9, 9, 9]));
+        assert_eq!(words(gpu.read_back(&a, "a").unwrap()), [9, 9, 9, 9]);
+    }
+}
