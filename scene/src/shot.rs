@@ -77,10 +77,12 @@ pub struct ShotOptions {
 /// that turns or walks between probes is then relit every few frames rather than every
 /// frame. A light that turns (its lighting keys' yaw) turns every walker's light alike, by
 /// the same turn relative to it as the walker's own turn the other way: the tolerance on
-/// heading holds for the two together. Zero relights at every change (exact).
+/// heading holds for the two together (with probes, whose maps the keys do not turn, for
+/// the maps and the scene's sun each). Zero relights at every change (exact).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct LightTolerance {
-    /// Radians of heading, the walker's relative to the light's yaw.
+    /// Radians of heading, the walker's relative to the light's maps and to its sun as
+    /// the lighting keys turn them.
     pub heading: f32,
     /// Of any probe's weight.
     pub weight: f32,
@@ -114,17 +116,21 @@ impl LightTolerance {
         if lit.occluder_key != now.occluder_key {
             return false;
         }
-        // The light's turn relative to the walker, since it was relit.
-        let relative = |l: &WalkerLight| l.yaw - l.heading;
-        let turn = (relative(now) - relative(lit) + std::f32::consts::PI)
-            .rem_euclid(std::f32::consts::TAU)
-            - std::f32::consts::PI;
+        // How far the light's maps and its sun have turned relative to the walker since
+        // it was relit, the farther of the two.
+        let wrap = |a: f32| {
+            (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
+        };
+        let turned = |yaw: fn(&WalkerLight) -> [f32; 2], k: usize| {
+            wrap((yaw(now)[k] - now.heading) - (yaw(lit)[k] - lit.heading)).abs()
+        };
+        let turn = turned(|l| l.yaw, 0).max(turned(|l| l.yaw, 1));
         let weight =
             |w: &[(usize, f32)], k: usize| w.iter().find(|p| p.0 == k).map_or(0.0, |p| p.1);
         let moved = (lit.weights.iter().chain(&now.weights))
             .map(|&(k, _)| (weight(&lit.weights, k) - weight(&now.weights, k)).abs())
             .fold(0.0f32, f32::max);
-        turn.abs() <= self.heading && moved <= self.weight
+        turn <= self.heading && moved <= self.weight
     }
 }
 
@@ -235,9 +241,10 @@ struct ProbeLights {
 #[derive(Debug, Clone)]
 struct WalkerLight {
     heading: f32,
-    /// The lighting's yaw at the frame (radians): the walker is lit by it turned by
-    /// `yaw − heading`.
-    yaw: f32,
+    /// How far the lighting's keys have turned its maps and its sun at the frame
+    /// (radians): the walker is lit by each turned by that less its heading. Probes' maps
+    /// do not turn with the keys (0), the scene's sun does.
+    yaw: [f32; 2],
     weights: Vec<(usize, f32)>,
     key: Vec<u32>,
     /// The other walkers in the way of its suns, in its frame ([`Occluder`]), and where
@@ -255,7 +262,7 @@ pub const OCCLUDER_STEP_M: f32 = 0.02;
 pub const OCCLUDER_STEP_RAD: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
 impl WalkerLight {
-    fn new(heading: f32, yaw: f32, weights: Vec<(usize, f32)>) -> Self {
+    fn new(heading: f32, yaw: [f32; 2], weights: Vec<(usize, f32)>) -> Self {
         let mut key = vec![heading.to_bits()];
         for &(k, w) in &weights {
             key.extend([k as u32, w.to_bits()]);
@@ -1242,7 +1249,13 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let n = self.scene.instances.len();
         let placements: Vec<Placement> = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
         let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
-        let yaw = self.scene.lighting_at(fp.time).yaw;
+        let keys = self.scene.lighting_at(fp.time).yaw;
+        let maps = if self.scene.probes.is_some() {
+            0.0
+        } else {
+            keys
+        };
+        let yaw = [maps, keys];
         let mut lights = Vec::with_capacity(n);
         for (i, here) in placements.iter().enumerate() {
             let weights = self.scene.probe_weights(i, fp.time);
@@ -1489,5 +1502,37 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         self.counters.peak_resident_bytes =
             self.counters.peak_resident_bytes.max(total(&self.cache));
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The light tolerance holds a walker's heading relative to the light the keys turn:
+    /// a light turning within it, or turning with the walker, keeps its poses; with
+    /// probes, whose maps the keys do not turn, a walker turning with the keys has turned
+    /// against the maps and is relit.
+    #[test]
+    fn the_tolerance_holds_the_heading_relative_to_what_the_keys_turn() {
+        let tolerance = LightTolerance::DEFAULT;
+        let deg = |d: f32| d.to_radians();
+        let light = |heading: f32, yaw: [f32; 2]| WalkerLight::new(deg(heading), yaw, Vec::new());
+        let keys = |d: f32| [deg(d), deg(d)];
+        let lit = light(30.0, keys(0.0));
+        assert!(tolerance.holds(&lit, &light(30.0, keys(1.5))));
+        assert!(!tolerance.holds(&lit, &light(30.0, keys(3.0))));
+        assert!(!tolerance.holds(&lit, &light(33.0, keys(0.0))));
+        // Walker and light turned alike: the same light relative to the walker.
+        assert!(tolerance.holds(&lit, &light(40.0, keys(10.0))));
+        // With probes: the maps stay, the sun turns with the keys.
+        let probes = |d: f32| [0.0, deg(d)];
+        let lit = light(30.0, probes(0.0));
+        assert!(tolerance.holds(&lit, &light(30.0, probes(1.5))));
+        assert!(!tolerance.holds(&lit, &light(40.0, probes(10.0))));
+        assert!(!tolerance.holds(&lit, &light(30.0, probes(3.0))));
+        // Exact: any turn relights.
+        assert!(!LightTolerance::EXACT.holds(&light(30.0, keys(0.0)), &light(30.0, keys(0.1))));
+        assert!(LightTolerance::EXACT.holds(&light(30.0, keys(0.1)), &light(30.0, keys(0.1))));
     }
 }
