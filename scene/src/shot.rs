@@ -121,10 +121,8 @@ impl LightTolerance {
         let wrap = |a: f32| {
             (a + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU) - std::f32::consts::PI
         };
-        let turned = |yaw: fn(&WalkerLight) -> [f32; 2], k: usize| {
-            wrap((yaw(now)[k] - now.heading) - (yaw(lit)[k] - lit.heading)).abs()
-        };
-        let turn = turned(|l| l.yaw, 0).max(turned(|l| l.yaw, 1));
+        let turned = |k: usize| wrap((now.yaw[k] - now.heading) - (lit.yaw[k] - lit.heading)).abs();
+        let turn = turned(0).max(turned(1));
         let weight =
             |w: &[(usize, f32)], k: usize| w.iter().find(|p| p.0 == k).map_or(0.0, |p| p.1);
         let moved = (lit.weights.iter().chain(&now.weights))
@@ -1120,7 +1118,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .into_iter()
                 .chain(fp.between[i].map(|(after, _)| (i, after)))
         });
-        let lights = self.walker_lights(fp, world)?;
+        let lights = self.walker_lights(fp, (world, lighting.yaw))?;
         for (i, pose) in drawn {
             let light = &lights[i];
             // A walker whose own light changes (it turns, or moves between probes) has
@@ -1242,14 +1240,17 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok((slots, made_resident))
     }
 
-    /// Every walker's own light at frame `fp` under `world`: its heading, the probes'
-    /// weights where it stands, and the other walkers in the way of its suns
-    /// ([`may_shade`]).
-    fn walker_lights(&mut self, fp: &FramePlan, world: Option<&World>) -> Result<Vec<WalkerLight>> {
+    /// Every walker's own light at frame `fp` under `world`, whose lighting keys turn it
+    /// by `keys` (radians): its heading, the probes' weights where it stands, and the
+    /// other walkers in the way of its suns ([`may_shade`]).
+    fn walker_lights(
+        &mut self,
+        fp: &FramePlan,
+        (world, keys): (Option<&World>, f32),
+    ) -> Result<Vec<WalkerLight>> {
         let n = self.scene.instances.len();
         let placements: Vec<Placement> = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
         let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
-        let keys = self.scene.lighting_at(fp.time).yaw;
         let maps = if self.scene.probes.is_some() {
             0.0
         } else {

@@ -756,19 +756,14 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         "[0.0, 1.4, 3.0]",
         "[0.0, 1.4, 3.0]",
     );
-    let mut args = vec![
-        "bench",
-        "frame",
-        scene.to_str().unwrap(),
-        "--walkers",
-        "1,3",
-        "--frames",
-        "2",
-        "--json",
-    ];
-    args.extend(gpu_flag());
-    let out = ok(&args);
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // `frf bench frame` of the scene with `extra` arguments, its JSON report.
+    let bench = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec!["bench", "frame", scene.to_str().unwrap(), "--json"];
+        args.extend(extra);
+        args.extend(gpu_flag());
+        serde_json::from_slice(&ok(&args).stdout).unwrap()
+    };
+    let report = bench(&["--walkers", "1,3", "--frames", "2"]);
     let rows = report["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 4, "{report}");
     for r in rows {
@@ -870,10 +865,7 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     // A light turning 1° a frame, within the shot's light tolerance (2°): the walker is
     // relit every third frame, not every frame (a light's turn relative to a walker is
     // held to the tolerance a walker's own turn is).
-    let mut slow = vec![
-        "bench",
-        "frame",
-        scene.to_str().unwrap(),
+    let slow = bench(&[
         "--walkers",
         "1",
         "--light",
@@ -882,10 +874,7 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         "1",
         "--frames",
         "6",
-        "--json",
-    ];
-    slow.extend(gpu_flag());
-    let slow: serde_json::Value = serde_json::from_slice(&ok(&slow).stdout).unwrap();
+    ]);
     assert_eq!(slow["turn_deg_per_frame"], 1.0, "{slow}");
     let relit = slow["rows"][0]["relights_per_frame"].as_f64().unwrap();
     assert!(relit > 0.0 && relit <= 0.5, "{slow}");
