@@ -128,7 +128,30 @@ impl LightTolerance {
         let moved = (lit.weights.iter().chain(&now.weights))
             .map(|&(k, _)| (weight(&lit.weights, k) - weight(&now.weights, k)).abs())
             .fold(0.0f32, f32::max);
-        turn <= self.heading && moved <= self.weight
+        // A light turning by the tolerance a frame holds every other frame, however the
+        // angles round: a ten-thousandth of the tolerance's slack (none when exact).
+        turn <= self.heading * (1.0 + 1e-4) && moved <= self.weight
+    }
+
+    /// The light of those `ahead` (the frames after `now`'s, in order) a walker lit now
+    /// is relit for: the last of those up to the first that does not hold `now` (when
+    /// `shared`, that has not `now`'s key: walkers of one key share its resident), or
+    /// `now`. A light turning steadily then holds for twice as many frames as one relit
+    /// for `now`, within the same tolerance (the frame is lit for the middle of its run).
+    fn farthest<'a>(
+        &self,
+        now: &'a WalkerLight,
+        ahead: impl IntoIterator<Item = &'a WalkerLight>,
+        shared: bool,
+    ) -> &'a WalkerLight {
+        let mut chosen = now;
+        for light in ahead {
+            if !self.holds(light, now) || (shared && light.key != now.key) {
+                break;
+            }
+            chosen = light;
+        }
+        chosen
     }
 }
 
@@ -244,6 +267,10 @@ struct WalkerLight {
     /// do not turn with the keys (0), the scene's sun does.
     yaw: [f32; 2],
     weights: Vec<(usize, f32)>,
+    /// How much farther the keys have turned the light than the frame's own lighting it
+    /// is relit under (radians): nonzero for a light looked ahead to
+    /// ([`LOOK_AHEAD_FRAMES`]).
+    ahead: f32,
     key: Vec<u32>,
     /// The other walkers in the way of its suns, in its frame ([`Occluder`]), and where
     /// they stand relative to it, to [`OCCLUDER_STEP_M`] and [`OCCLUDER_STEP_RAD`]
@@ -259,6 +286,11 @@ pub const OCCLUDER_STEP_M: f32 = 0.02;
 /// (See [`OCCLUDER_STEP_M`].)
 pub const OCCLUDER_STEP_RAD: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
+/// Frames ahead whose light a walker may be relit for, where it holds the light of the
+/// frame relit ([`LightTolerance::farthest`]): a light turning a quarter of the tolerance
+/// a frame or faster is relit half as often.
+pub const LOOK_AHEAD_FRAMES: usize = 4;
+
 impl WalkerLight {
     fn new(heading: f32, yaw: [f32; 2], weights: Vec<(usize, f32)>) -> Self {
         let mut key = vec![heading.to_bits()];
@@ -269,6 +301,7 @@ impl WalkerLight {
             heading,
             yaw,
             weights,
+            ahead: 0.0,
             key,
             occluders: Vec::new(),
             occluder_key: Vec::new(),
@@ -1118,7 +1151,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .into_iter()
                 .chain(fp.between[i].map(|(after, _)| (i, after)))
         });
-        let lights = self.walker_lights(fp, (world, lighting.yaw))?;
+        let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
+        let lights = self.walker_lights(fp, (suns, lighting.yaw))?;
+        // The lights of the frames ahead, worked out when a walker is first relit.
+        let mut ahead = None;
         for (i, pose) in drawn {
             let light = &lights[i];
             // A walker whose own light changes (it turns, or moves between probes) has
@@ -1155,7 +1191,9 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 }
                 Some(k) => {
                     // The same views under a new light, turned or moved: relit where they
-                    // are.
+                    // are, for the light ahead that holds this frame's.
+                    let light =
+                        &self.light_ahead(fp, (&lighting, world), &mut ahead, (i, light))?;
                     self.cache[k].lit = light.clone();
                     let t = Instant::now();
                     self.relight_cached(k, world, light)?;
@@ -1170,10 +1208,12 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                     k
                 }
                 None => {
+                    let wanted = wanted.cloned();
+                    let light =
+                        &self.light_ahead(fp, (&lighting, world), &mut ahead, (i, light))?;
                     let t = Instant::now();
                     // Another walker's copy of views that cover these lends them, basis
                     // codes and all (the first made, so that copies share one).
-                    let wanted = wanted.cloned();
                     let like = self
                         .cache
                         .iter()
@@ -1240,17 +1280,82 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         Ok((slots, made_resident))
     }
 
-    /// Every walker's own light at frame `fp` under `world`, whose lighting keys turn it
-    /// by `keys` (radians): its heading, the probes' weights where it stands, and the
-    /// other walkers in the way of its suns ([`may_shade`]).
+    /// The light walker `i`, whose own light at frame `fp` (under `lighting`, `world`) is
+    /// `now`, is relit for ([`LightTolerance::farthest`]): that of the farthest frame of
+    /// the next [`LOOK_AHEAD_FRAMES`] (at the scene's rate) whose light holds `now`, so
+    /// that the frames after it hold too. A resident shared by walkers of one light is
+    /// relit for one that keeps their key. `ahead`: the frames' lights, worked out the
+    /// first time one is asked for.
+    fn light_ahead(
+        &mut self,
+        fp: &FramePlan,
+        (lighting, world): (&LightingAt, Option<&World>),
+        ahead: &mut Option<Vec<Vec<WalkerLight>>>,
+        (i, now): (usize, &WalkerLight),
+    ) -> Result<WalkerLight> {
+        if ahead.is_none() {
+            *ahead = Some(self.lights_ahead(fp, lighting, world)?);
+        }
+        let lights = ahead.iter().flatten().map(|l| &l[i]);
+        let shared = !self.own_light[i];
+        Ok((self.options.light_tolerance)
+            .farthest(now, lights, shared)
+            .clone())
+    }
+
+    /// Every walker's light at each of the [`LOOK_AHEAD_FRAMES`] frames after `fp` (under
+    /// `lighting`, `world`), at the scene's rate, up to the first whose lighting is not
+    /// the frame's turned (or, with probes, whose maps the keys do not turn, turned at
+    /// all): each as the frame's lighting turned by how far the keys turn it by then
+    /// ([`WalkerLight::ahead`]). None when the tolerance is exact.
+    fn lights_ahead(
+        &mut self,
+        fp: &FramePlan,
+        lighting: &LightingAt,
+        world: Option<&World>,
+    ) -> Result<Vec<Vec<WalkerLight>>> {
+        let step = 1.0 / self.scene.fps;
+        let tolerance = self.options.light_tolerance;
+        let mut out = Vec::new();
+        if tolerance == LightTolerance::EXACT || !(step.is_finite() && step > 0.0) {
+            return Ok(out);
+        }
+        let key = LightingKey::of(lighting);
+        for k in 1..=LOOK_AHEAD_FRAMES {
+            let t = fp.time + k as f64 * step;
+            let l = self.scene.lighting_at(t);
+            let turn = l.yaw - lighting.yaw;
+            let turned = turn != 0.0;
+            if !LightingKey::of(&l).turned_alike(&key) || (turned && self.scene.probes.is_some()) {
+                break;
+            }
+            let spin = glam::Mat3::from_rotation_y(turn);
+            let suns: Vec<glam::Vec3> = world
+                .map_or(&[][..], |w| &w.sun_directions[..])
+                .iter()
+                .map(|&d| spin * d)
+                .collect();
+            let frame = self.frame_at(fp.index + k, t);
+            let mut lights = self.walker_lights(&frame, (&suns, l.yaw))?;
+            for light in &mut lights {
+                light.ahead = turn;
+            }
+            out.push(lights);
+        }
+        Ok(out)
+    }
+
+    /// Every walker's own light at frame `fp` under suns toward `suns` (scene frame,
+    /// unit), the lighting keys turning the light by `keys` (radians): its heading, the
+    /// probes' weights where it stands, and the other walkers in the way of its suns
+    /// ([`may_shade`]).
     fn walker_lights(
         &mut self,
         fp: &FramePlan,
-        (world, keys): (Option<&World>, f32),
+        (suns, keys): (&[glam::Vec3], f32),
     ) -> Result<Vec<WalkerLight>> {
         let n = self.scene.instances.len();
         let placements: Vec<Placement> = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
-        let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
         let maps = if self.scene.probes.is_some() {
             0.0
         } else {
@@ -1337,7 +1442,11 @@ impl<'a, R: ReadAt> Shot<'a, R> {
             ),
         };
         let occluders = light.occluders.clone();
-        Lighting::Tabled(scene_frame.turned(-light.heading).with_occluders(occluders))
+        Lighting::Tabled(
+            scene_frame
+                .turned(light.ahead - light.heading)
+                .with_occluders(occluders),
+        )
     }
 
     /// Relights cache entry `k` for its walker's light `light` under `world`: its views'
@@ -1388,7 +1497,7 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         let (Some(hull), Some(world)) = (self.field.hull_shared(pose)?, world) else {
             return Ok(None);
         };
-        let env = walker_map(world, &light.weights)?.rotated(-light.heading);
+        let env = walker_map(world, &light.weights)?.rotated(light.ahead - light.heading);
         let ground = self
             .field
             .header()
@@ -1532,8 +1641,58 @@ mod tests {
         assert!(tolerance.holds(&lit, &light(30.0, probes(1.5))));
         assert!(!tolerance.holds(&lit, &light(40.0, probes(10.0))));
         assert!(!tolerance.holds(&lit, &light(30.0, probes(3.0))));
+        // A light turning by the tolerance holds, at any yaw the rounding meets.
+        for k in 0..180 {
+            let lit = light(37.3, keys(2.0 * k as f32));
+            let now = light(37.3, keys(2.0 * (k + 1) as f32));
+            assert!(tolerance.holds(&lit, &now), "turned to {}°", 2 * (k + 1));
+        }
         // Exact: any turn relights.
         assert!(!LightTolerance::EXACT.holds(&light(30.0, keys(0.0)), &light(30.0, keys(0.1))));
         assert!(LightTolerance::EXACT.holds(&light(30.0, keys(0.1)), &light(30.0, keys(0.1))));
+    }
+
+    /// A walker relit is lit for the farthest light ahead that holds its own: under the 2°
+    /// tolerance, a light turning 1° a frame is lit for two frames ahead, which holds the
+    /// four frames after (relit every fifth frame instead of every third); one turning 3°
+    /// a frame for its own; a resident shared by walkers of one light keeps their key.
+    #[test]
+    fn a_relight_is_lit_for_the_farthest_light_ahead_that_holds() {
+        let tolerance = LightTolerance::DEFAULT;
+        let light = |heading: f32, keys: f32| {
+            WalkerLight::new(heading.to_radians(), [keys.to_radians(); 2], Vec::new())
+        };
+        let ahead = |rate: f32| -> Vec<WalkerLight> {
+            (1..=LOOK_AHEAD_FRAMES)
+                .map(|k| light(30.0, rate * k as f32))
+                .collect()
+        };
+        let now = light(30.0, 0.0);
+        let slow = ahead(1.0);
+        let lit = tolerance.farthest(&now, &slow, false);
+        assert_eq!(lit.yaw, slow[1].yaw);
+        for k in 0..=4 {
+            assert!(tolerance.holds(lit, &light(30.0, k as f32)), "frame {k}");
+        }
+        assert!(!tolerance.holds(lit, &light(30.0, 5.0)));
+        // Turning faster than the tolerance: lit for its own frame.
+        let fast = ahead(3.0);
+        assert_eq!(tolerance.farthest(&now, &fast, false).yaw, now.yaw);
+        // A walker turning: its own resident is lit ahead; a shared one (all of whose
+        // walkers have one key) is not.
+        let turning: Vec<WalkerLight> = (1..=4).map(|k| light(30.0 + k as f32, 0.0)).collect();
+        assert_eq!(
+            tolerance.farthest(&now, &turning, false).heading,
+            turning[1].heading
+        );
+        assert_eq!(
+            tolerance.farthest(&now, &turning, true).heading,
+            now.heading
+        );
+        // Exact: its own.
+        assert_eq!(
+            LightTolerance::EXACT.farthest(&now, &slow, false).yaw,
+            now.yaw
+        );
     }
 }

@@ -862,9 +862,12 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
-    // A light turning 1° a frame, within the shot's light tolerance (2°): the walker is
-    // relit every third frame, not every frame (a light's turn relative to a walker is
-    // held to the tolerance a walker's own turn is).
+    // A light turning 1° a frame, within the shot's light tolerance (2°): a light's turn
+    // relative to a walker is held to the tolerance a walker's own turn is, and a walker
+    // is lit for the farthest frame ahead whose light holds its own. Lit at frame 0 for
+    // frame 2's light, it holds frames 0 to 4 and is relit once in 9 frames, at frame 5
+    // (for frame 7's); lit for its own frame, every third frame (2 of 9); relit for any
+    // turn, every frame.
     let slow = bench(&[
         "--walkers",
         "1",
@@ -873,11 +876,11 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         "--turn-deg",
         "1",
         "--frames",
-        "6",
+        "9",
     ]);
     assert_eq!(slow["turn_deg_per_frame"], 1.0, "{slow}");
     let relit = slow["rows"][0]["relights_per_frame"].as_f64().unwrap();
-    assert!(relit > 0.0 && relit <= 0.5, "{slow}");
+    assert!(relit > 0.0 && relit <= 1.0 / 9.0 + 1e-9, "{slow}");
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--turn-deg", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--turn-deg 0"), "{}", stderr(&bad));
