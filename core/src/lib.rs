@@ -30,6 +30,7 @@ pub mod progress;
 pub mod sh;
 pub mod shared_data;
 pub mod sun;
+pub mod thread_clock;
 pub mod volume;
 
 pub use argument::BadArgument;

@@ -30,12 +30,17 @@
 //! - `submit_ms_per_frame`: of the host's work, the time inside `queue.submit` (on
 //!   lavapipe, which runs the work submitted on the calling thread, the device's work:
 //!   the host's own is then `host_ms_per_frame` less this);
+//! - `host_cpu_ms_per_frame`: the calling thread's CPU time in the frame outside its
+//!   submissions and waits: the host's own work, free of the time other processes took
+//!   of a shared machine, which wall times count (work the host hands to other threads
+//!   is not in it); where the system does not say, none;
 //! - `gpu_timestamps_ms_per_frame`: the device's time in the frame's passes by GPU
 //!   timestamp queries, where the adapter has them (`passes` gives each pass's).
 
 use std::time::Instant;
 
 use frf_core::progress::Progress;
+use frf_core::thread_clock::thread_cpu;
 use frf_reflectance::FieldFile;
 use frf_reflectance::container::ReadAt;
 use frf_render::gpu::pass_clock::PassTime;
@@ -180,6 +185,10 @@ pub struct FrameBenchRow {
     /// on a software adapter that runs the work submitted on the calling thread
     /// (lavapipe), the device's work too.
     pub submit_ms_per_frame: f64,
+    /// Median CPU time per frame of the calling thread outside its submissions and
+    /// waits on the device, ms (see the module docs; `None` where the system does not
+    /// say).
+    pub host_cpu_ms_per_frame: Option<f64>,
     /// Median frame, ms.
     pub wall_ms_per_frame: f64,
     /// The first frame (not counted in the medians), ms: every walker's poses read,
@@ -247,18 +256,22 @@ impl FrameBenchReport {
             self.turn_deg_per_frame,
             self.light_tolerance_deg
         );
-        out += "walkers  light     motion     host ms (relighting, submit)  gpu ms  wall ms  \
-                relit/frame  peak MB  first ms\n";
+        out += "walkers  light     motion     host ms (relighting, submit, own cpu)  gpu ms  \
+                wall ms  relit/frame  peak MB  first ms\n";
         for r in &self.rows {
+            let cpu = r
+                .host_cpu_ms_per_frame
+                .map_or_else(|| "-".to_string(), |c| format!("{c:.1}"));
             out += &format!(
-                "{:>7}  {:<8} {:<9} {:>8.1} {:>10.1} {:>9.1} {:>7.1} {:>8.1} {:>12.1} {:>8.1} \
-                 {:>9.1}\n",
+                "{:>7}  {:<8} {:<9} {:>8.1} {:>10.1} {:>9.1} {:>8} {:>7.1} {:>8.1} {:>12.1} \
+                 {:>8.1} {:>9.1}\n",
                 r.walkers,
                 r.light.name(),
                 r.motion.name(),
                 r.host_ms_per_frame,
                 r.residency_ms_per_frame,
                 r.submit_ms_per_frame,
+                cpu,
                 r.gpu_ms_per_frame,
                 r.wall_ms_per_frame,
                 r.relights_per_frame,
@@ -319,9 +332,13 @@ impl FrameBenchReport {
             for light in [LightMode::Constant, LightMode::Turning] {
                 if let (Some(a), Some(b)) = (find(lo.walkers, light), find(hi.walkers, light)) {
                     let own = |r: &FrameBenchRow| r.host_ms_per_frame - r.submit_ms_per_frame;
+                    let cpu = match (b.host_cpu_ms_per_frame, a.host_cpu_ms_per_frame) {
+                        (Some(b), Some(a)) => format!("; its own CPU time: {:.2}x", b / a),
+                        _ => String::new(),
+                    };
                     out += &format!(
                         "{light} light: host per frame at {} walkers / at {}: {:.2}x \
-                         (less its submissions: {:.2}x)\n",
+                         (less its submissions: {:.2}x{cpu})\n",
                         b.walkers,
                         a.walkers,
                         b.host_ms_per_frame / a.host_ms_per_frame,
@@ -451,6 +468,7 @@ pub fn run_frame_bench<R: ReadAt>(
             let mut waited = Vec::new();
             let mut residency = Vec::new();
             let mut submitting = Vec::new();
+            let mut own_cpu = Vec::new();
             let mut passes: Vec<Vec<PassTime>> = Vec::new();
             let mut relights = 0;
             let mut first = 0.0;
@@ -458,6 +476,8 @@ pub fn run_frame_bench<R: ReadAt>(
                 let before = waited_on(shot.render_device());
                 let submitted_before = submitted_on(shot.render_device());
                 let resident_before = shot.counters().residency_seconds;
+                let device_cpu_before = device_cpu_on(shot.render_device());
+                let cpu_before = thread_cpu();
                 let t = Instant::now();
                 let made = if options.readback {
                     shot.render(f, false)?.made_resident.len()
@@ -465,6 +485,10 @@ pub fn run_frame_bench<R: ReadAt>(
                     shot.draw_unread(f)?.len()
                 };
                 let w = t.elapsed().as_secs_f64() * 1e3;
+                let cpu = thread_cpu().zip(cpu_before).map(|(after, before)| {
+                    let device = device_cpu_on(shot.render_device()) - device_cpu_before;
+                    (after.saturating_sub(before).as_secs_f64() - device).max(0.0) * 1e3
+                });
                 // The frame's waits, counted before the pass times are read: reading them
                 // waits on the device again, outside the frame's wall time (counting
                 // that wait made the host's share negative on a loaded machine).
@@ -477,6 +501,7 @@ pub fn run_frame_bench<R: ReadAt>(
                     waited.push(frame_waited);
                     residency.push((shot.counters().residency_seconds - resident_before) * 1e3);
                     submitting.push((submitted_on(shot.render_device()) - submitted_before) * 1e3);
+                    own_cpu.extend(cpu);
                     relights += made;
                     passes.push(times);
                 }
@@ -491,6 +516,7 @@ pub fn run_frame_bench<R: ReadAt>(
                 gpu_ms_per_frame: median(&waited),
                 residency_ms_per_frame: median(&residency),
                 submit_ms_per_frame: median(&submitting),
+                host_cpu_ms_per_frame: (!own_cpu.is_empty()).then(|| median(&own_cpu)),
                 wall_ms_per_frame: median(&wall),
                 first_frame_ms: first,
                 gpu_timestamps_ms_per_frame: (pass_clock == "gpu-timestamps").then(|| {
@@ -556,6 +582,15 @@ fn walking(
 fn waited_on(device: &Device) -> f64 {
     match device {
         Device::Gpu(gpu) => gpu.waited().as_secs_f64(),
+        Device::Cpu => 0.0,
+    }
+}
+
+/// CPU seconds the threads that submitted to `device` or waited on it spent doing so
+/// (none on the CPU).
+fn device_cpu_on(device: &Device) -> f64 {
+    match device {
+        Device::Gpu(gpu) => gpu.submitted_and_waited_cpu().as_secs_f64(),
         Device::Cpu => 0.0,
     }
 }

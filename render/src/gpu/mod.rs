@@ -40,6 +40,7 @@ pub mod rebin;
 pub mod relight;
 pub mod scope;
 pub mod shadow;
+mod spent;
 pub mod sun_depth;
 pub mod time_morph;
 pub mod timing;
@@ -95,10 +96,10 @@ pub struct Gpu {
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
     staging: std::sync::Mutex<Vec<readback::FrameStaging>>,
-    /// Nanoseconds the host has waited on the device ([`Gpu::waited`]).
-    waited_ns: std::sync::atomic::AtomicU64,
-    /// Nanoseconds the host has spent in `queue.submit` ([`Gpu::submitted`]).
-    submitted_ns: std::sync::atomic::AtomicU64,
+    /// Time the host has waited on the device ([`Gpu::waited`]).
+    waited: spent::Spent,
+    /// Time the host has spent in `queue.submit` ([`Gpu::submitted`]).
+    submitted: spent::Spent,
     rebin: rebin::RebinPass,
     /// How the frame pass runs.
     stage: rebin::PassKind,
@@ -172,8 +173,8 @@ impl Gpu {
             uploads: std::sync::Mutex::default(),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
-            waited_ns: std::sync::atomic::AtomicU64::new(0),
-            submitted_ns: std::sync::atomic::AtomicU64::new(0),
+            waited: spent::Spent::default(),
+            submitted: spent::Spent::default(),
             rebin: rebin::RebinPass::new(&device, formats::PoseFormats::DEFAULT),
             stage: rebin::PassKind::Compute,
             targets: kept::Kept::new(KEPT_TARGETS),
@@ -253,7 +254,7 @@ impl Gpu {
 
     /// Runs `f`, a call that may block on the device, counting its time as waiting.
     fn waiting<T>(&self, f: impl FnOnce() -> T) -> T {
-        counted(&self.waited_ns, f)
+        self.waited.run(f)
     }
 
     /// Submits `buffers` to the queue, counting the time it takes ([`Gpu::submitted`]).
@@ -261,23 +262,28 @@ impl Gpu {
         &self,
         buffers: impl IntoIterator<Item = wgpu::CommandBuffer>,
     ) -> wgpu::SubmissionIndex {
-        counted(&self.submitted_ns, || self.queue.submit(buffers))
+        self.submitted.run(|| self.queue.submit(buffers))
     }
 
     /// How long the host has spent submitting so far (inside `queue.submit`): part of
     /// its own work, but where the adapter is software that runs the work submitted on
     /// the calling thread (lavapipe), the device's work too.
     pub fn submitted(&self) -> std::time::Duration {
-        std::time::Duration::from_nanos(
-            self.submitted_ns.load(std::sync::atomic::Ordering::Relaxed),
-        )
+        self.submitted.wall()
+    }
+
+    /// The CPU time of the threads that submitted work or waited on the device, spent
+    /// doing so (zero where the system does not say): on a software adapter, the
+    /// device's work done on the calling thread ([`spent`]).
+    pub fn submitted_and_waited_cpu(&self) -> std::time::Duration {
+        self.submitted.cpu() + self.waited.cpu()
     }
 
     /// How long the host has waited on the device so far (every fence and readback; not
     /// submissions, which are host work): what a frame's wall time less this is the
     /// host's own work.
     pub fn waited(&self) -> std::time::Duration {
-        std::time::Duration::from_nanos(self.waited_ns.load(std::sync::atomic::Ordering::Relaxed))
+        self.waited.wall()
     }
 
     /// The whole of `buffer` (a `COPY_SRC` buffer the passes write), copied to a readback
@@ -310,15 +316,4 @@ impl Gpu {
         buffer.unmap();
         Ok(bytes)
     }
-}
-
-/// Runs `f`, adding the nanoseconds it takes to `total`.
-fn counted<T>(total: &std::sync::atomic::AtomicU64, f: impl FnOnce() -> T) -> T {
-    let start = std::time::Instant::now();
-    let out = f();
-    total.fetch_add(
-        start.elapsed().as_nanos() as u64,
-        std::sync::atomic::Ordering::Relaxed,
-    );
-    out
 }
