@@ -796,7 +796,7 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
         // Submitting is part of the host's work.
         let submit = ms("submit_ms_per_frame");
         assert!(submit > 0.0 && submit <= host, "{r}");
-        // The calling thread's own CPU time (Linux says it): each frame's is within its
+        // The calling thread's own CPU time (Unix has its clock): each frame's is within its
         // wall time, and so is their median.
         let cpu = ms("host_cpu_ms_per_frame");
         assert!(cpu > 0.0 && cpu <= wall, "{r}");
