@@ -269,16 +269,22 @@ pub struct GpuRelightJob {
     pub pad1: u32,
 }
 
-/// `ShadowParams` of `shadow.wgsl`.
+/// `ShadowJob` of `shadow.wgsl`: one walker's shadow relit into a layer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
-pub struct GpuShadowParams {
-    /// Texels per side of the maps.
-    pub texels: u32,
+pub struct GpuShadowJob {
+    /// Where its maps start in the maps' buffer (floats).
+    pub maps_at: u32,
     /// Maps.
     pub maps: u32,
-    /// Padding to 16 bytes.
-    pub pad: [u32; 2],
+    /// Texels per side of the maps.
+    pub texels: u32,
+    /// Where its weights start in the weights' buffer (`vec4`s).
+    pub weights_at: u32,
+    /// The layer of the output it writes.
+    pub layer: u32,
+    /// Padding to 32 bytes.
+    pub pad: [u32; 3],
 }
 
 /// `Composite` of `composite.wgsl`.

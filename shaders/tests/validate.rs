@@ -10,8 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuHullAt, GpuInstance, GpuLightFitParams, GpuPresent,
-    GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowParams,
-    GpuSunDepthJob, GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuView,
+    GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowJob, GpuSunDepthJob,
+    GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -325,9 +325,9 @@ fn pod_structs_match_naga_layouts() {
     let shadow = module(&shaders::composed(shaders::SHADOW), "shadow");
     check_layout!(
         &shadow,
-        "ShadowParams",
-        GpuShadowParams,
-        [texels, maps, pad]
+        "ShadowJob",
+        GpuShadowJob,
+        [maps_at, maps, texels, weights_at, layer, pad]
     );
     let present = module(&shaders::composed(shaders::PRESENT), "present");
     check_layout!(

@@ -21,6 +21,7 @@ use super::bind::bind_group;
 use super::pose::{GpuPose, RelitShadowInfo};
 use super::readback::PendingFrame;
 use super::rebin::{frame_stats, frame_uniform};
+use super::shadow::ShadowDraw;
 use crate::RenderError;
 use crate::composite::{Backdrop, GroundLook, Layers, back_to_front};
 use crate::cpu::FrameStats;
@@ -359,15 +360,9 @@ impl Gpu {
             self.morph_in_time(encoder, &subjects, &between, size, (variant, by_depth));
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
-            let (gpu_instances, touched) = place_walkers(
-                encoder,
-                instances,
-                &order,
-                &drawn,
-                &subjects,
-                &t,
-                shadow_info,
-            );
+            let (gpu_instances, touched, shadows) =
+                place_walkers(instances, &order, &drawn, &subjects, shadow_info);
+            self.record_shadows(encoder, &shadows, &t.shadows)?;
             let mut params = backdrop.params;
             if let Some(info) = shadow_info {
                 params.has_shadow = 1;
@@ -454,7 +449,7 @@ impl Gpu {
 fn shared_shadow(instances: &[GpuInstanceRef]) -> Result<Option<RelitShadowInfo>> {
     let infos: Vec<RelitShadowInfo> = instances
         .iter()
-        .filter_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.1))
+        .filter_map(|i| i.shadow_pose().shadow.as_ref().map(|s| s.info()))
         .collect();
     let shadow_info = infos.first().map(|first| RelitShadowInfo {
         texels: infos.iter().map(|i| i.texels).max().unwrap_or(1),
@@ -471,45 +466,31 @@ fn shared_shadow(instances: &[GpuInstanceRef]) -> Result<Option<RelitShadowInfo>
 }
 
 /// Each walker, back to front (`order`; `drawn`: its render's pose, camera and box),
-/// placed for the composite: its instance, and the pixels it may touch (its render's
-/// box, and where it sees its shadow's patch of ground); its relit shadow is copied into
-/// its layer of the targets' shadows.
-fn place_walkers(
-    encoder: &mut wgpu::CommandEncoder,
-    instances: &[GpuInstanceRef],
+/// placed for the composite: its instance, the pixels it may touch (its render's box,
+/// and where it sees its shadow's patch of ground), and its shadow to draw into its
+/// layer of the targets' shadows.
+fn place_walkers<'a>(
+    instances: &'a [GpuInstanceRef],
     order: &[usize],
     drawn: &[(&GpuPose, Camera, PixelBox)],
     subjects: &Subjects,
-    t: &CompositeTargets,
     shadow_info: Option<RelitShadowInfo>,
-) -> (Vec<GpuInstance>, Vec<PixelBox>) {
+) -> (Vec<GpuInstance>, Vec<PixelBox>, Vec<ShadowDraw<'a>>) {
     let mut gpu_instances = Vec::with_capacity(order.len());
+    let mut shadows = Vec::new();
     // Per walker, the pixels it may touch: its render's box, and where it sees its
     // shadow's patch of ground.
     let mut touched = Vec::with_capacity(order.len());
     for (layer, &k) in order.iter().enumerate() {
         let i = &instances[k];
         let m = i.world_from_subject.inverse();
-        let texels = i.shadow_pose().shadow.as_ref().map_or(0, |s| s.1.texels);
-        if let Some((texture, _)) = &i.shadow_pose().shadow {
-            encoder.copy_texture_to_texture(
-                texture.as_image_copy(),
-                wgpu::TexelCopyTextureInfo {
-                    texture: &t.shadows,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer as u32,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::Extent3d {
-                    width: texels,
-                    height: texels,
-                    depth_or_array_layers: 1,
-                },
-            );
+        let shadow = i.shadow_pose().shadow.as_ref();
+        let texels = shadow.map_or(0, |s| s.info().texels);
+        if let Some(shadow) = shadow {
+            shadows.push(ShadowDraw {
+                shadow,
+                layer: layer as u32,
+            });
         }
         let shadow_box = match shadow_info {
             Some(info) if texels > 0 => ground_box(&drawn[layer].1, 0.5 * info.extent_m),
@@ -525,5 +506,5 @@ fn place_walkers(
             place: subjects.place(layer).0.to_array(),
         });
     }
-    (gpu_instances, touched)
+    (gpu_instances, touched, shadows)
 }

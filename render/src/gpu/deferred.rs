@@ -1,10 +1,10 @@
 //! Dispatches gathered by kind between two submissions and recorded as one compute pass
 //! per kind: every pose relit between two frames (a turning light relights a crowd) adds
-//! its dispatches to the relight pass and its shadow's to the shadow pass, instead of a
-//! pass of its own each, and the lookups of its light on the device to a pass before
-//! them all (none waits for another). [`Gpu::submit`] records them, lights, relights,
-//! then shadows, after what the pending encoder already holds (the clears of the
-//! relights' peaks).
+//! its dispatches to the relight pass, instead of a pass of its own each, and the
+//! lookups of its light on the device to a pass before them all (none waits for
+//! another). [`Gpu::submit`] records them, lights then relights, after what the pending
+//! encoder already holds (the clears of the relights' peaks). Shadows are relit by the
+//! frame that draws them, every walker's in one dispatch ([`super::shadow`]).
 
 use super::Gpu;
 use super::timing::compute_pass_writes;
@@ -17,19 +17,16 @@ pub(super) enum Kind {
     Light,
     /// The relighting pass (its sums, then its encoding), [`super::relight`].
     Relight,
-    /// The relit shadow, [`super::shadow`].
-    Shadow,
 }
 
 impl Kind {
-    const ALL: [Kind; 3] = [Kind::Light, Kind::Relight, Kind::Shadow];
+    const ALL: [Kind; 2] = [Kind::Light, Kind::Relight];
 
     /// The pass's name (in the timings).
     fn name(self) -> &'static str {
         match self {
             Kind::Light => "turn light",
             Kind::Relight => "relight",
-            Kind::Shadow => "shadow",
         }
     }
 }

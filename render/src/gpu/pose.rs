@@ -19,6 +19,7 @@ use crate::error::Result;
 use crate::geometry::PoseGeometry;
 use crate::rectified::gpu_frame;
 use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
+use crate::shadow::ShadowMaps;
 use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuView};
 
 /// How the frame pass binds a resident pose (made by [`super::rebin::RebinPass`]): the
@@ -42,19 +43,38 @@ pub struct GpuPose {
     /// holds on the GPU.
     pub geometry: Arc<PoseGeometry>,
     pub(super) quad_count: u32,
-    /// The relit shadow of the ground, when the pose has shadow maps and a lighting.
-    pub(super) shadow: Option<(wgpu::Texture, RelitShadowInfo)>,
-    /// The shadow maps and weights it was relit from, kept to relight it again.
-    pub(super) shadow_maps: Option<MapRelight>,
+    /// The shadow it casts on the ground, when it has shadow maps and a lighting.
+    pub(super) shadow: Option<PoseShadow>,
 }
 
-/// A pose's shadow maps resident with their weights and relit texture, bound
-/// ([`super::shadow`]): relit again by writing the weights.
-pub struct MapRelight {
-    pub(super) texels: u32,
-    pub(super) maps: usize,
-    pub(super) weights: wgpu::Buffer,
-    pub(super) bind: wgpu::BindGroup,
+/// The shadow a resident pose casts ([`super::shadow`]).
+pub enum PoseShadow {
+    /// Its shadow maps (shared by the poses made from the same ones) and the weight of
+    /// each under its light: relit by the frame that draws it.
+    Maps {
+        /// The maps, one per condition of their spec.
+        maps: Arc<ShadowMaps>,
+        /// Per map, the light its condition brings to the ground (rgb).
+        weights: Vec<[f32; 4]>,
+        /// Their size and patch of ground.
+        info: RelitShadowInfo,
+    },
+    /// Relit on the host (traced).
+    Relit {
+        /// The relit shadow (rgb, alpha 1).
+        texture: wgpu::Texture,
+        /// Its size and patch of ground.
+        info: RelitShadowInfo,
+    },
+}
+
+impl PoseShadow {
+    /// Its size and patch of ground.
+    pub fn info(&self) -> RelitShadowInfo {
+        match self {
+            PoseShadow::Maps { info, .. } | PoseShadow::Relit { info, .. } => *info,
+        }
+    }
 }
 
 /// What the composite pass needs to know of a relit shadow texture.
@@ -88,7 +108,7 @@ impl GpuPose {
 
     /// The ground patch of the resident relit shadow.
     pub fn shadow_ground(&self) -> Option<GroundGrid> {
-        self.shadow.as_ref().map(|(_, i)| GroundGrid {
+        self.shadow.as_ref().map(|s| s.info()).map(|i| GroundGrid {
             extent_m: i.extent_m,
             texels: i.texels,
         })
@@ -97,7 +117,6 @@ impl GpuPose {
     /// Drops the relit shadow.
     pub fn clear_shadow(&mut self) {
         self.shadow = None;
-        self.shadow_maps = None;
     }
 }
 
@@ -463,7 +482,6 @@ impl Gpu {
             geometry: geometry.clone(),
             quad_count: quads.len() as u32,
             shadow: None,
-            shadow_maps: None,
         }
     }
 
