@@ -338,27 +338,65 @@ impl WalkerLight {
     }
 }
 
-/// Whether a walker standing at `there` may shade one at `here` under suns from
-/// `suns` (unit, scene frame): it stands toward one of them, within a body's width of the
-/// line from `here` toward it, and no farther than the shadow of a person reaches under
-/// it ([`frf_render::shadow_reach`]).
-fn may_shade(here: glam::Vec3, there: glam::Vec3, suns: &[glam::Vec3]) -> bool {
-    use frf_render::shadow_reach::{NOMINAL_SUBJECT, shadow_reach};
-    // Two bodies' radii, and a margin for the hulls' extent.
-    const WIDTH_M: f32 = 1.0;
-    let rel = glam::Vec2::new(there.x - here.x, there.z - here.z);
-    suns.iter().any(|d| {
+/// Two bodies' radii, and a margin for the hulls' extent: how near the line toward a
+/// sun another walker stands to shade one ([`may_shade`]).
+const SHADE_WIDTH_M: f32 = 1.0;
+
+/// A sun as [`may_shade`] reads it: worked out once a frame, not once a pair.
+#[derive(Debug, Clone, Copy)]
+enum SunReach {
+    /// Below the horizon: no one shades anyone.
+    Below,
+    /// Straight overhead: a walker shades only what it stands over.
+    Overhead,
+    /// Toward `toward` (unit, on the ground), a person's shadow `reach` metres long
+    /// ([`frf_render::shadow_reach`]).
+    Toward { toward: glam::Vec2, reach: f32 },
+}
+
+impl SunReach {
+    /// The sun toward `d` (unit, scene frame).
+    fn of(d: glam::Vec3) -> Self {
+        use frf_render::shadow_reach::{NOMINAL_SUBJECT, shadow_reach};
         let horizontal = glam::Vec2::new(d.x, d.z);
-        if d.y <= 0.0 || horizontal.length() < 1e-6 {
-            // Straight overhead a walker shades only what it stands over.
-            return d.y > 0.0 && rel.length() < WIDTH_M;
+        if d.y <= 0.0 {
+            SunReach::Below
+        } else if horizontal.length() < 1e-6 {
+            SunReach::Overhead
+        } else {
+            SunReach::Toward {
+                toward: horizontal.normalize(),
+                reach: shadow_reach(d.y.asin(), NOMINAL_SUBJECT),
+            }
         }
-        let toward = horizontal.normalize();
-        let along = rel.dot(toward);
-        let across = (rel - toward * along).length();
-        let reach = shadow_reach(d.y.asin(), NOMINAL_SUBJECT);
-        along > -WIDTH_M && along < reach + WIDTH_M && across < WIDTH_M
+    }
+}
+
+/// Whether a walker standing at `there` may shade one at `here` under `suns`: it stands
+/// toward one of them, within a body's width of the line from `here` toward it, and no
+/// farther than the shadow of a person reaches under it.
+fn may_shade(here: glam::Vec3, there: glam::Vec3, suns: &[SunReach]) -> bool {
+    let rel = glam::Vec2::new(there.x - here.x, there.z - here.z);
+    suns.iter().any(|sun| match *sun {
+        SunReach::Below => false,
+        SunReach::Overhead => rel.length() < SHADE_WIDTH_M,
+        SunReach::Toward { toward, reach } => {
+            let along = rel.dot(toward);
+            let across = (rel - toward * along).length();
+            along > -SHADE_WIDTH_M && along < reach + SHADE_WIDTH_M && across < SHADE_WIDTH_M
+        }
     })
+}
+
+/// A frame's light as its walkers see it: the frame, where each walker stands, its suns,
+/// the turn of the keys' light (maps, sun) and how much farther that is than the light
+/// walkers are relit under ([`WalkerLight::ahead`]).
+struct FrameLight {
+    fp: FramePlan,
+    placements: Vec<Placement>,
+    suns: Vec<SunReach>,
+    yaw: [f32; 2],
+    ahead: f32,
 }
 
 /// The map that lights a walker under `world` (scene frame): the scene's, or with probes
@@ -1152,7 +1190,10 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .chain(fp.between[i].map(|(after, _)| (i, after)))
         });
         let suns = world.map_or(&[][..], |w| &w.sun_directions[..]);
-        let lights = self.walker_lights(fp, (suns, lighting.yaw))?;
+        let frame = self.frame_light(fp.clone(), (suns, lighting.yaw, 0.0));
+        let lights = (0..fp.poses.len())
+            .map(|i| self.walker_light(&frame, i))
+            .collect::<Result<Vec<_>>>()?;
         // The lights of the frames ahead, worked out when a walker is first relit.
         let mut ahead = None;
         for (i, pose) in drawn {
@@ -1290,35 +1331,46 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         &mut self,
         fp: &FramePlan,
         (lighting, world): (&LightingAt, Option<&World>),
-        ahead: &mut Option<Vec<Vec<WalkerLight>>>,
+        ahead: &mut Option<Vec<FrameLight>>,
         (i, now): (usize, &WalkerLight),
     ) -> Result<WalkerLight> {
-        if ahead.is_none() {
-            *ahead = Some(self.lights_ahead(fp, lighting, world)?);
+        let frames = match ahead {
+            Some(frames) => frames,
+            None => ahead.insert(self.lights_ahead(fp, lighting, world)),
+        };
+        // The walker's own light at each frame ahead, up to the first that does not
+        // hold its light now ([`LightTolerance::farthest`]).
+        let mut lights = Vec::new();
+        for frame in frames.iter() {
+            let light = self.walker_light(frame, i)?;
+            let holds = self.options.light_tolerance.holds(&light, now);
+            lights.push(light);
+            if !holds {
+                break;
+            }
         }
-        let lights = ahead.iter().flatten().map(|l| &l[i]);
         let shared = !self.own_light[i];
         Ok((self.options.light_tolerance)
-            .farthest(now, lights, shared)
+            .farthest(now, &lights, shared)
             .clone())
     }
 
-    /// Every walker's light at each of the [`LOOK_AHEAD_FRAMES`] frames after `fp` (under
+    /// The light of each of the [`LOOK_AHEAD_FRAMES`] frames after `fp` (under
     /// `lighting`, `world`), at the scene's rate, up to the first whose lighting is not
     /// the frame's turned (or, with probes, whose maps the keys do not turn, turned at
     /// all): each as the frame's lighting turned by how far the keys turn it by then
     /// ([`WalkerLight::ahead`]). None when the tolerance is exact.
     fn lights_ahead(
-        &mut self,
+        &self,
         fp: &FramePlan,
         lighting: &LightingAt,
         world: Option<&World>,
-    ) -> Result<Vec<Vec<WalkerLight>>> {
+    ) -> Vec<FrameLight> {
         let step = 1.0 / self.scene.fps;
         let tolerance = self.options.light_tolerance;
         let mut out = Vec::new();
         if tolerance == LightTolerance::EXACT || !(step.is_finite() && step > 0.0) {
-            return Ok(out);
+            return out;
         }
         let key = LightingKey::of(lighting);
         for k in 1..=LOOK_AHEAD_FRAMES {
@@ -1336,56 +1388,60 @@ impl<'a, R: ReadAt> Shot<'a, R> {
                 .map(|&d| spin * d)
                 .collect();
             let frame = self.frame_at(fp.index + k, t);
-            let mut lights = self.walker_lights(&frame, (&suns, l.yaw))?;
-            for light in &mut lights {
-                light.ahead = turn;
-            }
-            out.push(lights);
+            out.push(self.frame_light(frame, (&suns, l.yaw, turn)));
         }
-        Ok(out)
+        out
     }
 
-    /// Every walker's own light at frame `fp` under suns toward `suns` (scene frame,
-    /// unit), the lighting keys turning the light by `keys` (radians): its heading, the
-    /// probes' weights where it stands, and the other walkers in the way of its suns
-    /// ([`may_shade`]).
-    fn walker_lights(
-        &mut self,
-        fp: &FramePlan,
-        (suns, keys): (&[glam::Vec3], f32),
-    ) -> Result<Vec<WalkerLight>> {
+    /// Frame `fp`'s light under suns toward `suns` (scene frame, unit), the lighting keys
+    /// turning the light by `keys` (radians), `ahead` farther than the light walkers are
+    /// relit under.
+    fn frame_light(
+        &self,
+        fp: FramePlan,
+        (suns, keys, ahead): (&[glam::Vec3], f32, f32),
+    ) -> FrameLight {
         let n = self.scene.instances.len();
-        let placements: Vec<Placement> = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
+        let placements = (0..n).map(|i| self.scene.placement(i, fp.time)).collect();
         let maps = if self.scene.probes.is_some() {
             0.0
         } else {
             keys
         };
-        let yaw = [maps, keys];
-        let mut lights = Vec::with_capacity(n);
-        for (i, here) in placements.iter().enumerate() {
-            let weights = self.scene.probe_weights(i, fp.time);
-            let mut light = WalkerLight::new(here.heading, yaw, weights);
-            let subject_from_world = here.world_from_subject().inverse();
-            for (j, there) in placements.iter().enumerate() {
-                let shades = self.options.walker_shadows && j != i;
-                if !shades || !may_shade(here.position, there.position, suns) {
-                    continue;
-                }
-                // The nearer of the two poses it is drawn between casts the shadow.
-                let pose = match fp.between[j] {
-                    Some((after, s)) if s >= 0.5 => after,
-                    _ => fp.poses[j],
-                };
-                let Some(hull) = self.hull(pose)? else {
-                    continue;
-                };
-                let here_from_there = subject_from_world.compose(&there.world_from_subject());
-                light.with_occluder(j, (pose, hull), here_from_there);
-            }
-            lights.push(light);
+        FrameLight {
+            placements,
+            suns: suns.iter().map(|&d| SunReach::of(d)).collect(),
+            yaw: [maps, keys],
+            ahead,
+            fp,
         }
-        Ok(lights)
+    }
+
+    /// Walker `i`'s own light in `frame`: its heading, the probes' weights where it
+    /// stands, and the other walkers in the way of its suns ([`may_shade`]).
+    fn walker_light(&mut self, frame: &FrameLight, i: usize) -> Result<WalkerLight> {
+        let here = &frame.placements[i];
+        let weights = self.scene.probe_weights(i, frame.fp.time);
+        let mut light = WalkerLight::new(here.heading, frame.yaw, weights);
+        light.ahead = frame.ahead;
+        let subject_from_world = here.world_from_subject().inverse();
+        for (j, there) in frame.placements.iter().enumerate() {
+            let shades = self.options.walker_shadows && j != i;
+            if !shades || !may_shade(here.position, there.position, &frame.suns) {
+                continue;
+            }
+            // The nearer of the two poses it is drawn between casts the shadow.
+            let pose = match frame.fp.between[j] {
+                Some((after, s)) if s >= 0.5 => after,
+                _ => frame.fp.poses[j],
+            };
+            let Some(hull) = self.hull(pose)? else {
+                continue;
+            };
+            let here_from_there = subject_from_world.compose(&there.world_from_subject());
+            light.with_occluder(j, (pose, hull), here_from_there);
+        }
+        Ok(light)
     }
 
     /// The visual hull of pose `pose`, read once.
