@@ -399,6 +399,16 @@ impl Cylinder {
         ColumnIndex::gpu(self.index.as_ref())
     }
 
+    /// Quads (and walls) it holds.
+    pub fn quad_count(&self) -> usize {
+        self.quads.len()
+    }
+
+    /// Bytes [`Cylinder::column_index_gpu`] makes, without making them.
+    pub fn column_index_gpu_bytes(&self) -> usize {
+        ColumnIndex::gpu_bytes(self.index.as_ref())
+    }
+
     /// The quads and walls, as the GPU needs them.
     pub fn quads(&self) -> Vec<QuadData> {
         self.quads
@@ -484,6 +494,18 @@ mod tests {
             }
         }
         (centres, 36, 3)
+    }
+
+    /// What the GPU is given is counted without being made: the same bytes.
+    #[test]
+    fn the_gpu_bytes_are_counted_as_made() {
+        let (centres, cols, rows) = grid();
+        let cyl = Cylinder::new(&centres, cols, rows, true);
+        assert_eq!(cyl.quad_count(), cyl.quads().len());
+        let (index, ranges) = cyl.column_index_gpu();
+        assert!(ranges.len() > 1, "an index of one range tells nothing");
+        let made = std::mem::size_of_val(&index) + std::mem::size_of_val(ranges.as_slice());
+        assert_eq!(cyl.column_index_gpu_bytes(), made);
     }
 
     #[test]

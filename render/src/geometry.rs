@@ -293,13 +293,13 @@ impl PoseGeometry {
     /// decoding tables and the proxy.
     pub fn resident_bytes(&self) -> u64 {
         let texels = self.crop.texels() as u64;
-        let quads = self.cylinder.quads().len() as u64;
-        let (index, ranges) = self.cylinder.column_index_gpu();
+        // Counted, not made: a crowd's relights ask every frame.
+        let quads = self.cylinder.quad_count() as u64;
         texels
             * (4 * self.prelit_layer_count.max(1) as u64 + 2 * self.flow_layer_count.max(1) as u64)
             + self.views() as u64 * std::mem::size_of::<GpuView>() as u64
             + quads * std::mem::size_of::<GpuQuad>() as u64
-            + (std::mem::size_of_val(&index) + std::mem::size_of_val(ranges.as_slice())) as u64
+            + self.cylinder.column_index_gpu_bytes() as u64
             + TABLE_BYTES
             + self.proxy.resident_bytes()
     }

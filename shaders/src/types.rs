@@ -400,10 +400,13 @@ pub struct GpuTimeMorph {
     /// 1: the walker's depth is the nearer of its two poses' (the morph's depth written
     /// beside it); 0: no depth is read or written.
     pub by_depth: u32,
+    /// The morph's page among the morphs' pages.
+    pub morph_page: u32,
     /// Padding.
-    pub pad1: f32,
-    /// Padding.
-    pub pad2: f32,
+    pub pad: u32,
+    /// The pages of pose `k`'s render (among the subjects'), of pose `k'`'s and of the
+    /// two poses' motion renders (among the scratch renders').
+    pub pages: [u32; 4],
 }
 
 /// `TurnParams` of `turn_light.wgsl`: a batch of views whose light the device looks up.

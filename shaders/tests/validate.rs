@@ -368,7 +368,7 @@ fn pod_structs_match_naga_layouts() {
         "TimeMorph",
         GpuTimeMorph,
         [
-            to_image, bounds, at_poses, at_motions, at_morph, s, by_depth, pad1, pad2
+            to_image, bounds, at_poses, at_motions, at_morph, s, by_depth, morph_page, pad, pages
         ]
     );
 }

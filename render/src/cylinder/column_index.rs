@@ -282,6 +282,12 @@ impl ColumnIndex {
         }
     }
 
+    /// Bytes [`ColumnIndex::gpu`] makes (its header and ranges), without making them.
+    pub(super) fn gpu_bytes(index: Option<&Self>) -> usize {
+        std::mem::size_of::<GpuColumnIndex>()
+            + std::mem::size_of::<[f32; 2]>() * index.map_or(1, |c| c.ranges.len())
+    }
+
     /// The index as the GPU reads it: header and ranges (`index` `None`: disabled, one
     /// empty range).
     pub(super) fn gpu(index: Option<&Self>) -> (GpuColumnIndex, Vec<[f32; 2]>) {

@@ -215,11 +215,6 @@ impl Subjects {
         &self.targets.depth
     }
 
-    /// The view of `page` of the depths.
-    pub(super) fn depth_page_view(&self, page: u32) -> &wgpu::TextureView {
-        self.targets.depth_page_view(page)
-    }
-
     /// The id of the targets they are drawn into ([`SubjectTargets::id`]).
     pub fn id(&self) -> u64 {
         self.targets.id
@@ -329,9 +324,8 @@ pub(super) struct SubjectTargets {
     /// Names these targets in the keys of bind groups made of them ([`super::kept`]).
     pub(super) id: u64,
     texture: wgpu::Texture,
-    /// The renders' depths, texel for texel beside `texture` (R32Float), and its pages.
+    /// The renders' depths, texel for texel beside `texture` (R32Float).
     depth: wgpu::Texture,
-    depth_pages: Vec<wgpu::TextureView>,
     pages: Vec<wgpu::TextureView>,
     slots: Vec<SlotTargets>,
     /// Every slot's frame uniform, each at its multiple of `stride`: a frame writes them
@@ -414,7 +408,6 @@ impl SubjectTargets {
             view_formats: &[],
         });
         let all_depth = array_view(&depth);
-        let depth_pages = page_views(&depth);
         let stats = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("stats"),
             size: 16,
@@ -474,7 +467,6 @@ impl SubjectTargets {
             id: super::kept::unique_id(),
             texture,
             depth,
-            depth_pages,
             pages,
             slots,
             uniforms,
@@ -510,11 +502,6 @@ impl SubjectTargets {
     /// The depths' texture array.
     pub(super) fn depth_texture(&self) -> &wgpu::Texture {
         &self.depth
-    }
-
-    /// The view of `page` of the depths.
-    pub(super) fn depth_page_view(&self, page: u32) -> &wgpu::TextureView {
-        &self.depth_pages[page as usize]
     }
 
     /// The fragment pass's frame bind group of `slot`.

@@ -10,9 +10,8 @@
 use frf_core::camera::Camera;
 use frf_shaders::types::GpuTimeMorph;
 use glam::Mat2;
-use wgpu::util::DeviceExt;
 
-use super::bind::uniform_stride;
+use super::bind::{bind_group, buffer_with, storage, storage_texture_array, texture_array};
 use super::pose::GpuPose;
 use super::rebin::{DrawnRender, Place, SubjectTargets, Subjects, places, workgroups};
 use super::timing::compute_pass_writes;
@@ -43,47 +42,22 @@ impl TimeMorphPass {
     /// Compiles the pass on `device`.
     pub fn new(device: &wgpu::Device) -> Self {
         let module = shaders::module(device, "time morph", shaders::TIME_MORPH);
-        let storage = |binding, format| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        };
-        let texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
+        let texture = |binding| {
+            texture_array(
+                binding,
+                wgpu::TextureSampleType::Float { filterable: false },
+            )
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("time morph"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                storage::<GpuTimeMorph>(0, true, wgpu::ShaderStages::COMPUTE),
                 texture(1),
                 texture(2),
-                texture(3),
+                storage_texture_array(3, wgpu::TextureFormat::Rgba32Float),
                 texture(4),
-                storage(5, wgpu::TextureFormat::Rgba32Float),
-                texture(6),
-                texture(7),
-                storage(8, wgpu::TextureFormat::R32Float),
+                texture(5),
+                storage_texture_array(6, wgpu::TextureFormat::R32Float),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -142,100 +116,100 @@ impl Gpu {
         // Every walker's three renders, in one go, then their morphs in one pass.
         let drawn = between_renders(walkers, &renders);
         self.draw_renders(encoder, &scratch, &drawn, (variant, by_depth), None, false);
-        let groups = self.morph_groups(&scratch, subjects, walkers, (&renders, &morphs), by_depth);
-        {
+        let group = self.morph_group(
+            &scratch,
+            subjects,
+            walkers,
+            (&renders, &morphs, render_pages),
+            by_depth,
+        );
+        // One dispatch for every walker (a layer of workgroups each) over the largest box.
+        let (x, y) = walkers
+            .iter()
+            .map(|w| workgroups(w.within.size()))
+            .fold((0, 0), |(a, b), (x, y)| (a.max(x), b.max(y)));
+        if x * y > 0 {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("time morph"),
                 timestamp_writes: compute_pass_writes(self.pass_timestamps("time morph", None)),
             });
             pass.set_pipeline(&self.time_morph.pipeline);
-            for (w, group) in walkers.iter().zip(&groups) {
-                let (x, y) = workgroups(w.within.size());
-                if x * y > 0 {
-                    pass.set_bind_group(0, group, &[]);
-                    pass.dispatch_workgroups(x, y, 1);
-                }
-            }
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(x, y, walkers.len() as u32);
         }
         copy_morphs(encoder, &scratch, subjects, walkers, (&morphs, by_depth));
     }
 
-    /// Each walker's morph bind group (`renders`: three places a walker, `morphs`: one):
-    /// their uniforms in one buffer, each bound at its stride.
-    fn morph_groups(
+    /// The morphs' bind group (`renders`: three places a walker, on the first
+    /// `render_pages` pages of `scratch`; `morphs`: one, on the pages after them): every
+    /// walker's record in one buffer, the pages as arrays.
+    fn morph_group(
         &self,
         scratch: &SubjectTargets,
         subjects: &Subjects,
         walkers: &[BetweenDraw],
-        (renders, morphs): (&[Place], &[Place]),
+        (renders, morphs, render_pages): (&[Place], &[Place], u32),
         by_depth: bool,
-    ) -> Vec<wgpu::BindGroup> {
-        let size_of_uniform = std::mem::size_of::<GpuTimeMorph>();
-        let stride = uniform_stride(&self.device, size_of_uniform);
-        let mut bytes = vec![0u8; stride * walkers.len()];
-        for (j, w) in walkers.iter().enumerate() {
-            let (before, _) = subjects.place(w.layer);
-            let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
-            let pair = |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
-            let m: Mat2 = crate::motion::motion_to_image(&w.camera);
-            let uniform = GpuTimeMorph {
-                to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
-                bounds: w.within.to_array(),
-                at_poses: pair(before, after),
-                at_motions: pair(before_motion, after_motion),
-                at_morph: pair(morphs[j], morphs[j]),
-                s: w.between.s,
-                by_depth: by_depth as u32,
-                pad1: 0.0,
-                pad2: 0.0,
-            };
-            bytes[j * stride..][..size_of_uniform].copy_from_slice(bytemuck::bytes_of(&uniform));
-        }
-        let buffer = self
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("time morphs"),
-                contents: &bytes,
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-        fn view(v: &wgpu::TextureView, binding: u32) -> wgpu::BindGroupEntry<'_> {
-            wgpu::BindGroupEntry {
-                binding,
-                resource: wgpu::BindingResource::TextureView(v),
-            }
-        }
-        let page = |p: Place| scratch.page_view(p.page);
-        let depth_page = |p: Place| scratch.depth_page_view(p.page);
-        walkers
+    ) -> wgpu::BindGroup {
+        let records: Vec<GpuTimeMorph> = walkers
             .iter()
             .enumerate()
             .map(|(j, w)| {
-                let (before, before_view) = subjects.place(w.layer);
+                let (before, _) = subjects.place(w.layer);
                 let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
-                self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("time morph"),
-                    layout: &self.time_morph.layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                                buffer: &buffer,
-                                offset: (j * stride) as u64,
-                                size: std::num::NonZeroU64::new(size_of_uniform as u64),
-                            }),
-                        },
-                        view(before_view, 1),
-                        view(page(after), 2),
-                        view(page(before_motion), 3),
-                        view(page(after_motion), 4),
-                        view(page(morphs[j]), 5),
-                        view(subjects.depth_page_view(before.page), 6),
-                        view(depth_page(after), 7),
-                        view(depth_page(morphs[j]), 8),
+                let pair =
+                    |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
+                let m: Mat2 = crate::motion::motion_to_image(&w.camera);
+                GpuTimeMorph {
+                    to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
+                    bounds: w.within.to_array(),
+                    at_poses: pair(before, after),
+                    at_motions: pair(before_motion, after_motion),
+                    at_morph: pair(morphs[j], morphs[j]),
+                    s: w.between.s,
+                    by_depth: by_depth as u32,
+                    morph_page: morphs[j].page - render_pages,
+                    pad: 0,
+                    pages: [
+                        before.page,
+                        after.page,
+                        before_motion.page,
+                        after_motion.page,
                     ],
-                })
+                }
             })
-            .collect()
+            .collect();
+        let buffer = buffer_with(
+            &self.device,
+            "time morphs",
+            bytemuck::cast_slice(&records),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let layers = |t: &wgpu::Texture, first: u32, count: Option<u32>| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                base_array_layer: first,
+                array_layer_count: count,
+                ..Default::default()
+            })
+        };
+        let views = [
+            layers(subjects.texture(), 0, None),
+            layers(scratch.texture(), 0, Some(render_pages)),
+            layers(scratch.texture(), render_pages, None),
+            layers(subjects.depth_texture(), 0, None),
+            layers(scratch.depth_texture(), 0, Some(render_pages)),
+            layers(scratch.depth_texture(), render_pages, None),
+        ];
+        let resources = std::iter::once(buffer.as_entire_binding())
+            .chain(views.iter().map(wgpu::BindingResource::TextureView))
+            .collect();
+        bind_group(
+            &self.device,
+            "time morph",
+            &self.time_morph.layout,
+            resources,
+        )
     }
 }
 
