@@ -342,8 +342,6 @@ impl Gpu {
                 .collect();
             // Walkers that may overlap are put over each other by depth, pixel by pixel.
             let by_depth = drawn.len() > 1;
-            let subjects =
-                self.draw_subjects(encoder, &drawn, size, (variant, by_depth), timestamps);
             let between: Vec<BetweenDraw> = order
                 .iter()
                 .enumerate()
@@ -357,7 +355,16 @@ impl Gpu {
                     })
                 })
                 .collect();
-            self.morph_in_time(encoder, &subjects, &between, size, (variant, by_depth));
+            // Room for each morph in time on the subjects' pages after the renders'.
+            let morphs: Vec<PixelBox> = between.iter().map(|b| b.within).collect();
+            let mut subjects = self.draw_subjects(
+                encoder,
+                (&drawn, &morphs),
+                size,
+                (variant, by_depth),
+                timestamps,
+            );
+            self.morph_in_time(encoder, &mut subjects, &between, size, (variant, by_depth));
             let n_shadow = shadow_info.map_or(1, |s| s.texels);
             let t = self.composite_targets((size, order.len() as u32, n_shadow));
             let (gpu_instances, touched, shadows) =
@@ -503,7 +510,7 @@ fn place_walkers<'a>(
             col_z: m.rotation.z_axis.extend(0.0).to_array(),
             translation: m.translation.extend(texels as f32).to_array(),
             bounds: drawn[layer].2.to_array(),
-            place: subjects.place(layer).0.to_array(),
+            place: subjects.shown(layer).to_array(),
         });
     }
     (gpu_instances, touched, shadows)

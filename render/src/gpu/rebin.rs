@@ -183,6 +183,13 @@ pub(super) struct Subjects {
     outside: usize,
     /// Per walker (in drawing order), where its render lies.
     places: Vec<Place>,
+    /// Pages the walkers' renders take (the first); room for the morphs in time follows
+    /// them ([`Subjects::morph_place`]).
+    render_pages: u32,
+    /// Where each morph in time asked for is to lie, on the pages after the renders'.
+    morphs: Vec<Place>,
+    /// Per walker, where the composite reads it: its render, or its morph in time.
+    shown: Vec<Place>,
 }
 
 /// What happened to a frame's pixels: the counters' bytes as the class pass left them
@@ -224,6 +231,26 @@ impl Subjects {
     pub(super) fn place(&self, k: usize) -> (Place, &wgpu::TextureView) {
         let place = self.places[k];
         (place, self.targets.page_view(place.page))
+    }
+
+    /// Pages the walkers' renders take, before the morphs'.
+    pub(super) fn render_pages(&self) -> u32 {
+        self.render_pages
+    }
+
+    /// Where morph `j` (of those asked for when drawn) is to lie.
+    pub(super) fn morph_place(&self, j: usize) -> Place {
+        self.morphs[j]
+    }
+
+    /// Walker `k` is shown by morph `j` ([`Subjects::shown`]).
+    pub(super) fn show_morph(&mut self, k: usize, j: usize) {
+        self.shown[k] = self.morphs[j];
+    }
+
+    /// Where the composite reads walker `k`: its render, or its morph in time.
+    pub(super) fn shown(&self, k: usize) -> Place {
+        self.shown[k]
     }
 }
 
@@ -635,17 +662,24 @@ impl Gpu {
     /// camera (in its subject frame) within its pixel box, the boxes packed into pages
     /// of `size` ([`Place`]), in the order given (back to front; the composite pass puts
     /// each over the ones before it), and their pixel classes counted (the pixels
-    /// outside a box as missed).
+    /// outside a box as missed). Room is kept on pages after theirs for a morph in time
+    /// of each box of `morphs` ([`super::time_morph`]).
     pub(super) fn draw_subjects(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        instances: &[(&GpuPose, Camera, PixelBox)],
+        (instances, morphs): (&[(&GpuPose, Camera, PixelBox)], &[PixelBox]),
         size: (u32, u32),
         (variant, depth): (Variant, bool),
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> Subjects {
         let boxes: Vec<PixelBox> = instances.iter().map(|i| i.2).collect();
-        let (places, pages) = places(&boxes, size, 0);
+        let (places, render_pages) = places(&boxes, size, 0);
+        let (morph_places, morph_pages) = if morphs.is_empty() {
+            (Vec::new(), 0)
+        } else {
+            self::places(morphs, size, render_pages)
+        };
+        let pages = render_pages + morph_pages;
         let targets = self.subject_targets(size, instances.len().max(1) as u32, pages);
         // The pixels shaded; the pass counts those clamped or missed beside them.
         let shaded = instances.iter().map(|i| i.2.pixels() as u32).sum::<u32>();
@@ -678,7 +712,10 @@ impl Gpu {
         Subjects {
             targets,
             outside,
+            shown: places.clone(),
             places,
+            render_pages,
+            morphs: morph_places,
         }
     }
 
@@ -784,7 +821,7 @@ impl Gpu {
             let whole = PixelBox::whole(size.0, size.1);
             let subject = self.draw_subjects(
                 &mut encoder,
-                &[(pose, *camera, whole)],
+                (&[(pose, *camera, whole)], &[]),
                 size,
                 (variant, false),
                 None,

@@ -1,12 +1,12 @@
 //! The GPU twin of [`crate::motion::time_morph`]: walkers between two captured poses.
 //! Pose `k`'s render is drawn into the walker's place in the frame's subjects, as any
 //! walker's; pose `k'`'s render and both poses' motion renders into targets kept for
-//! frames between poses; `shaders/time_morph.wgsl` morphs them in time into a fourth
-//! render there, which is copied over the walker's before the composite reads it. All of
-//! it within the walker's pixel box alone, each render packed with others into pages
-//! ([`crate::atlas`]; the morphs on pages of their own, so that a pass never reads the
-//! page it writes): nothing reads a render outside its box, so a far walker's morph costs
-//! its own pixels, not the frame's.
+//! frames between poses; `shaders/time_morph.wgsl` morphs them in time, every walker in
+//! one dispatch, into a place kept for it on the subjects' pages after the renders'
+//! (so that the pass never reads a page it writes), where the composite reads the walker
+//! ([`Subjects::shown`]). All of it within the walker's pixel box alone, each render
+//! packed with others into pages ([`crate::atlas`]): nothing reads a render outside its
+//! box, so a far walker's morph costs its own pixels, not the frame's.
 use frf_core::camera::Camera;
 use frf_shaders::types::GpuTimeMorph;
 use glam::Mat2;
@@ -88,12 +88,14 @@ pub(super) struct BetweenDraw<'a> {
 }
 
 impl Gpu {
-    /// Records the morph in time of every walker of `walkers` into `encoder`, over its
-    /// render in `subjects` (where pose `k` is already drawn; see the module docs).
+    /// Records the morph in time of every walker of `walkers` into `encoder`, from its
+    /// render in `subjects` (where pose `k` is already drawn) into the place kept there
+    /// for it (walker `j` of `walkers`, morph `j`), which then shows it (see the module
+    /// docs).
     pub(super) fn morph_in_time(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        subjects: &Subjects,
+        subjects: &mut Subjects,
         walkers: &[BetweenDraw],
         size: (u32, u32),
         (variant, by_depth): (Variant, bool),
@@ -101,14 +103,9 @@ impl Gpu {
         if walkers.is_empty() {
             return;
         }
-        // Three renders a walker (pose k', and both poses' motion) packed into pages,
-        // and each walker's morph into pages of its own after them: a pass never reads
-        // the page it writes.
+        // Three renders a walker (pose k', and both poses' motion) packed into pages.
         let boxes: Vec<PixelBox> = walkers.iter().flat_map(|w| [w.within; 3]).collect();
-        let (renders, render_pages) = places(&boxes, size, 0);
-        let boxes: Vec<PixelBox> = walkers.iter().map(|w| w.within).collect();
-        let (morphs, morph_pages) = places(&boxes, size, render_pages);
-        let pages = render_pages + morph_pages;
+        let (renders, pages) = places(&boxes, size, 0);
         let slots = 3 * walkers.len() as u32;
         let scratch = self.between_targets.get((size, slots, pages), || {
             SubjectTargets::new(&self.device, &self.rebin, size, slots, pages)
@@ -116,13 +113,7 @@ impl Gpu {
         // Every walker's three renders, in one go, then their morphs in one pass.
         let drawn = between_renders(walkers, &renders);
         self.draw_renders(encoder, &scratch, &drawn, (variant, by_depth), None, false);
-        let group = self.morph_group(
-            &scratch,
-            subjects,
-            walkers,
-            (&renders, &morphs, render_pages),
-            by_depth,
-        );
+        let group = self.morph_group(&scratch, subjects, walkers, &renders, by_depth);
         // One dispatch for every walker (a layer of workgroups each) over the largest box.
         let (x, y) = walkers
             .iter()
@@ -137,20 +128,24 @@ impl Gpu {
             pass.set_bind_group(0, &group, &[]);
             pass.dispatch_workgroups(x, y, walkers.len() as u32);
         }
-        copy_morphs(encoder, &scratch, subjects, walkers, (&morphs, by_depth));
+        // The composite reads each walker's morph where it was written.
+        for (j, w) in walkers.iter().enumerate() {
+            subjects.show_morph(w.layer, j);
+        }
     }
 
-    /// The morphs' bind group (`renders`: three places a walker, on the first
-    /// `render_pages` pages of `scratch`; `morphs`: one, on the pages after them): every
-    /// walker's record in one buffer, the pages as arrays.
+    /// The morphs' bind group (`renders`: three places a walker on `scratch`; walker
+    /// `j`'s morph at the subjects' morph place `j`, on the pages after the renders'):
+    /// every walker's record in one buffer, the pages as arrays.
     fn morph_group(
         &self,
         scratch: &SubjectTargets,
         subjects: &Subjects,
         walkers: &[BetweenDraw],
-        (renders, morphs, render_pages): (&[Place], &[Place], u32),
+        renders: &[Place],
         by_depth: bool,
     ) -> wgpu::BindGroup {
+        let render_pages = subjects.render_pages();
         let records: Vec<GpuTimeMorph> = walkers
             .iter()
             .enumerate()
@@ -160,15 +155,16 @@ impl Gpu {
                 let pair =
                     |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
                 let m: Mat2 = crate::motion::motion_to_image(&w.camera);
+                let morph = subjects.morph_place(j);
                 GpuTimeMorph {
                     to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
                     bounds: w.within.to_array(),
                     at_poses: pair(before, after),
                     at_motions: pair(before_motion, after_motion),
-                    at_morph: pair(morphs[j], morphs[j]),
+                    at_morph: pair(morph, morph),
                     s: w.between.s,
                     by_depth: by_depth as u32,
-                    morph_page: morphs[j].page - render_pages,
+                    morph_page: morph.page - render_pages,
                     pad: 0,
                     pages: [
                         before.page,
@@ -193,13 +189,14 @@ impl Gpu {
                 ..Default::default()
             })
         };
+        // The subjects' renders read, their morphs' pages written: apart.
         let views = [
-            layers(subjects.texture(), 0, None),
-            layers(scratch.texture(), 0, Some(render_pages)),
-            layers(scratch.texture(), render_pages, None),
-            layers(subjects.depth_texture(), 0, None),
-            layers(scratch.depth_texture(), 0, Some(render_pages)),
-            layers(scratch.depth_texture(), render_pages, None),
+            layers(subjects.texture(), 0, Some(render_pages)),
+            layers(scratch.texture(), 0, None),
+            layers(subjects.texture(), render_pages, None),
+            layers(subjects.depth_texture(), 0, Some(render_pages)),
+            layers(scratch.depth_texture(), 0, None),
+            layers(subjects.depth_texture(), render_pages, None),
         ];
         let resources = std::iter::once(buffer.as_entire_binding())
             .chain(views.iter().map(wgpu::BindingResource::TextureView))
@@ -237,53 +234,4 @@ fn between_renders<'a>(
                 })
         })
         .collect()
-}
-
-/// Each morphed walker copied over its render in the subjects, after every morph has
-/// read the subjects (the walkers' places do not overlap), within its box only: nothing
-/// outside is read.
-fn copy_morphs(
-    encoder: &mut wgpu::CommandEncoder,
-    scratch: &SubjectTargets,
-    subjects: &Subjects,
-    walkers: &[BetweenDraw],
-    (morphs, by_depth): (&[Place], bool),
-) {
-    for (w, &morph) in walkers.iter().zip(morphs) {
-        let (before, _) = subjects.place(w.layer);
-        let (width, height) = w.within.size();
-        if width * height == 0 {
-            continue;
-        }
-        let at = |texture, place: Place| {
-            let (x, y) = place.texel(w.within.x0, w.within.y0);
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d {
-                    x,
-                    y,
-                    z: place.page,
-                },
-                aspect: wgpu::TextureAspect::All,
-            }
-        };
-        let extent = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        };
-        encoder.copy_texture_to_texture(
-            at(scratch.texture(), morph),
-            at(subjects.texture(), before),
-            extent,
-        );
-        if by_depth {
-            encoder.copy_texture_to_texture(
-                at(scratch.depth_texture(), morph),
-                at(subjects.depth_texture(), before),
-                extent,
-            );
-        }
-    }
 }
