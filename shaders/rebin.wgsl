@@ -19,7 +19,15 @@
 // the proxy, 2 occlusion-aware morphs) are constants written before the pass
 // (`frf_shaders::frame_pass`), so the shader compiled holds that morph alone.
 
-@group(0) @binding(0) var<uniform> frame: Frame;
+// The frames' records, 256 bytes apart (`FRAME_STRIDE` in render/src/gpu/rebin.rs): a
+// render's own first. A compute dispatch of several renders of one pose reads render z's
+// at z (`FRAMES_BOUND` at most); every entry point copies its record into `frame`.
+struct FrameRecord {
+    f: Frame,
+    pad: array<vec4<u32>, 6>,
+}
+@group(0) @binding(0) var<uniform> frames: array<FrameRecord, 64>;
+var<private> frame: Frame;
 // Pixels clamped above, clamped below and missed, at 1 to 3 (compute entry points; those
 // inside the grid, the rest of the shaded pixels, are not counted: a count of every pixel
 // would be an atomic per pixel on one word).
@@ -172,6 +180,7 @@ fn shade(position: vec2<f32>) -> vec4<f32> {
 // Drawn into the layer `frame.place.z`, where frame pixel p lies at p + frame.place.xy.
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    frame = frames[0].f;
     return shade(position.xy - vec2<f32>(frame.place.xy));
 }
 
@@ -185,6 +194,7 @@ fn count_class(kind: u32) {
 // The frame pass as a compute dispatch: shades and counts the pixel classes.
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    frame = frames[id.z].f;
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         let c = classify(vec2<f32>(p) + 0.5);
@@ -201,6 +211,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
 // The pixel classes alone, for frames drawn by the fragment pass.
 @compute @workgroup_size(8, 8)
 fn cs_classes(@builtin(global_invocation_id) id: vec3<u32>) {
+    frame = frames[id.z].f;
     let p = id.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         count_class(classify(vec2<f32>(p) + 0.5).kind);

@@ -68,6 +68,17 @@ pub struct RebinPass {
 /// ([`Variant::flags`]).
 type MorphKey = (u32, u32);
 
+/// Bytes from one frame record to the next in the frames' buffer (`FrameRecord` of
+/// `shaders/rebin.wgsl`: a [`GpuFrame`] and its padding): a multiple of every device's
+/// uniform offset alignment, so a slot's range starts at its own.
+const FRAME_STRIDE: usize = 256;
+/// Records a slot's range binds: its own and those after it, read by a dispatch that
+/// draws as many renders of one pose (`frames` of `shaders/rebin.wgsl`).
+const FRAMES_BOUND: usize = 64;
+/// What a slot binds of the frames' buffer.
+type FrameRecords = [[u8; FRAME_STRIDE]; FRAMES_BOUND];
+const _: () = assert!(std::mem::size_of::<GpuFrame>() <= FRAME_STRIDE);
+
 /// The frame pass's pipelines of one morph (its module compiled with the constants `KIND`
 /// and `FLAGS`, [`frf_shaders::frame_pass`]).
 pub(super) struct MorphPipelines {
@@ -86,11 +97,11 @@ impl RebinPass {
                 entries,
             })
         };
-        let frame_layout = layout("frame", &[uniform::<GpuFrame>(0, both)]);
+        let frame_layout = layout("frame", &[uniform::<FrameRecords>(0, both)]);
         let compute_layout = layout(
             "frame (compute)",
             &[
-                uniform::<GpuFrame>(0, both),
+                uniform::<FrameRecords>(0, both),
                 storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
                 storage_texture_array(2, wgpu::TextureFormat::Rgba32Float),
                 storage_texture_array(3, wgpu::TextureFormat::R32Float),
@@ -99,7 +110,7 @@ impl RebinPass {
         let classes_layout = layout(
             "frame (classes)",
             &[
-                uniform::<GpuFrame>(0, both),
+                uniform::<FrameRecords>(0, both),
                 storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
             ],
         );
@@ -451,9 +462,9 @@ impl SubjectTargets {
             })
         };
         let pages = page_views(&texture);
-        let size_of_frame = std::mem::size_of::<GpuFrame>();
-        let stride = super::bind::uniform_stride(device, size_of_frame);
-        let uniforms = uniform_buffer(device, "frames", stride * slots as usize);
+        // A slot's range holds the records after it too ([`FRAMES_BOUND`]).
+        let stride = FRAME_STRIDE;
+        let uniforms = uniform_buffer(device, "frames", stride * (slots as usize + FRAMES_BOUND));
         let slots = (0..slots as usize)
             .map(|slot| {
                 let frame = wgpu::BindGroupEntry {
@@ -461,7 +472,7 @@ impl SubjectTargets {
                     resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                         buffer: &uniforms,
                         offset: (slot * stride) as u64,
-                        size: std::num::NonZeroU64::new(size_of_frame as u64),
+                        size: std::num::NonZeroU64::new(size_of::<FrameRecords>() as u64),
                     }),
                 };
                 let stats = wgpu::BindGroupEntry {
@@ -632,14 +643,28 @@ impl RebinPass {
             timestamp_writes: super::timing::compute_pass_writes(timestamps),
         });
         pass.set_pipeline(&pipelines.compute);
-        for &(slot, pose_group, within) in renders {
-            let (x, y) = workgroups(within.size());
+        // Renders of one pose in consecutive slots: one dispatch, a layer of workgroups
+        // a render, over the largest of their boxes.
+        let mut at = 0;
+        while at < renders.len() {
+            let (slot, pose_group, _) = renders[at];
+            let run = renders[at..]
+                .iter()
+                .take(FRAMES_BOUND)
+                .enumerate()
+                .take_while(|(k, r)| r.0 == slot + k && std::ptr::eq(r.1, pose_group))
+                .count();
+            let (x, y) = renders[at..at + run]
+                .iter()
+                .map(|r| workgroups(r.2.size()))
+                .fold((0, 0), |(a, b), (x, y)| (a.max(x), b.max(y)));
+            at += run;
             if x * y == 0 {
                 continue;
             }
             pass.set_bind_group(0, &targets.slots[slot].compute, &[]);
             pass.set_bind_group(1, pose_group, &[]);
-            pass.dispatch_workgroups(x, y, 1);
+            pass.dispatch_workgroups(x, y, run as u32);
         }
     }
 }
@@ -733,6 +758,18 @@ impl Gpu {
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
+        // Renders of one pose next to each other (their slots in that order), so that
+        // the compute pass draws them in one dispatch ([`RebinPass::record_compute`]).
+        let mut order: Vec<usize> = (0..renders.len()).collect();
+        if self.stage == PassKind::Compute {
+            let first_of = |k: usize| {
+                (0..=k)
+                    .find(|&j| std::ptr::eq(renders[j].0, renders[k].0))
+                    .unwrap_or(k)
+            };
+            order.sort_by_key(|&k| first_of(k));
+        }
+        let renders: Vec<&(&GpuPose, DrawnRender)> = order.iter().map(|&k| &renders[k]).collect();
         let frames: Vec<GpuFrame> = renders
             .iter()
             .map(|(pose, d)| {
