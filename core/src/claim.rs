@@ -110,9 +110,8 @@ fn remove_temporaries(dir: &Path, prefix: &str) -> Vec<PathBuf> {
 
 /// Whether `file` (open) is still the file at `path` (not removed or replaced since).
 fn same_file(file: &File, path: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
     match (file.metadata(), std::fs::metadata(path)) {
-        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        (Ok(a), Ok(b)) => crate::atomic::same_inode(&a, &b),
         _ => false,
     }
 }

@@ -117,6 +117,25 @@ pub fn sprite_sheet(
 ) -> Result<SpriteReport> {
     let started = Instant::now();
     check(options)?;
+    // Neither output may be an input, nor the two outputs one file.
+    let json_path = sheet_json_path(png);
+    let light = match &options.env {
+        EnvSource::File(p) => Some(p.as_path()),
+        _ => None,
+    };
+    let inputs: Vec<&Path> = std::iter::once(field_path).chain(light).collect();
+    for out in [png, json_path.as_path()] {
+        frf_core::atomic::refuse_overwriting_inputs(out, &inputs)?;
+    }
+    if json_path == png {
+        return Err(frf_core::CoreError::BadOutput {
+            path: png.to_path_buf(),
+            problem: "the sheet's JSON is written beside the image with the extension .json: \
+                      the image needs another extension (.png)"
+                .into(),
+        }
+        .into());
+    }
     let field = FieldFile::open(field_path)?;
     frf_render::resident::check_renderable(&field)?;
     let header = field.header().clone();
@@ -205,7 +224,6 @@ pub fn sprite_sheet(
         "source": field_path.file_name().map(|n| n.to_string_lossy().into_owned()),
         "frames": frames,
     });
-    let json_path = sheet_json_path(png);
     let text = serde_json::to_string_pretty(&document)
         .map_err(|e| ExportError::Field(format!("the sheet's JSON: {e}")))?;
     frf_core::atomic::write_bytes_atomic(&json_path, text.as_bytes())?;

@@ -106,6 +106,7 @@ struct ViewOut {
 /// Exports `field` to `out` (written to a temporary file and renamed).
 pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<ExportReport> {
     let started = Instant::now();
+    frf_core::atomic::refuse_overwriting_inputs(out, &[field_path])?;
     let field = FieldFile::open(field_path)?;
     check_exportable(&field)?;
     let header = field.header().clone();

@@ -33,6 +33,9 @@ pub fn run(args: EnvShArgs) -> CliResult {
         );
     }
     let started = Instant::now();
+    if let EnvSource::File(map) = &args.env {
+        frf_core::atomic::refuse_overwriting_inputs(&args.out, &[map.as_path()])?;
+    }
     let env = args
         .env
         .load_required("the light to project")?

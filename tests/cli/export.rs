@@ -192,3 +192,122 @@ fn export_sprites_writes_a_sheet_whose_frames_are_frf_renders() {
         assert!(!bad.exists() && !dir.path().join("bad.json").exists());
     }
 }
+
+/// Issue 59: an output that names an input (by any path), or that another output of the
+/// same run names, is refused with the input left as it was; an output that is not a
+/// regular file is never replaced by a renamed temporary (a pipe refused, a device
+/// written in place, its error reported).
+#[test]
+fn an_output_never_replaces_an_input_or_a_file_that_is_not_regular() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let field = dir.path().join("field.frf");
+    std::fs::copy(&f.field, &field).unwrap();
+    let before = std::fs::read(&field).unwrap();
+    let same = dir.path().join(".").join("field.frf");
+    for out in [&field, &same] {
+        let o = frf(&[
+            "export",
+            field.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "export over its field accepted");
+        assert!(stderr(&o).contains("an input"), "{}", stderr(&o));
+        let sprites = frf(&[
+            "export",
+            field.to_str().unwrap(),
+            "--sprites",
+            "--cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!sprites.status.success(), "sprites over the field accepted");
+        assert_eq!(
+            std::fs::read(&field).unwrap(),
+            before,
+            "the field was replaced"
+        );
+    }
+    // The sheet's JSON goes beside the image as NAME.json: an image named so is refused,
+    // and so is a sheet whose JSON would replace the light it is lit by.
+    let sheet_json = dir.path().join("sheet.json");
+    let o = frf(&[
+        "export",
+        field.to_str().unwrap(),
+        "--sprites",
+        "--cpu",
+        "--out",
+        sheet_json.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains(".json"), "{}", stderr(&o));
+    assert!(!sheet_json.exists());
+    let light = dir.path().join("light.json");
+    assert!(
+        frf(&["env-sh", "sky", "--out", light.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let light_before = std::fs::read(&light).unwrap();
+    let png = dir.path().join("light.png");
+    let o = frf(&[
+        "export",
+        field.to_str().unwrap(),
+        "--sprites",
+        "--cpu",
+        "--env",
+        light.to_str().unwrap(),
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        !o.status.success(),
+        "a sheet whose JSON replaces its light accepted"
+    );
+    assert_eq!(std::fs::read(&light).unwrap(), light_before);
+    // env-sh over its own map.
+    let map = dir.path().join("map.json");
+    std::fs::copy(&light, &map).unwrap();
+    let o = frf(&[
+        "env-sh",
+        map.to_str().unwrap(),
+        "--out",
+        map.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success(), "env-sh over its map accepted");
+    assert_eq!(std::fs::read(&map).unwrap(), light_before);
+    // A pipe is refused, not replaced by a regular file.
+    let pipe = dir.path().join("pipe.json");
+    assert!(
+        Command::new("mkfifo")
+            .arg(&pipe)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let o = frf(&["env-sh", "sky", "--out", pipe.to_str().unwrap()]);
+    assert!(!o.status.success(), "a pipe replaced");
+    assert!(stderr(&o).contains("not a regular file"), "{}", stderr(&o));
+    use std::os::unix::fs::FileTypeExt;
+    let kind = std::fs::symlink_metadata(&pipe).unwrap().file_type();
+    assert!(kind.is_fifo(), "the pipe is now {kind:?}");
+    // A device is written where it is: /dev/null takes it, /dev/full reports its error.
+    if std::fs::metadata("/dev/full").is_ok_and(|m| m.file_type().is_char_device()) {
+        assert!(
+            frf(&["env-sh", "sky", "--out", "/dev/null"])
+                .status
+                .success()
+        );
+        let o = frf(&["env-sh", "sky", "--out", "/dev/full"]);
+        assert!(
+            !o.status.success(),
+            "a write to /dev/full reported as written"
+        );
+        assert!(stderr(&o).contains("/dev/full"), "{}", stderr(&o));
+        for device in ["/dev/null", "/dev/full"] {
+            let kind = std::fs::symlink_metadata(device).unwrap().file_type();
+            assert!(kind.is_char_device(), "{device} is now {kind:?}");
+        }
+    }
+}
