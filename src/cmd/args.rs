@@ -225,12 +225,18 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
         .map(|p| p.trim().parse().map_err(|_| bad()))
         .collect::<Result<_, _>>()?;
     let most = frf_core::capture::MAX_POSES_PER_CYCLE;
-    match poses.iter().find(|&&p| p >= most) {
-        Some(p) => Err(format!(
+    if let Some(p) = poses.iter().find(|&&p| p >= most) {
+        return Err(format!(
             "--poses {s:?}: pose {p} is beyond any cycle (at most {most} poses)"
-        )),
-        None => Ok(poses),
+        ));
     }
+    if let Some((k, p)) = (poses.iter().enumerate()).find(|(k, p)| poses[..*k].contains(p)) {
+        return Err(format!(
+            "--poses {s:?}: pose {p} is given twice (the second time at place {})",
+            k + 1
+        ));
+    }
+    Ok(poses)
 }
 
 /// Parses an environment: a `.hdr` / `.exr` file, `sky`, `uniform` or `none`.
@@ -606,6 +612,13 @@ mod tests {
                 .contains("at most")
         );
         assert!(parse_poses("1,4294967295").unwrap_err().contains("beyond"));
+        // A pose given twice is refused (it exported, merged and rendered twice).
+        assert!(
+            parse_poses("0,0")
+                .unwrap_err()
+                .contains("pose 0 is given twice")
+        );
+        assert!(parse_poses("2,1,2").unwrap_err().contains("twice"));
         let o = parse_orbit("3,1.2").unwrap();
         assert_eq!((o.radius, o.height, o.sweep_deg), (3.0, 1.2, 360.0));
         assert_eq!(parse_env("none"), Ok(EnvSource::None));

@@ -90,16 +90,26 @@ fn parse_headings(s: &str) -> Result<Headings, String> {
             (0..n).map(|i| i as f32 * 360.0 / n as f32).collect(),
         ));
     }
-    s.split(',')
+    let headings: Vec<f32> = s
+        .split(',')
         .map(|a| {
             a.trim()
                 .parse::<f32>()
                 .ok()
-                .filter(|a| a.is_finite())
-                .ok_or_else(|| format!("{s:?}: a count of headings or a list of degrees"))
+                .filter(|a| a.is_finite() && a.abs() <= 360.0)
+                .ok_or_else(|| {
+                    format!("{s:?}: a count of headings or a list of degrees from -360 to 360")
+                })
         })
-        .collect::<Result<_, _>>()
-        .map(Headings)
+        .collect::<Result<_, _>>()?;
+    // Two headings of one direction draw the same row twice.
+    let turn = |a: f32| a.rem_euclid(360.0);
+    for (k, &a) in headings.iter().enumerate() {
+        if let Some(&b) = headings[..k].iter().find(|&&b| turn(b) == turn(a)) {
+            return Err(format!("{s:?}: headings {b} and {a} are one direction"));
+        }
+    }
+    Ok(Headings(headings))
 }
 
 fn parse_tier(s: &str) -> Result<Tier, String> {
@@ -120,7 +130,8 @@ fn parse_views(s: &str) -> Result<ViewSelection, String> {
             .map(ViewSelection::Ring)
             .map_err(|_| format!("ring:{v}: expected a camera row number"));
     }
-    s.split(';')
+    let views = s
+        .split(';')
         .map(|p| {
             let (u, v) = p
                 .split_once(',')
@@ -134,8 +145,16 @@ fn parse_views(s: &str) -> Result<ViewSelection, String> {
                     .map_err(|_| format!("{p:?}: expected U,V"))?,
             ))
         })
-        .collect::<Result<Vec<_>, String>>()
-        .map(ViewSelection::List)
+        .collect::<Result<Vec<(usize, usize)>, String>>()?;
+    if let Some((k, v)) = (views.iter().enumerate()).find(|(k, v)| views[..*k].contains(v)) {
+        return Err(format!(
+            "{s:?}: view {},{} is given twice (the second time at place {})",
+            v.0,
+            v.1,
+            k + 1
+        ));
+    }
+    Ok(ViewSelection::List(views))
 }
 
 /// Runs `frf export`.

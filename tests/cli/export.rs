@@ -73,6 +73,13 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
         ("--jpeg-quality", "0", "--jpeg-quality 0"),
         ("--mesh-voxel", "0", "--mesh-voxel 0"),
         ("--tier", "tiny", "expected full or compact"),
+        // Issue 59: a pose, view or heading given twice drew it twice; a heading of
+        // 1e30 degrees was accepted.
+        ("--poses", "0,0", "pose 0 is given twice"),
+        ("--views", "0,0;0,0", "view 0,0 is given twice"),
+        ("--headings", "0,0,0", "one direction"),
+        ("--headings", "90,-270", "one direction"),
+        ("--headings", "1e30,0", "-360 to 360"),
     ] {
         let o = frf(&[
             "export",
