@@ -126,7 +126,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                 "pose {pose} has no visual hull (ingest it without --no-shadows)"
             ))
         })?;
-        let mesh = hull_mesh(&hull, options.mesh_voxel_m)?;
+        let mesh = hull_mesh(&hull, options.mesh_voxel_m, pose)?;
         let before = glb.binary_bytes();
         let positions = glb.vec3(&mesh.positions);
         let indices = glb.indices(&mesh.indices);
