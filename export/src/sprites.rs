@@ -79,11 +79,20 @@ pub fn sheet_json_path(png: &Path) -> PathBuf {
     png.with_extension("json")
 }
 
+/// The largest side of a sprite frame, pixels.
+pub const MOST_FRAME_SIDE: u32 = 2048;
+
+/// Why a sprite frame of `(w, h)` pixels is refused, if it is.
+pub fn frame_size_problem((w, h): (u32, u32)) -> Option<String> {
+    let side = 1..=MOST_FRAME_SIDE;
+    (!side.contains(&w) || !side.contains(&h))
+        .then(|| format!("--sprite-size {w}x{h}: 1 to {MOST_FRAME_SIDE} pixels a side"))
+}
+
 fn check(options: &SpriteOptions) -> Result<()> {
     let bad = |m: String| Err(ExportError::Option(m));
-    let (w, h) = options.frame_size;
-    if !(1..=2048).contains(&w) || !(1..=2048).contains(&h) {
-        return bad(format!("--sprite-size {w}x{h}: 1 to 2048 pixels a side"));
+    if let Some(problem) = frame_size_problem(options.frame_size) {
+        return bad(problem);
     }
     if !(-30.0..=30.0).contains(&options.exposure_stops) {
         return bad(format!(

@@ -58,7 +58,7 @@ pub struct ExportArgs {
     #[arg(long, default_value = "8", value_parser = parse_headings)]
     headings: Headings,
     /// Sprites: a frame's size `WxH`.
-    #[arg(long, default_value = "128x180", value_parser = parse_size)]
+    #[arg(long, default_value = "128x180", value_parser = parse_sprite_size)]
     sprite_size: (u32, u32),
     /// Sprites: the cameras' `RADIUS,HEIGHT` about the walker, metres.
     #[arg(long, default_value = "3.2,1.1", value_parser = parse_radius_height)]
@@ -110,6 +110,21 @@ fn parse_headings(s: &str) -> Result<Headings, String> {
         }
     }
     Ok(Headings(headings))
+}
+
+/// `--sprite-size`: a frame's `WxH`, within what a sheet allows (named once, not first
+/// by the general size parser's wider bound).
+fn parse_sprite_size(s: &str) -> Result<(u32, u32), String> {
+    let size = parse_size(s).map_err(|_| {
+        format!(
+            "{s:?}: expected WxH, 1 to {} pixels a side",
+            frf_export::sprites::MOST_FRAME_SIDE
+        )
+    })?;
+    match frf_export::sprites::frame_size_problem(size) {
+        Some(problem) => Err(problem),
+        None => Ok(size),
+    }
 }
 
 fn parse_tier(s: &str) -> Result<Tier, String> {

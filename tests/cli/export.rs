@@ -80,6 +80,9 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
         ("--headings", "0,0,0", "one direction"),
         ("--headings", "90,-270", "one direction"),
         ("--headings", "1e30,0", "-360 to 360"),
+        // The size parser said 1 to 8192, the sheet's check 2048: one bound, said once.
+        ("--sprite-size", "4096x4096", "1 to 2048 pixels a side"),
+        ("--sprite-size", "0x10", "1 to 2048 pixels a side"),
     ] {
         let o = frf(&[
             "export",
