@@ -58,8 +58,8 @@ struct FrameArgs {
     #[arg(long)]
     field: Option<PathBuf>,
     /// Walker counts, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,10,40,100")]
-    walkers: Vec<usize>,
+    #[arg(long, default_value = "1,10,40,100", value_parser = parse_counts)]
+    walkers: Counts,
     /// Lightings timed.
     #[arg(long, value_enum, default_value = "both")]
     light: LightArg,
@@ -193,7 +193,7 @@ fn frame(args: FrameArgs) -> CliResult {
     let h = field.header();
     let size = scene.frame_size(args.size, (h.width, h.height))?;
     let options = FrameBenchOptions {
-        walkers: args.walkers,
+        walkers: args.walkers.0,
         lights: match args.light {
             LightArg::Constant => vec![LightMode::Constant],
             LightArg::Turning => vec![LightMode::Turning],
@@ -281,4 +281,31 @@ fn interp(args: InterpArgs) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
     Ok(())
+}
+
+/// `--walkers`: counts, each once.
+#[derive(Clone, Debug)]
+pub struct Counts(Vec<usize>);
+
+/// `1,10,40`: every count a whole number, none empty (a stray comma) or given twice
+/// (it was timed twice).
+fn parse_counts(s: &str) -> Result<Counts, String> {
+    let counts: Vec<usize> = s
+        .split(',')
+        .map(|c| match c.trim() {
+            "" => Err(format!(
+                "{s:?}: an empty count (a comma with nothing beside it)"
+            )),
+            c => c
+                .parse()
+                .map_err(|_| format!("{s:?}: {c:?} is not a whole number")),
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some((k, c)) = (counts.iter().enumerate()).find(|(k, c)| counts[..*k].contains(c)) {
+        return Err(format!(
+            "{s:?}: {c} is given twice (the second time at place {})",
+            k + 1
+        ));
+    }
+    Ok(Counts(counts))
 }

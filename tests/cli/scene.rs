@@ -866,6 +866,18 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let bad = frf(&["bench", "frame", scene.to_str().unwrap(), "--walkers", "0"]);
     assert!(!bad.status.success());
     assert!(stderr(&bad).contains("--walkers 0"), "{}", stderr(&bad));
+    // Issue 59: a stray comma was "invalid value ''"; a count given twice was timed twice.
+    for (walkers, want) in [("1,", "an empty count"), ("1,2,1", "1 is given twice")] {
+        let bad = frf(&[
+            "bench",
+            "frame",
+            scene.to_str().unwrap(),
+            "--walkers",
+            walkers,
+        ]);
+        assert!(!bad.status.success(), "--walkers {walkers} accepted");
+        assert!(stderr(&bad).contains(want), "{}", stderr(&bad));
+    }
     // A light turning 1° a frame, within the shot's light tolerance (2°): a light's turn
     // relative to a walker is held to the tolerance a walker's own turn is, and a walker
     // is lit for the farthest frame ahead whose light holds its own. Lit at frame 0 for
