@@ -762,12 +762,8 @@ impl Gpu {
         // the compute pass draws them in one dispatch ([`RebinPass::record_compute`]).
         let mut order: Vec<usize> = (0..renders.len()).collect();
         if self.stage == PassKind::Compute {
-            let first_of = |k: usize| {
-                (0..=k)
-                    .find(|&j| std::ptr::eq(renders[j].0, renders[k].0))
-                    .unwrap_or(k)
-            };
-            order.sort_by_key(|&k| first_of(k));
+            // Where each render lands is in its record, so any order draws the same.
+            order.sort_by_key(|&k| std::ptr::from_ref::<GpuPose>(renders[k].0) as usize);
         }
         let renders: Vec<&(&GpuPose, DrawnRender)> = order.iter().map(|&k| &renders[k]).collect();
         let frames: Vec<GpuFrame> = renders
