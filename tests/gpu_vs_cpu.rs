@@ -818,8 +818,10 @@ fn on_device<'a>(
 /// by the ground's shape), two maps cross-faded (a sun from each), a walker in the way
 /// of the sun, and a plan that leaves conditions out. Coefficients within 1e-3 (relative;
 /// measured 3.8e-4 at most, the suns' nearest weights through the GPU's `acos`), scales
-/// within 5e-4 and codes within 1 of the CPU twin. Control: the coefficients of the light
-/// the pose was made under differ.
+/// within 5e-4 and codes within 1 of the CPU twin. Every case is looked up in one
+/// submission (one dispatch for all, each pose's coefficients a range of a shared page),
+/// and one more pose relit under two of the lights before it ends as the later. Control:
+/// the coefficients of the light the pose was made under differ.
 #[test]
 fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
     use frf_reflectance::project::FloorModel;
@@ -875,23 +877,45 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
             bounds: frf_render::footprint::SubjectBounds::DESIGN,
         })
     };
-    for (what, light, used) in &cases {
-        let plan = plan_of(*used);
+    // Every pose made first, then every light looked up before one submission; the host's
+    // coefficients written in the same order in one submission of their own (the suns'
+    // maps, whose places the coefficients hold, then lie alike).
+    let sources: Vec<_> = (cases.iter())
+        .map(|(_, light, used)| {
+            let plan = plan_of(*used);
+            first
+                .relit(&field, &Lighting::Tabled(light.clone()), plan.as_ref())
+                .unwrap()
+        })
+        .collect();
+    let order: Vec<usize> = (0..cases.len()).chain([0, 1]).collect();
+    let poses = || -> Vec<_> {
+        (0..=cases.len())
+            .map(|_| gpu.upload_pose(&first).unwrap())
+            .collect()
+    };
+    let (mut devices, mut hosts) = (poses(), poses());
+    gpu.flush();
+    // The last pose relit under the first light, then the second's: it ends as the second.
+    for (n, &k) in order.iter().enumerate() {
+        let (_, light, used) = &cases[k];
         let turned = on_device(light, &field, *used);
-        let mut device = gpu.upload_pose(&first).unwrap();
-        gpu.flush();
-        assert!(gpu.relight_turned(&mut device, &first, &turned).unwrap());
-        let looked_up = gpu.read_coefficients(&device).unwrap();
-        let source = first
-            .relit(&field, &Lighting::Tabled(light.clone()), plan.as_ref())
+        let device = &mut devices[n.min(cases.len())];
+        assert!(gpu.relight_turned(device, &first, &turned).unwrap());
+    }
+    gpu.flush();
+    for (n, &k) in order.iter().enumerate() {
+        gpu.relight_pose(&mut hosts[n.min(cases.len())], &sources[k])
             .unwrap();
+    }
+    for (n, (device, host)) in devices.iter().zip(&hosts).enumerate() {
+        let k = if n < cases.len() { n } else { 1 };
+        let (what, source) = (cases[k].0, &sources[k]);
+        let looked_up = gpu.read_coefficients(device).unwrap();
         // Every case relights suns by the normals; the cross-fade one from each map.
-        let suns = if *what == "two maps" { 2 } else { 1 };
+        let suns = if what == "two maps" { 2 } else { 1 };
         assert_eq!(source.suns.len(), suns, "{what}");
-        let mut host = gpu.upload_pose(&first).unwrap();
-        gpu.flush();
-        gpu.relight_pose(&mut host, &source).unwrap();
-        let worked_out = gpu.read_coefficients(&host).unwrap();
+        let worked_out = gpu.read_coefficients(host).unwrap();
         assert_eq!(looked_up.len(), worked_out.len(), "{what}: batches");
         let mut most = 0.0f32;
         for (a, b) in looked_up.iter().flatten().zip(worked_out.iter().flatten()) {
@@ -900,13 +924,13 @@ fn a_light_looked_up_on_the_device_relights_as_the_host_works_it_out() {
                 most = most.max(d);
                 assert!(
                     d < 1e-3,
-                    "{what}: coefficient {a:?} looked up, {b:?} worked out"
+                    "{what} (pose {n}): coefficient {a:?} looked up, {b:?} worked out"
                 );
             }
         }
-        eprintln!("{what}: largest relative difference {most:.2e}");
-        let cpu = ResidentPose::relight_cpu(&source);
-        assert_relit_within(&gpu, &device, &cpu, (what, 5e-4));
+        eprintln!("{what} (pose {n}): largest relative difference {most:.2e}");
+        let cpu = ResidentPose::relight_cpu(source);
+        assert_relit_within(&gpu, device, &cpu, (what, 5e-4));
     }
     // Control: the pose as made (the sky unturned) is not what the last light relights.
     let made = gpu.upload_pose(&first).unwrap();

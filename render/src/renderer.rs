@@ -325,8 +325,9 @@ impl Device {
 
     /// Relights `resident` with `source`'s coefficients, `source` being its own views
     /// under a new light ([`PoseSource::relit`]), and its shadow maps with them. On the
-    /// GPU this records one relighting dispatch per batch of views and one for the shadow
-    /// (sent with the next frame), and uploads nothing but the coefficients.
+    /// GPU this records one relighting dispatch pair per batch of views (sent with the next
+    /// frame, the shadow relit by the frame that draws it), and uploads nothing but the
+    /// coefficients.
     pub fn relight(&self, resident: &mut Resident, source: &PoseSource) -> Result<()> {
         if !std::sync::Arc::ptr_eq(&resident.source.basis, &source.basis) {
             return Err(crate::RenderError::Misuse(

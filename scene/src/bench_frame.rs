@@ -280,13 +280,13 @@ impl FrameBenchReport {
             );
         }
         if self.rows.iter().any(|r| !r.passes.is_empty()) {
-            out += "device ms per frame by pass (GPU timestamps, medians; passes per frame), \
-                    and in all:\n";
+            out += "device ms per frame by pass (GPU timestamps, medians; passes and \
+                    dispatches per frame), and in all:\n";
             for r in &self.rows {
                 let passes: Vec<String> = r
                     .passes
                     .iter()
-                    .map(|p| format!("{} {:.1} ({})", p.pass, p.ms, p.passes))
+                    .map(|p| format!("{} {:.1} ({}/{})", p.pass, p.ms, p.passes, p.dispatches))
                     .collect();
                 out += &format!(
                     "{:>7}  {:<8} {:<9} {}; all {:.1}\n",
@@ -628,8 +628,12 @@ fn median_passes(frames: &[Vec<PassTime>]) -> Vec<PassTime> {
             let of = |f: &Vec<PassTime>| f.iter().find(|p| p.pass == name).cloned();
             let ms: Vec<f64> = frames.iter().map(|f| of(f).map_or(0.0, |p| p.ms)).collect();
             let count: usize = frames.iter().map(|f| of(f).map_or(0, |p| p.passes)).sum();
+            let dispatches: usize = (frames.iter())
+                .map(|f| of(f).map_or(0, |p| p.dispatches))
+                .sum();
             PassTime {
                 passes: count / frames.len().max(1),
+                dispatches: dispatches / frames.len().max(1),
                 ms: median(&ms),
                 pass: name,
             }

@@ -409,20 +409,16 @@ pub struct GpuTimeMorph {
     pub pages: [u32; 4],
 }
 
-/// `TurnParams` of `turn_light.wgsl`: a batch of views whose light the device looks up.
+/// `TurnParams` of `turn_light.wgsl`: what every relight of one dispatch shares.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuTurnParams {
-    /// Views in the batch.
-    pub jobs: u32,
-    /// Conditions of the field.
-    pub conditions: u32,
+    /// Relights in the dispatch (a row of workgroups each).
+    pub relights: u32,
     /// Samples of a yaw table per turn.
     pub samples: u32,
     /// Sun slots per job.
     pub sun_slots: u32,
-    /// Where the plan's mask of conditions starts in the job data.
-    pub mask: u32,
     /// A table's coarse map, texels across.
     pub coarse_w: u32,
     /// Its texels down.
@@ -433,10 +429,38 @@ pub struct GpuTurnParams {
     pub trust_low: f32,
     /// The error at which it has fallen to 0.
     pub trust_high: f32,
+}
+
+/// `TurnRelight` of `turn_light.wgsl`: one batch of a pose's views relit under one light,
+/// where its parts lie in the buffers the dispatch binds.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct GpuTurnRelight {
+    /// Where its jobs start in the data page (`vec4`s; two a job).
+    pub jobs_at: u32,
+    /// Its jobs (views).
+    pub jobs: u32,
     /// Threads per job: the most conditions of a job, then the sun slots.
     pub items: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// Where the field's conditions start in the data page (`vec4`s; four a condition).
+    pub conditions_at: u32,
+    /// Conditions of the field.
+    pub conditions: u32,
+    /// Where its words (the jobs' images' scales, then the plan's mask) start in the
+    /// data page (`vec4`s; four words each).
+    pub words_at: u32,
+    /// Where the plan's mask of conditions starts among its words.
+    pub mask: u32,
+    /// Where its light's record starts among the lights (`vec4`s).
+    pub light_at: u32,
+    /// Where its coefficients start in the coefficients' page (`vec4`s).
+    pub coefficients_at: u32,
+    /// Padding to 48 bytes.
+    pub pad1: u32,
+    /// Padding.
+    pub pad2: u32,
+    /// Padding.
+    pub pad3: u32,
 }
 
 /// `TurnJob` of `turn_light.wgsl`: one view of a batch whose light the device looks up.
@@ -451,7 +475,7 @@ pub struct GpuTurnJob {
     pub turn: f32,
     /// 1 when it holds normals (room for the floor conditions' shares), else 0.
     pub normals: u32,
-    /// Where its images' scales start in the job data.
+    /// Where its images' scales start among its relight's words.
     pub scales: u32,
     /// Padding to 32 bytes.
     pub pad1: u32,

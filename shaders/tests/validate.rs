@@ -11,7 +11,7 @@ use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuHullAt, GpuInstance, GpuLightFitParams, GpuPresent,
     GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowJob, GpuSunDepthJob,
-    GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuView,
+    GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuTurnRelight, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -286,18 +286,33 @@ fn pod_structs_match_naga_layouts() {
         "TurnParams",
         GpuTurnParams,
         [
-            jobs,
-            conditions,
+            relights,
             samples,
             sun_slots,
-            mask,
             coarse_w,
             coarse_h,
             ratio_floor,
             trust_low,
-            trust_high,
+            trust_high
+        ]
+    );
+    check_layout!(
+        &turn,
+        "TurnRelight",
+        GpuTurnRelight,
+        [
+            jobs_at,
+            jobs,
             items,
-            pad
+            conditions_at,
+            conditions,
+            words_at,
+            mask,
+            light_at,
+            coefficients_at,
+            pad1,
+            pad2,
+            pad3
         ]
     );
     check_layout!(

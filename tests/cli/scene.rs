@@ -745,7 +745,7 @@ fn a_turning_light_relit_in_place_draws_what_a_fresh_residency_draws() {
 
 /// `frf bench frame` (issue 37): a row per walker count and lighting, the fields its JSON
 /// promises, turning rows relighting every walker every frame and constant ones none;
-/// per-pass device times where the adapter has timestamps (issue 47).
+/// per-pass device times and dispatches where the adapter has timestamps (issues 47, 58).
 #[test]
 fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     let dir = tempfile::tempdir().unwrap();
@@ -819,6 +819,15 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
             }
             assert_eq!(pass("relight").is_some(), r["light"] == "turning", "{r}");
             assert!(ms("gpu_timestamps_ms_per_frame") > 0.0, "{r}");
+            // Dispatches a frame that do not grow with walkers: every walker's light looked
+            // up on the device in one, every shadow in one, the composite one; the frame
+            // pass one per pose drawn at least (here every walker draws the one pose).
+            let dispatches = |name: &str| pass(name).map(|p| p["dispatches"].as_u64().unwrap());
+            if r["light"] == "turning" {
+                assert_eq!(dispatches("turn light"), Some(1), "{r}");
+            }
+            assert_eq!(dispatches("composite"), Some(1), "{r}");
+            assert!(dispatches("frame").unwrap() >= 1, "{r}");
         } else {
             assert!(passes.is_empty(), "{r}");
             assert!(r["gpu_timestamps_ms_per_frame"].is_null(), "{r}");

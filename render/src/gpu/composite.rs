@@ -443,6 +443,7 @@ impl Gpu {
             ),
         });
         pass.set_pipeline(&self.composite.pipeline);
+        self.dispatched("composite", 1);
         pass.set_bind_group(0, &t.frame_group, &[]);
         pass.set_bind_group(1, &*image_group, &[]);
         let size = t.targets[0].size();

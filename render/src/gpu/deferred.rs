@@ -1,10 +1,10 @@
 //! Dispatches gathered by kind between two submissions and recorded as one compute pass
 //! per kind: every pose relit between two frames (a turning light relights a crowd) adds
-//! its dispatches to the relight pass, instead of a pass of its own each, and the
-//! lookups of its light on the device to a pass before them all (none waits for
-//! another). [`Gpu::submit`] records them, lights then relights, after what the pending
-//! encoder already holds (the clears of the relights' peaks). Shadows are relit by the
-//! frame that draws them, every walker's in one dispatch ([`super::shadow`]).
+//! its dispatches to the relight pass, instead of a pass of its own each. [`Gpu::submit`]
+//! records them after what the pending encoder already holds (the clears of the
+//! relights' peaks) and after the one dispatch that looks every relight's light up on the
+//! device ([`super::turn_light`]). Shadows are relit by the frame that draws them, every
+//! walker's in one dispatch ([`super::shadow`]).
 
 use super::Gpu;
 use super::timing::compute_pass_writes;
@@ -12,20 +12,16 @@ use super::timing::compute_pass_writes;
 /// The kinds, in the order they are recorded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kind {
-    /// The lights looked up on the device ([`super::turn_light`]): every relight's
-    /// coefficients, written before any relight reads them.
-    Light,
     /// The relighting pass (its sums, then its encoding), [`super::relight`].
     Relight,
 }
 
 impl Kind {
-    const ALL: [Kind; 2] = [Kind::Light, Kind::Relight];
+    const ALL: [Kind; 1] = [Kind::Relight];
 
     /// The pass's name (in the timings).
     fn name(self) -> &'static str {
         match self {
-            Kind::Light => "turn light",
             Kind::Relight => "relight",
         }
     }
@@ -80,6 +76,10 @@ impl Gpu {
             if of_kind.peek().is_none() {
                 continue;
             }
+            self.dispatched(
+                kind.name(),
+                gathered.iter().filter(|(k, _)| *k == kind).count(),
+            );
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(kind.name()),
                 timestamp_writes: compute_pass_writes(self.pass_timestamps(kind.name(), None)),

@@ -24,6 +24,7 @@
 //! `COPY_BYTES_PER_ROW_ALIGNMENT` ([`bind`]).
 
 pub mod adapter;
+mod arena;
 pub mod bench;
 pub mod bind;
 pub mod composite;
@@ -77,6 +78,13 @@ fn wgpu_err<E: std::error::Error + Send + Sync + 'static>(
 /// Frame sizes (and walker counts) whose targets a GPU keeps.
 const KEPT_TARGETS: usize = 4;
 
+/// Bytes of a page of relit poses' coefficients (a pose's batch of views takes some
+/// hundreds of kilobytes at full detail; a larger one opens a page of its own).
+const COEFFICIENT_PAGE_BYTES: u64 = 32 << 20;
+/// Bytes of a page of what the device looks a light up with (a pose's jobs, conditions
+/// and scales: some kilobytes).
+const TURN_DATA_PAGE_BYTES: u64 = 4 << 20;
+
 /// An open GPU with the renderer's pipelines.
 pub struct Gpu {
     device: wgpu::Device,
@@ -92,6 +100,11 @@ pub struct Gpu {
     deferred: std::sync::Mutex<deferred::Deferred>,
     /// Small writes gathered between submissions, sent as one ([`uploads`]).
     uploads: std::sync::Mutex<uploads::Uploads>,
+    /// Every relit pose's coefficients, a range each ([`relight`]).
+    coefficients: arena::Arena,
+    /// Every pose relit on the device: its views' jobs, the field's conditions and the
+    /// views' scales, a range each ([`turn_light`]).
+    turn_data: arena::Arena,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
@@ -171,6 +184,20 @@ impl Gpu {
             pending: std::sync::Mutex::new(None),
             deferred: std::sync::Mutex::default(),
             uploads: std::sync::Mutex::default(),
+            coefficients: arena::Arena::new(
+                &device,
+                "coefficients",
+                wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                COEFFICIENT_PAGE_BYTES,
+            ),
+            turn_data: arena::Arena::new(
+                &device,
+                "turn data",
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                TURN_DATA_PAGE_BYTES,
+            ),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited: spent::Spent::default(),
@@ -289,12 +316,22 @@ impl Gpu {
     /// The whole of `buffer` (a `COPY_SRC` buffer the passes write), copied to a readback
     /// buffer labelled `label` and read once the device has written it.
     pub(crate) fn read_back(&self, buffer: &wgpu::Buffer, label: &str) -> Result<Vec<u8>> {
-        let size = buffer.size();
+        self.read_back_range(buffer, (0, buffer.size()), label)
+    }
+
+    /// `size` bytes of `buffer` from `offset` on (multiples of 4), read back as
+    /// [`Gpu::read_back`] reads a whole buffer.
+    pub(crate) fn read_back_range(
+        &self,
+        buffer: &wgpu::Buffer,
+        (offset, size): (u64, u64),
+        label: &str,
+    ) -> Result<Vec<u8>> {
         let readback = bind::readback_buffer(&self.device, label, size);
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        encoder.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
+        encoder.copy_buffer_to_buffer(buffer, offset, &readback, 0, size);
         self.submit([encoder.finish()]);
         self.read_buffer(&readback)
     }

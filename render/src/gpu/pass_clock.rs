@@ -3,7 +3,9 @@
 //! in time, shadows, the composite) writes GPU timestamps at its beginning and end into
 //! one query set, and [`Gpu::pass_times`] resolves what the passes recorded since the last
 //! call wrote, summed by the pass's name. Adapters without `TIMESTAMP_QUERY` time nothing
-//! (the list is empty). This is what `frf bench frame` reports beside its wall times.
+//! (the list is empty). Each pass also counts the dispatches (or draws) it records, which
+//! is what grows with walkers where the passes do not. This is what `frf bench frame`
+//! reports beside its wall times.
 
 use std::sync::Mutex;
 
@@ -26,6 +28,8 @@ pub struct PassTime {
     pub pass: String,
     /// How many passes of that name ran.
     pub passes: usize,
+    /// How many dispatches (or draws) they recorded.
+    pub dispatches: usize,
     /// Their summed GPU time, milliseconds (timestamps at each pass's beginning and end).
     pub ms: f64,
 }
@@ -37,6 +41,8 @@ pub(super) struct PassClock {
     readback: wgpu::Buffer,
     /// Pass `i` (named here) took queries `2i` and `2i + 1`.
     names: Mutex<Vec<&'static str>>,
+    /// Dispatches recorded since the last read, by pass name.
+    dispatches: Mutex<Vec<(&'static str, usize)>>,
 }
 
 impl PassClock {
@@ -57,6 +63,7 @@ impl PassClock {
             }),
             readback: readback_buffer(device, "pass clock readback", bytes),
             names: Mutex::new(Vec::new()),
+            dispatches: Mutex::new(Vec::new()),
         }
     }
 }
@@ -91,6 +98,19 @@ impl Gpu {
         Some((&clock.set, 2 * i))
     }
 
+    /// Counts `n` dispatches (or draws) recorded in a pass named `name`, when passes are
+    /// timed.
+    pub(super) fn dispatched(&self, name: &'static str, n: usize) {
+        let Some(clock) = self.pass_clock.get() else {
+            return;
+        };
+        let mut counts = clock.dispatches.lock().unwrap_or_else(|e| e.into_inner());
+        match counts.iter_mut().find(|(k, _)| *k == name) {
+            Some((_, c)) => *c += n,
+            None => counts.push((name, n)),
+        }
+    }
+
     /// The device time of every pass timed since the last call (their work submitted),
     /// summed by name in the order first recorded; waits for the device. Empty when
     /// passes are not timed.
@@ -99,6 +119,13 @@ impl Gpu {
             return Ok(Vec::new());
         };
         let names = std::mem::take(&mut *clock.names.lock().unwrap_or_else(|e| e.into_inner()));
+        let dispatches =
+            std::mem::take(&mut *clock.dispatches.lock().unwrap_or_else(|e| e.into_inner()));
+        let dispatched = |name: &str| {
+            (dispatches.iter())
+                .find(|(k, _)| *k == name)
+                .map_or(0, |(_, n)| *n)
+        };
         if names.is_empty() {
             return Ok(Vec::new());
         }
@@ -128,6 +155,7 @@ impl Gpu {
                 None => times.push(PassTime {
                     pass: (*name).to_string(),
                     passes: 1,
+                    dispatches: dispatched(name),
                     ms,
                 }),
             }

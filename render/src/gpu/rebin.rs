@@ -628,7 +628,7 @@ impl RebinPass {
 impl RebinPass {
     /// Records the compute frame pass of every render of `renders` (its slot in
     /// `targets`, pose bind group and pixel box) in one pass, with the pass's timestamps
-    /// when given; each counts its pixel classes as it shades.
+    /// when given; each counts its pixel classes as it shades. Returns the dispatches.
     pub(super) fn record_compute(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -636,8 +636,9 @@ impl RebinPass {
         renders: &[(usize, &wgpu::BindGroup, PixelBox)],
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
-    ) {
+    ) -> usize {
         let pipelines = self.pipelines(variant);
+        let mut dispatches = 0;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("rebin"),
             timestamp_writes: super::timing::compute_pass_writes(timestamps),
@@ -665,7 +666,9 @@ impl RebinPass {
             pass.set_bind_group(0, &targets.slots[slot].compute, &[]);
             pass.set_bind_group(1, pose_group, &[]);
             pass.dispatch_workgroups(x, y, run as u32);
+            dispatches += 1;
         }
+        dispatches
     }
 }
 
@@ -785,10 +788,12 @@ impl Gpu {
                     .map(|(slot, (pose, d))| (slot, &pose.bind_group, d.within))
                     .collect();
                 let timestamps = self.pass_timestamps("frame", timestamps);
-                self.rebin
-                    .record_compute(encoder, targets, &groups, variant, timestamps);
+                let dispatches =
+                    (self.rebin).record_compute(encoder, targets, &groups, variant, timestamps);
+                self.dispatched("frame", dispatches);
             }
             PassKind::Fragment => {
+                self.dispatched("frame", renders.len());
                 for (slot, (pose, d)) in renders.iter().enumerate() {
                     self.rebin.record(
                         encoder,

@@ -19,9 +19,10 @@ use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::{RATIO_FLOOR, group_cone};
 use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight, TRUST_ERROR};
-use frf_shaders::types::{GpuRelightJob, GpuRelightParams};
+use frf_shaders::types::{GpuRelightJob, GpuRelightParams, GpuTurnRelight};
 use wgpu::util::DeviceExt;
 
+use super::arena::ArenaRange;
 use super::bind::{
     bind_group, buffer_with, compute_pipeline, empty_buffer, storage, storage_texture_array,
     table_bytes, uniform,
@@ -136,7 +137,9 @@ impl GpuBasis {
 /// (one buffer per batch) and the views' peaks.
 pub struct PoseRelight {
     basis: Arc<GpuBasis>,
-    coefficients: Vec<wgpu::Buffer>,
+    /// Its coefficients, a range of the shared pages a batch (the device's look-ups of
+    /// every pose relit in a submission write them in one dispatch).
+    coefficients: Vec<Arc<ArenaRange>>,
     peaks: wgpu::Buffer,
     /// Its hull, whose maps toward the suns the GPU makes at each relight (none without
     /// a hull: its suns cast no shadow).
@@ -151,14 +154,11 @@ pub struct PoseRelight {
 }
 
 /// What a pose keeps to be relit on the device (`super::turn_light`): per batch of views
-/// its parameters, jobs, scales and the plan's mask, and its threads; the field's
-/// conditions; the buffer its light's record goes in.
+/// its jobs, the field's conditions, its views' scales and the plan's mask (a range of the
+/// shared pages), the record of where they lie (where its light and coefficients lie
+/// filled in at each relight), and its threads.
 pub struct TurnState {
-    pub(super) batches: Vec<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer, u32)>,
-    pub(super) conditions: wgpu::Buffer,
-    pub(super) light: wgpu::Buffer,
-    /// Its bind groups (one a batch) and the tables' buffer they bind.
-    pub(super) binds: std::sync::Mutex<Option<(wgpu::Buffer, Vec<wgpu::BindGroup>)>>,
+    pub(super) batches: Vec<(Arc<ArenaRange>, GpuTurnRelight, u32)>,
 }
 
 /// Bind groups kept, with the buffers that change between relights they bind.
@@ -176,7 +176,7 @@ impl PoseRelight {
     }
 
     /// The coefficients of its batch `b` (none past its batches).
-    pub(super) fn coefficient_buffer(&self, b: usize) -> Option<&wgpu::Buffer> {
+    pub(super) fn coefficient_range(&self, b: usize) -> Option<&Arc<ArenaRange>> {
         self.coefficients.get(b)
     }
 }
@@ -506,7 +506,10 @@ impl Gpu {
             coefficients: basis
                 .batches
                 .iter()
-                .map(|b| buffer("coefficients", b.coefficients.max(1) * 16, dst))
+                .map(|b| {
+                    let bytes = (b.coefficients.max(1) * 16) as u64;
+                    Arc::new(self.coefficients.take(&self.device, bytes))
+                })
                 .collect(),
             peaks: buffer("peaks", views.max(1) * 4, dst),
             basis,
@@ -533,23 +536,28 @@ impl Gpu {
             self.ask_sun_maps(hull, &maps)
         });
         let maps = relight.sun_maps.as_ref();
-        for (batch, buffer) in relight.basis.batches.iter().zip(&relight.coefficients) {
+        // A look-up of its light gathered before would overwrite these.
+        self.forget_turns(relight);
+        for (batch, range) in relight.basis.batches.iter().zip(&relight.coefficients) {
             let packed = packed_coefficients(batch, source, maps);
-            self.upload(buffer, 0, bytemuck::cast_slice(&packed));
+            self.upload(
+                range.buffer(),
+                range.offset(),
+                bytemuck::cast_slice(&packed),
+            );
         }
-        self.record_relight_passes(relight, (|| target.clone(), views), |_| None);
+        self.record_relight_passes(relight, (|| target.clone(), views));
     }
 
-    /// Records the passes that relight `relight`'s views from the coefficients in its
-    /// buffers into the pre-lit array `target`, their scales into the view table `views`:
-    /// per batch of views, the dispatch `before` gives for it (the light on the device,
-    /// [`super::turn_light`], which writes the coefficients: in the pass ahead of the
-    /// relights), then the sums and their encoding.
+    /// Records the passes that relight `relight`'s views from its coefficients into the
+    /// pre-lit array `target`, their scales into the view table `views`: per batch of
+    /// views the sums and their encoding (after the look-ups of every light on the
+    /// device gathered for the submission, [`super::turn_light`], which write the
+    /// coefficients).
     pub(super) fn record_relight_passes(
         &self,
         relight: &PoseRelight,
         (target, views): (impl Fn() -> wgpu::TextureView, &wgpu::Buffer),
-        before: impl Fn(usize) -> Option<Dispatch>,
     ) {
         let maps = relight.sun_maps.as_ref();
         let basis = &relight.basis;
@@ -578,7 +586,7 @@ impl Gpu {
                         vec![
                             batch.params.as_entire_binding(),
                             batch.codes.as_entire_binding(),
-                            coefficients.as_entire_binding(),
+                            coefficients.binding(),
                             self.relight.gamma.as_entire_binding(),
                             relit.as_entire_binding(),
                             relight.peaks.as_entire_binding(),
@@ -593,8 +601,7 @@ impl Gpu {
             *kept = Some((key, binds));
         }
         let binds = &kept.as_ref().expect("made above").1;
-        for (b, (batch, bind)) in basis.batches.iter().zip(binds).enumerate() {
-            self.defer(Kind::Light, before(b));
+        for (batch, bind) in basis.batches.iter().zip(binds) {
             // The sums, then their encoding (wgpu orders the two dispatches' use of the
             // scratch and the peaks), in the pass every relight of the frame shares.
             let pair = [&self.relight.relight, &self.relight.encode].map(|pipeline| Dispatch {
@@ -652,7 +659,9 @@ impl Gpu {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .take();
-        // The relights and shadows gathered, a pass each, after the pending clears.
+        // The lights looked up on the device, then the relights gathered, a pass each,
+        // after the pending clears.
+        let pending = self.record_turns(pending);
         let pending = self.record_deferred(pending).map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
         // The small writes every later piece reads, then the suns' maps the pending

@@ -322,6 +322,7 @@ impl Gpu {
             ),
         });
         pass.set_pipeline(&self.shadow.pipeline);
+        self.dispatched("shadow", 1);
         pass.set_bind_group(0, &bind, &[]);
         let groups = side.div_ceil(WORKGROUP);
         pass.dispatch_workgroups(groups, groups, jobs.len() as u32);

@@ -364,6 +364,7 @@ impl Gpu {
                 timestamp_writes: compute_pass_writes(self.pass_timestamps("sun depth", None)),
             });
             pass.set_pipeline(&self.sun_depth.pipeline);
+            self.dispatched("sun depth", 1);
             pass.set_bind_group(0, &bind, &[]);
             let groups = (batch.most_texels as u32).div_ceil(WORKGROUP);
             pass.dispatch_workgroups(groups, batch.maps.len() as u32, 1);

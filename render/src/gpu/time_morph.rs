@@ -125,6 +125,7 @@ impl Gpu {
                 timestamp_writes: compute_pass_writes(self.pass_timestamps("time morph", None)),
             });
             pass.set_pipeline(&self.time_morph.pipeline);
+            self.dispatched("time morph", 1);
             pass.set_bind_group(0, &group, &[]);
             pass.dispatch_workgroups(x, y, walkers.len() as u32);
         }

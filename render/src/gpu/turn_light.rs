@@ -1,11 +1,14 @@
 //! A light on the device (`shaders/turn_light.wgsl`; docs/design.md section 4.1, *A light
 //! on the device*): the yaw tables of a light's maps held on the GPU, and a relight that
-//! writes one small record (the maps' turns and weights, the suns' maps) where the host
+//! gathers one small record (the maps' turns and weights, the suns' maps) where the host
 //! path works out and uploads every view's coefficients ([`super::relight`]). The views'
-//! coefficients are then looked up by their turn in one dispatch per batch of views, in a
-//! pass of their own ahead of the relighting pass that reads them (`super::deferred`): a
-//! turning light and a crowd of walkers on curves cost the host a record per relight,
-//! whatever the views.
+//! coefficients of every pose relit between two submissions are then looked up by their
+//! turn in one dispatch (a row of workgroups a batch of views), in a pass of its own ahead
+//! of the relighting pass that reads them: each pose's coefficients, and its jobs, the
+//! field's conditions and its views' scales, are ranges of a few shared pages
+//! ([`super::arena`]). A turning light and a crowd of walkers on curves cost the host a
+//! record per relight, whatever the views, and the device one dispatch, whatever the
+//! walkers.
 //!
 //! Twin of the host path: the same entries as `packed_coefficients` of the lighting
 //! `PoseSource::relit` works out, to within float rounding (the turn's bracket is found in
@@ -26,29 +29,64 @@ use frf_reflectance::sun_light::{
 };
 use frf_reflectance::yaw_light::{TakenSun, YawLight, YawTerm};
 use frf_reflectance::yaw_table::{Part, SAMPLES_PER_TURN, YawTable};
-use frf_shaders::types::{GpuTurnJob, GpuTurnParams};
+use frf_shaders::types::{GpuTurnJob, GpuTurnParams, GpuTurnRelight};
 
-use super::bind::{bind_group, buffer_with, compute_pipeline, empty_buffer, storage, uniform};
-use super::deferred::Dispatch;
+use super::arena::ArenaRange;
+use super::bind::{bind_group, buffer_with, compute_pipeline, storage, uniform};
 use super::pose::GpuPose;
 use super::relight::{PoseRelight, TurnState};
+use super::timing::compute_pass_writes;
 use super::{Gpu, shaders};
 use crate::error::{RenderError, Result};
 use crate::resident::PoseSource;
 
 /// Workgroup size of the pass (`@workgroup_size(64)`).
 const WORKGROUP: u32 = 64;
-/// Record entries (`vec4`) per map of a light, and per sun.
-const TERM: usize = 2;
-const SUN: usize = 5;
 /// The most maps a light relit on the device has (more: the host relights it).
 const MOST_TERMS: usize = 8;
 
-/// The pass and the tables it holds.
+/// The pass, the tables it holds and the look-ups gathered for the next submission.
 pub struct TurnLightPass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
     tables: Mutex<HeldTables>,
+    gathered: Mutex<Gathered>,
+}
+
+/// The look-ups gathered since the last submission: every light's record, one after the
+/// other, and per batch of views relit what it reads and writes; the buffers the records
+/// go through, kept between submissions.
+#[derive(Default)]
+struct Gathered {
+    lights: Vec<[f32; 4]>,
+    relights: Vec<Option<GatheredRelight>>,
+    /// Where each batch's coefficients (the range's page and offset) was gathered last:
+    /// a batch relit twice before a submission is looked up once, for its later light.
+    at: std::collections::HashMap<(usize, u64), usize>,
+    records: Option<wgpu::Buffer>,
+    light_buffer: Option<wgpu::Buffer>,
+}
+
+/// A batch of views to look a light up for, with the ranges it reads and writes (held
+/// until the submission, so that neither is taken by another pose meanwhile), the tables'
+/// buffer its light's record points into and the size of their coarse maps.
+struct GatheredRelight {
+    data: Arc<ArenaRange>,
+    coefficients: Arc<ArenaRange>,
+    tables: wgpu::Buffer,
+    coarse: (u32, u32),
+    record: GpuTurnRelight,
+    threads: u32,
+}
+
+impl GatheredRelight {
+    /// The buffers and sizes one dispatch must share.
+    fn same_dispatch(&self, other: &Self) -> bool {
+        self.data.buffer() == other.data.buffer()
+            && self.coefficients.buffer() == other.coefficients.buffer()
+            && self.tables == other.tables
+            && self.coarse == other.coarse
+    }
 }
 
 /// Every table the device holds, one after the other in one buffer (made again, larger,
@@ -86,12 +124,11 @@ impl TurnLightPass {
             label: Some("turn light"),
             entries: &[
                 uniform::<GpuTurnParams>(0, c),
-                storage::<GpuTurnJob>(1, true, c),
-                storage::<f32>(2, true, c),
+                storage::<GpuTurnRelight>(1, true, c),
+                storage::<[f32; 4]>(2, true, c),
                 storage::<[f32; 4]>(3, true, c),
                 storage::<[f32; 4]>(4, true, c),
-                storage::<[f32; 4]>(5, true, c),
-                storage::<[f32; 4]>(6, false, c),
+                storage::<[f32; 4]>(5, false, c),
             ],
         });
         let pipeline = compute_pipeline(device, "turn light", &[&layout], &module, "turn_light");
@@ -99,6 +136,7 @@ impl TurnLightPass {
             layout,
             pipeline,
             tables: Mutex::default(),
+            gathered: Mutex::default(),
         }
     }
 }
@@ -190,6 +228,158 @@ impl HeldTables {
     }
 }
 
+impl Gathered {
+    /// Adds `relight`, in place of one gathered before for the same coefficients.
+    fn push(&mut self, relight: GatheredRelight) {
+        let key = relight.coefficients.key();
+        if let Some(&i) = self.at.get(&key) {
+            self.relights[i] = None;
+        }
+        self.at.insert(key, self.relights.len());
+        self.relights.push(Some(relight));
+    }
+
+    /// Every batch gathered (in order), in runs that one dispatch takes: the same pages
+    /// and tables, and at most a dispatch's rows of workgroups.
+    fn dispatches(&mut self) -> Vec<Vec<GatheredRelight>> {
+        let mut runs: Vec<Vec<GatheredRelight>> = Vec::new();
+        for r in self.relights.drain(..).flatten() {
+            match runs
+                .iter_mut()
+                .find(|run| run.len() < MOST_ROWS && run[0].same_dispatch(&r))
+            {
+                Some(run) => run.push(r),
+                None => runs.push(vec![r]),
+            }
+        }
+        self.at.clear();
+        runs
+    }
+}
+
+/// The most rows of workgroups a dispatch has (wgpu's least limit on a dimension).
+const MOST_ROWS: usize = 65_535;
+
+impl Gpu {
+    /// Lets go of the look-ups gathered for `relight`'s coefficients (the host writes
+    /// them instead).
+    pub(super) fn forget_turns(&self, relight: &PoseRelight) {
+        let mut gathered = (self.turn_light.gathered.lock()).unwrap_or_else(|e| e.into_inner());
+        if gathered.relights.is_empty() {
+            return;
+        }
+        for range in (0..).map_while(|b| relight.coefficient_range(b)) {
+            if let Some(i) = gathered.at.remove(&range.key()) {
+                gathered.relights[i] = None;
+            }
+        }
+    }
+
+    /// Records the look-ups gathered since the last submission into `encoder` (made when
+    /// there is none) as one pass: a dispatch for every run of them on the same pages
+    /// (one, unless a crowd's coefficients outgrow a page), a row of workgroups a batch of
+    /// views. Their records and lights are uploaded with the submission's small writes.
+    pub(super) fn record_turns(
+        &self,
+        encoder: Option<wgpu::CommandEncoder>,
+    ) -> Option<wgpu::CommandEncoder> {
+        let mut gathered = (self.turn_light.gathered.lock()).unwrap_or_else(|e| e.into_inner());
+        let runs = gathered.dispatches();
+        if runs.is_empty() {
+            gathered.lights.clear();
+            return encoder;
+        }
+        // Each run's records from a multiple of the binding alignment on, in one buffer.
+        let align = (self.device.limits().min_storage_buffer_offset_alignment as usize).max(16);
+        let mut records: Vec<u8> = Vec::new();
+        let mut placed = Vec::with_capacity(runs.len());
+        for run in &runs {
+            records.resize(records.len().next_multiple_of(align), 0);
+            let at = records.len() as u64;
+            for r in run {
+                records.extend_from_slice(bytemuck::bytes_of(&r.record));
+            }
+            placed.push((at, records.len() as u64 - at));
+        }
+        let lights = std::mem::take(&mut gathered.lights);
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let kept = |slot: &mut Option<wgpu::Buffer>, label: &str, bytes: &[u8]| {
+            let needed = bytes.len() as u64;
+            if slot.as_ref().is_none_or(|b| b.size() < needed) {
+                *slot = Some(self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: needed.next_power_of_two().max(4096),
+                    usage,
+                    mapped_at_creation: false,
+                }));
+            }
+            let buffer = slot.clone().expect("made above");
+            self.upload(&buffer, 0, bytes);
+            buffer
+        };
+        let record_buffer = kept(&mut gathered.records, "turn records", &records);
+        let light_buffer = kept(
+            &mut gathered.light_buffer,
+            "turn lights",
+            bytemuck::cast_slice(&lights),
+        );
+        drop(gathered);
+        let mut encoder = encoder.unwrap_or_else(|| {
+            self.device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("pending"),
+                })
+        });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("turn light"),
+            timestamp_writes: compute_pass_writes(self.pass_timestamps("turn light", None)),
+        });
+        pass.set_pipeline(&self.turn_light.pipeline);
+        self.dispatched("turn light", runs.len());
+        for (run, (at, size)) in runs.iter().zip(placed) {
+            let first = &run[0];
+            let params = GpuTurnParams {
+                relights: run.len() as u32,
+                samples: SAMPLES_PER_TURN as u32,
+                sun_slots: MAX_SUNS as u32,
+                coarse_w: first.coarse.0,
+                coarse_h: first.coarse.1,
+                ratio_floor: RATIO_FLOOR,
+                trust_low: TRUST_ERROR[0],
+                trust_high: TRUST_ERROR[1],
+            };
+            let params = buffer_with(
+                &self.device,
+                "turn params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::UNIFORM,
+            );
+            let bind = bind_group(
+                &self.device,
+                "turn light",
+                &self.turn_light.layout,
+                vec![
+                    params.as_entire_binding(),
+                    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &record_buffer,
+                        offset: at,
+                        size: wgpu::BufferSize::new(size),
+                    }),
+                    first.data.buffer().as_entire_binding(),
+                    first.tables.as_entire_binding(),
+                    light_buffer.as_entire_binding(),
+                    first.coefficients.buffer().as_entire_binding(),
+                ],
+            );
+            let threads = run.iter().map(|r| r.threads).max().unwrap_or(0);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(threads.div_ceil(WORKGROUP).max(1), run.len() as u32, 1);
+        }
+        drop(pass);
+        Some(encoder)
+    }
+}
+
 /// Tables the device holds before those no light holds any more are let go of (a scene
 /// whose sun moves makes a table of it at each new place).
 const MOST_TABLES: usize = 16;
@@ -242,21 +432,23 @@ impl Gpu {
             .len()
     }
 
-    /// What `relight`'s batches need to be relit on the device (see [`TurnState`]).
+    /// What `relight`'s batches need to be relit on the device (see [`TurnState`]): per
+    /// batch its jobs (two `vec4`s each), the field's conditions (four each) and its words
+    /// (its views' scales, then the plan's mask, four a `vec4`) in a range of the shared
+    /// pages, uploaded once.
     fn turn_state(
         &self,
         relight: &PoseRelight,
         source: &PoseSource,
         light: &TurnedLight,
-        coarse: (u32, u32),
     ) -> TurnState {
-        let storage = wgpu::BufferUsages::STORAGE;
         let turntables = light.pose.turntables();
+        let conditions = condition_table(light.conditions);
         let batches = relight
             .basis()
             .batch_jobs()
             .map(|(views, offsets)| {
-                let mut data: Vec<f32> = Vec::new();
+                let mut words: Vec<f32> = Vec::new();
                 let jobs: Vec<GpuTurnJob> = views
                     .iter()
                     .zip(offsets)
@@ -269,73 +461,42 @@ impl Gpu {
                             normals: u32::from(
                                 source.normals.get(i).is_some_and(|n| !n.is_empty()),
                             ),
-                            scales: data.len() as u32,
+                            scales: words.len() as u32,
                             ..bytemuck::Zeroable::zeroed()
                         };
-                        data.extend(scales);
+                        words.extend(scales);
                         job
                     })
                     .collect();
-                let mask = data.len() as u32;
+                let mask = words.len() as u32;
                 let items = jobs.iter().map(|j| j.tiles).max().unwrap_or(0) + MAX_SUNS as u32;
-                data.extend((0..light.conditions.len()).map(|k| {
+                words.extend((0..light.conditions.len()).map(|k| {
                     let used = light.used.is_none_or(|u| u.get(k).copied().unwrap_or(true));
                     if used { 1.0 } else { 0.0 }
                 }));
-                let params = GpuTurnParams {
+                words.resize(words.len().next_multiple_of(4), 0.0);
+                let mut data: Vec<[f32; 4]> = bytemuck::cast_slice(&jobs).to_vec();
+                let conditions_at = data.len() as u32;
+                data.extend_from_slice(&conditions);
+                let words_at = data.len() as u32;
+                data.extend(words.chunks_exact(4).map(|w| [w[0], w[1], w[2], w[3]]));
+                let range = self.turn_data.take(&self.device, (data.len() * 16) as u64);
+                self.upload(range.buffer(), range.offset(), bytemuck::cast_slice(&data));
+                let base = range.vec4_offset();
+                let record = GpuTurnRelight {
+                    jobs_at: base,
                     jobs: jobs.len() as u32,
-                    conditions: light.conditions.len() as u32,
-                    samples: SAMPLES_PER_TURN as u32,
-                    sun_slots: MAX_SUNS as u32,
-                    mask,
-                    coarse_w: coarse.0,
-                    coarse_h: coarse.1,
-                    ratio_floor: RATIO_FLOOR,
-                    trust_low: TRUST_ERROR[0],
-                    trust_high: TRUST_ERROR[1],
                     items,
-                    pad: 0,
+                    conditions_at: base + conditions_at,
+                    conditions: light.conditions.len() as u32,
+                    words_at: base + words_at,
+                    mask,
+                    ..bytemuck::Zeroable::zeroed()
                 };
-                let n = jobs.len() as u32 * items;
-                (
-                    buffer_with(
-                        &self.device,
-                        "turn params",
-                        bytemuck::bytes_of(&params),
-                        wgpu::BufferUsages::UNIFORM,
-                    ),
-                    buffer_with(
-                        &self.device,
-                        "turn jobs",
-                        bytemuck::cast_slice(&jobs),
-                        storage,
-                    ),
-                    buffer_with(
-                        &self.device,
-                        "turn data",
-                        bytemuck::cast_slice(&data),
-                        storage,
-                    ),
-                    n,
-                )
+                (Arc::new(range), record, jobs.len() as u32 * items)
             })
             .collect();
-        TurnState {
-            batches,
-            conditions: buffer_with(
-                &self.device,
-                "turn conditions",
-                bytemuck::cast_slice(&condition_table(light.conditions)),
-                storage,
-            ),
-            light: empty_buffer(
-                &self.device,
-                "turn light",
-                (1 + TERM * MOST_TERMS + SUN * MAX_SUNS) * 16,
-                storage | wgpu::BufferUsages::COPY_DST,
-            ),
-            binds: Mutex::new(None),
-        }
+        TurnState { batches }
     }
 
     /// Relights `pose` (made resident from `source`, its views) under `light` on the
@@ -413,47 +574,33 @@ impl Gpu {
                 hull.as_deref(),
             );
             if relight.turn.is_none() {
-                relight.turn = Some(self.turn_state(relight, source, light, coarse));
+                relight.turn = Some(self.turn_state(relight, source, light));
             }
-            let state = relight.turn.as_ref().expect("made above");
-            self.upload(&state.light, 0, bytemuck::cast_slice(&record));
             let relight = pose.relight.as_ref().expect("checked above");
             let state = relight.turn.as_ref().expect("made above");
-            // The bind groups of its last relight serve while the tables are the same.
-            let mut kept = state.binds.lock().unwrap_or_else(|e| e.into_inner());
-            if kept.as_ref().is_none_or(|(a, _)| *a != arena) {
-                let binds = (state.batches.iter().enumerate())
-                    .filter_map(|(b, (params, jobs, data, _))| {
-                        let coefficients = relight.coefficient_buffer(b)?;
-                        Some(bind_group(
-                            &self.device,
-                            "turn light",
-                            &self.turn_light.layout,
-                            vec![
-                                params.as_entire_binding(),
-                                jobs.as_entire_binding(),
-                                data.as_entire_binding(),
-                                state.conditions.as_entire_binding(),
-                                arena.as_entire_binding(),
-                                state.light.as_entire_binding(),
-                                coefficients.as_entire_binding(),
-                            ],
-                        ))
-                    })
-                    .collect();
-                *kept = Some((arena.clone(), binds));
+            let mut gathered = (self.turn_light.gathered.lock()).unwrap_or_else(|e| e.into_inner());
+            let light_at = gathered.lights.len() as u32;
+            gathered.lights.extend(record);
+            for (b, (data, record, threads)) in state.batches.iter().enumerate() {
+                let Some(coefficients) = relight.coefficient_range(b) else {
+                    continue;
+                };
+                gathered.push(GatheredRelight {
+                    data: data.clone(),
+                    coefficients: coefficients.clone(),
+                    tables: arena.clone(),
+                    coarse,
+                    record: GpuTurnRelight {
+                        light_at,
+                        coefficients_at: coefficients.vec4_offset(),
+                        ..*record
+                    },
+                    threads: *threads,
+                });
             }
-            let binds = &kept.as_ref().expect("made above").1;
-            let before = |b: usize| {
-                let (_, _, _, n) = state.batches.get(b)?;
-                Some(Dispatch {
-                    pipeline: self.turn_light.pipeline.clone(),
-                    bind: binds.get(b)?.clone(),
-                    groups: [n.div_ceil(WORKGROUP).max(1), 1, 1],
-                })
-            };
+            drop(gathered);
             let target = || pose.prelit_codes_view();
-            self.record_relight_passes(relight, (target, &pose.views), before);
+            self.record_relight_passes(relight, (target, &pose.views));
             Ok(true)
         })
     }
@@ -467,9 +614,10 @@ impl Gpu {
         };
         self.scoped("reading a pose's coefficients back", || {
             (0..)
-                .map_while(|b| relight.coefficient_buffer(b))
-                .map(|buffer| {
-                    let bytes = self.read_back(buffer, "coefficients readback")?;
+                .map_while(|b| relight.coefficient_range(b))
+                .map(|range| {
+                    let at = (range.offset(), range.size());
+                    let bytes = self.read_back_range(range.buffer(), at, "coefficients")?;
                     Ok(bytemuck::cast_slice(&bytes).to_vec())
                 })
                 .collect()
