@@ -197,3 +197,64 @@ fn files_round_trip_and_bad_ones_are_refused_by_name() {
     std::fs::write(&path, f.to_string()).unwrap();
     assert!(ShLight::load(&path).is_err());
 }
+
+/// A map of fewer than `MIN_MAP_ROWS` rows read from a file is integrated as its texels'
+/// regions: the L2 light of a uniform 1x1, 2x1 and 4x2 map is band 0 alone (bands 1-8
+/// within 1e-3 of it; 8e-4 measured, the row centres' error at 32 rows), `L * 2 sqrt(pi)`; a 2x1 map of two halves projects as the same
+/// halves on a 256x128 grid (within 1e-3 of its band 0), and a loaded map keeps its total
+/// light. Control: the same images wrapped as they are (`EnvMap::from_image`, texel
+/// centres alone) give bands 1-8 as bright as band 0.
+#[test]
+fn a_tiny_map_integrates_its_texels_regions() {
+    use frf_core::image::Image;
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, img: &frf_core::image::RgbImage| {
+        let path = dir.path().join(name);
+        frf_core::io::write_exr_rgb(&path, img).unwrap();
+        EnvMap::load(&path).unwrap()
+    };
+    let largest_past_band_0 = |sh: &ShLight| {
+        sh.coefficients[1..]
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, &c| m.max(c.abs()))
+    };
+    let band_0 = 2.0 * PI.sqrt();
+    for (w, h) in [(1, 1), (2, 1), (4, 2)] {
+        let img = Image::new(w, h, [1.0f32, 2.0, 3.0]);
+        let sh = read(&format!("u{w}x{h}.exr"), &img).to_sh();
+        for c in 0..3 {
+            let want = (c + 1) as f32 * band_0;
+            let got = sh.coefficients[0][c];
+            assert!((got - want).abs() < 1e-4 * want, "{w}x{h}: {got} vs {want}");
+        }
+        // Against the brightest channel's band 0.
+        let past = largest_past_band_0(&sh);
+        assert!(
+            past < 1e-3 * 3.0 * band_0,
+            "{w}x{h}: bands 1-8 up to {past}"
+        );
+        // Control: the centres alone.
+        let centres = EnvMap::from_image(img).unwrap().to_sh();
+        assert!(
+            largest_past_band_0(&centres) > 0.5 * band_0,
+            "{w}x{h}: the centres alone ring less than expected"
+        );
+    }
+    // Two halves: west 1, east 4.
+    let halves = Image::from_vec(2, 1, vec![[1.0f32; 3], [4.0; 3]]).unwrap();
+    let loaded = read("halves.exr", &halves);
+    let fine = Image::from_fn(
+        256,
+        128,
+        |x, _| if x < 128 { [1.0f32; 3] } else { [4.0; 3] },
+    );
+    let want = EnvMap::from_image(fine).unwrap().to_sh();
+    let got = loaded.to_sh();
+    for (a, b) in got.coefficients.iter().zip(&want.coefficients) {
+        let scale = want.coefficients[0][0];
+        assert!((a[0] - b[0]).abs() < 1e-3 * scale, "{a:?} vs {b:?}");
+    }
+    let total = loaded.total_light()[0];
+    assert!((total - 10.0 * PI).abs() < 1e-4 * total, "total {total}");
+}

@@ -74,3 +74,56 @@ fn env_sh_writes_the_projection_and_renders_an_l2_light_as_itself() {
     );
     assert!(!out.join("frame_0000.png").exists());
 }
+
+/// A 1x1 uniform map is the uniform light it stands for (issue 59): `env-sh` keeps 100 %
+/// of its energy in band 0 (it reported 900 %) and a frame under it is the frame under the
+/// built-in uniform light of the same radiance (its subject was 12 times darker). A map
+/// with a negative texel is read with a warning naming the file and the value (it was
+/// clamped silently).
+#[test]
+fn a_one_texel_map_lights_as_the_uniform_light_and_a_negative_texel_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one.exr");
+    frf_core::io::write_exr_rgb(&one, &frf_core::image::Image::new(1, 1, [1.0f32; 3])).unwrap();
+    let sh = dir.path().join("one.json");
+    let o = frf(&[
+        "env-sh",
+        one.to_str().unwrap(),
+        "--out",
+        sh.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("energy kept by L2 (sum of squared coefficients / integral of squared radiance, luminance): 100.0 %"), "{text}");
+    let direct = one_frame("uniform", &dir.path().join("direct")).unwrap();
+    let by_map = one_frame(one.to_str().unwrap(), &dir.path().join("map")).unwrap();
+    let subject = |img: &image::RgbaImage| {
+        let lit: Vec<f64> = (img.pixels())
+            .filter(|p| p[3] > 200)
+            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+            .collect();
+        lit.iter().sum::<f64>() / lit.len().max(1) as f64
+    };
+    let (a, b) = (subject(&direct), subject(&by_map));
+    assert!(
+        a > 30.0 && (a - b).abs() < 0.03 * a,
+        "uniform {a:.1}, 1x1 map {b:.1}"
+    );
+    // A texel of -1e6 among positive ones.
+    let mut img = frf_core::image::Image::new(8, 4, [1.0f32; 3]);
+    img.set(3, 2, [-1e6, 1.0, 1.0]);
+    let negative = dir.path().join("negative.exr");
+    frf_core::io::write_exr_rgb(&negative, &img).unwrap();
+    let o = frf(&[
+        "env-sh",
+        negative.to_str().unwrap(),
+        "--out",
+        dir.path().join("negative.json").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("negative.exr") && err.contains("-1.000e6") && err.contains("clamped"),
+        "{err}"
+    );
+}
