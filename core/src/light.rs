@@ -50,6 +50,43 @@ pub fn direction_from_azimuth_elevation(azimuth: f32, elevation: f32) -> Vec3 {
     )
 }
 
+/// The largest turn (a yaw, an azimuth) taken, degrees either way: beyond it a double no
+/// longer holds the angle to a whole degree (doubles hold every whole number to 2^53, about
+/// 9e15), so the turn it names is not known.
+pub const MOST_TURN_DEG: f64 = 1e15;
+
+/// `degrees` as the same turn within ±180°, reduced in double precision (as it is when
+/// already within): 1e9° is -80°, the turn 1e9 mod 360 names, where f32 radians of 1e9°
+/// miss it by degrees.
+pub fn within_half_turn(degrees: f64) -> f64 {
+    if degrees.abs() <= 180.0 {
+        degrees
+    } else {
+        (degrees + 180.0).rem_euclid(360.0) - 180.0
+    }
+}
+
+/// The radians of a turn of `degrees` ([`within_half_turn`] first; an angle within ±180°
+/// converts as `f32::to_radians` converts it).
+pub fn turn_radians(degrees: f64) -> f32 {
+    (within_half_turn(degrees) as f32).to_radians()
+}
+
+/// `degrees` as a turn, refused where it is not finite or beyond [`MOST_TURN_DEG`] (the
+/// problem in words).
+pub fn checked_turn(degrees: f64) -> std::result::Result<f64, String> {
+    if !degrees.is_finite() {
+        return Err(format!("{degrees}° is not a finite angle"));
+    }
+    if degrees.abs() > MOST_TURN_DEG {
+        return Err(format!(
+            "{degrees:e}° is beyond ±{MOST_TURN_DEG:e}°, where a double no longer holds the turn \
+             to a whole degree"
+        ));
+    }
+    Ok(degrees)
+}
+
 /// Azimuth and elevation (radians) of a unit direction.
 #[inline]
 pub fn azimuth_elevation(d: Vec3) -> (f32, f32) {
@@ -58,6 +95,35 @@ pub fn azimuth_elevation(d: Vec3) -> (f32, f32) {
 
 #[cfg(test)]
 mod tests {
+    /// Turns of any size name the turn they are mod 360, reduced in double precision: the
+    /// same radians as the angle within ±180° (exactly), where f32 radians of the angle
+    /// itself are off by degrees; beyond the stated range and not finite are refused.
+    #[test]
+    fn a_turn_is_reduced_in_double_precision() {
+        use super::*;
+        for (deg, same) in [
+            (1e9, -80.0),
+            (1e15, -80.0),
+            (-1e9, 80.0),
+            (540.0, -180.0),
+            (-190.0, 170.0),
+            (359.5, -0.5),
+        ] {
+            assert_eq!(turn_radians(deg), (same as f32).to_radians(), "{deg}");
+        }
+        // Within ±180°: as before, bit for bit.
+        for deg in [0.0f32, 0.7, -179.9, 180.0, 42.123] {
+            assert_eq!(turn_radians(f64::from(deg)), deg.to_radians());
+        }
+        // Control: f32 radians of 1e9° are not -80°'s turn.
+        let naive = (1e9f32).to_radians();
+        let off = (naive.sin() - (-80f32).to_radians().sin()).abs();
+        assert!(off > 0.01, "{off}");
+        assert!(checked_turn(1e15).is_ok());
+        assert!(checked_turn(2e15).unwrap_err().contains("beyond"));
+        assert!(checked_turn(f64::NAN).is_err());
+    }
+
     use super::*;
 
     #[test]

@@ -408,7 +408,7 @@ pub fn standing_twin(
     let key = |time: f64, env: &frf_core::env::EnvSource| frf_scene::LightKey {
         time,
         env: env.clone(),
-        yaw: l.yaw - heading,
+        yaw_deg: f64::from(l.yaw - heading).to_degrees(),
         intensity: l.intensity,
     };
     twin.lighting = match l.maps.as_slice() {

@@ -158,7 +158,7 @@ pub fn sprite_sheet(
     let first = poses[0];
     let look = FieldLook {
         env: options.env.clone(),
-        yaw: 0.0,
+        yaw_deg: 0.0,
         sun: options.sun,
         floor: FloorModel::Environment,
         camera: Trajectory::Orbit(Orbit {

@@ -406,7 +406,7 @@ pub fn bench_scene(
             },
             LightKey {
                 time: s.end,
-                yaw: key.yaw + (turn_deg * (frames + 1) as f32).to_radians(),
+                yaw_deg: key.yaw_deg + f64::from(turn_deg) * (frames + 1) as f64,
                 ..key
             },
         ],

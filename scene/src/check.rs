@@ -209,7 +209,7 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
     let mut lighting = vec![LightKey {
         time: f64::NEG_INFINITY,
         env: base_env,
-        yaw: finite(r, "lighting.yaw_deg", &l.yaw_deg)?.to_radians(),
+        yaw_deg: turn(r, "lighting.yaw_deg", &l.yaw_deg)?,
         intensity: finite(r, "lighting.intensity", &l.intensity)?,
     }];
     for (i, k) in l.key.iter().enumerate() {
@@ -230,9 +230,9 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
                 Some(e) => env(r, &field("env"), e)?,
                 None => prev.env.clone(),
             },
-            yaw: match &key.yaw_deg {
-                Some(y) => finite(r, &field("yaw_deg"), y)?.to_radians(),
-                None => prev.yaw,
+            yaw_deg: match &key.yaw_deg {
+                Some(y) => turn(r, &field("yaw_deg"), y)?,
+                None => prev.yaw_deg,
             },
             intensity: match &key.intensity {
                 Some(v) => finite(r, &field("intensity"), v)?,
@@ -298,8 +298,8 @@ pub fn probes(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Probes>> {
         if !position.is_finite() || position.abs().max_element() > MAX_DISTANCE_M {
             return Err(r.error(&field("position"), p.span(), "finite metres within 10 km"));
         }
-        if !v.yaw_deg.is_finite() {
-            return Err(r.error(&field("yaw_deg"), p.span(), "a finite angle"));
+        if let Err(problem) = frf_core::light::checked_turn(v.yaw_deg) {
+            return Err(r.error(&field("yaw_deg"), p.span(), problem));
         }
         if !(v.intensity >= 0.0 && v.intensity <= MAX_INTENSITY) {
             return Err(r.error(
@@ -311,7 +311,7 @@ pub fn probes(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Probes>> {
         probes.push(Probe {
             position,
             env: source,
-            yaw: radians(v.yaw_deg),
+            yaw: frf_core::light::turn_radians(v.yaw_deg),
             intensity: v.intensity,
             suns: v.suns,
         });
@@ -484,6 +484,12 @@ pub fn instances(r: &Reporter, raw: &SceneToml) -> Result<Vec<Instance>> {
     Ok(instances)
 }
 
+/// A turn in degrees from a scene file (a light's yaw), refused naming the field where it
+/// is not finite or beyond [`frf_core::light::MOST_TURN_DEG`].
+fn turn(r: &Reporter, field: &str, v: &At<f64>) -> Result<f64> {
+    frf_core::light::checked_turn(*v.get_ref()).map_err(|problem| r.error(field, v.span(), problem))
+}
+
 /// An angle in degrees as radians, reduced to a turn in double precision first (so that
 /// 10^9 degrees is the same heading as its remainder).
 fn radians(deg: f64) -> f32 {
@@ -542,11 +548,13 @@ pub fn sun(r: &Reporter, l: &At<LightingToml>) -> Result<Option<Sun>> {
             d
         }
         (None, Some(az), Some(el)) => {
-            let (az, el) = (finite("azimuth_deg", az)?, finite("elevation_deg", el)?);
+            let az = frf_core::light::checked_turn(az).map_err(|e| bad("azimuth_deg", e))?;
+            let el = finite("elevation_deg", el)?;
             if !(-90.0..=90.0).contains(&el) {
                 return Err(bad("elevation_deg", format!("{el}° is not within ±90°")));
             }
-            frf_core::light::direction_from_azimuth_elevation(az.to_radians(), el.to_radians())
+            let az = frf_core::light::turn_radians(az);
+            frf_core::light::direction_from_azimuth_elevation(az, el.to_radians())
         }
         _ => {
             return Err(bad(

@@ -39,7 +39,7 @@ pub fn explain<R: ReadAt>(
     let lighting = match &scene.lighting[0].env.load()? {
         Some(env) => Lighting::Environment {
             env: env
-                .rotated(scene.lighting[0].yaw)
+                .rotated(frf_core::light::turn_radians(scene.lighting[0].yaw_deg))
                 .scaled(scene.lighting[0].intensity),
             floor: scene.floor,
         },

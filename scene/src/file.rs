@@ -113,7 +113,7 @@ pub struct SceneToml {
 #[serde(deny_unknown_fields)]
 pub struct TimeToml {
     /// Seconds (64-bit: a frame's instant is `start + i / fps` at any time of day).
-    #[serde(default = "zero_seconds")]
+    #[serde(default = "zero_f64")]
     pub start: At<f64>,
     /// Seconds, exclusive.
     pub end: At<f64>,
@@ -174,8 +174,8 @@ pub struct LightingToml {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub env: Option<At<String>>,
     /// Degrees.
-    #[serde(default = "zero")]
-    pub yaw_deg: At<f32>,
+    #[serde(default = "zero_f64")]
+    pub yaw_deg: At<f64>,
     /// Multiplier.
     #[serde(default = "one")]
     pub intensity: At<f32>,
@@ -230,7 +230,7 @@ fn one_f32() -> f32 {
 pub struct SunToml {
     /// Degrees from `+z` toward `+x`.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub azimuth_deg: Option<f32>,
+    pub azimuth_deg: Option<f64>,
     /// Degrees above the horizon.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub elevation_deg: Option<f32>,
@@ -255,7 +255,7 @@ fn zero() -> At<f32> {
     At::new(0..0, 0.0)
 }
 
-fn zero_seconds() -> At<f64> {
+fn zero_f64() -> At<f64> {
     At::new(0..0, 0.0)
 }
 
@@ -278,7 +278,7 @@ pub struct LightKeyToml {
     pub env: Option<At<String>>,
     /// Degrees.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub yaw_deg: Option<At<f32>>,
+    pub yaw_deg: Option<At<f64>>,
     /// Multiplier.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub intensity: Option<At<f32>>,

@@ -44,6 +44,7 @@ use std::path::{Path, PathBuf};
 
 use frf_core::camera::Camera;
 use frf_core::env::EnvSource;
+use frf_core::light::turn_radians;
 use frf_reflectance::project::FloorModel;
 
 pub use crate::error::{Result, SceneError};
@@ -118,8 +119,10 @@ pub struct LightKey {
     pub time: f64,
     /// The environment from this key on.
     pub env: EnvSource,
-    /// Radians.
-    pub yaw: f32,
+    /// Its turn about `+y`, degrees as given (keys turning more than half a turn apart
+    /// turn the light that far between them); the light at an instant takes it within
+    /// ±180° in double precision ([`frf_core::light::turn_radians`]).
+    pub yaw_deg: f64,
     /// Multiplier of the environment's radiance.
     pub intensity: f32,
 }
@@ -369,11 +372,12 @@ impl Scene {
         let a = &k[i];
         let sun = |yaw: f32, intensity: f32| self.sun.map(|s| s.rotated(yaw).scaled(intensity));
         let Some(b) = k.get(i + 1) else {
+            let yaw = turn_radians(a.yaw_deg);
             return LightingAt {
                 maps: vec![(a.env.clone(), 1.0)],
-                yaw: a.yaw,
+                yaw,
                 intensity: a.intensity,
-                sun: sun(a.yaw, a.intensity),
+                sun: sun(yaw, a.intensity),
             };
         };
         let s = if a.time.is_finite() {
@@ -387,7 +391,7 @@ impl Scene {
             vec![(a.env.clone(), 1.0 - s), (b.env.clone(), s)]
         };
         let (yaw, intensity) = (
-            a.yaw + s * (b.yaw - a.yaw),
+            turn_radians(a.yaw_deg + f64::from(s) * (b.yaw_deg - a.yaw_deg)),
             a.intensity + s * (b.intensity - a.intensity),
         );
         LightingAt {

@@ -25,8 +25,8 @@ pub const FIELD_PREVIEW_FPS: f64 = 12.0;
 pub struct FieldLook {
     /// The environment.
     pub env: EnvSource,
-    /// Its yaw, radians.
-    pub yaw: f32,
+    /// Its yaw, degrees.
+    pub yaw_deg: f64,
     /// A sun added to it (`--sun`).
     pub sun: Option<frf_core::sun::Sun>,
     /// What lights the subject from below.
@@ -40,14 +40,14 @@ pub struct FieldLook {
 }
 
 impl FieldLook {
-    /// How the viewer shows a field: lit by `env` (turned by `yaw` radians) over that
+    /// How the viewer shows a field: lit by `env` (turned by `yaw_deg`) over that
     /// environment with the maps' shadow (nothing behind it unlit), the plan of its live
     /// shot made from an orbit around the walker (the viewer starts at a captured view).
-    pub fn viewer(env: EnvSource, yaw: f32, floor: FloorModel) -> Self {
+    pub fn viewer(env: EnvSource, yaw_deg: f64, floor: FloorModel) -> Self {
         let lit = env != EnvSource::None;
         FieldLook {
             env,
-            yaw,
+            yaw_deg,
             sun: None,
             floor,
             camera: Trajectory::Orbit(Orbit {
@@ -90,7 +90,7 @@ impl Scene {
             lighting: vec![LightKey {
                 time: f64::NEG_INFINITY,
                 env: look.env,
-                yaw: look.yaw,
+                yaw_deg: look.yaw_deg,
                 intensity: 1.0,
             }],
             sun: look.sun,

@@ -122,6 +122,51 @@ fn errors_name_the_field_and_its_line() {
     assert!(e.contains("instance[0]") && e.contains("ground"), "{e}");
 }
 
+/// A light's yaw of any size is the turn it names mod 360, reduced in double precision
+/// (1e9° is -80°: the f32 radians it was turned by missed it by degrees), while keys more
+/// than half a turn apart still turn the light that far between them (0° to 720°: two
+/// turns); a yaw or a sun's azimuth beyond the stated range is refused naming the field.
+#[test]
+fn a_yaw_is_the_turn_it_names_and_keys_turn_as_far_as_they_say() {
+    let at = |yaw: &str| {
+        let text = MINIMAL.replace("env = \"sky\"", &format!("env = \"sky\"\nyaw_deg = {yaw}"));
+        scene(&text).unwrap().lighting_at(0.0).yaw
+    };
+    assert_eq!(at("1e9"), (-80f32).to_radians());
+    assert_eq!(at("1e15"), at("-80.0"));
+    assert_eq!(at("30.0"), 30f32.to_radians());
+    let text = MINIMAL.replace(
+        "env = \"sky\"",
+        "env = \"sky\"\n[[lighting.key]]\ntime = 0.0\nyaw_deg = 0.0\n[[lighting.key]]\ntime = 1.0\nyaw_deg = 720.0",
+    );
+    let s = scene(&text).unwrap();
+    for (t, deg) in [
+        (0.125f64, 90.0f32),
+        (0.375, -90.0),
+        (0.625, 90.0),
+        (0.875, -90.0),
+    ] {
+        let yaw = s.lighting_at(t).yaw;
+        assert!((yaw - deg.to_radians()).abs() < 1e-5, "t {t}: {yaw}");
+    }
+    for (field, text) in [
+        (
+            "yaw_deg",
+            MINIMAL.replace("env = \"sky\"", "env = \"sky\"\nyaw_deg = 1e16"),
+        ),
+        (
+            "azimuth_deg",
+            MINIMAL.replace(
+                "env = \"sky\"",
+                "env = \"sky\"\nsun = { azimuth_deg = 1e20, elevation_deg = 30.0 }",
+            ),
+        ),
+    ] {
+        let e = error(&text);
+        assert!(e.contains(field) && e.contains("beyond"), "{e}");
+    }
+}
+
 #[test]
 fn lighting_keys_interpolate_and_cross_fade_maps() {
     let text = MINIMAL.replace(

@@ -133,6 +133,19 @@ pub fn parse_degrees(s: &str) -> Result<f32, String> {
     Ok(v)
 }
 
+/// Parses a turn (a light's yaw, a sun's azimuth) in degrees: read in double precision
+/// and kept as the same turn within ±180° ([`frf_core::light::within_half_turn`]: 1e9 is
+/// -80, the turn 1e9 mod 360 names), refused where not finite or beyond
+/// [`frf_core::light::MOST_TURN_DEG`].
+pub fn parse_turn(s: &str) -> Result<f32, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: {e} (degrees)"))?;
+    let v = frf_core::light::checked_turn(v).map_err(|e| format!("`{s}`: {e}"))?;
+    Ok(frf_core::light::within_half_turn(v) as f32)
+}
+
 /// Parses a vertical field of view in degrees, within the range a camera path allows.
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     use frf_scene::path::{MAX_FOV_DEG, MIN_FOV_DEG};
@@ -252,8 +265,9 @@ pub struct LightingArgs {
     /// photographs as captured (a file named like one of the words: `./sky`).
     #[arg(long, value_parser = parse_env)]
     pub env: Option<EnvSource>,
-    /// Yaw of the environment about the vertical axis, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
+    /// Yaw of the environment about the vertical axis, degrees (any turn; kept within
+    /// ±180°).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_turn)]
     pub yaw: f32,
     /// What lights the subject from below.
     #[arg(long, value_enum, default_value = "env")]
@@ -295,9 +309,9 @@ impl SunSpec {
 
 /// Parses `--sun`.
 pub fn parse_sun(s: &str) -> Result<SunSpec, String> {
-    let v: Vec<f32> = s
+    let v: Vec<f64> = s
         .split(',')
-        .map(|x| x.trim().parse::<f32>())
+        .map(|x| x.trim().parse::<f64>())
         .collect::<Result<_, _>>()
         .map_err(|_| {
             format!("{s:?} is not AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]] in numbers")
@@ -307,11 +321,14 @@ pub fn parse_sun(s: &str) -> Result<SunSpec, String> {
             "{s:?} is not AZIMUTH,ELEVATION[,DIAMETER[,ILLUMINANCE]] (2 to 4 finite numbers)"
         ));
     }
+    let azimuth = frf_core::light::checked_turn(v[0]).map_err(|e| format!("azimuth {e}"))?;
     let spec = SunSpec {
-        azimuth_deg: v[0],
-        elevation_deg: v[1],
-        diameter_deg: v.get(2).copied().unwrap_or(frf_core::sun::SUN_DIAMETER_DEG),
-        illuminance: v.get(3).copied().unwrap_or(10.0),
+        azimuth_deg: frf_core::light::within_half_turn(azimuth) as f32,
+        elevation_deg: v[1] as f32,
+        diameter_deg: v
+            .get(2)
+            .map_or(frf_core::sun::SUN_DIAMETER_DEG, |&d| d as f32),
+        illuminance: v.get(3).map_or(10.0, |&e| e as f32),
     };
     if !(-90.0..=90.0).contains(&spec.elevation_deg) {
         return Err(format!(

@@ -18,7 +18,7 @@ pub struct EnvShArgs {
     /// The environment: a latitude–longitude `.hdr` / `.exr`, or `sky`.
     env: EnvSource,
     /// Turn the map about the vertical axis first, degrees (as `frf render --yaw`).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::cmd::args::parse_turn)]
     yaw: f32,
     /// Output SH light (`.json`).
     #[arg(long)]
@@ -27,11 +27,6 @@ pub struct EnvShArgs {
 
 /// Runs `frf env-sh`.
 pub fn run(args: EnvShArgs) -> CliResult {
-    if !args.yaw.is_finite() {
-        return Err(
-            frf_core::BadArgument::new("--yaw", args.yaw, "a finite angle in degrees").into(),
-        );
-    }
     let started = Instant::now();
     if let EnvSource::File(map) = &args.env {
         frf_core::atomic::refuse_overwriting_inputs(&args.out, &[map.as_path()])?;

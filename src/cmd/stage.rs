@@ -132,7 +132,7 @@ struct TruthArgs {
     #[arg(long, conflicts_with = "basis", value_parser = parse_env)]
     env: Option<EnvSource>,
     /// Yaw of the environment, degrees.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::cmd::args::parse_turn)]
     yaw: f32,
     /// Median-cut lights the environment is reduced to.
     #[arg(long, default_value_t = DEFAULT_ENVIRONMENT_LIGHTS)]

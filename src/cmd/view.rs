@@ -15,7 +15,7 @@ use frf_view::ViewOptions;
 
 use crate::CliResult;
 use crate::cmd::args::{
-    FloorArg, SunSpec, VariantArg, parse_degrees, parse_env, parse_size, parse_sun,
+    FloorArg, SunSpec, VariantArg, parse_env, parse_size, parse_sun, parse_turn,
 };
 
 /// Memory the resident poses may hold by default, MB.
@@ -36,7 +36,7 @@ pub struct ViewArgs {
     #[arg(long, value_parser = parse_env)]
     pub env: Vec<EnvSource>,
     /// Yaw of a field's environment, degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_degrees)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_turn)]
     pub yaw: f32,
     /// What lights a field's subject from below.
     #[arg(long, value_enum, default_value = "env")]
@@ -76,7 +76,7 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
     let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
     let look = FieldLook {
         sun: args.sun.as_ref().map(SunSpec::sun).transpose()?,
-        ..FieldLook::viewer(env, args.yaw.to_radians(), args.floor.into())
+        ..FieldLook::viewer(env, f64::from(args.yaw), args.floor.into())
     };
     // The walk plays from pose 0.
     Ok(Scene {

@@ -127,3 +127,30 @@ fn a_one_texel_map_lights_as_the_uniform_light_and_a_negative_texel_is_warned_of
         "{err}"
     );
 }
+
+/// `env-sh --yaw` of any size turns the map by the turn it names mod 360 (1e9° is -80°;
+/// its f32 radians gave coefficients off by up to 0.85), and beyond the stated range it is
+/// refused by name (issue 59).
+#[test]
+fn a_yaw_of_any_size_is_the_turn_it_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let project = |yaw: &str| {
+        let out = dir.path().join(format!("sky_{yaw}.json"));
+        let o = frf(&[
+            "env-sh",
+            "sky",
+            "--yaw",
+            yaw,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        frf_core::sh::ShLight::load(&out).unwrap()
+    };
+    assert_eq!(project("1e9"), project("-80"));
+    assert_ne!(project("1e9"), project("0"));
+    let o = frf(&["env-sh", "sky", "--yaw", "2e15", "--out", "x.json"]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert!(e.contains("--yaw") && e.contains("beyond"), "{e}");
+}

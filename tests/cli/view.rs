@@ -444,7 +444,7 @@ fn keys_and_the_mouse_drive_the_viewer_as_a_person_does() {
     assert!(said.contains("rc=0"), "{said}");
     assert!(said.contains("recorded 2 camera keys"), "{said}");
     let scene = frf_scene::Scene::load(&shot).unwrap();
-    assert!((scene.lighting[0].yaw.to_degrees() - 15.0).abs() < 1e-3);
+    assert!((scene.lighting[0].yaw_deg - 15.0).abs() < 1e-3);
     let frf_scene::path::Trajectory::Path(path) = &scene.camera else {
         panic!("a recorded move is a path of keys");
     };

@@ -120,7 +120,7 @@ pub fn scene_toml(
         },
         lighting: written(LightingToml {
             env: Some(written(env_text(&base.env))),
-            yaw_deg: written(base.yaw.to_degrees()),
+            yaw_deg: written(base.yaw_deg),
             intensity: written(base.intensity),
             floor: written(
                 match scene.floor {
@@ -135,7 +135,7 @@ pub fn scene_toml(
                     written(LightKeyToml {
                         time: written(k.time),
                         env: Some(written(env_text(&k.env))),
-                        yaw_deg: Some(written(k.yaw.to_degrees())),
+                        yaw_deg: Some(written(k.yaw_deg)),
                         intensity: Some(written(k.intensity)),
                     })
                 })

@@ -124,7 +124,7 @@ impl<'a> Viewer<'a> {
             exposure: scene.exposure,
             envs,
             env: None,
-            yaw_deg: base.yaw.to_degrees(),
+            yaw_deg: frf_core::light::within_half_turn(base.yaw_deg) as f32,
             intensity: base.intensity,
             shadow_when_on: match scene.shadow {
                 ShadowSpec::Traced => ShadowSpec::Traced,
@@ -252,12 +252,12 @@ impl<'a> Viewer<'a> {
             return Ok(());
         };
         let env = self.envs[i].clone();
-        let (yaw, intensity) = (self.yaw_deg.to_radians(), self.intensity);
+        let (yaw_deg, intensity) = (f64::from(self.yaw_deg), self.intensity);
         self.shot.edit(|s| {
             s.lighting = vec![LightKey {
                 time: f64::NEG_INFINITY,
                 env,
-                yaw,
+                yaw_deg,
                 intensity,
             }];
         })?;
@@ -301,9 +301,9 @@ impl<'a> Viewer<'a> {
     }
 
     /// Turns the light by `yaw_deg` (from the scene's own lighting, the environment of its
-    /// first key).
+    /// first key), kept within ±180° (reduced in double precision).
     pub fn set_yaw(&mut self, yaw_deg: f32) -> Result<(), ViewError> {
-        self.yaw_deg = yaw_deg;
+        self.yaw_deg = frf_core::light::within_half_turn(f64::from(yaw_deg)) as f32;
         self.take_light()
     }
 
