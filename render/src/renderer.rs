@@ -194,17 +194,18 @@ impl<'a> Walker<'a> {
         let mut i = self.resident.gpu_instance(self.world_from_subject)?;
         i.within = self.within;
         if let Some((after, s)) = self.between {
-            let gpu = |k: Option<&'a ResidentKind>, step| match k {
+            let gpu = |k: Option<&'a ResidentKind>, of: &Resident, step| match k {
                 Some(ResidentKind::Gpu(p)) => Ok(&**p),
                 Some(ResidentKind::Cpu { .. }) => Err(crate::RenderError::Misuse(
                     "a CPU-resident pose given to the GPU renderer".into(),
                 )),
-                None => Err(no_motion(step)),
+                None => Err(no_motion(of, step)),
             };
+            let before = self.resident;
             i.between = Some(GpuBetween {
-                after: gpu(Some(&after.kind), PoseStep::Next)?,
-                before_motion: gpu(self.resident.motion[0].as_deref(), PoseStep::Next)?,
-                after_motion: gpu(after.motion[1].as_deref(), PoseStep::Prev)?,
+                after: gpu(Some(&after.kind), after, PoseStep::Next)?,
+                before_motion: gpu(before.motion[0].as_deref(), before, PoseStep::Next)?,
+                after_motion: gpu(after.motion[1].as_deref(), after, PoseStep::Prev)?,
                 s,
             });
         }
@@ -606,11 +607,13 @@ impl Device {
                 None => img,
                 Some((after, s)) => {
                     let [next, prev] = [PoseStep::Next, PoseStep::Prev].map(|step| {
-                        let m = match step {
-                            PoseStep::Next => &w.resident.motion[0],
-                            PoseStep::Prev => &after.motion[1],
+                        let of = match step {
+                            PoseStep::Next => w.resident,
+                            PoseStep::Prev => after,
                         };
-                        m.as_deref().ok_or_else(|| no_motion(step))
+                        of.motion[step.index()]
+                            .as_deref()
+                            .ok_or_else(|| no_motion(of, step))
                     });
                     let after_img = render(cpu_pose(&after.kind)?, &seen).0;
                     let before_motion = render(cpu_pose(next?)?, &seen).0;
@@ -658,9 +661,19 @@ impl Device {
     }
 }
 
-/// The GPU's view of every walker of a frame ([`Walker::gpu_instance`]).
+/// The GPU's view of every walker of a frame ([`Walker::gpu_instance`]); a walker that
+/// cannot be drawn is named.
 fn gpu_instances<'a>(walkers: &[Walker<'a>]) -> Result<Vec<GpuInstanceRef<'a>>> {
-    walkers.iter().map(Walker::gpu_instance).collect()
+    (walkers.iter().enumerate())
+        .map(|(k, w)| {
+            w.gpu_instance().map_err(|e| match e {
+                crate::RenderError::Misuse(m) => {
+                    crate::RenderError::Misuse(format!("walker {k}: {m}"))
+                }
+                other => other,
+            })
+        })
+        .collect()
 }
 
 /// Bytes `kind` holds where it is rendered.
@@ -681,10 +694,13 @@ fn cpu_pose(kind: &ResidentKind) -> Result<&ResidentPose> {
     }
 }
 
-/// The error of a frame between poses whose motion toward `step` was not made.
-fn no_motion(step: PoseStep) -> crate::RenderError {
+/// The error of a frame between poses whose pose `of` lacks its motion toward `step`
+/// (not made: the field holds no flow to that pose, or the plan did not ask for it).
+fn no_motion(of: &Resident, step: PoseStep) -> crate::RenderError {
     crate::RenderError::Misuse(format!(
-        "a frame between poses lacks a pose's motion {}",
+        "a frame between poses lacks pose {}'s motion {} (no flow between the poses was \
+         read for it)",
+        of.source.geometry.pose,
         step.name()
     ))
 }
