@@ -58,6 +58,19 @@ fn decode_with<R: std::io::BufRead + std::io::Seek>(
             what: path.display().to_string(),
             problem: l.to_string(),
         },
+        image::ImageError::Unsupported(u) => match u.kind() {
+            image::error::UnsupportedErrorKind::Format(
+                image::error::ImageFormatHint::PathExtension(ext),
+            ) => CoreError::bad_file(
+                path,
+                format!(
+                    "not an image: files named .{} are not an image format this reads (an \
+                     environment is a .hdr or .exr file)",
+                    ext.to_string_lossy()
+                ),
+            ),
+            _ => CoreError::bad_file(path, format!("cannot decode image: {u}")),
+        },
         other => CoreError::bad_file(path, format!("cannot decode image: {other}")),
     };
     let decoder = reader.into_decoder().map_err(failed)?;
@@ -442,6 +455,21 @@ mod tests {
         // Half a file is an error naming it, not a panic.
         let e = read_rgb_bytes(&path, &bytes[..bytes.len() / 2]).unwrap_err();
         assert!(e.to_string().contains("a.png"), "{e}");
+    }
+
+    /// A file whose name is no image format's (a field given as a map) is named with its
+    /// extension in words (it read "The file extension `.\"frf\"` was not recognized").
+    #[test]
+    fn a_file_of_no_image_format_is_named_plainly() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("walk.frf");
+        std::fs::write(&path, b"FRF1 not an image").unwrap();
+        let e = read_hdr_rgb(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("walk.frf") && e.contains("files named .frf are not an image format"),
+            "{e}"
+        );
+        assert!(!e.contains('"') && !e.contains('`'), "{e}");
     }
 
     #[test]

@@ -216,20 +216,24 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 /// Parses `--poses`: a list `0,1` or a half-open range `0..4`.
 pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
-    let bad = || format!("--poses {s:?}: expected e.g. 0,1 or 0..4");
+    let bad = || format!("{s:?} is not a list of poses: expected e.g. 0,1 or 0..4");
+    if s.trim().is_empty() {
+        return Err("no pose given: expected e.g. 0,1 or 0..4".into());
+    }
+    let most = frf_core::capture::MAX_POSES_PER_CYCLE;
     if let Some((a, b)) = s.split_once("..") {
         let (a, b): (u32, u32) = (
             a.trim().parse().map_err(|_| bad())?,
             b.trim().parse().map_err(|_| bad())?,
         );
         if a >= b {
-            return Err(bad());
-        }
-        let most = frf_core::capture::MAX_POSES_PER_CYCLE;
-        if b > most {
             return Err(format!(
-                "--poses {s:?}: a cycle holds at most {most} poses (0..{most})"
+                "the range {a}..{b} holds no pose (its end is after its last pose: 0..4 is \
+                 poses 0 to 3)"
             ));
+        }
+        if b > most {
+            return Err(format!("a cycle holds at most {most} poses (0..{most})"));
         }
         return Ok((a..b).collect());
     }
@@ -237,15 +241,14 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
         .split(',')
         .map(|p| p.trim().parse().map_err(|_| bad()))
         .collect::<Result<_, _>>()?;
-    let most = frf_core::capture::MAX_POSES_PER_CYCLE;
     if let Some(p) = poses.iter().find(|&&p| p >= most) {
         return Err(format!(
-            "--poses {s:?}: pose {p} is beyond any cycle (at most {most} poses)"
+            "pose {p} is beyond any cycle (at most {most} poses)"
         ));
     }
     if let Some((k, p)) = (poses.iter().enumerate()).find(|(k, p)| poses[..*k].contains(p)) {
         return Err(format!(
-            "--poses {s:?}: pose {p} is given twice (the second time at place {})",
+            "pose {p} is given twice (the second time at place {})",
             k + 1
         ));
     }
@@ -621,7 +624,20 @@ mod tests {
         );
         assert_eq!(parse_poses("0..3"), Ok(vec![0, 1, 2]));
         assert_eq!(parse_poses("4,1"), Ok(vec![4, 1]));
-        assert!(parse_poses("3..3").unwrap_err().contains("--poses"));
+        // An empty or reversed range is named as such, once (clap names the flag and the
+        // value; the message said "--poses \"\": expected --poses ..." before).
+        let e = parse_poses("3..3").unwrap_err();
+        assert!(
+            e.contains("3..3 holds no pose") && !e.contains("--poses"),
+            "{e}"
+        );
+        assert!(
+            parse_poses("1..0")
+                .unwrap_err()
+                .contains("1..0 holds no pose")
+        );
+        assert!(parse_poses("").unwrap_err().starts_with("no pose given"));
+        assert!(parse_poses(" ").unwrap_err().starts_with("no pose given"));
         // Bounded before anything is allocated (issue 35: 0..4294967295 took 23 GB).
         assert!(
             parse_poses("0..4294967295")
