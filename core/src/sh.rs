@@ -98,6 +98,39 @@ pub struct Convention {
 }
 
 impl Convention {
+    /// Each field in which it differs from `other`, in words (`condon_shortley_phase`:
+    /// true here, false there).
+    pub fn differences(&self, other: &Self) -> Vec<String> {
+        let mut out = Vec::new();
+        let mut field = |name: &str, a: String, b: String| {
+            if a != b {
+                out.push(format!("{name} {a}, frf's {b}"));
+            }
+        };
+        field("order", self.order.join(" "), other.order.join(" "));
+        field(
+            "normalisation",
+            format!("{:?}", self.normalisation),
+            format!("{:?}", other.normalisation),
+        );
+        field(
+            "condon_shortley_phase",
+            self.condon_shortley_phase.to_string(),
+            other.condon_shortley_phase.to_string(),
+        );
+        field(
+            "quantity",
+            format!("{:?}", self.quantity),
+            format!("{:?}", other.quantity),
+        );
+        field(
+            "frame",
+            format!("{:?}", self.frame),
+            format!("{:?}", other.frame),
+        );
+        out
+    }
+
     /// frf's convention.
     pub fn frf() -> Self {
         Self {
@@ -216,7 +249,9 @@ impl ShLight {
     /// and a total light beyond [`MAX_TOTAL_LIGHT`].
     pub fn load(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|e| CoreError::io(path, e))?;
-        let file: ShFile = serde_json::from_slice(&bytes).map_err(|e| {
+        // A byte-order mark some editors write is not JSON: read past it.
+        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+        let file: ShFile = serde_json::from_slice(bytes).map_err(|e| {
             CoreError::bad_file(path, format!("not an SH light ({SH_FORMAT} JSON): {e}"))
         })?;
         let bad = |m: String| Err(CoreError::bad_file(path, m));
@@ -229,11 +264,11 @@ impl ShLight {
                 file.version
             ));
         }
-        if file.convention != Convention::frf() {
+        let differ = file.convention.differences(&Convention::frf());
+        if !differ.is_empty() {
             return bad(format!(
-                "its convention {:?} is not frf's {:?} (convert it first: docs/export.md)",
-                file.convention,
-                Convention::frf()
+                "its convention is not frf's: {} (convert it first: docs/export.md)",
+                differ.join("; ")
             ));
         }
         let coefficients: [Rgb; SH_COUNT] = match file.coefficients.try_into() {
@@ -248,6 +283,14 @@ impl ShLight {
             .position(|c| c.iter().any(|v| !v.is_finite()))
         {
             return bad(format!("coefficient {i} is not finite"));
+        }
+        // Band 0 is the light's total (√(4π) c_0): below zero it would take light away.
+        if let Some(c) = coefficients[0].iter().position(|&v| v < 0.0) {
+            return bad(format!(
+                "band 0 (its total light) is negative in channel {c} ({:e}): a light \
+                 cannot take light away",
+                coefficients[0][c]
+            ));
         }
         // ∫ L dω = √(4π) c_0: the band-0 term carries all of the total light.
         let total = coefficients[0].map(|c| (c as f64 * (4.0 * std::f64::consts::PI).sqrt()).abs());

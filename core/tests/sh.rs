@@ -175,7 +175,12 @@ fn files_round_trip_and_bad_ones_are_refused_by_name() {
                 "\"condon_shortley_phase\": false",
                 "\"condon_shortley_phase\": true",
             ),
-            "convention",
+            "its convention is not frf's: condon_shortley_phase true, frf's false",
+        ),
+        // Band 0 below zero: a light that takes light away (it rendered at -16 dB).
+        (
+            text.replacen("5.5,", "-5.5,", 1),
+            "band 0 (its total light) is negative in channel 1",
         ),
         (text.replace("frf-sh-l2", "other"), "format"),
         (text[..text.len() / 2].to_string(), "not an SH light"),
@@ -184,7 +189,14 @@ fn files_round_trip_and_bad_ones_are_refused_by_name() {
         std::fs::write(&path, bad).unwrap();
         let e = ShLight::load(&path).unwrap_err().to_string();
         assert!(e.contains(want) && e.contains("light.json"), "{e}");
+        // The difference named, not two structs printed.
+        assert!(!e.contains("Convention {"), "{e}");
     }
+    // A byte-order mark before the JSON is read past.
+    let mut with_bom = b"\xEF\xBB\xBF".to_vec();
+    with_bom.extend_from_slice(text.as_bytes());
+    std::fs::write(&path, with_bom).unwrap();
+    assert_eq!(ShLight::load(&path).unwrap(), l);
     let mut f: serde_json::Value = serde_json::from_str(&text).unwrap();
     f["coefficients"].as_array_mut().unwrap().pop();
     std::fs::write(&path, f.to_string()).unwrap();
@@ -195,13 +207,25 @@ fn files_round_trip_and_bad_ones_are_refused_by_name() {
         .unwrap()
         .push(serde_json::json!([1e39, 0, 0]));
     std::fs::write(&path, f.to_string()).unwrap();
-    assert!(ShLight::load(&path).is_err());
+    let e = ShLight::load(&path).unwrap_err().to_string();
+    // Beyond f32 is refused as JSON out of f32's range.
+    assert!(e.contains("number out of range"), "{e}");
+    // Beyond the stated 1e30 of total light, and not only at f32's end.
+    f["coefficients"].as_array_mut().unwrap().pop();
+    f["coefficients"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!([0, 0, 0]));
+    f["coefficients"][0] = serde_json::json!([1e30, 1.0, 1.0]);
+    std::fs::write(&path, f.to_string()).unwrap();
+    let e = ShLight::load(&path).unwrap_err().to_string();
+    assert!(e.contains("beyond what relighting can sum"), "{e}");
 }
 
 /// A map of fewer than `MIN_MAP_ROWS` rows read from a file is integrated as its texels'
 /// regions: the L2 light of a uniform 1x1, 2x1 and 4x2 map is band 0 alone (bands 1-8
-/// within 1e-3 of it; 8e-4 measured, the row centres' error at 32 rows), `L * 2 sqrt(pi)`; a 2x1 map of two halves projects as the same
-/// halves on a 256x128 grid (within 1e-3 of its band 0), and a loaded map keeps its total
+/// within 1e-3 of it; 8e-4 measured, the row centres' error at 32 rows), `L * 2 sqrt(pi)`;
+/// a 2x1 map of two halves projects as the same halves on a 256x128 grid (within 1e-3 of its band 0), and a loaded map keeps its total
 /// light. Control: the same images wrapped as they are (`EnvMap::from_image`, texel
 /// centres alone) give bands 1-8 as bright as band 0.
 #[test]
