@@ -170,8 +170,8 @@ struct InterpArgs {
     /// Frames the CPU reference renders per variant and size.
     #[arg(long, default_value_t = 3)]
     cpu_repeats: u32,
-    /// The CPU reference renders sizes up to this many megapixels.
-    #[arg(long, default_value_t = 2.1)]
+    /// The CPU reference renders sizes up to this many megapixels (0: none).
+    #[arg(long, default_value_t = 2.1, allow_negative_numbers = true, value_parser = parse_megapixels)]
     cpu_max_mp: f64,
     /// Print the report as JSON on stdout.
     #[arg(long)]
@@ -242,12 +242,26 @@ fn interp(args: InterpArgs) -> CliResult {
                 Some(_) => args.lighting.lighting(conditions)?.0,
                 None => Lighting::Unlit,
             };
+            // Its errors name the pose.
             PoseSource::load(&field, args.pose, &lighting)
-                .map_err(|e| format!("{}: pose {}: {e}", path.display(), args.pose))?
+                .map_err(|e| format!("{}: {e}", path.display()))?
         }
         None => synthetic_pose()?,
     };
     let pose = ResidentPose::relight_cpu(&source);
+    if let Some((k, (w, h))) =
+        (args.sizes.iter().enumerate()).find(|(k, s)| args.sizes[..*k].contains(s))
+    {
+        return Err(frf_core::BadArgument::new(
+            "--size",
+            format!("{w}x{h}"),
+            format!(
+                "each size once (given again at place {}; it was timed twice)",
+                k + 1
+            ),
+        )
+        .into());
+    }
     let sizes = if args.sizes.is_empty() {
         DEFAULT_SIZES.to_vec()
     } else {
@@ -267,7 +281,7 @@ fn interp(args: InterpArgs) -> CliResult {
         warmup: args.warmup,
         repeats: args.repeats,
         cpu_repeats: args.cpu_repeats,
-        cpu_max_pixels: (args.cpu_max_mp.max(0.0) * 1e6) as u64,
+        cpu_max_pixels: (args.cpu_max_mp * 1e6) as u64,
     };
     options.check()?;
     let gpu = Gpu::new()?;
@@ -289,6 +303,21 @@ pub struct Counts(Vec<usize>);
 
 /// `1,10,40`: every count a whole number, none empty (a stray comma) or given twice
 /// (it was timed twice).
+/// Parses a number of megapixels: finite, 0 or more (NaN and -1 skipped the CPU reference
+/// without a word).
+fn parse_megapixels(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: {e} (megapixels)"))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!(
+            "`{s}` megapixels: a finite number, 0 or more (0 renders no CPU reference)"
+        ));
+    }
+    Ok(v)
+}
+
 fn parse_counts(s: &str) -> Result<Counts, String> {
     let counts: Vec<usize> = s
         .split(',')

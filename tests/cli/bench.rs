@@ -79,6 +79,41 @@ fn absurd_sizes_and_missing_fields_are_refused() {
     let o = frf(&["bench", "interp", "--size", "0x48"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("0x48"), "{}", stderr(&o));
+    // A CPU reference bound that is no number of megapixels (it skipped the reference
+    // without a word).
+    for bad in ["NaN", "-1", "inf"] {
+        let o = frf(&["bench", "interp", "--cpu-max-mp", bad]);
+        assert_eq!(o.status.code(), Some(2), "{bad}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("--cpu-max-mp") && stderr(&o).contains("0 or more"),
+            "{}",
+            stderr(&o)
+        );
+    }
+    // A size given twice (it was timed twice).
+    let o = frf(&["bench", "interp", "--size", "64x48", "--size", "64x48"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("given again at place 2"),
+        "{}",
+        stderr(&o)
+    );
+    // A pose the field lacks, said once (it read "pose 7: pose 7 is not in the field").
+    let f = frf_testkit::tiny_field();
+    let o = frf(&[
+        "bench",
+        "interp",
+        "--field",
+        f.field.to_str().unwrap(),
+        "--pose",
+        "7",
+    ]);
+    let e = stderr(&o);
+    assert!(
+        !o.status.success() && e.contains("pose 7 is not in the field"),
+        "{e}"
+    );
+    assert_eq!(e.matches("pose 7").count(), 1, "{e}");
     let o = frf(&["bench", "interp", "--field", "/nonexistent/field.frf"]);
     assert!(!o.status.success());
     assert!(
