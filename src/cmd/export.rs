@@ -26,17 +26,17 @@ pub struct ExportArgs {
     #[arg(long)]
     poses: Option<String>,
     /// Views: `all`, `ring:V` (camera row V all the way round) or a list `U,V;U,V;...`.
-    #[arg(long, default_value = "all", value_parser = parse_views)]
+    #[arg(long, default_value = "all", value_parser = parse_views, conflicts_with = "sprites")]
     views: ViewSelection,
     /// Voxel side of the hull meshes, metres (a walking silhouette for any viewer).
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, conflicts_with = "sprites")]
     mesh_voxel: f32,
     /// The transfer's tier: `full` (nine RGB coefficients a texel) or `compact` (nine
     /// grey coefficients and a colour: a third of the transfer's bytes).
-    #[arg(long, default_value = "full", value_parser = parse_tier)]
+    #[arg(long, default_value = "full", value_parser = parse_tier, conflicts_with = "sprites")]
     tier: Tier,
     /// JPEG quality of the SH transfer atlases.
-    #[arg(long, default_value_t = 95)]
+    #[arg(long, default_value_t = 95, conflicts_with = "sprites")]
     jpeg_quality: u8,
     /// Also print the report as JSON.
     #[arg(long)]
@@ -47,33 +47,39 @@ pub struct ExportArgs {
     sprites: bool,
     /// Sprites: the light, an environment (.hdr/.exr), `sky`, `uniform` or an L2 file
     /// of `frf env-sh`.
-    #[arg(long, value_parser = parse_env, default_value = "sky")]
+    #[arg(long, value_parser = parse_env, default_value = "sky", requires = "sprites")]
     env: EnvSource,
     /// Sprites: a sun added to the light, `AZ,EL[,DIAM[,E]]` as `frf render --sun`.
-    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]")]
+    #[arg(long, value_parser = parse_sun, allow_hyphen_values = true, value_name = "AZ,EL[,DIAM[,E]]", requires = "sprites")]
     sun: Option<SunSpec>,
     /// Sprites: `N` headings evenly round the walker from azimuth 0, or a list of camera
-    /// azimuths in degrees (`0,90,180,270`; 0 on +z, 90 on +x: the stage's walker walks
-    /// toward +x, so 0 sees its left side and 90 its front).
-    #[arg(long, default_value = "8", value_parser = parse_headings)]
+    /// azimuths in degrees (`0,90,180,270`; one heading as a list of one: `90,`; 0 on +z,
+    /// 90 on +x: the stage's walker walks toward +x, so 0 sees its left side and 90 its
+    /// front).
+    #[arg(long, default_value = "8", value_parser = parse_headings, requires = "sprites")]
     headings: Headings,
     /// Sprites: a frame's size `WxH`.
-    #[arg(long, default_value = "128x180", value_parser = parse_sprite_size)]
+    #[arg(long, default_value = "128x180", value_parser = parse_sprite_size, requires = "sprites")]
     sprite_size: (u32, u32),
     /// Sprites: the cameras' `RADIUS,HEIGHT` about the walker, metres.
-    #[arg(long, default_value = "3.2,1.1", value_parser = parse_radius_height)]
+    #[arg(long, default_value = "3.2,1.1", value_parser = parse_radius_height, requires = "sprites")]
     sprite_orbit: (f32, f32),
     /// Sprites: the point looked at, `x,y,z` metres.
-    #[arg(long, default_value = "0,0.9,0", value_parser = parse_point, allow_hyphen_values = true)]
+    #[arg(long, default_value = "0,0.9,0", value_parser = parse_point, allow_hyphen_values = true, requires = "sprites")]
     look_at: [f32; 3],
     /// Sprites: vertical field of view, degrees.
-    #[arg(long, default_value_t = 35.0, value_parser = parse_fov)]
+    #[arg(long, default_value_t = 35.0, value_parser = parse_fov, requires = "sprites")]
     fov: f32,
     /// Sprites: exposure of the sheet, stops.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_negative_numbers = true,
+        requires = "sprites"
+    )]
     exposure: f32,
     /// Sprites: render with the CPU reference instead of the GPU.
-    #[arg(long)]
+    #[arg(long, requires = "sprites")]
     cpu: bool,
 }
 
@@ -90,7 +96,13 @@ fn parse_headings(s: &str) -> Result<Headings, String> {
             (0..n).map(|i| i as f32 * 360.0 / n as f32).collect(),
         ));
     }
-    let headings: Vec<f32> = s
+    // A list of one heading ends with its comma (`90,`), where `90` alone is a count.
+    let list = s
+        .trim()
+        .strip_suffix(',')
+        .filter(|l| !l.contains(','))
+        .unwrap_or(s);
+    let headings: Vec<f32> = list
         .split(',')
         .map(|a| {
             a.trim()
@@ -182,6 +194,29 @@ pub fn run(args: ExportArgs) -> CliResult {
         .map_err(|e| {
             frf_core::BadArgument::new("--poses", args.poses.as_deref().unwrap_or(""), e)
         })?;
+    // An output named for the other mode's file (a sheet written as walk.glb, a glTF as
+    // sheet.png) is refused; a name without an extension (a device) is taken as it is.
+    let (wanted, other) = if args.sprites {
+        ("png", "a sprite sheet is a PNG (drop --sprites for a .glb)")
+    } else {
+        (
+            "glb",
+            "a walker is written as binary glTF (add --sprites for a PNG sheet)",
+        )
+    };
+    if let Some(ext) = args
+        .out
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        && ext != wanted
+    {
+        return Err(frf_core::BadArgument::new(
+            "--out",
+            args.out.display(),
+            format!("a .{wanted} file, not .{ext}: {other}"),
+        )
+        .into());
+    }
     if args.sprites {
         return sprites(&args, poses);
     }
@@ -249,4 +284,24 @@ fn sprites(args: &ExportArgs, poses: Option<Vec<u32>>) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&r)?);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--headings`: a number is a count, a list is degrees, and one heading is a list of
+    /// one with its comma (`90,`: one whole-degree heading could not be asked for).
+    #[test]
+    fn headings_are_a_count_or_a_list_of_one_or_more() {
+        assert_eq!(parse_headings("90,").unwrap().0, vec![90.0]);
+        assert_eq!(parse_headings(" -45, ").unwrap().0, vec![-45.0]);
+        assert_eq!(
+            parse_headings("4").unwrap().0,
+            vec![0.0, 90.0, 180.0, 270.0]
+        );
+        assert_eq!(parse_headings("0,90").unwrap().0, vec![0.0, 90.0]);
+        assert!(parse_headings("0,90,").is_err());
+        assert!(parse_headings(",").is_err());
+    }
 }

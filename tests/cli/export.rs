@@ -83,6 +83,10 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
         // The size parser said 1 to 8192, the sheet's check 2048: one bound, said once.
         ("--sprite-size", "4096x4096", "1 to 2048 pixels a side"),
         ("--sprite-size", "0x10", "1 to 2048 pixels a side"),
+        // Options of the sheet given to a glTF export were ignored silently.
+        ("--sun", "60,40", "--sprites"),
+        ("--env", "nosuch.hdr", "--sprites"),
+        ("--exposure", "1", "--sprites"),
     ] {
         let o = frf(&[
             "export",
@@ -95,6 +99,35 @@ fn export_refuses_bad_options_and_fields_it_cannot_export() {
         assert!(!o.status.success(), "{flag} {value} accepted");
         assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
         assert!(!out.exists());
+    }
+    // The glTF's options given to a sheet, and an output named for the other mode's file.
+    let sheet = dir.path().join("sheet.png");
+    for (args, want) in [
+        (
+            vec![
+                "--sprites",
+                "--out",
+                sheet.to_str().unwrap(),
+                "--tier",
+                "compact",
+            ],
+            "cannot be used with",
+        ),
+        (
+            vec!["--out", sheet.to_str().unwrap()],
+            "expected a .glb file, not .png",
+        ),
+        (
+            vec!["--sprites", "--out", out.to_str().unwrap()],
+            "expected a .png file, not .glb",
+        ),
+    ] {
+        let mut all = vec!["export", f.field.to_str().unwrap()];
+        all.extend(args.iter().copied());
+        let o = frf(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{args:?}: {}", stderr(&o));
+        assert!(!out.exists() && !sheet.exists());
     }
     // Not a field at all.
     let junk = dir.path().join("junk.frf");
@@ -211,10 +244,12 @@ fn export_sprites_writes_a_sheet_whose_frames_are_frf_renders() {
 fn an_output_never_replaces_an_input_or_a_file_that_is_not_regular() {
     let f = frf_testkit::tiny_field();
     let dir = tempfile::tempdir().unwrap();
-    let field = dir.path().join("field.frf");
+    // A field named without an extension (an output named field.frf is refused first as
+    // no .glb or .png).
+    let field = dir.path().join("field");
     std::fs::copy(&f.field, &field).unwrap();
     let before = std::fs::read(&field).unwrap();
-    let same = dir.path().join(".").join("field.frf");
+    let same = dir.path().join(".").join("field");
     for out in [&field, &same] {
         let o = frf(&[
             "export",
