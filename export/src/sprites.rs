@@ -82,6 +82,10 @@ pub fn sheet_json_path(png: &Path) -> PathBuf {
 /// The largest side of a sprite frame, pixels.
 pub const MOST_FRAME_SIDE: u32 = 2048;
 
+/// The most pixels a side of a sheet: the largest texture engines take (and a sheet that
+/// size is 4 GiB while it is rendered, four floats a pixel).
+pub const MOST_SHEET_SIDE: usize = 16384;
+
 /// Why a sprite frame of `(w, h)` pixels is refused, if it is.
 pub fn frame_size_problem((w, h): (u32, u32)) -> Option<String> {
     let side = 1..=MOST_FRAME_SIDE;
@@ -155,6 +159,18 @@ pub fn sprite_sheet(
             .collect::<std::result::Result<_, _>>()?,
         None => header.pose_list(),
     };
+    let (fw, fh) = options.frame_size;
+    let (columns, rows) = (poses.len(), options.headings_deg.len());
+    let (sw, sh) = (fw as usize * columns, fh as usize * rows);
+    if sw > MOST_SHEET_SIDE || sh > MOST_SHEET_SIDE {
+        return Err(ExportError::Option(format!(
+            "a sheet of {sw}x{sh} pixels ({columns} pose(s) x {rows} heading(s) of {fw}x{fh}) \
+             is beyond {MOST_SHEET_SIDE} pixels a side, the largest texture engines take ({:.0} \
+             GiB to hold while rendering): fewer --headings or --poses, or a smaller \
+             --sprite-size",
+            (sw * sh * 16) as f64 / f64::from(1u32 << 30)
+        )));
+    }
     let first = poses[0];
     let look = FieldLook {
         env: options.env.clone(),
@@ -186,8 +202,6 @@ pub fn sprite_sheet(
         walker_shadows: true,
     };
     let mut shot = Shot::live(scene, &field, device, shot_options)?;
-    let (fw, fh) = options.frame_size;
-    let (columns, rows) = (poses.len(), options.headings_deg.len());
     let mut sheet = Image::new(fw as usize * columns, fh as usize * rows, [0.0f32; 4]);
     let mut frames = Vec::new();
     let progress = frf_core::bars::bar("sprites");

@@ -234,6 +234,27 @@ fn export_sprites_writes_a_sheet_whose_frames_are_frf_renders() {
         assert!(stderr(&o).contains(want), "{flag} {value}: {}", stderr(&o));
         assert!(!bad.exists() && !dir.path().join("bad.json").exists());
     }
+    // A sheet beyond what engines take is refused before anything renders (64 headings
+    // of 2048x2048 asked for 32 GiB and more, unchecked).
+    let bad = dir.path().join("huge.png");
+    let o = frf(&[
+        "export",
+        f.field.to_str().unwrap(),
+        "--sprites",
+        "--out",
+        bad.to_str().unwrap(),
+        "--sprite-size",
+        "2048x2048",
+        "--headings",
+        "9",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("2048x18432 pixels") && stderr(&o).contains("beyond 16384"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!bad.exists());
 }
 
 /// Issue 59: an output that names an input (by any path), or that another output of the
