@@ -1,13 +1,30 @@
 // Validates .glb files with the Khronos glTF validator (npm gltf-validator) and prints
-// its report's counts as one JSON line per file; exits 1 when any file has an error.
+// its report's counts as one JSON line per file; exits 1 when any file has an error or
+// cannot be read or parsed (its line then says why), 2 when no file is given. Every issue
+// is counted: the validator is run without its cap on reported issues, which an export's
+// thousands of infos would otherwise fill before the buffers and accessors are checked.
 //   node player/validate.mjs walker.glb [more.glb ...]
 import { readFile } from 'node:fs/promises';
 import validator from 'gltf-validator';
 
+const paths = process.argv.slice(2);
+if (paths.length === 0) {
+  console.error('usage: node player/validate.mjs FILE.glb [FILE.glb ...]');
+  process.exit(2);
+}
 let failed = false;
-for (const path of process.argv.slice(2)) {
-  const bytes = new Uint8Array(await readFile(path));
-  const report = await validator.validateBytes(bytes, { uri: path, maxIssues: 50 });
+for (const path of paths) {
+  let report;
+  try {
+    const bytes = new Uint8Array(await readFile(path));
+    report = await validator.validateBytes(bytes, { uri: path, maxIssues: 0 });
+  } catch (e) {
+    // A missing file, or bytes the validator cannot take at all.
+    const why = e && e.code === 'ENOENT' ? 'file not found' : String(e?.message ?? e);
+    console.log(JSON.stringify({ file: path, error: why }));
+    failed = true;
+    continue;
+  }
   const issues = report.issues;
   const errors = issues.messages.filter((m) => m.severity === 0);
   console.log(JSON.stringify({
@@ -16,8 +33,9 @@ for (const path of process.argv.slice(2)) {
     warnings: issues.numWarnings,
     infos: issues.numInfos,
     hints: issues.numHints,
+    truncated: Boolean(issues.truncated),
     first_errors: errors.slice(0, 5).map((m) => `${m.code} ${m.pointer ?? ''}: ${m.message}`),
   }));
-  if (issues.numErrors > 0) failed = true;
+  if (issues.numErrors > 0 || issues.truncated) failed = true;
 }
 process.exit(failed ? 1 : 0);

@@ -59,6 +59,65 @@ fn export_writes_a_glb_the_khronos_validator_passes() {
         (Some(0), Some(0)),
         "{line}"
     );
+    // Every issue was counted (the cap of 50 stopped before the accessors were checked).
+    assert_eq!(r["truncated"], false, "{line}");
+    assert!(r["infos"].as_u64().unwrap() > 50, "{line}");
+
+    // Controls: an accessor's `max` changed is an error the check reports (it said 0
+    // errors, exit 0, under the cap); a truncated file, a missing one and none at all
+    // are said in a line or refused, not a stack trace.
+    let validate = |args: &[&Path]| {
+        let v = Command::new("node")
+            .arg(player().join("validate.mjs"))
+            .args(args)
+            .output()
+            .unwrap();
+        let line = String::from_utf8_lossy(&v.stdout).trim().to_string();
+        (
+            v.status.code(),
+            line,
+            String::from_utf8_lossy(&v.stderr).to_string(),
+        )
+    };
+    let bytes = std::fs::read(&out).unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let accessor = (doc["accessors"].as_array_mut().unwrap().iter_mut())
+        .find(|a| a["max"].is_array())
+        .unwrap();
+    let max = accessor["max"][0].as_f64().unwrap();
+    accessor["max"][0] = serde_json::json!(max + 1.0);
+    let mut json = serde_json::to_vec(&doc).unwrap();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let rest = &bytes[20 + json_len..];
+    let mut glb = bytes[..8].to_vec();
+    glb.extend(((12 + 8 + json.len() + rest.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend(rest);
+    let broken = dir.path().join("broken.glb");
+    std::fs::write(&broken, &glb).unwrap();
+    let (code, line, err) = validate(&[&broken]);
+    assert_eq!(code, Some(1), "{line} {err}");
+    assert!(line.contains("ACCESSOR_MAX_MISMATCH"), "{line}");
+    let truncated = dir.path().join("truncated.glb");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
+    for path in [truncated.as_path(), &dir.path().join("missing.glb")] {
+        let (code, line, err) = validate(&[path]);
+        assert_eq!(code, Some(1), "{line} {err}");
+        let r: serde_json::Value =
+            serde_json::from_str(&line).unwrap_or_else(|e| panic!("{e}: {line} {err}"));
+        assert!(r["file"].is_string(), "{line}");
+        assert!(
+            r["errors"].as_u64().unwrap_or(1) > 0 || r["error"].is_string(),
+            "{line}"
+        );
+        assert!(!err.contains("    at "), "a stack trace: {err}");
+    }
+    let (code, _, err) = validate(&[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("usage"), "{err}");
 }
 
 #[test]
