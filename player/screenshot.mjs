@@ -9,8 +9,8 @@
 // toward +x) and elevation EL, degrees, of illuminance E, lighting by the normals.
 // `--time-frames K` times K frames after the first (ms per frame). Chromium is found at
 // $CHROMIUM, else /usr/bin/chromium (scripts/setup.sh installs it).
-import { readFile, writeFile, rename, stat } from 'node:fs/promises';
-import { basename, resolve } from 'node:path';
+import { readFile, writeFile, rename, stat, unlink } from 'node:fs/promises';
+import { basename, dirname, resolve } from 'node:path';
 import puppeteer from 'puppeteer-core';
 import { encode } from 'fast-png';
 import { serve } from './serve.mjs';
@@ -68,16 +68,42 @@ function parse(argv) {
 
 const o = parse(process.argv.slice(2));
 const glbPath = resolve(o.glb);
-await stat(glbPath).catch(() => fail(`${o.glb}: no such file`));
+const glbStat = await stat(glbPath).catch(() => fail(`${o.glb}: no such file`));
+if (!glbStat.isFile()) fail(`${o.glb}: not a file (a .glb of frf export)`);
 const shText = await readFile(o.sh, 'utf8').catch((e) => fail(`${o.sh}: ${e.message}`));
+// The output's place is checked before anything renders: a directory, or a folder that
+// is not there, failed only after the render (leaving its temporary file).
+const outStat = await stat(o.out).catch(() => null);
+if (outStat?.isDirectory()) fail(`--out ${o.out}: a directory; give the PNG's file name`);
+const outDir = await stat(dirname(resolve(o.out))).catch(() => null);
+if (!outDir?.isDirectory()) fail(`--out ${o.out}: the folder ${dirname(o.out)} does not exist`);
 const server = await serve(0, { '/job/walker.glb': glbPath });
 const base = `http://127.0.0.1:${server.address().port}`;
+// Talking to Chromium over a pipe: if this process is killed (even by SIGKILL) the pipe
+// closes and Chromium ends with it, crash handler and all.
 const browser = await puppeteer.launch({
   executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
   headless: true,
+  pipe: true,
+  handleSIGINT: false,
+  handleSIGTERM: false,
+  handleSIGHUP: false,
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox',
-    '--disable-dev-shm-usage', '--js-flags=--max-old-space-size=8192'],
+    '--disable-dev-shm-usage', '--disable-breakpad', '--disable-crash-reporter',
+    '--js-flags=--max-old-space-size=8192'],
 });
+// A signal ends the run plainly: the browser closed, nothing written, 128 + its number
+// (the page's work it cuts short is not reported as an error of its own).
+let interrupted = false;
+for (const [signal, number] of [['SIGINT', 2], ['SIGTERM', 15], ['SIGHUP', 1]]) {
+  process.on(signal, async () => {
+    interrupted = true;
+    console.error(`screenshot: interrupted (${signal}); nothing written`);
+    await browser.close().catch(() => {});
+    server.close();
+    process.exit(128 + number);
+  });
+}
 let result;
 try {
   const page = await browser.newPage();
@@ -94,6 +120,7 @@ try {
     sun: o.sun ?? null, timedFrames: o.timeFrames,
   });
 } catch (e) {
+  if (interrupted) await new Promise(() => {});
   await browser.close();
   server.close();
   fail(String(e.message ?? e).replace(/^Error: /, '').split('\n')[0]);
@@ -103,8 +130,13 @@ server.close();
 const rgba = Buffer.from(result.rgba, 'base64');
 const png = encode({ width: o.width, height: o.height, data: new Uint8Array(rgba), channels: 4, depth: 8 });
 const tmp = `${o.out}.tmp-${process.pid}`;
-await writeFile(tmp, png);
-await rename(tmp, o.out);
+try {
+  await writeFile(tmp, png);
+  await rename(tmp, o.out);
+} catch (e) {
+  await unlink(tmp).catch(() => {});
+  fail(`--out ${o.out}: ${e.message}`);
+}
 const report = {
   out: o.out, pose: result.pose, width: o.width, height: o.height,
   ms_per_frame: result.msPerFrame, timed_frames: o.timeFrames, load_ms: result.loadMs,

@@ -279,6 +279,31 @@ fn the_player_refuses_damaged_walkers_and_draws_one_without_normals_without_its_
         assert!(!out.exists(), "nothing is written for {}", file.display());
     }
 
+    // Where the frame cannot go, or the walker is no file, it is said before anything
+    // renders (a directory as --out rendered for seconds, then left DIR.tmp-PID and a
+    // stack trace; a directory as --glb said "404 Not Found").
+    let nowhere = dir.path().join("nodir").join("x.png");
+    for (glb_at, out, want) in [
+        (glb.as_path(), dir.path(), "a directory"),
+        (glb.as_path(), nowhere.as_path(), "does not exist"),
+        (dir.path(), &dir.path().join("y.png"), "not a file"),
+    ] {
+        let o = screenshot(glb_at, &sh, &shot, "32x45", None, out);
+        assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+        assert!(stderr(&o).contains(want), "{}", stderr(&o));
+        assert!(
+            !stderr(&o).contains("    at "),
+            "a stack trace: {}",
+            stderr(&o)
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().contains(".tmp-"))
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+
     // Normals gone: the sun cannot light it; the SH part draws, and the player says so.
     let bare = dir.path().join("bare.glb");
     std::fs::write(
