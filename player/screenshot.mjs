@@ -2,11 +2,13 @@
 // writes it as a PNG (8-bit sRGB, straight alpha: as `frf render` writes its frames):
 //
 //   node player/screenshot.mjs --glb F --pose N --camera X,Y,Z --look-at X,Y,Z --fov DEG \
-//     --size WxH --sh SH.json [--sun AZ,EL,E] --out OUT.png [--time-frames K] [--json]
+//     --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] --out OUT.png [--time-frames K] [--json]
 //
 // The camera is frf's `look_at` (subject frame, +y up, vertical field of view in
-// degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun at azimuth AZ (from +z
-// toward +x) and elevation EL, degrees, of illuminance E, lighting by the normals.
+// degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun as frf's `--sun`: azimuth AZ
+// (from +z toward +x) and elevation EL, degrees, a disc DIAM degrees across (0.53 when
+// not given; it does not change the player's light) and illuminance E (10 when not
+// given), lighting by the normals (below the horizon, softly through the L2 light).
 // `--time-frames K` times K frames after the first (ms per frame). Chromium is found at
 // $CHROMIUM, else /usr/bin/chromium (scripts/setup.sh installs it).
 import { readFile, writeFile, rename, stat, unlink } from 'node:fs/promises';
@@ -22,9 +24,11 @@ function fail(message) {
 
 function parse(argv) {
   const o = { pose: null, fov: 35, timeFrames: 0, json: false };
-  const numbers = (flag, text, n) => {
-    const v = text.split(',').map(Number);
-    if (v.length !== n || v.some((x) => !Number.isFinite(x))) fail(`${flag} ${text}: expected ${n} numbers separated by commas`);
+  const numbers = (flag, text, n, most = n) => {
+    const v = text.split(',').map((x) => (x.trim() === '' ? NaN : Number(x)));
+    if (v.length < n || v.length > most || v.some((x) => !Number.isFinite(x))) {
+      fail(`${flag} ${text}: expected ${n === most ? n : `${n} to ${most}`} numbers separated by commas`);
+    }
     return v;
   };
   // `--flag value` or `--flag=value` (the form for values starting with a minus sign).
@@ -48,7 +52,7 @@ function parse(argv) {
         break;
       }
       case '--sh': o.sh = value(); break;
-      case '--sun': o.sun = numbers(flag, value(), 3); break;
+      case '--sun': o.sun = numbers(flag, value(), 2, 4); break;
       case '--out': o.out = value(); break;
       case '--time-frames': o.timeFrames = numbers(flag, value(), 1)[0]; break;
       case '--json': o.json = true; break;
@@ -62,7 +66,12 @@ function parse(argv) {
   if (!(o.width >= 1 && o.height >= 1 && o.width <= 8192 && o.height <= 8192)) fail(`--size ${o.width}x${o.height}: 1 to 8192 pixels a side`);
   if (!(o.fov > 0.1 && o.fov < 170)) fail(`--fov ${o.fov}: expected degrees in (0.1, 170)`);
   if (!(Number.isInteger(o.timeFrames) && o.timeFrames >= 0 && o.timeFrames <= 1000)) fail(`--time-frames ${o.timeFrames}: 0 to 1000`);
-  if (o.sun && !(o.sun[2] >= 0)) fail(`--sun ${o.sun}: the illuminance must be at least 0`);
+  if (o.sun) {
+    const [, el, diam = 0.53, e = 10] = o.sun;
+    if (!(el >= -90 && el <= 90)) fail(`--sun ${o.sun}: elevation ${el}° is not within ±90°`);
+    if (!(diam > 0 && diam <= 20)) fail(`--sun ${o.sun}: diameter ${diam}° is not within (0, 20]°`);
+    if (!(e >= 0 && e <= 1e30)) fail(`--sun ${o.sun}: illuminance ${e} is not from 0 to 1e30 (as frf takes)`);
+  }
   return o;
 }
 

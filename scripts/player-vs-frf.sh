@@ -16,7 +16,7 @@ for case in "$@"; do
   name="${u}_${v}${az:+_sun_${az}_${el}_${e}}"
   read -r -a flags <<< "$(node player/grid-camera.mjs "$out/walker.glb" "$u,$v")"
   sun=(); frfsun=()
-  if [ -n "${az:-}" ]; then sun=(--sun "$az,$el,$e"); frfsun=(--sun "$az,$el,0.53,$e"); fi
+  if [ -n "${az:-}" ]; then sun=(--sun "$az,$el,0.53,$e"); frfsun=(--sun "$az,$el,0.53,$e"); fi
   node player/screenshot.mjs --glb "$out/walker.glb" --pose 0 "${flags[@]}" --sh "$out/sky.json" \
     "${sun[@]}" --out "$out/$name-player.png" >/dev/null
   cam=${flags[0]#--camera=}; look=${flags[1]#--look-at=}

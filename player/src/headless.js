@@ -27,8 +27,11 @@ window.frfRender = async (job) => {
   const started = performance.now();
   const ext = player.load(bytes, job.glbName);
   const sh = parseShLight(job.shText, job.shName, ext.sh);
+  // `AZ,EL[,DIAM[,E]]` as frf's --sun (the disc's diameter does not change the player's
+  // light; E 10 when not given, as in frf).
+  const e = job.sun?.[3] ?? 10;
   const sun = job.sun
-    ? { direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180), illuminance: [job.sun[2], job.sun[2], job.sun[2]] }
+    ? { direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180), illuminance: [e, e, e] }
     : undefined;
   player.setLight(sh, sun);
   const pose = job.pose ?? player.poseNumbers()[0];

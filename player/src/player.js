@@ -6,6 +6,7 @@
 // shown and kept; the pre-lit layers are redone when the light changes.
 import * as THREE from 'three';
 import { parseGlb, poseMesh, BadFile } from './glb.js';
+import { MAX_TOTAL_LIGHT } from './sh.js';
 import { png, greyJpeg, expect } from './images.js';
 import {
   poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
@@ -130,13 +131,33 @@ export class FrfPlayer {
   /** The pose numbers the export holds, in order. */
   poseNumbers() { return this.ext.poses.map((p) => p.pose); }
 
-  /** The L2 light (9 RGB radiance coefficients) and an optional sun { direction, illuminance RGB }. */
+  /**
+   * The L2 light (9 RGB radiance coefficients) and an optional sun { direction,
+   * illuminance RGB }. A sun at or below the horizon lights the walker as frf lights it,
+   * from below and softly (through its floor conditions there): its L2 projection joins the
+   * light, with no sharp shading or shadow, and a note says so.
+   */
   setLight(sh, sun = NO_SUN) {
     if (!Array.isArray(sh) || sh.length !== 9 || sh.some((c) => c.length !== 3 || c.some((v) => !Number.isFinite(v)))) {
       throw new Error('an L2 light is nine finite [r, g, b] coefficients');
     }
+    const e = sun.illuminance;
+    if (!Array.isArray(e) || e.length !== 3 || e.some((v) => !(Number.isFinite(v) && v >= 0 && v <= MAX_TOTAL_LIGHT))) {
+      throw new Error('a sun\'s illuminance is three finite values from 0 to 1e30 (as frf takes)');
+    }
+    const d = new THREE.Vector3(...sun.direction);
+    if (!(d.length() > 0) || !Number.isFinite(d.length())) throw new Error('a sun\'s direction is a non-zero vector');
+    d.normalize();
     this.sh = sh.map((c) => [...c]);
-    this.sun = sun;
+    this.sun = { direction: d.toArray(), illuminance: [...e] };
+    if (d.y <= 0 && e.some((v) => v > 0)) {
+      const basis = new Array(9);
+      THREE.SphericalHarmonics3.getBasisAt(d, basis);
+      for (let i = 0; i < 9; i++) for (let c = 0; c < 3; c++) this.sh[i][c] += e[c] * basis[i];
+      this.sun = NO_SUN;
+      const note = 'the sun is below the horizon: it lights the walker from below as its L2 light, softly, with no sharp shading or shadow (as frf lights it through the floor conditions)';
+      if (!this.notes?.includes(note)) (this.notes ??= []).push(note);
+    }
     this.lightVersion++;
   }
 

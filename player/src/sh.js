@@ -3,22 +3,42 @@
 
 export const SH_FORMAT = 'frf-sh-l2';
 
+/** The most total light a light may carry (`∫ L dω`, any channel), as frf takes (1e30). */
+export const MAX_TOTAL_LIGHT = 1e30;
+
 /** The nine [r, g, b] radiance coefficients of an SH light file's text (`name` for messages). */
 export function parseShLight(text, name, expectedConvention) {
   let doc;
   try {
-    doc = JSON.parse(text);
+    // A byte-order mark some editors write is not JSON: read past it (as frf does).
+    doc = JSON.parse(text.replace(/^\uFEFF/, ''));
   } catch (e) {
     throw new Error(`${name}: not JSON (${e.message})`);
   }
   if (doc.format !== SH_FORMAT) throw new Error(`${name}: format ${JSON.stringify(doc.format)}, expected ${SH_FORMAT}`);
+  if (typeof doc.version !== 'number') {
+    throw new Error(`${name}: version ${JSON.stringify(doc.version)} is not a number (this player reads version 1)`);
+  }
   if (doc.version !== 1) throw new Error(`${name}: version ${doc.version}, this player reads version 1`);
   const c = doc.coefficients;
   if (!Array.isArray(c) || c.length !== 9 || c.some((x) => !Array.isArray(x) || x.length !== 3 || x.some((v) => typeof v !== 'number' || !Number.isFinite(v)))) {
     throw new Error(`${name}: coefficients must be nine [r, g, b] finite numbers`);
   }
-  if (expectedConvention && canonical(doc.convention) !== canonical(expectedConvention)) {
-    throw new Error(`${name}: its SH convention differs from the walker's: ${JSON.stringify(doc.convention)}`);
+  // What frf refuses, the player refuses too: a negative band 0 (negative total light)
+  // and a total light beyond what relighting sums in 32-bit floats.
+  const negative = c[0].findIndex((v) => v < 0);
+  if (negative >= 0) {
+    throw new Error(`${name}: band 0 (its total light) is negative in channel ${negative}: a light cannot take light away`);
+  }
+  const total = Math.max(...c[0]) * Math.sqrt(4 * Math.PI);
+  if (total > MAX_TOTAL_LIGHT) {
+    throw new Error(`${name}: its total light ${total.toExponential(1)} is beyond what relighting can sum (at most 1e30)`);
+  }
+  if (expectedConvention) {
+    const differ = Object.keys({ ...expectedConvention, ...(doc.convention ?? {}) }).sort()
+      .filter((k) => canonical(doc.convention?.[k]) !== canonical(expectedConvention[k]))
+      .map((k) => `${k} ${canonical(doc.convention?.[k])}, the walker's ${canonical(expectedConvention[k])}`);
+    if (differ.length > 0) throw new Error(`${name}: its SH convention differs from the walker's: ${differ.join('; ')}`);
   }
   return c;
 }

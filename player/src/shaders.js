@@ -93,8 +93,9 @@ void main() {
       }
     }
   }
-  // Texels that relight negative (an L2 light rings below zero) are black, as in frf.
-  outColor = vec4(max(rgb, vec3(0.0)), alpha);
+  // Texels that relight negative (an L2 light rings below zero) are black, as in frf; a
+  // light too bright for half floats saturates (an overflow to infinity drew it dark).
+  outColor = vec4(clamp(rgb, vec3(0.0), vec3(65504.0)), alpha);
 }
 `;
 

@@ -140,9 +140,8 @@ fn frf_frame(
         out.display().to_string(),
     ];
     if let Some(s) = sun {
-        // AZ,EL,E of the player is AZ,EL,DIAMETER,E of frf (its default disc).
-        let p: Vec<&str> = s.split(',').collect();
-        args.extend(["--sun".into(), format!("{},{},0.53,{}", p[0], p[1], p[2])]);
+        // The player's --sun is frf's.
+        args.extend(["--sun".into(), s.to_string()]);
     }
     args.extend(frf_testkit::cpu_flag().map(String::from));
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -206,13 +205,24 @@ fn the_player_in_chromium_draws_what_frf_renders() {
     let document = frf_export::read::Export::open(&glb).unwrap().document;
     // (u, v, sun, least subject PSNR): a captured view, a quad's centre, a captured view
     // with a sun lighting by the normals (the issue's targets).
-    for (u, v, sun, least) in [
+    for (k, u, v, sun, least) in [
         (3.0, 1.0, None, 35.0),
         (3.5, 0.5, None, 30.0),
-        (20.0, 0.0, Some("60,40,3"), 30.0),
-    ] {
+        (20.0, 0.0, Some("60,40,0.53,3"), 30.0),
+        // frf's default sun (E = 10; measured 30.8 dB).
+        (20.0, 0.0, Some("60,40"), 30.0),
+        // A sun below the horizon: frf lights the walker from below softly, through its
+        // floor conditions; the player adds the sun's L2 projection to its light (it lit
+        // the walker by its normals). Measured 19.5 dB here (24.4 by the normals) and
+        // 28.6 from the front (21.0 by the normals): the L2 band limit of a point light.
+        (20.0, 0.0, Some("60,-30,0.53,10"), 18.0),
+    ]
+    .into_iter()
+    .enumerate()
+    .map(|(k, (u, v, sun, least))| (k, u, v, sun, least))
+    {
         let shot = grid_camera(&document, u, v);
-        let case = dir.path().join(format!("{u}-{v}"));
+        let case = dir.path().join(format!("{k}-{u}-{v}"));
         std::fs::create_dir_all(&case).unwrap();
         let out = case.join("player.png");
         let o = screenshot(&glb, &sh, &shot, "64x90", sun, &out);
@@ -231,7 +241,35 @@ fn the_player_in_chromium_draws_what_frf_renders() {
             psnr >= least,
             "({u}, {v}), sun {sun:?}: {psnr:.2} dB < {least}"
         );
+        if sun.is_some_and(|s| s.contains(",-")) {
+            assert!(
+                report["notes"].to_string().contains("below the horizon"),
+                "{report}"
+            );
+        }
     }
+    // A sun too bright for half floats saturates the walker (it drew it dark: mean 9.6
+    // against 109 without a sun). frf's own frame of it is not the reference: it shows
+    // black texels where its basis' prediction of so bright a sun goes negative.
+    let shot = grid_camera(&document, 20.0, 0.0);
+    let (bright, none) = (dir.path().join("bright.png"), dir.path().join("none.png"));
+    for (sun, out) in [(Some("60,40,0.53,1e30"), &bright), (None, &none)] {
+        let o = screenshot(&glb, &sh, &shot, "64x90", sun, out);
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let mean = |p: &Path| {
+        let img = image::open(p).unwrap().to_rgba8();
+        let lit: Vec<f64> = (img.pixels())
+            .filter(|p| p[3] > 200)
+            .map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2]))
+            .collect();
+        lit.iter().sum::<f64>() / lit.len().max(1) as f64
+    };
+    let (b, n) = (mean(&bright), mean(&none));
+    assert!(
+        b > n,
+        "a sun of 1e30: subject mean {b:.1} against {n:.1} without"
+    );
 }
 
 /// The GLB `bytes` with its JSON chunk changed by `edit`, packed again as the exporter
@@ -321,7 +359,7 @@ fn the_player_refuses_damaged_walkers_and_draws_one_without_normals_without_its_
     )
     .unwrap();
     let (lit, plain) = (dir.path().join("sun.png"), dir.path().join("plain.png"));
-    let o = screenshot(&bare, &sh, &shot, "32x45", Some("60,40,10"), &lit);
+    let o = screenshot(&bare, &sh, &shot, "32x45", Some("60,40,0.53,10"), &lit);
     assert!(o.status.success(), "{}", stderr(&o));
     let report: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(
@@ -338,4 +376,84 @@ fn the_player_refuses_damaged_walkers_and_draws_one_without_normals_without_its_
         image::open(&plain).unwrap().to_rgba8(),
         "without normals a sun adds nothing"
     );
+}
+
+/// The player reads an SH light file as frf does (issue 59): what frf refuses it refuses
+/// (a negative band 0, a total light beyond 1e30, a version given as a string, another
+/// convention, named by its field), and a byte-order mark is read past by both. It drew
+/// the files frf refuses.
+#[test]
+fn the_player_reads_sh_files_as_frf_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let sh = dir.path().join("sky.json");
+    assert!(
+        frf(&["env-sh", "sky", "--out", sh.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let text = std::fs::read_to_string(&sh).unwrap();
+    let doc: Value = serde_json::from_str(&text).unwrap();
+    let edited = |edit: &dyn Fn(&mut Value)| {
+        let mut d = doc.clone();
+        edit(&mut d);
+        serde_json::to_string_pretty(&d).unwrap()
+    };
+    let cases: Vec<(&str, String, Option<&str>)> = vec![
+        ("as written", text.clone(), None),
+        ("with a byte-order mark", format!("\u{feff}{text}"), None),
+        (
+            "band 0 negative",
+            edited(&|d| d["coefficients"][0][1] = (-1.0).into()),
+            Some("band 0 (its total light) is negative in channel 1"),
+        ),
+        (
+            "beyond 1e30",
+            edited(&|d| d["coefficients"][0][0] = 1e30.into()),
+            Some("beyond what relighting can sum"),
+        ),
+        (
+            "version a string",
+            edited(&|d| d["version"] = "1".into()),
+            Some("version \"1\""),
+        ),
+        (
+            "another convention",
+            edited(&|d| d["convention"]["condon_shortley_phase"] = true.into()),
+            Some("condon_shortley_phase true"),
+        ),
+    ];
+    let module = player().join("src/sh.js");
+    for (what, content, refused) in cases {
+        let path = dir.path().join("case.json");
+        std::fs::write(&path, &content).unwrap();
+        let by_frf = frf_core::sh::ShLight::load(&path);
+        assert_eq!(by_frf.is_err(), refused.is_some(), "{what}: frf {by_frf:?}");
+        let script = format!(
+            "import {{ readFileSync }} from 'node:fs';\n\
+             const m = await import({module:?});\n\
+             const doc = JSON.parse({expected:?});\n\
+             try {{ m.parseShLight(readFileSync({path:?}, 'utf8'), 'case.json', doc.convention); console.log('read'); }}\n\
+             catch (e) {{ console.log('refused: ' + e.message); }}",
+            module = format!("file://{}", module.display()),
+            expected = text,
+            path = path.display().to_string(),
+        );
+        let o = Command::new("node")
+            .args(["--input-type=module", "-e", &script])
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&o.stdout).trim().to_string();
+        match refused {
+            None => assert_eq!(said, "read", "{what}: {said} {}", stderr(&o)),
+            Some(want) => assert!(
+                said.starts_with("refused") && said.contains(want),
+                "{what}: the player {said}"
+            ),
+        }
+        if let (Err(e), Some(want)) = (&by_frf, refused)
+            && what != "version a string"
+        {
+            assert!(e.to_string().contains(want), "{what}: frf {e}");
+        }
+    }
 }
