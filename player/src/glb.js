@@ -71,6 +71,19 @@ function checkExtension(ext, bad) {
       if (!(v.u < g.columns && v.v < g.rows) || !v.transfer || v.alpha === undefined) {
         throw bad(`pose ${p.pose}: a view (${v.u},${v.v}) outside the grid or without transfer or alpha`);
       }
+      // The numbers a view is relit by, each present and finite (a `scale` of null was read
+      // as 0: a black view).
+      const triples = (x, n) => Array.isArray(x) && x.length === n
+        && x.every((t) => Array.isArray(t) && t.length === 3 && t.every((c) => typeof c === 'number' && Number.isFinite(c)));
+      const triple = (x) => triples([x], 1);
+      const where = `pose ${p.pose}, view (${v.u},${v.v})`;
+      if (!triples(v.transfer.scale, 9) || !triples(v.transfer.offset, 9)) {
+        throw bad(`${where}: transfer scale and offset must be nine [r, g, b] finite numbers each`);
+      }
+      if (v.albedo && !triple(v.albedo.scale)) throw bad(`${where}: albedo scale must be three finite numbers`);
+      if (v.transfer.colour && !triple(v.transfer.colour.scale)) {
+        throw bad(`${where}: transfer colour scale must be three finite numbers`);
+      }
     }
   }
   if (!['full', 'compact', undefined].includes(ext.tier)) throw bad(`unknown tier ${ext.tier}`);

@@ -54,6 +54,11 @@ window.frfRender = async (job) => {
   renderer.readRenderTargetPixels(target, 0, 0, job.width, job.height, pixels);
   // Rows bottom up in the target; the PNG's top down. Straight alpha, sRGB.
   const out = new Uint8Array(4 * job.width * job.height);
+  let covered = 0;
+  for (let i = 3; i < pixels.length; i += 4) if (pixels[i] > 0) covered++;
+  if (covered === 0) {
+    player.notes.push('nothing of the walker is in the frame: the camera sees none of it through the views exported (a camera far above or below the grid of cameras, or looking away)');
+  }
   for (let y = 0; y < job.height; y++) {
     for (let x = 0; x < job.width; x++) {
       const i = 4 * ((job.height - 1 - y) * job.width + x);

@@ -123,6 +123,24 @@ export class FrfPlayer {
     if (this.ext.poses.some((p) => p.views.some((v) => v.normals === null || v.normals === undefined))) {
       this.notes.push(`${name} holds no fitted normals for some views: a sun lights only the SH part there`);
     }
+    // A ray is drawn through a quad of four views; an export of fewer (one view, one ring)
+    // draws part of the walker or none of it, and says so.
+    const { columns, rows, wraps } = this.grid;
+    const spans = wraps ? columns : columns - 1;
+    for (const p of this.ext.poses) {
+      const have = new Set(p.views.map((v) => v.u * rows + v.v));
+      let whole = 0;
+      for (let u = 0; u < spans; u++) {
+        for (let v = 0; v + 1 < rows; v++) {
+          const u1 = (u + 1) % columns;
+          if ([u * rows + v, u * rows + v + 1, u1 * rows + v, u1 * rows + v + 1].every((k) => have.has(k))) whole++;
+        }
+      }
+      const quads = spans * Math.max(rows - 1, 0);
+      if (whole < quads) {
+        this.notes.push(`pose ${p.pose}: ${whole} of the grid's ${quads} quads hold their four views: the walker is drawn ${whole === 0 ? 'nowhere' : 'only'} where a camera's rays pass through ${whole === 0 ? 'one' : 'those'} (export every view for all of it)`);
+      }
+    }
     for (const p of this.poses.values()) p.dispose();
     this.poses.clear();
     return this.ext;

@@ -457,3 +457,79 @@ fn the_player_reads_sh_files_as_frf_does() {
         }
     }
 }
+
+/// What the player cannot draw it says (issue 59): an export of one view or one ring of
+/// views draws the walker nowhere or partly (it drew a transparent frame, exit 0, no
+/// note), a camera far above the grid sees nothing of it, and a view relit by a `scale`
+/// of null is refused (it was read as 0).
+#[test]
+fn the_player_says_what_it_cannot_draw() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, sh) = exported(dir.path());
+    let shot = Shot {
+        eye: [0.0, 1.0, 4.5],
+        look_at: [0.0, 0.9, 0.0],
+        fov_deg: 30.0,
+    };
+    let notes = |glb: &Path, shot: &Shot, name: &str| {
+        let out = dir.path().join(name);
+        let o = screenshot(glb, &sh, shot, "32x45", None, &out);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+        report["notes"].to_string()
+    };
+    for (views, want) in [
+        ("0,0", "0 of the grid's"),
+        ("ring:1", "quads hold their four views"),
+    ] {
+        let part = dir
+            .path()
+            .join(format!("part_{}.glb", views.replace([',', ':'], "_")));
+        let o = frf(&[
+            "export",
+            f.field.to_str().unwrap(),
+            "--poses",
+            "0",
+            "--views",
+            views,
+            "--out",
+            part.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let said = notes(&part, &shot, "part.png");
+        assert!(said.contains(want), "--views {views}: {said}");
+    }
+    // The whole export from the front: nothing to say; from far above: nothing seen.
+    assert!(!notes(&glb, &shot, "front.png").contains("quads"));
+    let above = Shot {
+        eye: [0.0, 60.0, 0.5],
+        look_at: [0.0, 0.9, 0.0],
+        fov_deg: 30.0,
+    };
+    let said = notes(&glb, &above, "above.png");
+    assert!(
+        said.contains("nothing of the walker is in the frame"),
+        "{said}"
+    );
+    // A scale of null.
+    let bytes = std::fs::read(&glb).unwrap();
+    let nulled = dir.path().join("nulled.glb");
+    std::fs::write(
+        &nulled,
+        with_json(&bytes, |d| {
+            d["extensions"]["FRF_flowed_reflectance_field"]["poses"][0]["views"][0]["transfer"]
+                ["scale"][2] = Value::Null;
+        }),
+    )
+    .unwrap();
+    let out = dir.path().join("nulled.png");
+    let o = screenshot(&nulled, &sh, &shot, "32x45", None, &out);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("transfer scale and offset"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+}
