@@ -296,6 +296,15 @@ impl FrameBenchReport {
                     passes.join(", "),
                     r.gpu_timestamps_ms_per_frame.unwrap_or(f64::NAN)
                 );
+                let untimed: usize = r.passes.iter().map(|p| p.untimed).sum();
+                if untimed > 0 {
+                    out += &format!(
+                        "warning: {} walkers, {} light: {untimed} passes a frame past the pass \
+                         clock's capacity were not timed; the times above under-count them\n",
+                        r.walkers,
+                        r.light.name()
+                    );
+                }
             }
         }
         let row = |w: usize, l: LightMode, m: Motion| {
@@ -628,12 +637,14 @@ fn median_passes(frames: &[Vec<PassTime>]) -> Vec<PassTime> {
             let of = |f: &Vec<PassTime>| f.iter().find(|p| p.pass == name).cloned();
             let ms: Vec<f64> = frames.iter().map(|f| of(f).map_or(0.0, |p| p.ms)).collect();
             let count: usize = frames.iter().map(|f| of(f).map_or(0, |p| p.passes)).sum();
-            let dispatches: usize = (frames.iter())
-                .map(|f| of(f).map_or(0, |p| p.dispatches))
-                .sum();
+            let sum = |get: fn(&PassTime) -> usize| -> usize {
+                frames.iter().map(|f| of(f).map_or(0, |p| get(&p))).sum()
+            };
+            let (dispatches, untimed) = (sum(|p| p.dispatches), sum(|p| p.untimed));
             PassTime {
                 passes: count / frames.len().max(1),
                 dispatches: dispatches / frames.len().max(1),
+                untimed: untimed.div_ceil(frames.len().max(1)),
                 ms: median(&ms),
                 pass: name,
             }

@@ -216,9 +216,10 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 /// Parses `--poses`: a list `0,1` or a half-open range `0..4`.
 pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
-    let bad = || format!("{s:?} is not a list of poses: expected e.g. 0,1 or 0..4");
+    const LIKE: &str = "poses, e.g. 0,1 or 0..4";
+    let bad = || LIKE.to_string();
     if s.trim().is_empty() {
-        return Err("no pose given: expected e.g. 0,1 or 0..4".into());
+        return Err(format!("{LIKE} (none given)"));
     }
     let most = frf_core::capture::MAX_POSES_PER_CYCLE;
     if let Some((a, b)) = s.split_once("..") {
@@ -228,12 +229,12 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
         );
         if a >= b {
             return Err(format!(
-                "the range {a}..{b} holds no pose (its end is after its last pose: 0..4 is \
-                 poses 0 to 3)"
+                "a range whose end is after its start, e.g. 0..4 for poses 0 to 3 ({a}..{b} \
+                 holds no pose)"
             ));
         }
         if b > most {
-            return Err(format!("a cycle holds at most {most} poses (0..{most})"));
+            return Err(format!("poses below {most} (a cycle holds at most {most})"));
         }
         return Ok((a..b).collect());
     }
@@ -243,16 +244,21 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
         .collect::<Result<_, _>>()?;
     if let Some(p) = poses.iter().find(|&&p| p >= most) {
         return Err(format!(
-            "pose {p} is beyond any cycle (at most {most} poses)"
+            "poses below {most} (pose {p} is beyond any cycle of at most {most})"
         ));
     }
     if let Some((k, p)) = (poses.iter().enumerate()).find(|(k, p)| poses[..*k].contains(p)) {
         return Err(format!(
-            "pose {p} is given twice (the second time at place {})",
+            "each pose once (pose {p} is given twice, the second time at place {})",
             k + 1
         ));
     }
     Ok(poses)
+}
+
+/// The poses `flag` names ([`parse_poses`]), refused naming the flag and the value.
+pub fn poses_arg(flag: &str, s: &str) -> Result<Vec<u32>, frf_core::BadArgument> {
+    parse_poses(s).map_err(|e| frf_core::BadArgument::new(flag, s, e))
 }
 
 /// Parses an environment: a `.hdr` / `.exr` file, `sky`, `uniform` or `none`.

@@ -9,8 +9,8 @@ use frf_export::{ExportOptions, Tier, ViewSelection};
 
 use crate::CliResult;
 use crate::cmd::args::{
-    SunSpec, parse_env, parse_fov, parse_point, parse_poses, parse_radius_height, parse_size,
-    parse_sun,
+    SunSpec, parse_env, parse_fov, parse_point, parse_radius_height, parse_size, parse_sun,
+    poses_arg,
 };
 use frf_core::env::EnvSource;
 
@@ -186,14 +186,9 @@ fn parse_views(s: &str) -> Result<ViewSelection, String> {
 
 /// Runs `frf export`.
 pub fn run(args: ExportArgs) -> CliResult {
-    let poses = args
-        .poses
-        .as_deref()
-        .map(parse_poses)
-        .transpose()
-        .map_err(|e| {
-            frf_core::BadArgument::new("--poses", args.poses.as_deref().unwrap_or(""), e)
-        })?;
+    let poses = (args.poses.as_deref())
+        .map(|p| poses_arg("--poses", p))
+        .transpose()?;
     // An output named for the other mode's file (a sheet written as walk.glb, a glTF as
     // sheet.png) is refused; a name without an extension (a device) is taken as it is.
     let (wanted, other) = if args.sprites {

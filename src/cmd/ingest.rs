@@ -11,7 +11,7 @@ use frf_ingest::guided::InterViewFlow;
 use frf_ingest::pipeline::{IngestOptions, ingest};
 
 use crate::CliResult;
-use crate::cmd::args::{FlowPresetArg, ShadowArgs, parse_poses};
+use crate::cmd::args::{FlowPresetArg, ShadowArgs, poses_arg};
 use frf_core::bars::Bars;
 
 /// Arguments of `frf ingest`.
@@ -146,7 +146,7 @@ pub fn run(args: IngestArgs) -> CliResult {
         poses: args
             .poses
             .as_deref()
-            .map(parse_poses)
+            .map(|p| poses_arg("--poses", p))
             .transpose()?
             .unwrap_or_default(),
         shadows: args.shadows.options()?,

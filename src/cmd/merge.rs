@@ -35,8 +35,9 @@ fn expected(spec: &str) -> CliResult<(Vec<u32>, String)> {
         let capture = frf_core::capture::Capture::open_manifest(dir)?;
         return Ok((capture.poses().to_vec(), format!("the capture {spec}")));
     }
-    let poses = crate::cmd::args::parse_poses(spec)
-        .map_err(|e| e.replace("--poses", "--expect") + ", or a capture directory")?;
+    let poses = crate::cmd::args::parse_poses(spec).map_err(|e| {
+        frf_core::BadArgument::new("--expect", spec, e + ", or a capture directory")
+    })?;
     Ok((poses, format!("--expect {spec}")))
 }
 

@@ -13,7 +13,7 @@ use frf_stage::truth_shot::{TruthCamera, TruthLight, parse_basis};
 use frf_stage::{Gait, Preset, SetFlowTruth, StageConfig};
 
 use crate::CliResult;
-use crate::cmd::args::{parse_env, parse_point, parse_poses, parse_size};
+use crate::cmd::args::{parse_env, parse_point, parse_size, poses_arg};
 use frf_core::bars::bar;
 
 /// Arguments of `frf stage`.
@@ -175,7 +175,7 @@ fn capture(args: CaptureArgs) -> CliResult {
         GaitArg::Run => Gait::Run,
     };
     if let Some(p) = &args.poses {
-        config.poses = parse_poses(p)?;
+        config.poses = poses_arg("--poses", p)?;
     }
     if let Some(s) = args.set_flow {
         config.set_flow_truth = match s {

@@ -198,7 +198,7 @@ const CASES: &[Case] = &[
             "{out}/m.frf",
         ],
         file: "--expect",
-        problem: &["at most 100000 poses"],
+        problem: &["a cycle holds at most 100000"],
     },
     Case {
         args: &[
