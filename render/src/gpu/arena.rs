@@ -1,7 +1,10 @@
 //! Buffers shared by many poses, each pose holding a range of one of a few pages, so that
 //! one dispatch can read or write every pose's part (docs/design.md section 4.9). A range
 //! stays where it was placed for as long as its holder keeps it (bind groups made over it
-//! stay valid) and is given back when the holder drops it. A page is a fixed-size buffer;
+//! stay valid) and is given back when the holder drops it, but taken again only after the
+//! next submission ([`Arena::recycle`]): work recorded before it may still read or write
+//! the range, and a new holder's first writes (uploads) go to the queue ahead of that
+//! work. A page is a fixed-size buffer;
 //! a range that does not fit in any page's free room opens a new page (one as large as
 //! the range where it outgrows the page size), so nothing ever moves.
 //!
@@ -78,10 +81,12 @@ impl Spans {
     }
 }
 
-/// One page: its buffer and its free room.
+/// One page: its buffer, its free room, and the ranges given back since the last
+/// submission (free once it is sent).
 struct Page {
     buffer: wgpu::Buffer,
     spans: Mutex<Spans>,
+    retired: Mutex<Vec<(u64, u64)>>,
 }
 
 impl Page {
@@ -109,7 +114,9 @@ pub(super) struct ArenaRange {
 
 impl Drop for ArenaRange {
     fn drop(&mut self) {
-        self.page.spans().give(self.offset, self.size);
+        (self.page.retired.lock())
+            .unwrap_or_else(|e| e.into_inner())
+            .push((self.offset, self.size));
     }
 }
 
@@ -193,15 +200,55 @@ impl Arena {
                 mapped_at_creation: false,
             }),
             spans: Mutex::new(spans),
+            retired: Mutex::new(Vec::new()),
         });
         pages.push(page.clone());
         ArenaRange { page, offset, size }
+    }
+
+    /// Makes the ranges given back before a submission free again, once it is sent: the
+    /// work that may read them is then ahead, in the queue, of any later write to them.
+    pub(super) fn recycle(&self) {
+        let pages = self.pages.lock().unwrap_or_else(|e| e.into_inner());
+        for page in pages.iter() {
+            let retired =
+                std::mem::take(&mut *page.retired.lock().unwrap_or_else(|e| e.into_inner()));
+            let mut spans = page.spans();
+            for (at, size) in retired {
+                spans.give(at, size);
+            }
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A range given back is not taken again before the next submission (work recorded
+    /// before may still read it, and a new holder's uploads would be queued ahead of that
+    /// work: a walker relit from another's coefficients), and is after it.
+    #[test]
+    fn a_range_given_back_is_taken_again_only_after_a_submission() {
+        let gpu = match crate::gpu::Gpu::new() {
+            Ok(g) => g,
+            Err(e) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => {
+                eprintln!("skipped (FRF_SKIP_GPU=1): {e}");
+                return;
+            }
+            Err(e) => panic!("no GPU adapter ({e}); install mesa-vulkan-drivers"),
+        };
+        let (device, arena) = (gpu.device(), &gpu.coefficients);
+        let first = arena.take(device, 1000);
+        let at = first.offset();
+        drop(first);
+        let second = arena.take(device, 1000);
+        assert_ne!(second.offset(), at, "taken again before a submission");
+        gpu.submit([]);
+        let third = arena.take(device, 1000);
+        assert_eq!(third.offset(), at, "free again after the submission");
+        drop(second);
+    }
 
     /// Ranges taken never overlap and start aligned; room given back is merged and taken
     /// again, until the page is whole again.

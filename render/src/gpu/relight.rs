@@ -671,7 +671,12 @@ impl Gpu {
         if let Some(p) = pending {
             self.submit_counted([p]);
         }
-        self.submit_counted(buffers)
+        let index = self.submit_counted(buffers);
+        // Ranges of the shared pages let go of before now are free again: what read them
+        // is in the queue ahead of any later write.
+        self.coefficients.recycle();
+        self.turn_data.recycle();
+        index
     }
 
     /// Submits the pending work (before a caller submits its own encoder).
