@@ -34,7 +34,7 @@ pub struct SpriteOptions {
     /// A sun added to it.
     pub sun: Option<frf_core::sun::Sun>,
     /// Camera azimuths about the walker, degrees (0 on `+z`, increasing toward `+x`;
-    /// the stage's walker walks toward `+x`: 0 sees its left side, 90 its front): the
+    /// the stage's walker walks toward `+x`: 0 sees its right side, 90 its front): the
     /// sheet's rows.
     pub headings_deg: Vec<f32>,
     /// Poses (default: all the field's): the sheet's columns.
@@ -242,7 +242,7 @@ pub fn sprite_sheet(
         "sun": options.sun.map(|s| json!({"direction": s.direction().to_array(), "illuminance": s.illuminance()})),
         "camera": {"radius_m": options.radius_m, "height_m": options.height_m,
                    "look_at": options.look_at.to_array(), "fov_deg": options.fov_deg,
-                   "heading": "azimuth of the camera about the walker, degrees: 0 on +z, increasing toward +x (the stage's walker walks toward +x: 0 sees its left side, 90 its front)"},
+                   "heading": "azimuth of the camera about the walker, degrees: 0 on +z, increasing toward +x (the stage's walker walks toward +x: 0 sees its right side, 90 its front)"},
         "pivot": "pixel (x right, y down, within the frame) where the walker's foot point on the ground lands",
         "source": field_path.file_name().map(|n| n.to_string_lossy().into_owned()),
         "frames": frames,

@@ -54,7 +54,7 @@ pub struct ExportArgs {
     sun: Option<SunSpec>,
     /// Sprites: `N` headings evenly round the walker from azimuth 0, or a list of camera
     /// azimuths in degrees (`0,90,180,270`; one heading as a list of one: `90,`; 0 on +z,
-    /// 90 on +x: the stage's walker walks toward +x, so 0 sees its left side and 90 its
+    /// 90 on +x: the stage's walker walks toward +x, so 0 sees its right side and 90 its
     /// front).
     #[arg(long, default_value = "8", value_parser = parse_headings, requires = "sprites")]
     headings: Headings,
