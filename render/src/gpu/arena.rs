@@ -230,13 +230,8 @@ mod tests {
     /// work: a walker relit from another's coefficients), and is after it.
     #[test]
     fn a_range_given_back_is_taken_again_only_after_a_submission() {
-        let gpu = match crate::gpu::Gpu::new() {
-            Ok(g) => g,
-            Err(e) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => {
-                eprintln!("skipped (FRF_SKIP_GPU=1): {e}");
-                return;
-            }
-            Err(e) => panic!("no GPU adapter ({e}); install mesa-vulkan-drivers"),
+        let Some(gpu) = crate::gpu::Gpu::for_tests() else {
+            return;
         };
         let (device, arena) = (gpu.device(), &gpu.coefficients);
         let first = arena.take(device, 1000);

@@ -223,6 +223,20 @@ impl Gpu {
         }
     }
 
+    /// The device a unit test runs on: `None` (said) where there is none and
+    /// `FRF_SKIP_GPU=1` allows it; a missing adapter fails the test otherwise.
+    #[cfg(test)]
+    pub(crate) fn for_tests() -> Option<Self> {
+        match Self::new() {
+            Ok(g) => Some(g),
+            Err(e) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => {
+                eprintln!("skipped (FRF_SKIP_GPU=1): {e}");
+                None
+            }
+            Err(e) => panic!("no GPU adapter ({e}); install mesa-vulkan-drivers"),
+        }
+    }
+
     /// Runs `f` inside error scopes ([`scope::scoped`]).
     pub(crate) fn scoped<T>(
         &self,

@@ -75,20 +75,13 @@ impl Gpu {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-
     /// Writes gathered land where they were aimed when the next submission goes, the
     /// later of two to the same place wins, the kept buffer grows past its first size,
     /// and what was sent is not sent again.
     #[test]
     fn writes_land_in_order_in_one_submission() {
-        let gpu = match Gpu::new() {
-            Ok(g) => g,
-            Err(e) if std::env::var("FRF_SKIP_GPU").is_ok_and(|v| v == "1") => {
-                eprintln!("skipped (FRF_SKIP_GPU=1): {e}");
-                return;
-            }
-            Err(e) => panic!("no GPU adapter ({e}); install mesa-vulkan-drivers"),
+        let Some(gpu) = crate::gpu::Gpu::for_tests() else {
+            return;
         };
         let usage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_DST
