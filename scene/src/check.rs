@@ -254,8 +254,15 @@ pub fn lighting(r: &Reporter, l: &At<LightingToml>) -> Result<(Vec<LightKey>, Fl
             ));
         }
     }
-    if lighting.iter().any(|k| k.env == EnvSource::None) && lighting.len() > 1 {
-        return Err(r.error("lighting.env", span, "`none` cannot be keyframed"));
+    // `none` alone shows the field unlit, which nothing turns or scales; with a sun it is
+    // a black sky the sun lights, which a key may turn and scale like any light.
+    if lighting.iter().any(|k| k.env == EnvSource::None) && lighting.len() > 1 && l.sun.is_none() {
+        return Err(r.error(
+            "lighting.env",
+            span,
+            "`none` cannot be keyframed: it shows the field unlit (give a sun to light it, \
+             which keys then turn and scale)",
+        ));
     }
     let floor = match word(r, "lighting.floor", &l.floor, &["env", "ground"])? {
         "env" => FloorModel::Environment,

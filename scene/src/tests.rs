@@ -167,6 +167,27 @@ fn a_yaw_is_the_turn_it_names_and_keys_turn_as_far_as_they_say() {
     }
 }
 
+/// A lone sun (`env = "none"` and a sun: a black sky it lights) is turned by yaw keys like
+/// any light (it was refused as "`none` cannot be keyframed"); `none` without a sun, the
+/// field shown unlit, still cannot be keyed.
+#[test]
+fn a_lone_sun_is_turned_by_yaw_keys() {
+    let keys = "\n[[lighting.key]]\ntime = 0.0\nyaw_deg = 0.0\n[[lighting.key]]\ntime = 1.0\nyaw_deg = 90.0";
+    let sun = "\nsun = { azimuth_deg = 0.0, elevation_deg = 30.0, illuminance = 10.0 }";
+    let text = MINIMAL.replace("env = \"sky\"", &format!("env = \"none\"{sun}{keys}"));
+    let s = scene(&text).unwrap();
+    let at = |t: f64| s.lighting_at(t).sun.unwrap().direction();
+    let (start, half) = (at(0.0), at(0.5));
+    // Azimuth 0 is +z; a yaw of 45° turns it toward +x.
+    assert!(start.x.abs() < 1e-5 && start.z > 0.8, "{start}");
+    assert!((half.x - half.z).abs() < 1e-4 && half.x > 0.5, "{half}");
+    let e = error(&MINIMAL.replace("env = \"sky\"", &format!("env = \"none\"{keys}")));
+    assert!(
+        e.contains("cannot be keyframed") && e.contains("give a sun"),
+        "{e}"
+    );
+}
+
 #[test]
 fn lighting_keys_interpolate_and_cross_fade_maps() {
     let text = MINIMAL.replace(
