@@ -40,8 +40,42 @@ fn env_sh_writes_the_projection_and_renders_an_l2_light_as_itself() {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(text.contains("energy kept by L2"), "{text}");
     let written = frf_core::sh::ShLight::load(&sky).unwrap();
-    let want = frf_core::env::EnvMap::sky().to_sh();
-    assert_eq!(written, want);
+    let map = frf_core::env::EnvMap::sky();
+    assert_eq!(written, map.to_sh());
+    // Checked apart from the projection's code too (it was checked against the same
+    // `to_sh` call): band 0 is the total light over 2 sqrt(pi), and band 1's y term
+    // (three.js's second, sqrt(3 / 4 pi) y) its light weighted by height, each summed
+    // here texel by texel.
+    let img = map.image();
+    let (mut total, mut up) = ([0.0f64; 3], [0.0f64; 3]);
+    for y in 0..img.height() {
+        let omega = f64::from(map.texel_solid_angle(y));
+        for x in 0..img.width() {
+            let d = map.direction_of(x as f32, y as f32);
+            let l = img.get(x, y);
+            for c in 0..3 {
+                total[c] += f64::from(l[c]) * omega;
+                up[c] += f64::from(l[c]) * f64::from(d.y) * omega;
+            }
+        }
+    }
+    let pi = std::f64::consts::PI;
+    for c in 0..3 {
+        let band_0 = total[c] / (2.0 * pi.sqrt());
+        let y_term = (3.0 / (4.0 * pi)).sqrt() * up[c];
+        let (got_0, got_y) = (
+            f64::from(written.coefficients[0][c]),
+            f64::from(written.coefficients[1][c]),
+        );
+        assert!(
+            (got_0 - band_0).abs() < 1e-4 * band_0,
+            "band 0: {got_0} vs {band_0}"
+        );
+        assert!(
+            (got_y - y_term).abs() < 1e-3 * band_0,
+            "band 1 y: {got_y} vs {y_term}"
+        );
+    }
 
     // A furnace is band 0 alone: through its file it lights as itself.
     let uniform = dir.path().join("uniform.json");
