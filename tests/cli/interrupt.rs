@@ -218,38 +218,53 @@ fn a_read_only_output_directory_is_refused_naming_it() {
 fn an_interrupted_ingest_leaves_no_lock_or_temporary() {
     let dir = tempfile::tempdir().unwrap();
     let cap = crate::common::staged_capture(dir.path());
-    let out = dir.path().join("out");
-    std::fs::create_dir(&out).unwrap();
-    let field = out.join("f.frf");
-    let mut child = frf_command(&[
-        "ingest",
-        cap.to_str().unwrap(),
-        "--no-eval",
-        "--out",
-        field.to_str().unwrap(),
-    ])
-    .stdout(Stdio::null())
-    .stderr(Stdio::null())
-    .spawn()
-    .unwrap();
-    let lock = out.join(".f.frf.lock");
-    while !lock.exists() {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "the ingest ended before it could be interrupted"
+    // Ctrl-C and SIGTERM, to an ingest and to `stage field`, as the README says (only
+    // SIGINT to an ingest was tested).
+    for (k, (command, signal)) in [
+        ("ingest", "INT"),
+        ("ingest", "TERM"),
+        ("stage field", "TERM"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let out = dir.path().join(format!("out{k}"));
+        std::fs::create_dir(&out).unwrap();
+        let field = out.join("f.frf");
+        let mut args: Vec<&str> = command.split(' ').collect();
+        match command {
+            "ingest" => args.extend([cap.to_str().unwrap(), "--no-eval"]),
+            _ => args.extend(["--capture", cap.to_str().unwrap()]),
+        }
+        args.extend(["--out", field.to_str().unwrap()]);
+        let mut child = frf_command(&args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let lock = out.join(".f.frf.lock");
+        while !lock.exists() {
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "{command} ended before it could be interrupted"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        let sent = Command::new("kill")
+            .args([&format!("-{signal}"), &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let status = child.wait().unwrap();
+        assert_eq!(
+            status.code(),
+            Some(130),
+            "{command}, SIG{signal}: {status:?}"
         );
-        std::thread::sleep(Duration::from_millis(5));
+        let left: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert!(left.is_empty(), "{command}, SIG{signal}: {left:?}");
     }
-    let sent = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(130), "{status:?}");
-    let left: Vec<_> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert!(left.is_empty(), "{left:?}");
 }
