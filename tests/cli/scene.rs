@@ -929,8 +929,9 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
     }
 }
 
-/// `--sun` on a scene replaces the scene's sun and says so (it was once ignored
-/// silently); `--yaw`, which a scene's lighting keys give, is refused.
+/// `--sun` on a scene is added to its lighting, or replaces the scene's own sun, and says
+/// which (it was once ignored silently); `--yaw`, which a scene's lighting keys give, is
+/// refused.
 #[test]
 fn a_sun_flag_on_a_scene_is_used_and_said() {
     let dir = tempfile::tempdir().unwrap();
@@ -972,6 +973,59 @@ fn a_sun_flag_on_a_scene_is_used_and_said() {
     let o = frf(&["render", scene.to_str().unwrap(), "--yaw", "30", "--plan"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--yaw"), "{}", stderr(&o));
+
+    // A scene with a sun of its own: the flag's replaces it (the frame is the frame of
+    // the scene whose own sun is the flag's), not added to it (this was untested).
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let with_sun = |az: f32, e: f32| {
+        text.replace(
+            "env = \"sky\"",
+            &format!(
+                "env = \"sky\"\n[lighting.sun]\nazimuth_deg = {az}\nelevation_deg = 30.0\n\
+                 angular_diameter_deg = 0.53\nilluminance = {e}"
+            ),
+        )
+    };
+    let own = dir.path().join("own.toml");
+    std::fs::write(&own, with_sun(-120.0, 300.0)).unwrap();
+    let same = dir.path().join("same.toml");
+    std::fs::write(&same, with_sun(22.0, 500.0)).unwrap();
+    let render_of = |file: &std::path::Path, out: &str, extra: &[&str]| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "render",
+            file.to_str().unwrap(),
+            "--frames",
+            "0..1",
+            "--cpu",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = ok(&args);
+        (read_exr(&out.join("frame_0000.exr")), stderr(&o))
+    };
+    let (replaced, said) = render_of(&own, "replaced", &["--sun", "22,30,0.53,500"]);
+    assert!(said.contains("--sun: replaces the scene's sun"), "{said}");
+    let (reference, _) = render_of(&same, "reference", &[]);
+    let (kept, _) = render_of(&own, "kept", &[]);
+    let worst = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max)
+    };
+    assert!(
+        worst(&replaced, &reference) < 1e-5,
+        "{}",
+        worst(&replaced, &reference)
+    );
+    // Control: the scene's own sun gives another frame.
+    assert!(
+        worst(&kept, &reference) > 1e-2,
+        "{}",
+        worst(&kept, &reference)
+    );
 }
 
 /// Two walkers side by side walking toward the camera under a low sun from their left,
