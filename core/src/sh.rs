@@ -100,35 +100,20 @@ pub struct Convention {
 impl Convention {
     /// Each field in which it differs from `other`, in words (`condon_shortley_phase`:
     /// true here, false there).
+    /// Compared as written (its JSON), so a field added to it is compared too.
     pub fn differences(&self, other: &Self) -> Vec<String> {
-        let mut out = Vec::new();
-        let mut field = |name: &str, a: String, b: String| {
-            if a != b {
-                out.push(format!("{name} {a}, frf's {b}"));
-            }
+        let json = |c: &Self| match serde_json::to_value(c) {
+            Ok(serde_json::Value::Object(m)) => m,
+            _ => serde_json::Map::new(),
         };
-        field("order", self.order.join(" "), other.order.join(" "));
-        field(
-            "normalisation",
-            format!("{:?}", self.normalisation),
-            format!("{:?}", other.normalisation),
-        );
-        field(
-            "condon_shortley_phase",
-            self.condon_shortley_phase.to_string(),
-            other.condon_shortley_phase.to_string(),
-        );
-        field(
-            "quantity",
-            format!("{:?}", self.quantity),
-            format!("{:?}", other.quantity),
-        );
-        field(
-            "frame",
-            format!("{:?}", self.frame),
-            format!("{:?}", other.frame),
-        );
-        out
+        let (mine, theirs) = (json(self), json(other));
+        (mine.iter())
+            .filter(|(k, v)| theirs.get(*k) != Some(*v))
+            .map(|(k, v)| {
+                let frf = theirs.get(k).map_or("none".into(), ToString::to_string);
+                format!("{k} {v}, frf's {frf}")
+            })
+            .collect()
     }
 
     /// frf's convention.

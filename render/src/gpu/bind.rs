@@ -257,6 +257,27 @@ pub fn empty_buffer(
     })
 }
 
+/// The buffer kept in `slot` when it holds `needed` bytes, else a new one of `usage` (the
+/// next power of two, at least `least` bytes) kept there instead: a buffer written anew
+/// at each submission, grown to what the largest needed.
+pub fn kept_buffer(
+    device: &wgpu::Device,
+    slot: &mut Option<wgpu::Buffer>,
+    (label, usage): (&str, wgpu::BufferUsages),
+    needed: u64,
+    least: u64,
+) -> wgpu::Buffer {
+    if slot.as_ref().is_none_or(|b| b.size() < needed) {
+        *slot = Some(device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: needed.next_power_of_two().max(least),
+            usage,
+            mapped_at_creation: false,
+        }));
+    }
+    slot.clone().expect("kept above")
+}
+
 /// A buffer to read `size` bytes back into.
 pub fn readback_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {

@@ -65,12 +65,7 @@ impl Gpu {
         if gathered.is_empty() {
             return encoder;
         }
-        let mut encoder = encoder.unwrap_or_else(|| {
-            self.device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("pending"),
-                })
-        });
+        let mut encoder = encoder.unwrap_or_else(|| self.pending_encoder());
         for kind in Kind::ALL {
             let mut of_kind = gathered.iter().filter(|(k, _)| *k == kind).peekable();
             if of_kind.peek().is_none() {

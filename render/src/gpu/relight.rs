@@ -637,13 +637,16 @@ impl Gpu {
     /// frames (relights, shadows) that [`Gpu::submit`] sends ahead of the next.
     pub(super) fn with_pending<T>(&self, f: impl FnOnce(&mut wgpu::CommandEncoder) -> T) -> T {
         let mut pending = self.pending.lock().unwrap_or_else(|e| e.into_inner());
-        let encoder = pending.get_or_insert_with(|| {
-            self.device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("pending"),
-                })
-        });
+        let encoder = pending.get_or_insert_with(|| self.pending_encoder());
         f(encoder)
+    }
+
+    /// A new encoder for the work recorded between frames.
+    pub(super) fn pending_encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("pending"),
+            })
     }
 
     /// Submits `buffers`, after the pending work (in a submission of its own, so that a

@@ -32,7 +32,7 @@ use frf_reflectance::yaw_table::{Part, SAMPLES_PER_TURN, YawTable};
 use frf_shaders::types::{GpuTurnJob, GpuTurnParams, GpuTurnRelight};
 
 use super::arena::ArenaRange;
-use super::bind::{bind_group, buffer_with, compute_pipeline, storage, uniform};
+use super::bind::{bind_group, buffer_with, compute_pipeline, kept_buffer, storage, uniform};
 use super::pose::GpuPose;
 use super::relight::{PoseRelight, TurnState};
 use super::timing::compute_pass_writes;
@@ -304,16 +304,7 @@ impl Gpu {
         let lights = std::mem::take(&mut gathered.lights);
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let kept = |slot: &mut Option<wgpu::Buffer>, label: &str, bytes: &[u8]| {
-            let needed = bytes.len() as u64;
-            if slot.as_ref().is_none_or(|b| b.size() < needed) {
-                *slot = Some(self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size: needed.next_power_of_two().max(4096),
-                    usage,
-                    mapped_at_creation: false,
-                }));
-            }
-            let buffer = slot.clone().expect("made above");
+            let buffer = kept_buffer(&self.device, slot, (label, usage), bytes.len() as u64, 4096);
             self.upload(&buffer, 0, bytes);
             buffer
         };
@@ -324,12 +315,7 @@ impl Gpu {
             bytemuck::cast_slice(&lights),
         );
         drop(gathered);
-        let mut encoder = encoder.unwrap_or_else(|| {
-            self.device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("pending"),
-                })
-        });
+        let mut encoder = encoder.unwrap_or_else(|| self.pending_encoder());
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("turn light"),
             timestamp_writes: compute_pass_writes(self.pass_timestamps("turn light", None)),

@@ -8,6 +8,7 @@
 //! ends with the later bytes, as with `write_buffer`.
 
 use super::Gpu;
+use super::bind::kept_buffer;
 
 /// Bytes the kept buffer holds at first (it grows to what a submission needs).
 const FIRST_BYTES: u64 = 64 << 10;
@@ -47,17 +48,14 @@ impl Gpu {
             return;
         }
         let needed = uploads.bytes.len() as u64;
-        let fits = (uploads.buffer.as_ref()).is_some_and(|b| b.size() >= needed);
-        if !fits {
-            let size = needed.next_power_of_two().max(FIRST_BYTES);
-            uploads.buffer = Some(self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("uploads"),
-                size,
-                usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }));
-        }
-        let buffer = uploads.buffer.clone().expect("made above");
+        let usage = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let buffer = kept_buffer(
+            &self.device,
+            &mut uploads.buffer,
+            ("uploads", usage),
+            needed,
+            FIRST_BYTES,
+        );
         self.queue.write_buffer(&buffer, 0, &uploads.bytes);
         let mut encoder = self
             .device
