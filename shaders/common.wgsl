@@ -80,6 +80,10 @@ struct Frame {
     // Where the frame pass writes: pixel p of the frame at texel p + place.xy of layer
     // place.z of its target (`render/src/atlas.rs`; w unused).
     place: vec4<i32>,
+    // Where the pose's pre-lit views lie in the shared pages bound beside it (words: x
+    // its views' scales, y its first layer's codes; `render/src/gpu/prelit.rs`), when
+    // they are stored there.
+    prelit: vec4<u32>,
 }
 
 // The pose's geometric proxy: the visual hull's grid (its bits are bound beside it) and

@@ -6,11 +6,16 @@
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(2) var target_image: texture_storage_2d_array<rgba32float, write>;
-@group(1) @binding(0) var prelit: texture_2d_array<u32>;
+// The shared pages of pre-lit codes (`render/src/gpu/prelit.rs`); the pose's from word
+// `frame.prelit.y`.
+@group(1) @binding(0) var<storage, read> prelit: array<u32>;
 
 fn fetch(pixel: vec2<u32>) -> vec4<f32> {
     let size = frame.crop_size;
-    let t = textureLoad(prelit, vec2<i32>(pixel % size), i32((pixel.x / size.x) % (frame.columns * frame.rows)), 0);
+    let p = pixel % size;
+    let layer = (pixel.x / size.x) % (frame.columns * frame.rows);
+    let code = prelit[frame.prelit.y + (layer * size.y + p.y) * size.x + p.x];
+    let t = vec4<u32>(code & 255u, (code >> 8u) & 255u, (code >> 16u) & 255u, code >> 24u);
     return vec4<f32>(t) * (1.0 / 255.0);
 }
 

@@ -24,9 +24,9 @@
 // at z (`FRAMES_BOUND` at most); every entry point copies its record into `frame`.
 struct FrameRecord {
     f: Frame,
-    pad: array<vec4<u32>, 6>,
+    pad: array<vec4<u32>, 5>,
 }
-@group(0) @binding(0) var<uniform> frames: array<FrameRecord, 64>;
+@group(0) @binding(0) var<uniform> frames: array<FrameRecord, 256>;
 var<private> frame: Frame;
 // Pixels clamped above, clamped below and missed, at 1 to 3 (compute entry points; those
 // inside the grid, the rest of the shaded pixels, are not counted: a count of every pixel
@@ -41,7 +41,7 @@ var<private> frame: Frame;
 
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
-@group(1) @binding(4) var<storage, read> tables: Tables;
+@group(1) @binding(4) var<uniform> tables: Tables;
 @group(1) @binding(5) var<storage, read> proxy: Proxy;
 // The hull's occupancy: voxel i at bit i % 32 of word i / 32.
 @group(1) @binding(6) var<storage, read> hull_bits: array<u32>;

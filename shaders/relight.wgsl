@@ -1,9 +1,9 @@
 // The relighting pass (docs/design.md section 4.1), a batch of views at once (one row of
 // workgroups per view): the weighted sum of each view's basis images (JPEG-decoded 8-bit
 // gamma-2.2 codes, linearized through the table the CPU uses), then its encoding into its
-// layer of the pre-lit texture as sRGB codes of colour / scale, the scale being the
-// view's brightest value, which the encoding also writes into the pose's view table (the
-// frame pass reads it there: nothing goes back to the host). The codes stay resident
+// layer of the pose's pre-lit range as sRGB codes of colour / scale, the scale being the
+// view's brightest value, which the encoding also writes at the range's start (the frame
+// pass reads it there: nothing goes back to the host). The codes stay resident
 // between relights; a new light rewrites only the coefficients. Twin of
 // `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
 //
@@ -24,8 +24,9 @@ struct RelightParams {
     y0: u32,
     // Sun slots per job.
     sun_slots: u32,
-    pad1: u32,
-    pad2: u32,
+    // Words from the start of the pose's pre-lit range to its first layer's codes.
+    codes_at: u32,
+    pad: u32,
 }
 
 // One view of the batch: where its codes and coefficients start, how many basis images
@@ -68,17 +69,19 @@ struct Job {
 // lights, each its direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
-@group(0) @binding(3) var<storage, read> gamma: array<vec4<f32>, 64>;
+@group(0) @binding(3) var<uniform> gamma: array<vec4<f32>, 64>;
 // The relit colour (and alpha code) of every texel of every view, between the passes.
 @group(0) @binding(4) var<storage, read_write> relit: array<vec4<f32>>;
 // Per view: the largest relit value, as the bits of a non-negative f32 (whose order
 // `atomicMax` on u32 preserves).
 @group(0) @binding(5) var<storage, read_write> peaks: array<atomic<u32>>;
-// The pre-lit texture, every layer.
-@group(0) @binding(6) var output: texture_storage_2d_array<rgba8uint, write>;
+// The pose's pre-lit range of the shared pages (`render/src/gpu/prelit.rs`): per view
+// its scale (f32 bits), then from `params.codes_at` per layer its texels, each packed
+// RGBA8 (the sRGB codes of colour / scale, the alpha code).
+@group(0) @binding(6) var<storage, read_write> prelit: array<u32>;
 @group(0) @binding(7) var<storage, read> jobs: array<Job>;
-// The pose's view table, whose `scale` the encoding sets.
-@group(0) @binding(8) var<storage, read_write> views: array<View>;
+// The pose's view table (its cameras).
+@group(0) @binding(8) var<storage, read> views: array<View>;
 // The suns' maps of the hull, one after the other: per texel (x fastest), how far toward
 // its sun the hull reaches along its line.
 @group(0) @binding(9) var<storage, read> sun_depths: array<f32>;
@@ -417,15 +420,12 @@ fn encode(@builtin(global_invocation_id) id: vec3<u32>) {
         scale = 1.0;
     }
     if (i == 0u) {
-        views[job.view].scale = scale;
+        prelit[job.view] = bitcast<u32>(scale);
     }
     let r = relit[job.relit_offset + i];
-    let code = vec4<u32>(
-        u32(round(srgb_encode(r.x / scale) * 255.0)),
-        u32(round(srgb_encode(r.y / scale) * 255.0)),
-        u32(round(srgb_encode(r.z / scale) * 255.0)),
-        u32(r.w),
-    );
-    let p = vec2<i32>(i32(i % params.width), i32(i / params.width));
-    textureStore(output, p, i32(job.layer), code);
+    let code = u32(round(srgb_encode(r.x / scale) * 255.0))
+        | (u32(round(srgb_encode(r.y / scale) * 255.0)) << 8u)
+        | (u32(round(srgb_encode(r.z / scale) * 255.0)) << 16u)
+        | (u32(r.w) << 24u);
+    prelit[params.codes_at + job.layer * params.texels + i] = code;
 }

@@ -83,6 +83,33 @@ fn tiny_field_source(env: &EnvMap) -> PoseSource {
     frf_testkit::tiny_field().source(env)
 }
 
+/// Relit copies of one pose's views (walkers under lights of their own) share the frame
+/// pass's tables, and with them one bind group and one dispatch (their pre-lit views
+/// ranges of one page), while each keeps its own light; the pose loaded apart (views and
+/// flows of its own) is drawn apart.
+#[test]
+fn relit_copies_of_one_pose_are_drawn_together_each_under_its_own_light() {
+    use frf_reflectance::project::FloorModel;
+    use frf_render::resident::Lighting;
+    let Some(gpu) = gpu() else { return };
+    let fixture = frf_testkit::tiny_field();
+    let field = FieldFile::open(&fixture.field).unwrap();
+    let sky = EnvMap::sky();
+    let first = fixture.source(&sky);
+    let lighting = Lighting::Environment {
+        env: sky.rotated(2.0),
+        floor: FloorModel::Environment,
+    };
+    let turned = first.relit(&field, &lighting, None).unwrap();
+    let a = gpu.upload_pose(&first).unwrap();
+    let b = gpu.upload_pose_sharing(&turned, a.basis()).unwrap();
+    assert!(a.draws_with(&b));
+    assert_relit_as_the_cpu(&gpu, &a, &ResidentPose::relight_cpu(&first), "first");
+    assert_relit_as_the_cpu(&gpu, &b, &ResidentPose::relight_cpu(&turned), "turned");
+    let apart = gpu.upload_pose(&fixture.source(&sky)).unwrap();
+    assert!(!a.draws_with(&apart));
+}
+
 #[test]
 fn gpu_and_cpu_agree_on_the_tiny_stage_field() {
     let Some(gpu) = gpu() else { return };

@@ -1,8 +1,10 @@
-// Pre-lit views as integer codes (`Rgba8Uint`): RGB the sRGB codes of colour / the
-// view's scale, A the alpha code; decoded texel by texel through the table, then
-// filtered in the shader. The exact twin of `ResidentPose::sample_prelit`.
+// Pre-lit views as integer codes in the shared pages (`render/src/gpu/prelit.rs`): from
+// word `frame.prelit.x` per view its scale (f32 bits), from `frame.prelit.y` per layer its
+// texels, each RGB the sRGB codes of colour / the view's scale and A the alpha code
+// (packed RGBA8); decoded texel by texel through the table, then filtered in the shader.
+// The exact twin of `ResidentPose::sample_prelit`.
 
-@group(1) @binding(0) var prelit: texture_2d_array<u32>;
+@group(1) @binding(0) var<storage, read> prelit: array<u32>;
 
 fn srgb_value(code: u32) -> f32 {
     return tables.srgb[code / 4u][code % 4u];
@@ -15,10 +17,13 @@ fn sample_prelit(view: u32, s: vec2<f32>) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let c = crop_position(s);
-    let scale = views[view].scale;
+    let scale = bitcast<f32>(prelit[frame.prelit.x + view]);
+    let first = frame.prelit.y + u32(layer) * frame.crop_size.x * frame.crop_size.y;
     var out = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
-        let t = textureLoad(prelit, c.texel[k], layer, 0);
+        let p = vec2<u32>(c.texel[k]);
+        let code = prelit[first + p.y * frame.crop_size.x + p.x];
+        let t = vec4<u32>(code & 255u, (code >> 8u) & 255u, (code >> 16u) & 255u, code >> 24u);
         let wt = c.weight[k];
         out.x += wt * (scale * srgb_value(t.x));
         out.y += wt * (scale * srgb_value(t.y));

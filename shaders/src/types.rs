@@ -121,6 +121,10 @@ pub struct GpuFrame {
     /// Where the frame pass writes: pixel `p` of the frame at texel `p + place.xy` of
     /// layer `place.z` of its target (`frf_render::atlas`; w unused).
     pub place: [i32; 4],
+    /// Where the pose's pre-lit views lie in the shared pages bound beside it, in words
+    /// from the page's start: `[scales, codes, 0, 0]`, its views' scales (f32 bits) and
+    /// its first layer's codes (`frf_render::gpu::prelit`); zero where they are a texture.
+    pub prelit: [u32; 4],
 }
 
 /// `Proxy` of `common.wgsl`: the pose's geometric proxy (`frf_render::proxy`).
@@ -217,10 +221,11 @@ pub struct GpuRelightParams {
     /// Sun slots per job: each job's coefficients hold this many suns, those unused last
     /// and marked empty.
     pub sun_slots: u32,
+    /// Words from the start of the pose's pre-lit range to its first layer's codes (its
+    /// views' scales come first; `frf_render::gpu::prelit`).
+    pub codes_at: u32,
     /// Padding to 16 bytes.
-    pub pad1: u32,
-    /// Padding.
-    pub pad2: u32,
+    pub pad: u32,
 }
 
 /// `LightFitParams` of `light_fit.wgsl`.
@@ -258,7 +263,7 @@ pub struct GpuRelightJob {
     pub tiles: u32,
     /// Its view index (of its peak).
     pub view: u32,
-    /// Its layer of the pre-lit texture.
+    /// Its layer of the pre-lit views.
     pub layer: u32,
     /// Its first texel in the batch's relit scratch.
     pub relit_offset: u32,

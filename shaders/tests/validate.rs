@@ -210,7 +210,8 @@ fn pod_structs_match_naga_layouts() {
             flags,
             depth,
             bounds,
-            place
+            place,
+            prelit
         ]
     );
     check_layout!(
@@ -263,7 +264,7 @@ fn pod_structs_match_naga_layouts() {
         &relight,
         "RelightParams",
         GpuRelightParams,
-        [texels, width, jobs, x0, y0, sun_slots, pad1, pad2]
+        [texels, width, jobs, x0, y0, sun_slots, codes_at, pad]
     );
     check_layout!(
         &relight,

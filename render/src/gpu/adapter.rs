@@ -32,6 +32,8 @@ pub const ADAPTER_ENV: &str = "FRF_ADAPTER";
 
 /// Storage buffers the frame pass binds in its compute stage.
 const STORAGE_BUFFERS: u32 = 8;
+/// Bytes of the frame records one dispatch of the frame pass binds.
+const FRAME_RECORDS_BYTES: u64 = size_of::<super::rebin::FrameRecords>() as u64;
 
 /// The adapter named on the command line, which wins over [`ADAPTER_ENV`].
 static PREFERRED: OnceLock<String> = OnceLock::new();
@@ -117,6 +119,12 @@ pub fn lacks(adapter: &wgpu::Adapter) -> Vec<String> {
         out.push(format!(
             "{STORAGE_BUFFERS} storage buffers per shader stage (it has {})",
             limits.max_storage_buffers_per_shader_stage
+        ));
+    }
+    if limits.max_uniform_buffer_binding_size < FRAME_RECORDS_BYTES {
+        out.push(format!(
+            "a uniform binding of {FRAME_RECORDS_BYTES} bytes (it has {})",
+            limits.max_uniform_buffer_binding_size
         ));
     }
     if limits.max_storage_textures_per_shader_stage < 1 {

@@ -11,7 +11,7 @@ use frf_core::image::{Image, Rgba};
 use serde::Serialize;
 
 use super::Gpu;
-use super::bind::{compute_pipeline, full_screen_pipeline, texture_array};
+use super::bind::{compute_pipeline, full_screen_pipeline};
 use super::formats::{FlowFormat, ImageFormat, PoseFormats};
 use super::pose::GpuPose;
 use super::rebin::{PassKind, Place, RebinPass, SubjectTargets, frame_uniform, workgroups};
@@ -182,7 +182,7 @@ impl FloorPass {
         let module = super::shaders::module(device, "floor", super::shaders::FLOOR);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("floor"),
-            entries: &[texture_array(0, wgpu::TextureSampleType::Uint)],
+            entries: &[PoseFormats::DEFAULT.image.layout_entry(0)],
         });
         let fragment = full_screen_pipeline(
             device,
@@ -377,7 +377,7 @@ fn floor_rows(
     let codes_pass = RebinPass::new(&gpu.device, PoseFormats::DEFAULT);
     let codes_pose = gpu.upload_resident(pose, &codes_pass.pose)?;
     let floor = FloorPass::new(&gpu.device, &codes_pass);
-    let floor_group = floor_bind_group(gpu, &floor, &codes_pose);
+    let floor_group = floor_bind_group(gpu, &floor, &codes_pose)?;
     for &size in &options.sizes {
         let camera = bench_camera(size)?;
         let targets = SubjectTargets::new(&gpu.device, &codes_pass, size, 1, 1);
@@ -556,16 +556,18 @@ fn row(
     }
 }
 
-fn floor_bind_group(gpu: &Gpu, floor: &FloorPass, pose: &GpuPose) -> wgpu::BindGroup {
-    let view = pose.prelit_codes_view();
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+fn floor_bind_group(gpu: &Gpu, floor: &FloorPass, pose: &GpuPose) -> Result<wgpu::BindGroup> {
+    let range = pose.prelit_range().ok_or_else(|| {
+        crate::RenderError::Misuse("the floor pass reads pre-lit codes, not a texture".into())
+    })?;
+    Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("floor"),
         layout: &floor.layout,
         entries: &[wgpu::BindGroupEntry {
             binding: 0,
-            resource: wgpu::BindingResource::TextureView(&view),
+            resource: range.page().as_entire_binding(),
         }],
-    })
+    }))
 }
 
 fn record_floor(

@@ -6,7 +6,7 @@
 //!
 //! | choice | texture | filtered by | bytes a texel | against the CPU reference |
 //! |---|---|---|---|---|
-//! | image `codes` | `Rgba8Uint` | the shader, texel by texel through the sRGB table | 4 | exact |
+//! | image `codes` | packed RGBA8 in the shared pages ([`super::prelit`]) | the shader, texel by texel through the sRGB table | 4 | exact |
 //! | image `srgb8` | `Rgba8UnormSrgb` (the same bytes) | the sampler (sRGB decoded before filtering) | 4 | the hardware's filter precision |
 //! | flow `codes8` | `Rg8Sint`, the stored log codes | the shader, texel by texel through the code table | 2 | exact |
 //! | flow `f16` | `Rg16Float`, decoded at upload | the sampler | 4 | half precision |
@@ -46,7 +46,8 @@ impl ImageFormat {
         }
     }
 
-    /// The texture format of the pre-lit views.
+    /// The texture format of the pre-lit views (the codes' bytes are those of a
+    /// `Rgba8Uint` texel, though they lie in a buffer).
     pub fn texture(self) -> wgpu::TextureFormat {
         match self {
             ImageFormat::Codes => wgpu::TextureFormat::Rgba8Uint,
@@ -54,11 +55,19 @@ impl ImageFormat {
         }
     }
 
-    /// How the frame pass reads it.
-    pub fn sample_type(self) -> wgpu::TextureSampleType {
+    /// How the frame pass binds it, at `binding`: the shared pages of codes
+    /// ([`super::prelit`]) as a storage buffer, sRGB8 texels as a texture array.
+    pub fn layout_entry(self, binding: u32) -> wgpu::BindGroupLayoutEntry {
         match self {
-            ImageFormat::Codes => wgpu::TextureSampleType::Uint,
-            ImageFormat::Srgb8 => wgpu::TextureSampleType::Float { filterable: true },
+            ImageFormat::Codes => super::bind::storage::<u32>(
+                binding,
+                true,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            ),
+            ImageFormat::Srgb8 => super::bind::texture_array(
+                binding,
+                wgpu::TextureSampleType::Float { filterable: true },
+            ),
         }
     }
 

@@ -35,6 +35,8 @@ pub mod kept;
 pub mod light_fit;
 pub mod pass_clock;
 pub mod pose;
+mod pose_tables;
+mod prelit;
 pub mod present;
 pub mod readback;
 pub mod rebin;
@@ -105,6 +107,11 @@ pub struct Gpu {
     /// Every pose relit on the device: its views' jobs, the field's conditions and the
     /// views' scales, a range each ([`turn_light`]).
     turn_data: arena::Arena,
+    /// Every resident pose's pre-lit views, a range each ([`prelit`]).
+    prelit: arena::Arena,
+    /// The tables of the poses resident, shared by the relit copies of one pose's views
+    /// ([`pose_tables`]).
+    pose_tables: pose_tables::TablesKept,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
@@ -198,6 +205,15 @@ impl Gpu {
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 TURN_DATA_PAGE_BYTES,
             ),
+            prelit: arena::Arena::new(
+                &device,
+                "pre-lit views",
+                wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                prelit::PRELIT_PAGE_BYTES,
+            ),
+            pose_tables: pose_tables::TablesKept::default(),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited: spent::Spent::default(),

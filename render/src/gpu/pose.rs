@@ -1,26 +1,26 @@
 //! Making a pose resident on the GPU: its flows as RG8 integer texture arrays (the 8-bit
-//! log codes, decoded in the shader), the view and quad tables and the cylinder's column
-//! index as storage buffers, and every view relit on the GPU into an RGBA8 texture array
-//! ([`super::relight`], from basis codes kept resident and shared between the pose's
-//! relit copies).
+//! log codes, decoded in the shader) and its tables, shared by every relit copy of its
+//! views ([`super::pose_tables`]), and every view relit on the GPU into the pose's range
+//! of the shared pages of pre-lit views ([`super::prelit`]; [`super::relight`], from
+//! basis codes kept resident and shared between the pose's relit copies).
 
 use std::sync::Arc;
 
 use frf_core::volume::GroundGrid;
 use frf_reflectance::sun_light::{MAX_SUNS, SunLight};
-use glam::Quat;
 use wgpu::util::DeviceExt;
 
 use super::Gpu;
-use super::bind::{buffer_with, copy_to_buffer, table_bytes};
-use super::formats::PoseFormats;
+use super::bind::copy_to_buffer;
+use super::formats::{ImageFormat, PoseFormats};
+use super::pose_tables::{PoseTables, PrelitAt};
+use super::prelit::PrelitRange;
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
-use crate::rectified::gpu_frame;
-use crate::resident::{PoseSource, ResidentPose, decode_flow, srgb_lut};
+use crate::resident::{PoseSource, ResidentPose, decode_flow};
 use crate::shadow::ShadowMaps;
-use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuView};
+use frf_shaders::types::GpuView;
 
 /// How the frame pass binds a resident pose (made by [`super::rebin::RebinPass`]): the
 /// storage it reads ([`super::formats`]), the layout of bind group 1 and the sampler in it.
@@ -34,17 +34,28 @@ pub struct PoseBinding {
 /// A pose resident on the GPU.
 pub struct GpuPose {
     pub(super) bind_group: wgpu::BindGroup,
-    prelit: wgpu::Texture,
-    /// The view table (whose scales the relighting pass sets).
-    pub(super) views: wgpu::Buffer,
+    /// What names its bind group: renders of poses of one key are drawn in one dispatch.
+    pub(super) group_key: (u64, usize),
+    pub(super) prelit: Prelit,
+    /// Its flows and tables, shared with the other copies of its views
+    /// ([`super::pose_tables`]).
+    pub(super) tables: Arc<PoseTables>,
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
     pub(super) relight: Option<PoseRelight>,
     /// Grid, crop, cameras, cylinder; [`PoseGeometry::resident_bytes`] is what the pose
     /// holds on the GPU.
     pub geometry: Arc<PoseGeometry>,
-    pub(super) quad_count: u32,
     /// The shadow it casts on the ground, when it has shadow maps and a lighting.
     pub(super) shadow: Option<PoseShadow>,
+}
+
+/// Where a resident pose's pre-lit views are.
+pub(super) enum Prelit {
+    /// A range of the shared pages ([`super::prelit`]): the renderer's, relit on the GPU.
+    Shared(PrelitRange),
+    /// A texture array of its own, its scales in its view table (the benchmark's sRGB8
+    /// storage, [`super::formats`]).
+    Texture(wgpu::Texture),
 }
 
 /// The shadow a resident pose casts ([`super::shadow`]).
@@ -87,12 +98,24 @@ pub struct RelitShadowInfo {
 }
 
 impl GpuPose {
-    /// A view of the pre-lit texture array.
-    pub(super) fn prelit_codes_view(&self) -> wgpu::TextureView {
-        self.prelit.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        })
+    /// Its pre-lit views' range of the shared pages (none for a texture-stored pose).
+    pub(super) fn prelit_range(&self) -> Option<&PrelitRange> {
+        match &self.prelit {
+            Prelit::Shared(range) => Some(range),
+            Prelit::Texture(_) => None,
+        }
+    }
+
+    /// Where its pre-lit views lie in the shared pages (`prelit` of the frame pass's
+    /// record; zero for a texture).
+    pub(super) fn prelit_words(&self) -> [u32; 4] {
+        self.prelit_range().map_or([0; 4], PrelitRange::words)
+    }
+
+    /// Whether the frame pass draws its renders and `other`'s in one dispatch: relit
+    /// copies of one pose's views (its tables shared) whose pre-lit views lie in one page.
+    pub fn draws_with(&self, other: &GpuPose) -> bool {
+        self.group_key == other.group_key
     }
 
     /// The basis codes it is relit from, shared with the other poses relit from them;
@@ -155,137 +178,174 @@ impl Gpu {
 
     fn upload_pose_unscoped(&self, source: &PoseSource, basis: Arc<GpuBasis>) -> Result<GpuPose> {
         let geometry = &source.geometry;
-        let crop = geometry.crop;
-        let texels = crop.texels();
-        let extent = |layers: u32| wgpu::Extent3d {
-            width: crop.width,
-            height: crop.height,
-            depth_or_array_layers: layers.max(1),
+        let pass = &self.rebin.pose;
+        let tables = self.pose_tables(
+            std::ptr::eq(pass, &self.rebin.pose),
+            (geometry, &source.flows),
+            None,
+            || {
+                // One layer per stored flow, in the order of the geometry's flow layers.
+                let codes = source.flows.codes.iter().flat_map(|f| f.iter().flatten());
+                let mut bytes: Vec<u8> = codes
+                    .flat_map(|c| c.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
+                    .collect();
+                if bytes.is_empty() {
+                    // Unknown: no displacement.
+                    bytes = vec![128u8; geometry.crop.texels() * 2];
+                }
+                self.flows_texture(geometry, wgpu::TextureFormat::Rg8Sint, bytes)
+            },
+        );
+        // Scales are set by the relighting pass; a view not relit keeps 1.
+        let range = self.take_prelit(
+            geometry.views(),
+            geometry.prelit_layer_count,
+            geometry.crop.texels(),
+        );
+        let mut pose = self.resident_pose(pass, tables, Prelit::Shared(range), geometry);
+        let hull = pose.geometry.proxy.hull_shared().cloned();
+        let mut relight = self.pose_relight(basis, geometry.views(), hull);
+        if let Some(target) = pose.prelit_range() {
+            self.record_relight(&mut relight, source, (target, &pose.tables.views));
+        }
+        pose.relight = Some(relight);
+        Ok(pose)
+    }
+
+    /// A pose of `geometry` drawn from `tables` and `prelit` by `pass`.
+    fn resident_pose(
+        &self,
+        pass: &PoseBinding,
+        tables: Arc<PoseTables>,
+        prelit: Prelit,
+        geometry: &Arc<PoseGeometry>,
+    ) -> GpuPose {
+        let at = match &prelit {
+            Prelit::Shared(range) => PrelitAt::Shared(range),
+            Prelit::Texture(texture) => PrelitAt::Texture(texture),
         };
-        // Flows: one layer per stored flow, in the order of the geometry's flow layers.
-        let mut flow_data: Vec<u8> = Vec::with_capacity(geometry.flow_layer_count * texels * 2);
-        for f in &source.flows.codes {
-            for codes in f.iter().flatten() {
-                flow_data.extend(codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]));
-            }
+        let (bind_group, group_key) = self.pose_group((&pass.layout, &pass.sampler), &tables, at);
+        GpuPose {
+            bind_group,
+            group_key,
+            prelit,
+            tables,
+            relight: None,
+            geometry: geometry.clone(),
+            shadow: None,
         }
-        if flow_data.is_empty() {
-            flow_data = vec![128u8; texels * 2];
-        }
-        let flows = self.device.create_texture_with_data(
+    }
+
+    /// A texture array of `geometry`'s crop, a layer a stored flow (one at least), of
+    /// `format`, holding `bytes` (zero flow where there are none).
+    fn flows_texture(
+        &self,
+        geometry: &PoseGeometry,
+        format: wgpu::TextureFormat,
+        bytes: Vec<u8>,
+    ) -> wgpu::Texture {
+        self.crop_texture(
+            geometry,
+            ("flows", format),
+            geometry.flow_layer_count,
+            &bytes,
+        )
+    }
+
+    /// A texture array of `geometry`'s crop, `layers` layers (one at least) of `format`
+    /// holding `bytes`, layer after layer (zeros where it is empty).
+    fn crop_texture(
+        &self,
+        geometry: &PoseGeometry,
+        (label, format): (&str, wgpu::TextureFormat),
+        layers: usize,
+        bytes: &[u8],
+    ) -> wgpu::Texture {
+        let crop = geometry.crop;
+        let layers = layers.max(1);
+        let zeros;
+        let bytes = if bytes.is_empty() {
+            let texel = format.block_copy_size(None).unwrap_or(4) as usize;
+            zeros = vec![0u8; crop.texels() * layers * texel];
+            &zeros
+        } else {
+            bytes
+        };
+        self.device.create_texture_with_data(
             &self.queue,
             &wgpu::TextureDescriptor {
-                label: Some("flows"),
-                size: extent(geometry.flow_layer_count as u32),
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: crop.width,
+                    height: crop.height,
+                    depth_or_array_layers: layers as u32,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rg8Sint,
+                format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
             },
             wgpu::util::TextureDataOrder::LayerMajor,
-            &flow_data,
-        );
-        let prelit = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("prelit"),
-            size: extent(geometry.prelit_layer_count as u32),
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8Uint,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        // Scales are set by the relighting pass; a view not relit keeps 1.
-        let mut pose = self.bind_pose(
-            &self.rebin.pose,
-            &source.geometry,
-            vec![1.0; geometry.views()],
-            prelit,
-            &flows,
-            source.flows.table,
-        );
-        let hull = pose.geometry.proxy.hull_shared().cloned();
-        let mut relight = self.pose_relight(basis, geometry.views(), hull);
-        self.record_relight(
-            &mut relight,
-            source,
-            (&pose.prelit_codes_view(), &pose.views),
-        );
-        pose.relight = Some(relight);
-        Ok(pose)
+            bytes,
+        )
     }
 
     /// Relights `pose` with `source`'s coefficients (the views and geometry it was made
     /// from): new coefficients and one dispatch pair per batch of views
     /// ([`super::relight`]), recorded with the pending work, not submitted.
     pub fn relight_pose(&self, pose: &mut GpuPose, source: &PoseSource) -> Result<()> {
-        if pose.relight.is_none() {
-            // Let go of ([`GpuPose::release_basis`]): uploaded again.
-            let basis = self.upload_basis(source)?;
-            let hull = pose.geometry.proxy.hull_shared().cloned();
-            let relight = self.pose_relight(basis, source.geometry.views(), hull);
-            pose.relight = Some(relight);
-        }
-        self.scoped("relighting a resident pose", || {
-            let target = pose.prelit_codes_view();
-            let relight = pose.relight.as_mut().ok_or_else(|| {
-                crate::RenderError::Misuse("relighting a pose of no basis".into())
-            })?;
+        let Prelit::Shared(target) = &pose.prelit else {
+            return Err(crate::RenderError::Misuse(
+                "relighting a pose whose pre-lit views are a texture".into(),
+            ));
+        };
+        let mut relight = match pose.relight.take() {
+            Some(r) => r,
+            None => {
+                // Let go of ([`GpuPose::release_basis`]): uploaded again.
+                let basis = self.upload_basis(source)?;
+                let hull = pose.geometry.proxy.hull_shared().cloned();
+                self.pose_relight(basis, source.geometry.views(), hull)
+            }
+        };
+        let done = self.scoped("relighting a resident pose", || {
             if !relight.basis().holds(&source.basis) {
                 return Err(crate::RenderError::Misuse(
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(relight, source, (&target, &pose.views));
+            self.record_relight(&mut relight, source, (target, &pose.tables.views));
             Ok(())
-        })
+        });
+        pose.relight = Some(relight);
+        done
     }
 
     /// The views' pre-lit colour scales as the GPU holds them (for tests and inspection).
     pub fn read_scales(&self, pose: &GpuPose) -> Result<Vec<f32>> {
-        self.scoped("reading a pose's scales back", || {
-            let bytes = self.read_back(&pose.views, "views readback")?;
-            let views: &[GpuView] = bytemuck::cast_slice(&bytes);
-            Ok(views[..pose.geometry.views()]
-                .iter()
-                .map(|v| v.scale)
-                .collect())
+        self.scoped("reading a pose's scales back", || match &pose.prelit {
+            Prelit::Shared(range) => Ok(self.read_prelit_range(range)?.0),
+            Prelit::Texture(_) => {
+                let bytes = self.read_back(&pose.tables.views, "views readback")?;
+                let views: &[GpuView] = bytemuck::cast_slice(&bytes);
+                Ok(views[..pose.geometry.views()]
+                    .iter()
+                    .map(|v| v.scale)
+                    .collect())
+            }
         })
     }
 
     /// Makes a pose relit on the CPU resident with the storage `pass` reads
     /// ([`super::formats`]): its pre-lit codes and flows uploaded in those formats (the
-    /// benchmark's way to compare them; the renderer relights on the GPU).
+    /// benchmark's way to compare them, and the motion views'; the renderer relights on
+    /// the GPU).
     pub fn upload_resident(&self, resident: &ResidentPose, pass: &PoseBinding) -> Result<GpuPose> {
         self.scoped("making a CPU-relit pose resident", || {
             let geometry = &resident.geometry;
-            let crop = geometry.crop;
-            let texels = crop.texels();
-            let texture = |label, format, layers: usize, bytes: &[u8]| {
-                self.device.create_texture_with_data(
-                    &self.queue,
-                    &wgpu::TextureDescriptor {
-                        label: Some(label),
-                        size: wgpu::Extent3d {
-                            width: crop.width,
-                            height: crop.height,
-                            depth_or_array_layers: layers.max(1) as u32,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                        view_formats: &[],
-                    },
-                    wgpu::util::TextureDataOrder::LayerMajor,
-                    bytes,
-                )
-            };
+            let texels = geometry.crop.texels();
             // The held views' texels, layer by layer (a held view without texels: zero).
             let mut prelit_bytes: Vec<u8> =
                 Vec::with_capacity(geometry.prelit_layer_count.max(1) * texels * 4);
@@ -299,47 +359,48 @@ impl Gpu {
                     prelit_bytes.extend(view.iter().flatten());
                 }
             }
-            if prelit_bytes.is_empty() {
-                prelit_bytes = vec![0; texels * 4];
-            }
-            let prelit = texture(
-                "prelit",
-                pass.formats.image.texture(),
-                geometry.prelit_layer_count,
-                &prelit_bytes,
-            );
-            let stored = resident.flows.codes.iter().flat_map(|f| f.iter().flatten());
-            let q = &resident.flows.quantizer;
-            let decoded: Vec<[f32; 2]> = stored
-                .clone()
-                .flat_map(|codes| codes.iter().map(|&c| decode_flow(c, q).to_array()))
-                .collect();
-            let mut bytes = match pass.formats.flow.encode(&decoded) {
-                Some(b) => b,
-                None => stored
-                    .flat_map(|codes| codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
-                    .collect(),
-            };
-            if bytes.is_empty() {
-                bytes = match pass.formats.flow.encode(&vec![[0.0; 2]; texels]) {
+            let flows = || {
+                let stored = resident.flows.codes.iter().flat_map(|f| f.iter().flatten());
+                let q = &resident.flows.quantizer;
+                let decoded: Vec<[f32; 2]> = stored
+                    .clone()
+                    .flat_map(|codes| codes.iter().map(|&c| decode_flow(c, q).to_array()))
+                    .collect();
+                let mut bytes = match pass.formats.flow.encode(&decoded) {
                     Some(b) => b,
-                    None => vec![128u8; texels * 2],
+                    None => stored
+                        .flat_map(|codes| codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
+                        .collect(),
                 };
-            }
-            let flows = texture(
-                "flows",
-                pass.formats.flow.texture(),
-                geometry.flow_layer_count,
-                &bytes,
-            );
-            Ok(self.bind_pose(
-                pass,
-                geometry,
-                resident.scales.clone(),
-                prelit,
-                &flows,
-                resident.flows.table,
-            ))
+                if bytes.is_empty() {
+                    bytes = match pass.formats.flow.encode(&vec![[0.0; 2]; texels]) {
+                        Some(b) => b,
+                        None => vec![128u8; texels * 2],
+                    };
+                }
+                self.flows_texture(geometry, pass.formats.flow.texture(), bytes)
+            };
+            let source = (geometry, &resident.flows);
+            let layers = geometry.prelit_layer_count;
+            let (tables, prelit) = match pass.formats.image {
+                ImageFormat::Codes => (
+                    self.pose_tables(std::ptr::eq(pass, &self.rebin.pose), source, None, flows),
+                    Prelit::Shared(self.prelit_with(&resident.scales, layers, &prelit_bytes)),
+                ),
+                ImageFormat::Srgb8 => {
+                    let format = pass.formats.image.texture();
+                    let texture =
+                        self.crop_texture(geometry, ("prelit", format), layers, &prelit_bytes);
+                    let tables = self.pose_tables(
+                        std::ptr::eq(pass, &self.rebin.pose),
+                        source,
+                        Some(&resident.scales),
+                        flows,
+                    );
+                    (tables, Prelit::Texture(texture))
+                }
+            };
+            Ok(self.resident_pose(pass, tables, prelit, geometry))
         })
     }
 
@@ -349,159 +410,35 @@ impl Gpu {
         self.upload_resident(motion, &self.rebin.pose)
     }
 
-    /// The pose's tables uploaded and bound with its textures for `pass`.
-    fn bind_pose(
-        &self,
-        pass: &PoseBinding,
-        geometry: &Arc<PoseGeometry>,
-        scales: Vec<f32>,
-        prelit: wgpu::Texture,
-        flows: &wgpu::Texture,
-        flow_table: [f32; 256],
-    ) -> GpuPose {
-        let gpu_views: Vec<GpuView> = geometry
-            .cameras
-            .iter()
-            .zip(&scales)
-            .zip(&geometry.flow_layers)
-            .zip(&geometry.prelit_layers)
-            .map(|(((cam, &scale), l), &prelit_layer)| {
-                let q = Quat::from_mat3(&cam.world_from_camera.rotation);
-                let k = &cam.intrinsics;
-                GpuView {
-                    rotation: q.to_array(),
-                    centre: cam.centre().to_array(),
-                    scale,
-                    intrinsics: [k.fx, k.fy, k.cx, k.cy],
-                    flow_layers: *l,
-                    prelit_layer,
-                    pad0: 0,
-                    pad1: 0,
-                    pad2: 0,
-                }
-            })
-            .collect();
-        let quads: Vec<GpuQuad> = geometry
-            .cylinder
-            .quads()
-            .iter()
-            .map(|q| GpuQuad {
-                p00: q.p00.to_array(),
-                u: q.u,
-                e1: q.e1.to_array(),
-                v: q.v,
-                e2: q.e2.to_array(),
-                wall: q.wall,
-                e3: q.e3.to_array(),
-                wall_gamma: q.wall_gamma,
-                normal: q.normal.to_array(),
-                pad: 0.0,
-            })
-            .collect();
-        let buffer = |label: &str, contents: &[u8]| {
-            buffer_with(&self.device, label, contents, wgpu::BufferUsages::STORAGE)
-        };
-        let view_buffer = buffer_with(
-            &self.device,
-            "views",
-            bytemuck::cast_slice(&gpu_views),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        );
-        let quad_buffer = buffer("quads", bytemuck::cast_slice(&quads));
-        let tables = buffer("tables", &table_bytes(&[srgb_lut(), flow_table]));
-        let (index, ranges) = geometry.cylinder.column_index_gpu();
-        let mut index_bytes = bytemuck::bytes_of(&index).to_vec();
-        index_bytes.extend_from_slice(bytemuck::cast_slice(&ranges));
-        let index_buffer = buffer("column index", &index_bytes);
-        let (proxy, hull_words) = geometry.proxy.gpu();
-        let proxy_buffer = buffer("proxy", bytemuck::bytes_of(&proxy));
-        let hull_buffer = buffer("hull", bytemuck::cast_slice(&hull_words));
-        let frames: Vec<GpuQuadFrame> = geometry
-            .frames
-            .iter()
-            .map(|f| gpu_frame(f.as_ref()))
-            .collect();
-        let frame_buffer = buffer("quad frames", bytemuck::cast_slice(&frames));
-        let view_of = |t: &wgpu::Texture| {
-            t.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            })
-        };
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pose"),
-            layout: &pass.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&view_of(&prelit)),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view_of(flows)),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: view_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: quad_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: tables.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: proxy_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: hull_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: index_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: wgpu::BindingResource::Sampler(&pass.sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 9,
-                    resource: frame_buffer.as_entire_binding(),
-                },
-            ],
-        });
-        GpuPose {
-            bind_group,
-            prelit,
-            views: view_buffer,
-            relight: None,
-            geometry: geometry.clone(),
-            quad_count: quads.len() as u32,
-            shadow: None,
-        }
-    }
-
     /// Reads back the pre-lit texels of every view (for tests and inspection; a view not
     /// held reads as no texels).
     pub fn read_prelit(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
         self.scoped("reading pre-lit views back", || {
-            self.read_prelit_unscoped(pose)
+            let layers = match &pose.prelit {
+                Prelit::Shared(range) => self.read_prelit_range(range)?.1,
+                Prelit::Texture(texture) => self.read_texture_layers(texture)?,
+            };
+            Ok(pose
+                .geometry
+                .prelit_layers
+                .iter()
+                .map(|&l| usize::try_from(l).map_or(Vec::new(), |l| layers[l].clone()))
+                .collect())
         })
     }
 
-    fn read_prelit_unscoped(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
-        let (w, h) = (pose.geometry.crop.width, pose.geometry.crop.height);
-        let g = &pose.geometry;
-        let layers = g.prelit_layer_count.max(1) as u32;
+    /// Every layer's texels of a texture array of 4-byte texels.
+    fn read_texture_layers(&self, texture: &wgpu::Texture) -> Result<Vec<Vec<[u8; 4]>>> {
+        let (w, h, layers) = (
+            texture.width(),
+            texture.height(),
+            texture.depth_or_array_layers(),
+        );
         let row = (w * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prelit readback"),
-            size: (row * h * layers) as u64,
+            size: u64::from(row * h * layers),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -510,16 +447,11 @@ impl Gpu {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("prelit readback"),
             });
-        copy_to_buffer(&mut encoder, &pose.prelit, &buffer, row, (w, h, layers));
+        copy_to_buffer(&mut encoder, texture, &buffer, row, (w, h, layers));
         self.submit([encoder.finish()]);
         let bytes = self.read_buffer(&buffer)?;
-        Ok(g.prelit_layers
-            .iter()
-            .map(|&l| {
-                if l < 0 {
-                    return Vec::new();
-                }
-                let l = l as usize;
+        Ok((0..layers as usize)
+            .map(|l| {
                 (0..h as usize)
                     .flat_map(|y| {
                         let start = (l * h as usize + y) * row as usize;

@@ -74,9 +74,9 @@ type MorphKey = (u32, u32);
 const FRAME_STRIDE: usize = 256;
 /// Records a slot's range binds: its own and those after it, read by a dispatch that
 /// draws as many renders of one pose (`frames` of `shaders/rebin.wgsl`).
-const FRAMES_BOUND: usize = 64;
+const FRAMES_BOUND: usize = 256;
 /// What a slot binds of the frames' buffer.
-type FrameRecords = [[u8; FRAME_STRIDE]; FRAMES_BOUND];
+pub(super) type FrameRecords = [[u8; FRAME_STRIDE]; FRAMES_BOUND];
 const _: () = assert!(std::mem::size_of::<GpuFrame>() <= FRAME_STRIDE);
 
 /// The frame pass's pipelines of one morph (its module compiled with the constants `KIND`
@@ -117,11 +117,11 @@ impl RebinPass {
         let pose_layout = layout(
             "pose",
             &[
-                texture_array(0, formats.image.sample_type()),
+                formats.image.layout_entry(0),
                 texture_array(1, formats.flow.sample_type()),
                 storage::<GpuView>(2, true, both),
                 storage::<GpuQuad>(3, true, both),
-                storage::<[[f32; 256]; 2]>(4, true, both),
+                uniform::<[[f32; 256]; 2]>(4, both),
                 storage::<GpuProxy>(5, true, both),
                 storage::<u32>(6, true, both),
                 // The column index's header and at least one span's range.
@@ -287,9 +287,11 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         depth: 0,
         bounds: PixelBox::whole(camera.width, camera.height).to_array(),
         place: [0; 4],
+        prelit: [0; 4],
     };
     if let Some(pose) = pose {
-        f.quad_count = pose.quad_count;
+        f.quad_count = pose.tables.quad_count;
+        f.prelit = pose.prelit_words();
         f.columns = pose.geometry.columns as u32;
         f.rows = pose.geometry.rows as u32;
         f.crop_origin = [pose.geometry.crop.x0, pose.geometry.crop.y0];
@@ -627,13 +629,13 @@ impl RebinPass {
 
 impl RebinPass {
     /// Records the compute frame pass of every render of `renders` (its slot in
-    /// `targets`, pose bind group and pixel box) in one pass, with the pass's timestamps
-    /// when given; each counts its pixel classes as it shades. Returns the dispatches.
+    /// `targets`, pose and pixel box) in one pass, with the pass's timestamps when given;
+    /// each counts its pixel classes as it shades. Returns the dispatches.
     pub(super) fn record_compute(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
-        renders: &[(usize, &wgpu::BindGroup, PixelBox)],
+        renders: &[(usize, &GpuPose, PixelBox)],
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
     ) -> usize {
@@ -644,16 +646,17 @@ impl RebinPass {
             timestamp_writes: super::timing::compute_pass_writes(timestamps),
         });
         pass.set_pipeline(&pipelines.compute);
-        // Renders of one pose in consecutive slots: one dispatch, a layer of workgroups
-        // a render, over the largest of their boxes.
+        // Renders of poses of one bind group (copies of one pose's views in one page of
+        // pre-lit views, [`super::pose_tables`]) in consecutive slots: one dispatch, a
+        // layer of workgroups a render, over the largest of their boxes.
         let mut at = 0;
         while at < renders.len() {
-            let (slot, pose_group, _) = renders[at];
+            let (slot, pose, _) = renders[at];
             let run = renders[at..]
                 .iter()
                 .take(FRAMES_BOUND)
                 .enumerate()
-                .take_while(|(k, r)| r.0 == slot + k && std::ptr::eq(r.1, pose_group))
+                .take_while(|(k, r)| r.0 == slot + k && r.1.group_key == pose.group_key)
                 .count();
             let (x, y) = renders[at..at + run]
                 .iter()
@@ -664,7 +667,7 @@ impl RebinPass {
                 continue;
             }
             pass.set_bind_group(0, &targets.slots[slot].compute, &[]);
-            pass.set_bind_group(1, pose_group, &[]);
+            pass.set_bind_group(1, &pose.bind_group, &[]);
             pass.dispatch_workgroups(x, y, run as u32);
             dispatches += 1;
         }
@@ -761,12 +764,12 @@ impl Gpu {
         timestamps: Option<(&wgpu::QuerySet, u32)>,
         classes: bool,
     ) {
-        // Renders of one pose next to each other (their slots in that order), so that
-        // the compute pass draws them in one dispatch ([`RebinPass::record_compute`]).
+        // Renders of one bind group next to each other (their slots in that order), so
+        // that the compute pass draws them in one dispatch ([`RebinPass::record_compute`]).
         let mut order: Vec<usize> = (0..renders.len()).collect();
         if self.stage == PassKind::Compute {
             // Where each render lands is in its record, so any order draws the same.
-            order.sort_by_key(|&k| std::ptr::from_ref::<GpuPose>(renders[k].0) as usize);
+            order.sort_by_key(|&k| renders[k].0.group_key);
         }
         let renders: Vec<&(&GpuPose, DrawnRender)> = order.iter().map(|&k| &renders[k]).collect();
         let frames: Vec<GpuFrame> = renders
@@ -785,7 +788,7 @@ impl Gpu {
                 let groups: Vec<_> = renders
                     .iter()
                     .enumerate()
-                    .map(|(slot, (pose, d))| (slot, &pose.bind_group, d.within))
+                    .map(|(slot, (pose, d))| (slot, *pose, d.within))
                     .collect();
                 let timestamps = self.pass_timestamps("frame", timestamps);
                 let dispatches =

@@ -6,8 +6,8 @@
 //! light is then one dispatch pair per batch of views: the new coefficients written into
 //! the pose's own buffer (by the host, or looked up by the device from the light's yaw
 //! tables, [`super::turn_light`]), the weighted sum of the basis images, and its encoding
-//! into the pose's pre-lit layers with each view's peak as its scale, written by the GPU
-//! into the pose's view table. Nothing is uploaded again, nothing is read back and
+//! into the pose's pre-lit layers with each view's peak as its scale, both written by the
+//! GPU into the pose's range of the shared pre-lit pages ([`super::prelit`]). Nothing is uploaded again, nothing is read back and
 //! nothing waits: the dispatches of every pose relit between two frames go into one
 //! relight pass ([`super::deferred`]), after the one dispatch that made all their suns'
 //! maps ([`super::sun_depth`]), which [`Gpu::submit`] sends just ahead of the next frame.
@@ -24,10 +24,10 @@ use wgpu::util::DeviceExt;
 
 use super::arena::ArenaRange;
 use super::bind::{
-    bind_group, buffer_with, compute_pipeline, empty_buffer, storage, storage_texture_array,
-    table_bytes, uniform,
+    bind_group, buffer_with, compute_pipeline, empty_buffer, storage, table_bytes, uniform,
 };
 use super::deferred::{Dispatch, Kind};
+use super::prelit::{PrelitRange, head_words};
 use super::sun_depth::SunMapsAt;
 use super::{Gpu, shaders};
 use crate::error::Result;
@@ -61,12 +61,12 @@ impl RelightPass {
                 uniform::<GpuRelightParams>(0, c),
                 storage::<u32>(1, true, c),
                 storage::<[f32; 4]>(2, true, c),
-                storage::<[[f32; 4]; 64]>(3, true, c),
+                uniform::<[[f32; 4]; 64]>(3, c),
                 storage::<[f32; 4]>(4, false, c),
                 storage::<u32>(5, false, c),
-                storage_texture_array(6, wgpu::TextureFormat::Rgba8Uint),
+                storage::<u32>(6, false, c),
                 storage::<GpuRelightJob>(7, true, c),
-                storage::<frf_shaders::types::GpuView>(8, false, c),
+                storage::<frf_shaders::types::GpuView>(8, true, c),
                 storage::<f32>(9, true, c),
             ],
         });
@@ -74,7 +74,7 @@ impl RelightPass {
         let gamma = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("gamma"),
             contents: &table_bytes(&[frf_reflectance::imagecodec::gamma_lut()]),
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::UNIFORM,
         });
         let no_depths = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("no sun depths"),
@@ -469,8 +469,8 @@ impl Gpu {
             x0: crop.x0,
             y0: crop.y0,
             sun_slots: MAX_SUNS as u32,
-            pad1: 0,
-            pad2: 0,
+            codes_at: head_words(source.geometry.views()),
+            pad: 0,
         };
         let buffer =
             |label: &str, contents: &[u8], usage| buffer_with(&self.device, label, contents, usage);
@@ -523,13 +523,13 @@ impl Gpu {
     /// Asks for its suns' maps ([`super::sun_depth`], made with every other walker's in
     /// one dispatch ahead of the relights), writes `source`'s coefficients into
     /// `relight`'s buffers and records the passes that relight its views into the
-    /// pre-lit array `target`, their scales into the pose's view table `views`
+    /// pose's pre-lit range `target`, reading its cameras from its view table `views`
     /// ([`Gpu::relight_pose`]); keeps where the maps are.
     pub(super) fn record_relight(
         &self,
         relight: &mut PoseRelight,
         source: &PoseSource,
-        (target, views): (&wgpu::TextureView, &wgpu::Buffer),
+        target: (&PrelitRange, &wgpu::Buffer),
     ) {
         relight.sun_maps = relight.hull.as_ref().map(|hull| {
             let maps: Vec<_> = source.suns.iter().map(|s| s.depth.as_ref()).collect();
@@ -546,18 +546,18 @@ impl Gpu {
                 bytemuck::cast_slice(&packed),
             );
         }
-        self.record_relight_passes(relight, (|| target.clone(), views));
+        self.record_relight_passes(relight, target);
     }
 
     /// Records the passes that relight `relight`'s views from its coefficients into the
-    /// pre-lit array `target`, their scales into the view table `views`: per batch of
-    /// views the sums and their encoding (after the look-ups of every light on the
-    /// device gathered for the submission, [`super::turn_light`], which write the
-    /// coefficients).
+    /// pose's pre-lit range `target` (codes and scales), reading its cameras from its
+    /// view table `views`: per batch of views the sums and their encoding (after the
+    /// look-ups of every light on the device gathered for the submission,
+    /// [`super::turn_light`], which write the coefficients).
     pub(super) fn record_relight_passes(
         &self,
         relight: &PoseRelight,
-        (target, views): (impl Fn() -> wgpu::TextureView, &wgpu::Buffer),
+        (target, views): (&PrelitRange, &wgpu::Buffer),
     ) {
         let maps = relight.sun_maps.as_ref();
         let basis = &relight.basis;
@@ -576,7 +576,6 @@ impl Gpu {
         let key = (relit.clone(), depths.clone());
         let mut kept = relight.binds.lock().unwrap_or_else(|e| e.into_inner());
         if kept.as_ref().is_none_or(|(k, _)| *k != key) {
-            let target = target();
             let binds = (basis.batches.iter().zip(&relight.coefficients))
                 .map(|(batch, coefficients)| {
                     bind_group(
@@ -590,7 +589,7 @@ impl Gpu {
                             self.relight.gamma.as_entire_binding(),
                             relit.as_entire_binding(),
                             relight.peaks.as_entire_binding(),
-                            wgpu::BindingResource::TextureView(&target),
+                            target.binding(),
                             batch.jobs.as_entire_binding(),
                             views.as_entire_binding(),
                             depths.as_entire_binding(),

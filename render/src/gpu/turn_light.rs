@@ -585,8 +585,9 @@ impl Gpu {
                 });
             }
             drop(gathered);
-            let target = || pose.prelit_codes_view();
-            self.record_relight_passes(relight, (target, &pose.views));
+            if let Some(target) = pose.prelit_range() {
+                self.record_relight_passes(relight, (target, &pose.tables.views));
+            }
             Ok(true)
         })
     }
