@@ -3,22 +3,16 @@
 // this file), and the pure functions of light-field re-binning, twins of
 // `render/src/cylinder.rs` and `render/src/morph/` operation for operation.
 
-// One view of the pose.
+// One view of the pose: its camera (what a copy of the pose read of it, its scale and
+// layers, lies with the copy's pre-lit views: `render/src/gpu/prelit.rs`).
 struct View {
     // Orientation of `world_from_camera`, a quaternion (x, y, z, w).
     rotation: vec4<f32>,
-    // Camera centre (subject frame) and the view's pre-lit colour scale.
+    // Camera centre (subject frame).
     centre: vec3<f32>,
-    scale: f32,
+    pad: f32,
     // fx, fy, cx, cy.
     intrinsics: vec4<f32>,
-    // Flow texture layer toward right, left, up, down; -1 where there is none.
-    flow_layers: vec4<i32>,
-    // Pre-lit texture layer; -1 for a view not held (transparent).
-    prelit_layer: i32,
-    pad0: i32,
-    pad1: i32,
-    pad2: i32,
 }
 
 // A quad of the cylinder of camera centres (or a wall above / below the grid).
@@ -80,9 +74,9 @@ struct Frame {
     // Where the frame pass writes: pixel p of the frame at texel p + place.xy of layer
     // place.z of its target (`render/src/atlas.rs`; w unused).
     place: vec4<i32>,
-    // Where the pose's pre-lit views lie in the shared pages bound beside it (words: x
-    // its views' scales, y its first layer's codes; `render/src/gpu/prelit.rs`), when
-    // they are stored there.
+    // Where the pose's copy lies in the shared pages bound beside it (words; x its views'
+    // heads: scale, pre-lit layer and flow layers, y its first pre-lit layer's codes,
+    // z its flows' codes; `render/src/gpu/prelit.rs`).
     prelit: vec4<u32>,
 }
 

@@ -39,6 +39,11 @@ var<private> frame: Frame;
 // (`subject_depth`), which orders walkers that overlap in the composite.
 @group(0) @binding(3) var depth_image: texture_storage_2d_array<r32float, write>;
 
+// The shared pages of pose copies (`render/src/gpu/prelit.rs`): a render's views'
+// heads from word `frame.prelit.x`, 8 words a view: its pre-lit scale (f32 bits), its
+// pre-lit layer (-1: not held, transparent), two unused, its flow layers toward right,
+// left, up, down (-1: none stored); its pre-lit codes from `frame.prelit.y`.
+@group(1) @binding(0) var<storage, read> prelit: array<u32>;
 @group(1) @binding(2) var<storage, read> views: array<View>;
 @group(1) @binding(3) var<storage, read> quads: array<Quad>;
 @group(1) @binding(4) var<uniform> tables: Tables;
@@ -82,10 +87,25 @@ fn crop_uv(s: vec2<f32>) -> vec2<f32> {
     return (s - vec2<f32>(frame.crop_origin) + 0.5) / vec2<f32>(frame.crop_size);
 }
 
+// Where view `view`'s head starts in `prelit`.
+fn view_head(view: u32) -> u32 {
+    return frame.prelit.x + view * 8u;
+}
+
+// The view's pre-lit colour scale.
+fn view_scale(view: u32) -> f32 {
+    return bitcast<f32>(prelit[view_head(view)]);
+}
+
+// The view's pre-lit layer; -1 for a view not held.
+fn prelit_layer(view: u32) -> i32 {
+    return bitcast<i32>(prelit[view_head(view) + 1u]);
+}
+
 // Bilinear sample of the flow from a view toward `dir` (0 right, 1 left, 2 up, 3 down);
 // absent flows displace by zero.
 fn sample_flow(view: u32, dir: u32, s: vec2<f32>) -> vec2<f32> {
-    let layer = views[view].flow_layers[dir];
+    let layer = bitcast<i32>(prelit[view_head(view) + 4u + dir]);
     if (layer < 0) {
         return vec2<f32>(0.0);
     }

@@ -75,9 +75,9 @@ struct Job {
 // Per view: the largest relit value, as the bits of a non-negative f32 (whose order
 // `atomicMax` on u32 preserves).
 @group(0) @binding(5) var<storage, read_write> peaks: array<atomic<u32>>;
-// The pose's pre-lit range of the shared pages (`render/src/gpu/prelit.rs`): per view
-// its scale (f32 bits), then from `params.codes_at` per layer its texels, each packed
-// RGBA8 (the sRGB codes of colour / scale, the alpha code).
+// The pose's range of the shared pages (`render/src/gpu/prelit.rs`): per view its head
+// of 8 words, its scale first (f32 bits), then from `params.codes_at` per layer its
+// texels, each packed RGBA8 (the sRGB codes of colour / scale, the alpha code).
 @group(0) @binding(6) var<storage, read_write> prelit: array<u32>;
 @group(0) @binding(7) var<storage, read> jobs: array<Job>;
 // The pose's view table (its cameras).
@@ -420,7 +420,7 @@ fn encode(@builtin(global_invocation_id) id: vec3<u32>) {
         scale = 1.0;
     }
     if (i == 0u) {
-        prelit[job.view] = bitcast<u32>(scale);
+        prelit[job.view * 8u] = bitcast<u32>(scale);
     }
     let r = relit[job.relit_offset + i];
     let code = u32(round(srgb_encode(r.x / scale) * 255.0))

@@ -83,31 +83,65 @@ fn tiny_field_source(env: &EnvMap) -> PoseSource {
     frf_testkit::tiny_field().source(env)
 }
 
-/// Relit copies of one pose's views (walkers under lights of their own) share the frame
-/// pass's tables, and with them one bind group and one dispatch (their pre-lit views
-/// ranges of one page), while each keeps its own light; the pose loaded apart (views and
-/// flows of its own) is drawn apart.
+/// Copies of one pose (walkers under lights of their own, read by plans of their own)
+/// share the frame pass's tables, and with them one bind group and one dispatch, while
+/// each keeps its own light, views and flows: the copy that read every other view is
+/// relit and drawn as its CPU twin. The pose at a coarser level of detail (other cameras)
+/// is drawn apart.
 #[test]
-fn relit_copies_of_one_pose_are_drawn_together_each_under_its_own_light() {
+fn copies_of_one_pose_read_by_other_plans_are_drawn_together_each_its_own() {
     use frf_reflectance::project::FloorModel;
     use frf_render::resident::Lighting;
     let Some(gpu) = gpu() else { return };
     let fixture = frf_testkit::tiny_field();
     let field = FieldFile::open(&fixture.field).unwrap();
     let sky = EnvMap::sky();
-    let first = fixture.source(&sky);
-    let lighting = Lighting::Environment {
-        env: sky.rotated(2.0),
+    let lit = |yaw: f32| Lighting::Environment {
+        env: sky.rotated(yaw),
         floor: FloorModel::Environment,
     };
-    let turned = first.relit(&field, &lighting, None).unwrap();
-    let a = gpu.upload_pose(&first).unwrap();
-    let b = gpu.upload_pose_sharing(&turned, a.basis()).unwrap();
+    let full = PoseSource::load_at(&field, 0, &lit(0.0), None, 0, None).unwrap();
+    let views = full.geometry.views();
+    let plan = frf_render::pose_plan::PosePlan {
+        pose: 0,
+        views: (0..views).map(|i| i % 2 == 0).collect(),
+        flows: vec![[true; 4]; views],
+        conditions: vec![true; field.header().conditions.len()],
+        shadow_maps: false,
+        hull: true,
+        pose_flows: [false; 2],
+        level: 0,
+        shadow_level: 0,
+        bounds: frf_render::footprint::SubjectBounds::DESIGN,
+    };
+    let half = PoseSource::load_at(&field, 0, &lit(2.0), Some(&plan), 0, None).unwrap();
+    assert!(half.geometry.prelit_layer_count < full.geometry.prelit_layer_count);
+    let a = gpu.upload_pose(&full).unwrap();
+    let b = gpu.upload_pose(&half).unwrap();
     assert!(a.draws_with(&b));
-    assert_relit_as_the_cpu(&gpu, &a, &ResidentPose::relight_cpu(&first), "first");
-    assert_relit_as_the_cpu(&gpu, &b, &ResidentPose::relight_cpu(&turned), "turned");
-    let apart = gpu.upload_pose(&fixture.source(&sky)).unwrap();
-    assert!(!a.draws_with(&apart));
+    let cpu = ResidentPose::relight_cpu(&half);
+    assert_relit_as_the_cpu(&gpu, &a, &ResidentPose::relight_cpu(&full), "every view");
+    assert_relit_as_the_cpu(&gpu, &b, &cpu, "every other view");
+    let cam = Camera::look_at(
+        Vec3::new(2.2, 1.4, 3.0),
+        Vec3::new(0.0, 0.9, 0.0),
+        Vec3::Y,
+        0.55,
+        64,
+        90,
+    )
+    .unwrap();
+    let (g, _) = gpu.render(&b, &cam, Variant::FourWay).unwrap();
+    let (c, _) = render_cpu(&cpu, &cam, Variant::FourWay);
+    let worst = (g.pixels().iter().zip(c.pixels()))
+        .flat_map(|(x, y)| (0..4).map(move |k| (x[k] - y[k]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(
+        worst <= 2e-3,
+        "every other view: largest difference {worst}"
+    );
+    let coarse = PoseSource::load_at(&field, 0, &lit(0.0), None, 1, None).unwrap();
+    assert!(!a.draws_with(&gpu.upload_pose(&coarse).unwrap()));
 }
 
 #[test]

@@ -1,10 +1,8 @@
-// Pre-lit views as integer codes in the shared pages (`render/src/gpu/prelit.rs`): from
-// word `frame.prelit.x` per view its scale (f32 bits), from `frame.prelit.y` per layer its
-// texels, each RGB the sRGB codes of colour / the view's scale and A the alpha code
-// (packed RGBA8); decoded texel by texel through the table, then filtered in the shader.
-// The exact twin of `ResidentPose::sample_prelit`.
-
-@group(1) @binding(0) var<storage, read> prelit: array<u32>;
+// Pre-lit views as integer codes in the shared pages bound as `prelit`
+// (`render/src/gpu/prelit.rs`): from word `frame.prelit.y` per layer its texels, each RGB
+// the sRGB codes of colour / the view's scale and A the alpha code (packed RGBA8);
+// decoded texel by texel through the table, then filtered in the shader. The exact twin
+// of `ResidentPose::sample_prelit`.
 
 fn srgb_value(code: u32) -> f32 {
     return tables.srgb[code / 4u][code % 4u];
@@ -12,12 +10,12 @@ fn srgb_value(code: u32) -> f32 {
 
 // Bilinear sample of a pre-lit view at full-image coordinates s (edge repeated).
 fn sample_prelit(view: u32, s: vec2<f32>) -> vec4<f32> {
-    let layer = views[view].prelit_layer;
+    let layer = prelit_layer(view);
     if (layer < 0) {
         return vec4<f32>(0.0);
     }
     let c = crop_position(s);
-    let scale = bitcast<f32>(prelit[frame.prelit.x + view]);
+    let scale = view_scale(view);
     let first = frame.prelit.y + u32(layer) * frame.crop_size.x * frame.crop_size.y;
     var out = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {

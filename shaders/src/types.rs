@@ -12,20 +12,10 @@ pub struct GpuView {
     pub rotation: [f32; 4],
     /// Camera centre.
     pub centre: [f32; 3],
-    /// Pre-lit colour scale.
-    pub scale: f32,
+    /// Padding to 16 bytes.
+    pub pad: f32,
     /// fx, fy, cx, cy.
     pub intrinsics: [f32; 4],
-    /// Flow layers toward right, left, up, down; -1 none.
-    pub flow_layers: [i32; 4],
-    /// Pre-lit layer; -1 for a view not held (transparent).
-    pub prelit_layer: i32,
-    /// Padding to 16 bytes.
-    pub pad0: i32,
-    /// Padding.
-    pub pad1: i32,
-    /// Padding.
-    pub pad2: i32,
 }
 
 /// `Quad` of `common.wgsl`.
@@ -121,9 +111,10 @@ pub struct GpuFrame {
     /// Where the frame pass writes: pixel `p` of the frame at texel `p + place.xy` of
     /// layer `place.z` of its target (`frf_render::atlas`; w unused).
     pub place: [i32; 4],
-    /// Where the pose's pre-lit views lie in the shared pages bound beside it, in words
-    /// from the page's start: `[scales, codes, 0, 0]`, its views' scales (f32 bits) and
-    /// its first layer's codes (`frf_render::gpu::prelit`); zero where they are a texture.
+    /// Where the pose's copy lies in the shared pages bound beside it, in words from
+    /// the page's start: `[heads, codes, flows, 0]`, its views' heads (scale, pre-lit
+    /// layer, flow layers), its first pre-lit layer's codes and its flows' codes
+    /// (`frf_render::gpu::prelit`).
     pub prelit: [u32; 4],
 }
 

@@ -168,22 +168,7 @@ fn pod_structs_match_naga_layouts() {
         &shaders::frame_pass(shaders::PRELIT_CODES, shaders::FLOW_CODES, (4, 1)),
         "rebin",
     );
-    check_layout!(
-        &rebin,
-        "View",
-        GpuView,
-        [
-            rotation,
-            centre,
-            scale,
-            intrinsics,
-            flow_layers,
-            prelit_layer,
-            pad0,
-            pad1,
-            pad2
-        ]
-    );
+    check_layout!(&rebin, "View", GpuView, [rotation, centre, pad, intrinsics]);
     check_layout!(
         &rebin,
         "Quad",

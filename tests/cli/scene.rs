@@ -821,15 +821,15 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
             assert!(ms("gpu_timestamps_ms_per_frame") > 0.0, "{r}");
             // Dispatches a frame that do not grow with walkers: every walker's light looked
             // up on the device in one, every shadow in one, the composite one; the frame
-            // pass one for the relit copies of one pose's views whose pre-lit views share
-            // a page (walkers whose plans read other views hold tables of their own).
+            // pass one for the copies of a pose at a level of detail in a page (here every
+            // walker draws the one pose, at one or two levels: it was one a walker).
             let dispatches = |name: &str| pass(name).map(|p| p["dispatches"].as_u64().unwrap());
             if r["light"] == "turning" {
                 assert_eq!(dispatches("turn light"), Some(1), "{r}");
             }
             assert_eq!(dispatches("composite"), Some(1), "{r}");
             let frame = dispatches("frame").unwrap();
-            assert!(frame >= 1 && frame <= walkers as u64, "{r}");
+            assert!((1..=2).contains(&frame), "{r}");
         } else {
             assert!(passes.is_empty(), "{r}");
             assert!(r["gpu_timestamps_ms_per_frame"].is_null(), "{r}");

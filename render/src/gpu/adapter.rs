@@ -6,10 +6,10 @@
 //! the adapter whose name or backend contains it.
 //!
 //! What the passes need: `rgba32float` targets drawn into (the composite and the bench's
-//! fragment passes) and written as storage (the frame, relighting and shadow passes), the
-//! pose's integer textures (`rgba8uint`, `rg8sint`) read with `textureLoad`, and eight
-//! storage buffers in one compute stage (the frame pass's counters and seven of the
-//! pose's tables). The GL backend of Mesa, for one, cannot draw into `rgba32float`:
+//! fragment passes) and written as storage (the frame, relighting and shadow passes), nine
+//! storage buffers in one compute stage (the frame pass's counters, the shared pages of
+//! pre-lit views and of flows, and six of the pose's tables) and a uniform binding of
+//! 256 renders' frame records (64 KiB). The GL backend of Mesa, for one, cannot draw into `rgba32float`:
 //! on a machine that has both, the default adapter used to be GL and every render failed
 //! ("Format Rgba32Float is not renderable"); a machine with GL alone is told so, and to
 //! render with `--cpu`.
@@ -31,7 +31,7 @@ use crate::error::{RenderError, Result};
 pub const ADAPTER_ENV: &str = "FRF_ADAPTER";
 
 /// Storage buffers the frame pass binds in its compute stage.
-const STORAGE_BUFFERS: u32 = 8;
+const STORAGE_BUFFERS: u32 = 9;
 /// Bytes of the frame records one dispatch of the frame pass binds.
 const FRAME_RECORDS_BYTES: u64 = size_of::<super::rebin::FrameRecords>() as u64;
 
@@ -93,16 +93,6 @@ pub fn lacks(adapter: &wgpu::Adapter) -> Vec<String> {
             wgpu::TextureFormat::Rgba32Float,
             U::STORAGE_BINDING,
             "rgba32float storage textures",
-        ),
-        (
-            wgpu::TextureFormat::Rgba8Uint,
-            U::TEXTURE_BINDING,
-            "rgba8uint textures",
-        ),
-        (
-            wgpu::TextureFormat::Rg8Sint,
-            U::TEXTURE_BINDING,
-            "rg8sint textures",
         ),
     ];
     for (format, usage, what) in needs {

@@ -182,7 +182,11 @@ impl FloorPass {
         let module = super::shaders::module(device, "floor", super::shaders::FLOOR);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("floor"),
-            entries: &[PoseFormats::DEFAULT.image.layout_entry(0)],
+            entries: &[super::bind::storage::<u32>(
+                0,
+                true,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            )],
         });
         let fragment = full_screen_pipeline(
             device,

@@ -8,11 +8,15 @@
 //! |---|---|---|---|---|
 //! | image `codes` | packed RGBA8 in the shared pages ([`super::prelit`]) | the shader, texel by texel through the sRGB table | 4 | exact |
 //! | image `srgb8` | `Rgba8UnormSrgb` (the same bytes) | the sampler (sRGB decoded before filtering) | 4 | the hardware's filter precision |
-//! | flow `codes8` | `Rg8Sint`, the stored log codes | the shader, texel by texel through the code table | 2 | exact |
+//! | flow `codes8` | the stored log codes, two bytes a texel in the shared pages | the shader, texel by texel through the code table | 2 | exact |
 //! | flow `f16` | `Rg16Float`, decoded at upload | the sampler | 4 | half precision |
 //! | flow `f32` | `Rg32Float`, decoded at upload | the shader (unfilterable) | 8 | exact |
 
 use super::shaders;
+
+/// Where the frame pass's pose group binds sRGB8 pre-lit texels
+/// (`shaders/sample/prelit_srgb.wgsl`).
+pub const PRELIT_TEXELS_BINDING: u32 = 10;
 
 /// How the pre-lit views are stored and filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -46,8 +50,8 @@ impl ImageFormat {
         }
     }
 
-    /// The texture format of the pre-lit views (the codes' bytes are those of a
-    /// `Rgba8Uint` texel, though they lie in a buffer).
+    /// The texture format of sRGB8 pre-lit views (the codes' bytes are those of a
+    /// `Rgba8Uint` texel, though they lie in the shared pages).
     pub fn texture(self) -> wgpu::TextureFormat {
         match self {
             ImageFormat::Codes => wgpu::TextureFormat::Rgba8Uint,
@@ -55,20 +59,10 @@ impl ImageFormat {
         }
     }
 
-    /// How the frame pass binds it, at `binding`: the shared pages of codes
-    /// ([`super::prelit`]) as a storage buffer, sRGB8 texels as a texture array.
-    pub fn layout_entry(self, binding: u32) -> wgpu::BindGroupLayoutEntry {
-        match self {
-            ImageFormat::Codes => super::bind::storage::<u32>(
-                binding,
-                true,
-                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
-            ),
-            ImageFormat::Srgb8 => super::bind::texture_array(
-                binding,
-                wgpu::TextureSampleType::Float { filterable: true },
-            ),
-        }
+    /// Whether the texels lie in a texture of the pose's own (bound at
+    /// [`PRELIT_TEXELS_BINDING`]) rather than in the shared pages.
+    pub fn in_texture(self) -> bool {
+        self == ImageFormat::Srgb8
     }
 
     fn snippet(self) -> &'static str {
@@ -101,13 +95,25 @@ impl FlowFormat {
         }
     }
 
-    /// How the frame pass reads it.
-    pub fn sample_type(self) -> wgpu::TextureSampleType {
+    /// How the frame pass binds it, at `binding`: the codes in the shared pages
+    /// ([`super::prelit`]) as a storage buffer, decoded flows as a texture array.
+    pub fn layout_entry(self, binding: u32) -> wgpu::BindGroupLayoutEntry {
+        let float = |filterable| wgpu::TextureSampleType::Float { filterable };
         match self {
-            FlowFormat::Codes8 => wgpu::TextureSampleType::Sint,
-            FlowFormat::F16 => wgpu::TextureSampleType::Float { filterable: true },
-            FlowFormat::F32 => wgpu::TextureSampleType::Float { filterable: false },
+            FlowFormat::Codes8 => super::bind::storage::<u32>(
+                binding,
+                true,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            ),
+            FlowFormat::F16 => super::bind::texture_array(binding, float(true)),
+            FlowFormat::F32 => super::bind::texture_array(binding, float(false)),
         }
+    }
+
+    /// Whether the flows lie in a texture of the pose's own rather than in the shared
+    /// pages.
+    pub fn in_texture(self) -> bool {
+        self != FlowFormat::Codes8
     }
 
     /// Bytes a flow texel takes.

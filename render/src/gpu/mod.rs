@@ -112,6 +112,9 @@ pub struct Gpu {
     /// The tables of the poses resident, shared by the relit copies of one pose's views
     /// ([`pose_tables`]).
     pose_tables: pose_tables::TablesKept,
+    /// The flows' codes of the poses resident, a range each, shared by the copies made
+    /// from the same flows ([`prelit`]).
+    flow_ranges: prelit::FlowsKept,
     /// The relighting pass's scratch buffer, kept ([`relight`]).
     relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
@@ -214,6 +217,7 @@ impl Gpu {
                 prelit::PRELIT_PAGE_BYTES,
             ),
             pose_tables: pose_tables::TablesKept::default(),
+            flow_ranges: prelit::FlowsKept::default(),
             relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited: spent::Spent::default(),

@@ -12,15 +12,14 @@ use wgpu::util::DeviceExt;
 
 use super::Gpu;
 use super::bind::copy_to_buffer;
-use super::formats::{ImageFormat, PoseFormats};
-use super::pose_tables::{PoseTables, PrelitAt};
-use super::prelit::PrelitRange;
+use super::formats::PoseFormats;
+use super::pose_tables::{FlowsAt, PoseTables};
+use super::prelit::{FlowRange, PrelitRange};
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
 use crate::resident::{PoseSource, ResidentPose, decode_flow};
 use crate::shadow::ShadowMaps;
-use frf_shaders::types::GpuView;
 
 /// How the frame pass binds a resident pose (made by [`super::rebin::RebinPass`]): the
 /// storage it reads ([`super::formats`]), the layout of bind group 1 and the sampler in it.
@@ -35,9 +34,16 @@ pub struct PoseBinding {
 pub struct GpuPose {
     pub(super) bind_group: wgpu::BindGroup,
     /// What names its bind group: renders of poses of one key are drawn in one dispatch.
-    pub(super) group_key: (u64, usize),
-    pub(super) prelit: Prelit,
-    /// Its flows and tables, shared with the other copies of its views
+    pub(super) group_key: (u64, usize, usize),
+    /// Its views' heads and pre-lit codes, a range of the shared pages
+    /// ([`super::prelit`]).
+    pub(super) prelit: PrelitRange,
+    /// Its pre-lit texels when a texture holds them (the benchmark's sRGB8 storage,
+    /// [`super::formats`]); `None`: they are in `prelit`.
+    texels: Option<wgpu::Texture>,
+    /// Its flows: a range of the shared pages, or (decoded, the benchmark's) a texture.
+    flows: Flows,
+    /// Its cameras and geometry, shared with the other copies of the pose
     /// ([`super::pose_tables`]).
     pub(super) tables: Arc<PoseTables>,
     /// Its basis codes and relighting buffers; `None` for a pose uploaded already lit.
@@ -49,12 +55,11 @@ pub struct GpuPose {
     pub(super) shadow: Option<PoseShadow>,
 }
 
-/// Where a resident pose's pre-lit views are.
-pub(super) enum Prelit {
-    /// A range of the shared pages ([`super::prelit`]): the renderer's, relit on the GPU.
-    Shared(PrelitRange),
-    /// A texture array of its own, its scales in its view table (the benchmark's sRGB8
-    /// storage, [`super::formats`]).
+/// Where a resident pose's flows are.
+enum Flows {
+    /// A range of the shared pages, shared by the copies made from the same flows.
+    Shared(Arc<FlowRange>),
+    /// A texture array of its own.
     Texture(wgpu::Texture),
 }
 
@@ -98,18 +103,21 @@ pub struct RelitShadowInfo {
 }
 
 impl GpuPose {
-    /// Its pre-lit views' range of the shared pages (none for a texture-stored pose).
+    /// Its pre-lit views' range of the shared pages, where the relighting pass writes
+    /// them (none where a texture holds its texels).
     pub(super) fn prelit_range(&self) -> Option<&PrelitRange> {
-        match &self.prelit {
-            Prelit::Shared(range) => Some(range),
-            Prelit::Texture(_) => None,
-        }
+        self.texels.is_none().then_some(&self.prelit)
     }
 
-    /// Where its pre-lit views lie in the shared pages (`prelit` of the frame pass's
-    /// record; zero for a texture).
+    /// Where its heads, pre-lit codes and flows lie in the shared pages (`prelit` of the
+    /// frame pass's record).
     pub(super) fn prelit_words(&self) -> [u32; 4] {
-        self.prelit_range().map_or([0; 4], PrelitRange::words)
+        let [heads, codes] = self.prelit.words();
+        let flows = match &self.flows {
+            Flows::Shared(r) => r.word(),
+            Flows::Texture(_) => 0,
+        };
+        [heads, codes, flows, 0]
     }
 
     /// Whether the frame pass draws its renders and `other`'s in one dispatch: relit
@@ -179,56 +187,42 @@ impl Gpu {
     fn upload_pose_unscoped(&self, source: &PoseSource, basis: Arc<GpuBasis>) -> Result<GpuPose> {
         let geometry = &source.geometry;
         let pass = &self.rebin.pose;
-        let tables = self.pose_tables(
-            std::ptr::eq(pass, &self.rebin.pose),
-            (geometry, &source.flows),
-            None,
-            || {
-                // One layer per stored flow, in the order of the geometry's flow layers.
-                let codes = source.flows.codes.iter().flat_map(|f| f.iter().flatten());
-                let mut bytes: Vec<u8> = codes
-                    .flat_map(|c| c.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
-                    .collect();
-                if bytes.is_empty() {
-                    // Unknown: no displacement.
-                    bytes = vec![128u8; geometry.crop.texels() * 2];
-                }
-                self.flows_texture(geometry, wgpu::TextureFormat::Rg8Sint, bytes)
-            },
-        );
+        let tables = self.pose_tables(true, geometry, &source.flows);
         // Scales are set by the relighting pass; a view not relit keeps 1.
-        let range = self.take_prelit(
-            geometry.views(),
-            geometry.prelit_layer_count,
-            geometry.crop.texels(),
-        );
-        let mut pose = self.resident_pose(pass, tables, Prelit::Shared(range), geometry);
+        let range = self.take_prelit(geometry, false);
+        let flows = Flows::Shared(self.flow_range(geometry, &source.flows));
+        let mut pose = self.resident_pose(pass, tables, (range, flows, None), geometry);
         let hull = pose.geometry.proxy.hull_shared().cloned();
         let mut relight = self.pose_relight(basis, geometry.views(), hull);
-        if let Some(target) = pose.prelit_range() {
-            self.record_relight(&mut relight, source, (target, &pose.tables.views));
-        }
+        self.record_relight(&mut relight, source, (&pose.prelit, &pose.tables.views));
         pose.relight = Some(relight);
         Ok(pose)
     }
 
-    /// A pose of `geometry` drawn from `tables` and `prelit` by `pass`.
+    /// A pose of `geometry` drawn from `tables`, its `prelit` range, its `flows` and its
+    /// pre-lit `texels` where a texture holds them, by `pass`.
     fn resident_pose(
         &self,
         pass: &PoseBinding,
         tables: Arc<PoseTables>,
-        prelit: Prelit,
+        (prelit, flows, texels): (PrelitRange, Flows, Option<wgpu::Texture>),
         geometry: &Arc<PoseGeometry>,
     ) -> GpuPose {
-        let at = match &prelit {
-            Prelit::Shared(range) => PrelitAt::Shared(range),
-            Prelit::Texture(texture) => PrelitAt::Texture(texture),
+        let flows_at = match &flows {
+            Flows::Shared(r) => FlowsAt::Shared(r),
+            Flows::Texture(t) => FlowsAt::Texture(t),
         };
-        let (bind_group, group_key) = self.pose_group((&pass.layout, &pass.sampler), &tables, at);
+        let (bind_group, group_key) = self.pose_group(
+            (&pass.layout, &pass.sampler),
+            &tables,
+            (&prelit, flows_at, texels.as_ref()),
+        );
         GpuPose {
             bind_group,
             group_key,
             prelit,
+            texels,
+            flows,
             tables,
             relight: None,
             geometry: geometry.clone(),
@@ -296,11 +290,11 @@ impl Gpu {
     /// from): new coefficients and one dispatch pair per batch of views
     /// ([`super::relight`]), recorded with the pending work, not submitted.
     pub fn relight_pose(&self, pose: &mut GpuPose, source: &PoseSource) -> Result<()> {
-        let Prelit::Shared(target) = &pose.prelit else {
+        if pose.texels.is_some() {
             return Err(crate::RenderError::Misuse(
                 "relighting a pose whose pre-lit views are a texture".into(),
             ));
-        };
+        }
         let mut relight = match pose.relight.take() {
             Some(r) => r,
             None => {
@@ -316,7 +310,8 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            self.record_relight(&mut relight, source, (target, &pose.tables.views));
+            let target = (&pose.prelit, &pose.tables.views);
+            self.record_relight(&mut relight, source, target);
             Ok(())
         });
         pose.relight = Some(relight);
@@ -325,16 +320,8 @@ impl Gpu {
 
     /// The views' pre-lit colour scales as the GPU holds them (for tests and inspection).
     pub fn read_scales(&self, pose: &GpuPose) -> Result<Vec<f32>> {
-        self.scoped("reading a pose's scales back", || match &pose.prelit {
-            Prelit::Shared(range) => Ok(self.read_prelit_range(range)?.0),
-            Prelit::Texture(_) => {
-                let bytes = self.read_back(&pose.tables.views, "views readback")?;
-                let views: &[GpuView] = bytemuck::cast_slice(&bytes);
-                Ok(views[..pose.geometry.views()]
-                    .iter()
-                    .map(|v| v.scale)
-                    .collect())
-            }
+        self.scoped("reading a pose's scales back", || {
+            Ok(self.read_prelit_range(&pose.prelit)?.0)
         })
     }
 
@@ -348,7 +335,7 @@ impl Gpu {
             let texels = geometry.crop.texels();
             // The held views' texels, layer by layer (a held view without texels: zero).
             let mut prelit_bytes: Vec<u8> =
-                Vec::with_capacity(geometry.prelit_layer_count.max(1) * texels * 4);
+                Vec::with_capacity(geometry.prelit_layer_count * texels * 4);
             for (i, view) in resident.prelit.iter().enumerate() {
                 if !geometry.holds(i) {
                     continue;
@@ -359,48 +346,32 @@ impl Gpu {
                     prelit_bytes.extend(view.iter().flatten());
                 }
             }
-            let flows = || {
+            let flows = if pass.formats.flow.in_texture() {
                 let stored = resident.flows.codes.iter().flat_map(|f| f.iter().flatten());
                 let q = &resident.flows.quantizer;
                 let decoded: Vec<[f32; 2]> = stored
-                    .clone()
                     .flat_map(|codes| codes.iter().map(|&c| decode_flow(c, q).to_array()))
                     .collect();
-                let mut bytes = match pass.formats.flow.encode(&decoded) {
-                    Some(b) => b,
-                    None => stored
-                        .flat_map(|codes| codes.iter().flat_map(|c| [c[0] as u8, c[1] as u8]))
-                        .collect(),
-                };
-                if bytes.is_empty() {
-                    bytes = match pass.formats.flow.encode(&vec![[0.0; 2]; texels]) {
-                        Some(b) => b,
-                        None => vec![128u8; texels * 2],
-                    };
-                }
-                self.flows_texture(geometry, pass.formats.flow.texture(), bytes)
+                let bytes = pass.formats.flow.encode(&decoded).unwrap_or_default();
+                let format = pass.formats.flow.texture();
+                Flows::Texture(self.flows_texture(geometry, format, bytes))
+            } else {
+                Flows::Shared(self.flow_range(geometry, &resident.flows))
             };
-            let source = (geometry, &resident.flows);
-            let layers = geometry.prelit_layer_count;
-            let (tables, prelit) = match pass.formats.image {
-                ImageFormat::Codes => (
-                    self.pose_tables(std::ptr::eq(pass, &self.rebin.pose), source, None, flows),
-                    Prelit::Shared(self.prelit_with(&resident.scales, layers, &prelit_bytes)),
-                ),
-                ImageFormat::Srgb8 => {
-                    let format = pass.formats.image.texture();
-                    let texture =
-                        self.crop_texture(geometry, ("prelit", format), layers, &prelit_bytes);
-                    let tables = self.pose_tables(
-                        std::ptr::eq(pass, &self.rebin.pose),
-                        source,
-                        Some(&resident.scales),
-                        flows,
-                    );
-                    (tables, Prelit::Texture(texture))
-                }
+            let renderers = std::ptr::eq(pass, &self.rebin.pose);
+            let tables = self.pose_tables(renderers, geometry, &resident.flows);
+            let parts = if pass.formats.image.in_texture() {
+                let format = pass.formats.image.texture();
+                let layers = geometry.prelit_layer_count;
+                let texture =
+                    self.crop_texture(geometry, ("prelit", format), layers, &prelit_bytes);
+                let heads = self.prelit_with(geometry, &resident.scales, &[]);
+                (heads, flows, Some(texture))
+            } else {
+                let range = self.prelit_with(geometry, &resident.scales, &prelit_bytes);
+                (range, flows, None)
             };
-            Ok(self.resident_pose(pass, tables, prelit, geometry))
+            Ok(self.resident_pose(pass, tables, parts, geometry))
         })
     }
 
@@ -414,9 +385,9 @@ impl Gpu {
     /// held reads as no texels).
     pub fn read_prelit(&self, pose: &GpuPose) -> Result<Vec<Vec<[u8; 4]>>> {
         self.scoped("reading pre-lit views back", || {
-            let layers = match &pose.prelit {
-                Prelit::Shared(range) => self.read_prelit_range(range)?.1,
-                Prelit::Texture(texture) => self.read_texture_layers(texture)?,
+            let layers = match &pose.texels {
+                None => self.read_prelit_range(&pose.prelit)?.1,
+                Some(texture) => self.read_texture_layers(texture)?,
             };
             Ok(pose
                 .geometry

@@ -1,12 +1,12 @@
-//! What the frame pass reads of a resident pose besides its pre-lit views: its flows (a
-//! texture array), its view and quad tables, the code tables, its proxy and hull, the
-//! cylinder's column index and the quads' frames. They depend only on the pose's views
-//! and flows, so every relit copy of one pose's views (walkers under their own light or
-//! heading, the pose's motion views) shares one set, and with it one bind group a page of
-//! pre-lit views ([`super::prelit`]): the frame pass draws every render of those copies
-//! in a page in one dispatch (docs/design.md section 4.9). A pose whose pre-lit views are
-//! a texture (the benchmark's sRGB8 storage) holds its scales in its view table and so
-//! shares none.
+//! What the frame pass reads of a resident pose besides its copy's own part ([`super::prelit`]):
+//! its cameras (the view table), the quad table, the code tables, its proxy and hull,
+//! the cylinder's column index and the quads' frames. They depend only on the pose (its
+//! cameras, its hull, its flows' quantizer), not on the views a plan read nor on the
+//! light, so every copy of a pose at a level of detail (walkers under their own light or
+//! heading, read by plans of their own, the pose's motion views) shares one set, and with
+//! it one bind group a pair of pages (pre-lit, flows): the frame pass draws every render of
+//! those copies in one dispatch (docs/design.md section 4.9). The set is found again by
+//! what it holds (the bytes it uploaded and the hull it binds).
 
 use std::sync::{Arc, Mutex, Weak};
 
@@ -14,22 +14,21 @@ use glam::Quat;
 
 use super::Gpu;
 use super::bind::{buffer_with, table_bytes};
+use super::formats::PRELIT_TEXELS_BINDING;
 use super::kept::unique_id;
-use super::prelit::PrelitRange;
+use super::prelit::{FlowRange, PrelitRange};
 use crate::geometry::PoseGeometry;
-use crate::rectified::gpu_frame;
 use crate::resident::{PoseFlows, srgb_lut};
 use frf_shaders::types::{GpuQuad, GpuQuadFrame, GpuView};
 
 /// A resident pose's tables (see the module docs).
 pub(super) struct PoseTables {
-    /// What they were made from (what names them while they live).
-    geometry: Arc<PoseGeometry>,
-    flows: Arc<PoseFlows>,
+    /// What names them: every byte they uploaded but the hull's, and the hull (by address,
+    /// held).
+    key: (Vec<u8>, Option<Arc<frf_reflectance::hull::VoxelHull>>),
     /// Names them in the keys of bind groups.
     id: u64,
-    flows_view: wgpu::TextureView,
-    /// The view table (the cameras, and for a texture-stored pose its scales).
+    /// The view table (the cameras).
     pub(super) views: wgpu::Buffer,
     quads: wgpu::Buffer,
     tables: wgpu::Buffer,
@@ -38,203 +37,201 @@ pub(super) struct PoseTables {
     index: wgpu::Buffer,
     frames: wgpu::Buffer,
     pub(super) quad_count: u32,
-    /// Their bind group with each page of pre-lit views a copy lies in, made on first use.
-    groups: Mutex<Vec<(usize, wgpu::BindGroup)>>,
+    /// Their bind group with each pair of pages (pre-lit, flows) a copy lies in, made on
+    /// first use.
+    groups: Mutex<Vec<((usize, usize), wgpu::BindGroup)>>,
 }
 
-/// The tables of the poses resident, found again by the views and flows they were made
-/// from while a pose holds them.
+/// The tables of the poses resident, found again while a pose holds them.
 #[derive(Default)]
 pub(super) struct TablesKept(Mutex<Vec<Weak<PoseTables>>>);
 
-/// Where a pose's pre-lit views are, as its bind group binds them.
-pub(super) enum PrelitAt<'a> {
+/// Where a copy's flows are, as its bind group binds them.
+pub(super) enum FlowsAt<'a> {
     /// A range of the shared pages.
-    Shared(&'a PrelitRange),
-    /// A texture array of its own.
+    Shared(&'a FlowRange),
+    /// A texture array of its own (decoded flows, the benchmark's).
     Texture(&'a wgpu::Texture),
 }
 
+/// The bytes of the tables of `geometry` with `flows`' code table, in the order
+/// [`PoseTables`] holds them: views, quads, code tables, proxy, column index, frames.
+struct TableBytes {
+    parts: [Vec<u8>; 6],
+    hull_words: Vec<u32>,
+}
+
+fn table_parts(geometry: &PoseGeometry, flows: &PoseFlows) -> TableBytes {
+    let views: Vec<GpuView> = geometry
+        .cameras
+        .iter()
+        .map(|cam| {
+            let q = Quat::from_mat3(&cam.world_from_camera.rotation);
+            let k = &cam.intrinsics;
+            GpuView {
+                rotation: q.to_array(),
+                centre: cam.centre().to_array(),
+                pad: 0.0,
+                intrinsics: [k.fx, k.fy, k.cx, k.cy],
+            }
+        })
+        .collect();
+    let quads: Vec<GpuQuad> = geometry
+        .cylinder
+        .quads()
+        .iter()
+        .map(|q| GpuQuad {
+            p00: q.p00.to_array(),
+            u: q.u,
+            e1: q.e1.to_array(),
+            v: q.v,
+            e2: q.e2.to_array(),
+            wall: q.wall,
+            e3: q.e3.to_array(),
+            wall_gamma: q.wall_gamma,
+            normal: q.normal.to_array(),
+            pad: 0.0,
+        })
+        .collect();
+    let (index, ranges) = geometry.cylinder.column_index_gpu();
+    let mut index_bytes = bytemuck::bytes_of(&index).to_vec();
+    index_bytes.extend_from_slice(bytemuck::cast_slice(&ranges));
+    let (proxy, hull_words) = geometry.proxy.gpu();
+    let frames: Vec<GpuQuadFrame> = geometry
+        .frames
+        .iter()
+        .map(|f| crate::rectified::gpu_frame(f.as_ref()))
+        .collect();
+    TableBytes {
+        parts: [
+            bytemuck::cast_slice(&views).to_vec(),
+            bytemuck::cast_slice(&quads).to_vec(),
+            table_bytes(&[srgb_lut(), flows.table]),
+            bytemuck::bytes_of(&proxy).to_vec(),
+            index_bytes,
+            bytemuck::cast_slice(&frames).to_vec(),
+        ],
+        hull_words,
+    }
+}
+
 impl Gpu {
-    /// The tables of `geometry` and `flows`: those a resident copy of the same views holds
-    /// when the pre-lit views are shared (`scales` `None`) and the pass that draws them
-    /// is the renderer's (`renderers`), else new ones
-    /// (`scales`: a texture-stored pose's, written into its view table), whose flows
-    /// texture `flows_texture` makes.
+    /// The tables of `geometry` (with `flows`' code table): those a resident copy of the
+    /// same pose holds when `shared` (the renderer's own pass: a kept bind group is made
+    /// for one layout), else new ones.
     pub(super) fn pose_tables(
         &self,
-        renderers: bool,
-        (geometry, flows): (&Arc<PoseGeometry>, &Arc<PoseFlows>),
-        scales: Option<&[f32]>,
-        flows_texture: impl FnOnce() -> wgpu::Texture,
+        shared: bool,
+        geometry: &PoseGeometry,
+        flows: &PoseFlows,
     ) -> Arc<PoseTables> {
+        let made = table_parts(geometry, flows);
+        let key = (made.parts.concat(), geometry.proxy.hull_shared().cloned());
+        let same = |t: &PoseTables| {
+            t.key.0 == key.0
+                && match (&t.key.1, &key.1) {
+                    (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                    (None, None) => true,
+                    _ => false,
+                }
+        };
         let mut kept = self.pose_tables.0.lock().unwrap_or_else(|e| e.into_inner());
         kept.retain(|t| t.strong_count() > 0);
-        // Only the renderer's own pass shares (a kept bind group is made for one layout).
-        let shared = scales.is_none() && renderers;
-        if shared {
-            let found = kept
-                .iter()
-                .filter_map(Weak::upgrade)
-                .find(|t| Arc::ptr_eq(&t.geometry, geometry) && Arc::ptr_eq(&t.flows, flows));
-            if let Some(t) = found {
-                return t;
-            }
+        if shared && let Some(t) = kept.iter().filter_map(Weak::upgrade).find(|t| same(t)) {
+            return t;
         }
-        let ones = vec![1.0; geometry.views()];
-        let tables = Arc::new(self.make_tables(
-            (geometry, flows),
-            scales.unwrap_or(&ones),
-            &flows_texture(),
-        ));
+        let [views, quads, tables, proxy, index, frames] = &made.parts;
+        let storage = |label: &str, contents: &[u8]| {
+            buffer_with(&self.device, label, contents, wgpu::BufferUsages::STORAGE)
+        };
+        let tables = Arc::new(PoseTables {
+            id: unique_id(),
+            views: storage("views", views),
+            quads: storage("quads", quads),
+            tables: buffer_with(&self.device, "tables", tables, wgpu::BufferUsages::UNIFORM),
+            proxy: storage("proxy", proxy),
+            hull: storage("hull", bytemuck::cast_slice(&made.hull_words)),
+            index: storage("column index", index),
+            frames: storage("quad frames", frames),
+            quad_count: geometry.cylinder.quads().len() as u32,
+            groups: Mutex::new(Vec::new()),
+            key,
+        });
         if shared {
             kept.push(Arc::downgrade(&tables));
         }
         tables
     }
 
-    fn make_tables(
-        &self,
-        (geometry, flows): (&Arc<PoseGeometry>, &Arc<PoseFlows>),
-        scales: &[f32],
-        flows_texture: &wgpu::Texture,
-    ) -> PoseTables {
-        let gpu_views: Vec<GpuView> = geometry
-            .cameras
-            .iter()
-            .zip(scales)
-            .zip(&geometry.flow_layers)
-            .zip(&geometry.prelit_layers)
-            .map(|(((cam, &scale), l), &prelit_layer)| {
-                let q = Quat::from_mat3(&cam.world_from_camera.rotation);
-                let k = &cam.intrinsics;
-                GpuView {
-                    rotation: q.to_array(),
-                    centre: cam.centre().to_array(),
-                    scale,
-                    intrinsics: [k.fx, k.fy, k.cx, k.cy],
-                    flow_layers: *l,
-                    prelit_layer,
-                    pad0: 0,
-                    pad1: 0,
-                    pad2: 0,
-                }
-            })
-            .collect();
-        let quads: Vec<GpuQuad> = geometry
-            .cylinder
-            .quads()
-            .iter()
-            .map(|q| GpuQuad {
-                p00: q.p00.to_array(),
-                u: q.u,
-                e1: q.e1.to_array(),
-                v: q.v,
-                e2: q.e2.to_array(),
-                wall: q.wall,
-                e3: q.e3.to_array(),
-                wall_gamma: q.wall_gamma,
-                normal: q.normal.to_array(),
-                pad: 0.0,
-            })
-            .collect();
-        let buffer = |label: &str, contents: &[u8]| {
-            buffer_with(&self.device, label, contents, wgpu::BufferUsages::STORAGE)
-        };
-        let (index, ranges) = geometry.cylinder.column_index_gpu();
-        let mut index_bytes = bytemuck::bytes_of(&index).to_vec();
-        index_bytes.extend_from_slice(bytemuck::cast_slice(&ranges));
-        let (proxy, hull_words) = geometry.proxy.gpu();
-        let frames: Vec<GpuQuadFrame> = geometry
-            .frames
-            .iter()
-            .map(|f| gpu_frame(f.as_ref()))
-            .collect();
-        PoseTables {
-            geometry: geometry.clone(),
-            flows: flows.clone(),
-            id: unique_id(),
-            flows_view: flows_texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            }),
-            views: buffer_with(
-                &self.device,
-                "views",
-                bytemuck::cast_slice(&gpu_views),
-                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            ),
-            quads: buffer("quads", bytemuck::cast_slice(&quads)),
-            tables: buffer_with(
-                &self.device,
-                "tables",
-                &table_bytes(&[srgb_lut(), flows.table]),
-                wgpu::BufferUsages::UNIFORM,
-            ),
-            proxy: buffer("proxy", bytemuck::bytes_of(&proxy)),
-            hull: buffer("hull", bytemuck::cast_slice(&hull_words)),
-            index: buffer("column index", &index_bytes),
-            frames: buffer("quad frames", bytemuck::cast_slice(&frames)),
-            quad_count: quads.len() as u32,
-            groups: Mutex::new(Vec::new()),
-        }
-    }
-
-    /// The bind group of `tables` with the pre-lit views `prelit` for the frame pass's
-    /// `layout` (and its `sampler`), and the key
-    /// that names it (renders of equal keys are drawn in one dispatch): one a page of the
-    /// shared pages, kept.
+    /// The bind group of `tables` with a copy's `prelit` range, its `flows` and the
+    /// texture of its pre-lit texels, if any, for the frame pass's `layout` (and its
+    /// `sampler`), and the key that names it (renders of equal keys are drawn in one
+    /// dispatch): one a pair of pages where nothing is a texture, kept.
     pub(super) fn pose_group(
         &self,
         (layout, sampler): (&wgpu::BindGroupLayout, &wgpu::Sampler),
         tables: &PoseTables,
-        prelit: PrelitAt<'_>,
-    ) -> (wgpu::BindGroup, (u64, usize)) {
-        let make = |resource: wgpu::BindingResource<'_>| {
+        (prelit, flows, texels): (&PrelitRange, FlowsAt<'_>, Option<&wgpu::Texture>),
+    ) -> (wgpu::BindGroup, (u64, usize, usize)) {
+        let array = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let flows_view = match flows {
+            FlowsAt::Texture(t) => Some(array(t)),
+            FlowsAt::Shared(_) => None,
+        };
+        let texels_view = texels.map(array);
+        let make = || {
+            let mut entries = vec![
+                entry(0, prelit.page().as_entire_binding()),
+                entry(
+                    1,
+                    match (&flows, &flows_view) {
+                        (_, Some(view)) => wgpu::BindingResource::TextureView(view),
+                        (FlowsAt::Shared(r), None) => r.page().as_entire_binding(),
+                        (FlowsAt::Texture(_), None) => unreachable!("made above"),
+                    },
+                ),
+                entry(2, tables.views.as_entire_binding()),
+                entry(3, tables.quads.as_entire_binding()),
+                entry(4, tables.tables.as_entire_binding()),
+                entry(5, tables.proxy.as_entire_binding()),
+                entry(6, tables.hull.as_entire_binding()),
+                entry(7, tables.index.as_entire_binding()),
+                entry(8, wgpu::BindingResource::Sampler(sampler)),
+                entry(9, tables.frames.as_entire_binding()),
+            ];
+            if let Some(view) = &texels_view {
+                entries.push(entry(
+                    PRELIT_TEXELS_BINDING,
+                    wgpu::BindingResource::TextureView(view),
+                ));
+            }
             self.device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("pose"),
                 layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource,
-                    },
-                    entry(1, wgpu::BindingResource::TextureView(&tables.flows_view)),
-                    entry(2, tables.views.as_entire_binding()),
-                    entry(3, tables.quads.as_entire_binding()),
-                    entry(4, tables.tables.as_entire_binding()),
-                    entry(5, tables.proxy.as_entire_binding()),
-                    entry(6, tables.hull.as_entire_binding()),
-                    entry(7, tables.index.as_entire_binding()),
-                    entry(8, wgpu::BindingResource::Sampler(sampler)),
-                    entry(9, tables.frames.as_entire_binding()),
-                ],
+                entries: &entries,
             })
         };
-        match prelit {
-            PrelitAt::Shared(range) => {
-                let page = range.page_key();
+        match (&flows, texels) {
+            (FlowsAt::Shared(f), None) => {
+                let pages = (prelit.page_key(), f.page_key());
                 let mut groups = tables.groups.lock().unwrap_or_else(|e| e.into_inner());
-                let group = match groups.iter().find(|(p, _)| *p == page) {
+                let group = match groups.iter().find(|(p, _)| *p == pages) {
                     Some((_, g)) => g.clone(),
                     None => {
-                        let g = make(range.page().as_entire_binding());
-                        groups.push((page, g.clone()));
+                        let g = make();
+                        groups.push((pages, g.clone()));
                         g
                     }
                 };
-                (group, (tables.id, page))
+                (group, (tables.id, pages.0, pages.1))
             }
-            PrelitAt::Texture(texture) => {
-                let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2Array),
-                    ..Default::default()
-                });
-                (
-                    make(wgpu::BindingResource::TextureView(&view)),
-                    (tables.id, 0),
-                )
-            }
+            // A texture is the copy's own: so is its bind group.
+            _ => (make(), (tables.id, unique_id() as usize, 0)),
         }
     }
 }

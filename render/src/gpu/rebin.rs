@@ -14,7 +14,7 @@ use super::bind::{
     compute_pipeline, full_screen_pipeline, loaded, readback_buffer, sampler, storage, storage_min,
     storage_texture_array, texture_array, uniform, uniform_buffer,
 };
-use super::formats::PoseFormats;
+use super::formats::{PRELIT_TEXELS_BINDING, PoseFormats};
 use super::pose::{GpuPose, PoseBinding};
 use super::readback::Readback;
 use crate::cpu::FrameStats;
@@ -114,22 +114,28 @@ impl RebinPass {
                 storage::<[u32; 4]>(1, false, wgpu::ShaderStages::COMPUTE),
             ],
         );
-        let pose_layout = layout(
-            "pose",
-            &[
-                formats.image.layout_entry(0),
-                texture_array(1, formats.flow.sample_type()),
-                storage::<GpuView>(2, true, both),
-                storage::<GpuQuad>(3, true, both),
-                uniform::<[[f32; 256]; 2]>(4, both),
-                storage::<GpuProxy>(5, true, both),
-                storage::<u32>(6, true, both),
-                // The column index's header and at least one span's range.
-                storage_min(7, true, both, (size_of::<GpuColumnIndex>() + 8) as u64),
-                sampler(8, both),
-                storage::<GpuQuadFrame>(9, true, both),
-            ],
-        );
+        // Binding 0: the shared pages (the copies' heads, and their codes); 1: flows;
+        // `PRELIT_TEXELS_BINDING`: pre-lit texels of a texture ([`super::formats`]).
+        let mut pose_entries = vec![
+            storage::<u32>(0, true, both),
+            formats.flow.layout_entry(1),
+            storage::<GpuView>(2, true, both),
+            storage::<GpuQuad>(3, true, both),
+            uniform::<[[f32; 256]; 2]>(4, both),
+            storage::<GpuProxy>(5, true, both),
+            storage::<u32>(6, true, both),
+            // The column index's header and at least one span's range.
+            storage_min(7, true, both, (size_of::<GpuColumnIndex>() + 8) as u64),
+            sampler(8, both),
+            storage::<GpuQuadFrame>(9, true, both),
+        ];
+        if formats.image.in_texture() {
+            pose_entries.push(texture_array(
+                PRELIT_TEXELS_BINDING,
+                wgpu::TextureSampleType::Float { filterable: true },
+            ));
+        }
+        let pose_layout = layout("pose", &pose_entries);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("bilinear"),
             mag_filter: wgpu::FilterMode::Linear,
