@@ -78,6 +78,10 @@ struct Frame {
     // heads: scale, pre-lit layer and flow layers, y its first pre-lit layer's codes,
     // z its flows' codes; `render/src/gpu/prelit.rs`).
     prelit: vec4<u32>,
+    // The compute frame pass's 8x8 tiles of `bounds`, numbered across its dispatch: x the
+    // render's first, y its tiles across, z its tiles; w (the dispatch's first record
+    // only) the renders of the dispatch.
+    tiles: vec4<u32>,
 }
 
 // The pose's geometric proxy: the visual hull's grid (its bits are bound beside it) and

@@ -24,7 +24,7 @@
 // at z (`FRAMES_BOUND` at most); every entry point copies its record into `frame`.
 struct FrameRecord {
     f: Frame,
-    pad: array<vec4<u32>, 5>,
+    pad: array<vec4<u32>, 4>,
 }
 @group(0) @binding(0) var<uniform> frames: array<FrameRecord, 256>;
 var<private> frame: Frame;
@@ -211,11 +211,38 @@ fn count_class(kind: u32) {
     }
 }
 
-// The frame pass as a compute dispatch: shades and counts the pixel classes.
+// The record of the dispatch whose tiles hold tile `w` (the last whose first tile is at
+// or before it), by bisection over the dispatch's records.
+fn record_of_tile(w: u32) -> u32 {
+    var lo = 0u;
+    var hi = frames[0].f.tiles.w;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (frames[mid].f.tiles.x <= w) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// The frame pass as a compute dispatch: shades and counts the pixel classes. Its
+// workgroups are the 8x8 tiles of every render's bounds one after another (`tiles` of
+// the records), rows of them when they outnumber a dimension's workgroups.
 @compute @workgroup_size(8, 8)
-fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
-    frame = frames[id.z].f;
-    let p = id.xy + frame.bounds.xy;
+fn cs_main(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_id) local: vec3<u32>,
+) {
+    let w = group.y * groups.x + group.x;
+    frame = frames[record_of_tile(w)].f;
+    let t = w - frame.tiles.x;
+    if (t >= frame.tiles.z) {
+        return;
+    }
+    let p = vec2<u32>(t % frame.tiles.y, t / frame.tiles.y) * 8u + local.xy + frame.bounds.xy;
     if (all(p < frame.bounds.zw)) {
         let c = classify(vec2<f32>(p) + 0.5);
         let at = vec2<i32>(p) + frame.place.xy;

@@ -116,6 +116,10 @@ pub struct GpuFrame {
     /// layer, flow layers), its first pre-lit layer's codes and its flows' codes
     /// (`frf_render::gpu::prelit`).
     pub prelit: [u32; 4],
+    /// The compute frame pass's 8x8 tiles of `bounds`, numbered across its dispatch:
+    /// `[first, across, tiles, renders]`, the render's first, its tiles across, its
+    /// tiles, and (the dispatch's first record only) the renders of the dispatch.
+    pub tiles: [u32; 4],
 }
 
 /// `Proxy` of `common.wgsl`: the pose's geometric proxy (`frf_render::proxy`).

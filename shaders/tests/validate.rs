@@ -196,7 +196,8 @@ fn pod_structs_match_naga_layouts() {
             depth,
             bounds,
             place,
-            prelit
+            prelit,
+            tiles
         ]
     );
     check_layout!(

@@ -50,6 +50,30 @@ pub(super) fn workgroups(size: (u32, u32)) -> (u32, u32) {
     (size.0.div_ceil(8), size.1.div_ceil(8))
 }
 
+/// Numbers the 8x8 tiles of `frames`' bounds one after another, as one dispatch of the
+/// compute frame pass draws them (`tiles` of their records; the first holds how many
+/// renders there are); the tiles in all.
+pub(super) fn number_tiles(frames: &mut [GpuFrame]) -> u32 {
+    let mut first = 0;
+    for f in frames.iter_mut() {
+        let [x0, y0, x1, y1] = f.bounds;
+        let (across, down) = workgroups((x1.saturating_sub(x0), y1.saturating_sub(y0)));
+        f.tiles = [first, across, across * down, 0];
+        first += across * down;
+    }
+    let renders = frames.len() as u32;
+    if let Some(f) = frames.first_mut() {
+        f.tiles[3] = renders;
+    }
+    first
+}
+
+/// The workgroups of a dispatch of `tiles` tiles: rows of the most a dimension holds.
+pub(super) fn tile_groups(tiles: u32) -> (u32, u32) {
+    const MOST: u32 = 65535;
+    (tiles.min(MOST), tiles.div_ceil(MOST))
+}
+
 /// The frame pass's layouts and pipelines for one [`PoseFormats`].
 pub struct RebinPass {
     /// How a pose is bound for these pipelines: the storage they read, the layout and
@@ -294,7 +318,9 @@ pub(super) fn frame_uniform(pose: Option<&GpuPose>, camera: &Camera, variant: Va
         bounds: PixelBox::whole(camera.width, camera.height).to_array(),
         place: [0; 4],
         prelit: [0; 4],
+        tiles: [0; 4],
     };
+    number_tiles(std::slice::from_mut(&mut f));
     if let Some(pose) = pose {
         f.quad_count = pose.tables.quad_count;
         f.prelit = pose.prelit_words();
@@ -612,7 +638,9 @@ impl RebinPass {
                 pass.set_pipeline(&pipelines.compute);
                 pass.set_bind_group(0, &t.compute, &[]);
                 pass.set_bind_group(1, pose_group, &[]);
+                // The slot's record numbers the tiles of `within` ([`number_tiles`]).
                 let (x, y) = workgroups(size);
+                let (x, y) = tile_groups(x * y);
                 if x * y > 0 {
                     pass.dispatch_workgroups(x, y, 1);
                 }
@@ -634,51 +662,48 @@ impl RebinPass {
 }
 
 impl RebinPass {
-    /// Records the compute frame pass of every render of `renders` (its slot in
-    /// `targets`, pose and pixel box) in one pass, with the pass's timestamps when given;
-    /// each counts its pixel classes as it shades. Returns the dispatches.
+    /// Records the compute frame pass of `dispatches` (each its first slot in
+    /// `targets`, the pose whose bind group its renders share, and its tiles, numbered by
+    /// [`number_tiles`] in its slots' records) in one pass, with the pass's timestamps
+    /// when given; each render counts its pixel classes as it shades.
     pub(super) fn record_compute(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &SubjectTargets,
-        renders: &[(usize, &GpuPose, PixelBox)],
+        dispatches: &[(usize, &GpuPose, u32)],
         variant: Variant,
         timestamps: Option<(&wgpu::QuerySet, u32)>,
-    ) -> usize {
+    ) {
         let pipelines = self.pipelines(variant);
-        let mut dispatches = 0;
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("rebin"),
             timestamp_writes: super::timing::compute_pass_writes(timestamps),
         });
         pass.set_pipeline(&pipelines.compute);
-        // Renders of poses of one bind group (copies of one pose's views in one page of
-        // pre-lit views, [`super::pose_tables`]) in consecutive slots: one dispatch, a
-        // layer of workgroups a render, over the largest of their boxes.
-        let mut at = 0;
-        while at < renders.len() {
-            let (slot, pose, _) = renders[at];
-            let run = renders[at..]
-                .iter()
-                .take(FRAMES_BOUND)
-                .enumerate()
-                .take_while(|(k, r)| r.0 == slot + k && r.1.group_key == pose.group_key)
-                .count();
-            let (x, y) = renders[at..at + run]
-                .iter()
-                .map(|r| workgroups(r.2.size()))
-                .fold((0, 0), |(a, b), (x, y)| (a.max(x), b.max(y)));
-            at += run;
-            if x * y == 0 {
-                continue;
-            }
+        for &(slot, pose, tiles) in dispatches {
+            let (x, y) = tile_groups(tiles);
             pass.set_bind_group(0, &targets.slots[slot].compute, &[]);
             pass.set_bind_group(1, &pose.bind_group, &[]);
-            pass.dispatch_workgroups(x, y, run as u32);
-            dispatches += 1;
+            pass.dispatch_workgroups(x, y, 1);
         }
-        dispatches
     }
+}
+
+/// The dispatches of the compute frame pass drawing `poses` (in slot order): renders of
+/// one bind group in consecutive slots, [`FRAMES_BOUND`] at most, are one; each its first
+/// slot and its length.
+fn runs(poses: &[&GpuPose]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut at = 0;
+    while at < poses.len() {
+        let key = poses[at].group_key;
+        let run = (poses[at..].iter().take(FRAMES_BOUND))
+            .take_while(|p| p.group_key == key)
+            .count();
+        out.push((at, run));
+        at += run;
+    }
+    out
 }
 
 impl Gpu {
@@ -778,7 +803,7 @@ impl Gpu {
             order.sort_by_key(|&k| renders[k].0.group_key);
         }
         let renders: Vec<&(&GpuPose, DrawnRender)> = order.iter().map(|&k| &renders[k]).collect();
-        let frames: Vec<GpuFrame> = renders
+        let mut frames: Vec<GpuFrame> = renders
             .iter()
             .map(|(pose, d)| {
                 let mut frame = frame_uniform(Some(pose), &d.camera, variant);
@@ -788,18 +813,19 @@ impl Gpu {
                 frame
             })
             .collect();
+        // Each dispatch's tiles numbered across its renders (an empty box has none).
+        let poses: Vec<&GpuPose> = renders.iter().map(|r| r.0).collect();
+        let dispatches: Vec<(usize, &GpuPose, u32)> = runs(&poses)
+            .into_iter()
+            .map(|(at, run)| (at, poses[at], number_tiles(&mut frames[at..at + run])))
+            .filter(|d| d.2 > 0)
+            .collect();
         targets.write_frames(&self.queue, &frames);
         match self.stage {
             PassKind::Compute => {
-                let groups: Vec<_> = renders
-                    .iter()
-                    .enumerate()
-                    .map(|(slot, (pose, d))| (slot, *pose, d.within))
-                    .collect();
                 let timestamps = self.pass_timestamps("frame", timestamps);
-                let dispatches =
-                    (self.rebin).record_compute(encoder, targets, &groups, variant, timestamps);
-                self.dispatched("frame", dispatches);
+                (self.rebin).record_compute(encoder, targets, &dispatches, variant, timestamps);
+                self.dispatched("frame", dispatches.len());
             }
             PassKind::Fragment => {
                 self.dispatched("frame", renders.len());
