@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 use frf_core::Fault;
 
 mod cmd;
+mod context;
 
 /// Errors of the binary: any library error, printed with its chain of causes.
 pub type CliResult<T = ()> = Result<T, Box<dyn std::error::Error + Send + Sync>>;
@@ -145,6 +146,9 @@ fn main() -> ExitCode {
 /// Who is at fault for a failed command: the libraries' errors say; what the command line
 /// itself refuses is a usage error; an error of the operating system is I/O.
 fn fault_of(e: &(dyn std::error::Error + 'static)) -> Fault {
+    if let Some(c) = e.downcast_ref::<context::Context>() {
+        return fault_of(c.inner());
+    }
     macro_rules! by_type {
         ($($t:ty),*) => {
             $(if let Some(e) = e.downcast_ref::<$t>() {

@@ -87,9 +87,17 @@ fn decode_with<R: std::io::BufRead + std::io::Seek>(
     DynamicImage::from_decoder(decoder).map_err(failed)
 }
 
+/// A missing file: the operating system's fault class, as opening it would say.
+fn not_found(path: &Path) -> CoreError {
+    CoreError::io(
+        path,
+        std::io::Error::new(std::io::ErrorKind::NotFound, "file not found"),
+    )
+}
+
 fn decode(path: &Path) -> Result<DynamicImage> {
     if !path.exists() {
-        return Err(CoreError::bad_file(path, "file not found"));
+        return Err(not_found(path));
     }
     decode_with(path, reader(path)?)
 }
@@ -163,7 +171,7 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String> {
 /// Width and height of an image file, read from its header only.
 pub fn image_dimensions(path: &Path) -> Result<(usize, usize)> {
     if !path.exists() {
-        return Err(CoreError::bad_file(path, "file not found"));
+        return Err(not_found(path));
     }
     let (w, h) = reader(path)?
         .into_dimensions()

@@ -382,7 +382,7 @@ impl LightingArgs {
         let source = self.source()?;
         let mut env = source
             .load()
-            .map_err(|e| format!("environment {source}: {e}"))?;
+            .map_err(crate::context::context(format!("environment {source}")))?;
         if let Some(sun) = self.sun()? {
             if let Some(note) = sun.below_horizon(self.floor == FloorArg::Ground) {
                 eprintln!("--sun: {note}");

@@ -244,7 +244,7 @@ fn interp(args: InterpArgs) -> CliResult {
             };
             // Its errors name the pose.
             PoseSource::load(&field, args.pose, &lighting)
-                .map_err(|e| format!("{}: {e}", path.display()))?
+                .map_err(crate::context::context(path.display().to_string()))?
         }
         None => synthetic_pose()?,
     };

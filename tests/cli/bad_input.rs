@@ -682,3 +682,36 @@ fn a_fifo_given_as_a_field_or_a_scene_is_refused_at_once() {
         );
     }
 }
+
+/// An environment that fails to load ends with its own fault's status, as the library
+/// says it (issue 59: `frf eval` and `frf bench` turned the error into a message, and
+/// every such failure into a usage error, 2): the status `frf render` gives the same map,
+/// 3 (damaged) for a garbage map and 5 (I/O) for a missing one; the message names the
+/// environment and the file.
+#[test]
+fn an_environment_that_fails_to_load_keeps_its_fault() {
+    let dir = tempfile::tempdir().unwrap();
+    let garbage = dir.path().join("garbage.hdr");
+    std::fs::write(&garbage, b"#?RADIANCE\nthis is not a picture\n").unwrap();
+    let missing = dir.path().join("missing.hdr");
+    let field = frf_testkit::tiny_field()
+        .field
+        .to_str()
+        .unwrap()
+        .to_string();
+    for (map, status) in [(&garbage, 3), (&missing, 5)] {
+        let map = map.to_str().unwrap();
+        let out = dir.path().join("o");
+        let out = out.to_str().unwrap();
+        let rendered = crate::common::frf(&[
+            "render", &field, "--orbit", "3,1.2", "--env", map, "--cpu", "--out", out,
+        ]);
+        let o = crate::common::frf(&[
+            "bench", "interp", "--field", &field, "--env", map, "--size", "16x16",
+        ]);
+        let said = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(status), "{said}");
+        assert_eq!(o.status.code(), rendered.status.code(), "{said}");
+        assert!(said.contains("environment") && said.contains(map), "{said}");
+    }
+}

@@ -23,7 +23,8 @@ pub fn run(args: &EvalArgs, input: &EvalInput) -> CliResult {
     let dir = match &args.fields {
         Some(d) => d.clone(),
         None => {
-            temporary = tempfile::tempdir().map_err(|e| format!("a temporary directory: {e}"))?;
+            temporary =
+                tempfile::tempdir().map_err(crate::context::context("a temporary directory"))?;
             temporary.path().to_path_buf()
         }
     };
