@@ -164,26 +164,17 @@ impl Sun {
         if (peak as f64).partial_cmp(&(SUN_CONTRAST * mean)) != Some(std::cmp::Ordering::Greater) {
             return Ok(None);
         }
-        // The bright texels connected to the peak (wrapping in azimuth).
-        let mut inside = vec![false; w * h];
-        let mut stack = vec![peak_i];
-        inside[peak_i] = true;
-        let mut region = Vec::new();
-        while let Some(i) = stack.pop() {
-            region.push(i);
-            let (x, y) = ((i % w) as i64, (i / w) as i64);
-            for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
-                let ny = y + dy;
-                if !(0..h as i64).contains(&ny) || !above[ny as usize] {
-                    continue;
-                }
-                let j = ny as usize * w + (x + dx).rem_euclid(w as i64) as usize;
-                if !inside[j] && lum(img.pixels()[j]) >= SUN_SHARE * peak {
-                    inside[j] = true;
-                    stack.push(j);
-                }
-            }
-        }
+        // The bright texels connected to the peak (wrapping in azimuth), at the loosest
+        // share of the peak that gives a compact region: a glow or a streak around the
+        // peak is left to the basis, and the peak's compact core is the sun (none when
+        // not even the core is compact).
+        let Some((region, inside)) = SHARES
+            .iter()
+            .map(|&share| bright_region(env, &above, peak_i, share * peak))
+            .find(|(region, _)| compact(env, region))
+        else {
+            return Ok(None);
+        };
         // The sky behind it: the median of the texels bordering the region.
         let mut ring: Vec<Rgb> = Vec::new();
         for &i in &region {
@@ -253,6 +244,74 @@ impl Sun {
             ..*self
         }
     }
+}
+
+/// Shares of the peak a sun's texels are tried at, loosest first ([`Sun::extract`]).
+const SHARES: [f32; 4] = [SUN_SHARE, 0.2, 0.4, 0.8];
+
+/// How much wider than a disc of its solid angle a region's light may spread and still
+/// be a sun ([`compact`]).
+const SPREAD: f64 = 1.5;
+
+/// The texels above the horizon (`above`, per row) connected to texel `peak_i` whose
+/// luminance is at least `least` (wrapping in azimuth), and which texels they are.
+fn bright_region(
+    env: &EnvMap,
+    above: &[bool],
+    peak_i: usize,
+    least: f32,
+) -> (Vec<usize>, Vec<bool>) {
+    let img = env.image();
+    let (w, h) = img.size();
+    let lum = |p: Rgb| crate::image::luminance(p);
+    let mut inside = vec![false; w * h];
+    let mut stack = vec![peak_i];
+    inside[peak_i] = true;
+    let mut region = Vec::new();
+    while let Some(i) = stack.pop() {
+        region.push(i);
+        let (x, y) = ((i % w) as i64, (i / w) as i64);
+        for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+            let ny = y + dy;
+            if !(0..h as i64).contains(&ny) || !above[ny as usize] {
+                continue;
+            }
+            let j = ny as usize * w + (x + dx).rem_euclid(w as i64) as usize;
+            if !inside[j] && lum(img.pixels()[j]) >= least {
+                inside[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    (region, inside)
+}
+
+/// Whether `region`'s light is gathered like a disc's: the angle its light spreads over
+/// around its mean direction (from the mean of the cosine to it, `(1 + cos r) / 2` over
+/// a uniform disc of radius `r`) is at most [`SPREAD`] times the radius of a disc of its
+/// solid angle, plus a texel. A ring, a streak or a broad glow spreads wider.
+fn compact(env: &EnvMap, region: &[usize]) -> bool {
+    let img = env.image();
+    let w = img.width();
+    let (mut omega, mut weight, mut towards) = (0.0f64, 0.0f64, glam::DVec3::ZERO);
+    for &i in region {
+        let o = env.texel_solid_angle(i / w) as f64;
+        let l = crate::image::luminance(img.pixels()[i]) as f64 * o;
+        omega += o;
+        weight += l;
+        towards += env.direction_of((i % w) as f32, (i / w) as f32).as_dvec3() * l;
+    }
+    if weight <= 0.0 {
+        return false;
+    }
+    let area = (1.0 - omega / (2.0 * std::f64::consts::PI))
+        .clamp(-1.0, 1.0)
+        .acos();
+    let spread = (2.0 * towards.length() / weight - 1.0)
+        .clamp(-1.0, 1.0)
+        .acos();
+    let texel = 2.0 * std::f64::consts::PI / w as f64;
+    spread <= SPREAD * area + texel
 }
 
 #[cfg(test)]
@@ -337,6 +396,38 @@ mod tests {
             .map(|i| [sky[i] + kg * g[i] + kh * hot[i]; 3])
             .collect();
         EnvMap::from_image(crate::image::Image::from_vec(w, h, pixels).unwrap()).unwrap()
+    }
+
+    /// A bright region far from a disc (an arc of cloud edge 90° long around the zenith,
+    /// 300 times the sky, carrying half the light) is not a sun however bright, where a
+    /// disc of the same light is (issue 59: a real overcast map's bright zenith was taken
+    /// for an 18° disc carrying 45 % of its light, and the walker relit by it lost 8 dB).
+    #[test]
+    fn a_bright_arc_is_not_taken_for_a_sun_and_a_disc_as_bright_is() {
+        let grid = EnvMap::uniform([0.0; 3], 256);
+        let (w, h) = grid.image().size();
+        let dirs: Vec<Vec3> = (0..w * h)
+            .map(|i| grid.direction_of((i % w) as f32, (i / w) as f32))
+            .collect();
+        let arc = |d: &Vec3| {
+            let elevation = d.y.clamp(-1.0, 1.0).asin().to_degrees();
+            let azimuth = d.z.atan2(d.x).to_degrees();
+            (elevation - 70.0).abs() < 1.5 && (0.0..90.0).contains(&azimuth)
+        };
+        let disc = |d: &Vec3| d.dot(Vec3::Y) > 4f32.to_radians().cos();
+        for (shape, is_sun) in [(&arc as &dyn Fn(&Vec3) -> bool, false), (&disc, true)] {
+            let pixels = dirs
+                .iter()
+                .map(|d| [if shape(d) { 300.0 } else { 1.0 }; 3])
+                .collect();
+            let map =
+                EnvMap::from_image(crate::image::Image::from_vec(w, h, pixels).unwrap()).unwrap();
+            assert_eq!(
+                Sun::extract(&map).unwrap().is_some(),
+                is_sun,
+                "sun: {is_sun}"
+            );
+        }
     }
 
     #[test]
