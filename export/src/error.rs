@@ -11,12 +11,6 @@ pub enum ExportError {
     /// A core error (files, images).
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
-    /// Rendering a sprite sheet failed.
-    #[error(transparent)]
-    Render(#[from] frf_render::RenderError),
-    /// The sprite sheet's shot failed.
-    #[error(transparent)]
-    Scene(#[from] frf_scene::SceneError),
     /// The field lacks what the export needs.
     #[error("the field cannot be exported: {0}")]
     Field(String),
@@ -39,8 +33,6 @@ impl ExportError {
         match self {
             Self::Reflectance(e) => e.fault(),
             Self::Core(e) => e.fault(),
-            Self::Render(e) => e.fault(),
-            Self::Scene(e) => e.fault(),
             Self::Field(_) => frf_core::Fault::Usage,
             Self::BadFile { .. } => frf_core::Fault::Damaged,
             Self::Option(_) => frf_core::Fault::Usage,

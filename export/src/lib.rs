@@ -11,8 +11,8 @@
 //!   flows to the grid neighbours the four-way morph draws between views with; and the
 //!   SH convention the transfer is for ([`frf_core::sh::Convention`]).
 //!
-//! - [`sprites`]: a relit sprite sheet (the walk cycle from a ring of headings, one PNG
-//!   and a JSON of frame rectangles and timing) for engines that play flipbooks.
+//! A relit sprite sheet (the walk cycle from a ring of headings, for engines that play
+//! flipbooks) is rendered by the scene system: `frf_scene::sprites`.
 //!
 //! What the SH tier cannot do: a sharp sun is not L2 (band 2 is a 60° lobe); a player
 //! adds it from the normals and albedo, as frf's sun relighting does from the normals.
@@ -22,7 +22,6 @@ pub mod format;
 pub mod glb;
 pub mod hull_mesh;
 pub mod read;
-pub mod sprites;
 pub mod view_maps;
 mod write;
 

@@ -105,6 +105,9 @@ pub enum SceneError {
     /// Images, cameras, environments, files.
     #[error(transparent)]
     Core(#[from] frf_core::CoreError),
+    /// A sprite sheet's option out of range (`crate::sprites`).
+    #[error("{0}")]
+    Sprites(String),
 }
 
 impl SceneError {
@@ -119,6 +122,7 @@ impl SceneError {
             | SceneError::FieldLacks { .. }
             | SceneError::Output { .. }
             | SceneError::MemoryBudget { .. }
+            | SceneError::Sprites(_)
             | SceneError::Argument(_) => Fault::Usage,
             SceneError::Misuse(_) | SceneError::Internal(_) => Fault::Internal,
             SceneError::Render(e) => e.fault(),

@@ -38,6 +38,7 @@ pub mod settings;
 pub mod shot;
 pub mod shot_report;
 pub mod spline;
+pub mod sprites;
 pub mod walk;
 
 use std::path::{Path, PathBuf};

@@ -130,10 +130,10 @@ fn parse_sprite_size(s: &str) -> Result<(u32, u32), String> {
     let size = parse_size(s).map_err(|_| {
         format!(
             "{s:?}: expected WxH, 1 to {} pixels a side",
-            frf_export::sprites::MOST_FRAME_SIDE
+            frf_scene::sprites::MOST_FRAME_SIDE
         )
     })?;
-    match frf_export::sprites::frame_size_problem(size) {
+    match frf_scene::sprites::frame_size_problem(size) {
         Some(problem) => Err(problem),
         None => Ok(size),
     }
@@ -249,7 +249,7 @@ pub fn run(args: ExportArgs) -> CliResult {
 
 /// `frf export --sprites`.
 fn sprites(args: &ExportArgs, poses: Option<Vec<u32>>) -> CliResult {
-    let options = frf_export::sprites::SpriteOptions {
+    let options = frf_scene::sprites::SpriteOptions {
         env: args.env.clone(),
         sun: args.sun.as_ref().map(SunSpec::sun).transpose()?,
         headings_deg: args.headings.0.clone(),
@@ -262,7 +262,7 @@ fn sprites(args: &ExportArgs, poses: Option<Vec<u32>>) -> CliResult {
         exposure_stops: args.exposure,
         cpu: args.cpu,
     };
-    let r = frf_export::sprites::sprite_sheet(&args.field, &args.out, &options)?;
+    let r = frf_scene::sprites::sprite_sheet(&args.field, &args.out, &options)?;
     println!(
         "{} written ({}x{} pixels: {} heading(s) x {} pose(s) of {}x{}) and {}, in {:.1} s",
         r.image.display(),

@@ -13,13 +13,14 @@ use frf_core::image::{Image, Rgba};
 use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
 use frf_render::renderer::Device;
-use frf_scene::path::{Orbit, Trajectory};
-use frf_scene::shot::{Shot, ShotOptions};
-use frf_scene::{BackdropSpec, FieldLook, Scene, ShadowSpec};
+
+use crate::path::{Orbit, Trajectory};
+use crate::shot::{Shot, ShotOptions};
+use crate::{BackdropSpec, FieldLook, Scene, ShadowSpec};
 use glam::Vec3;
 use serde_json::json;
 
-use crate::error::{ExportError, Result};
+use crate::error::{Result, SceneError};
 
 /// The sheet's JSON format name and version.
 pub const SPRITES_FORMAT: &str = "frf-sprites";
@@ -94,7 +95,7 @@ pub fn frame_size_problem((w, h): (u32, u32)) -> Option<String> {
 }
 
 fn check(options: &SpriteOptions) -> Result<()> {
-    let bad = |m: String| Err(ExportError::Option(m));
+    let bad = |m: String| Err(SceneError::Sprites(m));
     if let Some(problem) = frame_size_problem(options.frame_size) {
         return bad(problem);
     }
@@ -118,7 +119,7 @@ fn check(options: &SpriteOptions) -> Result<()> {
     };
     orbit
         .validate()
-        .map_err(|e| ExportError::Option(format!("--sprite-orbit/--fov: {e}")))
+        .map_err(|e| SceneError::Sprites(format!("--sprite-orbit/--fov: {e}")))
 }
 
 /// Renders `field`'s sheet into `png` and its JSON beside it (each written to a
@@ -163,7 +164,7 @@ pub fn sprite_sheet(
     let (columns, rows) = (poses.len(), options.headings_deg.len());
     let (sw, sh) = (fw as usize * columns, fh as usize * rows);
     if sw > MOST_SHEET_SIDE || sh > MOST_SHEET_SIDE {
-        return Err(ExportError::Option(format!(
+        return Err(SceneError::Sprites(format!(
             "a sheet of {sw}x{sh} pixels ({columns} pose(s) x {rows} heading(s) of {fw}x{fh}) \
              is beyond {MOST_SHEET_SIDE} pixels a side, the largest texture engines take ({:.0} \
              GiB to hold while rendering): fewer --headings or --poses, or a smaller \
@@ -198,7 +199,7 @@ pub fn sprite_sheet(
         planned: false,
         traced_lights: 256,
         detail: Some(0),
-        light_tolerance: frf_scene::shot::LightTolerance::DEFAULT,
+        light_tolerance: crate::shot::LightTolerance::DEFAULT,
         walker_shadows: true,
     };
     let mut shot = Shot::live(scene, &field, device, shot_options)?;
@@ -248,7 +249,7 @@ pub fn sprite_sheet(
         "frames": frames,
     });
     let text = serde_json::to_string_pretty(&document)
-        .map_err(|e| ExportError::Field(format!("the sheet's JSON: {e}")))?;
+        .map_err(|e| SceneError::Internal(format!("the sheet's JSON: {e}")))?;
     frf_core::atomic::write_bytes_atomic(&json_path, text.as_bytes())?;
     Ok(SpriteReport {
         image: png.to_path_buf(),
@@ -273,7 +274,7 @@ fn heading_camera(o: &SpriteOptions, heading: f32) -> Result<Camera> {
         o.frame_size.0,
         o.frame_size.1,
     )
-    .map_err(ExportError::Core)
+    .map_err(SceneError::Core)
 }
 
 /// Copies `frame` into `sheet` with its top-left corner at `(x0, y0)`.
