@@ -21,6 +21,7 @@ pub mod error;
 pub mod format;
 pub mod glb;
 pub mod hull_mesh;
+pub mod model;
 pub mod read;
 pub mod view_maps;
 mod write;

@@ -1,6 +1,7 @@
 //! Reading an export back (what a player does, in Rust: the reference for loaders and
-//! the tests' round trip): the GLB's chunks checked, the extension's version checked,
-//! a view's transfer decoded and relit by an L2 light.
+//! the tests' round trip): the GLB's chunks checked, the extension's version checked and
+//! its object parsed into the types the writer wrote it from ([`crate::model`]), a view's
+//! transfer decoded and relit by an L2 light.
 
 use std::path::{Path, PathBuf};
 
@@ -10,6 +11,7 @@ use serde_json::Value;
 
 use crate::error::{ExportError, Result};
 use crate::format::{ATLAS_COLUMNS, EXTENSION, VERSION};
+use crate::model::{Extension, ViewRecord};
 
 /// An export, read.
 #[derive(Debug)]
@@ -17,6 +19,7 @@ pub struct Export {
     path: PathBuf,
     /// The glTF document.
     pub document: Value,
+    extension: Extension,
     bin: Vec<u8>,
 }
 
@@ -79,16 +82,19 @@ impl Export {
                 ext["version"]
             )));
         }
+        let extension: Extension = serde_json::from_value(ext.clone())
+            .map_err(|e| bad(format!("its {EXTENSION} does not hold what it must: {e}")))?;
         Ok(Self {
             path: path.to_path_buf(),
             document,
+            extension,
             bin,
         })
     }
 
     /// The extension's object.
-    pub fn field(&self) -> &Value {
-        &self.document["extensions"][EXTENSION]
+    pub fn field(&self) -> &Extension {
+        &self.extension
     }
 
     fn bad(&self, problem: String) -> ExportError {
@@ -113,37 +119,27 @@ impl Export {
     }
 
     /// The view `(u, v)` of `pose`'s record.
-    pub fn view(&self, pose: u32, u: usize, v: usize) -> Result<&Value> {
-        let poses = self.field()["poses"]
-            .as_array()
-            .ok_or_else(|| self.bad("no poses".into()))?;
-        let p = poses
-            .iter()
-            .find(|p| p["pose"].as_u64() == Some(pose as u64))
+    pub fn view(&self, pose: u32, u: usize, v: usize) -> Result<&ViewRecord> {
+        let p = (self.extension.poses.iter())
+            .find(|p| p.pose == pose)
             .ok_or_else(|| self.bad(format!("pose {pose} is not in the export")))?;
-        p["views"]
-            .as_array()
-            .and_then(|vs| {
-                vs.iter().find(|x| {
-                    x["u"].as_u64() == Some(u as u64) && x["v"].as_u64() == Some(v as u64)
-                })
-            })
+        (p.views.iter())
+            .find(|x| x.u == u && x.v == v)
             .ok_or_else(|| self.bad(format!("view {u},{v} of pose {pose} is not in the export")))
     }
 
     /// A view's transfer, decoded: per texel, nine RGB coefficients.
     pub fn transfer(&self, pose: u32, u: usize, v: usize) -> Result<Image<[Rgb; SH_COUNT]>> {
         let view = self.view(pose, u, v)?;
-        let t = &view["transfer"];
-        let images = t["images"].as_array().map_or(0, Vec::len);
+        let t = &view.transfer;
+        let images = t.images.len();
         if images != 3 && images != 1 {
             return Err(self.bad(format!(
                 "view {u},{v} has {images} transfer atlases, expected 3 or 1"
             )));
         }
-        let atlas = (0..images)
-            .map(|c| {
-                let index = t["images"][c].as_u64().unwrap_or(u64::MAX) as usize;
+        let atlas = (t.images.iter().enumerate())
+            .map(|(c, &index)| {
                 image::load_from_memory(self.image_bytes(index)?)
                     .map(|i| i.to_luma8())
                     .map_err(|e| self.bad(format!("the transfer atlas {c} of view {u},{v}: {e}")))
@@ -158,24 +154,19 @@ impl Export {
             )));
         }
         // The compact tier: one grey atlas and a colour per texel.
-        let colour = if images == 1 {
-            let c = &t["colour"];
-            let png = image::load_from_memory(
-                self.image_bytes(c["image"].as_u64().unwrap_or(u64::MAX) as usize)?,
-            )
-            .map_err(|e| self.bad(format!("the transfer colour of view {u},{v}: {e}")))?
-            .to_rgb8();
-            let scale: Rgb = serde_json::from_value(c["scale"].clone())
-                .map_err(|e| self.bad(format!("the transfer colour scale of view {u},{v}: {e}")))?;
-            Some((png, scale))
-        } else {
-            None
+        let colour = match (&t.colour, images) {
+            (Some(c), 1) => {
+                let png = image::load_from_memory(self.image_bytes(c.image)?)
+                    .map_err(|e| self.bad(format!("the transfer colour of view {u},{v}: {e}")))?
+                    .to_rgb8();
+                Some((png, c.scale))
+            }
+            (None, 1) => {
+                return Err(self.bad(format!("view {u},{v} has one transfer atlas and no colour")));
+            }
+            _ => None,
         };
-        let coefficients = |key: &str| -> Result<[Rgb; SH_COUNT]> {
-            serde_json::from_value(t[key].clone())
-                .map_err(|e| self.bad(format!("the transfer {key} of view {u},{v}: {e}")))
-        };
-        let (scale, offset) = (coefficients("scale")?, coefficients("offset")?);
+        let (scale, offset) = (t.scale, t.offset);
         let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS) as u32;
         let (w, h) = (
             atlas[0].width() / ATLAS_COLUMNS as u32,
@@ -203,11 +194,9 @@ impl Export {
     /// A view's alpha.
     pub fn alpha(&self, pose: u32, u: usize, v: usize) -> Result<frf_core::image::GrayImage> {
         let view = self.view(pose, u, v)?;
-        let png = image::load_from_memory(
-            self.image_bytes(view["alpha"].as_u64().unwrap_or(u64::MAX) as usize)?,
-        )
-        .map_err(|e| self.bad(format!("the alpha of view {u},{v}: {e}")))?
-        .to_luma8();
+        let png = image::load_from_memory(self.image_bytes(view.alpha)?)
+            .map_err(|e| self.bad(format!("the alpha of view {u},{v}: {e}")))?
+            .to_luma8();
         Ok(Image::from_fn(
             png.width() as usize,
             png.height() as usize,

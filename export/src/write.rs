@@ -1,5 +1,6 @@
 //! The export itself: what is taken from the field, in which order, into the GLB.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
@@ -8,6 +9,7 @@ use frf_core::image::{GrayImage, Rgb};
 use frf_core::sh::{Convention, SH_COUNT};
 use frf_reflectance::FieldFile;
 use frf_reflectance::chunk::{ChunkKey, ChunkKind};
+use frf_reflectance::field::CameraRecord;
 use frf_reflectance::light_fit::LightFit;
 use frf_reflectance::sh_transfer::{sh_weights, texel_transfer};
 use glam::{Mat3, Vec3};
@@ -18,6 +20,9 @@ use crate::error::{ExportError, Result};
 use crate::format::{EXTENSION, VERSION};
 use crate::glb::Glb;
 use crate::hull_mesh::hull_mesh;
+use crate::model::{
+    Extension, Grid, PoseRecord, ScaledImage, TierName, Transfer, ViewRecord, Walk,
+};
 use crate::view_maps::{alpha_png, flow_png, normals_png, scaled_rgb_png, transfer_atlas};
 
 /// Which views of each pose are exported.
@@ -94,7 +99,7 @@ struct ViewOut {
     u: usize,
     v: usize,
     turntable_deg: f32,
-    camera: Value,
+    camera: CameraRecord,
     atlas: crate::view_maps::Atlas,
     colour: Option<(Vec<u8>, Rgb)>,
     alpha: Vec<u8>,
@@ -116,7 +121,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let mut sizes = [0u64; 6];
     let mut nodes = vec![json!({"name": "walker", "children": []})];
     let mut meshes = Vec::new();
-    let mut pose_json = Vec::new();
+    let mut pose_records = Vec::new();
     let mut triangles = 0;
     let mut exported_views = 0;
     for &pose in &poses {
@@ -181,30 +186,61 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                 encode_view(&field, pose, (u, v), rec, w, options)
             })
             .collect::<Result<_>>()?;
-        let view_json: Vec<Value> = encoded
+        let views: Vec<ViewRecord> = encoded
             .into_iter()
             .map(|e| add_view(&mut glb, &mut sizes, pose, e))
             .collect();
         // Every camera of the grid (u-major), the held views' and the others': a player
         // re-bins rays through the cylinder of all their centres.
-        let cameras: Vec<Value> = (0..header.columns)
+        let cameras: Vec<CameraRecord> = (0..header.columns)
             .flat_map(|u| (0..header.rows).map(move |v| (u, v)))
-            .map(|(u, v)| camera_json(&record.views[header.view_index(u, v)].camera))
+            .map(|(u, v)| record.views[header.view_index(u, v)].camera.clone())
             .collect();
         // Where frf starts a sun's shadow ray from the hull (a player's sun does the same).
         let offset = frf_reflectance::sun_light::shadow_offset_m(&hull);
-        pose_json.push(json!({"pose": pose, "time_s": record.time_s, "node": node,
-                              "cameras": cameras, "sun_shadow_offset_m": offset,
-                              "views": view_json}));
+        pose_records.push(PoseRecord {
+            pose,
+            time_s: record.time_s,
+            node,
+            cameras,
+            sun_shadow_offset_m: offset,
+            views,
+        });
     }
-    let animation = pose_animation(&mut glb, &poses, &header, &pose_json);
+    let nodes_of: Vec<usize> = pose_records.iter().map(|p| p.node).collect();
+    let animation = pose_animation(&mut glb, &poses, &header, &nodes_of);
     // The walk's speed as the field records it or its hulls tell it: what an engine moves
     // the walker by so that its feet stay planted (docs/export.md, "Root motion").
-    let walk = frf_reflectance::gait_speed::gait_speed_mps(&field)?.map(|speed| {
-        json!({"speed_mps": speed, "stride_m": speed * header.cycle_seconds,
-               "forward": [1.0, 0.0, 0.0],
-               "measured": header.gait_speed_mps.is_none()})
+    let walk = frf_reflectance::gait_speed::gait_speed_mps(&field)?.map(|speed| Walk {
+        speed_mps: speed,
+        stride_m: speed * header.cycle_seconds,
+        forward: [1.0, 0.0, 0.0],
+        measured: header.gait_speed_mps.is_none(),
     });
+    let extension = Extension {
+        version: VERSION,
+        tier: match options.tier {
+            Tier::Full => TierName::Full,
+            Tier::Compact => TierName::Compact,
+        },
+        sh: Convention::frf(),
+        grid: Grid {
+            columns: header.columns,
+            rows: header.rows,
+            wraps: header.wraps,
+            width: header.width,
+            height: header.height,
+        },
+        cycle_seconds: header.cycle_seconds,
+        poses_per_cycle: header.poses_per_cycle,
+        walk,
+        source: field_path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned()),
+        poses: pose_records,
+    };
+    let extension = serde_json::to_value(&extension)
+        .map_err(|e| ExportError::Field(format!("the extension's JSON: {e}")))?;
     let document = json!({
         "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
         "extensionsUsed": [EXTENSION],
@@ -214,18 +250,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         "meshes": meshes,
         "materials": [{"name": "hull", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
         "animations": [animation],
-        "extensions": {EXTENSION: {
-            "version": VERSION,
-            "tier": match options.tier { Tier::Full => "full", Tier::Compact => "compact" },
-            "sh": Convention::frf(),
-            "grid": {"columns": header.columns, "rows": header.rows, "wraps": header.wraps,
-                     "width": header.width, "height": header.height},
-            "cycle_seconds": header.cycle_seconds,
-            "poses_per_cycle": header.poses_per_cycle,
-            "walk": walk,
-            "source": field_path.file_name().map(|n| n.to_string_lossy().into_owned()),
-            "poses": pose_json,
-        }},
+        "extensions": {EXTENSION: extension},
     });
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
@@ -309,7 +334,7 @@ fn selection(field: &FieldFile, options: &ExportOptions) -> Result<Selection> {
 
 /// Adds view `e` of `pose`'s images to `glb` (their bytes counted in `sizes`, by
 /// section) and returns its record in the extension.
-fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> Value {
+fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> ViewRecord {
     let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
     let before = glb.binary_bytes();
     let rgb = ["red", "green", "blue"];
@@ -322,8 +347,9 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> Value
             )
         })
         .collect();
-    let colour = e.colour.as_ref().map(|(png, scale)| {
-        json!({"image": glb.image(png, "image/png", name("transfer colour")), "scale": scale})
+    let colour = e.colour.as_ref().map(|(png, scale)| ScaledImage {
+        image: glb.image(png, "image/png", name("transfer colour")),
+        scale: *scale,
     });
     sizes[0] += (glb.binary_bytes() - before) as u64;
     let before = glb.binary_bytes();
@@ -339,20 +365,31 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> Value
     let albedo = glb.image(&e.albedo.0, "image/png", name("albedo"));
     sizes[3] += (glb.binary_bytes() - before) as u64;
     let before = glb.binary_bytes();
-    let mut flows = serde_json::Map::new();
+    let mut flows = BTreeMap::new();
     for (n, bytes) in &e.flows {
         let image = glb.image(bytes, "image/png", name(&format!("flow {}", n.name())));
-        flows.insert(n.name().to_string(), json!(image));
+        flows.insert(n.name().to_string(), image);
     }
     sizes[4] += (glb.binary_bytes() - before) as u64;
-    json!({
-        "u": e.u, "v": e.v, "turntable_deg": e.turntable_deg, "camera": e.camera,
-        "alpha": alpha,
-        "transfer": {"images": atlas, "scale": e.atlas.scale, "offset": e.atlas.offset, "colour": colour},
-        "normals": normals,
-        "albedo": {"image": albedo, "scale": e.albedo.1},
-        "flows": flows,
-    })
+    ViewRecord {
+        u: e.u,
+        v: e.v,
+        turntable_deg: e.turntable_deg,
+        camera: e.camera,
+        alpha,
+        transfer: Transfer {
+            images: atlas,
+            scale: e.atlas.scale,
+            offset: e.atlas.offset,
+            colour,
+        },
+        normals,
+        albedo: ScaledImage {
+            image: albedo,
+            scale: e.albedo.1,
+        },
+        flows,
+    }
 }
 
 /// A field of one view (an OLAT set) or one condition (a ring of photographs) has
@@ -445,7 +482,7 @@ fn encode_view(
         u,
         v,
         turntable_deg: rec.turntable_deg,
-        camera: camera_json(&rec.camera),
+        camera: rec.camera.clone(),
         atlas,
         colour,
         alpha: alpha_png(&alpha)?,
@@ -455,19 +492,13 @@ fn encode_view(
     })
 }
 
-/// A camera as the extension holds it.
-fn camera_json(c: &frf_reflectance::field::CameraRecord) -> Value {
-    json!({"width": c.width, "height": c.height, "intrinsics": c.intrinsics,
-           "world_from_camera": c.world_from_camera})
-}
-
 /// The walk: each pose's node at scale 1 from its time to the next pose's, 0 otherwise,
 /// over one cycle.
 fn pose_animation(
     glb: &mut Glb,
     poses: &[u32],
     header: &frf_reflectance::FieldHeader,
-    pose_json: &[Value],
+    nodes_of: &[usize],
 ) -> Value {
     let period = header.cycle_seconds as f32 / header.poses_per_cycle.max(1) as f32;
     // A last key at the cycle's end shows the first pose again: the walk loops.
@@ -475,7 +506,7 @@ fn pose_animation(
     let input = glb.scalars(&times);
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
-    for (i, p) in pose_json.iter().enumerate() {
+    for (i, node) in nodes_of.iter().enumerate() {
         let scales: Vec<[f32; 3]> = (0..=poses.len())
             .map(|k| {
                 if k % poses.len() == i {
@@ -488,7 +519,7 @@ fn pose_animation(
         let output = glb.vec3_values(&scales);
         samplers.push(json!({"input": input, "output": output, "interpolation": "STEP"}));
         channels.push(
-            json!({"sampler": samplers.len() - 1, "target": {"node": p["node"], "path": "scale"}}),
+            json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": "scale"}}),
         );
     }
     json!({"name": "walk", "samplers": samplers, "channels": channels})

@@ -71,68 +71,114 @@ fn relights_as_frf(tier: Tier, floor_db: f64) {
         eprintln!("{tier:?} view {u},{v}: exported transfer against frf's relighting {psnr:.2} dB");
         assert!(psnr > floor_db, "{tier:?} view {u},{v}: {psnr:.2} dB");
     }
-    // What the schema requires is there.
+    // The schema names exactly the keys of what the writer wrote and the reader parsed
+    // (the types of `frf_export::model`), at every object it describes.
     let schema: serde_json::Value = serde_json::from_str(include_str!(
         "../schema/FRF_flowed_reflectance_field.schema.json"
     ))
     .unwrap();
-    let required = |v: &serde_json::Value| -> Vec<String> {
-        v["required"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|k| k.as_str().unwrap().to_string())
-            .collect()
-    };
-    for key in required(&schema) {
-        assert!(!glb.field()[&key].is_null(), "the extension lacks {key}");
-    }
-    let pose = &glb.field()["poses"][0];
-    for key in required(&schema["properties"]["poses"]["items"]) {
-        assert!(!pose[&key].is_null(), "a pose lacks {key}");
-    }
-    // Every camera of the grid, with what a camera requires.
-    let grid = &glb.field()["grid"];
-    let cameras = pose["cameras"].as_array().unwrap();
-    assert_eq!(
-        cameras.len() as u64,
-        grid["columns"].as_u64().unwrap() * grid["rows"].as_u64().unwrap()
+    let written = serde_json::to_value(glb.field()).unwrap();
+    let problems = schema_keys(&schema, &written, &schema, "extension");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    // Control: a key the schema does not name, and one it names gone, are both found.
+    let mut changed = written.clone();
+    changed["grid"]["depth"] = serde_json::json!(1);
+    changed["poses"][0]["views"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("turntable_deg");
+    let found = schema_keys(&schema, &changed, &schema, "extension").join("\n");
+    assert!(
+        found.contains("extension.grid.depth: not in the schema"),
+        "{found}"
     );
-    for key in required(&schema["$defs"]["camera"]) {
-        assert!(
-            cameras.iter().all(|c| !c[&key].is_null()),
-            "a camera lacks {key}"
-        );
-    }
-    for view in pose["views"].as_array().unwrap() {
-        for key in required(&schema["$defs"]["view"]) {
-            assert!(!view[&key].is_null(), "a view lacks {key}");
-        }
+    assert!(
+        found.contains("views[0].turntable_deg: in the schema, not written"),
+        "{found}"
+    );
+    let ext = glb.field();
+    let pose = &ext.poses[0];
+    // Every camera of the grid.
+    assert_eq!(pose.cameras.len(), ext.grid.columns * ext.grid.rows);
+    for view in &pose.views {
         let atlases = if tier == Tier::Full { 3 } else { 1 };
-        assert_eq!(
-            view["transfer"]["images"].as_array().unwrap().len(),
-            atlases
-        );
-        assert_eq!(view["transfer"]["colour"].is_null(), tier == Tier::Full);
+        assert_eq!(view.transfer.images.len(), atlases);
+        assert_eq!(view.transfer.colour.is_none(), tier == Tier::Full);
     }
     // The walk's speed and stride, as the field records them.
-    let walk = &glb.field()["walk"];
+    let walk = ext.walk.expect("the tiny stage records its belt's speed");
     let field = frf_reflectance::FieldFile::open(&frf_testkit::tiny_field().field).unwrap();
     let h = field.header();
     let speed = h
         .gait_speed_mps
         .expect("the tiny stage records its belt's speed");
-    assert!(
-        (walk["speed_mps"].as_f64().unwrap() - speed).abs() < 1e-9,
-        "{walk}"
-    );
-    assert!((walk["stride_m"].as_f64().unwrap() - speed * h.cycle_seconds).abs() < 1e-9);
-    assert_eq!(walk["measured"], false);
+    assert!((walk.speed_mps - speed).abs() < 1e-9, "{walk:?}");
+    assert!((walk.stride_m - speed * h.cycle_seconds).abs() < 1e-9);
+    assert!(!walk.measured);
     // The walk: a node per pose under the walker, an animation switching them.
     let d = &glb.document;
     assert_eq!(d["nodes"][0]["children"].as_array().unwrap().len(), 1);
     assert_eq!(d["animations"][0]["channels"].as_array().unwrap().len(), 1);
     assert!(d["meshes"][0]["primitives"][0]["attributes"]["POSITION"].is_u64());
+}
+
+/// Where `value` and the JSON schema `schema` (of root `root`) disagree on keys: at every
+/// object the schema describes (`properties`), a key it does not name, one it names that
+/// is absent, or one it requires that is null. Follows `$ref` into `$defs`, `items`,
+/// `anyOf` (null, or one branch that fits) and `additionalProperties`.
+fn schema_keys(
+    schema: &serde_json::Value,
+    value: &serde_json::Value,
+    root: &serde_json::Value,
+    at: &str,
+) -> Vec<String> {
+    if let Some(r) = schema["$ref"].as_str() {
+        let name = r.trim_start_matches("#/$defs/");
+        return schema_keys(&root["$defs"][name], value, root, at);
+    }
+    if let Some(branches) = schema["anyOf"].as_array() {
+        if value.is_null() {
+            return Vec::new();
+        }
+        let fits = branches
+            .iter()
+            .filter(|b| b["type"] != "null")
+            .map(|b| schema_keys(b, value, root, at))
+            .min_by_key(Vec::len);
+        return fits.unwrap_or_default();
+    }
+    let mut out = Vec::new();
+    if let (Some(props), Some(object)) = (schema["properties"].as_object(), value.as_object()) {
+        for key in object.keys().filter(|k| !props.contains_key(*k)) {
+            out.push(format!("{at}.{key}: not in the schema"));
+        }
+        for (key, sub) in props {
+            match object.get(key) {
+                None => out.push(format!("{at}.{key}: in the schema, not written")),
+                Some(v) => out.extend(schema_keys(sub, v, root, &format!("{at}.{key}"))),
+            }
+        }
+        let required = schema["required"].as_array().into_iter().flatten();
+        for key in required.filter_map(|k| k.as_str()) {
+            if object.get(key).is_none_or(serde_json::Value::is_null) {
+                out.push(format!("{at}.{key}: required, null"));
+            }
+        }
+    }
+    if let (Some(items), Some(array)) = (schema.get("items"), value.as_array()) {
+        for (i, v) in array.iter().enumerate() {
+            out.extend(schema_keys(items, v, root, &format!("{at}[{i}]")));
+        }
+    }
+    if let (Some(each), Some(object)) = (
+        schema.get("additionalProperties").filter(|a| a.is_object()),
+        value.as_object(),
+    ) {
+        for (key, v) in object {
+            out.extend(schema_keys(each, v, root, &format!("{at}.{key}")));
+        }
+    }
+    out
 }
 
 /// `bytes` with the first `from` replaced by `to` (of the same length).
@@ -243,7 +289,7 @@ fn a_field_without_normals_exports_without_them_and_says_so() {
         report.notes
     );
     let glb = Export::open(&out).unwrap();
-    assert!(glb.view(0, 3, 1).unwrap()["normals"].is_null());
+    assert!(glb.view(0, 3, 1).unwrap().normals.is_none());
     // Relighting by the transfer does not need them.
     assert!(glb.relight(0, 3, 1, &light()).is_ok());
 }
@@ -261,7 +307,7 @@ fn flows_are_the_fields_within_a_code_and_extended_beyond_the_subject() {
     let glb = Export::open(&out).unwrap();
     let field = FieldFile::open(&f.field).unwrap();
     let view = glb.view(0, 5, 1).unwrap();
-    let index = view["flows"]["right"].as_u64().unwrap() as usize;
+    let index = view.flows["right"];
     let png = image::load_from_memory(glb.image_bytes(index).unwrap())
         .unwrap()
         .into_luma_alpha16();

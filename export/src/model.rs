@@ -1,0 +1,135 @@
+//! The extension's object ([`crate::format::EXTENSION`]) as types: the writer builds one
+//! and serialises it, the reader parses into it, and a test holds the JSON schema
+//! (`export/schema/`) to what they serialise (every object closed to other keys), so the
+//! writer, the reader and the schema cannot drift apart. docs/export.md says what each
+//! field means.
+
+use std::collections::BTreeMap;
+
+use frf_core::image::Rgb;
+use frf_core::sh::{Convention, SH_COUNT};
+use frf_reflectance::field::CameraRecord;
+use serde::{Deserialize, Serialize};
+
+/// The extension's object.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Extension {
+    /// The format's version ([`crate::format::VERSION`]).
+    pub version: u32,
+    /// How the transfer is stored.
+    pub tier: TierName,
+    /// The convention of the transfer's nine coefficients.
+    pub sh: Convention,
+    /// The capture's grid of cameras.
+    pub grid: Grid,
+    /// Seconds a walk cycle takes.
+    pub cycle_seconds: f64,
+    /// Poses a cycle holds.
+    pub poses_per_cycle: u32,
+    /// The walk's speed, where the field records it or its hulls tell it (root motion).
+    pub walk: Option<Walk>,
+    /// The field's file name.
+    pub source: Option<String>,
+    /// The poses exported.
+    pub poses: Vec<PoseRecord>,
+}
+
+/// How the transfer is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TierName {
+    /// Three atlases, one a channel.
+    Full,
+    /// One grey atlas and a colour per texel.
+    Compact,
+}
+
+/// The capture's grid of cameras.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Grid {
+    /// Views round the turntable (walk cycles).
+    pub columns: usize,
+    /// Camera heights.
+    pub rows: usize,
+    /// Whether the columns close into a ring.
+    pub wraps: bool,
+    /// Captured image width, pixels.
+    pub width: u32,
+    /// Captured image height, pixels.
+    pub height: u32,
+}
+
+/// The walk's speed (root motion).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Walk {
+    /// Metres a second.
+    pub speed_mps: f64,
+    /// Metres a cycle.
+    pub stride_m: f64,
+    /// The direction walked, in the subject frame.
+    pub forward: [f64; 3],
+    /// Whether the speed was measured from the hulls (the field records none).
+    pub measured: bool,
+}
+
+/// One pose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PoseRecord {
+    /// The pose's index in the field.
+    pub pose: u32,
+    /// Its time in the cycle, seconds.
+    pub time_s: f64,
+    /// Its node (the hull mesh).
+    pub node: usize,
+    /// Every camera of the grid, `u`-major (a player re-bins rays through them all).
+    pub cameras: Vec<CameraRecord>,
+    /// How far from the hull's surface a sun's shadow ray starts, metres.
+    pub sun_shadow_offset_m: f32,
+    /// The views exported.
+    pub views: Vec<ViewRecord>,
+}
+
+/// One view of a pose.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ViewRecord {
+    /// Its column.
+    pub u: usize,
+    /// Its row.
+    pub v: usize,
+    /// The turntable's angle when it was captured, degrees.
+    pub turntable_deg: f32,
+    /// Its camera.
+    pub camera: CameraRecord,
+    /// Its alpha (an image's index).
+    pub alpha: usize,
+    /// Its SH transfer.
+    pub transfer: Transfer,
+    /// Its fitted normals (an image's index), where the field holds them.
+    pub normals: Option<usize>,
+    /// Its albedo.
+    pub albedo: ScaledImage,
+    /// Its flows toward its grid neighbours, by the neighbour's name (an image's index).
+    pub flows: BTreeMap<String, usize>,
+}
+
+/// A view's SH transfer: per coefficient and channel, `offset + scale × code`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Transfer {
+    /// The atlases (images' indices): three (red, green, blue) or one (grey, compact).
+    pub images: Vec<usize>,
+    /// Per coefficient and channel: a code's step.
+    pub scale: [Rgb; SH_COUNT],
+    /// Per coefficient and channel: the value of code 0.
+    pub offset: [Rgb; SH_COUNT],
+    /// The compact tier's colour per texel.
+    pub colour: Option<ScaledImage>,
+}
+
+/// An image and the scale of its codes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScaledImage {
+    /// The image's index.
+    pub image: usize,
+    /// Per channel: the value of code 255.
+    pub scale: Rgb,
+}
