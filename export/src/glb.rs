@@ -1,5 +1,6 @@
 //! A small binary glTF 2.0 writer: one buffer (the GLB's binary chunk) of 4-byte
-//! aligned views, accessors, images, and a JSON document the caller fills.
+//! aligned views, accessors, images, and a JSON document the caller fills; and the GLB
+//! container both ways ([`pack`], [`unpack`]), its layout named once here.
 
 use serde_json::{Value, json};
 
@@ -117,6 +118,19 @@ impl Glb {
     }
 }
 
+/// The container's magic, first in the file.
+pub const MAGIC: &[u8; 4] = b"glTF";
+/// The container's version.
+pub const CONTAINER_VERSION: u32 = 2;
+/// Bytes of the file's header (magic, version, total length).
+pub const HEADER_BYTES: usize = 12;
+/// Bytes of a chunk's header (length, type).
+pub const CHUNK_HEADER_BYTES: usize = 8;
+/// The JSON chunk's type.
+pub const JSON_CHUNK: &[u8; 4] = b"JSON";
+/// The binary chunk's type.
+pub const BIN_CHUNK: &[u8; 4] = b"BIN\0";
+
 /// A GLB container of `document` and the binary chunk `bin` (whose length is a multiple of
 /// four): the header, the JSON chunk padded with spaces, the binary chunk.
 pub fn pack(document: &Value, bin: &[u8]) -> Vec<u8> {
@@ -124,16 +138,77 @@ pub fn pack(document: &Value, bin: &[u8]) -> Vec<u8> {
     while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
-    let total = 12 + 8 + text.len() + 8 + bin.len();
+    let total = HEADER_BYTES + CHUNK_HEADER_BYTES + text.len() + CHUNK_HEADER_BYTES + bin.len();
     let mut out = Vec::with_capacity(total);
-    out.extend_from_slice(b"glTF");
-    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&CONTAINER_VERSION.to_le_bytes());
     out.extend_from_slice(&(total as u32).to_le_bytes());
     out.extend_from_slice(&(text.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(JSON_CHUNK);
     out.extend_from_slice(&text);
     out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
-    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(BIN_CHUNK);
     out.extend_from_slice(bin);
     out
+}
+
+/// The JSON document and the binary chunk of a GLB container, checked whole; what is
+/// wrong with it otherwise.
+pub fn unpack(bytes: &[u8]) -> Result<(Value, &[u8]), String> {
+    let word = |at: usize| -> Option<u32> {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    if bytes.get(0..4) != Some(MAGIC.as_slice()) {
+        return Err("not a binary glTF file (no glTF magic)".into());
+    }
+    if word(4) != Some(CONTAINER_VERSION) {
+        return Err(format!(
+            "glTF container version {:?}, expected {CONTAINER_VERSION}",
+            word(4)
+        ));
+    }
+    let total = word(8).unwrap_or(0) as usize;
+    if total != bytes.len() {
+        return Err(format!(
+            "its header says {total} bytes and it has {}: truncated or appended to",
+            bytes.len()
+        ));
+    }
+    let json_at = HEADER_BYTES + CHUNK_HEADER_BYTES;
+    let json_len = word(HEADER_BYTES).ok_or("no JSON chunk")? as usize;
+    if bytes.get(HEADER_BYTES + 4..json_at) != Some(JSON_CHUNK.as_slice())
+        || json_at + json_len > bytes.len()
+    {
+        return Err("the first chunk is not a whole JSON chunk".into());
+    }
+    let document: Value = serde_json::from_slice(&bytes[json_at..json_at + json_len])
+        .map_err(|e| format!("its JSON chunk does not parse: {e}"))?;
+    let at = json_at + json_len;
+    let bin_len = word(at).ok_or("no binary chunk")? as usize;
+    let bin_at = at + CHUNK_HEADER_BYTES;
+    if bytes.get(at + 4..bin_at) != Some(BIN_CHUNK.as_slice()) || bin_at + bin_len > bytes.len() {
+        return Err("the second chunk is not a whole binary chunk".into());
+    }
+    Ok((document, &bytes[bin_at..bin_at + bin_len]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_container_unpacks_to_what_was_packed_and_a_cut_one_is_refused() {
+        let document = json!({"asset": {"version": "2.0"}, "odd": "x"});
+        let bin = [1u8, 2, 3, 4, 5, 6, 7, 8];
+        let bytes = pack(&document, &bin);
+        let (back, chunk) = unpack(&bytes).unwrap();
+        assert_eq!((back, chunk), (document, &bin[..]));
+        let cut = unpack(&bytes[..bytes.len() - 4]).unwrap_err();
+        assert!(cut.contains("truncated"), "{cut}");
+        let mut other = bytes.clone();
+        other[0] = b'x';
+        assert!(unpack(&other).unwrap_err().contains("no glTF magic"));
+    }
 }

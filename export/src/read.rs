@@ -37,39 +37,8 @@ impl Export {
             file: path.to_path_buf(),
             problem,
         };
-        let word = |at: usize| -> Option<u32> {
-            bytes
-                .get(at..at + 4)
-                .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        };
-        if bytes.get(0..4) != Some(b"glTF") {
-            return Err(bad("not a binary glTF file (no glTF magic)".into()));
-        }
-        if word(4) != Some(2) {
-            return Err(bad(format!(
-                "glTF container version {:?}, expected 2",
-                word(4)
-            )));
-        }
-        let total = word(8).unwrap_or(0) as usize;
-        if total != bytes.len() {
-            return Err(bad(format!(
-                "its header says {total} bytes and it has {}: truncated or appended to",
-                bytes.len()
-            )));
-        }
-        let json_len = word(12).ok_or_else(|| bad("no JSON chunk".into()))? as usize;
-        if bytes.get(16..20) != Some(b"JSON") || 20 + json_len > bytes.len() {
-            return Err(bad("the first chunk is not a whole JSON chunk".into()));
-        }
-        let document: Value = serde_json::from_slice(&bytes[20..20 + json_len])
-            .map_err(|e| bad(format!("its JSON chunk does not parse: {e}")))?;
-        let at = 20 + json_len;
-        let bin_len = word(at).ok_or_else(|| bad("no binary chunk".into()))? as usize;
-        if bytes.get(at + 4..at + 8) != Some(b"BIN\0") || at + 8 + bin_len > bytes.len() {
-            return Err(bad("the second chunk is not a whole binary chunk".into()));
-        }
-        let bin = bytes[at + 8..at + 8 + bin_len].to_vec();
+        let (document, bin) = crate::glb::unpack(bytes).map_err(bad)?;
+        let bin = bin.to_vec();
         let ext = &document["extensions"][EXTENSION];
         if ext.is_null() {
             return Err(bad(format!(

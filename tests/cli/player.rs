@@ -275,12 +275,9 @@ fn the_player_in_chromium_draws_what_frf_renders() {
 /// The GLB `bytes` with its JSON chunk changed by `edit`, packed again as the exporter
 /// packs it.
 fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
-    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-    let json_len = word(12);
-    let mut doc: Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let (mut doc, bin) = frf_export::glb::unpack(bytes).unwrap();
     edit(&mut doc);
-    // The binary chunk after its 8-byte header.
-    frf_export::glb::pack(&doc, &bytes[20 + json_len + 8..])
+    frf_export::glb::pack(&doc, bin)
 }
 
 #[test]
