@@ -37,6 +37,17 @@ pub fn sphere_images(
     lights: &[Vec3],
     surface: &Surface,
 ) -> (Vec<RgbImage>, Vec<bool>) {
+    sphere_images_by(side, lights, |n, l, v| reflect(surface, n, l, v))
+}
+
+/// [`sphere_images`] of another reflectance: `reflect(n, l, v)`, the radiance a unit
+/// light from `l` sends toward `v` off a surface of normal `n` (data the stage's own
+/// model did not make, for judging a fit of that model).
+pub fn sphere_images_by(
+    side: usize,
+    lights: &[Vec3],
+    reflect: impl Fn(Vec3, Vec3, Vec3) -> frf_core::image::Rgb,
+) -> (Vec<RgbImage>, Vec<bool>) {
     let normal = |x: usize, y: usize| {
         let c = side as f32 / 2.0;
         let (u, v) = (
@@ -50,7 +61,7 @@ pub fn sphere_images(
         .iter()
         .map(|&l| {
             Image::from_fn(side, side, |x, y| {
-                normal(x, y).map_or([0.0; 3], |n| reflect(surface, n, l, Vec3::Z))
+                normal(x, y).map_or([0.0; 3], |n| reflect(n, l, Vec3::Z))
             })
         })
         .collect();
