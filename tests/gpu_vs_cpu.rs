@@ -75,6 +75,19 @@ fn assert_relit_within(
     }
 }
 
+/// A camera between the tiny field's 0° and 17° rows and between two of its columns.
+fn between_views() -> Camera {
+    Camera::look_at(
+        Vec3::new(2.2, 1.4, 3.0),
+        Vec3::new(0.0, 0.9, 0.0),
+        Vec3::Y,
+        0.55,
+        64,
+        90,
+    )
+    .unwrap()
+}
+
 fn tiny_source() -> PoseSource {
     tiny_field_source(&EnvMap::sky())
 }
@@ -122,15 +135,7 @@ fn copies_of_one_pose_read_by_other_plans_are_drawn_together_each_its_own() {
     let cpu = ResidentPose::relight_cpu(&half);
     assert_relit_as_the_cpu(&gpu, &a, &ResidentPose::relight_cpu(&full), "every view");
     assert_relit_as_the_cpu(&gpu, &b, &cpu, "every other view");
-    let cam = Camera::look_at(
-        Vec3::new(2.2, 1.4, 3.0),
-        Vec3::new(0.0, 0.9, 0.0),
-        Vec3::Y,
-        0.55,
-        64,
-        90,
-    )
-    .unwrap();
+    let cam = between_views();
     let (g, _) = gpu.render(&b, &cam, Variant::FourWay).unwrap();
     let (c, _) = render_cpu(&cpu, &cam, Variant::FourWay);
     let worst = (g.pixels().iter().zip(c.pixels()))
@@ -399,15 +404,7 @@ fn a_pose_relit_in_place_each_frame_equals_the_cpu_twin_and_a_fresh_upload() {
     let first = fixture.source(&sky);
     let mut pose = gpu.upload_pose(&first).unwrap();
     let shared = pose.basis().unwrap().clone();
-    let cam = Camera::look_at(
-        Vec3::new(2.2, 1.4, 3.0),
-        Vec3::new(0.0, 0.9, 0.0),
-        Vec3::Y,
-        0.55,
-        64,
-        90,
-    )
-    .unwrap();
+    let cam = between_views();
     for (frame, yaw) in [0.4f32, 1.3, 2.9, 4.4].into_iter().enumerate() {
         let lighting = Lighting::Environment {
             env: sky.rotated(yaw),
