@@ -67,7 +67,9 @@ pub fn within_half_turn(degrees: f64) -> f64 {
 }
 
 /// The radians of a turn of `degrees` ([`within_half_turn`] first; an angle within ±180°
-/// converts as `f32::to_radians` converts it).
+/// converts as `f32::to_radians` converts it). A turn is given in degrees, held in double
+/// precision (the command line's `--yaw`, a scene's `yaw_deg`) and made radians here, the
+/// one place, where it turns a map (`EnvMap::rotated`).
 pub fn turn_radians(degrees: f64) -> f32 {
     (within_half_turn(degrees) as f32).to_radians()
 }

@@ -137,13 +137,13 @@ pub fn parse_degrees(s: &str) -> Result<f32, String> {
 /// and kept as the same turn within ±180° ([`frf_core::light::within_half_turn`]: 1e9 is
 /// -80, the turn 1e9 mod 360 names), refused where not finite or beyond
 /// [`frf_core::light::MOST_TURN_DEG`].
-pub fn parse_turn(s: &str) -> Result<f32, String> {
+pub fn parse_turn(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
         .map_err(|e| format!("`{s}`: {e} (degrees)"))?;
     let v = frf_core::light::checked_turn(v).map_err(|e| format!("`{s}`: {e}"))?;
-    Ok(frf_core::light::within_half_turn(v) as f32)
+    Ok(frf_core::light::within_half_turn(v))
 }
 
 /// Parses a vertical field of view in degrees, within the range a camera path allows.
@@ -277,7 +277,7 @@ pub struct LightingArgs {
     /// Yaw of the environment about the vertical axis, degrees (any turn; kept within
     /// ±180°).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_turn)]
-    pub yaw: f32,
+    pub yaw: f64,
     /// What lights the subject from below.
     #[arg(long, value_enum, default_value = "env")]
     pub floor: FloorArg,
@@ -391,7 +391,7 @@ impl LightingArgs {
             let base = env.unwrap_or_else(|| EnvMap::uniform([0.0; 3], 128));
             env = Some(sun.lit(&base)?);
         }
-        let yaw = self.yaw.to_radians();
+        let yaw = frf_core::light::turn_radians(self.yaw);
         Ok(Lighting::of(env, yaw, self.floor.into(), conditions)?)
     }
 }

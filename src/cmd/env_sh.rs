@@ -19,7 +19,7 @@ pub struct EnvShArgs {
     env: EnvSource,
     /// Turn the map about the vertical axis first, degrees (as `frf render --yaw`).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::cmd::args::parse_turn)]
-    yaw: f32,
+    yaw: f64,
     /// Output SH light (`.json`).
     #[arg(long)]
     out: PathBuf,
@@ -34,7 +34,7 @@ pub fn run(args: EnvShArgs) -> CliResult {
     let env = args
         .env
         .load_required("the light to project")?
-        .rotated(args.yaw.to_radians());
+        .rotated(frf_core::light::turn_radians(args.yaw));
     let sh = env.to_sh();
     let kept = energy_kept(&env, &sh);
     let ringing = EnvMap::from_sh_clamped(&sh, SH_MAP_HEIGHT)?;

@@ -153,7 +153,7 @@ fn scene_of_flags(args: &RenderArgs, h: &FieldHeader, pose: u32) -> CliResult<Sc
     }
     let look = FieldLook {
         env: source,
-        yaw_deg: f64::from(args.lighting.yaw),
+        yaw_deg: args.lighting.yaw,
         sun: args.lighting.sun()?,
         floor: args.lighting.floor.into(),
         camera: trajectory,

@@ -133,7 +133,7 @@ struct TruthArgs {
     env: Option<EnvSource>,
     /// Yaw of the environment, degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::cmd::args::parse_turn)]
-    yaw: f32,
+    yaw: f64,
     /// Median-cut lights the environment is reduced to.
     #[arg(long, default_value_t = DEFAULT_ENVIRONMENT_LIGHTS)]
     lights: usize,
@@ -246,7 +246,7 @@ fn truth(args: TruthArgs) -> CliResult {
         (Some(source), _) => TruthLight::Environment {
             env: source
                 .load_required("a truth image needs lighting, or --basis")?
-                .rotated(args.yaw.to_radians()),
+                .rotated(frf_core::light::turn_radians(args.yaw)),
             name: source.to_string(),
             lights: args.lights,
         },

@@ -37,7 +37,7 @@ pub struct ViewArgs {
     pub env: Vec<EnvSource>,
     /// Yaw of a field's environment, degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_turn)]
-    pub yaw: f32,
+    pub yaw: f64,
     /// What lights a field's subject from below.
     #[arg(long, value_enum, default_value = "env")]
     pub floor: FloorArg,
@@ -76,7 +76,7 @@ fn field_scene(args: &ViewArgs, field: &FieldFile) -> CliResult<Scene> {
     let env = args.env.first().cloned().unwrap_or(EnvSource::Sky);
     let look = FieldLook {
         sun: args.sun.as_ref().map(SunSpec::sun).transpose()?,
-        ..FieldLook::viewer(env, f64::from(args.yaw), args.floor.into())
+        ..FieldLook::viewer(env, args.yaw, args.floor.into())
     };
     // The walk plays from pose 0.
     Ok(Scene {
