@@ -30,10 +30,15 @@ struct Shot {
 /// The camera blended bilinearly from pose 0's grid cameras at fractional `(u, v)`:
 /// a captured view at integers, a quad's centre at halves.
 fn grid_camera(document: &Value, u: f32, v: f32) -> Shot {
+    grid_camera_of(document, 0, u, v)
+}
+
+/// [`grid_camera`] of the export's `at`-th pose's cameras.
+fn grid_camera_of(document: &Value, at: usize, u: f32, v: f32) -> Shot {
     let ext = &document["extensions"]["FRF_flowed_reflectance_field"];
     let rows = ext["grid"]["rows"].as_u64().unwrap() as usize;
     let columns = ext["grid"]["columns"].as_u64().unwrap() as usize;
-    let cameras = ext["poses"][0]["cameras"].as_array().unwrap();
+    let cameras = ext["poses"][at]["cameras"].as_array().unwrap();
     let (u0, v0) = (u.floor() as usize, v.floor() as usize);
     let (fu, fv) = (u - u0 as f32, v - v0 as f32);
     let mut eye = [0.0f32; 3];
@@ -68,7 +73,7 @@ fn list(v: [f32; 3]) -> String {
     format!("{},{},{}", v[0], v[1], v[2])
 }
 
-/// `node player/screenshot.mjs` of `shot`.
+/// `node player/screenshot.mjs` of `shot`, pose 0.
 fn screenshot(
     glb: &Path,
     sh: &Path,
@@ -76,6 +81,18 @@ fn screenshot(
     size: &str,
     sun: Option<&str>,
     out: &Path,
+) -> Output {
+    screenshot_pose(glb, sh, shot, (size, sun), out, 0)
+}
+
+/// [`screenshot`] of `pose`.
+fn screenshot_pose(
+    glb: &Path,
+    sh: &Path,
+    shot: &Shot,
+    (size, sun): (&str, Option<&str>),
+    out: &Path,
+    pose: u32,
 ) -> Output {
     assert!(
         player().join("node_modules/puppeteer-core").exists(),
@@ -85,7 +102,7 @@ fn screenshot(
     c.arg(player().join("screenshot.mjs"))
         .arg("--glb")
         .arg(glb)
-        .args(["--pose", "0", "--size", size, "--json"])
+        .args(["--pose", &pose.to_string(), "--size", size, "--json"])
         .arg(format!("--camera={}", list(shot.eye)))
         .arg(format!("--look-at={}", list(shot.look_at)))
         .args(["--fov", &shot.fov_deg.to_string()])
@@ -108,6 +125,18 @@ fn frf_frame(
     size: &str,
     sun: Option<&str>,
     dir: &Path,
+) -> PathBuf {
+    frf_frame_pose(field, sh, shot, (size, sun), dir, None)
+}
+
+/// [`frf_frame`] of `pose` (`None`: the field's first).
+fn frf_frame_pose(
+    field: &Path,
+    sh: &Path,
+    shot: &Shot,
+    (size, sun): (&str, Option<&str>),
+    dir: &Path,
+    pose: Option<u32>,
 ) -> PathBuf {
     let path = dir.join("camera.toml");
     std::fs::write(
@@ -142,6 +171,9 @@ fn frf_frame(
     if let Some(s) = sun {
         // The player's --sun is frf's.
         args.extend(["--sun".into(), s.to_string()]);
+    }
+    if let Some(p) = pose {
+        args.extend(["--pose".into(), p.to_string()]);
     }
     args.extend(frf_testkit::cpu_flag().map(String::from));
     let refs: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -529,4 +561,64 @@ fn the_player_says_what_it_cannot_draw() {
         stderr(&o)
     );
     assert!(!out.exists());
+}
+
+/// A walker of two poses that differ (issue 59: the player's test exported one pose and
+/// could not see a wrong one): the player draws pose 6 as frf renders it, and pose 0
+/// drawn in its place (a player showing the wrong pose) misses by far.
+#[test]
+fn the_player_draws_the_pose_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let (capture, field) = (dir.path().join("capture"), dir.path().join("two.frf"));
+    let made = frf(&[
+        "stage",
+        "--preset",
+        "tiny",
+        "--poses",
+        "0,6",
+        "--perturbation",
+        "0",
+        "--out",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let made = frf(&[
+        "stage",
+        "field",
+        "--capture",
+        capture.to_str().unwrap(),
+        "--out",
+        field.to_str().unwrap(),
+    ]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let glb = dir.path().join("two.glb");
+    let o = frf(&[
+        "export",
+        field.to_str().unwrap(),
+        "--out",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sh = dir.path().join("sky.json");
+    let o = frf(&["env-sh", "sky", "--out", sh.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let document = frf_export::read::Export::open(&glb).unwrap().document;
+    // A captured view of pose 6 (the export's second).
+    let shot = grid_camera_of(&document, 1, 3.0, 1.0);
+    let reference = frf_frame_pose(&field, &sh, &shot, ("64x90", None), dir.path(), Some(6));
+    let score = |pose: u32| {
+        let out = dir.path().join(format!("player{pose}.png"));
+        let o = screenshot_pose(&glb, &sh, &shot, ("64x90", None), &out, pose);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(report["pose"], pose);
+        subject_psnr(&reference, &out)
+    };
+    let (right, wrong) = (score(6), score(0));
+    eprintln!("pose 6 against frf's pose 6: {right:.2} dB; pose 0 in its place {wrong:.2} dB");
+    assert!(right >= 35.0, "{right:.2} dB");
+    assert!(
+        wrong < right - 5.0,
+        "pose 0 {wrong:.2} dB against pose 6 {right:.2}"
+    );
 }
