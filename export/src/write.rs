@@ -209,38 +209,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     }
     let nodes_of: Vec<usize> = pose_records.iter().map(|p| p.node).collect();
     let animation = pose_animation(&mut glb, &poses, &header, &nodes_of);
-    // The walk's speed as the field records it or its hulls tell it: what an engine moves
-    // the walker by so that its feet stay planted (docs/export.md, "Root motion").
-    let walk = frf_reflectance::gait_speed::gait_speed_mps(&field)?.map(|speed| Walk {
-        speed_mps: speed,
-        stride_m: speed * header.cycle_seconds,
-        forward: [1.0, 0.0, 0.0],
-        measured: header.gait_speed_mps.is_none(),
-    });
-    let extension = Extension {
-        version: VERSION,
-        tier: match options.tier {
-            Tier::Full => TierName::Full,
-            Tier::Compact => TierName::Compact,
-        },
-        sh: Convention::frf(),
-        grid: Grid {
-            columns: header.columns,
-            rows: header.rows,
-            wraps: header.wraps,
-            width: header.width,
-            height: header.height,
-        },
-        cycle_seconds: header.cycle_seconds,
-        poses_per_cycle: header.poses_per_cycle,
-        walk,
-        source: field_path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned()),
-        poses: pose_records,
-    };
-    let extension = serde_json::to_value(&extension)
-        .map_err(|e| ExportError::Field(format!("the extension's JSON: {e}")))?;
+    let extension = extension_of(&field, field_path, options.tier, pose_records)?;
     let document = json!({
         "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
         "extensionsUsed": [EXTENSION],
@@ -272,6 +241,49 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         seconds: started.elapsed().as_secs_f64(),
         notes,
     })
+}
+
+/// The extension's object ([`crate::model`]) of `field` (read from `field_path`) holding
+/// `poses`, as JSON.
+fn extension_of(
+    field: &FieldFile,
+    field_path: &Path,
+    tier: Tier,
+    poses: Vec<PoseRecord>,
+) -> Result<Value> {
+    let header = field.header();
+    // The walk's speed as the field records it or its hulls tell it: what an engine moves
+    // the walker by so that its feet stay planted (docs/export.md, "Root motion").
+    let walk = frf_reflectance::gait_speed::gait_speed_mps(field)?.map(|speed| Walk {
+        speed_mps: speed,
+        stride_m: speed * header.cycle_seconds,
+        forward: [1.0, 0.0, 0.0],
+        measured: header.gait_speed_mps.is_none(),
+    });
+    let extension = Extension {
+        version: VERSION,
+        tier: match tier {
+            Tier::Full => TierName::Full,
+            Tier::Compact => TierName::Compact,
+        },
+        sh: Convention::frf(),
+        grid: Grid {
+            columns: header.columns,
+            rows: header.rows,
+            wraps: header.wraps,
+            width: header.width,
+            height: header.height,
+        },
+        cycle_seconds: header.cycle_seconds,
+        poses_per_cycle: header.poses_per_cycle,
+        walk,
+        source: field_path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned()),
+        poses,
+    };
+    serde_json::to_value(&extension)
+        .map_err(|e| ExportError::Field(format!("the extension's JSON: {e}")))
 }
 
 /// Poses, and views `(u, v)`.
