@@ -101,31 +101,31 @@ impl Proxy {
     /// The proxy as the GPU reads it: its description and the hull's occupancy words
     /// (one empty word without a hull: a binding is never empty).
     pub fn gpu(&self) -> (GpuProxy, Vec<u32>) {
-        let (info, words) = match self.hull.as_deref() {
+        let words = self.hull.as_deref().map_or_else(|| vec![0], |h| h.words());
+        (self.gpu_info(), words)
+    }
+
+    /// [`Proxy::gpu`]'s description alone (the hull's words are not copied).
+    pub fn gpu_info(&self) -> GpuProxy {
+        let info = match self.hull.as_deref() {
             Some(h) => {
                 let g = h.grid();
-                (
-                    GpuProxy {
-                        origin: g.origin,
-                        voxel: g.voxel_m,
-                        dims: g.dims,
-                        present: 1,
-                        block_words_at: h.block_words_at() as u32,
-                        block: BLOCK as u32,
-                        ..Zeroable::zeroed()
-                    },
-                    h.words(),
-                )
+                GpuProxy {
+                    origin: g.origin,
+                    voxel: g.voxel_m,
+                    dims: g.dims,
+                    present: 1,
+                    block_words_at: h.block_words_at() as u32,
+                    block: BLOCK as u32,
+                    ..Zeroable::zeroed()
+                }
             }
-            None => (GpuProxy::zeroed(), vec![0]),
+            None => GpuProxy::zeroed(),
         };
-        (
-            GpuProxy {
-                axis: self.axis.to_array(),
-                ..info
-            },
-            words,
-        )
+        GpuProxy {
+            axis: self.axis.to_array(),
+            ..info
+        }
     }
 
     /// Bytes the proxy holds where it is rendered.

@@ -13,8 +13,8 @@ use wgpu::util::DeviceExt;
 use super::Gpu;
 use super::bind::copy_to_buffer;
 use super::formats::PoseFormats;
-use super::pose_tables::{FlowsAt, PoseTables};
-use super::prelit::{FlowRange, PrelitRange};
+use super::pose_tables::{Flows, PoseTables};
+use super::prelit::PrelitRange;
 use super::relight::{GpuBasis, PoseRelight};
 use crate::error::Result;
 use crate::geometry::PoseGeometry;
@@ -53,14 +53,6 @@ pub struct GpuPose {
     pub geometry: Arc<PoseGeometry>,
     /// The shadow it casts on the ground, when it has shadow maps and a lighting.
     pub(super) shadow: Option<PoseShadow>,
-}
-
-/// Where a resident pose's flows are.
-enum Flows {
-    /// A range of the shared pages, shared by the copies made from the same flows.
-    Shared(Arc<FlowRange>),
-    /// A texture array of its own.
-    Texture(wgpu::Texture),
 }
 
 /// The shadow a resident pose casts ([`super::shadow`]).
@@ -189,7 +181,7 @@ impl Gpu {
         let pass = &self.rebin.pose;
         let tables = self.pose_tables(true, geometry, &source.flows);
         // Scales are set by the relighting pass; a view not relit keeps 1.
-        let range = self.take_prelit(geometry, false);
+        let range = self.take_prelit(geometry);
         let flows = Flows::Shared(self.flow_range(geometry, &source.flows));
         let mut pose = self.resident_pose(pass, tables, (range, flows, None), geometry);
         let hull = pose.geometry.proxy.hull_shared().cloned();
@@ -208,14 +200,10 @@ impl Gpu {
         (prelit, flows, texels): (PrelitRange, Flows, Option<wgpu::Texture>),
         geometry: &Arc<PoseGeometry>,
     ) -> GpuPose {
-        let flows_at = match &flows {
-            Flows::Shared(r) => FlowsAt::Shared(r),
-            Flows::Texture(t) => FlowsAt::Texture(t),
-        };
         let (bind_group, group_key) = self.pose_group(
             (&pass.layout, &pass.sampler),
             &tables,
-            (&prelit, flows_at, texels.as_ref()),
+            (&prelit, &flows, texels.as_ref()),
         );
         GpuPose {
             bind_group,

@@ -46,22 +46,18 @@ pub(super) struct PoseTables {
 #[derive(Default)]
 pub(super) struct TablesKept(Mutex<Vec<Weak<PoseTables>>>);
 
-/// Where a copy's flows are, as its bind group binds them.
-pub(super) enum FlowsAt<'a> {
-    /// A range of the shared pages.
-    Shared(&'a FlowRange),
+/// Where a resident copy's flows are.
+pub(super) enum Flows {
+    /// A range of the shared pages, shared by the copies made from the same flows.
+    Shared(Arc<FlowRange>),
     /// A texture array of its own (decoded flows, the benchmark's).
-    Texture(&'a wgpu::Texture),
+    Texture(wgpu::Texture),
 }
 
-/// The bytes of the tables of `geometry` with `flows`' code table, in the order
-/// [`PoseTables`] holds them: views, quads, code tables, proxy, column index, frames.
-struct TableBytes {
-    parts: [Vec<u8>; 6],
-    hull_words: Vec<u32>,
-}
-
-fn table_parts(geometry: &PoseGeometry, flows: &PoseFlows) -> TableBytes {
+/// The bytes of the tables of `geometry` with `flows`' code table but the hull's (named by
+/// the hull itself, copied only when the tables are made), in the order [`PoseTables`]
+/// holds them: views, quads, code tables, proxy, column index, frames.
+fn table_parts(geometry: &PoseGeometry, flows: &PoseFlows) -> [Vec<u8>; 6] {
     let views: Vec<GpuView> = geometry
         .cameras
         .iter()
@@ -96,23 +92,20 @@ fn table_parts(geometry: &PoseGeometry, flows: &PoseFlows) -> TableBytes {
     let (index, ranges) = geometry.cylinder.column_index_gpu();
     let mut index_bytes = bytemuck::bytes_of(&index).to_vec();
     index_bytes.extend_from_slice(bytemuck::cast_slice(&ranges));
-    let (proxy, hull_words) = geometry.proxy.gpu();
+    let proxy = geometry.proxy.gpu_info();
     let frames: Vec<GpuQuadFrame> = geometry
         .frames
         .iter()
         .map(|f| crate::rectified::gpu_frame(f.as_ref()))
         .collect();
-    TableBytes {
-        parts: [
-            bytemuck::cast_slice(&views).to_vec(),
-            bytemuck::cast_slice(&quads).to_vec(),
-            table_bytes(&[srgb_lut(), flows.table]),
-            bytemuck::bytes_of(&proxy).to_vec(),
-            index_bytes,
-            bytemuck::cast_slice(&frames).to_vec(),
-        ],
-        hull_words,
-    }
+    [
+        bytemuck::cast_slice(&views).to_vec(),
+        bytemuck::cast_slice(&quads).to_vec(),
+        table_bytes(&[srgb_lut(), flows.table]),
+        bytemuck::bytes_of(&proxy).to_vec(),
+        index_bytes,
+        bytemuck::cast_slice(&frames).to_vec(),
+    ]
 }
 
 impl Gpu {
@@ -126,7 +119,7 @@ impl Gpu {
         flows: &PoseFlows,
     ) -> Arc<PoseTables> {
         let made = table_parts(geometry, flows);
-        let key = (made.parts.concat(), geometry.proxy.hull_shared().cloned());
+        let key = (made.concat(), geometry.proxy.hull_shared().cloned());
         let same = |t: &PoseTables| {
             t.key.0 == key.0
                 && match (&t.key.1, &key.1) {
@@ -140,7 +133,8 @@ impl Gpu {
         if shared && let Some(t) = kept.iter().filter_map(Weak::upgrade).find(|t| same(t)) {
             return t;
         }
-        let [views, quads, tables, proxy, index, frames] = &made.parts;
+        let [views, quads, tables, proxy, index, frames] = &made;
+        let (_, hull_words) = geometry.proxy.gpu();
         let storage = |label: &str, contents: &[u8]| {
             buffer_with(&self.device, label, contents, wgpu::BufferUsages::STORAGE)
         };
@@ -150,7 +144,7 @@ impl Gpu {
             quads: storage("quads", quads),
             tables: buffer_with(&self.device, "tables", tables, wgpu::BufferUsages::UNIFORM),
             proxy: storage("proxy", proxy),
-            hull: storage("hull", bytemuck::cast_slice(&made.hull_words)),
+            hull: storage("hull", bytemuck::cast_slice(&hull_words)),
             index: storage("column index", index),
             frames: storage("quad frames", frames),
             quad_count: geometry.cylinder.quads().len() as u32,
@@ -171,7 +165,7 @@ impl Gpu {
         &self,
         (layout, sampler): (&wgpu::BindGroupLayout, &wgpu::Sampler),
         tables: &PoseTables,
-        (prelit, flows, texels): (&PrelitRange, FlowsAt<'_>, Option<&wgpu::Texture>),
+        (prelit, flows, texels): (&PrelitRange, &Flows, Option<&wgpu::Texture>),
     ) -> (wgpu::BindGroup, (u64, usize, usize)) {
         let array = |t: &wgpu::Texture| {
             t.create_view(&wgpu::TextureViewDescriptor {
@@ -180,8 +174,8 @@ impl Gpu {
             })
         };
         let flows_view = match flows {
-            FlowsAt::Texture(t) => Some(array(t)),
-            FlowsAt::Shared(_) => None,
+            Flows::Texture(t) => Some(array(t)),
+            Flows::Shared(_) => None,
         };
         let texels_view = texels.map(array);
         let make = || {
@@ -189,10 +183,10 @@ impl Gpu {
                 entry(0, prelit.page().as_entire_binding()),
                 entry(
                     1,
-                    match (&flows, &flows_view) {
+                    match (flows, &flows_view) {
                         (_, Some(view)) => wgpu::BindingResource::TextureView(view),
-                        (FlowsAt::Shared(r), None) => r.page().as_entire_binding(),
-                        (FlowsAt::Texture(_), None) => unreachable!("made above"),
+                        (Flows::Shared(r), None) => r.page().as_entire_binding(),
+                        (Flows::Texture(_), None) => unreachable!("made above"),
                     },
                 ),
                 entry(2, tables.views.as_entire_binding()),
@@ -216,8 +210,8 @@ impl Gpu {
                 entries: &entries,
             })
         };
-        match (&flows, texels) {
-            (FlowsAt::Shared(f), None) => {
+        match (flows, texels) {
+            (Flows::Shared(f), None) => {
                 let pages = (prelit.page_key(), f.page_key());
                 let mut groups = tables.groups.lock().unwrap_or_else(|e| e.into_inner());
                 let group = match groups.iter().find(|(p, _)| *p == pages) {

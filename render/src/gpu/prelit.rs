@@ -127,16 +127,12 @@ fn heads(geometry: &PoseGeometry, scales: &[f32]) -> Vec<u32> {
 }
 
 impl Gpu {
-    /// A range for a copy of `geometry`'s views: its heads (every scale 1: a view the
-    /// relighting pass does not write keeps it) and, unless `texels_apart` (a texture
-    /// holds them), its pre-lit layers, every texel zero (transparent) once the pending
-    /// work is sent, whoever held the range before.
-    pub(super) fn take_prelit(&self, geometry: &PoseGeometry, texels_apart: bool) -> PrelitRange {
-        let layers = if texels_apart {
-            0
-        } else {
-            geometry.prelit_layer_count
-        };
+    /// A range for a copy of `geometry`'s views, for the relighting pass to write: its
+    /// heads (every scale 1: a view the pass does not write keeps it) and its pre-lit
+    /// layers, every texel zero (transparent) once the pending work is sent, whoever held
+    /// the range before.
+    pub(super) fn take_prelit(&self, geometry: &PoseGeometry) -> PrelitRange {
+        let layers = geometry.prelit_layer_count;
         let texels = geometry.crop.texels();
         let bytes = u64::from(head_words(geometry.views())) * 4 + (layers * texels * 4) as u64;
         let range = PrelitRange {
