@@ -944,11 +944,12 @@ fn a_sun_flag_on_a_scene_is_used_and_said() {
         "[1.2, 1.3, 3.0]",
         "[1.2, 1.3, 3.0]",
     );
-    let render = |out: &str, extra: &[&str]| {
+    // `file`'s first frame (into `out`) with `extra` arguments, and what was said.
+    let render_of = |file: &std::path::Path, out: &str, extra: &[&str]| {
         let out = dir.path().join(out);
         let mut args = vec![
             "render",
-            scene.to_str().unwrap(),
+            file.to_str().unwrap(),
             "--frames",
             "0..1",
             "--cpu",
@@ -959,6 +960,7 @@ fn a_sun_flag_on_a_scene_is_used_and_said() {
         let o = ok(&args);
         (read_exr(&out.join("frame_0000.exr")), stderr(&o))
     };
+    let render = |out: &str, extra: &[&str]| render_of(&scene, out, extra);
     let (plain, _) = render("plain", &[]);
     let (sunlit, said) = render("sunlit", &["--sun", "22,30,0.53,500"]);
     assert!(
@@ -992,21 +994,6 @@ fn a_sun_flag_on_a_scene_is_used_and_said() {
     std::fs::write(&own, with_sun(-120.0, 300.0)).unwrap();
     let same = dir.path().join("same.toml");
     std::fs::write(&same, with_sun(22.0, 500.0)).unwrap();
-    let render_of = |file: &std::path::Path, out: &str, extra: &[&str]| {
-        let out = dir.path().join(out);
-        let mut args = vec![
-            "render",
-            file.to_str().unwrap(),
-            "--frames",
-            "0..1",
-            "--cpu",
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        let o = ok(&args);
-        (read_exr(&out.join("frame_0000.exr")), stderr(&o))
-    };
     let (replaced, said) = render_of(&own, "replaced", &["--sun", "22,30,0.53,500"]);
     assert!(said.contains("--sun: replaces the scene's sun"), "{said}");
     let (reference, _) = render_of(&same, "reference", &[]);
