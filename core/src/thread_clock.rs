@@ -26,24 +26,27 @@ pub fn thread_cpu() -> Option<Duration> {
 mod tests {
     use super::*;
 
-    /// Work advances the thread's CPU time, by no more than the wall time it took;
-    /// sleeping does not advance it.
+    /// Work advances the thread's CPU time, by no more than the wall time it took (give
+    /// or take the two clocks' disagreement on a virtual machine, where the thread's
+    /// clock is the guest scheduler's: a CI run saw 14.7 ms of work in a wall time read
+    /// just short of it); sleeping does not advance it.
     #[test]
     fn work_counts_and_sleeping_does_not() {
+        let wall = std::time::Instant::now();
         let Some(start) = thread_cpu() else {
             eprintln!("skipped: no thread CPU time on this system");
             return;
         };
-        let wall = std::time::Instant::now();
         let mut x = 0u64;
         for i in 0..20_000_000u64 {
             x = x.wrapping_mul(31).wrapping_add(std::hint::black_box(i));
         }
         std::hint::black_box(x);
         let worked = thread_cpu().expect("read once") - start;
+        let elapsed = wall.elapsed();
         assert!(
-            worked > Duration::ZERO && worked <= wall.elapsed(),
-            "{worked:?}"
+            worked > Duration::ZERO && worked <= elapsed + elapsed / 10 + Duration::from_millis(2),
+            "{worked:?} of work in {elapsed:?}"
         );
         let before = thread_cpu().expect("read once");
         std::thread::sleep(Duration::from_millis(100));
