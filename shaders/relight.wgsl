@@ -1,9 +1,10 @@
-// The relighting pass (docs/design.md section 4.1), a batch of views at once (one row of
-// workgroups per view): the weighted sum of each view's basis images (JPEG-decoded 8-bit
+// The relighting pass (docs/design.md section 4.1), every view of every pose copy relit in
+// a submission at once (one row of workgroups per view, its job): the weighted sum of each view's basis images (JPEG-decoded 8-bit
 // gamma-2.2 codes, linearized through the table the CPU uses), then its encoding into its
 // layer of the pose's pre-lit range as sRGB codes of colour / scale, the scale being the
-// view's brightest value, which the encoding also writes at the range's start (the frame
-// pass reads it there: nothing goes back to the host). The codes stay resident
+// view's brightest value, which the encoding also writes in the view's head (the frame
+// pass reads it there: nothing goes back to the host). Every buffer is a shared page (or
+// the submission's own): a job names where its parts lie in each. The codes stay resident
 // between relights; a new light rewrites only the coefficients. Twin of
 // `ResidentPose::relight_cpu` in `render/src/resident.rs`. Compiled after `common.wgsl`.
 //
@@ -13,26 +14,10 @@
 // shading under them; where they barely reach the texel, the normal's shading under the
 // sun times the least-squares ratio of every image to its shading under its condition.
 
-struct RelightParams {
-    // Texels per view (the pose's crop) and its row length.
-    texels: u32,
-    width: u32,
-    // Views in the batch.
-    jobs: u32,
-    // The crop's corner in the image, pixels.
-    x0: u32,
-    y0: u32,
-    // Sun slots per job.
-    sun_slots: u32,
-    // Words from the start of the pose's pre-lit range to its first layer's codes.
-    codes_at: u32,
-    pad: u32,
-}
-
-// One view of the batch: where its codes and coefficients start, how many basis images
-// it has, its index (for its peak) and its layer of the pre-lit texture.
+// One view of a copy (`GpuRelightJob`, `shaders/src/types.rs`, says what each holds).
 struct Job {
     basis_offset: u32,
+    coefficients_at: u32,
     coefficient_offset: u32,
     tiles: u32,
     view: u32,
@@ -41,14 +26,23 @@ struct Job {
     // 1 when its codes are followed by its texels' points on the hull (`t` along their
     // camera rays, as f32 bits).
     surface: u32,
-    pad1: u32,
+    peak: u32,
+    heads_at: u32,
+    codes_at: u32,
+    texels: u32,
+    width: u32,
+    x0: u32,
+    y0: u32,
+    sun_slots: u32,
+    camera: View,
 }
 
-@group(0) @binding(0) var<uniform> params: RelightParams;
 // Per view, tiles x texels, packed RGBA8: the basis codes; tile 0's alpha byte holds the
-// view's alpha code.
+// view's alpha code. A page of every pose's.
 @group(0) @binding(1) var<storage, read> basis: array<u32>;
-// Per view, from its `coefficient_offset`: per tile, rgb = coefficient x tile scale and
+// A page of every copy's coefficients: each copy's batch's from its job's
+// `coefficients_at` on, every index below counting from there ([`co`]). Per view, from its
+// `coefficient_offset`: per tile, rgb = coefficient x tile scale and
 // w = 0 when the condition is not used (by the light or its suns); per tile, where its
 // condition's lights are (x: its cone, its lights after it, y: how many, as f32; for a floor condition relit
 // by the ground's shape, z: where its lights' reweighted shares are, one a vec4 in x,
@@ -69,22 +63,29 @@ struct Job {
 // lights, each its direction (xyz, dome frame) and share of its condition's light (w).
 @group(0) @binding(2) var<storage, read> coefficients: array<vec4<f32>>;
 // Code -> (code / 255)^2.2.
-@group(0) @binding(3) var<uniform> gamma: array<vec4<f32>, 64>;
-// The relit colour (and alpha code) of every texel of every view, between the passes.
-@group(0) @binding(4) var<storage, read_write> relit: array<vec4<f32>>;
-// Per view: the largest relit value, as the bits of a non-negative f32 (whose order
+@group(0) @binding(0) var<uniform> gamma: array<vec4<f32>, 64>;
+// The relit colour (and alpha code) of every texel of every job, between the passes.
+@group(0) @binding(3) var<storage, read_write> relit: array<vec4<f32>>;
+// Per job: the largest relit value, as the bits of a non-negative f32 (whose order
 // `atomicMax` on u32 preserves).
-@group(0) @binding(5) var<storage, read_write> peaks: array<atomic<u32>>;
-// The pose's range of the shared pages (`render/src/gpu/prelit.rs`): per view its head
-// of 8 words, its scale first (f32 bits), then from `params.codes_at` per layer its
-// texels, each packed RGBA8 (the sRGB codes of colour / scale, the alpha code).
-@group(0) @binding(6) var<storage, read_write> prelit: array<u32>;
-@group(0) @binding(7) var<storage, read> jobs: array<Job>;
-// The pose's view table (its cameras).
-@group(0) @binding(8) var<storage, read> views: array<View>;
-// The suns' maps of the hull, one after the other: per texel (x fastest), how far toward
+@group(0) @binding(4) var<storage, read_write> peaks: array<atomic<u32>>;
+// A page of the copies' pre-lit ranges (`render/src/gpu/prelit.rs`): per view its head
+// of 8 words from its job's `heads_at`, its scale first (f32 bits), then from its
+// `codes_at` per layer its texels, each packed RGBA8 (the sRGB codes of colour / scale,
+// the alpha code).
+@group(0) @binding(5) var<storage, read_write> prelit: array<u32>;
+@group(0) @binding(6) var<storage, read> jobs: array<Job>;
+// The suns' maps of the hulls, one after the other: per texel (x fastest), how far toward
 // its sun the hull reaches along its line.
-@group(0) @binding(9) var<storage, read> sun_depths: array<f32>;
+@group(0) @binding(7) var<storage, read> sun_depths: array<f32>;
+
+// Where the invocation's job's coefficients start in their page (`coefficients_at`).
+var<private> coefficients_at: u32;
+
+// The coefficient `i` places from the invocation's job's copy's first.
+fn co(i: u32) -> vec4<f32> {
+    return coefficients[coefficients_at + i];
+}
 
 fn gamma_value(code: u32) -> f32 {
     return gamma[code / 4u][code % 4u];
@@ -92,7 +93,7 @@ fn gamma_value(code: u32) -> f32 {
 
 // Tile k's linear value at texel i of `job`, per unit of its scale.
 fn tile_value(job: Job, k: u32, i: u32) -> vec3<f32> {
-    let code = basis[job.basis_offset + k * params.texels + i];
+    let code = basis[job.basis_offset + k * job.texels + i];
     return vec3<f32>(
         gamma_value(code & 255u),
         gamma_value((code >> 8u) & 255u),
@@ -118,7 +119,7 @@ fn normal_of(cx: u32, cy: u32) -> vec3<f32> {
 // n . m where n sees every light of its cone, 0 where it sees none.
 fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     let first = u32(lights.x);
-    let cone = coefficients[first];
+    let cone = co(first);
     let d = dot(n, cone.xyz);
     if (d >= cone.w) {
         return d;
@@ -128,7 +129,7 @@ fn shading(lights: vec4<f32>, n: vec3<f32>) -> f32 {
     }
     var s = 0.0;
     for (var j = first + 1u; j <= first + u32(lights.y); j++) {
-        let l = coefficients[j];
+        let l = co(j);
         s += l.w * max(dot(n, l.xyz), 0.0);
     }
     return s;
@@ -146,10 +147,10 @@ fn floor_ratio(range: vec4<f32>, n: vec3<f32>) -> f32 {
     var own = 0.0;
     var env = 0.0;
     for (var j = 0u; j < u32(range.y); j++) {
-        let l = coefficients[first + j];
+        let l = co(first + j);
         let d = max(dot(n, l.xyz), 0.0);
         own += l.w * d;
-        env += coefficients[shares + j].x * d;
+        env += co(shares + j).x * d;
     }
     if (own > 0.0 && own >= range.w * env) {
         return env / own;
@@ -164,7 +165,7 @@ fn sun_slot(job: Job, s: u32) -> u32 {
 
 // Tile k's linear value at texel i of `job` times the sun of `slot` per unit of k's light.
 fn sunned(job: Job, slot: u32, k: u32, i: u32) -> vec3<f32> {
-    return coefficients[slot + k].rgb * tile_value(job, k, i);
+    return co(slot + k).rgb * tile_value(job, k, i);
 }
 
 fn lum(c: vec3<f32>) -> f32 {
@@ -175,21 +176,21 @@ fn lum(c: vec3<f32>) -> f32 {
 // none fitted, no trust). Twin of `SunLight::trust` (`reflectance/src/sun_light.rs`).
 fn trust(job: Job, slot: u32, i: u32, n: vec3<f32>) -> f32 {
     let head = slot + job.tiles;
-    let bounds = coefficients[head + 9u];
+    let bounds = co(head + 9u);
     if (all(n == vec3<f32>(0.0)) || bounds.x <= 0.0) {
         return 0.0;
     }
     let directions = job.coefficient_offset + job.tiles;
-    let nearest = coefficients[head + 1u];
-    let weights = coefficients[head + 2u];
-    let held = coefficients[head + 7u];
-    let held_weights = coefficients[head + 8u];
+    let nearest = co(head + 1u);
+    let weights = co(head + 2u);
+    let held = co(head + 7u);
+    let held_weights = co(head + 8u);
     var error = 0.0;
     var plain = 0.0;
     for (var j = 0u; j < min(u32(nearest.w), 2u); j++) {
         let k = u32(nearest[j]);
         let actual = lum(sunned(job, slot, k, i));
-        let wanted = shading(coefficients[directions + k], n);
+        let wanted = shading(co(directions + k), n);
         var shaded = 0.0;
         var interpolated = 0.0;
         for (var m = 0u; m < 2u; m++) {
@@ -198,7 +199,7 @@ fn trust(job: Job, slot: u32, i: u32, n: vec3<f32>) -> f32 {
                 continue;
             }
             let o = u32(held[2u * j + m]);
-            shaded += w * shading(coefficients[directions + o], n);
+            shaded += w * shading(co(directions + o), n);
             interpolated += w * lum(sunned(job, slot, o, i));
         }
         // As the sun is relit: dark where the normal faces away.
@@ -227,10 +228,10 @@ fn texel_surface(job: Job, i: u32) -> vec4<f32> {
     if (job.surface == 0u) {
         return vec4<f32>(0.0, 0.0, 0.0, 2.0);
     }
-    let t = bitcast<f32>(basis[job.basis_offset + job.tiles * params.texels + i]);
-    let view = views[job.view];
+    let t = bitcast<f32>(basis[job.basis_offset + job.tiles * job.texels + i]);
+    let view = job.camera;
     let k = view.intrinsics;
-    let pixel = vec2<f32>(f32(params.x0 + i % params.width), f32(params.y0 + i / params.width));
+    let pixel = vec2<f32>(f32(job.x0 + i % job.width), f32(job.y0 + i / job.width));
     let dc = vec3<f32>((pixel.x - k.z) / k.x, (pixel.y - k.w) / k.y, 1.0);
     let dir = normalize(quat_to_axes(view.rotation) * dc);
     if (t < 0.0) {
@@ -245,13 +246,13 @@ fn texel_surface(job: Job, i: u32) -> vec4<f32> {
 // (`reflectance/src/sun_light.rs`).
 fn sunlit(job: Job, slot: u32, surface: vec3<f32>) -> bool {
     let head = slot + job.tiles;
-    let subject = coefficients[head + 3u];
+    let subject = co(head + 3u);
     if (subject.w <= 0.0) {
         return true;
     }
-    let ax = coefficients[head + 4u];
-    let ay = coefficients[head + 5u];
-    let m = coefficients[head + 6u];
+    let ax = co(head + 4u);
+    let ay = co(head + 5u);
+    let m = co(head + 6u);
     let p = surface + subject.xyz * subject.w;
     let c = floor((vec2<f32>(dot(ax.xyz, p), dot(ay.xyz, p)) - vec2<f32>(ax.w, ay.w)) / m.x);
     if (!(c.x >= 0.0 && c.y >= 0.0 && c.x < m.y && c.y < m.z)) {
@@ -266,9 +267,9 @@ fn sunlit(job: Job, slot: u32, surface: vec3<f32>) -> bool {
 fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     let directions = job.coefficient_offset + job.tiles;
     let head = slot + job.tiles;
-    let sun = coefficients[head];
-    let nearest = coefficients[head + 1u];
-    let weights = coefficients[head + 2u];
+    let sun = co(head);
+    let nearest = co(head + 1u);
+    let weights = co(head + 2u);
     let none = all(n == vec3<f32>(0.0));
     let wanted = max(dot(n, sun.xyz), 0.0);
     if (!none && wanted <= 0.0) {
@@ -279,7 +280,7 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     for (var j = 0u; j < u32(nearest.w); j++) {
         let k = u32(nearest[j]);
         interpolated += weights[j] * sunned(job, slot, k, i);
-        shaded += weights[j] * shading(coefficients[directions + k], n);
+        shaded += weights[j] * shading(co(directions + k), n);
     }
     if (none) {
         return interpolated;
@@ -290,7 +291,7 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
     var num = vec3<f32>(0.0);
     var den = 0.0;
     for (var k = 0u; k < job.tiles; k++) {
-        let m = shading(coefficients[directions + k], n);
+        let m = shading(co(directions + k), n);
         if (m > 0.0) {
             num += sunned(job, slot, k, i) * m;
             den += m * m;
@@ -304,11 +305,15 @@ fn sun_light(job: Job, slot: u32, i: u32, n: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(64)
 fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= params.texels || id.y >= params.jobs) {
+    if (id.y >= arrayLength(&jobs)) {
         return;
     }
     let job = jobs[id.y];
+    let i = id.x;
+    if (i >= job.texels) {
+        return;
+    }
+    coefficients_at = job.coefficients_at;
     // A transparent texel holds no light (the colour is premultiplied): not relit.
     let alpha = basis[job.basis_offset + i] >> 24u;
     if (alpha == 0u) {
@@ -317,49 +322,49 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     // A view with suns holds its suns' coefficients, and its normals where it has them:
     // their codes are the alpha bytes of tiles 1 and 2.
-    let suns = params.sun_slots > 0u && coefficients[sun_slot(job, 0u) + job.tiles].w != 0.0;
+    let suns = job.sun_slots > 0u && co(sun_slot(job, 0u) + job.tiles).w != 0.0;
     // The texel's normal, where its view holds them (zero: none).
     var normal = vec3<f32>(0.0);
     if (job.tiles >= 3u) {
         normal = normal_of(
-            basis[job.basis_offset + params.texels + i] >> 24u,
-            basis[job.basis_offset + 2u * params.texels + i] >> 24u,
+            basis[job.basis_offset + job.texels + i] >> 24u,
+            basis[job.basis_offset + 2u * job.texels + i] >> 24u,
         );
     }
     var out = vec3<f32>(0.0);
     var basis_sun = vec3<f32>(0.0);
     for (var k = 0u; k < job.tiles; k++) {
-        let c = coefficients[job.coefficient_offset + k];
+        let c = co(job.coefficient_offset + k);
         if (c.w == 0.0) {
             continue;
         }
-        let code = basis[job.basis_offset + k * params.texels + i];
+        let code = basis[job.basis_offset + k * job.texels + i];
         let v = vec3<f32>(
             gamma_value(code & 255u),
             gamma_value((code >> 8u) & 255u),
             gamma_value((code >> 16u) & 255u),
         );
         // A floor condition relit by the ground's shape.
-        let range = coefficients[job.coefficient_offset + job.tiles + k];
+        let range = co(job.coefficient_offset + job.tiles + k);
         if (range.w > 0.0) {
             out += c.rgb * v * floor_ratio(range, normal);
         } else {
             out += c.rgb * v;
         }
         if (suns) {
-            basis_sun += coefficients[job.coefficient_offset + 2u * job.tiles + k].rgb * v;
+            basis_sun += co(job.coefficient_offset + 2u * job.tiles + k).rgb * v;
         }
     }
     if (suns) {
         let n = normal;
         var trusted = 0.0;
         var total = 0.0;
-        for (var s = 0u; s < params.sun_slots; s++) {
+        for (var s = 0u; s < job.sun_slots; s++) {
             let slot = sun_slot(job, s);
-            if (coefficients[slot + job.tiles].w == 0.0) {
+            if (co(slot + job.tiles).w == 0.0) {
                 break;
             }
-            let weight = coefficients[slot + job.tiles + 9u].y;
+            let weight = co(slot + job.tiles + 9u).y;
             trusted += weight * trust(job, slot, i, n);
             total += weight;
         }
@@ -370,9 +375,9 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
         var lit = vec3<f32>(0.0);
         if (t > 0.0) {
             var surface = vec4<f32>(0.0);
-            for (var s = 0u; s < params.sun_slots; s++) {
+            for (var s = 0u; s < job.sun_slots; s++) {
                 let slot = sun_slot(job, s);
-                if (coefficients[slot + job.tiles].w == 0.0) {
+                if (co(slot + job.tiles).w == 0.0) {
                     break;
                 }
                 // The texel's point on the hull is found once, where a sun would light.
@@ -395,8 +400,8 @@ fn relight(@builtin(global_invocation_id) id: vec3<u32>) {
     // Most texels are below the peak already found: read before writing, so that the
     // view's one counter is written (and contended) only while its peak still grows.
     let peak = bitcast<u32>(max(max(out.x, max(out.y, out.z)), 0.0));
-    if (peak > atomicLoad(&peaks[job.view])) {
-        atomicMax(&peaks[job.view], peak);
+    if (peak > atomicLoad(&peaks[job.peak])) {
+        atomicMax(&peaks[job.peak], peak);
     }
 }
 
@@ -410,22 +415,25 @@ fn srgb_encode(v: f32) -> f32 {
 
 @compute @workgroup_size(64)
 fn encode(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= params.texels || id.y >= params.jobs) {
+    if (id.y >= arrayLength(&jobs)) {
         return;
     }
     let job = jobs[id.y];
-    var scale = bitcast<f32>(atomicLoad(&peaks[job.view]));
+    let i = id.x;
+    if (i >= job.texels) {
+        return;
+    }
+    var scale = bitcast<f32>(atomicLoad(&peaks[job.peak]));
     if (scale <= 0.0) {
         scale = 1.0;
     }
     if (i == 0u) {
-        prelit[job.view * 8u] = bitcast<u32>(scale);
+        prelit[job.heads_at + job.view * 8u] = bitcast<u32>(scale);
     }
     let r = relit[job.relit_offset + i];
     let code = u32(round(srgb_encode(r.x / scale) * 255.0))
         | (u32(round(srgb_encode(r.y / scale) * 255.0)) << 8u)
         | (u32(round(srgb_encode(r.z / scale) * 255.0)) << 16u)
         | (u32(r.w) << 24u);
-    prelit[params.codes_at + job.layer * params.texels + i] = code;
+    prelit[job.codes_at + job.layer * job.texels + i] = code;
 }

@@ -198,31 +198,6 @@ pub struct GpuSunOccluder {
     pub there_t: [f32; 4],
 }
 
-/// `RelightParams` of `relight.wgsl`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
-pub struct GpuRelightParams {
-    /// Texels per view.
-    pub texels: u32,
-    /// Row length.
-    pub width: u32,
-    /// Views in the batch.
-    pub jobs: u32,
-    /// The crop's corner in the image, pixels: a texel's pixel is this plus its place
-    /// in the crop.
-    pub x0: u32,
-    /// See `x0`.
-    pub y0: u32,
-    /// Sun slots per job: each job's coefficients hold this many suns, those unused last
-    /// and marked empty.
-    pub sun_slots: u32,
-    /// Words from the start of the pose's pre-lit range to its first layer's codes (its
-    /// views' scales come first; `frf_render::gpu::prelit`).
-    pub codes_at: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
-}
-
 /// `LightFitParams` of `light_fit.wgsl`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
@@ -246,27 +221,49 @@ pub struct GpuLightFitParams {
     pub view: [f32; 4],
 }
 
-/// `Job` of `relight.wgsl`: one view of a relighting batch.
+/// `Job` of `relight.wgsl`: one view of a relit pose copy, of every copy relit in a
+/// submission (one dispatch reads them all: every offset counts from its binding's start,
+/// a shared page).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct GpuRelightJob {
-    /// Its first basis code in the batch's codes.
+    /// Its first basis code, words from the start of the basis page.
     pub basis_offset: u32,
-    /// Its first coefficient in the batch's coefficients.
+    /// Where its copy's batch's coefficients start in their page (`vec4`s): every index
+    /// the coefficients hold counts from there.
+    pub coefficients_at: u32,
+    /// Its first coefficient, from `coefficients_at`.
     pub coefficient_offset: u32,
     /// Its basis images.
     pub tiles: u32,
-    /// Its view index (of its peak).
+    /// Its view index (of its head in the copy's pre-lit range).
     pub view: u32,
-    /// Its layer of the pre-lit views.
+    /// Its layer of the copy's pre-lit views.
     pub layer: u32,
-    /// Its first texel in the batch's relit scratch.
+    /// Its first texel in the relit scratch.
     pub relit_offset: u32,
     /// 1 when its codes are followed by its texels' points on the hull (`t` along their
     /// camera rays, the bits of an f32), 0 without.
     pub surface: u32,
-    /// Padding.
-    pub pad1: u32,
+    /// Its peak's slot.
+    pub peak: u32,
+    /// Where its copy's heads start in the pre-lit page, words.
+    pub heads_at: u32,
+    /// Where its copy's first layer's codes start in the pre-lit page, words.
+    pub codes_at: u32,
+    /// Texels of its view (its pose's crop) and the crop's row length.
+    pub texels: u32,
+    /// See `texels`.
+    pub width: u32,
+    /// The crop's corner in the image, pixels: a texel's pixel is this plus its place
+    /// in the crop.
+    pub x0: u32,
+    /// See `x0`.
+    pub y0: u32,
+    /// Sun slots its coefficients hold, those unused last and marked empty.
+    pub sun_slots: u32,
+    /// Its camera.
+    pub camera: GpuView,
 }
 
 /// `ShadowJob` of `shadow.wgsl`: one walker's shadow relit into a layer.

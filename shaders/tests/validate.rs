@@ -10,8 +10,8 @@ use std::mem::{offset_of, size_of};
 use frf_shaders as shaders;
 use frf_shaders::types::{
     GpuColumnIndex, GpuComposite, GpuFrame, GpuHullAt, GpuInstance, GpuLightFitParams, GpuPresent,
-    GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuRelightParams, GpuShadowJob, GpuSunDepthJob,
-    GpuSunMap, GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuTurnRelight, GpuView,
+    GpuProxy, GpuQuad, GpuQuadFrame, GpuRelightJob, GpuShadowJob, GpuSunDepthJob, GpuSunMap,
+    GpuSunOccluder, GpuTimeMorph, GpuTurnJob, GpuTurnParams, GpuTurnRelight, GpuView,
 };
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
@@ -248,23 +248,26 @@ fn pod_structs_match_naga_layouts() {
     let relight = module(&shaders::composed(shaders::RELIGHT), "relight");
     check_layout!(
         &relight,
-        "RelightParams",
-        GpuRelightParams,
-        [texels, width, jobs, x0, y0, sun_slots, codes_at, pad]
-    );
-    check_layout!(
-        &relight,
         "Job",
         GpuRelightJob,
         [
             basis_offset,
+            coefficients_at,
             coefficient_offset,
             tiles,
             view,
             layer,
             relit_offset,
             surface,
-            pad1
+            peak,
+            heads_at,
+            codes_at,
+            texels,
+            width,
+            x0,
+            y0,
+            sun_slots,
+            camera
         ]
     );
     let turn = module(&shaders::composed(shaders::TURN_LIGHT), "turn_light");

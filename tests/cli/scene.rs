@@ -820,12 +820,15 @@ fn the_frame_bench_reports_a_row_per_walkers_and_light() {
             assert_eq!(pass("relight").is_some(), r["light"] == "turning", "{r}");
             assert!(ms("gpu_timestamps_ms_per_frame") > 0.0, "{r}");
             // Dispatches a frame that do not grow with walkers: every walker's light looked
-            // up on the device in one, every shadow in one, the composite one; the frame
-            // pass one for the copies of a pose at a level of detail in a page (here every
-            // walker draws the one pose, at one or two levels: it was one a walker).
+            // up on the device in one, every walker's views relit by one pair (sums,
+            // encoding: it was a pair a walker), every shadow in one, the composite one;
+            // the frame pass one for the copies of a pose at a level of detail in a page
+            // (here every walker draws the one pose, at one or two levels: it was one a
+            // walker).
             let dispatches = |name: &str| pass(name).map(|p| p["dispatches"].as_u64().unwrap());
             if r["light"] == "turning" {
                 assert_eq!(dispatches("turn light"), Some(1), "{r}");
+                assert_eq!(dispatches("relight"), Some(2), "{r}");
             }
             assert_eq!(dispatches("composite"), Some(1), "{r}");
             let frame = dispatches("frame").unwrap();

@@ -145,15 +145,6 @@ impl ArenaRange {
     pub(super) fn key(&self) -> (usize, u64) {
         (Arc::as_ptr(&self.page) as usize, self.offset)
     }
-
-    /// The range as a binding.
-    pub(super) fn binding(&self) -> wgpu::BindingResource<'_> {
-        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.page.buffer,
-            offset: self.offset,
-            size: wgpu::BufferSize::new(self.size),
-        })
-    }
 }
 
 impl Arena {

@@ -29,7 +29,6 @@ pub mod bench;
 pub mod bind;
 pub mod composite;
 mod composite_targets;
-mod deferred;
 pub mod formats;
 pub mod kept;
 pub mod light_fit;
@@ -41,6 +40,7 @@ pub mod present;
 pub mod readback;
 pub mod rebin;
 pub mod relight;
+mod relights;
 pub mod scope;
 pub mod shadow;
 mod spent;
@@ -99,9 +99,12 @@ pub struct Gpu {
     relight: relight::RelightPass,
     /// Work recorded between frames, sent ahead of the next ([`Gpu::submit`]).
     pending: std::sync::Mutex<Option<wgpu::CommandEncoder>>,
-    deferred: std::sync::Mutex<deferred::Deferred>,
+    /// Every pose copy relit since the last submission ([`relights`]).
+    relights: std::sync::Mutex<relights::Relights>,
     /// Small writes gathered between submissions, sent as one ([`uploads`]).
     uploads: std::sync::Mutex<uploads::Uploads>,
+    /// Every relit pose's basis codes, a range each ([`relight`]).
+    basis: arena::Arena,
     /// Every relit pose's coefficients, a range each ([`relight`]).
     coefficients: arena::Arena,
     /// Every pose relit on the device: its views' jobs, the field's conditions and the
@@ -115,8 +118,6 @@ pub struct Gpu {
     /// The flows' codes of the poses resident, a range each, shared by the copies made
     /// from the same flows ([`prelit`]).
     flow_ranges: prelit::FlowsKept,
-    /// The relighting pass's scratch buffer, kept ([`relight`]).
-    relit: std::sync::Mutex<Option<wgpu::Buffer>>,
     /// Staging sets of frames read back, kept for the next ([`readback`]).
     staging: std::sync::Mutex<Vec<readback::FrameStaging>>,
     /// Time the host has waited on the device ([`Gpu::waited`]).
@@ -192,8 +193,14 @@ impl Gpu {
         Self {
             relight: relight::RelightPass::new(&device),
             pending: std::sync::Mutex::new(None),
-            deferred: std::sync::Mutex::default(),
+            relights: std::sync::Mutex::default(),
             uploads: std::sync::Mutex::default(),
+            basis: arena::Arena::new(
+                &device,
+                "basis codes",
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                relight::BASIS_PAGE_BYTES,
+            ),
             coefficients: arena::Arena::new(
                 &device,
                 "coefficients",
@@ -218,7 +225,6 @@ impl Gpu {
             ),
             pose_tables: pose_tables::TablesKept::default(),
             flow_ranges: prelit::FlowsKept::default(),
-            relit: std::sync::Mutex::new(None),
             staging: std::sync::Mutex::new(Vec::new()),
             waited: spent::Spent::default(),
             submitted: spent::Spent::default(),

@@ -185,8 +185,8 @@ impl Gpu {
         let flows = Flows::Shared(self.flow_range(geometry, &source.flows));
         let mut pose = self.resident_pose(pass, tables, (range, flows, None), geometry);
         let hull = pose.geometry.proxy.hull_shared().cloned();
-        let mut relight = self.pose_relight(basis, geometry.views(), hull);
-        self.record_relight(&mut relight, source, (&pose.prelit, &pose.tables.views));
+        let mut relight = self.pose_relight(basis, hull);
+        self.record_relight(&mut relight, source, &pose.prelit);
         pose.relight = Some(relight);
         Ok(pose)
     }
@@ -289,7 +289,7 @@ impl Gpu {
                 // Let go of ([`GpuPose::release_basis`]): uploaded again.
                 let basis = self.upload_basis(source)?;
                 let hull = pose.geometry.proxy.hull_shared().cloned();
-                self.pose_relight(basis, source.geometry.views(), hull)
+                self.pose_relight(basis, hull)
             }
         };
         let done = self.scoped("relighting a resident pose", || {
@@ -298,8 +298,7 @@ impl Gpu {
                     "relighting a pose with another pose's views".into(),
                 ));
             }
-            let target = (&pose.prelit, &pose.tables.views);
-            self.record_relight(&mut relight, source, target);
+            self.record_relight(&mut relight, source, &pose.prelit);
             Ok(())
         });
         pose.relight = Some(relight);

@@ -10,6 +10,7 @@
 
 use std::sync::{Arc, Mutex, Weak};
 
+use frf_core::camera::Camera;
 use glam::Quat;
 
 use super::Gpu;
@@ -54,24 +55,22 @@ pub(super) enum Flows {
     Texture(wgpu::Texture),
 }
 
+/// A view table's entry: `camera`'s orientation, centre and intrinsics.
+pub(super) fn gpu_view(camera: &Camera) -> GpuView {
+    let k = &camera.intrinsics;
+    GpuView {
+        rotation: Quat::from_mat3(&camera.world_from_camera.rotation).to_array(),
+        centre: camera.centre().to_array(),
+        pad: 0.0,
+        intrinsics: [k.fx, k.fy, k.cx, k.cy],
+    }
+}
+
 /// The bytes of the tables of `geometry` with `flows`' code table but the hull's (named by
 /// the hull itself, copied only when the tables are made), in the order [`PoseTables`]
 /// holds them: views, quads, code tables, proxy, column index, frames.
 fn table_parts(geometry: &PoseGeometry, flows: &PoseFlows) -> [Vec<u8>; 6] {
-    let views: Vec<GpuView> = geometry
-        .cameras
-        .iter()
-        .map(|cam| {
-            let q = Quat::from_mat3(&cam.world_from_camera.rotation);
-            let k = &cam.intrinsics;
-            GpuView {
-                rotation: q.to_array(),
-                centre: cam.centre().to_array(),
-                pad: 0.0,
-                intrinsics: [k.fx, k.fy, k.cx, k.cy],
-            }
-        })
-        .collect();
+    let views: Vec<GpuView> = geometry.cameras.iter().map(gpu_view).collect();
     let quads: Vec<GpuQuad> = geometry
         .cylinder
         .quads()

@@ -58,11 +58,6 @@ impl PrelitRange {
         self.range.key().0
     }
 
-    /// The range as a binding (the relighting pass writes it alone).
-    pub(super) fn binding(&self) -> wgpu::BindingResource<'_> {
-        self.range.binding()
-    }
-
     /// Where its heads and its first layer's codes start, in words from the page's
     /// start (`prelit.xy` of the frame pass's record).
     pub(super) fn words(&self) -> [u32; 2] {

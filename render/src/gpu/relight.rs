@@ -1,16 +1,18 @@
 //! Relighting a resident pose on the GPU (`shaders/relight.wgsl`), twin of
 //! [`crate::resident::ResidentPose::relight_cpu`].
 //!
-//! A pose's basis codes are uploaded once ([`GpuBasis`], shared by every relit copy of
-//! the same views: walkers of other headings, the same walker under a new light). A
-//! light is then one dispatch pair per batch of views: the new coefficients written into
-//! the pose's own buffer (by the host, or looked up by the device from the light's yaw
-//! tables, [`super::turn_light`]), the weighted sum of the basis images, and its encoding
-//! into the pose's pre-lit layers with each view's peak as its scale, both written by the
-//! GPU into the pose's range of the shared pre-lit pages ([`super::prelit`]). Nothing is uploaded again, nothing is read back and
-//! nothing waits: the dispatches of every pose relit between two frames go into one
-//! relight pass ([`super::deferred`]), after the one dispatch that made all their suns'
-//! maps ([`super::sun_depth`]), which [`Gpu::submit`] sends just ahead of the next frame.
+//! A pose's basis codes are uploaded once into a range of the shared basis pages
+//! ([`GpuBasis`], shared by every relit copy of the same views: walkers of other headings,
+//! the same walker under a new light). A light is then its new coefficients, written into
+//! the copy's range of the coefficients' pages (by the host, or looked up by the device
+//! from the light's yaw tables, [`super::turn_light`]), and the copy's jobs, one a view,
+//! gathered with every other copy's relit before the next submission
+//! ([`super::relights`]): one dispatch sums the basis images of every job, one encodes
+//! them into the copies' pre-lit layers with each view's peak as its scale, both written
+//! by the GPU into the copies' ranges of the shared pre-lit pages ([`super::prelit`]).
+//! Nothing is uploaded again, nothing is read back and nothing waits; the pair runs after
+//! the one dispatch that made all their suns' maps ([`super::sun_depth`]), which
+//! [`Gpu::submit`] sends just ahead of the next frame.
 
 use std::sync::Arc;
 
@@ -19,32 +21,31 @@ use frf_reflectance::hull::VoxelHull;
 use frf_reflectance::imagecodec::BasisCodes;
 use frf_reflectance::light_fit::{RATIO_FLOOR, group_cone};
 use frf_reflectance::sun_light::{MAX_SUNS, NEAREST, SunLight, TRUST_ERROR};
-use frf_shaders::types::{GpuRelightJob, GpuRelightParams, GpuTurnRelight};
+use frf_shaders::types::{GpuRelightJob, GpuTurnRelight};
 use wgpu::util::DeviceExt;
 
 use super::arena::ArenaRange;
-use super::bind::{
-    bind_group, buffer_with, compute_pipeline, empty_buffer, storage, table_bytes, uniform,
-};
-use super::deferred::{Dispatch, Kind};
-use super::prelit::{PrelitRange, head_words};
+use super::bind::{compute_pipeline, storage, table_bytes, uniform};
+use super::pose_tables::gpu_view;
+use super::prelit::PrelitRange;
+use super::relights::Gathered;
 use super::sun_depth::SunMapsAt;
 use super::{Gpu, shaders};
 use crate::error::Result;
 use crate::resident::PoseSource;
 
-/// Workgroup size of the relighting pass (`@workgroup_size(64)`).
-const WORKGROUP: u32 = 64;
+/// Bytes of a page of basis codes (the device's largest storage binding caps it).
+pub(super) const BASIS_PAGE_BYTES: u64 = 1 << 30;
 
 /// Most bytes of basis codes one batch of views holds.
 const RELIGHT_BATCH_BYTES: usize = 64 << 20;
 
 /// The relighting pipelines and the gamma table they decode codes with.
 pub struct RelightPass {
-    layout: wgpu::BindGroupLayout,
-    relight: wgpu::ComputePipeline,
-    encode: wgpu::ComputePipeline,
-    gamma: wgpu::Buffer,
+    pub(super) layout: wgpu::BindGroupLayout,
+    pub(super) relight: wgpu::ComputePipeline,
+    pub(super) encode: wgpu::ComputePipeline,
+    pub(super) gamma: wgpu::Buffer,
     /// The suns' maps bound for a pose without a hull (never read: its suns cast no
     /// shadow; a binding is never empty).
     no_depths: wgpu::Buffer,
@@ -58,16 +59,14 @@ impl RelightPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("relight"),
             entries: &[
-                uniform::<GpuRelightParams>(0, c),
+                uniform::<[[f32; 4]; 64]>(0, c),
                 storage::<u32>(1, true, c),
                 storage::<[f32; 4]>(2, true, c),
-                uniform::<[[f32; 4]; 64]>(3, c),
-                storage::<[f32; 4]>(4, false, c),
+                storage::<[f32; 4]>(3, false, c),
+                storage::<u32>(4, false, c),
                 storage::<u32>(5, false, c),
-                storage::<u32>(6, false, c),
-                storage::<GpuRelightJob>(7, true, c),
-                storage::<frf_shaders::types::GpuView>(8, true, c),
-                storage::<f32>(9, true, c),
+                storage::<GpuRelightJob>(6, true, c),
+                storage::<f32>(7, true, c),
             ],
         });
         let compute = |entry: &str| compute_pipeline(device, entry, &[&layout], &module, entry);
@@ -95,9 +94,11 @@ impl RelightPass {
 struct BasisBatch {
     /// The views (indices into the pose's views), in job order.
     views: Vec<usize>,
-    params: wgpu::Buffer,
-    codes: wgpu::Buffer,
-    jobs: wgpu::Buffer,
+    /// Its codes, a range of the shared basis pages.
+    codes: ArenaRange,
+    /// Its jobs, their offsets counting from the batch's own codes and coefficients, and
+    /// no copy's parts (its peaks, scratch and pre-lit range) filled in.
+    jobs: Vec<GpuRelightJob>,
     /// Coefficients (`vec4`) the batch's jobs read.
     coefficients: usize,
     /// Per job, where its coefficients start.
@@ -109,7 +110,6 @@ pub struct GpuBasis {
     batches: Vec<BasisBatch>,
     /// The host codes it was made from, kept so that their address names it.
     made_from: Arc<Vec<BasisCodes>>,
-    texels: usize,
     bytes: u64,
 }
 
@@ -133,14 +133,13 @@ impl GpuBasis {
     }
 }
 
-/// What a relit pose keeps to be relit again: the shared codes, its own coefficients
-/// (one buffer per batch) and the views' peaks.
+/// What a relit pose keeps to be relit again: the shared codes and its own coefficients
+/// (a range a batch).
 pub struct PoseRelight {
     basis: Arc<GpuBasis>,
     /// Its coefficients, a range of the shared pages a batch (the device's look-ups of
     /// every pose relit in a submission write them in one dispatch).
     coefficients: Vec<Arc<ArenaRange>>,
-    peaks: wgpu::Buffer,
     /// Its hull, whose maps toward the suns the GPU makes at each relight (none without
     /// a hull: its suns cast no shadow).
     hull: Option<Arc<VoxelHull>>,
@@ -148,9 +147,6 @@ pub struct PoseRelight {
     pub(super) sun_maps: Option<SunMapsAt>,
     /// What relights it on the device ([`super::turn_light`]), made the first time.
     pub(super) turn: Option<TurnState>,
-    /// Its relighting pass's bind groups (one a batch) and the scratch and suns' maps'
-    /// buffers they bind, kept for the next relight.
-    binds: std::sync::Mutex<Option<BindsKept>>,
 }
 
 /// What a pose keeps to be relit on the device (`super::turn_light`): per batch of views
@@ -160,9 +156,6 @@ pub struct PoseRelight {
 pub struct TurnState {
     pub(super) batches: Vec<(Arc<ArenaRange>, GpuTurnRelight, u32)>,
 }
-
-/// Bind groups kept, with the buffers that change between relights they bind.
-type BindsKept = ((wgpu::Buffer, wgpu::Buffer), Vec<wgpu::BindGroup>);
 
 impl PoseRelight {
     /// The shared codes.
@@ -385,8 +378,7 @@ impl Gpu {
     /// batches of up to [`RELIGHT_BATCH_BYTES`].
     pub fn upload_basis(&self, source: &PoseSource) -> Result<Arc<GpuBasis>> {
         self.scoped("uploading basis codes", || {
-            let crop = source.geometry.crop;
-            let texels = crop.texels();
+            let texels = source.geometry.crop.texels();
             let read: Vec<usize> = (0..source.basis.len())
                 .filter(|&i| !source.is_blank(i) && source.geometry.prelit_layers[i] >= 0)
                 .collect();
@@ -404,14 +396,10 @@ impl Gpu {
                 .into_iter()
                 .map(|views| self.basis_batch(source, views))
                 .collect();
-            let bytes = batches
-                .iter()
-                .map(|b| b.codes.size() + b.jobs.size() + b.params.size())
-                .sum();
+            let bytes = batches.iter().map(|b| b.codes.size()).sum();
             Ok(Arc::new(GpuBasis {
                 batches,
                 made_from: source.basis.clone(),
-                texels,
                 bytes,
             }))
         })
@@ -419,7 +407,7 @@ impl Gpu {
 
     /// One batch of `views` of `source`: codes packed RGBA8 (tile 0's alpha byte holding
     /// the view's alpha code, tiles 1 and 2's its normal's codes), then the view's texels'
-    /// points on the hull where it has them; jobs and parameters.
+    /// points on the hull where it has them, in a range of the basis pages; its jobs.
     fn basis_batch(&self, source: &PoseSource, views: Vec<usize>) -> BasisBatch {
         let crop = source.geometry.crop;
         let texels = crop.texels();
@@ -435,9 +423,14 @@ impl Gpu {
                 tiles: basis.tiles.len() as u32,
                 view: i as u32,
                 layer: source.geometry.prelit_layers[i] as u32,
-                relit_offset: (j * texels) as u32,
                 surface: u32::from(!source.surfaces[i].is_empty()),
-                pad1: 0,
+                texels: texels as u32,
+                width: crop.width,
+                x0: crop.x0,
+                y0: crop.y0,
+                sun_slots: MAX_SUNS as u32,
+                camera: gpu_view(&source.geometry.cameras[i]),
+                ..bytemuck::Zeroable::zeroed()
             });
             offsets.push(coefficients as u32);
             coefficients += job_len(source, i);
@@ -462,46 +455,27 @@ impl Gpu {
         if codes.is_empty() {
             codes.push(0);
         }
-        let params = GpuRelightParams {
-            texels: texels as u32,
-            width: crop.width,
-            jobs: views.len() as u32,
-            x0: crop.x0,
-            y0: crop.y0,
-            sun_slots: MAX_SUNS as u32,
-            codes_at: head_words(source.geometry.views()),
-            pad: 0,
-        };
-        let buffer =
-            |label: &str, contents: &[u8], usage| buffer_with(&self.device, label, contents, usage);
-        let storage = wgpu::BufferUsages::STORAGE;
+        // A new range (a range given back is taken again only after a submission): the
+        // write lands ahead of any work that reads it.
+        let range = self.basis.take(&self.device, (codes.len() * 4) as u64);
+        self.queue
+            .write_buffer(range.buffer(), range.offset(), bytemuck::cast_slice(&codes));
         BasisBatch {
-            params: buffer(
-                "relight params",
-                bytemuck::bytes_of(&params),
-                wgpu::BufferUsages::UNIFORM,
-            ),
-            codes: buffer("basis", bytemuck::cast_slice(&codes), storage),
-            jobs: buffer("jobs", bytemuck::cast_slice(&jobs), storage),
+            codes: range,
+            jobs,
             views,
             coefficients,
             offsets,
         }
     }
 
-    /// A pose's own relighting buffers over the shared `basis`, for `views` views, with
-    /// its hull (`None`: none), whose suns' maps each relight makes.
+    /// A pose's own relighting buffers over the shared `basis`, with its hull (`None`:
+    /// none), whose suns' maps each relight makes.
     pub(super) fn pose_relight(
         &self,
         basis: Arc<GpuBasis>,
-        views: usize,
         hull: Option<Arc<VoxelHull>>,
     ) -> PoseRelight {
-        let buffer =
-            |label: &str, size: usize, usage| empty_buffer(&self.device, label, size, usage);
-        let dst = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_DST
-            | wgpu::BufferUsages::COPY_SRC;
         PoseRelight {
             coefficients: basis
                 .batches
@@ -511,25 +485,22 @@ impl Gpu {
                     Arc::new(self.coefficients.take(&self.device, bytes))
                 })
                 .collect(),
-            peaks: buffer("peaks", views.max(1) * 4, dst),
             basis,
             hull,
             sun_maps: None,
             turn: None,
-            binds: std::sync::Mutex::new(None),
         }
     }
 
     /// Asks for its suns' maps ([`super::sun_depth`], made with every other walker's in
     /// one dispatch ahead of the relights), writes `source`'s coefficients into
-    /// `relight`'s buffers and records the passes that relight its views into the
-    /// pose's pre-lit range `target`, reading its cameras from its view table `views`
-    /// ([`Gpu::relight_pose`]); keeps where the maps are.
+    /// `relight`'s buffers and gathers the jobs that relight its views into the pose's
+    /// pre-lit range `target` ([`Gpu::relight_pose`]); keeps where the maps are.
     pub(super) fn record_relight(
         &self,
         relight: &mut PoseRelight,
         source: &PoseSource,
-        target: (&PrelitRange, &wgpu::Buffer),
+        target: &PrelitRange,
     ) {
         relight.sun_maps = relight.hull.as_ref().map(|hull| {
             let maps: Vec<_> = source.suns.iter().map(|s| s.depth.as_ref()).collect();
@@ -546,89 +517,43 @@ impl Gpu {
                 bytemuck::cast_slice(&packed),
             );
         }
-        self.record_relight_passes(relight, target);
+        self.gather_relight(relight, target);
     }
 
-    /// Records the passes that relight `relight`'s views from its coefficients into the
-    /// pose's pre-lit range `target` (codes and scales), reading its cameras from its
-    /// view table `views`: per batch of views the sums and their encoding (after the
-    /// look-ups of every light on the device gathered for the submission,
-    /// [`super::turn_light`], which write the coefficients).
-    pub(super) fn record_relight_passes(
-        &self,
-        relight: &PoseRelight,
-        (target, views): (&PrelitRange, &wgpu::Buffer),
-    ) {
-        let maps = relight.sun_maps.as_ref();
-        let basis = &relight.basis;
-        let most_jobs = basis
-            .batches
-            .iter()
-            .map(|b| b.views.len())
-            .max()
-            .unwrap_or(0);
-        let relit = self.relit_scratch((basis.texels * most_jobs.max(1) * 16) as u64);
-        let depths = maps.map_or(&self.relight.no_depths, |m| &m.reach);
-        self.with_pending(|encoder| encoder.clear_buffer(&relight.peaks, 0, None));
-        let groups = (basis.texels as u32).div_ceil(WORKGROUP);
-        // The bind groups of its last relight serve while the scratch and the maps'
-        // buffer are the same.
-        let key = (relit.clone(), depths.clone());
-        let mut kept = relight.binds.lock().unwrap_or_else(|e| e.into_inner());
-        if kept.as_ref().is_none_or(|(k, _)| *k != key) {
-            let binds = (basis.batches.iter().zip(&relight.coefficients))
-                .map(|(batch, coefficients)| {
-                    bind_group(
-                        &self.device,
-                        "relight",
-                        &self.relight.layout,
-                        vec![
-                            batch.params.as_entire_binding(),
-                            batch.codes.as_entire_binding(),
-                            coefficients.binding(),
-                            self.relight.gamma.as_entire_binding(),
-                            relit.as_entire_binding(),
-                            relight.peaks.as_entire_binding(),
-                            target.binding(),
-                            batch.jobs.as_entire_binding(),
-                            views.as_entire_binding(),
-                            depths.as_entire_binding(),
-                        ],
-                    )
+    /// Gathers the jobs that relight `relight`'s views from its coefficients into the
+    /// pose's pre-lit range `target` (codes and scales), a batch of views at a time, for
+    /// the next submission's relighting pass ([`super::relights`]; after the look-ups of
+    /// every light on the device gathered for the submission, [`super::turn_light`],
+    /// which write the coefficients).
+    pub(super) fn gather_relight(&self, relight: &PoseRelight, target: &PrelitRange) {
+        let depths = relight
+            .sun_maps
+            .as_ref()
+            .map_or(&self.relight.no_depths, |m| &m.reach);
+        let [heads_at, codes_at] = target.words();
+        for (batch, coefficients) in relight.basis.batches.iter().zip(&relight.coefficients) {
+            let basis_at = (batch.codes.offset() / 4) as u32;
+            let jobs = batch
+                .jobs
+                .iter()
+                .map(|job| GpuRelightJob {
+                    basis_offset: basis_at + job.basis_offset,
+                    coefficients_at: coefficients.vec4_offset(),
+                    heads_at,
+                    codes_at,
+                    ..*job
                 })
                 .collect();
-            *kept = Some((key, binds));
-        }
-        let binds = &kept.as_ref().expect("made above").1;
-        for (batch, bind) in basis.batches.iter().zip(binds) {
-            // The sums, then their encoding (wgpu orders the two dispatches' use of the
-            // scratch and the peaks), in the pass every relight of the frame shares.
-            let pair = [&self.relight.relight, &self.relight.encode].map(|pipeline| Dispatch {
-                pipeline: pipeline.clone(),
-                bind: bind.clone(),
-                groups: [groups, batch.views.len() as u32, 1],
+            self.gather(Gathered {
+                coefficients: coefficients.key(),
+                pages: [
+                    batch.codes.buffer().clone(),
+                    coefficients.buffer().clone(),
+                    target.page().clone(),
+                    depths.clone(),
+                ],
+                jobs,
             });
-            self.defer(Kind::Relight, pair);
-        }
-    }
-
-    /// The scratch buffer relit colours go through between the two passes, at least
-    /// `size` bytes: one for every relight (their passes run in order), grown when a
-    /// larger batch needs it, instead of a new zeroed buffer each time.
-    fn relit_scratch(&self, size: u64) -> wgpu::Buffer {
-        let mut kept = self.relit.lock().unwrap_or_else(|e| e.into_inner());
-        match &*kept {
-            Some(b) if b.size() >= size => b.clone(),
-            _ => {
-                let b = self.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("relit"),
-                    size,
-                    usage: wgpu::BufferUsages::STORAGE,
-                    mapped_at_creation: false,
-                });
-                *kept = Some(b.clone());
-                b
-            }
         }
     }
 
@@ -664,7 +589,7 @@ impl Gpu {
         // The lights looked up on the device, then the relights gathered, a pass each,
         // after the pending clears.
         let pending = self.record_turns(pending);
-        let pending = self.record_deferred(pending).map(|p| p.finish());
+        let pending = self.record_relights(pending).map(|p| p.finish());
         let buffers: Vec<wgpu::CommandBuffer> = buffers.into_iter().collect();
         // The small writes every later piece reads, then the suns' maps the pending
         // relights read.

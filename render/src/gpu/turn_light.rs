@@ -586,7 +586,7 @@ impl Gpu {
             }
             drop(gathered);
             if let Some(target) = pose.prelit_range() {
-                self.record_relight_passes(relight, (target, &pose.tables.views));
+                self.gather_relight(relight, target);
             }
             Ok(true)
         })
