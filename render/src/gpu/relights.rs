@@ -133,7 +133,7 @@ impl Gpu {
         let align = (limits.min_storage_buffer_offset_alignment as usize).max(16);
         let most = (
             limits.max_compute_workgroups_per_dimension,
-            u64::from(limits.max_storage_buffer_binding_size),
+            limits.max_storage_buffer_binding_size,
             align,
         );
         let (runs, bytes) = runs(gathered, most);
