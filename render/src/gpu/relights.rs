@@ -219,7 +219,8 @@ mod tests {
 
     /// Jobs on the same pages share runs whatever order they were gathered in, a run
     /// never holds more jobs or scratch than asked, each job's scratch is its own within
-    /// its run, peaks are one a job, and each run's jobs start aligned.
+    /// its run, peaks are one a job, and each run's jobs start aligned; a copy gathered
+    /// twice is relit once.
     #[test]
     fn jobs_are_split_into_runs_that_fit() {
         let Some(gpu) = Gpu::for_tests() else {
@@ -266,5 +267,23 @@ mod tests {
         assert_eq!(of(|j| j.texels), [10, 20, 30, 40, 1, 5]);
         assert_eq!(of(|j| j.relit_offset), [0, 10, 30, 0, 40, 0]);
         assert_eq!(of(|j| j.peak), [0, 1, 2, 3, 4, 5]);
+        // A copy gathered twice before a submission is relit once, for its later light;
+        // another copy's batch stays.
+        let copy = |key: u64, texels: u32| Gathered {
+            coefficients: (1, key),
+            jobs: vec![GpuRelightJob {
+                texels,
+                ..bytemuck::Zeroable::zeroed()
+            }],
+            ..on(&a, &[])
+        };
+        for (key, texels) in [(7, 1), (8, 2), (7, 3)] {
+            gpu.gather(copy(key, texels));
+        }
+        let kept: Vec<u32> = (gpu.relights.lock().unwrap().gathered.iter())
+            .flatten()
+            .map(|g| g.jobs[0].texels)
+            .collect();
+        assert_eq!(kept, [2, 3]);
     }
 }
