@@ -139,6 +139,9 @@ impl Proxy {
     /// without a hull, and for a vertical ray that misses it.
     pub fn point(&self, origin: Vec3, dir: Vec3) -> Option<Vec3> {
         let hull = self.hull.as_ref()?;
+        // Walked along the unit direction, as the depth is (the GPU walks the ray once
+        // for both).
+        let dir = dir.normalize_or_zero();
         if let Some(t) = hull.first_hit(origin, dir) {
             return Some(origin + dir * t);
         }

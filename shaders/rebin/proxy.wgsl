@@ -9,6 +9,23 @@ fn hull_first_hit(origin: vec3<f32>, dir: vec3<f32>) -> f32 {
     return hull_first_hit_of(proxy, 0u, origin, dir);
 }
 
+// The first hull hit of the ray an invocation shades, along its unit direction, walked
+// once: every entry point of the frame pass shades one pixel an invocation, and the
+// solved morph's starting point, a clamped ray's point and the walker's depth all ask it
+// of that pixel's ray (from the frame's centre), which walked the hull twice before.
+var<private> ray_hit: f32;
+var<private> ray_walked: bool;
+
+// `hull_first_hit` of the invocation's ray (`origin`, `unit`: its unit direction), walked
+// the first time it is asked.
+fn ray_first_hit(origin: vec3<f32>, unit: vec3<f32>) -> f32 {
+    if (!ray_walked) {
+        ray_hit = hull_first_hit(origin, unit);
+        ray_walked = true;
+    }
+    return ray_hit;
+}
+
 // What a ray that misses the hull adds to the depth: twin of `proxy::MISS_DEPTH_M`.
 const MISS_DEPTH_M: f32 = 1e4;
 
@@ -17,7 +34,7 @@ const MISS_DEPTH_M: f32 = 1e4;
 // vertical ray: its horizontal distance to the axis). Twin of `Proxy::depth`.
 fn subject_depth(origin: vec3<f32>, dir_in: vec3<f32>) -> f32 {
     let dir = normalize_or_zero(dir_in);
-    let t = hull_first_hit(origin, dir);
+    let t = ray_first_hit(origin, dir);
     if (t >= 0.0) {
         return t;
     }
@@ -31,12 +48,14 @@ fn subject_depth(origin: vec3<f32>, dir_in: vec3<f32>) -> f32 {
 }
 
 // Where the ray meets the subject as far as the proxy knows (w = 1), or w = 0 without a
-// hull and for a vertical ray beside it: twin of `Proxy::point`.
-fn proxy_point(origin: vec3<f32>, dir: vec3<f32>) -> vec4<f32> {
+// hull and for a vertical ray beside it: twin of `Proxy::point` (walked along the unit
+// direction, as the depth is).
+fn proxy_point(origin: vec3<f32>, dir_in: vec3<f32>) -> vec4<f32> {
     if (proxy.present == 0u) {
         return vec4<f32>(0.0);
     }
-    let t = hull_first_hit(origin, dir);
+    let dir = normalize_or_zero(dir_in);
+    let t = ray_first_hit(origin, dir);
     if (t >= 0.0) {
         return vec4<f32>(origin + dir * t, 1.0);
     }
