@@ -115,6 +115,23 @@ fn numbers(s: &str, what: &str) -> Result<Vec<f32>, String> {
         .collect()
 }
 
+/// Refuses an `--out` whose extension is not `wanted` (`why`: what the command writes
+/// instead); a name without an extension (a device) is taken as it is.
+pub fn expect_out_extension(
+    out: &std::path::Path,
+    wanted: &str,
+    why: &str,
+) -> Result<(), frf_core::BadArgument> {
+    match out.extension().map(|e| e.to_string_lossy().to_lowercase()) {
+        Some(ext) if ext != wanted => Err(frf_core::BadArgument::new(
+            "--out",
+            out.display(),
+            format!("a .{wanted} file, not .{ext}: {why}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Parses `x,y,z` (metres).
 pub fn parse_point(s: &str) -> Result<[f32; 3], String> {
     let v = numbers(s, "point")?;

@@ -28,6 +28,7 @@ pub struct EnvShArgs {
 /// Runs `frf env-sh`.
 pub fn run(args: EnvShArgs) -> CliResult {
     let started = Instant::now();
+    crate::cmd::args::expect_out_extension(&args.out, "json", "an SH light is a JSON file")?;
     if let EnvSource::File(map) = &args.env {
         frf_core::atomic::refuse_overwriting_inputs(&args.out, &[map.as_path()])?;
     }

@@ -199,19 +199,7 @@ pub fn run(args: ExportArgs) -> CliResult {
             "a walker is written as binary glTF (add --sprites for a PNG sheet)",
         )
     };
-    if let Some(ext) = args
-        .out
-        .extension()
-        .map(|e| e.to_string_lossy().to_lowercase())
-        && ext != wanted
-    {
-        return Err(frf_core::BadArgument::new(
-            "--out",
-            args.out.display(),
-            format!("a .{wanted} file, not .{ext}: {other}"),
-        )
-        .into());
-    }
+    crate::cmd::args::expect_out_extension(&args.out, wanted, other)?;
     if args.sprites {
         return sprites(&args, poses);
     }

@@ -319,7 +319,7 @@ fn export_sprites_writes_a_sheet_whose_frames_are_frf_renders() {
 /// Issue 59: an output that names an input (by any path), or that another output of the
 /// same run names, is refused with the input left as it was; an output that is not a
 /// regular file is never replaced by a renamed temporary (a pipe refused, a device
-/// written in place, its error reported).
+/// written in place, its error reported); `env-sh` writes only what is named `.json`.
 #[test]
 fn an_output_never_replaces_an_input_or_a_file_that_is_not_regular() {
     let f = frf_testkit::tiny_field();
@@ -402,6 +402,13 @@ fn an_output_never_replaces_an_input_or_a_file_that_is_not_regular() {
     ]);
     assert!(!o.status.success(), "env-sh over its map accepted");
     assert_eq!(std::fs::read(&map).unwrap(), light_before);
+    // An SH light named as another kind of file (a field) is refused, the file kept.
+    let field = dir.path().join("walk.frf");
+    std::fs::write(&field, b"a field").unwrap();
+    let o = frf(&["env-sh", "sky", "--out", field.to_str().unwrap()]);
+    assert!(!o.status.success(), "an SH light written over walk.frf");
+    assert!(stderr(&o).contains("not .frf"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&field).unwrap(), b"a field");
     // A pipe is refused, not replaced by a regular file.
     let pipe = dir.path().join("pipe.json");
     assert!(
