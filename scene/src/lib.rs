@@ -39,6 +39,7 @@ pub mod shot;
 pub mod shot_report;
 pub mod spline;
 pub mod sprites;
+pub mod text;
 pub mod walk;
 
 use std::path::{Path, PathBuf};
