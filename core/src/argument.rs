@@ -38,6 +38,15 @@ impl BadArgument {
     }
 }
 
+/// The first item of `items` given before: its place (from 1) and the item; `None` where
+/// each is given once. A list a user gives (poses, views, walker counts, sizes) names each
+/// value once, or its work is done twice.
+pub fn given_twice<T: PartialEq>(items: &[T]) -> Option<(usize, &T)> {
+    (items.iter().enumerate())
+        .find(|(k, v)| items[..*k].contains(v))
+        .map(|(k, v)| (k + 1, v))
+}
+
 /// `value` if it lies in `lo..=hi` (a NaN never does), else a [`BadArgument`] naming it;
 /// `unit` follows the bounds in the message (`"degrees"`, or `""`).
 pub fn within<T: PartialOrd + Display + Copy>(

@@ -48,6 +48,59 @@ pub enum Tier {
     Compact,
 }
 
+/// `full` or `compact` (`frf export --tier`).
+impl std::str::FromStr for Tier {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "full" => Ok(Tier::Full),
+            "compact" => Ok(Tier::Compact),
+            other => Err(format!("{other:?}: expected full or compact")),
+        }
+    }
+}
+
+/// `all`, `ring:V` (a row of cameras) or `U,V;U,V;...`, each view once (`frf export
+/// --views`).
+impl std::str::FromStr for ViewSelection {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        if s == "all" {
+            return Ok(ViewSelection::All);
+        }
+        if let Some(v) = s.strip_prefix("ring:") {
+            return v
+                .parse()
+                .map(ViewSelection::Ring)
+                .map_err(|_| format!("ring:{v}: expected a camera row number"));
+        }
+        let views = s
+            .split(';')
+            .map(|p| {
+                let (u, v) = p
+                    .split_once(',')
+                    .ok_or_else(|| format!("{p:?}: expected U,V"))?;
+                Ok((
+                    u.trim()
+                        .parse()
+                        .map_err(|_| format!("{p:?}: expected U,V"))?,
+                    v.trim()
+                        .parse()
+                        .map_err(|_| format!("{p:?}: expected U,V"))?,
+                ))
+            })
+            .collect::<std::result::Result<Vec<(usize, usize)>, String>>()?;
+        if let Some((k, (u, v))) = frf_core::argument::given_twice(&views) {
+            return Err(format!(
+                "{s:?}: view {u},{v} is given twice (the second time at place {k})"
+            ));
+        }
+        Ok(ViewSelection::List(views))
+    }
+}
+
 /// What to export.
 #[derive(Debug, Clone)]
 pub struct ExportOptions {

@@ -4,6 +4,7 @@
 //! as clap prints it; the bounds are the scene file's (a command line and a scene refuse
 //! the same values).
 
+use frf_core::argument::given_twice;
 use frf_core::sun::Sun;
 use serde::Serialize;
 
@@ -137,10 +138,9 @@ pub fn parse_poses(s: &str) -> Result<Vec<u32>, String> {
             "poses below {most} (pose {p} is beyond any cycle of at most {most})"
         ));
     }
-    if let Some((k, p)) = (poses.iter().enumerate()).find(|(k, p)| poses[..*k].contains(p)) {
+    if let Some((k, p)) = given_twice(&poses) {
         return Err(format!(
-            "each pose once (pose {p} is given twice, the second time at place {})",
-            k + 1
+            "each pose once (pose {p} is given twice, the second time at place {k})"
         ));
     }
     Ok(poses)
@@ -267,6 +267,105 @@ pub fn parse_ground(s: &str) -> Result<GroundArg, String> {
     Ok(GroundArg::Albedo(albedo))
 }
 
+/// `--headings`: camera azimuths, degrees.
+#[derive(Clone, Debug)]
+pub struct Headings(pub Vec<f32>);
+
+/// Parses `--headings`: a count of headings spread evenly from 0°, or a list of
+/// degrees (one heading: `90,`), each direction once.
+pub fn parse_headings(s: &str) -> Result<Headings, String> {
+    if let Ok(n) = s.trim().parse::<usize>() {
+        if !(1..=64).contains(&n) {
+            return Err(format!("{n} headings: 1 to 64"));
+        }
+        return Ok(Headings(
+            (0..n).map(|i| i as f32 * 360.0 / n as f32).collect(),
+        ));
+    }
+    // A list of one heading ends with its comma (`90,`), where `90` alone is a count.
+    let list = s
+        .trim()
+        .strip_suffix(',')
+        .filter(|l| !l.contains(','))
+        .unwrap_or(s);
+    let headings: Vec<f32> = list
+        .split(',')
+        .map(|a| {
+            a.trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|a| a.is_finite() && a.abs() <= 360.0)
+                .ok_or_else(|| {
+                    format!("{s:?}: a count of headings or a list of degrees from -360 to 360")
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    // Two headings of one direction draw the same row twice.
+    let turn = |a: f32| a.rem_euclid(360.0);
+    for (k, &a) in headings.iter().enumerate() {
+        if let Some(&b) = headings[..k].iter().find(|&&b| turn(b) == turn(a)) {
+            return Err(format!("{s:?}: headings {b} and {a} are one direction"));
+        }
+    }
+    Ok(Headings(headings))
+}
+
+/// `--sprite-size`: a frame's `WxH`, within what a sheet allows (named once, not first
+/// by the general size parser's wider bound).
+pub fn parse_sprite_size(s: &str) -> Result<(u32, u32), String> {
+    let size = parse_size(s).map_err(|_| {
+        format!(
+            "{s:?}: expected WxH, 1 to {} pixels a side",
+            crate::sprites::MOST_FRAME_SIDE
+        )
+    })?;
+    match crate::sprites::frame_size_problem(size) {
+        Some(problem) => Err(problem),
+        None => Ok(size),
+    }
+}
+
+/// `--walkers`: counts, each once.
+#[derive(Clone, Debug)]
+pub struct Counts(pub Vec<usize>);
+
+/// Parses a number of megapixels: finite, 0 or more (NaN and -1 skipped the CPU reference
+/// without a word).
+pub fn parse_megapixels(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{s}`: {e} (megapixels)"))?;
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(format!(
+            "`{s}` megapixels: a finite number, 0 or more (0 renders no CPU reference)"
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses `1,10,40`: every count a whole number, none empty (a stray comma) or given
+/// twice (it was timed twice).
+pub fn parse_counts(s: &str) -> Result<Counts, String> {
+    let counts: Vec<usize> = s
+        .split(',')
+        .map(|c| match c.trim() {
+            "" => Err(format!(
+                "{s:?}: an empty count (a comma with nothing beside it)"
+            )),
+            c => c
+                .parse()
+                .map_err(|_| format!("{s:?}: {c:?} is not a whole number")),
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some((k, c)) = given_twice(&counts) {
+        return Err(format!(
+            "{s:?}: {c} is given twice (the second time at place {k})"
+        ));
+    }
+    Ok(Counts(counts))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -317,5 +416,20 @@ mod tests {
         assert_eq!(parse_ground("0.3"), Ok(GroundArg::Albedo([0.3; 3])));
         assert!(parse_ground("1.5").unwrap_err().contains("0 to 1"));
         assert!(parse_ground("0.1,0.2").unwrap_err().contains("R,G,B"));
+    }
+
+    /// `--headings`: a number is a count, a list is degrees, and one heading is a list of
+    /// one with its comma (`90,`: one whole-degree heading could not be asked for).
+    #[test]
+    fn headings_are_a_count_or_a_list_of_one_or_more() {
+        assert_eq!(parse_headings("90,").unwrap().0, vec![90.0]);
+        assert_eq!(parse_headings(" -45, ").unwrap().0, vec![-45.0]);
+        assert_eq!(
+            parse_headings("4").unwrap().0,
+            vec![0.0, 90.0, 180.0, 270.0]
+        );
+        assert_eq!(parse_headings("0,90").unwrap().0, vec![0.0, 90.0]);
+        assert!(parse_headings("0,90,").is_err());
+        assert!(parse_headings(",").is_err());
     }
 }

@@ -20,6 +20,7 @@ use frf_core::bars::{Bars, bar};
 use frf_scene::Scene;
 use frf_scene::bench_frame::{FrameBenchOptions, LightMode, Motion, Spacing, run_frame_bench};
 use frf_scene::shot::ShotOptions;
+use frf_scene::text::{Counts, parse_counts, parse_megapixels};
 
 /// `frf bench ...`.
 #[derive(Args)]
@@ -249,18 +250,9 @@ fn interp(args: InterpArgs) -> CliResult {
         None => synthetic_pose()?,
     };
     let pose = ResidentPose::relight_cpu(&source);
-    if let Some((k, (w, h))) =
-        (args.sizes.iter().enumerate()).find(|(k, s)| args.sizes[..*k].contains(s))
-    {
-        return Err(frf_core::BadArgument::new(
-            "--size",
-            format!("{w}x{h}"),
-            format!(
-                "each size once (given again at place {}; it was timed twice)",
-                k + 1
-            ),
-        )
-        .into());
+    if let Some((k, (w, h))) = frf_core::argument::given_twice(&args.sizes) {
+        let allowed = format!("each size once (given again at place {k}; it was timed twice)");
+        return Err(frf_core::BadArgument::new("--size", format!("{w}x{h}"), allowed).into());
     }
     let sizes = if args.sizes.is_empty() {
         DEFAULT_SIZES.to_vec()
@@ -295,46 +287,4 @@ fn interp(args: InterpArgs) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&report)?);
     }
     Ok(())
-}
-
-/// `--walkers`: counts, each once.
-#[derive(Clone, Debug)]
-pub struct Counts(Vec<usize>);
-
-/// `1,10,40`: every count a whole number, none empty (a stray comma) or given twice
-/// (it was timed twice).
-/// Parses a number of megapixels: finite, 0 or more (NaN and -1 skipped the CPU reference
-/// without a word).
-fn parse_megapixels(s: &str) -> Result<f64, String> {
-    let v: f64 = s
-        .trim()
-        .parse()
-        .map_err(|e| format!("`{s}`: {e} (megapixels)"))?;
-    if !(v.is_finite() && v >= 0.0) {
-        return Err(format!(
-            "`{s}` megapixels: a finite number, 0 or more (0 renders no CPU reference)"
-        ));
-    }
-    Ok(v)
-}
-
-fn parse_counts(s: &str) -> Result<Counts, String> {
-    let counts: Vec<usize> = s
-        .split(',')
-        .map(|c| match c.trim() {
-            "" => Err(format!(
-                "{s:?}: an empty count (a comma with nothing beside it)"
-            )),
-            c => c
-                .parse()
-                .map_err(|_| format!("{s:?}: {c:?} is not a whole number")),
-        })
-        .collect::<Result<_, _>>()?;
-    if let Some((k, c)) = (counts.iter().enumerate()).find(|(k, c)| counts[..*k].contains(c)) {
-        return Err(format!(
-            "{s:?}: {c} is given twice (the second time at place {})",
-            k + 1
-        ));
-    }
-    Ok(Counts(counts))
 }

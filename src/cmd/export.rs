@@ -9,10 +9,10 @@ use frf_export::{ExportOptions, Tier, ViewSelection};
 
 use crate::CliResult;
 use crate::cmd::args::{
-    SunSpec, parse_env, parse_fov, parse_point, parse_radius_height, parse_size, parse_sun,
-    poses_arg,
+    SunSpec, parse_env, parse_fov, parse_point, parse_radius_height, parse_sun, poses_arg,
 };
 use frf_core::env::EnvSource;
+use frf_scene::text::{Headings, parse_headings, parse_sprite_size};
 
 /// Arguments of `frf export`.
 #[derive(Args)]
@@ -26,14 +26,14 @@ pub struct ExportArgs {
     #[arg(long)]
     poses: Option<String>,
     /// Views: `all`, `ring:V` (camera row V all the way round) or a list `U,V;U,V;...`.
-    #[arg(long, default_value = "all", value_parser = parse_views, conflicts_with = "sprites")]
+    #[arg(long, default_value = "all", value_parser = <ViewSelection as std::str::FromStr>::from_str, conflicts_with = "sprites")]
     views: ViewSelection,
     /// Voxel side of the hull meshes, metres (a walking silhouette for any viewer).
     #[arg(long, default_value_t = 0.02, conflicts_with = "sprites")]
     mesh_voxel: f32,
     /// The transfer's tier: `full` (nine RGB coefficients a texel) or `compact` (nine
     /// grey coefficients and a colour: a third of the transfer's bytes).
-    #[arg(long, default_value = "full", value_parser = parse_tier, conflicts_with = "sprites")]
+    #[arg(long, default_value = "full", value_parser = <Tier as std::str::FromStr>::from_str, conflicts_with = "sprites")]
     tier: Tier,
     /// JPEG quality of the SH transfer atlases.
     #[arg(long, default_value_t = 95, conflicts_with = "sprites")]
@@ -81,107 +81,6 @@ pub struct ExportArgs {
     /// Sprites: render with the CPU reference instead of the GPU.
     #[arg(long, requires = "sprites")]
     cpu: bool,
-}
-
-/// `--headings`: camera azimuths, degrees.
-#[derive(Clone, Debug)]
-pub struct Headings(Vec<f32>);
-
-fn parse_headings(s: &str) -> Result<Headings, String> {
-    if let Ok(n) = s.trim().parse::<usize>() {
-        if !(1..=64).contains(&n) {
-            return Err(format!("{n} headings: 1 to 64"));
-        }
-        return Ok(Headings(
-            (0..n).map(|i| i as f32 * 360.0 / n as f32).collect(),
-        ));
-    }
-    // A list of one heading ends with its comma (`90,`), where `90` alone is a count.
-    let list = s
-        .trim()
-        .strip_suffix(',')
-        .filter(|l| !l.contains(','))
-        .unwrap_or(s);
-    let headings: Vec<f32> = list
-        .split(',')
-        .map(|a| {
-            a.trim()
-                .parse::<f32>()
-                .ok()
-                .filter(|a| a.is_finite() && a.abs() <= 360.0)
-                .ok_or_else(|| {
-                    format!("{s:?}: a count of headings or a list of degrees from -360 to 360")
-                })
-        })
-        .collect::<Result<_, _>>()?;
-    // Two headings of one direction draw the same row twice.
-    let turn = |a: f32| a.rem_euclid(360.0);
-    for (k, &a) in headings.iter().enumerate() {
-        if let Some(&b) = headings[..k].iter().find(|&&b| turn(b) == turn(a)) {
-            return Err(format!("{s:?}: headings {b} and {a} are one direction"));
-        }
-    }
-    Ok(Headings(headings))
-}
-
-/// `--sprite-size`: a frame's `WxH`, within what a sheet allows (named once, not first
-/// by the general size parser's wider bound).
-fn parse_sprite_size(s: &str) -> Result<(u32, u32), String> {
-    let size = parse_size(s).map_err(|_| {
-        format!(
-            "{s:?}: expected WxH, 1 to {} pixels a side",
-            frf_scene::sprites::MOST_FRAME_SIDE
-        )
-    })?;
-    match frf_scene::sprites::frame_size_problem(size) {
-        Some(problem) => Err(problem),
-        None => Ok(size),
-    }
-}
-
-fn parse_tier(s: &str) -> Result<Tier, String> {
-    match s {
-        "full" => Ok(Tier::Full),
-        "compact" => Ok(Tier::Compact),
-        other => Err(format!("{other:?}: expected full or compact")),
-    }
-}
-
-fn parse_views(s: &str) -> Result<ViewSelection, String> {
-    if s == "all" {
-        return Ok(ViewSelection::All);
-    }
-    if let Some(v) = s.strip_prefix("ring:") {
-        return v
-            .parse()
-            .map(ViewSelection::Ring)
-            .map_err(|_| format!("ring:{v}: expected a camera row number"));
-    }
-    let views = s
-        .split(';')
-        .map(|p| {
-            let (u, v) = p
-                .split_once(',')
-                .ok_or_else(|| format!("{p:?}: expected U,V"))?;
-            Ok((
-                u.trim()
-                    .parse()
-                    .map_err(|_| format!("{p:?}: expected U,V"))?,
-                v.trim()
-                    .parse()
-                    .map_err(|_| format!("{p:?}: expected U,V"))?,
-            ))
-        })
-        .collect::<Result<Vec<(usize, usize)>, String>>()?;
-    if let Some((k, v)) = (views.iter().enumerate()).find(|(k, v)| views[..*k].contains(v)) {
-        return Err(format!(
-            "{s:?}: view {},{} is given twice (the second time at place {})",
-            v.0,
-            v.1,
-            k + 1
-        ));
-    }
-    Ok(ViewSelection::List(views))
 }
 
 /// Runs `frf export`.
@@ -267,24 +166,4 @@ fn sprites(args: &ExportArgs, poses: Option<Vec<u32>>) -> CliResult {
         println!("{}", serde_json::to_string_pretty(&r)?);
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `--headings`: a number is a count, a list is degrees, and one heading is a list of
-    /// one with its comma (`90,`: one whole-degree heading could not be asked for).
-    #[test]
-    fn headings_are_a_count_or_a_list_of_one_or_more() {
-        assert_eq!(parse_headings("90,").unwrap().0, vec![90.0]);
-        assert_eq!(parse_headings(" -45, ").unwrap().0, vec![-45.0]);
-        assert_eq!(
-            parse_headings("4").unwrap().0,
-            vec![0.0, 90.0, 180.0, 270.0]
-        );
-        assert_eq!(parse_headings("0,90").unwrap().0, vec![0.0, 90.0]);
-        assert!(parse_headings("0,90,").is_err());
-        assert!(parse_headings(",").is_err());
-    }
 }
