@@ -54,6 +54,7 @@ const OWN_SHARE: f32 = 0.5;
 /// Which instant of the walk a frame's truth shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum TruthAt {
     /// The frame's own instant (what a viewer expects to see).
     Instant,

@@ -8,6 +8,7 @@ use crate::penalty::Penalty;
 
 /// A named trade-off between error and run time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Preset {
     /// About 3x OpenCV's DIS (medium) in time and more accurate: one luminance plane,
     /// solved up to half resolution.

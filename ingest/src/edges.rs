@@ -44,6 +44,7 @@ const INTERIOR: f32 = 1.0 - 1e-4;
 
 /// What ingest does about backdrop light at the subject's edges.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum EdgeMethod {
     /// Matte with the blurred binary matte, as the original did.
     None,

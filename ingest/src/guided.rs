@@ -38,6 +38,7 @@ use crate::error::{IngestError, Result};
 
 /// How the flows between neighbouring views are measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum InterViewFlow {
     /// Image matching guided by the pose's visual hull ([`guided_flow`]).
     #[default]

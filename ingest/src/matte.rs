@@ -38,10 +38,13 @@ fn check_same(what: &str, a: &RgbImage, b: &RgbImage) -> Result<()> {
 
 /// Which pixels of a track frame are foreground.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MatteRule {
     /// The track frame is brighter than the matte frame (Einarsson et al.).
+    #[cfg_attr(feature = "clap", value(name = "paper"))]
     TrackBrighterThanMatte,
     /// The matte frame is darker than half its clean plate (unbiased at silhouettes).
+    #[cfg_attr(feature = "clap", value(name = "half-clean"))]
     MatteBelowHalfCleanPlate,
 }
 

@@ -112,6 +112,7 @@ impl LightMode {
 /// How far apart the counted frames are in the scene's time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Spacing {
     /// A millisecond: every walker keeps its pose, only the lighting changes.
     Held,

@@ -7,7 +7,6 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use frf_core::env::{EnvMap, EnvSource};
 use frf_core::sun::Sun;
-use frf_flow::Preset;
 use frf_ingest::shadows::{DEFAULT_LIGHT_SAMPLES, DEFAULT_MISSES, ShadowOptions};
 use frf_reflectance::project::FloorModel;
 use frf_render::morph::Variant;
@@ -22,27 +21,6 @@ pub use frf_scene::text::{
     parse_orbit, parse_point, parse_poses, parse_radius_height, parse_size, parse_sun, parse_turn,
     poses_arg,
 };
-
-/// A preset of the optical-flow estimator.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum FlowPresetArg {
-    /// Fastest: luminance, solved up to half resolution.
-    Fast,
-    /// Colour, full resolution, median filtering.
-    Balanced,
-    /// Classic+NL-style: texture decomposition, GNC, weighted median.
-    Accurate,
-}
-
-impl From<FlowPresetArg> for Preset {
-    fn from(p: FlowPresetArg) -> Self {
-        match p {
-            FlowPresetArg::Fast => Preset::Fast,
-            FlowPresetArg::Balanced => Preset::Balanced,
-            FlowPresetArg::Accurate => Preset::Accurate,
-        }
-    }
-}
 
 /// What lights the subject from below (the floor conditions of the basis).
 #[derive(Clone, Copy, Debug, ValueEnum, Serialize, PartialEq, Eq)]

@@ -81,7 +81,7 @@ struct FrameArgs {
     /// How far apart the frames are: `held` (1 ms: every walker keeps its pose, only the
     /// light changes) or `shot` (the scene's frame interval: poses stream in as in a render).
     #[arg(long, value_enum, default_value = "held")]
-    spacing: SpacingArg,
+    spacing: Spacing,
     /// Frame size, WxH (default: the scene's, else the field's).
     #[arg(long, value_parser = parse_size)]
     size: Option<(u32, u32)>,
@@ -110,15 +110,6 @@ enum MotionArg {
     Walking,
     /// Both.
     Both,
-}
-
-/// `--spacing`.
-#[derive(Clone, Copy, ValueEnum)]
-enum SpacingArg {
-    /// 1 ms apart: poses held.
-    Held,
-    /// As the scene's frames.
-    Shot,
 }
 
 /// Which storage formats to time.
@@ -207,10 +198,7 @@ fn frame(args: FrameArgs) -> CliResult {
             MotionArg::Both => vec![Motion::Standing, Motion::Walking],
         },
         frames: args.frames,
-        spacing: match args.spacing {
-            SpacingArg::Held => Spacing::Held,
-            SpacingArg::Shot => Spacing::Shot,
-        },
+        spacing: args.spacing,
         size,
         shot: ShotOptions {
             memory_budget: args.memory_budget.saturating_mul(1_000_000),

@@ -4,19 +4,18 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use frf_flow::FlowParams;
 use frf_flow::bench::threads;
 use frf_flow::files::{FlowFiles, bench_dir, flow_files};
-use frf_flow::{FlowParams, Preset};
 
 use crate::CliResult;
-use crate::cmd::args::FlowPresetArg;
 
 /// Options shared by both commands: which parameters to use.
 #[derive(Args)]
 pub struct ParamArgs {
     /// Preset of the estimator.
     #[arg(long, value_enum, default_value = "balanced")]
-    preset: FlowPresetArg,
+    preset: frf_flow::Preset,
     /// Reach larger displacements (horizontal view pairs: up to ~20 px at 320x448).
     #[arg(long)]
     wide_search: bool,
@@ -27,7 +26,7 @@ pub struct ParamArgs {
 
 impl ParamArgs {
     fn params(&self) -> CliResult<FlowParams> {
-        let mut params = FlowParams::preset(self.preset.into());
+        let mut params = FlowParams::preset(self.preset);
         if self.wide_search {
             params = params.wide_search();
         }
@@ -41,7 +40,7 @@ impl ParamArgs {
     }
 
     fn label(&self) -> String {
-        let mut label = Preset::from(self.preset).name().to_string();
+        let mut label = self.preset.name().to_string();
         if self.wide_search {
             label.push_str("+wide");
         }

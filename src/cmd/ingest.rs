@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use frf_eval::ingest::StageEvaluator;
 use frf_ingest::edges::EdgeMethod;
 use frf_ingest::evidence::Evaluator;
@@ -11,7 +11,7 @@ use frf_ingest::guided::InterViewFlow;
 use frf_ingest::pipeline::{IngestOptions, ingest};
 
 use crate::CliResult;
-use crate::cmd::args::{FlowPresetArg, ShadowArgs, poses_arg};
+use crate::cmd::args::{ShadowArgs, poses_arg};
 use frf_core::bars::Bars;
 
 /// Arguments of `frf ingest`.
@@ -53,7 +53,7 @@ pub struct IngestArgs {
 pub struct IngestMethodArgs {
     /// Optical-flow preset for registration and inter-view flow.
     #[arg(long, value_enum, default_value = "balanced")]
-    flow_preset: FlowPresetArg,
+    flow_preset: frf_flow::Preset,
     /// Override a flow parameter, `key=value` (repeatable; keys as `frf flow --set`).
     #[arg(long = "flow-set", value_name = "KEY=VALUE")]
     flow_set: Vec<String>,
@@ -66,30 +66,24 @@ pub struct IngestMethodArgs {
     /// Matte rule: `half-clean` (the matte frame darker than half its clean plate;
     /// unbiased at silhouettes) or `paper` (the track frame brighter than the matte frame).
     #[arg(long, value_enum, default_value = "half-clean")]
-    matte_rule: MatteArg,
+    matte_rule: frf_ingest::matte::MatteRule,
     /// Backdrop light at the subject's edges: `solve` (alpha of edge pixels solved from
     /// the matte frame, then matted with it), `extend` (the interior's colour extended
     /// under the edge) or `none` (the blurred binary matte, as the original).
     #[arg(long, value_enum, default_value = "solve")]
-    edge: EdgeArg,
+    edge: EdgeMethod,
     /// Flow between neighbouring views: `hull` (the reprojection of the pose's visual
     /// hull, refined on the images) or `images` (image matching alone, through the plane
     /// of the turntable's axis, as before).
     #[arg(long, value_enum, default_value = "hull")]
-    inter_view_flow: InterViewArg,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum InterViewArg {
-    Hull,
-    Images,
+    inter_view_flow: InterViewFlow,
 }
 
 impl IngestMethodArgs {
     /// These settings over `frf ingest`'s other defaults.
     pub fn options(&self) -> CliResult<IngestOptions> {
         Ok(IngestOptions {
-            flow_preset: self.flow_preset.into(),
+            flow_preset: self.flow_preset,
             flow_settings: self
                 .flow_set
                 .iter()
@@ -101,40 +95,11 @@ impl IngestMethodArgs {
                 .collect::<Result<_, _>>()?,
             jpeg_quality: self.jpeg_quality,
             predict_flow: !self.no_flow_prediction,
-            matte_rule: match self.matte_rule {
-                MatteArg::HalfClean => frf_ingest::matte::MatteRule::MatteBelowHalfCleanPlate,
-                MatteArg::Paper => frf_ingest::matte::MatteRule::TrackBrighterThanMatte,
-            },
-            edge: self.edge.into(),
-            inter_view_flow: match self.inter_view_flow {
-                InterViewArg::Hull => InterViewFlow::Hull,
-                InterViewArg::Images => InterViewFlow::Images,
-            },
+            matte_rule: self.matte_rule,
+            edge: self.edge,
+            inter_view_flow: self.inter_view_flow,
             ..IngestOptions::default()
         })
-    }
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum MatteArg {
-    HalfClean,
-    Paper,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum EdgeArg {
-    Solve,
-    Extend,
-    None,
-}
-
-impl From<EdgeArg> for EdgeMethod {
-    fn from(e: EdgeArg) -> Self {
-        match e {
-            EdgeArg::Solve => EdgeMethod::Solve,
-            EdgeArg::Extend => EdgeMethod::Extend,
-            EdgeArg::None => EdgeMethod::None,
-        }
     }
 }
 
@@ -214,7 +179,7 @@ pub struct RingArgs {
     out: PathBuf,
     /// Optical-flow preset for the flow between neighbouring photographs.
     #[arg(long, value_enum, default_value = "accurate")]
-    flow_preset: FlowPresetArg,
+    flow_preset: frf_flow::Preset,
     /// JPEG quality of the images.
     #[arg(long, default_value_t = 95, value_parser = clap::value_parser!(u8).range(1..=100))]
     jpeg_quality: u8,
@@ -230,7 +195,7 @@ pub fn run_ring(args: RingArgs) -> CliResult {
     let r = frf_ingest::ring::ingest_ring(
         &args.par,
         &args.out,
-        &frf_flow::FlowParams::preset(args.flow_preset.into()),
+        &frf_flow::FlowParams::preset(args.flow_preset),
         args.jpeg_quality,
         args.stride,
     )?;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use frf_core::env::EnvSource;
 use frf_core::io::{write_exr_rgba, write_png8_srgba};
 use frf_stage::truth::DEFAULT_ENVIRONMENT_LIGHTS;
@@ -38,31 +38,11 @@ enum StageCommand {
     CodecCurve(crate::cmd::stage_field::CodecArgs),
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum PresetArg {
-    Tiny,
-    Small,
-    Paper,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum GaitArg {
-    Walk,
-    Run,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum SetFlowArg {
-    All,
-    Track,
-    None,
-}
-
 #[derive(Args)]
 struct CaptureArgs {
     /// Size preset: tiny (64x90, seconds), small (160x224, the demo), paper (320x448).
     #[arg(long, value_enum, default_value = "tiny")]
-    preset: PresetArg,
+    preset: Preset,
     /// Output capture directory (created; a rerun with the same settings resumes).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -71,13 +51,13 @@ struct CaptureArgs {
     seed: u64,
     /// Walking or running.
     #[arg(long, value_enum, default_value = "walk")]
-    gait: GaitArg,
+    gait: Gait,
     /// Poses to render, e.g. `0,1` or `0..4` (default: the preset's).
     #[arg(long)]
     poses: Option<String>,
     /// Which true flows from T1 to the other slots of each set to write.
     #[arg(long, value_enum)]
-    set_flow: Option<SetFlowArg>,
+    set_flow: Option<SetFlowTruth>,
     /// Film only the poses and views this scene file needs (with all its frames); with
     /// `--poses`, of those poses (a scene that morphs between poses draws its frames
     /// between the ones kept).
@@ -164,25 +144,14 @@ pub fn run(args: StageArgs) -> CliResult {
 
 fn capture(args: CaptureArgs) -> CliResult {
     let out = args.out.ok_or("frf stage: --out DIR is required")?;
-    let mut config = StageConfig::preset(match args.preset {
-        PresetArg::Tiny => Preset::Tiny,
-        PresetArg::Small => Preset::Small,
-        PresetArg::Paper => Preset::Paper,
-    });
+    let mut config = StageConfig::preset(args.preset);
     config.seed = args.seed;
-    config.gait = match args.gait {
-        GaitArg::Walk => Gait::Walk,
-        GaitArg::Run => Gait::Run,
-    };
+    config.gait = args.gait;
     if let Some(p) = &args.poses {
         config.poses = poses_arg("--poses", p)?;
     }
     if let Some(s) = args.set_flow {
-        config.set_flow_truth = match s {
-            SetFlowArg::All => SetFlowTruth::All,
-            SetFlowArg::Track => SetFlowTruth::Track,
-            SetFlowArg::None => SetFlowTruth::None,
-        };
+        config.set_flow_truth = s;
     }
     config.noise = !args.no_noise;
     if let Some((w, h)) = args.size {

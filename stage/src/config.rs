@@ -11,6 +11,7 @@ use crate::rig::Exposure;
 /// The named presets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Preset {
     /// About 64x90 pixels, all 36x3 views, 2 poses: for tests and CI, seconds.
     Tiny,
@@ -37,6 +38,7 @@ impl Preset {
 /// Which true flows from the reference track frame to the other slots of a set to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum SetFlowTruth {
     /// To every slot of the set.
     All,

@@ -31,6 +31,7 @@ use crate::rng::{gaussian, hash};
 /// The kind of cyclic motion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Gait {
     /// Walking, 1.0 s per cycle.
     Walk,

@@ -83,7 +83,7 @@ pub struct EvalArgs {
     /// a frame between two captured poses is judged against the walker in between) or the
     /// drawn pose's (`pose`: the error of the view alone).
     #[arg(long, value_enum, default_value = "instant")]
-    pub truth_at: TruthAtArg,
+    pub truth_at: frf_eval::shot::TruthAt,
     /// With a scene: how far a walker's own light may move before its poses are relit
     /// (as `frf render --light-tolerance`).
     #[arg(long, value_parser = crate::cmd::args::parse_light_tolerance)]
@@ -112,24 +112,6 @@ pub struct EvalArgs {
     /// Ground of the composites' environment backdrop: `env` or an albedo `A` / `R,G,B`.
     #[arg(long, value_parser = parse_ground, default_value = "env")]
     pub ground: GroundArg,
-}
-
-/// [`frf_eval::shot::TruthAt`] on the command line.
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum TruthAtArg {
-    /// The frame's own instant.
-    Instant,
-    /// The instant of the pose drawn.
-    Pose,
-}
-
-impl From<TruthAtArg> for frf_eval::shot::TruthAt {
-    fn from(a: TruthAtArg) -> Self {
-        match a {
-            TruthAtArg::Instant => Self::Instant,
-            TruthAtArg::Pose => Self::Pose,
-        }
-    }
 }
 
 /// What `frf eval` and `frf eval-ring` compare, on which renderer, and how they report.

@@ -25,7 +25,7 @@ pub fn run(args: &EvalArgs) -> CliResult {
     let how = ShotEval {
         frames: args.frames.unwrap_or(DEFAULT_FRAMES),
         lights: args.lights,
-        truth_at: args.truth_at.into(),
+        truth_at: args.truth_at,
         light_tolerance: args
             .light_tolerance
             .unwrap_or(frf_scene::shot::LightTolerance::DEFAULT),
