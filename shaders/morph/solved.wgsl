@@ -26,8 +26,10 @@ struct QuadFrame {
 // Per quad (u, v) of the grid, u-major, max(rows - 1, 1) per column.
 @group(1) @binding(9) var<storage, read> quad_frames: array<QuadFrame>;
 
-// Fixed-point steps per source (`solved::ITERATIONS`).
+// Fixed-point steps per source at most (`solved::ITERATIONS`), and from the proxy's depth
+// (`solved::PROXY_ITERATIONS`).
 const SOLVE_ITERATIONS: i32 = 2;
+const PROXY_ITERATIONS: i32 = 1;
 // A step this short ends the iteration (`solved::SETTLED_PX`); last-step length at which
 // a source weighs 1/e, and the least factor (`solved::SETTLE_PX`, `solved::SETTLE_FLOOR`).
 const SETTLED_PX: f32 = 0.01;
@@ -79,6 +81,8 @@ struct SolvedOutput {
     centre: vec2<f32>,
     s: vec2<f32>,
     inverse_depth: f32,
+    // Fixed-point steps at most.
+    steps: i32,
     ok: bool,
 }
 
@@ -117,10 +121,12 @@ fn solved_output(hit: Hit, origin: vec3<f32>, dir: vec3<f32>) -> SolvedOutput {
     }
     let plane = to_plane(f, centre);
     var inverse_depth = 1.0 / quad_frames[f].fixation_depth;
+    out.steps = SOLVE_ITERATIONS;
     if (point.w > 0.0) {
         let v = 1.0 / (to_plane(f, point.xyz).z - plane.z);
         if (finite(v) && v > 0.0) {
             inverse_depth = v;
+            out.steps = PROXY_ITERATIONS;
         }
     }
     out.centre = plane.xy;
@@ -170,7 +176,7 @@ fn solve_source(f: u32, q: vec4<u32>, k: u32, out: SolvedOutput) -> vec3<f32> {
     var here = out.s + (out.centre - frame_centre(f, k)) * vec2<f32>(k_f.x, k_f.y) * out.inverse_depth;
     var x = homography(quad_frames[f].from_rectified[k], here);
     var step = 0.0;
-    for (var i = 0; i < SOLVE_ITERATIONS; i++) {
+    for (var i = 0; i < out.steps; i++) {
         var d = vec2<f32>(0.0);
         if (ac.x != 0.0 || any(across != vec2<f32>(0.0))) {
             let fh = sample_flow(view, toward_h, x);

@@ -20,10 +20,10 @@
 //! H_X(x) + D(x) = s,
 //! ```
 //!
-//! found by the fixed-point iteration `x ← H_X⁻¹(s − D(x))` (at most [`ITERATIONS`]
-//! steps, fewer once a step is shorter than [`SETTLED_PX`]),
-//! started at the depth the proxy gives the ray (its first hull voxel), else at the
-//! quad's fixation depth: that start picks, where a limb folds over another, the surface
+//! found by the fixed-point iteration `x ← H_X⁻¹(s − D(x))` (one step from the depth the
+//! proxy gives the ray, [`PROXY_ITERATIONS`]; at most [`ITERATIONS`] from the quad's
+//! fixation depth, fewer once a step is shorter than [`SETTLED_PX`]), started at the
+//! depth the proxy gives the ray (its first hull voxel), else at the quad's fixation depth: that start picks, where a limb folds over another, the surface
 //! the ray meets first. Each step reads the view's own two flows at its own pixel, so
 //! the displacement is right where the flow changes fast (limb edges, feet), which E06's
 //! formula, reading another view's flow at the output pixel, is not.
@@ -57,6 +57,20 @@ use crate::resident::ResidentPose;
 /// perturbation capture (subject PSNR, oracle / ingested field): 2 steps 32.30 / 29.60 dB,
 /// 3 steps 32.45 / 29.51 dB, 4 steps 32.42 dB (oracle), at 2/3 the cost of 3 on lavapipe.
 pub const ITERATIONS: usize = 2;
+/// Fixed-point steps per source that start from the depth the proxy gives the ray (a
+/// pose with a visual hull): a ray of the subject starts on the hull, whose depth is the
+/// surface's to within its voxels, and from there one step lands where a second moves it
+/// by hundredths of a pixel; a ray that misses the hull sees nothing of the subject.
+/// Chosen on seed 7's pose 0 (oracle / ingested field, 16 quad centres, one step against
+/// two: sky 32.85 / 31.89 against 32.90 / 31.74, Pisa 32.28 / 30.95 against 32.18 /
+/// 30.74, Grace 31.11 / 30.36 against 31.05 / 30.26; the six camera paths' mean 30.58 /
+/// 30.37 against 30.56 / 30.29), reported on pose 12 (oracle: sky 31.35 against 31.39,
+/// Pisa 32.16 against 32.10, the paths' mean 29.57 against 29.53); the four-way pass
+/// 11-15 % cheaper on lavapipe (docs/results/render.md). Without a proxy the solve starts
+/// at the quad's fixation depth and takes [`ITERATIONS`]: one step from there cost a
+/// ring of photographs without a hull 0.58 dB (dinoSparseRing, every other view held
+/// out: 17.82 -> 17.24 dB).
+pub const PROXY_ITERATIONS: usize = 1;
 /// A fixed-point step shorter than this (pixels) ends the iteration: the solution has
 /// settled far below the resolution of the stored flows.
 pub const SETTLED_PX: f32 = 0.01;
@@ -81,6 +95,9 @@ pub struct Output {
     pub s: Vec2,
     /// Inverse depth (1/m, along the plane's normal) the solve starts from.
     pub inverse_depth: f32,
+    /// Fixed-point steps at most: [`PROXY_ITERATIONS`] from the proxy's depth,
+    /// [`ITERATIONS`] from the quad's fixation depth.
+    pub steps: usize,
 }
 
 /// The output camera of a ray that crossed the quad of `frame` at `hit` (see the module
@@ -117,14 +134,17 @@ pub fn output(
         }
     };
     let plane = frame.to_plane(centre);
-    let inverse_depth = point
+    let from_point = point
         .map(|p| 1.0 / (frame.to_plane(p).z - plane.z))
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .unwrap_or(1.0 / frame.fixation_depth);
+        .filter(|v| v.is_finite() && *v > 0.0);
     Some(Output {
         centre: plane.truncate(),
         s,
-        inverse_depth,
+        inverse_depth: from_point.unwrap_or(1.0 / frame.fixation_depth),
+        steps: match from_point {
+            Some(_) => PROXY_ITERATIONS,
+            None => ITERATIONS,
+        },
     })
 }
 
@@ -202,7 +222,7 @@ pub fn solve(
     let mut here = out.s + frame.parallax(frame.centres[k], out.centre) * out.inverse_depth;
     let mut x = apply(&frame.from_rectified[k], here);
     let mut step = 0.0;
-    for _ in 0..ITERATIONS {
+    for _ in 0..out.steps {
         here = out.s - displacement(x, here);
         let next = apply(&frame.from_rectified[k], here);
         step = (next - x).length();
