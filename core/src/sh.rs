@@ -34,7 +34,7 @@
 use std::f32::consts::PI;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
@@ -80,6 +80,19 @@ pub fn sh_basis(d: Vec3) -> [f32; SH_COUNT] {
 
 /// The cosine lobe's factor per band (`Â_l`): the irradiance's coefficient is `Â_l c_i`.
 pub const COSINE_LOBE: [f32; 3] = [PI, 2.0 * PI / 3.0, PI / 4.0];
+
+/// How the engines' glTF importers place frf's (glTF's) directions in their own world
+/// frames, as [`ShLight::in_frame`] takes them: `(engine, to)`, `d_engine = to · d`.
+/// three.js, Godot and Bevy keep glTF's axes (`+y` up, right-handed); Unity's importers
+/// (UnityGLTF, glTFast) negate `x` to make the frame left-handed. Unreal's (z up,
+/// left-handed, centimetres) is not listed: its importer's axis order could not be
+/// checked here (docs/export.md).
+pub const ENGINE_FRAMES: [(&str, Mat3); 4] = [
+    ("three.js", Mat3::IDENTITY),
+    ("Godot", Mat3::IDENTITY),
+    ("Bevy", Mat3::IDENTITY),
+    ("Unity", Mat3::from_cols(Vec3::NEG_X, Vec3::Y, Vec3::Z)),
+];
 
 /// The convention a file declares (see the module text); a file declaring another is
 /// refused rather than misread.
@@ -182,6 +195,45 @@ impl ShLight {
     /// Wraps coefficients in frf's convention.
     pub fn from_coefficients(coefficients: [Rgb; SH_COUNT]) -> Self {
         Self { coefficients }
+    }
+
+    /// The same light in a frame whose directions are `to · d` (`to` orthogonal: a
+    /// rotation, or a reflection such as an engine's change of handedness): the
+    /// coefficients whose radiance at `to · d` is this light's at `d`, exactly (an L2
+    /// light is a polynomial of degree 2 on the sphere, `a + b · d + dᵀ Q d`, which `to`
+    /// maps to `a + (to b) · d' + d'ᵀ (to Q toᵀ) d'`). [`ENGINE_FRAMES`] names the
+    /// engines' frames.
+    pub fn in_frame(&self, to: Mat3) -> Self {
+        const K1: f32 = 0.488_603;
+        const KXY: f32 = 1.092_548;
+        const K6: f32 = 0.315_392;
+        const K8: f32 = 0.546_274;
+        let mut out = [[0.0f32; 3]; SH_COUNT];
+        for ch in 0..3 {
+            let c = |i: usize| self.coefficients[i][ch];
+            let b = to * Vec3::new(c(3), c(1), c(2)) * K1;
+            // The quadratic part, traceless (on the sphere 3z² − 1 = 2z² − x² − y²).
+            let (xy, yz, xz) = (KXY * c(4) / 2.0, KXY * c(5) / 2.0, KXY * c(7) / 2.0);
+            let (xx, yy, zz) = (
+                -K6 * c(6) + K8 * c(8),
+                -K6 * c(6) - K8 * c(8),
+                2.0 * K6 * c(6),
+            );
+            let q = Mat3::from_cols(
+                Vec3::new(xx, xy, xz),
+                Vec3::new(xy, yy, yz),
+                Vec3::new(xz, yz, zz),
+            );
+            let q = to * q * to.transpose();
+            out[0][ch] = c(0);
+            (out[3][ch], out[1][ch], out[2][ch]) = (b.x / K1, b.y / K1, b.z / K1);
+            out[4][ch] = 2.0 * q.y_axis.x / KXY;
+            out[5][ch] = 2.0 * q.z_axis.y / KXY;
+            out[7][ch] = 2.0 * q.z_axis.x / KXY;
+            out[6][ch] = q.z_axis.z / (2.0 * K6);
+            out[8][ch] = (q.x_axis.x - q.y_axis.y) / (2.0 * K8);
+        }
+        Self::from_coefficients(out)
     }
 
     /// Unity's seven shader vectors (`unity_SHAr, SHAg, SHAb, SHBr, SHBg, SHBb, SHC`),

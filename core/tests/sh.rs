@@ -1,15 +1,15 @@
 //! L2 lights (`frf_core::sh`) and their maps (`frf_core::env`): the basis is orthonormal,
 //! a projection recovers a band-limited light, irradiance is the cosine integral and
-//! three.js's published constants, the conventions round trip, and files round trip or
-//! are refused by name.
+//! three.js's published constants, the conventions round trip, a light in an engine's
+//! frame is the same light, and files round trip or are refused by name.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
 use std::f32::consts::PI;
 
 use frf_core::env::EnvMap;
-use frf_core::sh::{SH_COUNT, SH_ORDER, ShLight, sh_basis, weighted};
-use glam::Vec3;
+use frf_core::sh::{ENGINE_FRAMES, SH_COUNT, SH_ORDER, ShLight, sh_basis, weighted};
+use glam::{Mat3, Vec3};
 
 /// Unit directions spread over the sphere.
 fn directions(n: usize) -> Vec<Vec3> {
@@ -281,4 +281,76 @@ fn a_tiny_map_integrates_its_texels_regions() {
     }
     let total = loaded.total_light()[0];
     assert!((total - 10.0 * PI).abs() < 1e-4 * total, "total {total}");
+}
+
+/// Unity's `ShadeSH9` of its seven shader vectors `v` at normal `n`, channel `c`.
+fn shade_sh9(v: &[[f32; 4]; 7], n: Vec3, c: usize) -> f32 {
+    let (a, b) = (v[c], v[3 + c]);
+    a[0] * n.x
+        + a[1] * n.y
+        + a[2] * n.z
+        + a[3]
+        + b[0] * n.x * n.y
+        + b[1] * n.y * n.z
+        + b[2] * n.z * n.z
+        + b[3] * n.z * n.x
+        + v[6][c] * (n.x * n.x - n.y * n.y)
+}
+
+/// Issue 60: a light taken into an engine's frame is the same light: its radiance at the
+/// engine's direction of `d` is frf's at `d`, for each engine's frame, a turn and a z-up
+/// left-handed frame; Unity's shader vectors of the light in Unity's frame shade Unity's
+/// normal as frf's irradiance shades frf's (the worked example of docs/export.md), where
+/// the light left in frf's frame does not (the control: the mirror matters).
+#[test]
+fn a_light_in_an_engines_frame_is_the_same_light() {
+    let l = light();
+    let mut frames: Vec<(&str, Mat3)> = ENGINE_FRAMES.to_vec();
+    frames.push((
+        "a turn",
+        Mat3::from_rotation_y(0.7) * Mat3::from_rotation_x(-0.4),
+    ));
+    // z up, left-handed: (x, y, z) -> (z, -x, y).
+    frames.push((
+        "z up",
+        Mat3::from_cols(Vec3::new(0.0, -1.0, 0.0), Vec3::Z, Vec3::X),
+    ));
+    for (name, to) in frames {
+        let moved = l.in_frame(to);
+        for d in directions(40) {
+            let (a, b) = (moved.radiance(to * d), l.radiance(d));
+            assert!(
+                (0..3).all(|c| (a[c] - b[c]).abs() < 1e-4),
+                "{name}: {a:?} against {b:?} at {d}"
+            );
+        }
+    }
+    // The worked example: a light brighter toward +x, radiance 0.282095 + 0.5 * 0.488603
+    // x; in Unity's frame its x coefficient changes sign, and toward Unity's -x (frf's
+    // +x) it is as bright.
+    let mut c = [[0.0f32; 3]; SH_COUNT];
+    (c[0], c[3]) = ([1.0; 3], [0.5; 3]);
+    let example = ShLight::from_coefficients(c);
+    let unity = ENGINE_FRAMES[3].1;
+    let in_unity = example.in_frame(unity);
+    assert!((in_unity.coefficients[3][0] + 0.5).abs() < 1e-6);
+    let want = 0.282_095 + 0.5 * 0.488_603;
+    assert!((example.radiance(Vec3::X)[0] - want).abs() < 1e-6);
+    assert!((in_unity.radiance(Vec3::NEG_X)[0] - want).abs() < 1e-6);
+    // Unity's ShadeSH9 of the light in Unity's frame, at Unity's normal.
+    let v = l.in_frame(unity).unity_shader_vectors();
+    let unmoved = l.unity_shader_vectors();
+    let mut control = 0.0f32;
+    for n in directions(20) {
+        let e = l.irradiance(n);
+        for c in 0..3 {
+            let shade = shade_sh9(&v, unity * n, c);
+            assert!((shade - e[c] / PI).abs() < 1e-4, "{shade} {}", e[c] / PI);
+            control = control.max((shade_sh9(&unmoved, unity * n, c) - e[c] / PI).abs());
+        }
+    }
+    assert!(
+        control > 1e-2,
+        "the light left unmirrored shades Unity's normals alike"
+    );
 }
