@@ -208,8 +208,7 @@ impl ShLight {
         const KXY: f32 = 1.092_548;
         const K6: f32 = 0.315_392;
         const K8: f32 = 0.546_274;
-        let mut out = [[0.0f32; 3]; SH_COUNT];
-        for ch in 0..3 {
+        let channel = |ch: usize| -> [f32; SH_COUNT] {
             let c = |i: usize| self.coefficients[i][ch];
             let b = to * Vec3::new(c(3), c(1), c(2)) * K1;
             // The quadratic part, traceless (on the sphere 3z² − 1 = 2z² − x² − y²).
@@ -225,14 +224,20 @@ impl ShLight {
                 Vec3::new(xz, yz, zz),
             );
             let q = to * q * to.transpose();
-            out[0][ch] = c(0);
-            (out[3][ch], out[1][ch], out[2][ch]) = (b.x / K1, b.y / K1, b.z / K1);
-            out[4][ch] = 2.0 * q.y_axis.x / KXY;
-            out[5][ch] = 2.0 * q.z_axis.y / KXY;
-            out[7][ch] = 2.0 * q.z_axis.x / KXY;
-            out[6][ch] = q.z_axis.z / (2.0 * K6);
-            out[8][ch] = (q.x_axis.x - q.y_axis.y) / (2.0 * K8);
-        }
+            [
+                c(0),
+                b.y / K1,
+                b.z / K1,
+                b.x / K1,
+                2.0 * q.y_axis.x / KXY,
+                2.0 * q.z_axis.y / KXY,
+                q.z_axis.z / (2.0 * K6),
+                2.0 * q.z_axis.x / KXY,
+                (q.x_axis.x - q.y_axis.y) / (2.0 * K8),
+            ]
+        };
+        let per = [channel(0), channel(1), channel(2)];
+        let out = std::array::from_fn(|i| [per[0][i], per[1][i], per[2][i]]);
         Self::from_coefficients(out)
     }
 
