@@ -62,19 +62,27 @@ pub const SH_FORMAT: &str = "frf-sh-l2";
 /// Their version.
 pub const SH_VERSION: u32 = 1;
 
+/// The basis' normalising constants (see the module text): band 0's, band 1's, then
+/// band 2's for `xy`, `yz` and `xz`, for `3z² − 1` and for `x² − y²`.
+const K0: f32 = 0.282_095;
+const K1: f32 = 0.488_603;
+const K2: f32 = 1.092_548;
+const K6: f32 = 0.315_392;
+const K8: f32 = 0.546_274;
+
 /// The basis functions at unit direction `d` (see the module text).
 pub fn sh_basis(d: Vec3) -> [f32; SH_COUNT] {
     let (x, y, z) = (d.x, d.y, d.z);
     [
-        0.282_095,
-        0.488_603 * y,
-        0.488_603 * z,
-        0.488_603 * x,
-        1.092_548 * x * y,
-        1.092_548 * y * z,
-        0.315_392 * (3.0 * z * z - 1.0),
-        1.092_548 * x * z,
-        0.546_274 * (x * x - y * y),
+        K0,
+        K1 * y,
+        K1 * z,
+        K1 * x,
+        K2 * x * y,
+        K2 * y * z,
+        K6 * (3.0 * z * z - 1.0),
+        K2 * x * z,
+        K8 * (x * x - y * y),
     ]
 }
 
@@ -204,15 +212,11 @@ impl ShLight {
     /// maps to `a + (to b) · d' + d'ᵀ (to Q toᵀ) d'`). [`ENGINE_FRAMES`] names the
     /// engines' frames.
     pub fn in_frame(&self, to: Mat3) -> Self {
-        const K1: f32 = 0.488_603;
-        const KXY: f32 = 1.092_548;
-        const K6: f32 = 0.315_392;
-        const K8: f32 = 0.546_274;
         let channel = |ch: usize| -> [f32; SH_COUNT] {
             let c = |i: usize| self.coefficients[i][ch];
             let b = to * Vec3::new(c(3), c(1), c(2)) * K1;
             // The quadratic part, traceless (on the sphere 3z² − 1 = 2z² − x² − y²).
-            let (xy, yz, xz) = (KXY * c(4) / 2.0, KXY * c(5) / 2.0, KXY * c(7) / 2.0);
+            let (xy, yz, xz) = (K2 * c(4) / 2.0, K2 * c(5) / 2.0, K2 * c(7) / 2.0);
             let (xx, yy, zz) = (
                 -K6 * c(6) + K8 * c(8),
                 -K6 * c(6) - K8 * c(8),
@@ -229,10 +233,10 @@ impl ShLight {
                 b.y / K1,
                 b.z / K1,
                 b.x / K1,
-                2.0 * q.y_axis.x / KXY,
-                2.0 * q.z_axis.y / KXY,
+                2.0 * q.y_axis.x / K2,
+                2.0 * q.z_axis.y / K2,
                 q.z_axis.z / (2.0 * K6),
-                2.0 * q.z_axis.x / KXY,
+                2.0 * q.z_axis.x / K2,
                 (q.x_axis.x - q.y_axis.y) / (2.0 * K8),
             ]
         };
@@ -255,18 +259,18 @@ impl ShLight {
         let mut out = [[0.0f32; 4]; 7];
         for ch in 0..3 {
             out[ch] = [
-                a1 * 0.488_603 * c[3][ch],
-                a1 * 0.488_603 * c[1][ch],
-                a1 * 0.488_603 * c[2][ch],
-                a0 * 0.282_095 * c[0][ch] - a2 * 0.315_392 * c[6][ch],
+                a1 * K1 * c[3][ch],
+                a1 * K1 * c[1][ch],
+                a1 * K1 * c[2][ch],
+                a0 * K0 * c[0][ch] - a2 * K6 * c[6][ch],
             ];
             out[3 + ch] = [
-                a2 * 1.092_548 * c[4][ch],
-                a2 * 1.092_548 * c[5][ch],
-                a2 * 3.0 * 0.315_392 * c[6][ch],
-                a2 * 1.092_548 * c[7][ch],
+                a2 * K2 * c[4][ch],
+                a2 * K2 * c[5][ch],
+                a2 * 3.0 * K6 * c[6][ch],
+                a2 * K2 * c[7][ch],
             ];
-            out[6][ch] = a2 * 0.546_274 * c[8][ch];
+            out[6][ch] = a2 * K8 * c[8][ch];
         }
         out[6][3] = 1.0;
         out

@@ -75,10 +75,13 @@ fn runs(
         let mut open = false;
         for job in jobs {
             let need = u64::from(job.texels) * 16;
-            let full = runs.last().is_none_or(|r: &Run| {
-                r.jobs == most_jobs || (r.jobs > 0 && r.scratch + need > most_scratch)
-            });
-            if !open || full {
+            // A run of these pages is open and has room for the job (a first job always
+            // starts one, whatever its scratch).
+            let fits = open
+                && runs
+                    .last()
+                    .is_some_and(|r: &Run| r.jobs < most_jobs && r.scratch + need <= most_scratch);
+            if !fits {
                 bytes.resize(bytes.len().next_multiple_of(align), 0);
                 runs.push(Run {
                     pages: pages.clone(),
