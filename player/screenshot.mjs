@@ -1,9 +1,13 @@
 // Renders one frame of a walker (`frf export`) in headless Chromium (software GL) and
 // writes it as a PNG (8-bit sRGB, straight alpha: as `frf render` writes its frames):
 //
-//   node player/screenshot.mjs --glb F --pose N --camera X,Y,Z --look-at X,Y,Z --fov DEG \
-//     --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] --out OUT.png [--time-frames K] [--json]
+//   node player/screenshot.mjs --glb F [--pose N | --time SECONDS [--interpolate flow|nearest]] \
+//     --camera X,Y,Z --look-at X,Y,Z --fov DEG --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] \
+//     --out OUT.png [--time-frames K] [--json]
 //
+// `--pose N` draws a pose; `--time SECONDS` an instant of the walk (from pose 0's, looping
+// every cycle), between two poses morphed in time by their motion as frf does (`flow`), or
+// the nearest pose (`nearest`, as frf's `interpolate = "nearest"`).
 // The camera is frf's `look_at` (subject frame, +y up, vertical field of view in
 // degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun as frf's `--sun`: azimuth AZ
 // (from +z toward +x) and elevation EL, degrees, a disc DIAM degrees across (0.53 when
@@ -23,7 +27,7 @@ function fail(message) {
 }
 
 function parse(argv) {
-  const o = { pose: null, fov: 35, timeFrames: 0, json: false };
+  const o = { pose: null, time: null, interpolate: 'flow', fov: 35, timeFrames: 0, json: false };
   const numbers = (flag, text, n, most = n) => {
     const v = text.split(',').map((x) => (x.trim() === '' ? NaN : Number(x)));
     if (v.length < n || v.length > most || v.some((x) => !Number.isFinite(x))) {
@@ -42,6 +46,8 @@ function parse(argv) {
     switch (flag) {
       case '--glb': o.glb = value(); break;
       case '--pose': o.pose = numbers(flag, value(), 1)[0]; break;
+      case '--time': o.time = numbers(flag, value(), 1)[0]; break;
+      case '--interpolate': o.interpolate = value(); break;
       case '--camera': o.camera = numbers(flag, value(), 3); break;
       case '--look-at': o.lookAt = numbers(flag, value(), 3); break;
       case '--fov': o.fov = numbers(flag, value(), 1)[0]; break;
@@ -63,6 +69,9 @@ function parse(argv) {
     if (o[k] === undefined) fail(`--${k === 'width' ? 'size' : k} is required`);
   }
   o.lookAt ??= [0, 0.9, 0];
+  if (o.pose !== null && o.time !== null) fail('--pose and --time: give one (a pose, or an instant of the walk)');
+  if (o.time !== null && Math.abs(o.time) > 1e9) fail(`--time ${o.time}: expected seconds within ±1e9`);
+  if (!['flow', 'nearest'].includes(o.interpolate)) fail(`--interpolate ${o.interpolate}: expected flow or nearest`);
   if (!(o.width >= 1 && o.height >= 1 && o.width <= 8192 && o.height <= 8192)) fail(`--size ${o.width}x${o.height}: 1 to 8192 pixels a side`);
   if (!(o.fov > 0.1 && o.fov < 170)) fail(`--fov ${o.fov}: expected degrees in (0.1, 170)`);
   if (!(Number.isInteger(o.timeFrames) && o.timeFrames >= 0 && o.timeFrames <= 1000)) fail(`--time-frames ${o.timeFrames}: 0 to 1000`);
@@ -125,7 +134,7 @@ try {
   });
   result = await page.evaluate((job) => window.frfRender(job), {
     glbUrl: '/job/walker.glb', glbName: basename(o.glb), shText, shName: basename(o.sh),
-    pose: o.pose, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
+    pose: o.pose, time: o.time, interpolate: o.interpolate, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
     sun: o.sun ?? null, timedFrames: o.timeFrames,
   });
 } catch (e) {
@@ -147,8 +156,8 @@ try {
   fail(`--out ${o.out}: ${e.message}`);
 }
 const report = {
-  out: o.out, pose: result.pose, width: o.width, height: o.height,
+  out: o.out, pose: result.at.before, between: result.at.s > 0 ? { after: result.at.after, s: result.at.s } : null, width: o.width, height: o.height,
   ms_per_frame: result.msPerFrame, timed_frames: o.timeFrames, load_ms: result.loadMs,
   gl_renderer: result.renderer, notes: result.notes,
 };
-console.log(o.json ? JSON.stringify(report) : `wrote ${o.out} (${o.width}x${o.height}, pose ${result.pose}${result.msPerFrame ? `, ${result.msPerFrame.toFixed(1)} ms per frame on ${result.renderer}` : ''})`);
+console.log(o.json ? JSON.stringify(report) : `wrote ${o.out} (${o.width}x${o.height}, pose ${result.at.before}${result.at.s > 0 ? ` to ${result.at.after} at ${result.at.s.toFixed(3)}` : ''}${result.msPerFrame ? `, ${result.msPerFrame.toFixed(1)} ms per frame on ${result.renderer}` : ''})`);

@@ -29,6 +29,7 @@ pub mod preview;
 pub mod progress;
 pub mod sh;
 pub mod shared_data;
+pub mod subject_motion;
 pub mod sun;
 pub mod thread_clock;
 pub mod volume;

@@ -13,3 +13,5 @@ pub const ATLAS_COLUMNS: usize = 3;
 pub const FLOW_SCALE: f32 = 256.0;
 /// See [`FLOW_SCALE`]: flows from −128 to +128 px at 1/256 px.
 pub const FLOW_OFFSET_PX: f32 = 128.0;
+/// Motion is 16-bit: a stored value `q` is `(q − MOTION_ZERO) · step_m` metres.
+pub const MOTION_ZERO: u16 = 32768;

@@ -85,6 +85,9 @@ pub struct PoseRecord {
     pub cameras: Vec<CameraRecord>,
     /// How far from the hull's surface a sun's shadow ray starts, metres.
     pub sun_shadow_offset_m: f32,
+    /// The field's poses its views' motion leads to, by the step's name (`next`,
+    /// `prev`): only where the field holds pose-to-pose flows.
+    pub motion_to: BTreeMap<String, u32>,
     /// The views exported.
     pub views: Vec<ViewRecord>,
 }
@@ -110,6 +113,19 @@ pub struct ViewRecord {
     pub albedo: ScaledImage,
     /// Its flows toward its grid neighbours, by the neighbour's name (an image's index).
     pub flows: BTreeMap<String, usize>,
+    /// The subject's motion toward the next and the previous pose, by the step's name
+    /// (`next`, `prev`), where the field holds pose-to-pose flows.
+    pub motion: BTreeMap<String, MotionImage>,
+}
+
+/// A view's motion toward another pose: metres across the subject's axis (tangential to
+/// the circle of cameras) and up it, per texel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MotionImage {
+    /// A 16-bit grey-alpha PNG (across in grey, up in alpha): `(q − 32768) · step_m`.
+    pub image: usize,
+    /// Metres a code.
+    pub step_m: f32,
 }
 
 /// A view's SH transfer: per coefficient and channel, `offset + scale × code`.

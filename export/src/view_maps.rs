@@ -3,19 +3,20 @@
 //! channels, which are not a colour), each of 3 x 3 tiles with a scale and offset per
 //! tile and channel (`value = offset + scale · code`, codes 0–255 linear), alpha as an 8-bit grey PNG, normals (subject frame) as an
 //! RGBA PNG (`n = 2 · rgb / 255 − 1`, alpha 0 where none was fitted), albedo as an RGB PNG
-//! with a scale per channel, and flows as 16-bit grey-alpha PNGs ([`crate::format`]).
+//! with a scale per channel, and flows and the subject's motion toward the next and previous
+//! pose as 16-bit grey-alpha PNGs ([`crate::format`]).
 
 use std::io::Cursor;
 
 use frf_core::image::{FlowImage, GrayImage, Rgb};
 use frf_core::sh::SH_COUNT;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use image::codecs::jpeg::JpegEncoder;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
 
 use crate::error::{ExportError, Result};
-use crate::format::{ATLAS_COLUMNS, FLOW_OFFSET_PX, FLOW_SCALE};
+use crate::format::{ATLAS_COLUMNS, FLOW_OFFSET_PX, FLOW_SCALE, MOTION_ZERO};
 
 /// A transfer's atlases and how to read their codes back.
 #[derive(Debug, Clone)]
@@ -158,4 +159,56 @@ pub fn flow_png(flow: &FlowImage) -> Result<Vec<u8>> {
         .flat_map(|v| v.to_ne_bytes())
         .collect();
     png(&bytes, w, h, ExtendedColorType::La16)
+}
+
+/// A view's motion (metres across the axis and up it) as a 16-bit grey-alpha PNG and its
+/// metres a code ([`MOTION_ZERO`] is none).
+pub fn motion_png(metres: &[Vec2], w: usize, h: usize) -> Result<(Vec<u8>, f32)> {
+    let reach = metres
+        .iter()
+        .map(|m| m.abs().max_element())
+        .fold(0.0f32, f32::max);
+    let step = (reach / f32::from(MOTION_ZERO - 1)).max(f32::MIN_POSITIVE);
+    let zero = f32::from(MOTION_ZERO);
+    let q = |m: f32| (m / step + zero).round().clamp(0.0, 65535.0) as u16;
+    let bytes: Vec<u8> = metres
+        .iter()
+        .flat_map(|m| [q(m.x), q(m.y)])
+        .flat_map(|v| v.to_ne_bytes())
+        .collect();
+    Ok((png(&bytes, w, h, ExtendedColorType::La16)?, step))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Motion comes back from its PNG within half a code, signs and all, and a view that
+    /// does not move stores its zero exactly.
+    #[test]
+    fn motion_survives_its_png() {
+        let (w, h) = (7, 5);
+        let metres: Vec<Vec2> = (0..w * h)
+            .map(|i| Vec2::new(0.2 * (i as f32 / 34.0 - 0.5), -0.03 + 0.002 * i as f32))
+            .collect();
+        let (bytes, step) = motion_png(&metres, w, h).unwrap();
+        let img = image::load_from_memory(&bytes).unwrap().into_luma_alpha16();
+        assert_eq!(img.dimensions(), (w as u32, h as u32));
+        for (m, p) in metres.iter().zip(img.pixels()) {
+            let got = Vec2::new(
+                (f32::from(p[0]) - f32::from(MOTION_ZERO)) * step,
+                (f32::from(p[1]) - f32::from(MOTION_ZERO)) * step,
+            );
+            assert!(
+                (got - *m).abs().max_element() <= 0.5 * step + 1e-9,
+                "{m} -> {got}"
+            );
+        }
+        let (bytes, _) = motion_png(&[Vec2::ZERO; 4], 2, 2).unwrap();
+        let img = image::load_from_memory(&bytes).unwrap().into_luma_alpha16();
+        assert!(
+            img.pixels()
+                .all(|p| p[0] == MOTION_ZERO && p[1] == MOTION_ZERO)
+        );
+    }
 }

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-use frf_core::grid::Neighbour;
+use frf_core::grid::{Neighbour, PoseStep};
 use frf_core::image::{GrayImage, Rgb};
 use frf_core::sh::{Convention, SH_COUNT};
 use frf_reflectance::FieldFile;
@@ -21,9 +21,11 @@ use crate::format::{EXTENSION, VERSION};
 use crate::glb::Glb;
 use crate::hull_mesh::hull_mesh;
 use crate::model::{
-    Extension, Grid, PoseRecord, ScaledImage, TierName, Transfer, ViewRecord, Walk,
+    Extension, Grid, MotionImage, PoseRecord, ScaledImage, TierName, Transfer, ViewRecord, Walk,
 };
-use crate::view_maps::{alpha_png, flow_png, normals_png, scaled_rgb_png, transfer_atlas};
+use crate::view_maps::{
+    alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png, transfer_atlas,
+};
 
 /// Which views of each pose are exported.
 #[derive(Debug, Clone, PartialEq)]
@@ -139,8 +141,8 @@ pub struct ExportReport {
     pub views: usize,
     /// Triangles of all hull meshes.
     pub triangles: usize,
-    /// Bytes of the transfer atlases, alpha, normals, albedo, flows and meshes.
-    pub section_bytes: [(String, u64); 6],
+    /// Bytes of the transfer atlases, alpha, normals, albedo, flows, meshes and motion.
+    pub section_bytes: [(String, u64); 7],
     /// Wall seconds.
     pub seconds: f64,
     /// What the export lacks that a player may expect (a field without normals).
@@ -159,6 +161,7 @@ struct ViewOut {
     normals: Option<Vec<u8>>,
     albedo: (Vec<u8>, Rgb),
     flows: Vec<(Neighbour, Vec<u8>)>,
+    motion: Vec<(PoseStep, Vec<u8>, f32)>,
 }
 
 /// Exports `field` to `out` (written to a temporary file and renamed).
@@ -171,7 +174,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let (poses, wanted) = selection(&field, options)?;
     let projector = field.projector()?;
     let mut glb = Glb::default();
-    let mut sizes = [0u64; 6];
+    let mut sizes = [0u64; 7];
     let mut nodes = vec![json!({"name": "walker", "children": []})];
     let mut meshes = Vec::new();
     let mut pose_records = Vec::new();
@@ -257,6 +260,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             node,
             cameras,
             sun_shadow_offset_m: offset,
+            motion_to: motion_to(&record),
             views,
         });
     }
@@ -276,7 +280,9 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     });
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
-    let names = ["transfer", "alpha", "normals", "albedo", "flows", "meshes"];
+    let names = [
+        "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion",
+    ];
     let mut notes = Vec::new();
     if sizes[2] == 0 {
         notes.push(format!(
@@ -294,6 +300,18 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         seconds: started.elapsed().as_secs_f64(),
         notes,
     })
+}
+
+/// Where a pose's motion leads (`next`, `prev`): the poses its pose-to-pose flows reach.
+fn motion_to(record: &frf_reflectance::field::PoseRecord) -> BTreeMap<String, u32> {
+    let Some(to) = record.pose_flows_to else {
+        return BTreeMap::new();
+    };
+    PoseStep::ALL
+        .into_iter()
+        .zip(to)
+        .filter_map(|(step, to)| to.map(|p| (step_name(step).to_string(), p)))
+        .collect()
 }
 
 /// The extension's object ([`crate::model`]) of `field` (read from `field_path`) holding
@@ -399,7 +417,7 @@ fn selection(field: &FieldFile, options: &ExportOptions) -> Result<Selection> {
 
 /// Adds view `e` of `pose`'s images to `glb` (their bytes counted in `sizes`, by
 /// section) and returns its record in the extension.
-fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> ViewRecord {
+fn add_view(glb: &mut Glb, sizes: &mut [u64; 7], pose: u32, e: ViewOut) -> ViewRecord {
     let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
     let before = glb.binary_bytes();
     let rgb = ["red", "green", "blue"];
@@ -436,6 +454,20 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> ViewR
         flows.insert(n.name().to_string(), image);
     }
     sizes[4] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let mut motion = BTreeMap::new();
+    for (step, bytes, step_m) in &e.motion {
+        let name = name(&format!("motion {}", step_name(*step)));
+        let image = glb.image(bytes, "image/png", name);
+        motion.insert(
+            step_name(*step).to_string(),
+            MotionImage {
+                image,
+                step_m: *step_m,
+            },
+        );
+    }
+    sizes[6] += (glb.binary_bytes() - before) as u64;
     ViewRecord {
         u: e.u,
         v: e.v,
@@ -454,6 +486,15 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 6], pose: u32, e: ViewOut) -> ViewR
             scale: e.albedo.1,
         },
         flows,
+        motion,
+    }
+}
+
+/// A pose step's key in the extension.
+fn step_name(step: PoseStep) -> &'static str {
+    match step {
+        PoseStep::Next => "next",
+        PoseStep::Prev => "prev",
     }
 }
 
@@ -543,6 +584,7 @@ fn encode_view(
             flows.push((n, flow_png(&f)?));
         }
     }
+    let motion = view_motion(field, pose, (u, v), (w, h))?;
     Ok(ViewOut {
         u,
         v,
@@ -554,7 +596,47 @@ fn encode_view(
         normals,
         albedo,
         flows,
+        motion,
     })
+}
+
+/// View `(u, v)` of `pose`'s motion toward the poses its pose-to-pose flows lead to, in
+/// metres across the axis and up it (as frf's morph in time reads them,
+/// [`frf_core::subject_motion`]), beyond the subject its nearest known texel's.
+fn view_motion(
+    field: &FieldFile,
+    pose: u32,
+    (u, v): (usize, usize),
+    (w, h): (usize, usize),
+) -> Result<Vec<(PoseStep, Vec<u8>, f32)>> {
+    let header = field.header();
+    let poses = header.pose_list();
+    let camera = |pose: u32, u: usize| -> Result<frf_core::camera::Camera> {
+        header.pose(pose)?.views[header.view_index(u, v)]
+            .camera
+            .to_camera()
+            .map_err(|e| ExportError::Field(format!("pose {pose} view {u},{v}'s camera: {e}")))
+    };
+    let mut out = Vec::new();
+    for step in PoseStep::ALL {
+        let Some(flow) = field.pose_flow(pose, u, v, step)? else {
+            continue;
+        };
+        let Some((to_pose, to_u)) = step.of(pose, u, &poses, header.columns, header.wraps) else {
+            continue;
+        };
+        let (from, later) = (camera(pose, u)?, camera(to_pose, to_u)?);
+        let Some(metres) =
+            frf_core::subject_motion::view_motion_m(&from, &later, &flow, (w, h), |k| {
+                (k % w, k / w)
+            })
+        else {
+            continue;
+        };
+        let (png, step_m) = motion_png(&metres, w, h)?;
+        out.push((step, png, step_m));
+    }
+    Ok(out)
 }
 
 /// The walk: each pose's node at scale 1 from its time to the next pose's, 0 otherwise,

@@ -34,19 +34,26 @@ window.frfRender = async (job) => {
     ? { direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180), illuminance: [e, e, e] }
     : undefined;
   player.setLight(sh, sun);
-  const pose = job.pose ?? player.poseNumbers()[0];
-  await player.preparePose(pose);
+  // A pose's own instant, or an instant of the walk between poses.
+  let at;
+  if (job.time === null || job.time === undefined) {
+    const pose = job.pose ?? player.poseNumbers()[0];
+    await player.preparePose(pose);
+    at = { before: pose, after: pose, s: 0 };
+  } else {
+    at = await player.prepareInstant(job.time, job.interpolate ?? 'flow');
+  }
   const loadMs = performance.now() - started;
   const camera = FrfPlayer.camera(job.camera, job.lookAt, job.fov, job.width, job.height);
   const target = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
   const pixels = new Float32Array(4 * job.width * job.height);
   const gl = renderer.getContext();
   // One frame to compile, then the timed ones (each waits for the GPU by a readback).
-  player.draw(pose, camera, target);
+  player.drawInstant(at, camera, target);
   renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
   const t0 = performance.now();
   for (let i = 0; i < job.timedFrames; i++) {
-    player.draw(pose, camera, target);
+    player.drawInstant(at, camera, target);
     gl.finish();
     renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
   }
@@ -70,6 +77,6 @@ window.frfRender = async (job) => {
   }
   let binary = '';
   for (let i = 0; i < out.length; i += 0x8000) binary += String.fromCharCode(...out.subarray(i, i + 0x8000));
-  return { rgba: btoa(binary), msPerFrame, loadMs, pose, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+  return { rgba: btoa(binary), msPerFrame, loadMs, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
 };
 window.frfReady = true;

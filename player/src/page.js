@@ -1,7 +1,7 @@
 // The player's page: a walker drawn from a camera the mouse orbits (three.js
 // OrbitControls), relit by an L2 light (an `frf env-sh` file, or a three.js LightProbe
-// through `fromLightProbe`) and an optional sun by the normals, the walk cycle played
-// pose by pose at the capture's rate.
+// through `fromLightProbe`) and an optional sun by the normals, the walk played at the
+// capture's rate and morphed in time between its poses (or pose by pose, unticked).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { FrfPlayer, fullscreen } from './player.js';
@@ -54,7 +54,7 @@ async function loadGlb(bytes, name) {
     loaded = true;
     $('error').textContent = player.notes.join('\n');
     applyLight();
-    poseIndex = 0;
+    clock = 0;
   } catch (e) {
     loaded = false;
     showError(e);
@@ -97,8 +97,7 @@ if (query.get('glb')) {
     .catch(showError);
 }
 
-let poseIndex = 0;
-let poseClock = 0;
+let clock = 0;
 let last = performance.now();
 let busy = false;
 let drawMs = 0;
@@ -122,19 +121,10 @@ async function tick() {
     return;
   }
   const ext = player.ext;
-  const poses = player.poseNumbers();
-  if ($('play').checked && poses.length > 1) {
-    poseClock += dt;
-    const period = ext.cycle_seconds / Math.max(ext.poses_per_cycle, 1);
-    while (poseClock >= period) {
-      poseClock -= period;
-      poseIndex = (poseIndex + 1) % poses.length;
-    }
-  }
-  const pose = poses[poseIndex];
+  if ($('play').checked) clock = (clock + dt) % ext.cycle_seconds;
   busy = true;
   try {
-    await player.preparePose(pose);
+    const at = await player.prepareInstant(clock, $('morph').checked ? 'flow' : 'nearest');
     if (!frameTarget || frameTarget.width !== w || frameTarget.height !== h) {
       frameTarget?.dispose();
       frameTarget = new THREE.WebGLRenderTarget(w, h, { type: THREE.HalfFloatType, depthBuffer: false });
@@ -142,14 +132,15 @@ async function tick() {
     const eye = camera.position.toArray();
     const target = controls.target.toArray();
     const t0 = performance.now();
-    player.draw(pose, FrfPlayer.camera(eye, target, camera.fov, w, h), frameTarget);
+    player.drawInstant(at, FrfPlayer.camera(eye, target, camera.fov, w, h), frameTarget);
     present.uniforms.uFrame.value = frameTarget.texture;
     present.uniforms.uExposure.value = 2 ** Number($('exposure').value);
     present.uniforms.uSize.value.set(w, h);
     renderer.setRenderTarget(null);
     renderer.render(presentScene, camera);
     drawMs = 0.9 * drawMs + 0.1 * (performance.now() - t0);
-    $('status').textContent = `pose ${pose} (${poseIndex + 1} of ${poses.length}), ${ext.grid.columns}x${ext.grid.rows} views of ${ext.grid.width}x${ext.grid.height}\n` +
+    const when = at.s > 0 ? `poses ${at.before} to ${at.after} at ${at.s.toFixed(2)}` : `pose ${at.before}`;
+    $('status').textContent = `${clock.toFixed(3)} s: ${when} (${ext.poses.length} exported), ${ext.grid.columns}x${ext.grid.rows} views of ${ext.grid.width}x${ext.grid.height}\n` +
       `${w}x${h} pixels, ${drawMs.toFixed(1)} ms to issue a frame`;
   } catch (e) {
     showError(e);

@@ -2,8 +2,11 @@
 // relit on the GPU by an L2 light (the SH transfer) and an optional sun (the fitted
 // normals and albedo) into pre-lit layers, and each frame re-bins every pixel's ray
 // through the cylinder of camera centres and morphs the quad's views by the solved
-// four-way morph, as `frf render` does. A pose's textures are made when it is first
-// shown and kept; the pre-lit layers are redone when the light changes.
+// four-way morph, as `frf render` does. Between two poses (an instant of the walk) both
+// are drawn with their motion toward each other (the views' stored motion morphed into
+// the frame as colour is) and morphed in time, as `frf render` does (docs/design.md
+// section 4.7). A pose's textures are made when it is first shown and kept; the pre-lit
+// layers are redone when the light changes.
 import * as THREE from 'three';
 import { parseGlb, poseMesh, BadFile } from './glb.js';
 import { MAX_TOTAL_LIGHT } from './sh.js';
@@ -13,8 +16,9 @@ import {
 } from './geometry.js';
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
-  SUN_MAP_VERTEX, SUN_MAP_FRAGMENT,
+  SUN_MAP_VERTEX, SUN_MAP_FRAGMENT, TIME_MORPH_FRAGMENT,
 } from './shaders.js';
+import { instantOf, motionToImage } from './time.js';
 
 /** The sun's map of the hull, texels a side. */
 const SUN_MAP_SIZE = 512;
@@ -26,6 +30,10 @@ const SUN_MAP_SIZE = 512;
 const SHADOW_OFFSET_PER_HEIGHT = 0.17;
 
 const NEIGHBOURS = ['right', 'left', 'up', 'down'];
+/** The steps in time a view's motion is stored toward (`motion_to`'s keys). */
+const STEPS = ['next', 'prev'];
+/** A stored motion code of no motion. */
+const MOTION_ZERO = 32768;
 
 function arrayTexture(data, width, height, depth, format, type) {
   const t = new THREE.DataArrayTexture(data, width, height, depth);
@@ -107,6 +115,15 @@ export class FrfPlayer {
       },
       side: THREE.DoubleSide,
     });
+    this.timeMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: TIME_MORPH_FRAGMENT,
+      uniforms: {
+        uBefore: { value: null }, uAfter: { value: null }, uBeforeMotion: { value: null }, uAfterMotion: { value: null },
+        uToImage: { value: new THREE.Matrix2() }, uS: { value: 0 }, uHeight: { value: 0 },
+      },
+      depthTest: false, depthWrite: false, transparent: false, blending: THREE.NoBlending,
+    });
+    this.timeScene = fullscreen(this.timeMaterial);
     this.hullMaterial = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: HULL_VERTEX, fragmentShader: HULL_FRAGMENT,
       uniforms: { uViewProjection: { value: new THREE.Matrix4() }, uEye: { value: new THREE.Vector3() } },
@@ -255,8 +272,9 @@ export class FrfPlayer {
         flowLayer++;
       });
     }
+    const motion = this.#motionTextures(record);
     const pose = {
-      record, geometry, n,
+      record, geometry, n, motion,
       atlas: arrayTexture(atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
       alpha: arrayTexture(alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
       normals: arrayTexture(normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
@@ -281,6 +299,7 @@ export class FrfPlayer {
       hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
       dispose() {
         for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t.dispose();
+        for (const t of Object.values(this.motion)) t.dispose();
         this.ranges?.dispose();
         this.prelit.dispose();
         this.viewHull.dispose();
@@ -298,6 +317,35 @@ export class FrfPlayer {
       this.#drawHull(pose, camera, pose.viewHull, i, false);
     });
     return pose;
+  }
+
+  /**
+   * A pose's motion toward the poses its `motion_to` names, by step: one RG32F layer a
+   * view (metres across the axis and up it; a view without it stands still), read by
+   * the frame pass in place of the pre-lit colour (alpha 1 where a view is held).
+   */
+  #motionTextures(record) {
+    const { width: w, height: h } = this.grid;
+    const glb = this.glb;
+    const out = {};
+    for (const step of STEPS) {
+      if (record.motion_to?.[step] === undefined) continue;
+      if (!record.views.some((v) => v.motion?.[step] !== undefined)) continue;
+      const data = new Float32Array(2 * w * h * record.views.length);
+      record.views.forEach((v, i) => {
+        const m = v.motion?.[step];
+        if (m === undefined) return;
+        const what = `pose ${record.pose} view ${v.u},${v.v} motion ${step}`;
+        if (!(Number.isFinite(m.step_m) && m.step_m > 0)) throw new BadFile(glb.name, `${what}: step_m ${m.step_m}, expected metres above 0`);
+        const img = png(glb, m.image, what);
+        expect(glb, img, w, h, 2, what);
+        if (img.depth !== 16) throw new BadFile(glb.name, `${what}: ${img.depth}-bit, expected 16-bit`);
+        const layer = data.subarray(i * 2 * w * h, (i + 1) * 2 * w * h);
+        for (let t = 0; t < 2 * w * h; t++) layer[t] = (img.data[t] - MOTION_ZERO) * m.step_m;
+      });
+      out[step] = arrayTexture(data, w, h, record.views.length, THREE.RGFormat, THREE.FloatType);
+    }
+    return out;
   }
 
   #hullMesh(mesh) {
@@ -355,12 +403,94 @@ export class FrfPlayer {
    * render target of the camera's size, or null for the canvas): premultiplied linear RGBA.
    */
   draw(number, camera, target) {
+    const pose = this.#prepared(number);
+    this.#drawHull(pose, camera, this.#hullTarget(camera.width, camera.height), 0, true);
+    this.#frame(pose, camera, pose.prelit.texture, target);
+  }
+
+  /**
+   * The export's poses around instant `timeS` (seconds; `instantOf`), made ready to draw;
+   * with `interpolate` 'nearest' the nearest pose alone, as frf's `interpolate =
+   * "nearest"`. Where the two poses' motion does not lead to each other (an export of
+   * some of a field's poses) the nearest is drawn, and a note says so.
+   */
+  async prepareInstant(timeS, interpolate = 'flow') {
+    if (!['flow', 'nearest'].includes(interpolate)) throw new Error(`interpolate ${interpolate}: expected flow or nearest`);
+    let at = instantOf(this.ext, timeS);
+    if (at.s > 0) {
+      const record = (p) => this.ext.poses.find((q) => q.pose === p);
+      const linked = record(at.before).motion_to?.next === at.after && record(at.after).motion_to?.prev === at.before;
+      if (interpolate === 'nearest' || !linked) {
+        if (interpolate === 'flow') {
+          const note = `poses ${at.before} and ${at.after} hold no motion toward each other (the export holds some of the field's poses, or a field without pose-to-pose flows): the nearest pose is drawn between them`;
+          if (!this.notes.includes(note)) this.notes.push(note);
+        }
+        const p = at.s < 0.5 ? at.before : at.after;
+        at = { before: p, after: p, s: 0 };
+      }
+    }
+    await this.preparePose(at.before);
+    if (at.s > 0) {
+      await this.preparePose(at.after);
+      for (const [p, step] of [[at.before, 'next'], [at.after, 'prev']]) {
+        if (!this.poses.get(p).motion[step]) throw new BadFile(this.glb.name, `pose ${p} holds no view's motion ${step} though motion_to names it`);
+      }
+    }
+    return at;
+  }
+
+  /**
+   * Draws instant `at` (of `prepareInstant`) from `camera` into `target`: at a pose the
+   * pose; between two, each pose and its motion toward the other drawn into targets of
+   * their own and morphed in time (frf's `time_morph`).
+   */
+  drawInstant(at, camera, target) {
+    if (at.s === 0) {
+      this.draw(at.before, camera, target);
+      return;
+    }
+    const [before, after] = [this.#prepared(at.before), this.#prepared(at.after)];
+    const t = this.#timeTargets(camera.width, camera.height);
+    const hull = this.#hullTarget(camera.width, camera.height);
+    for (const [pose, step, colour, motion] of [[before, 'next', t[0], t[2]], [after, 'prev', t[1], t[3]]]) {
+      this.#drawHull(pose, camera, hull, 0, true);
+      this.#frame(pose, camera, pose.prelit.texture, colour);
+      this.#frame(pose, camera, pose.motion[step], motion);
+    }
+    const u = this.timeMaterial.uniforms;
+    [u.uBefore.value, u.uAfter.value, u.uBeforeMotion.value, u.uAfterMotion.value] = t.map((x) => x.texture);
+    const m = motionToImage(camera);
+    u.uToImage.value.set(m[0][0], m[1][0], m[0][1], m[1][1]);
+    u.uS.value = at.s;
+    u.uHeight.value = camera.height;
+    const saved = this.renderer.getRenderTarget();
+    this.renderer.setRenderTarget(target);
+    this.renderer.render(this.timeScene, this.camera);
+    this.renderer.setRenderTarget(saved);
+  }
+
+  #prepared(number) {
     const pose = this.poses.get(number);
     if (!pose || pose.lightVersion !== this.lightVersion) throw new Error(`pose ${number} is not prepared`);
+    return pose;
+  }
+
+  /** Four float targets of a frame's size: two poses' colour and their motions. */
+  #timeTargets(width, height) {
+    if (!this.timeTargets || this.timeTargets[0].width !== width || this.timeTargets[0].height !== height) {
+      this.timeTargets?.forEach((x) => x.dispose());
+      this.timeTargets = [0, 1, 2, 3].map(() => new THREE.WebGLRenderTarget(width, height, {
+        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
+        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      }));
+    }
+    return this.timeTargets;
+  }
+
+  /** The frame pass of `pose` (its hull pass drawn) reading `views` (pre-lit colour or motion). */
+  #frame(pose, camera, views, target) {
     const hullTarget = this.#hullTarget(camera.width, camera.height);
     const saved = this.renderer.getRenderTarget();
-    this.#drawHull(pose, camera, hullTarget, 0, true);
-    // The frame pass.
     const u = this.frameMaterial.uniforms;
     const [r, d, f] = camera.axes;
     u.uEye.value.set(...camera.centre);
@@ -374,7 +504,7 @@ export class FrfPlayer {
     u.uColumns.value = this.grid.columns;
     u.uRows.value = this.grid.rows;
     u.uFrameRows.value = pose.geometry.frameRows;
-    u.uPrelit.value = pose.prelit.texture;
+    u.uPrelit.value = views;
     u.uFlows.value = pose.flows;
     u.uHullT.value = hullTarget.texture;
     u.uHasHull.value = pose.geometry.hasHull ? 1 : 0;

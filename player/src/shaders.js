@@ -165,7 +165,10 @@ uniform int uHasHull;
 uniform vec2 uAxis;
 out vec4 outColor;
 
+// Fixed-point steps per source at most, and from the proxy's depth (frf's
+// solved::ITERATIONS and solved::PROXY_ITERATIONS).
 const int SOLVE_ITERATIONS = 2;
+const int PROXY_ITERATIONS = 1;
 const float SETTLED_PX = 0.01;
 const float SETTLE_PX = 2.0;
 const float SETTLE_FLOOR = 1e-3;
@@ -381,10 +384,10 @@ vec4 proxyPoint(vec3 origin, vec3 dir) {
   return vec4(origin + dir * max(-dot(o, d) / dd, 0.0), 1.0);
 }
 
-struct Output { vec2 centre; vec2 s; float inverseDepth; bool ok; };
+struct Output { vec2 centre; vec2 s; float inverseDepth; bool ok; int steps; };
 
 Output solvedOutput(Hit hit, vec3 origin, vec3 dir) {
-  Output out_ = Output(vec2(0.0), vec2(0.0), 0.0, false);
+  Output out_ = Output(vec2(0.0), vec2(0.0), 0.0, false, SOLVE_ITERATIONS);
   int f = frameIndex(hit);
   if (frameTexel(f, 0).w == 0.0) return out_;
   vec4 point = proxyPoint(origin, dir);
@@ -402,11 +405,15 @@ Output solvedOutput(Hit hit, vec3 origin, vec3 dir) {
   if (r.z == 0.0) return out_;
   vec3 plane = toPlane(f, centre);
   float inverseDepth = 1.0 / frameTexel(f, 30).x;
+  int steps = SOLVE_ITERATIONS;
   if (point.w > 0.0) {
     float v = 1.0 / (toPlane(f, point.xyz).z - plane.z);
-    if (finite(v) && v > 0.0) inverseDepth = v;
+    if (finite(v) && v > 0.0) {
+      inverseDepth = v;
+      steps = PROXY_ITERATIONS;
+    }
   }
-  return Output(plane.xy, r.xy, inverseDepth, true);
+  return Output(plane.xy, r.xy, inverseDepth, true, steps);
 }
 
 // A bilinear sample of a layer at pixel s (centres at integers, the edge
@@ -474,7 +481,7 @@ vec3 solveSource(int f, ivec4 q, int k, Output o) {
   vec2 here = o.s + (o.centre - frameCentre(f, k)) * focal * o.inverseDepth;
   vec2 x = homography(fromK, here);
   float step_ = 0.0;
-  for (int i = 0; i < SOLVE_ITERATIONS; i++) {
+  for (int i = 0; i < o.steps; i++) {
     vec2 d = vec2(0.0);
     if (ac.x != 0.0 || any(notEqual(across, vec2(0.0)))) {
       vec2 fh = sampleFlow(view, towardH, x);
@@ -542,5 +549,60 @@ void main() {
   vec4 f = texelFetch(uFrame, ivec2(gl_FragCoord.xy), 0);
   vec3 backdrop = mix(uBottom, uTop, gl_FragCoord.y / uSize.y);
   outColor = vec4(srgb(f.rgb * uExposure + backdrop * (1.0 - f.a)), 1.0);
+}
+`;
+
+/**
+ * The morph in time (frf's `shaders/time_morph.wgsl`): the frame a fraction uS of the way
+ * from pose k to k' samples k's render where the point was (back along k''s motion toward
+ * k, a fraction uS of it) and k''s where it will be (along k's motion, 1 − uS of it) and
+ * mixes them (1 − uS, uS). Motion renders hold metres across the axis and up it (.rg
+ * over .a; none where .a is 0), uToImage turns them into the frame's pixels.
+ */
+export const TIME_MORPH_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+uniform sampler2D uBefore;        // pose k, premultiplied linear
+uniform sampler2D uAfter;         // pose k'
+uniform sampler2D uBeforeMotion;  // k's motion toward k'
+uniform sampler2D uAfterMotion;   // k''s motion toward k
+uniform mat2 uToImage;
+uniform float uS;
+uniform int uHeight;
+out vec4 outColor;
+
+// Pixel p (y down) of a target whose rows run bottom up.
+vec4 at(sampler2D t, ivec2 p) { return texelFetch(t, ivec2(p.x, uHeight - 1 - p.y), 0); }
+
+vec2 motionAt(sampler2D t, ivec2 p) {
+  vec4 m = at(t, p);
+  return m.a < 1e-3 ? vec2(0.0) : uToImage * (m.rg / m.a);
+}
+
+// Bilinear at pixel q (centres at integers), zero beyond the frame (frf's Border::Zero).
+vec4 bilinearZero(sampler2D t, vec2 q) {
+  ivec2 size = textureSize(t, 0);
+  float limit = float(max(size.x, size.y) + 2);
+  vec2 c = clamp(q, vec2(-limit), vec2(size) + limit);
+  vec2 f0 = floor(c);
+  vec2 fr = c - f0;
+  ivec2 i0 = ivec2(f0);
+  vec4 acc = vec4(0.0);
+  for (int dy = 0; dy < 2; dy++) {
+    for (int dx = 0; dx < 2; dx++) {
+      float w = (dx == 1 ? fr.x : 1.0 - fr.x) * (dy == 1 ? fr.y : 1.0 - fr.y);
+      ivec2 p = i0 + ivec2(dx, dy);
+      if (w != 0.0 && all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, size))) acc += w * at(t, p);
+    }
+  }
+  return acc;
+}
+
+void main() {
+  ivec2 p = ivec2(int(gl_FragCoord.x), uHeight - 1 - int(gl_FragCoord.y));
+  vec2 here = vec2(p);
+  vec4 a = bilinearZero(uBefore, here + uS * motionAt(uAfterMotion, p));
+  vec4 b = bilinearZero(uAfter, here + (1.0 - uS) * motionAt(uBeforeMotion, p));
+  outColor = (1.0 - uS) * a + uS * b;
 }
 `;

@@ -12,6 +12,7 @@ mod interrupt;
 mod olat;
 mod outputs;
 mod player;
+mod player_motion;
 mod render;
 mod report;
 mod resume;

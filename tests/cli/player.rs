@@ -16,15 +16,15 @@ use serde_json::Value;
 
 use crate::common::{frf, stderr};
 
-fn player() -> PathBuf {
+pub(crate) fn player() -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/player")).to_path_buf()
 }
 
 /// A camera of the screenshot's flags: centre, a point looked at, vertical fov (degrees).
-struct Shot {
-    eye: [f32; 3],
-    look_at: [f32; 3],
-    fov_deg: f32,
+pub(crate) struct Shot {
+    pub(crate) eye: [f32; 3],
+    pub(crate) look_at: [f32; 3],
+    pub(crate) fov_deg: f32,
 }
 
 /// The camera blended bilinearly from pose 0's grid cameras at fractional `(u, v)`:
@@ -34,7 +34,7 @@ fn grid_camera(document: &Value, u: f32, v: f32) -> Shot {
 }
 
 /// [`grid_camera`] of the export's `at`-th pose's cameras.
-fn grid_camera_of(document: &Value, at: usize, u: f32, v: f32) -> Shot {
+pub(crate) fn grid_camera_of(document: &Value, at: usize, u: f32, v: f32) -> Shot {
     let ext = &document["extensions"]["FRF_flowed_reflectance_field"];
     let rows = ext["grid"]["rows"].as_u64().unwrap() as usize;
     let columns = ext["grid"]["columns"].as_u64().unwrap() as usize;
@@ -69,7 +69,7 @@ fn grid_camera_of(document: &Value, at: usize, u: f32, v: f32) -> Shot {
     }
 }
 
-fn list(v: [f32; 3]) -> String {
+pub(crate) fn list(v: [f32; 3]) -> String {
     format!("{},{},{}", v[0], v[1], v[2])
 }
 
@@ -184,7 +184,7 @@ fn frf_frame_pose(
 
 /// Subject PSNR of `b` against `a` (8-bit sRGB, straight alpha): linear premultiplied
 /// colour over the pixels either covers by half, peak `a`'s brightest.
-fn subject_psnr(a: &Path, b: &Path) -> f64 {
+pub(crate) fn subject_psnr(a: &Path, b: &Path) -> f64 {
     let load = |p: &Path| image::open(p).unwrap().to_rgba8();
     let (a, b) = (load(a), load(b));
     assert_eq!(a.dimensions(), b.dimensions());

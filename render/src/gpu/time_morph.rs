@@ -155,7 +155,7 @@ impl Gpu {
                 let [after, before_motion, after_motion] = [0, 1, 2].map(|k| renders[3 * j + k]);
                 let pair =
                     |a: Place, b: Place| [a.offset[0], a.offset[1], b.offset[0], b.offset[1]];
-                let m: Mat2 = crate::motion::motion_to_image(&w.camera);
+                let m: Mat2 = frf_core::subject_motion::motion_to_image(&w.camera);
                 let morph = subjects.morph_place(j);
                 GpuTimeMorph {
                     to_image: [m.x_axis.x, m.x_axis.y, m.y_axis.x, m.y_axis.y],
