@@ -3,11 +3,13 @@
 //
 //   node player/screenshot.mjs --glb F [--pose N | --time SECONDS [--interpolate flow|nearest]] \
 //     --camera X,Y,Z --look-at X,Y,Z --fov DEG --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] \
-//     --out OUT.png [--time-frames K] [--json]
+//     --out OUT.png [--time-frames K] [--box X,Y,Z,SX,SY,SZ,R,G,B ...] [--no-depth] [--json]
 //
 // `--pose N` draws a pose; `--time SECONDS` an instant of the walk (from pose 0's, looping
 // every cycle), between two poses morphed in time by their motion as frf does (`flow`), or
-// the nearest pose (`nearest`, as frf's `interpolate = "nearest"`).
+// the nearest pose (`nearest`, as frf's `interpolate = "nearest"`). Each `--box` puts an
+// unlit box (centre, size in metres, linear colour) in a three.js scene with the walker,
+// which is drawn with its hull's depth against them (laid over them with `--no-depth`).
 // The camera is frf's `look_at` (subject frame, +y up, vertical field of view in
 // degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun as frf's `--sun`: azimuth AZ
 // (from +z toward +x) and elevation EL, degrees, a disc DIAM degrees across (0.53 when
@@ -27,7 +29,7 @@ function fail(message) {
 }
 
 function parse(argv) {
-  const o = { pose: null, time: null, interpolate: 'flow', fov: 35, timeFrames: 0, json: false };
+  const o = { pose: null, time: null, interpolate: 'flow', fov: 35, timeFrames: 0, json: false, boxes: [], depth: true };
   const numbers = (flag, text, n, most = n) => {
     const v = text.split(',').map((x) => (x.trim() === '' ? NaN : Number(x)));
     if (v.length < n || v.length > most || v.some((x) => !Number.isFinite(x))) {
@@ -62,6 +64,8 @@ function parse(argv) {
       case '--out': o.out = value(); break;
       case '--time-frames': o.timeFrames = numbers(flag, value(), 1)[0]; break;
       case '--json': o.json = true; break;
+      case '--box': o.boxes.push(numbers(flag, value(), 9)); break;
+      case '--no-depth': o.depth = false; break;
       default: fail(`unknown flag ${flag}`);
     }
   }
@@ -135,7 +139,7 @@ try {
   result = await page.evaluate((job) => window.frfRender(job), {
     glbUrl: '/job/walker.glb', glbName: basename(o.glb), shText, shName: basename(o.sh),
     pose: o.pose, time: o.time, interpolate: o.interpolate, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
-    sun: o.sun ?? null, timedFrames: o.timeFrames,
+    sun: o.sun ?? null, timedFrames: o.timeFrames, boxes: o.boxes, depth: o.depth,
   });
 } catch (e) {
   if (interrupted) await new Promise(() => {});

@@ -5,6 +5,7 @@ import * as THREE from 'three';
 import { FrfPlayer } from './player.js';
 import { parseShLight } from './sh.js';
 import { sunDirection } from './geometry.js';
+import { subjectCamera, DepthComposite } from './scene.js';
 
 THREE.ColorManagement.enabled = false;
 
@@ -13,6 +14,34 @@ function srgbCode(x) {
   const v = Math.min(Math.max(x, 0), 1);
   const s = v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055;
   return Math.round(s * 255);
+}
+
+/**
+ * A frame of the walker (at the origin, unturned) among `job.boxes` (each centre, size
+ * and linear colour, unlit), drawn into `target` by the returned function.
+ */
+function sceneDraw(renderer, player, job, at, target) {
+  const scene = new THREE.Scene();
+  for (const [x, y, z, sx, sy, sz, r, g, b] of job.boxes) {
+    const box = new THREE.Mesh(new THREE.BoxGeometry(sx, sy, sz), new THREE.MeshBasicMaterial({ color: new THREE.Color(r, g, b) }));
+    box.position.set(x, y, z);
+    scene.add(box);
+  }
+  const camera = new THREE.PerspectiveCamera(job.fov, job.width / job.height, 0.01, 100);
+  camera.position.set(...job.camera);
+  camera.lookAt(...job.lookAt);
+  const walker = new THREE.Object3D();
+  const walkerFrame = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+  const composite = new DepthComposite(renderer);
+  return () => {
+    player.drawInstant(at, subjectCamera(camera, walker, job.width, job.height), walkerFrame);
+    renderer.setRenderTarget(target);
+    renderer.setClearColor(0x000000, 0);
+    renderer.clear(true, true, false);
+    renderer.render(scene, camera);
+    composite.draw(player, walkerFrame, camera, walker, target, job.depth !== false);
+    renderer.setRenderTarget(null);
+  };
 }
 
 window.frfRender = async (job) => {
@@ -45,15 +74,19 @@ window.frfRender = async (job) => {
   }
   const loadMs = performance.now() - started;
   const camera = FrfPlayer.camera(job.camera, job.lookAt, job.fov, job.width, job.height);
-  const target = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+  const target = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: Boolean(job.boxes?.length) });
+  // With boxes, the walker stands among them in a three.js scene (its depth against
+  // theirs, or laid over them without `depth`): `draw` leaves that frame in `target`.
+  let draw = () => player.drawInstant(at, camera, target);
+  if (job.boxes?.length) draw = sceneDraw(renderer, player, job, at, target);
   const pixels = new Float32Array(4 * job.width * job.height);
   const gl = renderer.getContext();
   // One frame to compile, then the timed ones (each waits for the GPU by a readback).
-  player.drawInstant(at, camera, target);
+  draw();
   renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
   const t0 = performance.now();
   for (let i = 0; i < job.timedFrames; i++) {
-    player.drawInstant(at, camera, target);
+    draw();
     gl.finish();
     renderer.readRenderTargetPixels(target, 0, 0, 1, 1, new Float32Array(4));
   }

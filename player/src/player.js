@@ -404,8 +404,10 @@ export class FrfPlayer {
    */
   draw(number, camera, target) {
     const pose = this.#prepared(number);
-    this.#drawHull(pose, camera, this.#hullTarget(camera.width, camera.height), 0, true);
-    this.#frame(pose, camera, pose.prelit.texture, target);
+    const hull = this.#hullTarget(camera.width, camera.height, 0);
+    this.#drawHull(pose, camera, hull, 0, true);
+    this.#frame(pose, camera, pose.prelit.texture, hull, target);
+    this.drawn = { camera, hulls: [hull], axis: pose.geometry.axis };
   }
 
   /**
@@ -451,12 +453,13 @@ export class FrfPlayer {
     }
     const [before, after] = [this.#prepared(at.before), this.#prepared(at.after)];
     const t = this.#timeTargets(camera.width, camera.height);
-    const hull = this.#hullTarget(camera.width, camera.height);
-    for (const [pose, step, colour, motion] of [[before, 'next', t[0], t[2]], [after, 'prev', t[1], t[3]]]) {
+    const hulls = [0, 1].map((k) => this.#hullTarget(camera.width, camera.height, k));
+    for (const [pose, step, colour, motion, hull] of [[before, 'next', t[0], t[2], hulls[0]], [after, 'prev', t[1], t[3], hulls[1]]]) {
       this.#drawHull(pose, camera, hull, 0, true);
-      this.#frame(pose, camera, pose.prelit.texture, colour);
-      this.#frame(pose, camera, pose.motion[step], motion);
+      this.#frame(pose, camera, pose.prelit.texture, hull, colour);
+      this.#frame(pose, camera, pose.motion[step], hull, motion);
     }
+    this.drawn = { camera, hulls, axis: before.geometry.axis };
     const u = this.timeMaterial.uniforms;
     [u.uBefore.value, u.uAfter.value, u.uBeforeMotion.value, u.uAfterMotion.value] = t.map((x) => x.texture);
     const m = motionToImage(camera);
@@ -487,9 +490,8 @@ export class FrfPlayer {
     return this.timeTargets;
   }
 
-  /** The frame pass of `pose` (its hull pass drawn) reading `views` (pre-lit colour or motion). */
-  #frame(pose, camera, views, target) {
-    const hullTarget = this.#hullTarget(camera.width, camera.height);
+  /** The frame pass of `pose` (its hull pass drawn into `hullTarget`) reading `views` (pre-lit colour or motion). */
+  #frame(pose, camera, views, hullTarget, target) {
     const saved = this.renderer.getRenderTarget();
     const u = this.frameMaterial.uniforms;
     const [r, d, f] = camera.axes;
@@ -589,15 +591,18 @@ export class FrfPlayer {
     u.uSunBox.value.copy(box);
   }
 
-  #hullTarget(width, height) {
-    if (!this.hullTarget || this.hullTarget.width !== width || this.hullTarget.height !== height) {
-      this.hullTarget?.dispose();
-      this.hullTarget = new THREE.WebGLRenderTarget(width, height, {
+  /** Hull target `k` of a frame's size (two: the poses either side of an instant). */
+  #hullTarget(width, height, k) {
+    this.hullTargets ??= [];
+    const h = this.hullTargets[k];
+    if (!h || h.width !== width || h.height !== height) {
+      h?.dispose();
+      this.hullTargets[k] = new THREE.WebGLRenderTarget(width, height, {
         type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
         minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
       });
     }
-    return this.hullTarget;
+    return this.hullTargets[k];
   }
 }
 

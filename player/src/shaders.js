@@ -606,3 +606,45 @@ void main() {
   outColor = (1.0 - uS) * a + uS * b;
 }
 `;
+
+/**
+ * The walker over a three.js scene: its frame (premultiplied) with the depth of its
+ * hull (the nearer of the two poses' between poses; where a pixel's ray misses the hull,
+ * its point nearest the hull's axis), so the scene's depth test hides what is behind.
+ */
+export const DEPTH_COMPOSITE_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+uniform sampler2D uFrame;
+uniform sampler2D uHullA;        // distance to the hull along the ray + 1, 0 none
+uniform sampler2D uHullB;
+uniform int uTwo;
+uniform vec3 uEye;               // the subject-frame camera
+uniform mat3 uAxes;
+uniform vec4 uK;
+uniform int uHeight;
+uniform vec2 uAxis;
+uniform mat4 uSubjectToClip;     // the scene camera's projection, view, and the walker's world
+uniform int uDepth;
+out vec4 outColor;
+
+void main() {
+  ivec2 q = ivec2(gl_FragCoord.xy);
+  vec4 c = texelFetch(uFrame, q, 0);
+  if (c.a <= 0.0) discard;
+  vec2 pixel = vec2(float(q.x), float(uHeight - 1 - q.y));
+  vec3 dir = normalize(uAxes * vec3((pixel.x - uK.z) / uK.x, (pixel.y - uK.w) / uK.y, 1.0));
+  float a = texelFetch(uHullA, q, 0).r - 1.0;
+  float b = uTwo == 1 ? texelFetch(uHullB, q, 0).r - 1.0 : -1.0;
+  float t = a >= 0.0 && b >= 0.0 ? min(a, b) : max(a, b);
+  if (t < 0.0) {
+    vec2 o = uEye.xz - uAxis;
+    vec2 d = dir.xz;
+    float dd = dot(d, d);
+    t = dd < 1e-8 ? 0.0 : max(-dot(o, d) / dd, 0.0);
+  }
+  vec4 clip = uSubjectToClip * vec4(uEye + dir * t, 1.0);
+  gl_FragDepth = uDepth == 1 ? clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0) : 0.0;
+  outColor = c;
+}
+`;

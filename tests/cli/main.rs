@@ -13,6 +13,7 @@ mod olat;
 mod outputs;
 mod player;
 mod player_motion;
+mod player_scene;
 mod render;
 mod report;
 mod resume;

@@ -211,7 +211,7 @@ pub(crate) fn subject_psnr(a: &Path, b: &Path) -> f64 {
 }
 
 /// The tiny oracle field's pose 0 exported, and the built-in sky's L2 light.
-fn exported(dir: &Path) -> (PathBuf, PathBuf) {
+pub(crate) fn exported(dir: &Path) -> (PathBuf, PathBuf) {
     let f = frf_testkit::tiny_field();
     let glb = dir.join("walker.glb");
     let o = frf(&[

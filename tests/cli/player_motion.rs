@@ -164,6 +164,20 @@ fn half_way_between_poses_the_player_moves_as_frf_does() {
         ext["poses"][0]["motion_to"]
     );
     assert_eq!(ext["poses"][1]["motion_to"]["prev"], 0);
+    // The motion images keep the file valid: the Khronos validator, uncapped.
+    let v = Command::new("node")
+        .arg(player().join("validate.mjs"))
+        .arg(glb)
+        .output()
+        .unwrap();
+    let line = String::from_utf8_lossy(&v.stdout);
+    let r: Value = serde_json::from_str(line.trim()).unwrap();
+    assert_eq!(
+        (r["errors"].as_u64(), r["warnings"].as_u64()),
+        (Some(0), Some(0)),
+        "{line}"
+    );
+    assert_eq!(r["truncated"], false, "{line}");
     // Quad centres and a captured view, in three rows of cameras round the walker.
     for (k, (u, v)) in [(3.5, 0.5), (20.0, 0.0), (11.5, 1.5)]
         .into_iter()
