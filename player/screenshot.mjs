@@ -3,13 +3,16 @@
 //
 //   node player/screenshot.mjs --glb F [--pose N | --time SECONDS [--interpolate flow|nearest]] \
 //     --camera X,Y,Z --look-at X,Y,Z --fov DEG --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] \
-//     --out OUT.png [--time-frames K] [--box X,Y,Z,SX,SY,SZ,R,G,B ...] [--no-depth] [--json]
+//     --out OUT.png [--time-frames K] [--box X,Y,Z,SX,SY,SZ,R,G,B ...] [--no-depth]
+//     [--shadow-out SHADOW.png] [--json]
 //
 // `--pose N` draws a pose; `--time SECONDS` an instant of the walk (from pose 0's, looping
 // every cycle), between two poses morphed in time by their motion as frf does (`flow`), or
 // the nearest pose (`nearest`, as frf's `interpolate = "nearest"`). Each `--box` puts an
 // unlit box (centre, size in metres, linear colour) in a three.js scene with the walker,
 // which is drawn with its hull's depth against them (laid over them with `--no-depth`).
+// `--shadow-out` also writes the ground's relative irradiance under the walker as the
+// camera sees the ground (frf's shadow layer; 1 unshadowed) as a 16-bit linear RGB PNG.
 // The camera is frf's `look_at` (subject frame, +y up, vertical field of view in
 // degrees); `--sh` an L2 light of `frf env-sh`; `--sun` a sun as frf's `--sun`: azimuth AZ
 // (from +z toward +x) and elevation EL, degrees, a disc DIAM degrees across (0.53 when
@@ -66,6 +69,7 @@ function parse(argv) {
       case '--json': o.json = true; break;
       case '--box': o.boxes.push(numbers(flag, value(), 9)); break;
       case '--no-depth': o.depth = false; break;
+      case '--shadow-out': o.shadowOut = value(); break;
       default: fail(`unknown flag ${flag}`);
     }
   }
@@ -139,7 +143,7 @@ try {
   result = await page.evaluate((job) => window.frfRender(job), {
     glbUrl: '/job/walker.glb', glbName: basename(o.glb), shText, shName: basename(o.sh),
     pose: o.pose, time: o.time, interpolate: o.interpolate, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
-    sun: o.sun ?? null, timedFrames: o.timeFrames, boxes: o.boxes, depth: o.depth,
+    sun: o.sun ?? null, timedFrames: o.timeFrames, boxes: o.boxes, depth: o.depth, shadowLayer: Boolean(o.shadowOut),
   });
 } catch (e) {
   if (interrupted) await new Promise(() => {});
@@ -151,13 +155,22 @@ await browser.close();
 server.close();
 const rgba = Buffer.from(result.rgba, 'base64');
 const png = encode({ width: o.width, height: o.height, data: new Uint8Array(rgba), channels: 4, depth: 8 });
-const tmp = `${o.out}.tmp-${process.pid}`;
-try {
-  await writeFile(tmp, png);
-  await rename(tmp, o.out);
-} catch (e) {
-  await unlink(tmp).catch(() => {});
-  fail(`--out ${o.out}: ${e.message}`);
+/** Writes `bytes` to `path` through a temporary file, or fails naming `flag`. */
+async function writeWhole(path, bytes, flag) {
+  const tmp = `${path}.tmp-${process.pid}`;
+  try {
+    await writeFile(tmp, bytes);
+    await rename(tmp, path);
+  } catch (e) {
+    await unlink(tmp).catch(() => {});
+    fail(`${flag} ${path}: ${e.message}`);
+  }
+}
+await writeWhole(o.out, png, '--out');
+if (o.shadowOut) {
+  const b = Buffer.from(result.shadow, 'base64');
+  const data = new Uint16Array(new Uint8Array(b).buffer);
+  await writeWhole(o.shadowOut, encode({ width: o.width, height: o.height, data, channels: 3, depth: 16 }), '--shadow-out');
 }
 const report = {
   out: o.out, pose: result.at.before, between: result.at.s > 0 ? { after: result.at.after, s: result.at.s } : null, width: o.width, height: o.height,

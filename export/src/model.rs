@@ -30,6 +30,8 @@ pub struct Extension {
     pub walk: Option<Walk>,
     /// The field's file name.
     pub source: Option<String>,
+    /// The ground-shadow basis' patch and weights, where the field holds shadow maps.
+    pub ground_shadow: Option<GroundShadow>,
     /// The poses exported.
     pub poses: Vec<PoseRecord>,
 }
@@ -72,6 +74,23 @@ pub struct Walk {
     pub measured: bool,
 }
 
+/// The ground-shadow basis (frf's attenuation maps, one per upper lighting condition) and
+/// how an L2 light relights it: the ground's relative irradiance under light `c_i` is
+/// `S(x) = Σ_m w_m A_m(x) / Σ_m w_m` per channel, `w_m = Σ_i c_i weights[m][i]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GroundShadow {
+    /// Side of the square patch under the subject, metres (centred on its axis).
+    pub extent_m: f32,
+    /// Texels a side of each map (rows along `+z`, columns along `+x`).
+    pub texels: u32,
+    /// Where the maps start fading to 1 toward the patch's edge, a fraction of the half
+    /// side.
+    pub edge_fade_from: f32,
+    /// Per map: the SH weights of its condition times the irradiance it delivers to the
+    /// unshadowed ground (nine RGB).
+    pub weights: Vec<[Rgb; SH_COUNT]>,
+}
+
 /// One pose.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PoseRecord {
@@ -85,6 +104,9 @@ pub struct PoseRecord {
     pub cameras: Vec<CameraRecord>,
     /// How far from the hull's surface a sun's shadow ray starts, metres.
     pub sun_shadow_offset_m: f32,
+    /// Its ground-shadow maps (an image's index: a grey PNG of the maps one above the
+    /// other), where the field holds them.
+    pub ground_shadow: Option<usize>,
     /// The field's poses its views' motion leads to, by the step's name (`next`,
     /// `prev`): only where the field holds pose-to-pose flows.
     pub motion_to: BTreeMap<String, u32>,

@@ -161,6 +161,18 @@ pub fn flow_png(flow: &FlowImage) -> Result<Vec<u8>> {
     png(&bytes, w, h, ExtendedColorType::La16)
 }
 
+/// A pose's ground-shadow maps (values 0 to 1, all of one size) as one 8-bit grey PNG,
+/// map `m` at rows `m · height` on.
+pub fn stacked_maps_png(maps: &[GrayImage]) -> Result<Vec<u8>> {
+    let (w, h) = maps.first().map_or((1, 1), |m| m.size());
+    let bytes: Vec<u8> = maps
+        .iter()
+        .flat_map(|m| m.pixels().iter())
+        .map(|&a| (a.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    png(&bytes, w, h * maps.len().max(1), ExtendedColorType::L8)
+}
+
 /// A view's motion (metres across the axis and up it) as a 16-bit grey-alpha PNG and its
 /// metres a code ([`MOTION_ZERO`] is none).
 pub fn motion_png(metres: &[Vec2], w: usize, h: usize) -> Result<(Vec<u8>, f32)> {

@@ -21,7 +21,8 @@ use crate::format::{EXTENSION, VERSION};
 use crate::glb::Glb;
 use crate::hull_mesh::hull_mesh;
 use crate::model::{
-    Extension, Grid, MotionImage, PoseRecord, ScaledImage, TierName, Transfer, ViewRecord, Walk,
+    Extension, Grid, GroundShadow, MotionImage, PoseRecord, ScaledImage, TierName, Transfer,
+    ViewRecord, Walk,
 };
 use crate::view_maps::{
     alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png, transfer_atlas,
@@ -141,8 +142,9 @@ pub struct ExportReport {
     pub views: usize,
     /// Triangles of all hull meshes.
     pub triangles: usize,
-    /// Bytes of the transfer atlases, alpha, normals, albedo, flows, meshes and motion.
-    pub section_bytes: [(String, u64); 7],
+    /// Bytes of the transfer atlases, alpha, normals, albedo, flows, meshes, motion and
+    /// ground shadows.
+    pub section_bytes: [(String, u64); 8],
     /// Wall seconds.
     pub seconds: f64,
     /// What the export lacks that a player may expect (a field without normals).
@@ -174,7 +176,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let (poses, wanted) = selection(&field, options)?;
     let projector = field.projector()?;
     let mut glb = Glb::default();
-    let mut sizes = [0u64; 7];
+    let mut sizes = [0u64; 8];
     let mut nodes = vec![json!({"name": "walker", "children": []})];
     let mut meshes = Vec::new();
     let mut pose_records = Vec::new();
@@ -204,6 +206,16 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             .expect("an array")
             .push(json!(node));
 
+        let ground_shadow = match field.shadows(pose)? {
+            Some(maps) => {
+                let before = glb.binary_bytes();
+                let png = crate::view_maps::stacked_maps_png(&maps)?;
+                let image = glb.image(&png, "image/png", format!("pose {pose} ground shadow"));
+                sizes[7] += (glb.binary_bytes() - before) as u64;
+                Some(image)
+            }
+            None => None,
+        };
         // A field ingested for a scene holds some views of a pose: `all` takes those.
         let held = |&(u, v): &(usize, usize)| {
             field.has(&ChunkKey {
@@ -260,6 +272,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             node,
             cameras,
             sun_shadow_offset_m: offset,
+            ground_shadow,
             motion_to: motion_to(&record),
             views,
         });
@@ -281,7 +294,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
     let names = [
-        "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion",
+        "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion", "shadow",
     ];
     let mut notes = Vec::new();
     if sizes[2] == 0 {
@@ -300,6 +313,30 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         seconds: started.elapsed().as_secs_f64(),
         notes,
     })
+}
+
+/// The ground-shadow basis' patch and each map's SH weights (frf's ground coefficients
+/// at turntable angle 0, `render/src/shadow.rs`), where the field holds shadow maps.
+fn ground_shadow(field: &FieldFile) -> Result<Option<GroundShadow>> {
+    let h = field.header();
+    let Some(spec) = &h.shadows else {
+        return Ok(None);
+    };
+    let w = sh_weights(field.projector()?, &[0.0])?.remove(0);
+    let weights = spec
+        .conditions
+        .iter()
+        .map(|&k| {
+            let e = frf_reflectance::shadow::ground_irradiance(&h.conditions[k]);
+            w[k].map(|wi| [0, 1, 2].map(|c| wi[c] * e[c]))
+        })
+        .collect();
+    Ok(Some(GroundShadow {
+        extent_m: spec.ground.extent_m,
+        texels: spec.ground.texels,
+        edge_fade_from: frf_reflectance::shadow::EDGE_FADE_FROM,
+        weights,
+    }))
 }
 
 /// Where a pose's motion leads (`next`, `prev`): the poses its pose-to-pose flows reach.
@@ -351,6 +388,7 @@ fn extension_of(
         source: field_path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned()),
+        ground_shadow: ground_shadow(field)?,
         poses,
     };
     serde_json::to_value(&extension)
@@ -417,7 +455,7 @@ fn selection(field: &FieldFile, options: &ExportOptions) -> Result<Selection> {
 
 /// Adds view `e` of `pose`'s images to `glb` (their bytes counted in `sizes`, by
 /// section) and returns its record in the extension.
-fn add_view(glb: &mut Glb, sizes: &mut [u64; 7], pose: u32, e: ViewOut) -> ViewRecord {
+fn add_view(glb: &mut Glb, sizes: &mut [u64; 8], pose: u32, e: ViewOut) -> ViewRecord {
     let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
     let before = glb.binary_bytes();
     let rgb = ["red", "green", "blue"];

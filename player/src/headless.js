@@ -108,8 +108,27 @@ window.frfRender = async (job) => {
       out[o + 3] = Math.round(a * 255);
     }
   }
+  // The ground shadow as a layer (frf's frame_NNNN_shadow.exr): linear RGB floats.
+  let shadow = null;
+  if (job.shadowLayer) {
+    const layer = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false });
+    if (!player.drawGroundShadowLayer(at, camera, layer)) throw new Error(`${job.glbName} holds no ground shadow (exported from a field without shadow maps)`);
+    const s = new Float32Array(4 * job.width * job.height);
+    renderer.readRenderTargetPixels(layer, 0, 0, job.width, job.height, s);
+    const top = new Uint16Array(3 * job.width * job.height);
+    for (let y = 0; y < job.height; y++) {
+      for (let x = 0; x < job.width; x++) {
+        const i = 4 * ((job.height - 1 - y) * job.width + x);
+        for (let c = 0; c < 3; c++) top[3 * (y * job.width + x) + c] = Math.round(Math.min(Math.max(s[i + c], 0), 1) * 65535);
+      }
+    }
+    let b = '';
+    const bytes = new Uint8Array(top.buffer);
+    for (let i = 0; i < bytes.length; i += 0x8000) b += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+    shadow = btoa(b);
+  }
   let binary = '';
   for (let i = 0; i < out.length; i += 0x8000) binary += String.fromCharCode(...out.subarray(i, i + 0x8000));
-  return { rgba: btoa(binary), msPerFrame, loadMs, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+  return { rgba: btoa(binary), shadow, msPerFrame, loadMs, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
 };
 window.frfReady = true;

@@ -16,7 +16,8 @@ import {
 } from './geometry.js';
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
-  SUN_MAP_VERTEX, SUN_MAP_FRAGMENT, TIME_MORPH_FRAGMENT,
+  SUN_MAP_VERTEX, SUN_MAP_FRAGMENT, TIME_MORPH_FRAGMENT, GROUND_SHADOW_RELIGHT_FRAGMENT,
+  GROUND_SHADOW_LAYER_FRAGMENT,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
 
@@ -32,6 +33,8 @@ const SHADOW_OFFSET_PER_HEIGHT = 0.17;
 const NEIGHBOURS = ['right', 'left', 'up', 'down'];
 /** The steps in time a view's motion is stored toward (`motion_to`'s keys). */
 const STEPS = ['next', 'prev'];
+/** Ground-shadow maps a pose may hold at most (the shader's array of weights). */
+const MAX_SHADOW_MAPS = 64;
 /** A stored motion code of no motion. */
 const MOTION_ZERO = 32768;
 
@@ -115,6 +118,12 @@ export class FrfPlayer {
       },
       side: THREE.DoubleSide,
     });
+    this.groundMaterial = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: GROUND_SHADOW_RELIGHT_FRAGMENT,
+      uniforms: { uMaps: { value: null }, uWeights: { value: [] }, uCount: { value: 0 } },
+      depthTest: false, depthWrite: false, blending: THREE.NoBlending,
+    });
+    this.groundScene = fullscreen(this.groundMaterial);
     this.timeMaterial = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: TIME_MORPH_FRAGMENT,
       uniforms: {
@@ -273,8 +282,9 @@ export class FrfPlayer {
       });
     }
     const motion = this.#motionTextures(record);
+    const groundShadow = this.#groundShadowMaps(record);
     const pose = {
-      record, geometry, n, motion,
+      record, geometry, n, motion, groundShadow,
       atlas: arrayTexture(atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
       alpha: arrayTexture(alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
       normals: arrayTexture(normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
@@ -300,6 +310,8 @@ export class FrfPlayer {
       dispose() {
         for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t.dispose();
         for (const t of Object.values(this.motion)) t.dispose();
+        this.groundShadow?.maps.dispose();
+        this.groundShadow?.relit.dispose();
         this.ranges?.dispose();
         this.prelit.dispose();
         this.viewHull.dispose();
@@ -348,6 +360,89 @@ export class FrfPlayer {
     return out;
   }
 
+  /**
+   * A pose's ground-shadow maps (one R8 layer a map) and the target they are relit into
+   * (`relit`: the ground's relative irradiance S, RGB, texels a side, rows along +z);
+   * null where the export holds none.
+   */
+  #groundShadowMaps(record) {
+    const g = this.ext.ground_shadow;
+    if (record.ground_shadow === null || record.ground_shadow === undefined || !g) return null;
+    const what = `pose ${record.pose} ground shadow`;
+    const m = g.weights.length;
+    if (!(m >= 1 && m <= MAX_SHADOW_MAPS)) throw new BadFile(this.glb.name, `${what}: ${m} maps, expected 1 to ${MAX_SHADOW_MAPS}`);
+    const img = png(this.glb, record.ground_shadow, what);
+    expect(this.glb, img, g.texels, g.texels * m, 1, what);
+    return {
+      maps: arrayTexture(img.data, g.texels, g.texels, m, THREE.RedFormat, THREE.UnsignedByteType),
+      relit: new THREE.WebGLRenderTarget(g.texels, g.texels, {
+        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
+        minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+      }),
+    };
+  }
+
+  /** Relights a pose's ground-shadow maps by the light (frf's `ShadowMaps::relight`). */
+  #relightGroundShadow(pose) {
+    const g = this.ext.ground_shadow;
+    const u = this.groundMaterial.uniforms;
+    // w_m = Σ_i c_i weights[m][i], per channel.
+    const w = g.weights.map((byI) => new THREE.Vector3(...[0, 1, 2].map((c) => byI.reduce((sum, wi, i) => sum + this.sh[i][c] * wi[c], 0))));
+    while (w.length < MAX_SHADOW_MAPS) w.push(new THREE.Vector3());
+    u.uMaps.value = pose.groundShadow.maps;
+    u.uWeights.value = w;
+    u.uCount.value = g.weights.length;
+    const saved = this.renderer.getRenderTarget();
+    this.renderer.setRenderTarget(pose.groundShadow.relit);
+    this.renderer.render(this.groundScene, this.camera);
+    this.renderer.setRenderTarget(saved);
+  }
+
+  /**
+   * The relit ground shadow of the pose drawn at instant `at` (the nearer pose's between
+   * two, as frf), or null: { texture, extent_m, texels, edge_fade_from }.
+   */
+  groundShadow(at) {
+    const number = at.s < 0.5 ? at.before : at.after;
+    const pose = this.#prepared(number);
+    if (!pose.groundShadow) return null;
+    const g = this.ext.ground_shadow;
+    return { texture: pose.groundShadow.relit.texture, extent: g.extent_m, texels: g.texels, fadeFrom: g.edge_fade_from };
+  }
+
+  /**
+   * Draws the ground's relative irradiance under the walker at instant `at` as `camera`
+   * sees the ground y = 0 (1 where a ray misses it or the patch, frf's shadow layer)
+   * into `target`; false where the export holds no ground shadow.
+   */
+  drawGroundShadowLayer(at, camera, target) {
+    const shadow = this.groundShadow(at);
+    if (!shadow) return false;
+    this.layerMaterial ??= new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: GROUND_SHADOW_LAYER_FRAGMENT,
+      uniforms: {
+        uEye: { value: new THREE.Vector3() }, uAxes: { value: new THREE.Matrix3() }, uK: { value: new THREE.Vector4() },
+        uHeight: { value: 0 }, uShadow: { value: null }, uShadowExtent: { value: 0 }, uShadowFadeFrom: { value: 0 },
+      },
+      depthTest: false, depthWrite: false, blending: THREE.NoBlending,
+    });
+    this.layerScene ??= fullscreen(this.layerMaterial);
+    const u = this.layerMaterial.uniforms;
+    const [r, d, f] = camera.axes;
+    u.uEye.value.set(...camera.centre);
+    u.uAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
+    u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
+    u.uHeight.value = camera.height;
+    u.uShadow.value = shadow.texture;
+    u.uShadowExtent.value = shadow.extent;
+    u.uShadowFadeFrom.value = shadow.fadeFrom;
+    const saved = this.renderer.getRenderTarget();
+    this.renderer.setRenderTarget(target);
+    this.renderer.render(this.layerScene, this.camera);
+    this.renderer.setRenderTarget(saved);
+    return true;
+  }
+
   #hullMesh(mesh) {
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
@@ -374,6 +469,7 @@ export class FrfPlayer {
     const shadows = this.sun.illuminance.some((e) => e > 0) && pose.geometry.hasHull;
     u.uSunOffset.value = shadows ? pose.shadowOffset : -1;
     if (shadows) this.#sunMap(pose, u);
+    if (pose.groundShadow) this.#relightGroundShadow(pose);
     const saved = this.renderer.getRenderTarget();
     pose.record.views.forEach((v, i) => {
       const camera = pose.geometry.cameras[v.u * this.grid.rows + v.v];

@@ -1,11 +1,12 @@
 // The walker among a three.js scene's own objects: a camera of the scene seen from the
 // walker's frame (the walker an Object3D placed and turned in the world), the player's
 // frame composited over what the scene drew with the depth of the walker's hull, so that
-// an object in front hides it and it hides what is behind it; and its hull as an
-// invisible caster in three.js's shadow maps.
+// an object in front hides it and it hides what is behind it; its hull as an invisible
+// caster in three.js's shadow maps; and the exported ground-shadow basis, relit by the
+// walker's light, darkening the ground under it as frf's composite does.
 import * as THREE from 'three';
 import { fullscreen } from './player.js';
-import { FULLSCREEN_VERTEX, DEPTH_COMPOSITE_FRAGMENT } from './shaders.js';
+import { FULLSCREEN_VERTEX, DEPTH_COMPOSITE_FRAGMENT, GROUND_SHADOW_AT } from './shaders.js';
 
 /**
  * The player's camera (subject frame: the walker's) of a three.js PerspectiveCamera
@@ -96,5 +97,58 @@ export function hullCaster(player, number) {
   mesh.castShadow = true;
   mesh.receiveShadow = false;
   mesh.name = `hull of pose ${number}`;
+  return mesh;
+}
+
+const GROUND_VERTEX = /* glsl */ `
+precision highp float;
+in vec3 position;
+uniform mat4 modelMatrix;
+uniform mat4 viewMatrix;
+uniform mat4 projectionMatrix;
+out vec2 vXz;
+void main() {
+  vXz = position.xz;
+  gl_Position = projectionMatrix * viewMatrix * modelMatrix * vec4(position, 1.0);
+}
+`;
+const GROUND_FRAGMENT = /* glsl */ `
+precision highp float;
+in vec2 vXz;
+uniform sampler2D uShadow;
+uniform float uShadowExtent;
+uniform float uShadowFadeFrom;
+out vec4 outColor;
+${GROUND_SHADOW_AT}
+void main() { outColor = vec4(groundShadowAt(vXz), 1.0); }
+`;
+
+/**
+ * The walker's ground shadow as a mesh to add to its Object3D: a square of the patch's
+ * side just above y = 0 that multiplies what the scene drew under it by the ground's
+ * relative irradiance (frf's composite: ground × S). `update(at)` follows the pose drawn
+ * and the light; null where the export holds no ground shadow.
+ */
+export function groundShadowMesh(player) {
+  const g = player.ext.ground_shadow;
+  if (!g) return null;
+  const geometry = new THREE.PlaneGeometry(g.extent_m, g.extent_m);
+  geometry.rotateX(-Math.PI / 2);
+  const material = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: GROUND_VERTEX, fragmentShader: GROUND_FRAGMENT,
+    uniforms: { uShadow: { value: null }, uShadowExtent: { value: g.extent_m }, uShadowFadeFrom: { value: g.edge_fade_from } },
+    transparent: true, depthWrite: false,
+    blending: THREE.CustomBlending, blendSrc: THREE.ZeroFactor, blendDst: THREE.SrcColorFactor,
+    polygonOffset: true, polygonOffsetFactor: -1, polygonOffsetUnits: -1,
+  });
+  const mesh = new THREE.Mesh(geometry, material);
+  mesh.position.y = 1e-3;
+  mesh.renderOrder = 1;
+  mesh.name = 'walker ground shadow';
+  mesh.update = (at) => {
+    const shadow = player.groundShadow(at);
+    material.uniforms.uShadow.value = shadow?.texture ?? null;
+    mesh.visible = Boolean(shadow);
+  };
   return mesh;
 }

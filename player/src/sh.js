@@ -1,5 +1,7 @@
 // L2 light files (`frf env-sh`, format `frf-sh-l2` version 1; docs/export.md): read and
-// checked, for the browser and for node alike.
+// checked, for the browser and for node alike; and turned into a walker's frame.
+
+import * as THREE from 'three';
 
 export const SH_FORMAT = 'frf-sh-l2';
 
@@ -55,4 +57,36 @@ function canonical(value) {
 /** Nine [r, g, b] coefficients from a three.js LightProbe's `sh` (SphericalHarmonics3). */
 export function fromLightProbe(probe) {
   return probe.sh.coefficients.map((v) => [v.x, v.y, v.z]);
+}
+
+/**
+ * The L2 light `sh` (nine RGB, three.js order) as seen from a frame turned by `angle`
+ * radians about +y (a walker whose heading is `angle`): the light at direction d of that
+ * frame is the world's at d turned by `angle`. Projected back by quadrature over 4096
+ * directions of a Fibonacci sphere (a rotation keeps each band: exact but for rounding).
+ */
+export function turnedAboutY(sh, angle) {
+  const n = 4096;
+  const out = Array.from({ length: 9 }, () => [0, 0, 0]);
+  const basis = new Array(9);
+  const turned = new Array(9);
+  const d = new THREE.Vector3();
+  const r = new THREE.Vector3();
+  const [c, s] = [Math.cos(angle), Math.sin(angle)];
+  for (let k = 0; k < n; k++) {
+    const y = 1 - (2 * k + 1) / n;
+    const rho = Math.sqrt(1 - y * y);
+    const phi = k * Math.PI * (3 - Math.sqrt(5));
+    d.set(rho * Math.cos(phi), y, rho * Math.sin(phi));
+    // Turned by `angle` about +y (three.js's rotation.y).
+    r.set(c * d.x + s * d.z, d.y, -s * d.x + c * d.z);
+    THREE.SphericalHarmonics3.getBasisAt(d, basis);
+    THREE.SphericalHarmonics3.getBasisAt(r, turned);
+    for (let ch = 0; ch < 3; ch++) {
+      let l = 0;
+      for (let i = 0; i < 9; i++) l += sh[i][ch] * turned[i];
+      for (let i = 0; i < 9; i++) out[i][ch] += (l * basis[i] * 4 * Math.PI) / n;
+    }
+  }
+  return out;
 }

@@ -648,3 +648,78 @@ void main() {
   outColor = c;
 }
 `;
+
+/**
+ * The ground-shadow maps relit (frf's `ShadowMaps::relight`): per texel and channel
+ * S = Σ_m w_m A_m / Σ_m w_m, within [0, 1], 1 where nothing lights the ground from above.
+ */
+export const GROUND_SHADOW_RELIGHT_FRAGMENT = /* glsl */ `
+precision highp float;
+precision highp int;
+precision highp sampler2DArray;
+uniform sampler2DArray uMaps;    // R8: a map a layer, rows along +z
+uniform vec3 uWeights[64];
+uniform int uCount;
+out vec4 outColor;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec3 lit = vec3(0.0);
+  vec3 total = vec3(0.0);
+  for (int m = 0; m < uCount; m++) {
+    lit += uWeights[m] * texelFetch(uMaps, ivec3(p, m), 0).r;
+    total += uWeights[m];
+  }
+  vec3 s = vec3(1.0);
+  for (int c = 0; c < 3; c++) if (total[c] > 0.0) s[c] = clamp(lit[c] / total[c], 0.0, 1.0);
+  outColor = vec4(s, 1.0);
+}
+`;
+
+/**
+ * The ground's relative irradiance at ground point (x, z) of the subject frame (frf's
+ * `RelitShadow::at`): bilinear between texel centres, the edge texels held out to the
+ * border, faded to 1 toward the patch's edge, 1 off it. Needs uShadow (the relit maps,
+ * rows along +z), uShadowExtent, uShadowFadeFrom.
+ */
+export const GROUND_SHADOW_AT = /* glsl */ `
+vec3 groundShadowAt(vec2 xz) {
+  float half_ = 0.5 * uShadowExtent;
+  if (abs(xz.x) > half_ || abs(xz.y) > half_) return vec3(1.0);
+  vec2 size = vec2(textureSize(uShadow, 0));
+  vec2 t = (xz + half_) / (uShadowExtent / size) - 0.5;
+  vec2 c = clamp(t, vec2(0.0), size - 1.0);
+  vec2 f0 = floor(c);
+  vec2 fr = c - f0;
+  ivec2 a = ivec2(f0);
+  ivec2 b = min(a + 1, ivec2(size) - 1);
+  vec3 s = mix(mix(texelFetch(uShadow, a, 0).rgb, texelFetch(uShadow, ivec2(b.x, a.y), 0).rgb, fr.x),
+               mix(texelFetch(uShadow, ivec2(a.x, b.y), 0).rgb, texelFetch(uShadow, b, 0).rgb, fr.x), fr.y);
+  float e = clamp((max(abs(xz.x), abs(xz.y)) / half_ - uShadowFadeFrom) / (1.0 - uShadowFadeFrom), 0.0, 1.0);
+  float w = e * e * (3.0 - 2.0 * e);
+  return s + (1.0 - s) * w;
+}
+`;
+
+/** The ground shadow as a frame layer: each pixel's ray met with the ground y = 0. */
+export const GROUND_SHADOW_LAYER_FRAGMENT = /* glsl */ `
+precision highp float;
+uniform vec3 uEye;
+uniform mat3 uAxes;
+uniform vec4 uK;
+uniform int uHeight;
+uniform sampler2D uShadow;
+uniform float uShadowExtent;
+uniform float uShadowFadeFrom;
+out vec4 outColor;
+${GROUND_SHADOW_AT}
+void main() {
+  vec2 pixel = vec2(floor(gl_FragCoord.x), float(uHeight - 1) - floor(gl_FragCoord.y));
+  vec3 dir = normalize(uAxes * vec3((pixel.x - uK.z) / uK.x, (pixel.y - uK.w) / uK.y, 1.0));
+  vec3 s = vec3(1.0);
+  if (dir.y < 0.0 && uEye.y > 0.0) {
+    vec3 hit = uEye + dir * (-uEye.y / dir.y);
+    s = groundShadowAt(hit.xz);
+  }
+  outColor = vec4(s, 1.0);
+}
+`;

@@ -51,6 +51,11 @@ pub fn shadow_spec(
     }
 }
 
+/// Where a relit shadow starts fading to 1 (unshadowed) toward its patch's edge, as a
+/// fraction of the half side: a shadow longer than the patch thins out instead of ending
+/// on a straight line (`frf_render::shadow::edge_fade`; the export states it for players).
+pub const EDGE_FADE_FROM: f32 = 0.8;
+
 /// Irradiance (RGB) condition `c` delivers to the unshadowed ground: `Σ_l E_l max(0, d_l·y)`.
 pub fn ground_irradiance(c: &ConditionRecord) -> Rgb {
     c.lights.iter().fold([0.0; 3], |acc, l| {

@@ -147,8 +147,7 @@ pub struct RelitShadow {
     pub image: RgbImage,
 }
 
-/// Where the fade toward the patch's edge begins, as a fraction of the half side.
-pub const EDGE_FADE_FROM: f32 = 0.8;
+pub use frf_reflectance::shadow::EDGE_FADE_FROM;
 
 /// The weight of 1 (unshadowed) at ground point `(x, z)` of a patch of side `extent_m`
 /// centred on the subject: 0 inside [`EDGE_FADE_FROM`] of the half side (the maps as

@@ -162,3 +162,149 @@ fn a_box_in_front_of_the_walker_hides_it_and_one_behind_is_hidden() {
         "{hidden} hidden, {shown} shown"
     );
 }
+
+/// The ground shadow the player relights from the exported basis, seen as frf's shadow
+/// layer (the ground's relative irradiance under the walker) from a camera above the
+/// patch, against `frf render --layers` under the same L2 light; a ground left
+/// unshadowed (the control) misses by far.
+#[test]
+fn the_players_ground_shadow_is_frfs() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (glb, sh) = exported(d);
+    let document = frf_export::read::Export::open(&glb).unwrap().document;
+    let extent = document["extensions"]["FRF_flowed_reflectance_field"]["ground_shadow"]["extent_m"]
+        .as_f64()
+        .unwrap() as f32;
+    let (eye, look_at, fov_deg, (w, h)) = ([1.8, 2.2, 2.6], [0.0, 0.3, 0.0], 45.0, (160, 120));
+    let out = d.join("player.png");
+    let layer = d.join("shadow.png");
+    let o = Command::new("node")
+        .arg(player().join("screenshot.mjs"))
+        .arg("--glb")
+        .arg(&glb)
+        .args(["--pose", "0", "--fov", &fov_deg.to_string()])
+        .arg(format!("--camera={}", csv(&eye)))
+        .arg(format!("--look-at={}", csv(&look_at)))
+        .args(["--size", &format!("{w}x{h}"), "--sh"])
+        .arg(&sh)
+        .arg("--out")
+        .arg(&out)
+        .arg("--shadow-out")
+        .arg(&layer)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let camera_toml = d.join("camera.toml");
+    std::fs::write(
+        &camera_toml,
+        format!(
+            "[[key]]\ntime = 0.0\nposition = [{}]\nlook_at = [{}]\nfov_deg = {fov_deg}\n",
+            csv(&eye),
+            csv(&look_at)
+        ),
+    )
+    .unwrap();
+    let frf_out = d.join("frf");
+    let mut args = vec![
+        "render".to_string(),
+        f.field.display().to_string(),
+        "--env".into(),
+        sh.display().to_string(),
+        "--camera".into(),
+        camera_toml.display().to_string(),
+        "--frames".into(),
+        "1".into(),
+        "--detail".into(),
+        "0".into(),
+        "--size".into(),
+        format!("{w}x{h}"),
+        "--layers".into(),
+        "--out".into(),
+        frf_out.display().to_string(),
+    ];
+    args.extend(frf_testkit::cpu_flag().map(String::from));
+    let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = crate::common::frf(&refs);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = frf_core::io::read_hdr_rgb(&frf_out.join("frame_0000_shadow.exr")).unwrap();
+    let ours = image::open(&layer).unwrap().into_rgb16();
+    assert_eq!(
+        (reference.width(), reference.height()),
+        (w as usize, h as usize)
+    );
+    // The pixels whose ray meets the ground on the patch.
+    let camera = Camera::look_at(
+        Vec3::from(eye),
+        Vec3::from(look_at),
+        Vec3::Y,
+        f32::to_radians(fov_deg),
+        w,
+        h,
+    )
+    .unwrap();
+    let (mut se, mut se_unshadowed, mut n, mut shaded) = (0.0f64, 0.0f64, 0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let dir = camera.ray_direction(glam::Vec2::new(x as f32, y as f32));
+            let Some(hit) = frf_render::shadow::ground_hit(camera.centre(), dir) else {
+                continue;
+            };
+            if hit.x.abs() > extent / 2.0 || hit.z.abs() > extent / 2.0 {
+                continue;
+            }
+            let r = reference.get(x as usize, y as usize);
+            let p = ours.get_pixel(x, y);
+            for c in 0..3 {
+                let v = f64::from(p[c]) / 65535.0;
+                se += (v - f64::from(r[c])).powi(2);
+                se_unshadowed += (1.0 - f64::from(r[c])).powi(2);
+            }
+            n += 3;
+            shaded += usize::from(r[1] < 0.9);
+        }
+    }
+    assert!(n > 3000 && shaded > 100, "{n} samples, {shaded} shaded");
+    let psnr = |se: f64| 10.0 * (n as f64 / se).log10();
+    let (ours_db, none_db) = (psnr(se), psnr(se_unshadowed));
+    eprintln!(
+        "ground shadow against frf's over the patch: {ours_db:.2} dB (unshadowed: {none_db:.2} dB)"
+    );
+    assert!(ours_db >= 30.0, "{ours_db:.2} dB");
+    assert!(
+        none_db < 30.0,
+        "the unshadowed ground scores {none_db:.2} dB: the view shows too little shadow"
+    );
+}
+
+/// The demo page (player/scene.html): the walker of two poses walks its loop among a
+/// ground, a box and a sun, morphed between its poses, without an error.
+#[test]
+fn the_scene_page_walks_the_walker_round_its_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, sh) = exported(dir.path());
+    let o = Command::new("node")
+        .arg(player().join("page-check.mjs"))
+        .args(["--page", "scene.html", "--frames", "3", "--glb"])
+        .arg(&glb)
+        .arg("--sh")
+        .arg(&sh)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(r["frames"].as_u64().unwrap() >= 3, "{r}");
+    assert_eq!(r["error"], "", "{r}");
+    assert_eq!(r["logs"], serde_json::json!([]), "{r}");
+    assert!(r["status"].as_str().unwrap().contains("pose 0"), "{r}");
+    // A control: without a walker the page says so.
+    let o = Command::new("node")
+        .arg(player().join("page-check.mjs"))
+        .args(["--page", "scene.html", "--frames", "1", "--glb"])
+        .arg(dir.path().join("missing.glb"))
+        .output()
+        .unwrap();
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(r["error"].as_str().unwrap().contains("404"), "{r}");
+}
