@@ -20,6 +20,7 @@ import {
   GROUND_SHADOW_LAYER_FRAGMENT,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
+import { subjectBounds, flowReachM, pixelBox, unionBox } from './footprint.js';
 
 /** The sun's map of the hull, texels a side. */
 const SUN_MAP_SIZE = 512;
@@ -101,7 +102,7 @@ export class FrfPlayer {
         uEye: { value: new THREE.Vector3() }, uAxes: { value: new THREE.Matrix3() }, uK: { value: new THREE.Vector4() },
         uHeight: { value: 0 }, uQuads: { value: null }, uQuadCount: { value: 0 }, uFrames: { value: null },
         uViews: { value: null }, uColumns: { value: 0 }, uRows: { value: 0 }, uFrameRows: { value: 0 },
-        uPrelit: { value: null }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
+        uPrelit: { value: null }, uMotion: { value: null }, uWithMotion: { value: 0 }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
         uAxis: { value: new THREE.Vector2() }, uRanges: { value: null }, uIndexed: { value: 0 },
         uColAxis: { value: new THREE.Vector2() }, uColReference: { value: new THREE.Vector2() },
         uColOrientation: { value: 1 }, uRMin: { value: 0 }, uRMax: { value: 0 }, uSpans: { value: 0 },
@@ -239,14 +240,20 @@ export class FrfPlayer {
     const viewTable = new Float32Array(columns * rows * 2 * 4).fill(-1);
     geometry.cameras.forEach((c, g) => viewTable.set([...c.centre, -1], g * 8));
     let flowLayer = 0;
+    let maxFlow = 0;
+    // The JPEG atlases decode together (the browser decodes images off the page's
+    // thread); the PNGs are decoded on it as each view is filled in.
+    const jpegs = await Promise.all(views.flatMap((v, i) => Array.from({ length: channels }, (_, c) => {
+      const what = `pose ${record.pose} view ${v.u},${v.v} transfer`;
+      return greyJpeg(glb, v.transfer.images[c], what).then((img) => {
+        expect(glb, img, 3 * w, 3 * h, null, `${what} atlas`);
+        atlas.set(img.data, (i * channels + c) * 9 * w * h);
+      });
+    })));
+    void jpegs;
     for (let i = 0; i < n; i++) {
       const v = views[i];
       const what = (s) => `pose ${record.pose} view ${v.u},${v.v} ${s}`;
-      for (let c = 0; c < channels; c++) {
-        const img = await greyJpeg(glb, v.transfer.images[c], what('transfer'));
-        expect(glb, img, 3 * w, 3 * h, null, what('transfer atlas'));
-        atlas.set(img.data, (i * channels + c) * 9 * w * h);
-      }
       const a = png(glb, v.alpha, what('alpha'));
       expect(glb, a, w, h, 1, what('alpha'));
       alpha.set(a.data, i * w * h);
@@ -276,7 +283,10 @@ export class FrfPlayer {
         expect(glb, f, w, h, 2, what(`flow ${k}`));
         if (f.depth !== 16) throw new BadFile(glb.name, `${what(`flow ${k}`)}: ${f.depth}-bit, expected 16-bit`);
         const out = flows.subarray(flowLayer * 2 * w * h, (flowLayer + 1) * 2 * w * h);
-        for (let t = 0; t < 2 * w * h; t++) out[t] = f.data[t] / 256 - 128;
+        for (let t = 0; t < 2 * w * h; t++) {
+          out[t] = f.data[t] / 256 - 128;
+          maxFlow = Math.max(maxFlow, Math.abs(out[t]));
+        }
         viewTable[g * 8 + 4 + d] = flowLayer;
         flowLayer++;
       });
@@ -304,6 +314,9 @@ export class FrfPlayer {
         type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
         minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
       }),
+      // Where the walker can show (frf's SubjectBounds::of_pose): the frame passes shade
+      // only the pixels that see it.
+      bounds: subjectBounds(mesh.positions, flowReachM(maxFlow, views.map((v) => geometry.cameras[v.u * rows + v.v]))),
       shadowOffset: record.sun_shadow_offset_m ?? SHADOW_OFFSET_PER_HEIGHT * meshHeight(mesh.positions),
       lightVersion: -1,
       hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
@@ -501,9 +514,14 @@ export class FrfPlayer {
   draw(number, camera, target) {
     const pose = this.#prepared(number);
     const hull = this.#hullTarget(camera.width, camera.height, 0);
-    this.#drawHull(pose, camera, hull, 0, true);
-    this.#frame(pose, camera, pose.prelit.texture, hull, target);
     this.drawn = { camera, hulls: [hull], axis: pose.geometry.axis };
+    const box = pixelBox(pose.bounds, camera);
+    this.#clearBoxed([hull, target], box);
+    if (box) {
+      this.#drawHull(pose, camera, hull, 0, true);
+      this.#frame(pose, camera, pose.prelit.texture, hull, target);
+    }
+    this.#unboxed([hull, target]);
   }
 
   /**
@@ -550,14 +568,22 @@ export class FrfPlayer {
     const [before, after] = [this.#prepared(at.before), this.#prepared(at.after)];
     const t = this.#timeTargets(camera.width, camera.height);
     const hulls = [0, 1].map((k) => this.#hullTarget(camera.width, camera.height, k));
-    for (const [pose, step, colour, motion, hull] of [[before, 'next', t[0], t[2], hulls[0]], [after, 'prev', t[1], t[3], hulls[1]]]) {
-      this.#drawHull(pose, camera, hull, 0, true);
-      this.#frame(pose, camera, pose.prelit.texture, hull, colour);
-      this.#frame(pose, camera, pose.motion[step], hull, motion);
-    }
     this.drawn = { camera, hulls, axis: before.geometry.axis };
+    const box = unionBox(pixelBox(before.bounds, camera), pixelBox(after.bounds, camera));
+    const targets = [...t, ...hulls, target];
+    this.#clearBoxed(targets, box);
+    if (!box) {
+      this.#unboxed(targets);
+      return;
+    }
+    // Each pose's colour and its motion toward the other in one frame pass (two outputs).
+    for (const [pose, step, both, hull] of [[before, 'next', t[0], hulls[0]], [after, 'prev', t[1], hulls[1]]]) {
+      this.#drawHull(pose, camera, hull, 0, true);
+      this.#frame(pose, camera, pose.prelit.texture, hull, both, pose.motion[step]);
+    }
     const u = this.timeMaterial.uniforms;
-    [u.uBefore.value, u.uAfter.value, u.uBeforeMotion.value, u.uAfterMotion.value] = t.map((x) => x.texture);
+    [u.uBefore.value, u.uBeforeMotion.value] = t[0].textures;
+    [u.uAfter.value, u.uAfterMotion.value] = t[1].textures;
     const m = motionToImage(camera);
     u.uToImage.value.set(m[0][0], m[1][0], m[0][1], m[1][1]);
     u.uS.value = at.s;
@@ -566,6 +592,32 @@ export class FrfPlayer {
     this.renderer.setRenderTarget(target);
     this.renderer.render(this.timeScene, this.camera);
     this.renderer.setRenderTarget(saved);
+    this.#unboxed(targets);
+  }
+
+  /**
+   * Clears `targets` (render targets of a frame's size; null ones are skipped) whole and,
+   * with a pixel box `box` (frf's walker pixel box), has the passes that follow draw only
+   * its pixels: outside it the walker is transparent.
+   */
+  #clearBoxed(targets, box) {
+    const saved = this.renderer.getRenderTarget();
+    for (const t of targets.filter(Boolean)) {
+      t.scissorTest = false;
+      this.renderer.setRenderTarget(t);
+      this.renderer.setClearColor(0x000000, 0);
+      this.renderer.clear(true, true, false);
+      if (box) {
+        t.scissor.set(box.x0, t.height - box.y1, box.x1 - box.x0, box.y1 - box.y0);
+        t.scissorTest = true;
+      }
+    }
+    this.renderer.setRenderTarget(saved);
+  }
+
+  /** Ends `#clearBoxed`: `targets` drawn whole again. */
+  #unboxed(targets) {
+    for (const t of targets.filter(Boolean)) t.scissorTest = false;
   }
 
   #prepared(number) {
@@ -574,20 +626,24 @@ export class FrfPlayer {
     return pose;
   }
 
-  /** Four float targets of a frame's size: two poses' colour and their motions. */
+  /** Two float targets of a frame's size, two textures each: a pose's colour and motion. */
   #timeTargets(width, height) {
     if (!this.timeTargets || this.timeTargets[0].width !== width || this.timeTargets[0].height !== height) {
       this.timeTargets?.forEach((x) => x.dispose());
-      this.timeTargets = [0, 1, 2, 3].map(() => new THREE.WebGLRenderTarget(width, height, {
-        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
+      this.timeTargets = [0, 1].map(() => new THREE.WebGLRenderTarget(width, height, {
+        type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false, count: 2,
         minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
       }));
     }
     return this.timeTargets;
   }
 
-  /** The frame pass of `pose` (its hull pass drawn into `hullTarget`) reading `views` (pre-lit colour or motion). */
-  #frame(pose, camera, views, hullTarget, target) {
+  /**
+   * The frame pass of `pose` (its hull pass drawn into `hullTarget`) reading `views`
+   * (pre-lit colour) and, with `motion` (its motion views), morphing those too into the
+   * target's second texture.
+   */
+  #frame(pose, camera, views, hullTarget, target, motion = null) {
     const saved = this.renderer.getRenderTarget();
     const u = this.frameMaterial.uniforms;
     const [r, d, f] = camera.axes;
@@ -603,6 +659,8 @@ export class FrfPlayer {
     u.uRows.value = this.grid.rows;
     u.uFrameRows.value = pose.geometry.frameRows;
     u.uPrelit.value = views;
+    u.uMotion.value = motion ?? views;
+    u.uWithMotion.value = motion ? 1 : 0;
     u.uFlows.value = pose.flows;
     u.uHullT.value = hullTarget.texture;
     u.uHasHull.value = pose.geometry.hasHull ? 1 : 0;

@@ -159,11 +159,14 @@ uniform int uColumns;
 uniform int uRows;
 uniform int uFrameRows;
 uniform sampler2DArray uPrelit; // RGBA16F, premultiplied linear
+uniform sampler2DArray uMotion; // RG32F, metres across the axis and up it (alpha 1)
+uniform int uWithMotion;        // 1: the views' motion morphed too, into outMotion
 uniform sampler2DArray uFlows;  // RG32F, pixels
 uniform sampler2D uHullT;       // R32F: distance to the hull along the ray + 1, 0 none
 uniform int uHasHull;
 uniform vec2 uAxis;
-out vec4 outColor;
+layout(location = 0) out vec4 outColor;
+layout(location = 1) out vec4 outMotion;
 
 // Fixed-point steps per source at most, and from the proxy's depth (frf's
 // solved::ITERATIONS and solved::PROXY_ITERATIONS).
@@ -501,11 +504,20 @@ vec3 solveSource(int f, ivec4 q, int k, Output o) {
   return vec3(x, step_);
 }
 
-vec4 solvedMorph(Hit hit, Output o) {
+// A view's motion at pixel s (alpha 1 where the view is held, as its pre-lit colour).
+vec4 sampleMotion(int view, vec2 s) {
+  int layer = int(viewTexel(view, 0).w);
+  return layer < 0 ? vec4(0.0) : bilinearLayer(uMotion, layer, s);
+}
+
+// The four sources solved and mixed: the pre-lit colour into outColor, and with
+// uWithMotion the views' motion, by the same samples' weights, into outMotion.
+void solvedMorph(Hit hit, Output o) {
   int f = frameIndex(hit);
   ivec4 q = quadViews(hit);
   vec4 w = bilinearWeights(hit.beta, hit.gamma);
   vec4 acc = vec4(0.0);
+  vec4 motion = vec4(0.0);
   float total = 0.0;
   for (int k = 0; k < 4; k++) {
     if (w[k] <= 0.0) continue;
@@ -513,9 +525,11 @@ vec4 solvedMorph(Hit hit, Output o) {
     float settle = r.z / SETTLE_PX;
     float wk = w[k] * max(exp(-(settle * settle)), SETTLE_FLOOR);
     acc += samplePrelit(q[k], r.xy) * wk;
+    if (uWithMotion == 1) motion += sampleMotion(q[k], r.xy) * wk;
     total += wk;
   }
-  return total > 0.0 ? acc / total : acc;
+  outColor = total > 0.0 ? acc / total : acc;
+  outMotion = total > 0.0 ? motion / total : motion;
 }
 
 void main() {
@@ -525,10 +539,11 @@ void main() {
   vec3 dir = normalize(uAxes * dc);
   Hit hit = intersect(uEye, dir);
   outColor = vec4(0.0);
+  outMotion = vec4(0.0);
   if (hit.clamped == 3) return;
   Output o = solvedOutput(hit, uEye, dir);
   if (!o.ok) return;
-  outColor = solvedMorph(hit, o);
+  solvedMorph(hit, o);
 }
 `;
 

@@ -1,0 +1,90 @@
+// Where a pose's walker can show (frf's `render/src/footprint.rs`): a vertical cylinder
+// round its hull mesh's box grown by the reach of its flows, and the box of pixels where
+// a camera sees it. The player's passes shade only that box: outside it no ray can show
+// the walker, which is transparent there.
+
+/** Where on the subject's axis pixels per metre are measured (metres up: mid-body). */
+const AXIS_POINT_M = 1.0;
+
+/** Pixels per metre a camera sees at the subject's axis. */
+export function pixelsPerMetre(camera) {
+  const [x, y, z] = camera.centre;
+  const d = Math.hypot(x, y - AXIS_POINT_M, z);
+  return Math.max(Math.abs(camera.k.fx), Math.abs(camera.k.fy)) / Math.max(d, 1e-3);
+}
+
+/**
+ * The cylinder `{ axis: [x, z], radius, heights: [lo, hi] }` round the box of `positions`
+ * (a hull mesh's, xyz flat) grown by `margin` metres on every side.
+ */
+export function subjectBounds(positions, margin) {
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < positions.length; i += 3) {
+    for (let a = 0; a < 3; a++) {
+      lo[a] = Math.min(lo[a], positions[i + a]);
+      hi[a] = Math.max(hi[a], positions[i + a]);
+    }
+  }
+  return {
+    axis: [(lo[0] + hi[0]) / 2, (lo[2] + hi[2]) / 2],
+    radius: Math.hypot((hi[0] - lo[0]) / 2, (hi[2] - lo[2]) / 2) + margin,
+    heights: [lo[1] - margin, hi[1] + margin],
+  };
+}
+
+/**
+ * How far (metres, at the subject's axis) a pose's flows carry a sample: their largest
+ * component `maxFlowPx` (frf: its quantizer's range) times √2, and a pixel for the
+ * bilinear footprint, at the median pixels per metre of the views' `cameras`.
+ */
+export function flowReachM(maxFlowPx, cameras) {
+  const ppm = cameras.map(pixelsPerMetre).sort((a, b) => a - b);
+  const median = ppm[Math.floor(ppm.length / 2)] ?? 0;
+  return (maxFlowPx * Math.SQRT2 + 1) / median;
+}
+
+/** Projects subject-frame point `p` into `camera`'s pixels; null behind it. */
+function project(camera, p) {
+  const [r, d, f] = camera.axes;
+  const v = [p[0] - camera.centre[0], p[1] - camera.centre[1], p[2] - camera.centre[2]];
+  const z = f[0] * v[0] + f[1] * v[1] + f[2] * v[2];
+  if (z < 1e-3) return null;
+  return [
+    (camera.k.fx * (r[0] * v[0] + r[1] * v[1] + r[2] * v[2])) / z + camera.k.cx,
+    (camera.k.fy * (d[0] * v[0] + d[1] * v[1] + d[2] * v[2])) / z + camera.k.cy,
+  ];
+}
+
+/**
+ * The box of pixels `{ x0, y0, x1, y1 }` (rows down, ends exclusive) where `camera` sees
+ * `bounds`, a pixel's bilinear footprint either side: the whole frame when part of them
+ * is behind the camera, null when it sees none.
+ */
+export function pixelBox(bounds, camera) {
+  const { width: w, height: h } = camera;
+  // The 16-gon's circumradius, so that it holds the circle.
+  const r = bounds.radius / Math.cos(Math.PI / 16);
+  let [x0, y0, x1, y1] = [Infinity, Infinity, -Infinity, -Infinity];
+  for (let k = 0; k < 16; k++) {
+    const a = (k * 2 * Math.PI) / 16;
+    for (const y of bounds.heights) {
+      const p = project(camera, [bounds.axis[0] + r * Math.cos(a), y, bounds.axis[1] + r * Math.sin(a)]);
+      if (!p) return { x0: 0, y0: 0, x1: w, y1: h };
+      [x0, y0, x1, y1] = [Math.min(x0, p[0]), Math.min(y0, p[1]), Math.max(x1, p[0]), Math.max(y1, p[1])];
+    }
+  }
+  if (x1 < 0 || y1 < 0 || x0 > w - 1 || y0 > h - 1) return null;
+  const clamp = (v, max) => Math.min(Math.max(v, 0), max);
+  return {
+    x0: clamp(Math.floor(x0) - 1, w), y0: clamp(Math.floor(y0) - 1, h),
+    x1: clamp(Math.ceil(x1) + 2, w), y1: clamp(Math.ceil(y1) + 2, h),
+  };
+}
+
+/** The smallest box holding both (null: none). */
+export function unionBox(a, b) {
+  if (!a) return b;
+  if (!b) return a;
+  return { x0: Math.min(a.x0, b.x0), y0: Math.min(a.y0, b.y0), x1: Math.max(a.x1, b.x1), y1: Math.max(a.y1, b.y1) };
+}
