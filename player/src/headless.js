@@ -129,6 +129,8 @@ window.frfRender = async (job) => {
   }
   let binary = '';
   for (let i = 0; i < out.length; i += 0x8000) binary += String.fromCharCode(...out.subarray(i, i + 0x8000));
-  return { rgba: btoa(binary), shadow, msPerFrame, loadMs, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+  const parts = player.poses.get(at.before);
+  const loadParts = { ...parts.loadMs, relight: parts.relightMs };
+  return { rgba: btoa(binary), shadow, msPerFrame, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
 };
 window.frfReady = true;

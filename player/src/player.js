@@ -216,7 +216,9 @@ export class FrfPlayer {
       this.poses.set(number, pose);
     }
     if (pose.lightVersion !== this.lightVersion) {
+      const t0 = performance.now();
       this.#relight(pose);
+      pose.relightMs = performance.now() - t0;
       pose.lightVersion = this.lightVersion;
     }
     return pose;
@@ -243,6 +245,7 @@ export class FrfPlayer {
     let maxFlow = 0;
     // The JPEG atlases decode together (the browser decodes images off the page's
     // thread); the PNGs are decoded on it as each view is filled in.
+    const started = performance.now();
     const jpegs = await Promise.all(views.flatMap((v, i) => Array.from({ length: channels }, (_, c) => {
       const what = `pose ${record.pose} view ${v.u},${v.v} transfer`;
       return greyJpeg(glb, v.transfer.images[c], what).then((img) => {
@@ -251,6 +254,7 @@ export class FrfPlayer {
       });
     })));
     void jpegs;
+    const decodedJpeg = performance.now();
     for (let i = 0; i < n; i++) {
       const v = views[i];
       const what = (s) => `pose ${record.pose} view ${v.u},${v.v} ${s}`;
@@ -291,6 +295,7 @@ export class FrfPlayer {
         flowLayer++;
       });
     }
+    const decodedPng = performance.now();
     const motion = this.#motionTextures(record);
     const groundShadow = this.#groundShadowMaps(record);
     const pose = {
@@ -336,11 +341,17 @@ export class FrfPlayer {
       pose.index.ranges.forEach(([lo, hi], i) => r.set([lo, hi, 0, 0], 4 * i));
       pose.ranges = dataTexture(r, pose.index.ranges.length, 1);
     }
+    const madeMotion = performance.now();
     // Each view texel's distance to the hull along its ray (the sun's shadow rays start there).
     views.forEach((v, i) => {
       const camera = geometry.cameras[v.u * rows + v.v];
       this.#drawHull(pose, camera, pose.viewHull, i, false);
     });
+    // What loading took, by part (ms; the GPU's work as it was issued).
+    pose.loadMs = {
+      jpeg: decodedJpeg - started, png: decodedPng - decodedJpeg, motion: madeMotion - decodedPng,
+      hull: performance.now() - madeMotion,
+    };
     return pose;
   }
 
