@@ -69,6 +69,18 @@ export function fullscreen(material) {
   return scene;
 }
 
+/**
+ * Sets a pass's camera uniforms from a player camera: uEye (its centre), uAxes (columns:
+ * right, down, forward), uK (fx, fy, cx, cy) and uHeight (its rows).
+ */
+export function cameraUniforms(u, camera) {
+  const [r, d, f] = camera.axes;
+  u.uEye.value.set(...camera.centre);
+  u.uAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
+  u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
+  u.uHeight.value = camera.height;
+}
+
 /** A light: nine RGB radiance coefficients (three.js order) and an optional sun. */
 export const NO_SUN = { direction: [0, 1, 0], illuminance: [0, 0, 0] };
 
@@ -452,11 +464,7 @@ export class FrfPlayer {
     });
     this.layerScene ??= fullscreen(this.layerMaterial);
     const u = this.layerMaterial.uniforms;
-    const [r, d, f] = camera.axes;
-    u.uEye.value.set(...camera.centre);
-    u.uAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
-    u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
-    u.uHeight.value = camera.height;
+    cameraUniforms(u, camera);
     u.uShadow.value = shadow.texture;
     u.uShadowExtent.value = shadow.extent;
     u.uShadowFadeFrom.value = shadow.fadeFrom;
@@ -657,11 +665,7 @@ export class FrfPlayer {
   #frame(pose, camera, views, hullTarget, target, motion = null) {
     const saved = this.renderer.getRenderTarget();
     const u = this.frameMaterial.uniforms;
-    const [r, d, f] = camera.axes;
-    u.uEye.value.set(...camera.centre);
-    u.uAxes.value.set(r[0], d[0], f[0], r[1], d[1], f[1], r[2], d[2], f[2]);
-    u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
-    u.uHeight.value = camera.height;
+    cameraUniforms(u, camera);
     u.uQuads.value = pose.quads;
     u.uQuadCount.value = pose.geometry.quads.length;
     u.uFrames.value = pose.frames;

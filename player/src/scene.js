@@ -5,7 +5,7 @@
 // caster in three.js's shadow maps; and the exported ground-shadow basis, relit by the
 // walker's light, darkening the ground under it as frf's composite does.
 import * as THREE from 'three';
-import { fullscreen } from './player.js';
+import { fullscreen, cameraUniforms } from './player.js';
 import { FULLSCREEN_VERTEX, DEPTH_COMPOSITE_FRAGMENT, GROUND_SHADOW_AT } from './shaders.js';
 
 /**
@@ -58,16 +58,11 @@ export class DepthComposite {
   draw(player, frame, camera, walker, target, depth = true) {
     const u = this.material.uniforms;
     const d = player.drawn;
-    const c = d.camera;
-    const [r, dn, f] = c.axes;
     u.uFrame.value = frame.texture;
     u.uHullA.value = d.hulls[0].texture;
     u.uHullB.value = (d.hulls[1] ?? d.hulls[0]).texture;
     u.uTwo.value = d.hulls.length > 1 ? 1 : 0;
-    u.uEye.value.set(...c.centre);
-    u.uAxes.value.set(r[0], dn[0], f[0], r[1], dn[1], f[1], r[2], dn[2], f[2]);
-    u.uK.value.set(c.k.fx, c.k.fy, c.k.cx, c.k.cy);
-    u.uHeight.value = c.height;
+    cameraUniforms(u, d.camera);
     u.uAxis.value.set(...d.axis);
     camera.updateMatrixWorld();
     walker.updateMatrixWorld();

@@ -304,6 +304,33 @@ fn the_player_in_chromium_draws_what_frf_renders() {
     );
 }
 
+/// The tiny preset's `poses` staged without perturbation in `dir` and their oracle field
+/// (`frf stage field` with `extra` arguments), the capture's images removed: its path.
+pub(crate) fn staged_field(dir: &Path, poses: &str, extra: &[&str]) -> PathBuf {
+    let (capture, field) = (dir.join("capture"), dir.join("staged.frf"));
+    let made = frf(&[
+        "stage",
+        "--preset",
+        "tiny",
+        "--poses",
+        poses,
+        "--perturbation",
+        "0",
+        "--lights-per-axis",
+        "1",
+        "--out",
+        capture.to_str().unwrap(),
+    ]);
+    assert!(made.status.success(), "{}", stderr(&made));
+    let mut args = vec!["stage", "field", "--capture", capture.to_str().unwrap()];
+    args.extend(extra);
+    args.extend(["--out", field.to_str().unwrap()]);
+    let made = frf(&args);
+    assert!(made.status.success(), "{}", stderr(&made));
+    std::fs::remove_dir_all(&capture).unwrap();
+    field
+}
+
 /// The GLB `bytes` with its JSON chunk changed by `edit`, packed again as the exporter
 /// packs it.
 fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
@@ -569,28 +596,7 @@ fn the_player_says_what_it_cannot_draw() {
 #[test]
 fn the_player_draws_the_pose_asked_for() {
     let dir = tempfile::tempdir().unwrap();
-    let (capture, field) = (dir.path().join("capture"), dir.path().join("two.frf"));
-    let made = frf(&[
-        "stage",
-        "--preset",
-        "tiny",
-        "--poses",
-        "0,6",
-        "--perturbation",
-        "0",
-        "--out",
-        capture.to_str().unwrap(),
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
-    let made = frf(&[
-        "stage",
-        "field",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--out",
-        field.to_str().unwrap(),
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
+    let field = staged_field(dir.path(), "0,6", &[]);
     let glb = dir.path().join("two.glb");
     let o = frf(&[
         "export",

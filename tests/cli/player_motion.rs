@@ -13,7 +13,7 @@ use std::process::{Command, Output};
 use serde_json::Value;
 
 use crate::common::{frf, stderr};
-use crate::player::{Shot, grid_camera_of, list, player, subject_psnr};
+use crate::player::{Shot, grid_camera_of, list, player, staged_field, subject_psnr};
 
 /// The instant half-way between poses 0 and 3 of a 30-pose, one-second cycle.
 const HALF_WAY_S: f64 = 0.05;
@@ -105,33 +105,7 @@ fn two_poses() -> &'static TwoPoses {
 /// The tiny preset's poses 0 and 3 staged, their oracle field with its true pose flows,
 /// exported, and the built-in sky's L2 light.
 fn make_two_poses(dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
-    let (capture, field) = (dir.join("capture"), dir.join("two.frf"));
-    let made = frf(&[
-        "stage",
-        "--preset",
-        "tiny",
-        "--poses",
-        "0,3",
-        "--perturbation",
-        "0",
-        "--lights-per-axis",
-        "1",
-        "--out",
-        capture.to_str().unwrap(),
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
-    let made = frf(&[
-        "stage",
-        "field",
-        "--capture",
-        capture.to_str().unwrap(),
-        "--pose-flow",
-        "--out",
-        field.to_str().unwrap(),
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
-    // The capture's images are not needed again.
-    std::fs::remove_dir_all(&capture).unwrap();
+    let field = staged_field(dir, "0,3", &["--pose-flow"]);
     let glb = dir.join("two.glb");
     let o = frf(&[
         "export",
