@@ -46,7 +46,8 @@ scene.add(box);
 const probe = new THREE.LightProbe();
 scene.add(probe);
 const sunDir = new THREE.Vector3(...sunDirection((SUN.az * Math.PI) / 180, (SUN.el * Math.PI) / 180));
-const sun = new THREE.DirectionalLight(0xffffff, SUN.e / Math.PI);
+// three.js's DirectionalLight's intensity is the irradiance it gives a surface facing it.
+const sun = new THREE.DirectionalLight(0xffffff, SUN.e);
 sun.position.copy(sunDir).multiplyScalar(10);
 sun.castShadow = true;
 sun.shadow.mapSize.set(2048, 2048);
@@ -75,6 +76,27 @@ const present = new THREE.RawShaderMaterial({
 const presentScene = fullscreen(present);
 window.frfSceneFrames = 0;
 
+/** The irradiance (green) an L2 light `sh` gives a surface facing `n`, by quadrature. */
+function irradianceAt(sh, n) {
+  const count = 2048;
+  const basis = new Array(9);
+  const d = new THREE.Vector3();
+  let e = 0;
+  for (let k = 0; k < count; k++) {
+    const y = 1 - (2 * k + 1) / count;
+    const rho = Math.sqrt(1 - y * y);
+    const phi = k * Math.PI * (3 - Math.sqrt(5));
+    d.set(rho * Math.cos(phi), y, rho * Math.sin(phi));
+    const cos = d.dot(n);
+    if (cos <= 0) continue;
+    THREE.SphericalHarmonics3.getBasisAt(d, basis);
+    let l = 0;
+    for (let i = 0; i < 9; i++) l += sh[i][1] * basis[i];
+    e += (l * cos * 4 * Math.PI) / count;
+  }
+  return e;
+}
+
 async function start() {
   const query = new URLSearchParams(location.search);
   const url = query.get('glb');
@@ -90,6 +112,10 @@ async function start() {
     : [[0.9, 0.9, 0.95], [0.45, 0.45, 0.5], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0.05, 0.05, 0.05], [0, 0, 0], [0, 0, 0]];
   // The scene's objects see the same L2 light (three.js's LightProbe takes radiance SH).
   probe.sh.fromArray(sh.flat());
+  // Exposed so that white ground under the sky and the sun shows at 0.8, unless given.
+  const up = new THREE.Vector3(0, 1, 0);
+  const groundRadiance = irradianceAt(sh, up) / Math.PI + (SUN.e * Math.max(sunDir.dot(up), 0)) / Math.PI;
+  present.uniforms.uExposure.value = query.has('exposure') ? 2 ** Number(query.get('exposure')) : 0.8 / Math.max(groundRadiance, 1e-6);
   groundShadow = groundShadowMesh(player);
   if (groundShadow) walker.add(groundShadow);
   requestAnimationFrame(tick);
