@@ -279,8 +279,12 @@ export class FrfPlayer {
         normals.set(nm.data, i * 4 * w * h);
       }
       const rgbInto = (img, layer) => {
-        for (let t = 0; t < w * h; t++) {
-          albedo.set([img.data[3 * t], img.data[3 * t + 1], img.data[3 * t + 2], 255], (layer * w * h + t) * 4);
+        const d = img.data;
+        for (let t = 0, o = layer * w * h * 4; t < w * h; t++, o += 4) {
+          albedo[o] = d[3 * t];
+          albedo[o + 1] = d[3 * t + 1];
+          albedo[o + 2] = d[3 * t + 2];
+          albedo[o + 3] = 255;
         }
       };
       const al = png(glb, v.albedo.image, what('albedo'));
