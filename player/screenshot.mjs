@@ -174,7 +174,7 @@ if (o.shadowOut) {
 }
 const report = {
   out: o.out, pose: result.at.before, between: result.at.s > 0 ? { after: result.at.after, s: result.at.s } : null, width: o.width, height: o.height,
-  ms_per_frame: result.msPerFrame, timed_frames: o.timeFrames, load_ms: result.loadMs, load_parts_ms: result.loadParts,
+  ms_per_frame: result.msPerFrame, frame_parts_ms: result.partsMs, timed_frames: o.timeFrames, load_ms: result.loadMs, load_parts_ms: result.loadParts,
   gl_renderer: result.renderer, notes: result.notes,
 };
 console.log(o.json ? JSON.stringify(report) : `wrote ${o.out} (${o.width}x${o.height}, pose ${result.at.before}${result.at.s > 0 ? ` to ${result.at.after} at ${result.at.s.toFixed(3)}` : ''}${result.msPerFrame ? `, ${result.msPerFrame.toFixed(1)} ms per frame on ${result.renderer}` : ''})`);

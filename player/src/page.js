@@ -132,6 +132,8 @@ async function tick() {
     const eye = camera.position.toArray();
     const target = controls.target.toArray();
     const t0 = performance.now();
+    player.measure = $('measure').checked;
+    player.partsMs = {};
     player.drawInstant(at, FrfPlayer.camera(eye, target, camera.fov, w, h), frameTarget);
     present.uniforms.uFrame.value = frameTarget.texture;
     present.uniforms.uExposure.value = 2 ** Number($('exposure').value);
@@ -141,7 +143,8 @@ async function tick() {
     drawMs = 0.9 * drawMs + 0.1 * (performance.now() - t0);
     const when = at.s > 0 ? `poses ${at.before} to ${at.after} at ${at.s.toFixed(2)}` : `pose ${at.before}`;
     $('status').textContent = `${clock.toFixed(3)} s: ${when} (${ext.poses.length} exported), ${ext.grid.columns}x${ext.grid.rows} views of ${ext.grid.width}x${ext.grid.height}\n` +
-      `${w}x${h} pixels, ${drawMs.toFixed(1)} ms to issue a frame`;
+      `${w}x${h} pixels, ${drawMs.toFixed(1)} ms to issue a frame` +
+      (player.measure ? `\nwaited for, ms: ${Object.entries(player.partsMs).map(([k, v]) => `${k} ${v.toFixed(1)}`).join(', ')}` : '');
   } catch (e) {
     showError(e);
     loaded = false;

@@ -92,6 +92,10 @@ export class FrfPlayer {
     this.sh = Array.from({ length: 9 }, () => [0, 0, 0]);
     this.sun = NO_SUN;
     this.lightVersion = 0;
+    // With `measure`, each part of a frame is waited for and timed into `partsMs` (ms,
+    // summed until reset): what a frame costs by part, at the price of the waits.
+    this.measure = false;
+    this.partsMs = {};
     this.camera = new THREE.Camera();
     this.prelitMaterial = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: PRELIT_FRAGMENT,
@@ -541,8 +545,8 @@ export class FrfPlayer {
     const box = pixelBox(pose.bounds, camera);
     this.#clearBoxed([hull, target], box);
     if (box) {
-      this.#drawHull(pose, camera, hull, 0, true);
-      this.#frame(pose, camera, pose.prelit.texture, hull, target);
+      this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
+      this.#part('frame', target, () => this.#frame(pose, camera, pose.prelit.texture, hull, target));
     }
     this.#unboxed([hull, target]);
   }
@@ -601,8 +605,8 @@ export class FrfPlayer {
     }
     // Each pose's colour and its motion toward the other in one frame pass (two outputs).
     for (const [pose, step, both, hull] of [[before, 'next', t[0], hulls[0]], [after, 'prev', t[1], hulls[1]]]) {
-      this.#drawHull(pose, camera, hull, 0, true);
-      this.#frame(pose, camera, pose.prelit.texture, hull, both, pose.motion[step]);
+      this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
+      this.#part('frame', both, () => this.#frame(pose, camera, pose.prelit.texture, hull, both, pose.motion[step]));
     }
     const u = this.timeMaterial.uniforms;
     [u.uBefore.value, u.uBeforeMotion.value] = t[0].textures;
@@ -613,7 +617,7 @@ export class FrfPlayer {
     u.uHeight.value = camera.height;
     const saved = this.renderer.getRenderTarget();
     this.renderer.setRenderTarget(target);
-    this.renderer.render(this.timeScene, this.camera);
+    this.#part('time morph', target, () => this.renderer.render(this.timeScene, this.camera));
     this.renderer.setRenderTarget(saved);
     this.#unboxed(targets);
   }
@@ -641,6 +645,22 @@ export class FrfPlayer {
   /** Ends `#clearBoxed`: `targets` drawn whole again. */
   #unboxed(targets) {
     for (const t of targets.filter(Boolean)) t.scissorTest = false;
+  }
+
+  /**
+   * Runs `draw` (into render target `target`), timed into `partsMs[name]` with `measure`:
+   * waited for on both sides by reading a pixel of `target` back (gl.finish does not wait
+   * in Chromium, nor does a read of another target on SwiftShader).
+   */
+  #part(name, target, draw) {
+    if (!this.measure || !target) return draw();
+    const pixel = new Float32Array(4);
+    this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
+    const t0 = performance.now();
+    const out = draw();
+    this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
+    this.partsMs[name] = (this.partsMs[name] ?? 0) + performance.now() - t0;
+    return out;
   }
 
   #prepared(number) {
