@@ -337,3 +337,89 @@ fn flows_are_the_fields_within_a_code_and_extended_beyond_the_subject() {
         "{known} known, {unknown} extended"
     );
 }
+
+/// A view's motion toward the next pose and a pose's ground-shadow maps come back from the
+/// export as frf computes them (`frf_core::subject_motion::view_motion_m` of the field's
+/// pose flow; the field's attenuation maps) within half a code, and each pose says where
+/// its motion leads.
+#[test]
+fn motion_and_ground_shadows_are_the_fields_within_a_code() {
+    let f = frf_testkit::tiny_two_poses();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let options = ExportOptions {
+        views: ViewSelection::List(vec![(5, 1)]),
+        ..ExportOptions::default()
+    };
+    export(&f.field, &out, &options).unwrap();
+    let glb = Export::open(&out).unwrap();
+    let field = FieldFile::open(&f.field).unwrap();
+    let h = field.header();
+    let ext = &glb.document["extensions"]["FRF_flowed_reflectance_field"];
+    assert_eq!(
+        ext["poses"][0]["motion_to"],
+        serde_json::json!({"next": 3, "prev": 3})
+    );
+    assert_eq!(
+        ext["poses"][1]["motion_to"],
+        serde_json::json!({"next": 0, "prev": 0})
+    );
+    // Motion: pose 0's view 5,1 toward pose 3 (the same column within the cycle).
+    let view = glb.view(0, 5, 1).unwrap();
+    let motion = &view.motion["next"];
+    let png = image::load_from_memory(glb.image_bytes(motion.image).unwrap())
+        .unwrap()
+        .into_luma_alpha16();
+    let camera = |pose: u32| {
+        h.pose(pose).unwrap().views[h.view_index(5, 1)]
+            .camera
+            .to_camera()
+            .unwrap()
+    };
+    let flow = field
+        .pose_flow(0, 5, 1, frf_core::grid::PoseStep::Next)
+        .unwrap()
+        .unwrap();
+    let (w, hh) = flow.size();
+    let want =
+        frf_core::subject_motion::view_motion_m(&camera(0), &camera(3), &flow, (w, hh), |k| {
+            (k % w, k / w)
+        })
+        .unwrap();
+    let mut moving = 0;
+    for (p, m) in png.pixels().zip(&want) {
+        let got = [p[0], p[1]].map(|q| (f32::from(q) - 32768.0) * motion.step_m);
+        assert!(
+            (got[0] - m.x).abs() <= 0.5 * motion.step_m + 1e-7
+                && (got[1] - m.y).abs() <= 0.5 * motion.step_m + 1e-7,
+            "{got:?} vs {m}"
+        );
+        moving += usize::from(m.length() > 0.005);
+    }
+    assert!(moving > 200, "{moving} texels move by more than 5 mm");
+    // Ground shadow: the maps stacked, one above the other.
+    let maps = field.shadows(0).unwrap().unwrap();
+    let index = ext["poses"][0]["ground_shadow"].as_u64().unwrap() as usize;
+    let png = image::load_from_memory(glb.image_bytes(index).unwrap())
+        .unwrap()
+        .into_luma8();
+    let n = ext["ground_shadow"]["texels"].as_u64().unwrap() as u32;
+    assert_eq!(png.dimensions(), (n, n * maps.len() as u32));
+    assert_eq!(
+        ext["ground_shadow"]["weights"].as_array().unwrap().len(),
+        maps.len()
+    );
+    let mut shaded = 0;
+    for (m, map) in maps.iter().enumerate() {
+        for (k, &a) in map.pixels().iter().enumerate() {
+            let (x, y) = ((k as u32) % n, (k as u32) / n + m as u32 * n);
+            let got = f32::from(png.get_pixel(x, y)[0]) / 255.0;
+            assert!(
+                (got - a).abs() <= 0.5 / 255.0 + 1e-6,
+                "map {m} texel {k}: {got} vs {a}"
+            );
+            shaded += usize::from(a < 0.5);
+        }
+    }
+    assert!(shaded > 10, "{shaded} texels shaded");
+}

@@ -8,6 +8,9 @@
 //! the stage's configuration, so it serves as the `--capture` of `frf eval`. Building it
 //! takes about 10 s on two cores.
 //!
+//! [`tiny_two_poses`]: the same stage's poses 0 and 3 and their oracle field with the true
+//! flows between them.
+//!
 //! [`cpu_flag`]: whether command-line tests must render on the CPU reference.
 
 use std::path::{Path, PathBuf};
@@ -89,31 +92,45 @@ pub fn tiny_config() -> StageConfig {
     c
 }
 
+/// The tiny stage's poses 0 and 3 and their oracle field with the true flows between
+/// them (`pose_flows`), built on first use: the walk between poses, exported or drawn.
+///
+/// # Panics
+/// If the fixture cannot be built: a test that needs it fails.
+pub fn tiny_two_poses() -> &'static TinyField {
+    static FIXTURE: OnceLock<TinyField> = OnceLock::new();
+    FIXTURE.get_or_init(|| build(vec![0, 3], true))
+}
+
 /// The tiny stage's oracle field, built on first use (see the crate docs).
 ///
 /// # Panics
 /// If the fixture cannot be built: a test that needs it fails.
 pub fn tiny_field() -> &'static TinyField {
     static FIXTURE: OnceLock<TinyField> = OnceLock::new();
-    FIXTURE.get_or_init(|| {
-        let dir = tempfile::tempdir().expect("a temporary directory");
-        let config = tiny_config();
-        std::fs::write(
-            dir.path().join(frf_stage::writer::STAGE_FILE),
-            toml::to_string(&config).expect("the configuration serializes"),
-        )
-        .expect("the stage configuration is written");
-        let stage = Stage::new(config).expect("the tiny preset is valid");
-        let field = dir.path().join("tiny.frf");
-        let options = OracleOptions {
-            poses: vec![0],
-            jpeg_quality: 95,
-            predict_flow: true,
-            shadows: Some(ShadowOptions::default()),
-            pose_flows: false,
-        };
-        write_oracle_field(&stage, &field, &options, &|_, _| {})
-            .expect("the tiny oracle field is written");
-        TinyField { dir, stage, field }
-    })
+    FIXTURE.get_or_init(|| build(vec![0], false))
+}
+
+/// The tiny stage of `poses` and its oracle field (with pose flows when `pose_flows`).
+fn build(poses: Vec<u32>, pose_flows: bool) -> TinyField {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let mut config = tiny_config();
+    config.poses = poses.clone();
+    std::fs::write(
+        dir.path().join(frf_stage::writer::STAGE_FILE),
+        toml::to_string(&config).expect("the configuration serializes"),
+    )
+    .expect("the stage configuration is written");
+    let stage = Stage::new(config).expect("the tiny preset is valid");
+    let field = dir.path().join("tiny.frf");
+    let options = OracleOptions {
+        poses,
+        jpeg_quality: 95,
+        predict_flow: true,
+        shadows: Some(ShadowOptions::default()),
+        pose_flows,
+    };
+    write_oracle_field(&stage, &field, &options, &|_, _| {})
+        .expect("the tiny oracle field is written");
+    TinyField { dir, stage, field }
 }
