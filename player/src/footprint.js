@@ -2,6 +2,7 @@
 // round its hull mesh's box grown by the reach of its flows, and the box of pixels where
 // a camera sees it. The player's passes shade only that box: outside it no ray can show
 // the walker, which is transparent there.
+import { project } from './geometry.js';
 
 /** Where on the subject's axis pixels per metre are measured (metres up: mid-body). */
 const AXIS_POINT_M = 1.0;
@@ -42,18 +43,6 @@ export function flowReachM(maxFlowPx, cameras) {
   const ppm = cameras.map(pixelsPerMetre).sort((a, b) => a - b);
   const median = ppm[Math.floor(ppm.length / 2)] ?? 0;
   return (maxFlowPx * Math.SQRT2 + 1) / median;
-}
-
-/** Projects subject-frame point `p` into `camera`'s pixels; null behind it. */
-function project(camera, p) {
-  const [r, d, f] = camera.axes;
-  const v = [p[0] - camera.centre[0], p[1] - camera.centre[1], p[2] - camera.centre[2]];
-  const z = f[0] * v[0] + f[1] * v[1] + f[2] * v[2];
-  if (z < 1e-3) return null;
-  return [
-    (camera.k.fx * (r[0] * v[0] + r[1] * v[1] + r[2] * v[2])) / z + camera.k.cx,
-    (camera.k.fy * (d[0] * v[0] + d[1] * v[1] + d[2] * v[2])) / z + camera.k.cy,
-  ];
 }
 
 /**

@@ -17,6 +17,15 @@ export const normalizeOrZero = (a) => {
   return l > 0 ? scale(a, 1 / l) : [0, 0, 0];
 };
 
+/** A camera's projection of subject-frame point `q` (pixels, centres at integers), or null behind it (frf's `Camera::project`). */
+export function project(camera, q) {
+  const [r, d, f] = camera.axes;
+  const v = sub(q, camera.centre);
+  const z = dot(f, v);
+  if (z < 1e-3) return null;
+  return [(camera.k.fx * dot(r, v)) / z + camera.k.cx, (camera.k.fy * dot(d, v)) / z + camera.k.cy];
+}
+
 /** A camera of the extension: intrinsics, rotation columns (right, down, forward), centre. */
 export function cameraOf(record) {
   const m = record.world_from_camera;

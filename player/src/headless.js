@@ -9,6 +9,13 @@ import { subjectCamera, DepthComposite } from './scene.js';
 
 THREE.ColorManagement.enabled = false;
 
+/** Bytes as base64 (handed back to node through the page's JSON). */
+function base64(bytes) {
+  let binary = '';
+  for (let i = 0; i < bytes.length; i += 0x8000) binary += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+  return btoa(binary);
+}
+
 /** linear -> sRGB code, clamped. */
 function srgbCode(x) {
   const v = Math.min(Math.max(x, 0), 1);
@@ -132,15 +139,10 @@ window.frfRender = async (job) => {
         for (let c = 0; c < 3; c++) top[3 * (y * job.width + x) + c] = Math.round(Math.min(Math.max(s[i + c], 0), 1) * 65535);
       }
     }
-    let b = '';
-    const bytes = new Uint8Array(top.buffer);
-    for (let i = 0; i < bytes.length; i += 0x8000) b += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-    shadow = btoa(b);
+    shadow = base64(new Uint8Array(top.buffer));
   }
-  let binary = '';
-  for (let i = 0; i < out.length; i += 0x8000) binary += String.fromCharCode(...out.subarray(i, i + 0x8000));
   const parts = player.poses.get(at.before);
   const loadParts = { ...parts.loadMs, relight: parts.relightMs };
-  return { rgba: btoa(binary), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+  return { rgba: base64(out), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
 };
 window.frfReady = true;

@@ -8,7 +8,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { FrfPlayer, fullscreen } from './player.js';
-import { parseShLight, fromLightProbe, turnedAboutY } from './sh.js';
+import { parseShLight, turnedAboutY } from './sh.js';
 import { sunDirection } from './geometry.js';
 import { FULLSCREEN_VERTEX, PRESENT_FRAGMENT } from './shaders.js';
 import { subjectCamera, DepthComposite, hullCaster, groundShadowMesh } from './scene.js';
@@ -195,5 +195,3 @@ start().catch((e) => {
   $('error').textContent = String(e.message ?? e);
   console.error(e);
 });
-// (fromLightProbe is the other way round: a scene's LightProbe to the walker's light.)
-void fromLightProbe;

@@ -3,7 +3,7 @@
 // axis and up it, as the export stores it) into a camera's pixels. Twins of frf's
 // `scene/src/plan.rs` (`poses_around`) and `core/src/subject_motion.rs`
 // (`motion_to_image`).
-import { sub, dot, cross, normalizeOrZero, scale } from './geometry.js';
+import { dot, cross, normalizeOrZero, project } from './geometry.js';
 
 const STEP_M = 0.01;
 
@@ -32,15 +32,6 @@ export function instantOf(ext, timeS) {
   return { before, after, s };
 }
 
-/** A camera's projection of world point `q` (pixels), or null behind it. */
-function project(camera, q) {
-  const [r, d, f] = camera.axes;
-  const v = sub(q, camera.centre);
-  const z = dot(f, v);
-  if (z < 1e-3) return null;
-  return [camera.k.fx * dot(r, v) / z + camera.k.cx, camera.k.fy * dot(d, v) / z + camera.k.cy];
-}
-
 /**
  * The 2x2 map (columns, pixels per metre) from a subject motion at the axis (metres
  * across the axis, tangential to the circle of cameras, and up it) to what `camera`
@@ -65,5 +56,5 @@ export function motionToImage(camera) {
   const pa = project(camera, [p[0] + across[0] * STEP_M, p[1] + across[1] * STEP_M, p[2] + across[2] * STEP_M]);
   const py = project(camera, [p[0], p[1] + STEP_M, p[2]]);
   if (!p0 || !pa || !py) return [[0, 0], [0, 0]];
-  return [scale([pa[0] - p0[0], pa[1] - p0[1], 0], 1 / STEP_M).slice(0, 2), scale([py[0] - p0[0], py[1] - p0[1], 0], 1 / STEP_M).slice(0, 2)];
+  return [[(pa[0] - p0[0]) / STEP_M, (pa[1] - p0[1]) / STEP_M], [(py[0] - p0[0]) / STEP_M, (py[1] - p0[1]) / STEP_M]];
 }
