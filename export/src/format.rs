@@ -9,6 +9,9 @@ pub const VERSION: u32 = 1;
 /// A transfer atlas is 3 x 3 tiles of a view's size, coefficient `i` at column `i % 3`,
 /// row `i / 3`.
 pub const ATLAS_COLUMNS: usize = 3;
+/// A basis atlas (`frf export --basis`) is tiles of a view's size, 6 a row: condition
+/// `k` at column `k % 6`, row `k / 6` (26 conditions: 6 x 5, the atlas near square).
+pub const BASIS_COLUMNS: usize = 6;
 /// Flows are 16-bit: a stored value `q` is `q / FLOW_SCALE - FLOW_OFFSET_PX` pixels.
 pub const FLOW_SCALE: f32 = 256.0;
 /// See [`FLOW_SCALE`]: flows from −128 to +128 px at 1/256 px.

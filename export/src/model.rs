@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use frf_core::image::Rgb;
 use frf_core::sh::{Convention, SH_COUNT};
-use frf_reflectance::field::CameraRecord;
+use frf_reflectance::field::{CameraRecord, ConditionRecord};
 use serde::{Deserialize, Serialize};
 
 /// The extension's object.
@@ -32,6 +32,9 @@ pub struct Extension {
     pub source: Option<String>,
     /// The ground-shadow basis' patch and weights, where the field holds shadow maps.
     pub ground_shadow: Option<GroundShadow>,
+    /// The lighting basis' conditions, where the export holds the views' basis images
+    /// (`frf export --basis`): what a sun is relit by as frf relights it.
+    pub basis: Option<Basis>,
     /// The poses exported.
     pub poses: Vec<PoseRecord>,
 }
@@ -72,6 +75,17 @@ pub struct Walk {
     pub forward: [f64; 3],
     /// Whether the speed was measured from the hulls (the field records none).
     pub measured: bool,
+}
+
+/// The lighting basis whose images the views hold (`frf export --basis`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Basis {
+    /// Tiles a row of a view's basis atlas ([`crate::format::BASIS_COLUMNS`]).
+    pub columns: usize,
+    /// The conditions, in the order of the atlases' tiles: each its lights (dome frame:
+    /// a view's dome is the subject frame turned by its turntable angle), as the field
+    /// records them.
+    pub conditions: Vec<ConditionRecord>,
 }
 
 /// The ground-shadow basis (frf's attenuation maps, one per upper lighting condition) and
@@ -138,6 +152,20 @@ pub struct ViewRecord {
     /// The subject's motion toward the next and the previous pose, by the step's name
     /// (`next`, `prev`), where the field holds pose-to-pose flows.
     pub motion: BTreeMap<String, MotionImage>,
+    /// Its basis images (`frf export --basis`; else null).
+    pub basis: Option<BasisImages>,
+}
+
+/// A view's basis images, one tile per condition: radiance under the condition,
+/// `offset + scale × code` per condition and channel.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BasisImages {
+    /// The atlases (images' indices): red, green, blue.
+    pub images: Vec<usize>,
+    /// Per condition and channel: a code's step.
+    pub scale: Vec<Rgb>,
+    /// Per condition and channel: the value of code 0.
+    pub offset: Vec<Rgb>,
 }
 
 /// A view's motion toward another pose: metres across the subject's axis (tangential to

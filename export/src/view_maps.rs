@@ -18,15 +18,16 @@ use image::{ExtendedColorType, ImageEncoder};
 use crate::error::{ExportError, Result};
 use crate::format::{ATLAS_COLUMNS, FLOW_OFFSET_PX, FLOW_SCALE, MOTION_ZERO};
 
-/// A transfer's atlases and how to read their codes back.
+/// A view's tiles (the SH transfer's nine coefficients, or the basis' images) as atlases
+/// and how to read their codes back.
 #[derive(Debug, Clone)]
 pub struct Atlas {
     /// JPEG bytes, one grey atlas per channel encoded.
     pub jpeg: Vec<Vec<u8>>,
-    /// Per coefficient and channel: value per code.
-    pub scale: [Rgb; SH_COUNT],
-    /// Per coefficient and channel: value of code 0.
-    pub offset: [Rgb; SH_COUNT],
+    /// Per tile and channel: value per code.
+    pub scale: Vec<Rgb>,
+    /// Per tile and channel: value of code 0.
+    pub offset: Vec<Rgb>,
 }
 
 fn encoding_error(what: &str, e: image::ImageError) -> ExportError {
@@ -34,30 +35,46 @@ fn encoding_error(what: &str, e: image::ImageError) -> ExportError {
 }
 
 /// The atlases of a view's transfer (`w x h` texels, row-major) for its first
-/// `channels` channels (3; 1 for the compact tier's grey transfer), its ranges taken
-/// inside `alpha`; texels outside take the code of zero.
+/// `channels` channels (3; 1 for the compact tier's grey transfer), [`ATLAS_COLUMNS`]
+/// tiles a row ([`tile_atlas`]).
 pub fn transfer_atlas(
     transfer: &[[Rgb; SH_COUNT]],
     alpha: &GrayImage,
     quality: u8,
     channels: usize,
 ) -> Result<Atlas> {
+    let tiles = (SH_COUNT, ATLAS_COLUMNS);
+    tile_atlas(|p, i| transfer[p][i], tiles, alpha, quality, channels)
+}
+
+/// The grey JPEG atlases of `count` tiles of a view (`tile(texel, i)`: tile `i`'s value
+/// at texel `texel` of the `w x h` view, row-major), `columns` tiles a row, tile `i` at
+/// column `i % columns`, row `i / columns`, for the first `channels` channels; each
+/// tile's range taken inside `alpha`, texels outside taking the code of zero.
+pub fn tile_atlas(
+    tile: impl Fn(usize, usize) -> Rgb,
+    (count, columns): (usize, usize),
+    alpha: &GrayImage,
+    quality: u8,
+    channels: usize,
+) -> Result<Atlas> {
     let (w, h) = alpha.size();
-    let mut lo = [[f32::INFINITY; 3]; SH_COUNT];
-    let mut hi = [[f32::NEG_INFINITY; 3]; SH_COUNT];
-    for (t, &a) in transfer.iter().zip(alpha.pixels()) {
+    let mut lo = vec![[f32::INFINITY; 3]; count];
+    let mut hi = vec![[f32::NEG_INFINITY; 3]; count];
+    for (p, &a) in alpha.pixels().iter().enumerate() {
         if a > 0.0 {
-            for i in 0..SH_COUNT {
+            for i in 0..count {
+                let t = tile(p, i);
                 for c in 0..3 {
-                    lo[i][c] = lo[i][c].min(t[i][c]);
-                    hi[i][c] = hi[i][c].max(t[i][c]);
+                    lo[i][c] = lo[i][c].min(t[c]);
+                    hi[i][c] = hi[i][c].max(t[c]);
                 }
             }
         }
     }
-    let mut scale = [[0.0f32; 3]; SH_COUNT];
-    let mut offset = [[0.0f32; 3]; SH_COUNT];
-    for i in 0..SH_COUNT {
+    let mut scale = vec![[0.0f32; 3]; count];
+    let mut offset = vec![[0.0f32; 3]; count];
+    for i in 0..count {
         for c in 0..3 {
             if lo[i][c] > hi[i][c] {
                 (lo[i][c], hi[i][c]) = (0.0, 0.0);
@@ -66,15 +83,15 @@ pub fn transfer_atlas(
             scale[i][c] = ((hi[i][c] - lo[i][c]) / 255.0).max(f32::MIN_POSITIVE);
         }
     }
-    let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS);
-    let (aw, ah) = (w * ATLAS_COLUMNS, h * rows);
+    let rows = count.div_ceil(columns);
+    let (aw, ah) = (w * columns, h * rows);
     let channel = |c: usize| -> Result<Vec<u8>> {
         let mut pixels = vec![0u8; aw * ah];
-        for i in 0..SH_COUNT {
-            let (tx, ty) = ((i % ATLAS_COLUMNS) * w, (i / ATLAS_COLUMNS) * h);
+        for i in 0..count {
+            let (tx, ty) = ((i % columns) * w, (i / columns) * h);
             for y in 0..h {
                 for x in 0..w {
-                    let code = (transfer[y * w + x][i][c] - offset[i][c]) / scale[i][c];
+                    let code = (tile(y * w + x, i)[c] - offset[i][c]) / scale[i][c];
                     pixels[(ty + y) * aw + tx + x] = code.round().clamp(0.0, 255.0) as u8;
                 }
             }
@@ -82,7 +99,7 @@ pub fn transfer_atlas(
         let mut jpeg = Vec::new();
         JpegEncoder::new_with_quality(&mut jpeg, quality)
             .write_image(&pixels, aw as u32, ah as u32, ExtendedColorType::L8)
-            .map_err(|e| encoding_error("a transfer atlas", e))?;
+            .map_err(|e| encoding_error("an atlas", e))?;
         Ok(jpeg)
     };
     let jpeg = (0..channels.min(3)).map(channel).collect::<Result<_>>()?;

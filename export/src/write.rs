@@ -17,15 +17,15 @@ use rayon::prelude::*;
 use serde_json::{Value, json};
 
 use crate::error::{ExportError, Result};
-use crate::format::{EXTENSION, VERSION};
+use crate::format::{BASIS_COLUMNS, EXTENSION, VERSION};
 use crate::glb::Glb;
 use crate::hull_mesh::hull_mesh;
 use crate::model::{
-    Extension, Grid, GroundShadow, MotionImage, PoseRecord, ScaledImage, TierName, Transfer,
-    ViewRecord, Walk,
+    Basis, BasisImages, Extension, Grid, GroundShadow, MotionImage, PoseRecord, ScaledImage,
+    TierName, Transfer, ViewRecord, Walk,
 };
 use crate::view_maps::{
-    alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png, transfer_atlas,
+    alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png, tile_atlas, transfer_atlas,
 };
 
 /// Which views of each pose are exported.
@@ -115,8 +115,10 @@ pub struct ExportOptions {
     pub views: ViewSelection,
     /// Voxel side of the hull meshes, metres (never finer than the hull's own).
     pub mesh_voxel_m: f32,
-    /// JPEG quality of the transfer atlases.
+    /// JPEG quality of the transfer atlases (and the basis').
     pub jpeg_quality: u8,
+    /// Whether the views' basis images go too (what frf relights a sun by).
+    pub basis: bool,
 }
 
 impl Default for ExportOptions {
@@ -127,6 +129,7 @@ impl Default for ExportOptions {
             views: ViewSelection::All,
             mesh_voxel_m: 0.02,
             jpeg_quality: 95,
+            basis: false,
         }
     }
 }
@@ -142,14 +145,17 @@ pub struct ExportReport {
     pub views: usize,
     /// Triangles of all hull meshes.
     pub triangles: usize,
-    /// Bytes of the transfer atlases, alpha, normals, albedo, flows, meshes, motion and
-    /// ground shadows.
-    pub section_bytes: [(String, u64); 8],
+    /// Bytes of the transfer atlases, alpha, normals, albedo, flows, meshes, motion,
+    /// ground shadows and basis images.
+    pub section_bytes: [(String, u64); SECTIONS],
     /// Wall seconds.
     pub seconds: f64,
     /// What the export lacks that a player may expect (a field without normals).
     pub notes: Vec<String>,
 }
+
+/// The sections of an export's bytes ([`ExportReport::section_bytes`]).
+const SECTIONS: usize = 9;
 
 /// One view's maps, encoded.
 struct ViewOut {
@@ -164,6 +170,7 @@ struct ViewOut {
     albedo: (Vec<u8>, Rgb),
     flows: Vec<(Neighbour, Vec<u8>)>,
     motion: Vec<(PoseStep, Vec<u8>, f32)>,
+    basis: Option<crate::view_maps::Atlas>,
 }
 
 /// Exports `field` to `out` (written to a temporary file and renamed).
@@ -176,7 +183,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let (poses, wanted) = selection(&field, options)?;
     let projector = field.projector()?;
     let mut glb = Glb::default();
-    let mut sizes = [0u64; 8];
+    let mut sizes = [0u64; SECTIONS];
     let mut nodes = vec![json!({"name": "walker", "children": []})];
     let mut meshes = Vec::new();
     let mut pose_records = Vec::new();
@@ -279,7 +286,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     }
     let nodes_of: Vec<usize> = pose_records.iter().map(|p| p.node).collect();
     let animation = pose_animation(&mut glb, &poses, &header, &nodes_of);
-    let extension = extension_of(&field, field_path, options.tier, pose_records)?;
+    let extension = extension_of(&field, field_path, options, pose_records)?;
     let document = json!({
         "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
         "extensionsUsed": [EXTENSION],
@@ -295,6 +302,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
     let names = [
         "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion", "shadow",
+        "basis",
     ];
     let mut notes = Vec::new();
     if sizes[2] == 0 {
@@ -356,7 +364,7 @@ fn motion_to(record: &frf_reflectance::field::PoseRecord) -> BTreeMap<String, u3
 fn extension_of(
     field: &FieldFile,
     field_path: &Path,
-    tier: Tier,
+    options: &ExportOptions,
     poses: Vec<PoseRecord>,
 ) -> Result<Value> {
     let header = field.header();
@@ -370,7 +378,7 @@ fn extension_of(
     });
     let extension = Extension {
         version: VERSION,
-        tier: match tier {
+        tier: match options.tier {
             Tier::Full => TierName::Full,
             Tier::Compact => TierName::Compact,
         },
@@ -389,6 +397,10 @@ fn extension_of(
             .file_name()
             .map(|n| n.to_string_lossy().into_owned()),
         ground_shadow: ground_shadow(field)?,
+        basis: options.basis.then(|| Basis {
+            columns: BASIS_COLUMNS,
+            conditions: header.conditions.clone(),
+        }),
         poses,
     };
     serde_json::to_value(&extension)
@@ -455,7 +467,7 @@ fn selection(field: &FieldFile, options: &ExportOptions) -> Result<Selection> {
 
 /// Adds view `e` of `pose`'s images to `glb` (their bytes counted in `sizes`, by
 /// section) and returns its record in the extension.
-fn add_view(glb: &mut Glb, sizes: &mut [u64; 8], pose: u32, e: ViewOut) -> ViewRecord {
+fn add_view(glb: &mut Glb, sizes: &mut [u64; SECTIONS], pose: u32, e: ViewOut) -> ViewRecord {
     let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
     let before = glb.binary_bytes();
     let rgb = ["red", "green", "blue"];
@@ -506,6 +518,15 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 8], pose: u32, e: ViewOut) -> ViewR
         );
     }
     sizes[6] += (glb.binary_bytes() - before) as u64;
+    let before = glb.binary_bytes();
+    let basis = e.basis.map(|b| BasisImages {
+        images: (b.jpeg.iter().zip(rgb))
+            .map(|(jpeg, c)| glb.image(jpeg, "image/jpeg", name(&format!("basis {c}"))))
+            .collect(),
+        scale: b.scale,
+        offset: b.offset,
+    });
+    sizes[8] += (glb.binary_bytes() - before) as u64;
     ViewRecord {
         u: e.u,
         v: e.v,
@@ -514,8 +535,8 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 8], pose: u32, e: ViewOut) -> ViewR
         alpha,
         transfer: Transfer {
             images: atlas,
-            scale: e.atlas.scale,
-            offset: e.atlas.offset,
+            scale: nine(&e.atlas.scale),
+            offset: nine(&e.atlas.offset),
             colour,
         },
         normals,
@@ -525,7 +546,13 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; 8], pose: u32, e: ViewOut) -> ViewR
         },
         flows,
         motion,
+        basis,
     }
+}
+
+/// A transfer atlas' nine tiles' values (the atlas holds [`SH_COUNT`] by construction).
+fn nine(values: &[Rgb]) -> [Rgb; SH_COUNT] {
+    std::array::from_fn(|i| values[i])
 }
 
 /// A pose step's key in the extension.
@@ -623,6 +650,17 @@ fn encode_view(
         }
     }
     let motion = view_motion(field, pose, (u, v), (w, h))?;
+    // What frf relights a sun by: each condition's image, zero where nothing is seen.
+    let basis = options
+        .basis
+        .then(|| {
+            let tile = |p: usize, k: usize| match alpha.pixels()[p] > 0.0 {
+                true => basis[k].pixels()[p],
+                false => [0.0; 3],
+            };
+            tile_atlas(tile, (basis.len(), BASIS_COLUMNS), &alpha, quality, 3)
+        })
+        .transpose()?;
     Ok(ViewOut {
         u,
         v,
@@ -635,6 +673,7 @@ fn encode_view(
         albedo,
         flows,
         motion,
+        basis,
     })
 }
 

@@ -63,11 +63,16 @@ window.frfRender = async (job) => {
   const started = performance.now();
   const ext = player.load(bytes, job.glbName);
   const sh = parseShLight(job.shText, job.shName, ext.sh);
-  // `AZ,EL[,DIAM[,E]]` as frf's --sun (the disc's diameter does not change the player's
-  // light; E 10 when not given, as in frf).
+  // `AZ,EL[,DIAM[,E]]` as frf's --sun (the disc's diameter matters to a sun relit by the
+  // basis, through its compactness against a condition's cell; E 10 when not given, as in
+  // frf).
   const e = job.sun?.[3] ?? 10;
   const sun = job.sun
-    ? { direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180), illuminance: [e, e, e] }
+    ? {
+      direction: sunDirection(job.sun[0] * Math.PI / 180, job.sun[1] * Math.PI / 180),
+      illuminance: [e, e, e],
+      diameter_deg: job.sun[2] ?? 0.53,
+    }
     : undefined;
   player.setLight(sh, sun);
   // A pose's own instant, or an instant of the walk between poses.

@@ -20,6 +20,7 @@ import {
   GROUND_SHADOW_LAYER_FRAGMENT,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
+import { conditionTable, conditionTexture, sunViews, INVOLVED, MAX_CONDITIONS, NEAREST } from './sun.js';
 import { subjectBounds, flowReachM, pixelBox, unionBox } from './footprint.js';
 
 /** The sun's map of the hull, texels a side. */
@@ -108,6 +109,14 @@ export class FrfPlayer {
         uViewHull: { value: null }, uViewCentre: { value: new THREE.Vector3() }, uViewAxes: { value: new THREE.Matrix3() },
         uViewK: { value: new THREE.Vector4() }, uSunMap: { value: null }, uSunAxisX: { value: new THREE.Vector3() },
         uSunAxisY: { value: new THREE.Vector3() }, uSunBox: { value: new THREE.Vector4() }, uSunOffset: { value: -1 },
+        uBasisSun: { value: 0 }, uBasis: { value: null }, uConditions: { value: null }, uBasisColumns: { value: 1 },
+        uConditionCount: { value: 0 }, uLightsPer: { value: 0 },
+        uBasisScale: { value: Array.from({ length: MAX_CONDITIONS }, () => new THREE.Vector3()) },
+        uBasisOffset: { value: Array.from({ length: MAX_CONDITIONS }, () => new THREE.Vector3()) },
+        uDomeFromSubject: { value: new THREE.Matrix3() }, uSunDome: { value: new THREE.Vector3() },
+        uInvolved: { value: new Array(INVOLVED).fill(0) }, uInvolvedCount: { value: 0 }, uNearestCount: { value: 0 },
+        uNearestW: { value: [0, 0] }, uHeldPlace: { value: [0, 0, 0, 0] }, uHeldW: { value: [0, 0, 0, 0] },
+        uCompactness: { value: 0 }, uRegion: { value: 0 },
       },
       depthTest: false, depthWrite: false,
     });
@@ -210,7 +219,9 @@ export class FrfPlayer {
     if (!(d.length() > 0) || !Number.isFinite(d.length())) throw new Error('a sun\'s direction is a non-zero vector');
     d.normalize();
     this.sh = sh.map((c) => [...c]);
-    this.sun = { direction: d.toArray(), illuminance: [...e] };
+    const diameter = sun.diameter_deg ?? 0.53;
+    if (!(diameter > 0 && diameter <= 180)) throw new Error('a sun\'s angular diameter is above 0 and at most 180 degrees');
+    this.sun = { direction: d.toArray(), illuminance: [...e], diameter_deg: diameter };
     if (d.y <= 0 && e.some((v) => v > 0)) {
       const basis = new Array(9);
       THREE.SphericalHarmonics3.getBasisAt(d, basis);
@@ -232,6 +243,7 @@ export class FrfPlayer {
       this.poses.set(number, pose);
     }
     if (pose.lightVersion !== this.lightVersion) {
+      if (this.#basisSun() && !pose.basis) pose.basis = await this.#basisTiles(pose.record);
       const t0 = performance.now();
       this.#relight(pose);
       pose.relightMs = performance.now() - t0;
@@ -351,6 +363,7 @@ export class FrfPlayer {
         this.groundShadow?.maps.dispose();
         this.groundShadow?.relit.dispose();
         this.ranges?.dispose();
+        this.basis?.dispose();
         this.prelit.dispose();
         this.viewHull.dispose();
         this.hull.mesh.geometry.dispose();
@@ -494,6 +507,63 @@ export class FrfPlayer {
     return { mesh: m, scene };
   }
 
+  /** Whether the sun is relit as frf relights it: a sun, and the export's basis images. */
+  #basisSun() {
+    return Boolean(this.ext.basis) && this.sun.illuminance.some((e) => e > 0);
+  }
+
+  /** A pose's basis images decoded into one R8 array texture (layer 3 * view + channel). */
+  async #basisTiles(record) {
+    const { width: w, height: h } = this.grid;
+    const { columns, conditions } = this.ext.basis;
+    const [aw, ah] = [columns * w, Math.ceil(conditions.length / columns) * h];
+    const n = record.views.length;
+    const data = new Uint8Array(aw * ah * 3 * n);
+    await Promise.all(record.views.flatMap((v, i) => [0, 1, 2].map(async (c) => {
+      const what = `pose ${record.pose} view ${v.u},${v.v} basis`;
+      if (!v.basis || v.basis.images.length !== 3) throw new BadFile(this.glb.name, `${what}: the export's basis names ${conditions.length} conditions, and this view holds no three basis atlases`);
+      const img = await greyJpeg(this.glb, v.basis.images[c], what);
+      expect(this.glb, img, aw, ah, null, `${what} atlas`);
+      data.set(img.data, (3 * i + c) * aw * ah);
+    })));
+    return arrayTexture(data, aw, ah, 3 * n, THREE.RedFormat, THREE.UnsignedByteType);
+  }
+
+  /** Sets the pre-lit pass' sun-by-the-basis uniforms for the light, and returns the views' suns. */
+  #basisSunUniforms(pose, u) {
+    u.uBasisSun.value = this.#basisSun() ? 1 : 0;
+    if (!u.uBasisSun.value) return null;
+    const { columns, conditions } = this.ext.basis;
+    this.conditionTable ??= conditionTable(conditions);
+    this.conditionTexture?.texture.dispose();
+    this.conditionTexture = conditionTexture(this.conditionTable, this.sun.illuminance);
+    u.uBasis.value = pose.basis;
+    u.uConditions.value = this.conditionTexture.texture;
+    u.uBasisColumns.value = columns;
+    u.uConditionCount.value = conditions.length;
+    u.uLightsPer.value = this.conditionTexture.lights;
+    const radius = (this.sun.diameter_deg * Math.PI) / 360;
+    return sunViews(this.conditionTable, this.sun.direction, radius, pose.record.views.map((v) => v.turntable_deg));
+  }
+
+  /** Sets view `v`'s sun (of `#basisSunUniforms`) in the pre-lit pass' uniforms. */
+  static #viewSun(u, v, sun) {
+    v.basis.scale.forEach((c, k) => u.uBasisScale.value[k].set(...c));
+    v.basis.offset.forEach((c, k) => u.uBasisOffset.value[k].set(...c));
+    const t = (v.turntable_deg * Math.PI) / 180;
+    const [c, s] = [Math.cos(t), Math.sin(t)];
+    u.uDomeFromSubject.value.set(c, 0, s, 0, 1, 0, -s, 0, c);
+    u.uSunDome.value.set(...sun.direction);
+    u.uInvolved.value = Array.from({ length: INVOLVED }, (_, j) => sun.involved[j] ?? 0);
+    u.uInvolvedCount.value = sun.involved.length;
+    u.uNearestCount.value = sun.nearest.length;
+    u.uNearestW.value = Array.from({ length: NEAREST }, (_, j) => sun.nearest[j]?.[1] ?? 0);
+    u.uHeldPlace.value = Array.from({ length: 2 * NEAREST }, (_, j) => sun.heldAt[j >> 1]?.[j & 1]?.[0] ?? 0);
+    u.uHeldW.value = Array.from({ length: 2 * NEAREST }, (_, j) => sun.heldAt[j >> 1]?.[j & 1]?.[1] ?? 0);
+    u.uCompactness.value = sun.compactness;
+    u.uRegion.value = sun.region;
+  }
+
   #relight(pose) {
     const u = this.prelitMaterial.uniforms;
     const compact = this.ext.tier === 'compact';
@@ -510,8 +580,10 @@ export class FrfPlayer {
     u.uSunOffset.value = shadows ? pose.shadowOffset : -1;
     if (shadows) this.#sunMap(pose, u);
     if (pose.groundShadow) this.#relightGroundShadow(pose);
+    const suns = this.#basisSunUniforms(pose, u);
     const saved = this.renderer.getRenderTarget();
     pose.record.views.forEach((v, i) => {
+      if (suns) FrfPlayer.#viewSun(u, v, suns[i]);
       const camera = pose.geometry.cameras[v.u * this.grid.rows + v.v];
       const [r, d, f] = camera.axes;
       u.uViewCentre.value.set(...camera.centre);

@@ -45,6 +45,31 @@ uniform vec3 uSunAxisX;
 uniform vec3 uSunAxisY;
 uniform vec4 uSunBox;             // lo x, lo y, hi x, hi y along the axes
 uniform float uSunOffset;         // metres; < 0: no shadows
+// The sun relit as frf relights it (uBasisSun 1: the export holds the basis images;
+// player/src/sun.js makes these, sun_light.rs derives them): the basis' tiles (R8, layer
+// 3 * view + channel, uBasisColumns tiles a row, value offset + scale * code), the
+// conditions' table (column k: row 0 its cone, row 1 the sun's light per unit of its,
+// rows 2.. its lights), and the view's sun: its direction in the view's dome, the
+// conditions the trust reads (the nearest first), each nearest's held-out predictors
+// (places among them), how compact the sun is, and the condition whose region holds it.
+uniform int uBasisSun;
+uniform sampler2DArray uBasis;
+uniform highp sampler2D uConditions;
+uniform int uBasisColumns;
+uniform int uConditionCount;
+uniform int uLightsPer;
+uniform vec3 uBasisScale[32];
+uniform vec3 uBasisOffset[32];
+uniform mat3 uDomeFromSubject;
+uniform vec3 uSunDome;
+uniform int uInvolved[6];
+uniform int uInvolvedCount;
+uniform int uNearestCount;
+uniform float uNearestW[2];
+uniform int uHeldPlace[4];
+uniform float uHeldW[4];
+uniform float uCompactness;
+uniform int uRegion;
 out vec4 outColor;
 
 bool sunlit(ivec2 p) {
@@ -60,6 +85,103 @@ bool sunlit(ivec2 p) {
   float reach = texelFetch(uSunMap, ivec2(m), 0).r;
   if (reach == 0.0) return true;
   return !(reach - 100.0 > dot(uSunDir, q));
+}
+
+// Condition k's image at texel p, per unit of its light, times the sun's light
+// (SunLight::sunned).
+vec3 sunned(ivec2 p, ivec2 size, int k) {
+  ivec2 a = p + ivec2((k % uBasisColumns) * size.x, (k / uBasisColumns) * size.y);
+  vec3 code = vec3(texelFetch(uBasis, ivec3(a, 3 * uLayer), 0).r,
+                   texelFetch(uBasis, ivec3(a, 3 * uLayer + 1), 0).r,
+                   texelFetch(uBasis, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
+  return (uBasisOffset[k] + uBasisScale[k] * code) * texelFetch(uConditions, ivec2(k, 1), 0).rgb;
+}
+
+// Condition k's shading of a unit normal n (dome frame), per unit of its light: n . m
+// where n sees all its lights, 0 where none, its lights one by one between (cone_shading).
+float shading(int k, vec3 n) {
+  vec4 cone = texelFetch(uConditions, ivec2(k, 0), 0);
+  float d = dot(n, cone.xyz);
+  if (d >= cone.w) return d;
+  if (d <= -cone.w) return 0.0;
+  float s = 0.0;
+  for (int j = 0; j < uLightsPer; j++) {
+    vec4 l = texelFetch(uConditions, ivec2(k, 2 + j), 0);
+    s += l.w * max(dot(n, l.xyz), 0.0);
+  }
+  return s;
+}
+
+float lum(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+// The sun at texel p as frf relights it (suns_texel of one sun): the basis' sun (the
+// image of the condition whose region holds it), moved toward the normals' (the nearest
+// conditions' images times the ratio of the normal's shading under the sun to theirs,
+// where the hull does not hide the sun) by the trust: the sun's compactness times a
+// smooth step down as the texel's leave-one-out error goes from 2 to 5 (TRUST_ERROR).
+vec3 basisSun(ivec2 p, ivec2 size, bool hasNormal, vec3 n) {
+  vec3 basis = sunned(p, size, uRegion);
+  if (!hasNormal || uCompactness <= 0.0) return basis;
+  float lums[6];
+  float shades[6];
+  vec3 photos[6];
+  for (int j = 0; j < 6; j++) {
+    if (j >= uInvolvedCount) break;
+    photos[j] = sunned(p, size, uInvolved[j]);
+    lums[j] = lum(photos[j]);
+    shades[j] = shading(uInvolved[j], n);
+  }
+  float error = 0.0;
+  float plain = 0.0;
+  for (int j = 0; j < 2; j++) {
+    if (j >= uNearestCount) break;
+    float shaded = 0.0;
+    float interpolated = 0.0;
+    for (int m = 0; m < 2; m++) {
+      float w = uHeldW[2 * j + m];
+      if (w == 0.0) continue;
+      shaded += w * shades[uHeldPlace[2 * j + m]];
+      interpolated += w * lums[uHeldPlace[2 * j + m]];
+    }
+    float wanted = shades[j];
+    float predicted = wanted <= 0.0 ? 0.0
+      : (shaded >= 0.3 * wanted ? interpolated * wanted / shaded : interpolated);
+    error += uNearestW[j] * abs(predicted - lums[j]);
+    plain += uNearestW[j] * abs(interpolated - lums[j]);
+  }
+  float e = plain > 0.0 ? error / plain : (error > 0.0 ? 1e30 : 0.0);
+  float t = uCompactness * (1.0 - smoothstep(2.0, 5.0, e));
+  if (t <= 0.0) return basis;
+  // relight_texel: the nearest images by the ratio of shadings, or, where they barely
+  // reach the normal, the fit's shading scaled by every image's ratio to it.
+  float wanted = max(dot(n, uSunDome), 0.0);
+  vec3 s = vec3(0.0);
+  if (wanted > 0.0) {
+    vec3 interpolated = vec3(0.0);
+    float shaded = 0.0;
+    for (int j = 0; j < 2; j++) {
+      if (j >= uNearestCount) break;
+      interpolated += uNearestW[j] * photos[j];
+      shaded += uNearestW[j] * shades[j];
+    }
+    if (shaded >= 0.3 * wanted) {
+      s = interpolated * wanted / shaded;
+    } else {
+      vec3 num = vec3(0.0);
+      float den = 0.0;
+      for (int k = 0; k < 32; k++) {
+        if (k >= uConditionCount) break;
+        float m = shading(k, n);
+        if (m > 0.0) {
+          num += sunned(p, size, k) * m;
+          den += m * m;
+        }
+      }
+      if (den > 0.0) s = wanted * num / den;
+    }
+  }
+  vec3 lit = (any(notEqual(s, vec3(0.0))) && sunlit(p)) ? s : vec3(0.0);
+  return basis + t * (lit - basis);
 }
 
 void main() {
@@ -85,7 +207,10 @@ void main() {
       }
       rgb += uSh[i] * t;
     }
-    if (uHasNormals == 1 && any(greaterThan(uSunE, vec3(0.0)))) {
+    if (uBasisSun == 1) {
+      vec4 n = uHasNormals == 1 ? texelFetch(uNormals, ivec3(p, uLayer), 0) : vec4(0.0);
+      rgb += basisSun(p, size, n.a > 0.0, normalize(uDomeFromSubject * (n.rgb * 2.0 - 1.0)));
+    } else if (uHasNormals == 1 && any(greaterThan(uSunE, vec3(0.0)))) {
       vec4 n = texelFetch(uNormals, ivec3(p, uLayer), 0);
       if (n.a > 0.0 && sunlit(p)) {
         vec3 albedo = texelFetch(uAlbedo, ivec3(p, 2 * uLayer), 0).rgb * 255.0 * uAlbedoScale;

@@ -35,9 +35,14 @@ pub struct ExportArgs {
     /// grey coefficients and a colour: a third of the transfer's bytes).
     #[arg(long, default_value = "full", value_parser = <Tier as std::str::FromStr>::from_str, conflicts_with = "sprites")]
     tier: Tier,
-    /// JPEG quality of the SH transfer atlases.
+    /// JPEG quality of the SH transfer atlases (and the basis').
     #[arg(long, default_value_t = 95, conflicts_with = "sprites")]
     jpeg_quality: u8,
+    /// Also write each view's basis images (one per lighting condition, about three
+    /// times the transfer's bytes): what a player relights a sun by as frf does, with
+    /// frf's trust, instead of the albedo and normal alone.
+    #[arg(long, conflicts_with = "sprites")]
+    basis: bool,
     /// Also print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -108,6 +113,7 @@ pub fn run(args: ExportArgs) -> CliResult {
         views: args.views,
         mesh_voxel_m: args.mesh_voxel,
         jpeg_quality: args.jpeg_quality,
+        basis: args.basis,
     };
     let report = frf_export::export(&args.field, &args.out, &options)?;
     let field_bytes = std::fs::metadata(&args.field).map(|m| m.len()).unwrap_or(0);
