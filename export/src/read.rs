@@ -107,21 +107,7 @@ impl Export {
                 "view {u},{v} has {images} transfer atlases, expected 3 or 1"
             )));
         }
-        let atlas = (t.images.iter().enumerate())
-            .map(|(c, &index)| {
-                image::load_from_memory(self.image_bytes(index)?)
-                    .map(|i| i.to_luma8())
-                    .map_err(|e| self.bad(format!("the transfer atlas {c} of view {u},{v}: {e}")))
-            })
-            .collect::<Result<Vec<_>>>()?;
-        if atlas
-            .iter()
-            .any(|a| a.dimensions() != atlas[0].dimensions())
-        {
-            return Err(self.bad(format!(
-                "the transfer atlases of view {u},{v} differ in size"
-            )));
-        }
+        let atlas = self.grey_atlases(&t.images, &format!("transfer atlas of view {u},{v}"))?;
         // The compact tier: one grey atlas and a colour per texel.
         let colour = match (&t.colour, images) {
             (Some(c), 1) => {
@@ -158,6 +144,57 @@ impl Export {
                 }
             })
         }))
+    }
+
+    /// Grey atlases `images` decoded, checked to be of one size (`what` names them).
+    fn grey_atlases(&self, images: &[usize], what: &str) -> Result<Vec<image::GrayImage>> {
+        let atlas = (images.iter().enumerate())
+            .map(|(c, &index)| {
+                image::load_from_memory(self.image_bytes(index)?)
+                    .map(|i| i.to_luma8())
+                    .map_err(|e| self.bad(format!("the {what} {c}: {e}")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        if atlas
+            .iter()
+            .any(|a| a.dimensions() != atlas[0].dimensions())
+        {
+            return Err(self.bad(format!("the {what}es differ in size")));
+        }
+        Ok(atlas)
+    }
+
+    /// A view's basis images (`frf export --basis`), decoded: one RGB image per condition.
+    pub fn basis(&self, pose: u32, u: usize, v: usize) -> Result<Vec<RgbImage>> {
+        let view = self.view(pose, u, v)?;
+        let (Some(basis), Some(b)) = (&self.extension.basis, &view.basis) else {
+            return Err(self.bad(format!(
+                "view {u},{v} of pose {pose} holds no basis images (export with --basis)"
+            )));
+        };
+        let count = basis.conditions.len();
+        if b.images.len() != 3 || b.scale.len() != count || b.offset.len() != count {
+            return Err(self.bad(format!(
+                "view {u},{v}'s basis: {} atlases and {} scales for {count} conditions, expected 3 and {count}",
+                b.images.len(),
+                b.scale.len()
+            )));
+        }
+        let columns = basis.columns.max(1);
+        let atlas = self.grey_atlases(&b.images, &format!("basis atlas of view {u},{v}"))?;
+        let rows = count.div_ceil(columns) as u32;
+        let (w, h) = (atlas[0].width() / columns as u32, atlas[0].height() / rows);
+        Ok((0..count)
+            .map(|k| {
+                let (tx, ty) = ((k % columns) as u32 * w, (k / columns) as u32 * h);
+                Image::from_fn(w as usize, h as usize, |x, y| {
+                    std::array::from_fn(|c| {
+                        let code = atlas[c].get_pixel(tx + x as u32, ty + y as u32)[0] as f32;
+                        b.offset[k][c] + b.scale[k][c] * code
+                    })
+                })
+            })
+            .collect())
     }
 
     /// A view's alpha.

@@ -301,8 +301,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
     let names = [
-        "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion", "shadow",
-        "basis",
+        "transfer", "alpha", "normals", "albedo", "flows", "meshes", "motion", "shadow", "basis",
     ];
     let mut notes = Vec::new();
     if sizes[2] == 0 {

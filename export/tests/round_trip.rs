@@ -423,3 +423,66 @@ fn motion_and_ground_shadows_are_the_fields_within_a_code() {
     }
     assert!(shaded > 10, "{shaded} texels shaded");
 }
+
+/// `--basis`: each view's basis images come back as the field holds them (every condition,
+/// inside the matte, within the JPEG's error: above 40 dB of the condition's peak), with
+/// the field's conditions; without it, a view holds none and reading them is refused.
+#[test]
+fn basis_images_are_the_fields_within_the_jpegs_error() {
+    let f = frf_testkit::tiny_field();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let views = ViewSelection::List(vec![(3, 1)]);
+    let options = ExportOptions {
+        views: views.clone(),
+        basis: true,
+        ..ExportOptions::default()
+    };
+    let report = export(&f.field, &out, &options).unwrap();
+    let basis_bytes = report.section_bytes[8].1;
+    let transfer_bytes = report.section_bytes[0].1;
+    assert!(
+        basis_bytes > transfer_bytes,
+        "{basis_bytes} vs {transfer_bytes}"
+    );
+    let glb = Export::open(&out).unwrap();
+    let field = FieldFile::open(&f.field).unwrap();
+    assert_eq!(
+        glb.field().basis.as_ref().unwrap().conditions,
+        field.header().conditions
+    );
+    let (got, want) = (glb.basis(0, 3, 1).unwrap(), field.basis(0, 3, 1).unwrap());
+    let alpha = glb.alpha(0, 3, 1).unwrap();
+    assert_eq!(got.len(), want.len());
+    for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+        let (mut se, mut n, mut peak) = (0.0f64, 0usize, 0.0f32);
+        for ((g, w), &a) in g.pixels().iter().zip(w.pixels()).zip(alpha.pixels()) {
+            if a > 0.5 {
+                for c in 0..3 {
+                    se += ((g[c] - w[c]) as f64).powi(2);
+                    peak = peak.max(w[c]);
+                }
+                n += 3;
+            }
+        }
+        let psnr = 10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10();
+        assert!(
+            n > 300 && psnr > 40.0,
+            "condition {k}: {psnr:.2} dB over {n}"
+        );
+    }
+    // Without --basis: none, and asking for them is refused by name.
+    let plain = dir.path().join("plain.glb");
+    let options = ExportOptions {
+        views,
+        ..ExportOptions::default()
+    };
+    export(&f.field, &plain, &options).unwrap();
+    let glb = Export::open(&plain).unwrap();
+    assert!(glb.field().basis.is_none());
+    let e = glb.basis(0, 3, 1).unwrap_err().to_string();
+    assert!(
+        e.contains("plain.glb") && e.contains("no basis images"),
+        "{e}"
+    );
+}

@@ -193,9 +193,32 @@ export class FrfPlayer {
         this.notes.push(`pose ${p.pose}: ${whole} of the grid's ${quads} quads hold their four views: the walker is drawn ${whole === 0 ? 'nowhere' : 'only'} where a camera's rays pass through ${whole === 0 ? 'one' : 'those'} (export every view for all of it)`);
       }
     }
+    this.#checkBasis(name);
     for (const p of this.poses.values()) p.dispose();
     this.poses.clear();
+    this.conditionTable = null;
     return this.ext;
+  }
+
+  /** Refuses, by name, basis images the pre-lit pass cannot read as the extension says. */
+  #checkBasis(name) {
+    const basis = this.ext.basis;
+    if (basis === null || basis === undefined) return;
+    const count = basis.conditions?.length;
+    if (!(count >= 2 && count <= MAX_CONDITIONS)) throw new BadFile(name, `basis: ${count} conditions, this player takes 2 to ${MAX_CONDITIONS}`);
+    if (!(Number.isInteger(basis.columns) && basis.columns >= 1)) throw new BadFile(name, `basis: columns ${basis.columns} is not a positive integer`);
+    for (const [k, c] of basis.conditions.entries()) {
+      const ok = Array.isArray(c.lights) && c.lights.length > 0 && c.lights.every((l) => [l.direction, l.intensity].every((v) => Array.isArray(v) && v.length === 3 && v.every(Number.isFinite)));
+      if (!ok) throw new BadFile(name, `basis condition ${k} (${c.name}): its lights are not directions and intensities of three numbers`);
+    }
+    for (const p of this.ext.poses) {
+      for (const v of p.views) {
+        const b = v.basis;
+        if (!b || b.scale?.length !== count || b.offset?.length !== count || b.images?.length !== 3) {
+          throw new BadFile(name, `pose ${p.pose} view ${v.u},${v.v}: its basis holds no three atlases and ${count} scales and offsets, as the export's ${count} conditions ask`);
+        }
+      }
+    }
   }
 
   /** The pose numbers the export holds, in order. */

@@ -14,6 +14,7 @@ mod outputs;
 mod player;
 mod player_motion;
 mod player_scene;
+mod player_sun;
 mod render;
 mod report;
 mod resume;

@@ -29,7 +29,7 @@ pub(crate) struct Shot {
 
 /// The camera blended bilinearly from pose 0's grid cameras at fractional `(u, v)`:
 /// a captured view at integers, a quad's centre at halves.
-fn grid_camera(document: &Value, u: f32, v: f32) -> Shot {
+pub(crate) fn grid_camera(document: &Value, u: f32, v: f32) -> Shot {
     grid_camera_of(document, 0, u, v)
 }
 
@@ -74,7 +74,7 @@ pub(crate) fn list(v: [f32; 3]) -> String {
 }
 
 /// `node player/screenshot.mjs` of `shot`, pose 0.
-fn screenshot(
+pub(crate) fn screenshot(
     glb: &Path,
     sh: &Path,
     shot: &Shot,
@@ -118,7 +118,7 @@ fn screenshot_pose(
 }
 
 /// `frf render` of `shot` (one frame, no ground shadow), its PNG's path.
-fn frf_frame(
+pub(crate) fn frf_frame(
     field: &Path,
     sh: &Path,
     shot: &Shot,
@@ -333,7 +333,7 @@ pub(crate) fn staged_field(dir: &Path, poses: &str, extra: &[&str]) -> PathBuf {
 
 /// The GLB `bytes` with its JSON chunk changed by `edit`, packed again as the exporter
 /// packs it.
-fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
+pub(crate) fn with_json(bytes: &[u8], edit: impl FnOnce(&mut Value)) -> Vec<u8> {
     let (mut doc, bin) = frf_export::glb::unpack(bytes).unwrap();
     edit(&mut doc);
     frf_export::glb::pack(&doc, bin)
