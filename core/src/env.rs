@@ -74,7 +74,14 @@ impl EnvMap {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("json"))
         {
-            return Self::from_sh(&crate::sh::ShLight::load(path)?, SH_MAP_HEIGHT);
+            // Its suns (`frf env-sh --suns`) painted into the L2 light's map.
+            let (sh, suns) = crate::sh::ShLight::load_with_suns(path)?;
+            let mut map = Self::from_sh(&sh, SH_MAP_HEIGHT)?;
+            for s in suns {
+                let radius = 0.5 * s.diameter_deg.to_radians();
+                map = map.with_disc(Vec3::from(s.direction).normalize(), radius, s.illuminance)?;
+            }
+            return Ok(map);
         }
         let img = crate::io::read_hdr_rgb(path)?;
         let most_negative =
@@ -162,6 +169,41 @@ impl EnvMap {
             yaw: 0.0,
             clamped_texels: 0,
         })
+    }
+
+    /// The map with a distant disc of light added (a sun: unit `direction` toward it,
+    /// angular `radius` in radians, `∫ L dω` over it `illuminance`): its illuminance spread
+    /// over the texels whose centres the disc covers (the nearest texel when it covers
+    /// none), so that the map's `∫ L dω` grows by exactly the disc's.
+    pub fn with_disc(&self, direction: Vec3, radius: f32, illuminance: Rgb) -> Result<Self> {
+        let (w, h) = self.image().size();
+        let at = self.texel_of(direction);
+        let row = (at.y.round().max(0.0) as usize).min(h - 1);
+        // Rows within the disc's radius of its centre, and a texel's margin.
+        let reach = (radius / (PI / h as f32)).ceil() as usize + 1;
+        let cos_r = radius.cos();
+        let mut covered: Vec<(usize, usize)> = Vec::new();
+        for y in row.saturating_sub(reach)..(row + reach + 1).min(h) {
+            for x in 0..w {
+                if self.direction_of(x as f32, y as f32).dot(direction) >= cos_r {
+                    covered.push((x, y));
+                }
+            }
+        }
+        if covered.is_empty() {
+            covered.push(((at.x.round() as i64).rem_euclid(w as i64) as usize, row));
+        }
+        let omega: f32 = covered
+            .iter()
+            .map(|&(_, y)| self.texel_solid_angle(y))
+            .sum();
+        let add = illuminance.map(|e| e / omega);
+        let mut radiance = self.image().clone();
+        for (x, y) in covered {
+            let p = radiance.get(x, y);
+            radiance.set(x, y, [p[0] + add[0], p[1] + add[1], p[2] + add[2]]);
+        }
+        Ok(EnvMap::from_image(radiance)?.rotated(self.yaw()))
     }
 
     /// The projection of the map (its yaw included) onto the L2 basis ([`crate::sh`]):

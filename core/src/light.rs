@@ -6,6 +6,9 @@ use glam::Vec3;
 
 use crate::image::Rgb;
 
+/// The widest sun taken, degrees: wider is an area light, not a sun.
+pub const MAX_SUN_DIAMETER_DEG: f32 = 20.0;
+
 /// The largest total light (`∫ L dω`, any channel) a loaded map or light may carry: far
 /// above any real scene (the sun's is about 1e5 in units of sky radiance), far below
 /// f32's 3.4e38, so that relit sums and exposures stay finite.

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::image::Rgb;
-use crate::light::MAX_TOTAL_LIGHT;
+use crate::light::{MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT};
 
 /// Coefficients per channel of an L2 light.
 pub const SH_COUNT: usize = 9;
@@ -165,6 +165,22 @@ struct ShFile {
     coefficients: Vec<[f32; 3]>,
     #[serde(default, skip_serializing_if = "String::is_empty")]
     source: String,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    suns: Vec<ShSun>,
+}
+
+/// A sun a light file carries beside its L2 coefficients (`frf env-sh --suns`: the suns
+/// found in a map, the coefficients those of the map less them): a distant disc that
+/// frf paints into the light's map ([`crate::env::EnvMap::load`]) and a player relights
+/// sharply, as frf relights a map's suns.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ShSun {
+    /// Toward the sun, unit, the light's frame.
+    pub direction: [f32; 3],
+    /// Angular diameter, degrees (above 0, at most [`MAX_SUN_DIAMETER_DEG`]).
+    pub diameter_deg: f32,
+    /// `∫ L dω` over the disc, per channel.
+    pub illuminance: Rgb,
 }
 
 impl ShLight {
@@ -278,12 +294,18 @@ impl ShLight {
 
     /// Writes the light as JSON (temporary file, then renamed), naming `source`.
     pub fn save(&self, path: &Path, source: &str) -> Result<()> {
+        self.save_with_suns(path, source, &[])
+    }
+
+    /// [`ShLight::save`] with `suns` beside the coefficients.
+    pub fn save_with_suns(&self, path: &Path, source: &str, suns: &[ShSun]) -> Result<()> {
         let file = ShFile {
             format: SH_FORMAT.into(),
             version: SH_VERSION,
             convention: Convention::frf(),
             coefficients: self.coefficients.to_vec(),
             source: source.into(),
+            suns: suns.to_vec(),
         };
         let text = serde_json::to_string_pretty(&file)
             .map_err(|e| CoreError::bad_file(path, e.to_string()))?;
@@ -294,6 +316,13 @@ impl ShLight {
     /// another format, version or convention, a count other than 9, non-finite values
     /// and a total light beyond [`MAX_TOTAL_LIGHT`].
     pub fn load(path: &Path) -> Result<Self> {
+        Ok(Self::load_with_suns(path)?.0)
+    }
+
+    /// [`ShLight::load`] and the suns the file carries, each checked: a direction (finite,
+    /// not zero), a diameter above 0 and at most [`MAX_SUN_DIAMETER_DEG`], an illuminance
+    /// finite, not negative and at most [`MAX_TOTAL_LIGHT`].
+    pub fn load_with_suns(path: &Path) -> Result<(Self, Vec<ShSun>)> {
         let bytes = std::fs::read(path).map_err(|e| CoreError::io(path, e))?;
         // A byte-order mark some editors write is not JSON: read past it.
         let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
@@ -346,7 +375,29 @@ impl ShLight {
                 total.iter().fold(0.0f64, |a, &b| a.max(b))
             ));
         }
-        Ok(Self { coefficients })
+        for (k, sun) in file.suns.iter().enumerate() {
+            let d = Vec3::from(sun.direction);
+            if !d.is_finite() || d.abs().max_element() <= 0.0 {
+                return bad(format!(
+                    "sun {k}'s direction {:?} is not a direction",
+                    sun.direction
+                ));
+            }
+            if !(sun.diameter_deg > 0.0 && sun.diameter_deg <= MAX_SUN_DIAMETER_DEG) {
+                return bad(format!(
+                    "sun {k}'s diameter {}° is not within (0, {MAX_SUN_DIAMETER_DEG}]°",
+                    sun.diameter_deg
+                ));
+            }
+            let light = |c: &f32| c.is_finite() && *c >= 0.0 && f64::from(*c) <= MAX_TOTAL_LIGHT;
+            if !sun.illuminance.iter().all(light) {
+                return bad(format!(
+                    "sun {k}'s illuminance {:?} is not a finite, non-negative light",
+                    sun.illuminance
+                ));
+            }
+        }
+        Ok((Self { coefficients }, file.suns))
     }
 }
 

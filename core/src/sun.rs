@@ -13,7 +13,7 @@ use crate::error::{CoreError, Result};
 use crate::image::Rgb;
 
 /// The widest sun taken, degrees: wider is an area light, not a sun.
-pub const MAX_DIAMETER_DEG: f32 = 20.0;
+pub const MAX_DIAMETER_DEG: f32 = crate::light::MAX_SUN_DIAMETER_DEG;
 
 /// A map's brightest texel is a sun when it is this many times the map's mean radiance
 /// ([`Sun::extract`]).
@@ -105,31 +105,7 @@ impl Sun {
     /// the disc covers (the nearest texel when it covers none), so that the map's
     /// `∫ L dω` grows by exactly the sun's.
     pub fn lit(&self, env: &EnvMap) -> Result<EnvMap> {
-        let (w, h) = env.image().size();
-        let at = env.texel_of(self.direction);
-        let row = (at.y.round().max(0.0) as usize).min(h - 1);
-        // Rows within the disc's radius of its centre, and a texel's margin.
-        let reach = (self.radius() / (std::f32::consts::PI / h as f32)).ceil() as usize + 1;
-        let cos_r = self.radius().cos();
-        let mut covered: Vec<(usize, usize)> = Vec::new();
-        for y in row.saturating_sub(reach)..(row + reach + 1).min(h) {
-            for x in 0..w {
-                if env.direction_of(x as f32, y as f32).dot(self.direction) >= cos_r {
-                    covered.push((x, y));
-                }
-            }
-        }
-        if covered.is_empty() {
-            covered.push(((at.x.round() as i64).rem_euclid(w as i64) as usize, row));
-        }
-        let omega: f32 = covered.iter().map(|&(_, y)| env.texel_solid_angle(y)).sum();
-        let add = self.illuminance.map(|e| e / omega);
-        let mut radiance = env.image().clone();
-        for (x, y) in covered {
-            let p = radiance.get(x, y);
-            radiance.set(x, y, [p[0] + add[0], p[1] + add[1], p[2] + add[2]]);
-        }
-        Ok(EnvMap::from_image(radiance)?.rotated(env.yaw()))
+        env.with_disc(self.direction, self.radius(), self.illuminance)
     }
 
     /// The sun baked into `env`, and `env` without it: the texels around the brightest

@@ -353,3 +353,64 @@ fn a_light_in_an_engines_frame_is_the_same_light() {
         "the light left unmirrored shades Unity's normals alike"
     );
 }
+
+/// A light file's suns (`frf env-sh --suns`) come back as written, a bad one is refused
+/// by name, and frf paints them into the light's map: its `∫ L dω` grows by their
+/// illuminance, and [`frf_core::sun::Sun::extract`] finds the brightest where it was put.
+#[test]
+fn a_light_files_suns_round_trip_and_are_painted_into_its_map() {
+    use frf_core::sh::ShSun;
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("light.json");
+    let l = light();
+    let suns = [
+        ShSun {
+            direction: [0.5, 0.6, 0.2],
+            diameter_deg: 0.53,
+            illuminance: [9.0, 8.0, 7.0],
+        },
+        ShSun {
+            direction: [-0.3, 0.2, -0.9],
+            diameter_deg: 3.0,
+            illuminance: [1.0, 1.0, 1.0],
+        },
+    ];
+    l.save_with_suns(&path, "test", &suns).unwrap();
+    let (back, back_suns) = ShLight::load_with_suns(&path).unwrap();
+    assert_eq!((back, back_suns.as_slice()), (l.clone(), &suns[..]));
+    let with = frf_core::env::EnvMap::load(&path).unwrap().total_light();
+    l.save(&path, "test").unwrap();
+    let without = frf_core::env::EnvMap::load(&path).unwrap().total_light();
+    for c in 0..3 {
+        let added = with[c] - without[c];
+        let want = suns[0].illuminance[c] + suns[1].illuminance[c];
+        assert!((added - want).abs() < 1e-3 * want, "{added} vs {want}");
+    }
+    l.save_with_suns(&path, "test", &suns).unwrap();
+    let map = frf_core::env::EnvMap::load(&path).unwrap();
+    let (found, _) = frf_core::sun::Sun::extract(&map).unwrap().unwrap();
+    let want = glam::Vec3::from(suns[0].direction).normalize();
+    assert!(found.direction().angle_between(want) < 1.5f32.to_radians());
+    // Bad suns, refused by name.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut f: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for (edit, want) in [
+        (
+            serde_json::json!({"direction": [0, 0, 0], "diameter_deg": 1, "illuminance": [1, 1, 1]}),
+            "sun 1's direction",
+        ),
+        (
+            serde_json::json!({"direction": [0, 1, 0], "diameter_deg": 30, "illuminance": [1, 1, 1]}),
+            "sun 1's diameter 30°",
+        ),
+        (
+            serde_json::json!({"direction": [0, 1, 0], "diameter_deg": 1, "illuminance": [1, -1, 1]}),
+            "sun 1's illuminance",
+        ),
+    ] {
+        f["suns"][1] = edit;
+        std::fs::write(&path, f.to_string()).unwrap();
+        let e = ShLight::load(&path).unwrap_err().to_string();
+        assert!(e.contains(want) && e.contains("light.json"), "{e}");
+    }
+}

@@ -3,7 +3,7 @@
 // its PNG frames, and the time per frame.
 import * as THREE from 'three';
 import { FrfPlayer } from './player.js';
-import { parseShLight } from './sh.js';
+import { parseShLight, parseShSuns } from './sh.js';
 import { sunDirection } from './geometry.js';
 import { subjectCamera, DepthComposite } from './scene.js';
 
@@ -74,7 +74,9 @@ window.frfRender = async (job) => {
       diameter_deg: job.sun[2] ?? 0.53,
     }
     : undefined;
-  player.setLight(sh, sun);
+  // The suns the light file carries (found in a map by `frf env-sh --suns`), and --sun.
+  const suns = [...parseShSuns(job.shText, job.shName), ...(sun ? [sun] : [])];
+  player.setLight(sh, suns);
   // A pose's own instant, or an instant of the walk between poses.
   let at;
   if (job.time === null || job.time === undefined) {

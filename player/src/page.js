@@ -5,7 +5,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { FrfPlayer, fullscreen } from './player.js';
-import { parseShLight } from './sh.js';
+import { parseShLight, parseShSuns } from './sh.js';
 import { sunDirection } from './geometry.js';
 import { FULLSCREEN_VERTEX, PRESENT_FRAGMENT } from './shaders.js';
 
@@ -24,6 +24,7 @@ controls.update();
 
 // A soft default light until one is loaded: a white sky above a darker ground (L2).
 let sh = [[0.9, 0.9, 0.95], [0.45, 0.45, 0.5], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0, 0, 0], [0.05, 0.05, 0.05], [0, 0, 0], [0, 0, 0]];
+let fileSuns = [];
 let loaded = false;
 let frameTarget = null;
 const present = new THREE.RawShaderMaterial({
@@ -45,7 +46,8 @@ function applyLight() {
   const sun = $('sun').checked
     ? { direction: sunDirection(($('az').value * Math.PI) / 180, ($('el').value * Math.PI) / 180), illuminance: Array(3).fill(Number($('e').value)) }
     : undefined;
-  player.setLight(sh, sun);
+  // The light file's own suns (found in a map by `frf env-sh --suns`), and the page's.
+  player.setLight(sh, [...fileSuns, ...(sun ? [sun] : [])]);
 }
 
 async function loadGlb(bytes, name) {
@@ -64,6 +66,7 @@ async function loadGlb(bytes, name) {
 async function loadSh(text, name) {
   try {
     sh = parseShLight(text, name, loaded ? player.ext.sh : undefined);
+    fileSuns = parseShSuns(text, name);
     applyLight();
   } catch (e) {
     showError(e);

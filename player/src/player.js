@@ -225,34 +225,45 @@ export class FrfPlayer {
   poseNumbers() { return this.ext.poses.map((p) => p.pose); }
 
   /**
-   * The L2 light (9 RGB radiance coefficients) and an optional sun { direction,
-   * illuminance RGB }. A sun at or below the horizon lights the walker as frf lights it,
-   * from below and softly (through its floor conditions there): its L2 projection joins the
+   * The L2 light (9 RGB radiance coefficients) and suns: none, one or a list of
+   * { direction, illuminance RGB, diameter_deg (0.53 where not given) }. The brightest
+   * above the horizon is relit sharply (by the basis as frf relights it where the export
+   * holds its images, else by albedo and normal); the others join the L2 light, and a
+   * note says so. A sun at or below the horizon lights the walker as frf lights it, from
+   * below and softly (through its floor conditions there): its L2 projection joins the
    * light, with no sharp shading or shadow, and a note says so.
    */
-  setLight(sh, sun = NO_SUN) {
+  setLight(sh, suns = []) {
     if (!Array.isArray(sh) || sh.length !== 9 || sh.some((c) => c.length !== 3 || c.some((v) => !Number.isFinite(v)))) {
       throw new Error('an L2 light is nine finite [r, g, b] coefficients');
     }
-    const e = sun.illuminance;
-    if (!Array.isArray(e) || e.length !== 3 || e.some((v) => !(Number.isFinite(v) && v >= 0 && v <= MAX_TOTAL_LIGHT))) {
-      throw new Error('a sun\'s illuminance is three finite values from 0 to 1e30 (as frf takes)');
-    }
-    const d = new THREE.Vector3(...sun.direction);
-    if (!(d.length() > 0) || !Number.isFinite(d.length())) throw new Error('a sun\'s direction is a non-zero vector');
-    d.normalize();
+    const checked = (Array.isArray(suns) ? suns : [suns]).map((sun) => {
+      const e = sun.illuminance;
+      if (!Array.isArray(e) || e.length !== 3 || e.some((v) => !(Number.isFinite(v) && v >= 0 && v <= MAX_TOTAL_LIGHT))) {
+        throw new Error('a sun\'s illuminance is three finite values from 0 to 1e30 (as frf takes)');
+      }
+      const d = new THREE.Vector3(...sun.direction);
+      if (!(d.length() > 0) || !Number.isFinite(d.length())) throw new Error('a sun\'s direction is a non-zero vector');
+      const diameter = sun.diameter_deg ?? 0.53;
+      if (!(diameter > 0 && diameter <= 180)) throw new Error('a sun\'s angular diameter is above 0 and at most 180 degrees');
+      return { direction: d.normalize().toArray(), illuminance: [...e], diameter_deg: diameter };
+    }).filter((s) => s.illuminance.some((v) => v > 0));
     this.sh = sh.map((c) => [...c]);
-    const diameter = sun.diameter_deg ?? 0.53;
-    if (!(diameter > 0 && diameter <= 180)) throw new Error('a sun\'s angular diameter is above 0 and at most 180 degrees');
-    this.sun = { direction: d.toArray(), illuminance: [...e], diameter_deg: diameter };
-    if (d.y <= 0 && e.some((v) => v > 0)) {
+    // A sun as L2: its radiance coefficients, c_i = E Y_i(d).
+    const intoL2 = (s) => {
       const basis = new Array(9);
-      THREE.SphericalHarmonics3.getBasisAt(d, basis);
-      for (let i = 0; i < 9; i++) for (let c = 0; c < 3; c++) this.sh[i][c] += e[c] * basis[i];
-      this.sun = NO_SUN;
-      const note = 'the sun is below the horizon: it lights the walker from below as its L2 light, softly, with no sharp shading or shadow (as frf lights it through the floor conditions)';
-      if (!this.notes?.includes(note)) (this.notes ??= []).push(note);
-    }
+      THREE.SphericalHarmonics3.getBasisAt(new THREE.Vector3(...s.direction), basis);
+      for (let i = 0; i < 9; i++) for (let c = 0; c < 3; c++) this.sh[i][c] += s.illuminance[c] * basis[i];
+    };
+    const note = (text) => { if (!this.notes?.includes(text)) (this.notes ??= []).push(text); };
+    const below = checked.filter((s) => s.direction[1] <= 0);
+    below.forEach(intoL2);
+    if (below.length > 0) note('the sun is below the horizon: it lights the walker from below as its L2 light, softly, with no sharp shading or shadow (as frf lights it through the floor conditions)');
+    const lum = (s) => 0.2126 * s.illuminance[0] + 0.7152 * s.illuminance[1] + 0.0722 * s.illuminance[2];
+    const above = checked.filter((s) => s.direction[1] > 0).sort((a, b) => lum(b) - lum(a));
+    this.sun = above[0] ?? NO_SUN;
+    above.slice(1).forEach(intoL2);
+    if (above.length > 1) note(`${above.length} suns: the brightest is relit sharply, the other ${above.length - 1} join the L2 light (frf relights up to 4 sharply)`);
     this.lightVersion++;
   }
 

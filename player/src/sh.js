@@ -7,6 +7,8 @@ export const SH_FORMAT = 'frf-sh-l2';
 
 /** The most total light a light may carry (`∫ L dω`, any channel), as frf takes (1e30). */
 export const MAX_TOTAL_LIGHT = 1e30;
+/** The widest sun taken, degrees (frf's `MAX_SUN_DIAMETER_DEG`). */
+export const MAX_SUN_DIAMETER_DEG = 20;
 
 /** The nine [r, g, b] radiance coefficients of an SH light file's text (`name` for messages). */
 export function parseShLight(text, name, expectedConvention) {
@@ -43,6 +45,23 @@ export function parseShLight(text, name, expectedConvention) {
     if (differ.length > 0) throw new Error(`${name}: its SH convention differs from the walker's: ${differ.join('; ')}`);
   }
   return c;
+}
+
+/**
+ * The suns a light file carries beside its coefficients (`frf env-sh --suns`: the suns found
+ * in a map, the coefficients those of the map less them), checked as frf checks them:
+ * [{ direction, illuminance, diameter_deg }], none where it holds none.
+ */
+export function parseShSuns(text, name) {
+  const suns = JSON.parse(text.replace(/^\uFEFF/, '')).suns ?? [];
+  if (!Array.isArray(suns)) throw new Error(`${name}: suns must be a list`);
+  return suns.map((s, k) => {
+    const three = (v) => Array.isArray(v) && v.length === 3 && v.every((x) => typeof x === 'number' && Number.isFinite(x));
+    if (!three(s?.direction) || Math.max(...s.direction.map(Math.abs)) <= 0) throw new Error(`${name}: sun ${k}'s direction ${JSON.stringify(s?.direction)} is not a direction`);
+    if (!(s.diameter_deg > 0 && s.diameter_deg <= MAX_SUN_DIAMETER_DEG)) throw new Error(`${name}: sun ${k}'s diameter ${s.diameter_deg}° is not within (0, ${MAX_SUN_DIAMETER_DEG}]°`);
+    if (!three(s.illuminance) || s.illuminance.some((v) => v < 0 || v > MAX_TOTAL_LIGHT)) throw new Error(`${name}: sun ${k}'s illuminance ${JSON.stringify(s.illuminance)} is not a finite, non-negative light`);
+    return { direction: s.direction, illuminance: s.illuminance, diameter_deg: s.diameter_deg };
+  });
 }
 
 /** JSON with object keys sorted: two conventions compare whole, whatever their key order. */

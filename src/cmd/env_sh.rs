@@ -9,6 +9,9 @@ use std::time::Instant;
 
 use clap::Args;
 use frf_core::env::{EnvMap, EnvSource, SH_MAP_HEIGHT};
+use frf_core::sh::ShSun;
+use frf_core::sun::Sun;
+use frf_reflectance::sun_light::MAX_SUNS;
 
 use crate::CliResult;
 
@@ -20,6 +23,11 @@ pub struct EnvShArgs {
     /// Turn the map about the vertical axis first, degrees (as `frf render --yaw`).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = crate::cmd::args::parse_turn)]
     yaw: f64,
+    /// Take the map's suns out first (up to frf's 4, brightest first, as frf finds them
+    /// when it relights by the map) and write them beside the L2 coefficients of what is
+    /// left: a player relights them sharply, and frf paints them back (`--env SH.json`).
+    #[arg(long)]
+    suns: bool,
     /// Output SH light (`.json`).
     #[arg(long)]
     out: PathBuf,
@@ -36,11 +44,16 @@ pub fn run(args: EnvShArgs) -> CliResult {
         .env
         .load_required("the light to project")?
         .rotated(frf_core::light::turn_radians(args.yaw));
+    let (env, suns) = if args.suns {
+        found_suns(env)?
+    } else {
+        (env, Vec::new())
+    };
     let sh = env.to_sh();
     let kept = energy_kept(&env, &sh);
     let ringing = EnvMap::from_sh_clamped(&sh, SH_MAP_HEIGHT)?;
     let texels = ringing.image().pixels().len();
-    sh.save(&args.out, &args.env.name())?;
+    sh.save_with_suns(&args.out, &args.env.name(), &suns)?;
     println!(
         "L2 light of {} written to {} in {:.2} s",
         args.env,
@@ -55,11 +68,48 @@ pub fn run(args: EnvShArgs) -> CliResult {
         "  energy kept by L2 (sum of squared coefficients / integral of squared radiance, luminance): {:.1} %",
         100.0 * kept
     );
+    for (k, s) in suns.iter().enumerate() {
+        let d = glam::Vec3::from(s.direction);
+        println!(
+            "  sun {k}: azimuth {:.1}°, elevation {:.1}°, {:.2}° across, illuminance {:.3} {:.3} {:.3} (taken out of the L2 light)",
+            d.x.atan2(d.z).to_degrees(),
+            d.y.clamp(-1.0, 1.0).asin().to_degrees(),
+            s.diameter_deg,
+            s.illuminance[0],
+            s.illuminance[1],
+            s.illuminance[2]
+        );
+    }
+    if args.suns && suns.is_empty() {
+        println!(
+            "  no sun found in the map (none compact and {}x its mean)",
+            frf_core::sun::SUN_CONTRAST
+        );
+    }
     println!(
         "  texels where the L2 light rings below zero (kept when frf renders the file, as a player relights it): {:.1} %",
         100.0 * ringing.clamped_texels() as f64 / texels as f64
     );
     Ok(())
+}
+
+/// The map's suns (up to [`MAX_SUNS`], each found in what the last left, as frf's
+/// relighting finds them) and the map less them.
+fn found_suns(env: EnvMap) -> CliResult<(EnvMap, Vec<ShSun>)> {
+    let mut rest = env;
+    let mut suns = Vec::new();
+    while suns.len() < MAX_SUNS {
+        let Some((sun, less)) = Sun::extract(&rest)? else {
+            break;
+        };
+        suns.push(ShSun {
+            direction: sun.direction().to_array(),
+            diameter_deg: 2.0 * sun.radius().to_degrees(),
+            illuminance: sun.illuminance(),
+        });
+        rest = less;
+    }
+    Ok((rest, suns))
 }
 
 /// `Σ c_i² / ∫ L² dω` of the luminance: 1 for a light that is L2 already.

@@ -23,6 +23,8 @@ fn export_writes_a_glb_the_khronos_validator_passes() {
     let o = frf(&[
         "export",
         f.field.to_str().unwrap(),
+        // Every part an export may hold (the basis images too) is validated.
+        "--basis",
         "--out",
         out.to_str().unwrap(),
         "--json",

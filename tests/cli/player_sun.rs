@@ -69,7 +69,27 @@ fn the_player_relights_a_sun_by_the_basis_as_frf_does() {
     // The control: albedo and normal alone miss the target somewhere.
     let worst = control.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(worst < 30.0, "albedo and normal alone: {control:?}");
+    // The sky's own sun, found in its map (`frf env-sh --suns`): the light file carries
+    // it beside the L2 of the rest; frf paints it back and finds it again.
+    let found = dir.path().join("sky-suns.json");
+    let o = frf(&["env-sh", "sky", "--suns", "--out", found.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (u, v) in [(3.0, 1.0), (20.0, 0.0)] {
+        let shot = grid_camera(&document, u, v);
+        let case = dir.path().join(format!("found-{u}-{v}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let reference = frf_frame(&f.field, &found, &shot, "64x90", None, &case);
+        let out = case.join("player.png");
+        let o = screenshot(&basis, &found, &shot, "64x90", None, &out);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let psnr = subject_psnr(&reference, &out);
+        eprintln!("({u}, {v}), the sky's found sun: {psnr:.2} dB");
+        assert!(psnr >= 30.0, "({u}, {v}), found sun: {psnr:.2} dB");
+    }
 }
+
+/// A change to an export's JSON.
+type Edit = Box<dyn Fn(&mut Value)>;
 
 #[test]
 fn damaged_basis_images_are_refused_by_name() {
@@ -81,7 +101,7 @@ fn damaged_basis_images_are_refused_by_name() {
     let bytes = std::fs::read(&glb).unwrap();
     let document = frf_export::read::Export::open(&glb).unwrap().document;
     let shot = grid_camera(&document, 3.0, 1.0);
-    let edits: [(&str, Box<dyn Fn(&mut Value)>, &str); 3] = [
+    let edits: [(&str, Edit, &str); 3] = [
         (
             "scales",
             Box::new(|d| {
@@ -127,4 +147,18 @@ fn damaged_basis_images_are_refused_by_name() {
         );
         assert!(!out.exists(), "{name}: {out:?} written");
     }
+    // A light file's sun the player cannot take, refused by name as frf refuses it.
+    let mut light: Value = serde_json::from_slice(&std::fs::read(&sh).unwrap()).unwrap();
+    light["suns"] =
+        serde_json::json!([{"direction": [0, 1, 0], "diameter_deg": 30, "illuminance": [1, 1, 1]}]);
+    let bad = dir.path().join("bad-sun.json");
+    std::fs::write(&bad, light.to_string()).unwrap();
+    let out = dir.path().join("bad-sun.png");
+    let o = screenshot(&glb, &bad, &shot, "64x90", None, &out);
+    let err = stderr(&o);
+    assert!(!o.status.success() && !out.exists(), "{err}");
+    assert!(
+        err.contains("bad-sun.json") && err.contains("sun 0's diameter 30°"),
+        "{err}"
+    );
 }

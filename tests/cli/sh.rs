@@ -188,3 +188,47 @@ fn a_yaw_of_any_size_is_the_turn_it_names() {
     let e = stderr(&o);
     assert!(e.contains("--yaw") && e.contains("beyond"), "{e}");
 }
+
+/// `frf env-sh --suns`: the built-in sky's sun is found where the sky puts it (azimuth
+/// 60°, elevation 40°) and written beside the L2 light of the sky less it, whose total
+/// light is the sky's less the sun's; a map with no sun writes none and says so.
+#[test]
+fn env_sh_suns_takes_the_maps_suns_out_and_writes_them_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.json");
+    let o = frf(&["env-sh", "sky", "--suns", "--out", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("sun 0: azimuth 60.0°, elevation 40."),
+        "{text}"
+    );
+    let (rest, suns) = frf_core::sh::ShLight::load_with_suns(&path).unwrap();
+    assert_eq!(suns.len(), 1, "{suns:?}");
+    let whole = frf_core::env::EnvMap::sky().to_sh();
+    let band0 = (4.0 * std::f32::consts::PI).sqrt();
+    for c in 0..3 {
+        let taken = (whole.coefficients[0][c] - rest.coefficients[0][c]) * band0;
+        let e = suns[0].illuminance[c];
+        assert!(
+            (taken - e).abs() < 0.02 * e,
+            "channel {c}: {taken} taken, sun {e}"
+        );
+    }
+    let uniform = dir.path().join("uniform.json");
+    let o = frf(&[
+        "env-sh",
+        "uniform",
+        "--suns",
+        "--out",
+        uniform.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("no sun found"));
+    assert!(
+        frf_core::sh::ShLight::load_with_suns(&uniform)
+            .unwrap()
+            .1
+            .is_empty()
+    );
+}
