@@ -124,6 +124,11 @@ pub struct PoseRecord {
     /// The field's poses its views' motion leads to, by the step's name (`next`,
     /// `prev`): only where the field holds pose-to-pose flows.
     pub motion_to: BTreeMap<String, u32>,
+    /// The largest component of its views' flows as a reader decodes them, pixels: how
+    /// far a flow may carry colour beyond the hull, known before any flow is decoded
+    /// (`None` in exports written before it).
+    #[serde(default)]
+    pub max_flow_px: Option<f32>,
     /// The views exported.
     pub views: Vec<ViewRecord>,
 }

@@ -161,21 +161,26 @@ pub fn scaled_rgb_png(albedo: &[Rgb], w: usize, h: usize) -> Result<(Vec<u8>, Rg
     Ok((png(&bytes, w, h, ExtendedColorType::Rgb8)?, scale))
 }
 
-/// A flow as a 16-bit grey-alpha PNG (`u` in grey, `v` in alpha).
-pub fn flow_png(flow: &FlowImage) -> Result<Vec<u8>> {
+/// A flow as a 16-bit grey-alpha PNG (`u` in grey, `v` in alpha), and its largest
+/// component as a reader decodes it, pixels.
+pub fn flow_png(flow: &FlowImage) -> Result<(Vec<u8>, f32)> {
     let (w, h) = flow.size();
     let q = |f: f32| {
         ((f + FLOW_OFFSET_PX) * FLOW_SCALE)
             .round()
             .clamp(0.0, 65535.0) as u16
     };
-    let bytes: Vec<u8> = flow
+    let codes: Vec<u16> = flow
         .pixels()
         .iter()
         .flat_map(|f| [q(f[0]), q(f[1])])
-        .flat_map(|v| v.to_ne_bytes())
         .collect();
-    png(&bytes, w, h, ExtendedColorType::La16)
+    // The largest component a reader decodes (`q / FLOW_SCALE − FLOW_OFFSET_PX`).
+    let largest = (codes.iter())
+        .map(|&c| (f32::from(c) / FLOW_SCALE - FLOW_OFFSET_PX).abs())
+        .fold(0.0f32, f32::max);
+    let bytes: Vec<u8> = codes.iter().flat_map(|v| v.to_ne_bytes()).collect();
+    Ok((png(&bytes, w, h, ExtendedColorType::La16)?, largest))
 }
 
 /// A pose's ground-shadow maps (values 0 to 1, all of one size) as one 8-bit grey PNG,

@@ -169,6 +169,8 @@ struct ViewOut {
     normals: Option<Vec<u8>>,
     albedo: (Vec<u8>, Rgb),
     flows: Vec<(Neighbour, Vec<u8>)>,
+    /// The largest flow component of `flows`, pixels.
+    max_flow_px: f32,
     motion: Vec<(PoseStep, Vec<u8>, f32)>,
     basis: Option<crate::view_maps::Atlas>,
 }
@@ -261,6 +263,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
                 encode_view(&field, pose, (u, v), rec, w, options)
             })
             .collect::<Result<_>>()?;
+        let max_flow_px = encoded.iter().map(|e| e.max_flow_px).fold(0.0f32, f32::max);
         let views: Vec<ViewRecord> = encoded
             .into_iter()
             .map(|e| add_view(&mut glb, &mut sizes, pose, e))
@@ -281,6 +284,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             sun_shadow_offset_m: offset,
             ground_shadow,
             motion_to: motion_to(&record),
+            max_flow_px: Some(max_flow_px),
             views,
         });
     }
@@ -636,6 +640,7 @@ fn encode_view(
     let albedo: Vec<Rgb> = fit.albedo();
     let albedo = scaled_rgb_png(&albedo, w, h)?;
     let mut flows = Vec::new();
+    let mut max_flow_px = 0.0f32;
     for n in Neighbour::ALL {
         if let Some(mut f) = field.flow(pose, u, v, n)? {
             // Beyond the subject as frf reads it when it loads a pose: each unknown texel
@@ -645,7 +650,9 @@ fn encode_view(
                 p[0].abs() < frf_core::flo::UNKNOWN_THRESHOLD
                     && p[1].abs() < frf_core::flo::UNKNOWN_THRESHOLD
             });
-            flows.push((n, flow_png(&f)?));
+            let (png, largest) = flow_png(&f)?;
+            max_flow_px = max_flow_px.max(largest);
+            flows.push((n, png));
         }
     }
     let motion = view_motion(field, pose, (u, v), (w, h))?;
@@ -671,6 +678,7 @@ fn encode_view(
         normals,
         albedo,
         flows,
+        max_flow_px,
         motion,
         basis,
     })

@@ -78,16 +78,19 @@ window.frfRender = async (job) => {
   const suns = [...parseShSuns(job.shText, job.shName), ...(sun ? [sun] : [])];
   player.setLight(sh, suns);
   // A pose's own instant, or an instant of the walk between poses.
+  // Only the views the camera's rays reach are decoded (every view where the walker
+  // stands among boxes: the scene's camera sees it from its own frame).
+  const camera = FrfPlayer.camera(job.camera, job.lookAt, job.fov, job.width, job.height);
+  const cameras = job.boxes?.length || job.allViews ? null : [camera];
   let at;
   if (job.time === null || job.time === undefined) {
     const pose = job.pose ?? player.poseNumbers()[0];
-    await player.preparePose(pose);
+    await player.preparePose(pose, cameras);
     at = { before: pose, after: pose, s: 0 };
   } else {
-    at = await player.prepareInstant(job.time, job.interpolate ?? 'flow');
+    at = await player.prepareInstant(job.time, job.interpolate ?? 'flow', cameras);
   }
   const loadMs = performance.now() - started;
-  const camera = FrfPlayer.camera(job.camera, job.lookAt, job.fov, job.width, job.height);
   const target = new THREE.WebGLRenderTarget(job.width, job.height, { type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: Boolean(job.boxes?.length) });
   // With boxes, the walker stands among them in a three.js scene (its depth against
   // theirs, or laid over them without `depth`): `draw` leaves that frame in `target`.
@@ -150,6 +153,7 @@ window.frfRender = async (job) => {
   }
   const parts = player.poses.get(at.before);
   const loadParts = { ...parts.loadMs, relight: parts.relightMs };
-  return { rgba: base64(out), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER) };
+  const viewsDecoded = player.viewsDecoded();
+  return { rgba: base64(out), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER), viewsDecoded };
 };
 window.frfReady = true;

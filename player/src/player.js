@@ -127,7 +127,7 @@ export class FrfPlayer {
         uEye: { value: new THREE.Vector3() }, uAxes: { value: new THREE.Matrix3() }, uK: { value: new THREE.Vector4() },
         uHeight: { value: 0 }, uQuads: { value: null }, uQuadCount: { value: 0 }, uFrames: { value: null },
         uViews: { value: null }, uColumns: { value: 0 }, uRows: { value: 0 }, uFrameRows: { value: 0 },
-        uPrelit: { value: null }, uMotion: { value: null }, uWithMotion: { value: 0 }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
+        uPrelit: { value: null }, uMotion: { value: null }, uWithMotion: { value: 0 }, uQuadIds: { value: 0 }, uFlows: { value: null }, uHullT: { value: null }, uHasHull: { value: 0 },
         uAxis: { value: new THREE.Vector2() }, uRanges: { value: null }, uIndexed: { value: 0 },
         uColAxis: { value: new THREE.Vector2() }, uColReference: { value: new THREE.Vector2() },
         uColOrientation: { value: 1 }, uRMin: { value: 0 }, uRMax: { value: 0 }, uSpans: { value: 0 },
@@ -221,6 +221,11 @@ export class FrfPlayer {
     }
   }
 
+  /** Per pose made ready: its views decoded and its views in all, `{ pose: [decoded, views] }`. */
+  viewsDecoded() {
+    return Object.fromEntries([...this.poses].map(([k, p]) => [k, [p.decoded.filter(Boolean).length, p.n]]));
+  }
+
   /** The pose numbers the export holds, in order. */
   poseNumbers() { return this.ext.poses.map((p) => p.pose); }
 
@@ -267,8 +272,12 @@ export class FrfPlayer {
     this.lightVersion++;
   }
 
-  /** Makes pose `number` ready to draw (decoding its images the first time) and relit. */
-  async preparePose(number) {
+  /**
+   * Makes pose `number` ready to draw and relit: with `cameras` (FrfPlayer.camera), ready
+   * for those alone, its views decoded where their rays reach them (as frf's plan reads a
+   * shot's views; more are decoded when another camera needs them); without, every view.
+   */
+  async preparePose(number, cameras = null) {
     let pose = this.poses.get(number);
     if (!pose) {
       const record = this.ext.poses.find((p) => p.pose === number);
@@ -276,8 +285,13 @@ export class FrfPlayer {
       pose = await this.#makePose(record);
       this.poses.set(number, pose);
     }
+    const all = pose.record.views.map((_, i) => i);
+    const t = performance.now();
+    const which = cameras ? this.#viewsReached(pose, cameras) : all;
+    pose.loadMs.reach = (pose.loadMs.reach ?? 0) + performance.now() - t;
+    await this.#decodeViews(pose, which);
     if (pose.lightVersion !== this.lightVersion) {
-      if (this.#basisSun() && !pose.basis) pose.basis = await this.#basisTiles(pose.record);
+      if (this.#basisSun()) await this.#decodeBasis(pose);
       const t0 = performance.now();
       this.#relight(pose);
       pose.relightMs = performance.now() - t0;
@@ -286,6 +300,11 @@ export class FrfPlayer {
     return pose;
   }
 
+  /**
+   * A pose ready to decode: its mesh, geometry and empty view textures (every view's
+   * layer and flow layer placed), and where the walker can show. Its views' images are
+   * decoded by `#decodeViews`, all of them or those a camera's rays reach.
+   */
   async #makePose(record) {
     const { width: w, height: h, columns, rows } = this.grid;
     const glb = this.glb;
@@ -295,82 +314,37 @@ export class FrfPlayer {
     const mesh = poseMesh(glb, record);
     const geometry = poseGeometry(this.grid, record.cameras, mesh.positions);
     const channels = compact ? 1 : 3;
-    const atlas = new Uint8Array(9 * w * h * channels * n);
-    const alpha = new Uint8Array(w * h * n);
-    const normals = new Uint8Array(4 * w * h * n);
-    const albedo = new Uint8Array(4 * w * h * 2 * n);
-    const flowCount = views.reduce((s, v) => s + NEIGHBOURS.filter((k) => v.flows?.[k] !== undefined).length, 0);
-    const flows = new Float32Array(2 * w * h * Math.max(flowCount, 1));
+    const data = {
+      atlas: new Uint8Array(9 * w * h * channels * n),
+      alpha: new Uint8Array(w * h * n),
+      normals: new Uint8Array(4 * w * h * n),
+      albedo: new Uint8Array(4 * w * h * 2 * n),
+    };
+    // Each view's flows' layers, in the views' order.
+    const flowLayers = [];
+    let flowCount = 0;
+    views.forEach((v) => {
+      flowLayers.push(NEIGHBOURS.map((k) => (v.flows?.[k] === undefined ? -1 : flowCount++)));
+    });
+    data.flows = new Float32Array(2 * w * h * Math.max(flowCount, 1));
     const viewTable = new Float32Array(columns * rows * 2 * 4).fill(-1);
     geometry.cameras.forEach((c, g) => viewTable.set([...c.centre, -1], g * 8));
-    let flowLayer = 0;
-    let maxFlow = 0;
-    // The JPEG atlases decode together (the browser decodes images off the page's
-    // thread); the PNGs are decoded on it as each view is filled in.
-    const started = performance.now();
-    const jpegs = await Promise.all(views.flatMap((v, i) => Array.from({ length: channels }, (_, c) => {
-      const what = `pose ${record.pose} view ${v.u},${v.v} transfer`;
-      return greyJpeg(glb, v.transfer.images[c], what).then((img) => {
-        expect(glb, img, 3 * w, 3 * h, null, `${what} atlas`);
-        atlas.set(img.data, (i * channels + c) * 9 * w * h);
-      });
-    })));
-    void jpegs;
-    const decodedJpeg = performance.now();
-    for (let i = 0; i < n; i++) {
-      const v = views[i];
-      const what = (s) => `pose ${record.pose} view ${v.u},${v.v} ${s}`;
-      const a = png(glb, v.alpha, what('alpha'));
-      expect(glb, a, w, h, 1, what('alpha'));
-      alpha.set(a.data, i * w * h);
-      if (v.normals !== null && v.normals !== undefined) {
-        const nm = png(glb, v.normals, what('normals'));
-        expect(glb, nm, w, h, 4, what('normals'));
-        normals.set(nm.data, i * 4 * w * h);
-      }
-      const rgbInto = (img, layer) => {
-        const d = img.data;
-        for (let t = 0, o = layer * w * h * 4; t < w * h; t++, o += 4) {
-          albedo[o] = d[3 * t];
-          albedo[o + 1] = d[3 * t + 1];
-          albedo[o + 2] = d[3 * t + 2];
-          albedo[o + 3] = 255;
-        }
-      };
-      const al = png(glb, v.albedo.image, what('albedo'));
-      expect(glb, al, w, h, 3, what('albedo'));
-      rgbInto(al, 2 * i);
-      if (compact) {
-        const col = png(glb, v.transfer.colour.image, what('transfer colour'));
-        expect(glb, col, w, h, 3, what('transfer colour'));
-        rgbInto(col, 2 * i + 1);
-      }
+    views.forEach((v, i) => {
       const g = v.u * rows + v.v;
       viewTable[g * 8 + 3] = i;
-      NEIGHBOURS.forEach((k, d) => {
-        if (v.flows?.[k] === undefined) return;
-        const f = png(glb, v.flows[k], what(`flow ${k}`));
-        expect(glb, f, w, h, 2, what(`flow ${k}`));
-        if (f.depth !== 16) throw new BadFile(glb.name, `${what(`flow ${k}`)}: ${f.depth}-bit, expected 16-bit`);
-        const out = flows.subarray(flowLayer * 2 * w * h, (flowLayer + 1) * 2 * w * h);
-        for (let t = 0; t < 2 * w * h; t++) {
-          out[t] = f.data[t] / 256 - 128;
-          maxFlow = Math.max(maxFlow, Math.abs(out[t]));
-        }
-        viewTable[g * 8 + 4 + d] = flowLayer;
-        flowLayer++;
-      });
-    }
-    const decodedPng = performance.now();
+      flowLayers[i].forEach((layer, d) => { if (layer >= 0) viewTable[g * 8 + 4 + d] = layer; });
+    });
+    const started = performance.now();
     const motion = this.#motionTextures(record);
     const groundShadow = this.#groundShadowMaps(record);
     const pose = {
-      record, geometry, n, motion, groundShadow,
-      atlas: arrayTexture(atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
-      alpha: arrayTexture(alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
-      normals: arrayTexture(normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
-      albedo: arrayTexture(albedo, w, h, 2 * n, THREE.RGBAFormat, THREE.UnsignedByteType),
-      flows: arrayTexture(flows, w, h, Math.max(flowCount, 1), THREE.RGFormat, THREE.FloatType),
+      record, geometry, n, motion, groundShadow, data, flowLayers,
+      decoded: new Array(n).fill(false),
+      atlas: arrayTexture(data.atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
+      alpha: arrayTexture(data.alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
+      normals: arrayTexture(data.normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
+      albedo: arrayTexture(data.albedo, w, h, 2 * n, THREE.RGBAFormat, THREE.UnsignedByteType),
+      flows: arrayTexture(data.flows, w, h, Math.max(flowCount, 1), THREE.RGFormat, THREE.FloatType),
       views: dataTexture(viewTable, 2, columns * rows),
       quads: dataTexture(quadTexels(geometry.quads), 5, geometry.quads.length),
       frames: dataTexture(frameTexels(geometry.frames), FRAME_TEXELS, geometry.frames.length),
@@ -387,7 +361,7 @@ export class FrfPlayer {
       }),
       // Where the walker can show (frf's SubjectBounds::of_pose): the frame passes shade
       // only the pixels that see it.
-      bounds: subjectBounds(mesh.positions, flowReachM(maxFlow, views.map((v) => geometry.cameras[v.u * rows + v.v]))),
+      maxFlow: 0,
       shadowOffset: record.sun_shadow_offset_m ?? SHADOW_OFFSET_PER_HEIGHT * meshHeight(mesh.positions),
       lightVersion: -1,
       hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
@@ -408,18 +382,96 @@ export class FrfPlayer {
       pose.index.ranges.forEach(([lo, hi], i) => r.set([lo, hi, 0, 0], 4 * i));
       pose.ranges = dataTexture(r, pose.index.ranges.length, 1);
     }
-    const madeMotion = performance.now();
-    // Each view texel's distance to the hull along its ray (the sun's shadow rays start there).
-    views.forEach((v, i) => {
-      const camera = geometry.cameras[v.u * rows + v.v];
-      this.#drawHull(pose, camera, pose.viewHull, i, false);
-    });
-    // What loading took, by part (ms; the GPU's work as it was issued).
-    pose.loadMs = {
-      jpeg: decodedJpeg - started, png: decodedPng - decodedJpeg, motion: madeMotion - decodedPng,
-      hull: performance.now() - madeMotion,
-    };
+    // What loading took, by part (ms; the GPU's work as it was issued; the views' images
+    // and hulls are added as `#decodeViews` decodes them).
+    pose.loadMs = { jpeg: 0, png: 0, motion: performance.now() - started, hull: 0 };
+    // Where the walker can show (frf's SubjectBounds::of_pose): the hull grown by the
+    // flows' reach, which the export states (else every view is decoded to find it). The
+    // frame passes shade only the pixels that see it.
+    if (!Number.isFinite(record.max_flow_px)) await this.#decodeViews(pose, views.map((_, i) => i));
+    const reach = flowReachM(record.max_flow_px ?? pose.maxFlow, views.map((v) => geometry.cameras[v.u * rows + v.v]));
+    pose.bounds = subjectBounds(mesh.positions, reach);
     return pose;
+  }
+
+  /**
+   * Decodes views `which` (indices into the pose's views) not decoded yet into the pose's
+   * view textures: the JPEG atlases together (the browser decodes them off the page's
+   * thread), then the PNGs on it, view by view. Their pre-lit colour is made at the
+   * next relight.
+   */
+  async #decodeViews(pose, which) {
+    const { width: w, height: h } = this.grid;
+    const { glb } = this;
+    const { record, data } = pose;
+    const compact = this.ext.tier === 'compact';
+    const channels = compact ? 1 : 3;
+    const todo = [...new Set(which)].filter((i) => !pose.decoded[i]).sort((a, b) => a - b);
+    if (todo.length === 0) return;
+    const started = performance.now();
+    await Promise.all(todo.flatMap((i) => Array.from({ length: channels }, (_, c) => {
+      const v = record.views[i];
+      const what = `pose ${record.pose} view ${v.u},${v.v} transfer`;
+      return greyJpeg(glb, v.transfer.images[c], what).then((img) => {
+        expect(glb, img, 3 * w, 3 * h, null, `${what} atlas`);
+        data.atlas.set(img.data, (i * channels + c) * 9 * w * h);
+      });
+    })));
+    const decodedJpeg = performance.now();
+    for (const i of todo) {
+      const v = record.views[i];
+      const what = (s) => `pose ${record.pose} view ${v.u},${v.v} ${s}`;
+      const a = png(glb, v.alpha, what('alpha'));
+      expect(glb, a, w, h, 1, what('alpha'));
+      data.alpha.set(a.data, i * w * h);
+      if (v.normals !== null && v.normals !== undefined) {
+        const nm = png(glb, v.normals, what('normals'));
+        expect(glb, nm, w, h, 4, what('normals'));
+        data.normals.set(nm.data, i * 4 * w * h);
+      }
+      const rgbInto = (img, layer) => {
+        const d = img.data;
+        for (let t = 0, o = layer * w * h * 4; t < w * h; t++, o += 4) {
+          data.albedo[o] = d[3 * t];
+          data.albedo[o + 1] = d[3 * t + 1];
+          data.albedo[o + 2] = d[3 * t + 2];
+          data.albedo[o + 3] = 255;
+        }
+      };
+      const al = png(glb, v.albedo.image, what('albedo'));
+      expect(glb, al, w, h, 3, what('albedo'));
+      rgbInto(al, 2 * i);
+      if (compact) {
+        const col = png(glb, v.transfer.colour.image, what('transfer colour'));
+        expect(glb, col, w, h, 3, what('transfer colour'));
+        rgbInto(col, 2 * i + 1);
+      }
+      NEIGHBOURS.forEach((k, d) => {
+        const layer = pose.flowLayers[i][d];
+        if (layer < 0) return;
+        const f = png(glb, v.flows[k], what(`flow ${k}`));
+        expect(glb, f, w, h, 2, what(`flow ${k}`));
+        if (f.depth !== 16) throw new BadFile(glb.name, `${what(`flow ${k}`)}: ${f.depth}-bit, expected 16-bit`);
+        const out = data.flows.subarray(layer * 2 * w * h, (layer + 1) * 2 * w * h);
+        for (let t = 0; t < 2 * w * h; t++) {
+          out[t] = f.data[t] / 256 - 128;
+          pose.maxFlow = Math.max(pose.maxFlow, Math.abs(out[t]));
+        }
+      });
+      pose.decoded[i] = true;
+    }
+    for (const t of [pose.atlas, pose.alpha, pose.normals, pose.albedo, pose.flows]) t.needsUpdate = true;
+    // Each view texel's distance to the hull along its ray (the sun's shadow rays start there).
+    const decodedPng = performance.now();
+    for (const i of todo) {
+      const v = record.views[i];
+      this.#drawHull(pose, pose.geometry.cameras[v.u * this.grid.rows + v.v], pose.viewHull, i, false);
+    }
+    pose.loadMs.hull += performance.now() - decodedPng;
+    // Relit again (the new views' colour), and their basis images decoded with a sun.
+    pose.lightVersion = -1;
+    pose.loadMs.jpeg += decodedJpeg - started;
+    pose.loadMs.png += decodedPng - decodedJpeg;
   }
 
   /**
@@ -546,21 +598,72 @@ export class FrfPlayer {
     return Boolean(this.ext.basis) && this.sun.illuminance.some((e) => e > 0);
   }
 
-  /** A pose's basis images decoded into one R8 array texture (layer 3 * view + channel). */
-  async #basisTiles(record) {
+  /**
+   * A pose's basis images, for the views decoded, into one R8 array texture (layer
+   * 3 * view + channel): decoded when a sun first lights them.
+   */
+  async #decodeBasis(pose) {
     const { width: w, height: h } = this.grid;
     const { columns, conditions } = this.ext.basis;
     const [aw, ah] = [columns * w, Math.ceil(conditions.length / columns) * h];
+    const { record } = pose;
     const n = record.views.length;
-    const data = new Uint8Array(aw * ah * 3 * n);
-    await Promise.all(record.views.flatMap((v, i) => [0, 1, 2].map(async (c) => {
+    if (!pose.basis) {
+      pose.basisDecoded = new Array(n).fill(false);
+      pose.basis = arrayTexture(new Uint8Array(aw * ah * 3 * n), aw, ah, 3 * n, THREE.RedFormat, THREE.UnsignedByteType);
+    }
+    const todo = record.views.map((_, i) => i).filter((i) => pose.decoded[i] && !pose.basisDecoded[i]);
+    if (todo.length === 0) return;
+    const data = pose.basis.image.data;
+    await Promise.all(todo.flatMap((i) => [0, 1, 2].map(async (c) => {
+      const v = record.views[i];
       const what = `pose ${record.pose} view ${v.u},${v.v} basis`;
-      if (!v.basis || v.basis.images.length !== 3) throw new BadFile(this.glb.name, `${what}: the export's basis names ${conditions.length} conditions, and this view holds no three basis atlases`);
       const img = await greyJpeg(this.glb, v.basis.images[c], what);
       expect(this.glb, img, aw, ah, null, `${what} atlas`);
       data.set(img.data, (3 * i + c) * aw * ah);
     })));
-    return arrayTexture(data, aw, ah, 3 * n, THREE.RedFormat, THREE.UnsignedByteType);
+    todo.forEach((i) => { pose.basisDecoded[i] = true; });
+    pose.basis.needsUpdate = true;
+  }
+
+  /**
+   * The views (indices into the pose's views) whose quads `cameras`' rays through the
+   * walker's pixel box reach: the frame pass run in its quad mode (each pixel's quad, as
+   * the pass re-bins its ray through the cylinder of camera centres from the hull's hit)
+   * and read back. What the frame pass reads is those quads' four views and their flows.
+   */
+  #viewsReached(pose, cameras) {
+    const { rows, columns } = this.grid;
+    const index = new Map(pose.record.views.map((v, i) => [v.u * rows + v.v, i]));
+    const reached = new Set();
+    for (const camera of cameras) {
+      const box = pixelBox(pose.bounds, camera);
+      if (!box) continue;
+      const hull = this.#hullTarget(camera.width, camera.height, 0);
+      this.quadTarget = sized(this.quadTarget, camera.width, camera.height);
+      const target = this.quadTarget;
+      this.#clearBoxed([hull, target], box);
+      this.#drawHull(pose, camera, hull, 0, true);
+      this.#frame(pose, camera, pose.prelit.texture, hull, target, null, true);
+      this.#unboxed([hull, target]);
+      const [w, h] = [box.x1 - box.x0, box.y1 - box.y0];
+      const px = new Float32Array(4 * w * h);
+      this.renderer.readRenderTargetPixels(target, box.x0, target.height - box.y1, w, h, px);
+      for (let p = 0; p < w * h; p++) {
+        if (px[4 * p + 2] === 0) continue;
+        const [u, v] = [px[4 * p], px[4 * p + 1]];
+        // The quad's four views (the frame pass' quadViews).
+        const bottom = Math.min(v, rows - 1);
+        const upper = Math.min(rows > 1 ? v + 1 : v, rows - 1);
+        for (const uu of [u % columns, (u + 1) % columns]) {
+          for (const vv of [bottom, upper]) {
+            const i = index.get(uu * rows + vv);
+            if (i !== undefined) reached.add(i);
+          }
+        }
+      }
+    }
+    return [...reached];
   }
 
   /** Sets the pre-lit pass' sun-by-the-basis uniforms for the light, and returns the views' suns. */
@@ -617,6 +720,8 @@ export class FrfPlayer {
     const suns = this.#basisSunUniforms(pose, u);
     const saved = this.renderer.getRenderTarget();
     pose.record.views.forEach((v, i) => {
+      // A view not decoded (no camera's rays reach it yet) is relit once it is.
+      if (!pose.decoded[i]) return;
       if (suns) FrfPlayer.#viewSun(u, v, suns[i]);
       const camera = pose.geometry.cameras[v.u * this.grid.rows + v.v];
       const [r, d, f] = camera.axes;
@@ -663,7 +768,7 @@ export class FrfPlayer {
    * "nearest"`. Where the two poses' motion does not lead to each other (an export of
    * some of a field's poses) the nearest is drawn, and a note says so.
    */
-  async prepareInstant(timeS, interpolate = 'flow') {
+  async prepareInstant(timeS, interpolate = 'flow', cameras = null) {
     if (!['flow', 'nearest'].includes(interpolate)) throw new Error(`interpolate ${interpolate}: expected flow or nearest`);
     let at = instantOf(this.ext, timeS);
     if (at.s > 0) {
@@ -678,9 +783,9 @@ export class FrfPlayer {
         at = { before: p, after: p, s: 0 };
       }
     }
-    await this.preparePose(at.before);
+    await this.preparePose(at.before, cameras);
     if (at.s > 0) {
-      await this.preparePose(at.after);
+      await this.preparePose(at.after, cameras);
       for (const [p, step] of [[at.before, 'next'], [at.after, 'prev']]) {
         if (!this.poses.get(p).motion[step]) throw new BadFile(this.glb.name, `pose ${p} holds no view's motion ${step} though motion_to names it`);
       }
@@ -792,7 +897,7 @@ export class FrfPlayer {
    * (pre-lit colour) and, with `motion` (its motion views), morphing those too into the
    * target's second texture.
    */
-  #frame(pose, camera, views, hullTarget, target, motion = null) {
+  #frame(pose, camera, views, hullTarget, target, motion = null, quadsOnly = false) {
     const saved = this.renderer.getRenderTarget();
     const u = this.frameMaterial.uniforms;
     cameraUniforms(u, camera);
@@ -806,7 +911,10 @@ export class FrfPlayer {
     u.uPrelit.value = views;
     u.uMotion.value = motion ?? views;
     u.uWithMotion.value = motion ? 1 : 0;
-    u.uFlows.value = pose.flows;
+    // The quad mode reads no flow: the pose's (not decoded yet) are not uploaded for it.
+    this.noFlows ??= arrayTexture(new Float32Array(2), 1, 1, 1, THREE.RGFormat, THREE.FloatType);
+    u.uFlows.value = quadsOnly ? this.noFlows : pose.flows;
+    u.uQuadIds.value = quadsOnly ? 1 : 0;
     u.uHullT.value = hullTarget.texture;
     u.uHasHull.value = pose.geometry.hasHull ? 1 : 0;
     u.uAxis.value.set(...pose.geometry.axis);
@@ -903,6 +1011,16 @@ export class FrfPlayer {
     }
     return this.hullTargets[k];
   }
+}
+
+/** `target` if it is `width` x `height`, else a float RGBA target of that size (the old one disposed). */
+function sized(target, width, height) {
+  if (target && target.width === width && target.height === height) return target;
+  target?.dispose();
+  return new THREE.WebGLRenderTarget(width, height, {
+    type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
+    minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+  });
 }
 
 /** The height of a mesh's positions' box. */

@@ -286,6 +286,7 @@ uniform int uFrameRows;
 uniform sampler2DArray uPrelit; // RGBA16F, premultiplied linear
 uniform sampler2DArray uMotion; // RG32F, metres across the axis and up it (alpha 1)
 uniform int uWithMotion;        // 1: the views' motion morphed too, into outMotion
+uniform int uQuadIds;           // 1: each pixel's quad instead of its colour
 uniform sampler2DArray uFlows;  // RG32F, pixels
 uniform sampler2D uHullT;       // R32F: distance to the hull along the ray + 1, 0 none
 uniform int uHasHull;
@@ -666,6 +667,12 @@ void main() {
   outColor = vec4(0.0);
   outMotion = vec4(0.0);
   if (hit.clamped == 3) return;
+  // The quad mode: which quad the pixel's ray reads (its column, row, and 1), not its
+  // colour (the views a camera needs decoded, FrfPlayer's #viewsReached).
+  if (uQuadIds == 1) {
+    outColor = vec4(float(hit.u % uColumns), float(hit.v), 1.0, 0.0);
+    return;
+  }
   Output o = solvedOutput(hit, uEye, dir);
   if (!o.ok) return;
   solvedMorph(hit, o);

@@ -628,3 +628,57 @@ fn the_player_draws_the_pose_asked_for() {
         "pose 0 {wrong:.2} dB against pose 6 {right:.2}"
     );
 }
+
+/// A pose decodes only the views its camera's rays reach (the frame pass' quads, read
+/// back), and draws the same frame as with every view decoded (`--all-views`, the
+/// control): from a captured view, a quad's centre and a camera above the grid.
+#[test]
+fn the_player_decodes_only_the_views_a_camera_reaches() {
+    let dir = tempfile::tempdir().unwrap();
+    let (glb, sh) = exported(dir.path());
+    let document = frf_export::read::Export::open(&glb).unwrap().document;
+    let mut above = grid_camera(&document, 3.0, 1.0);
+    above.eye = [above.eye[0] * 0.5, 3.0, above.eye[2] * 0.5];
+    for (k, shot) in [
+        grid_camera(&document, 3.0, 1.0),
+        grid_camera(&document, 20.5, 0.5),
+        above,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let mut frames = Vec::new();
+        for all in [false, true] {
+            let out = dir.path().join(format!("{k}-{all}.png"));
+            let mut c = Command::new("node");
+            c.arg(player().join("screenshot.mjs"))
+                .arg("--glb")
+                .arg(&glb)
+                .args(["--pose", "0", "--size", "64x90", "--json", "--sun", "60,40"])
+                .arg(format!("--camera={}", list(shot.eye)))
+                .arg(format!("--look-at={}", list(shot.look_at)))
+                .args(["--fov", &shot.fov_deg.to_string()])
+                .arg("--sh")
+                .arg(&sh)
+                .arg("--out")
+                .arg(&out);
+            if all {
+                c.arg("--all-views");
+            }
+            let o = c.output().unwrap();
+            assert!(o.status.success(), "{}", stderr(&o));
+            let report: Value = serde_json::from_slice(&o.stdout).unwrap();
+            let [decoded, views] =
+                [0, 1].map(|i| report["views_decoded"]["0"][i].as_u64().unwrap());
+            eprintln!("camera {k}, all views {all}: {decoded} of {views} views decoded");
+            assert_eq!(views, 108);
+            if all {
+                assert_eq!(decoded, 108);
+            } else {
+                assert!((4..=60).contains(&decoded), "camera {k}: {decoded} decoded");
+            }
+            frames.push(std::fs::read(&out).unwrap());
+        }
+        assert!(frames[0] == frames[1], "camera {k}: the frames differ");
+    }
+}
