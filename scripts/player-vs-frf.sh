@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The web player against `frf render`: pose 0 of FIELD exported, lit by the built-in sky's
-# L2 light (and optionally a sun), drawn by both from cameras of the grid (captured views
-# at integer U,V, quad centres at halves) and compared (subject PSNR, player/compare.mjs).
+# L2 light (or the light file LIGHT, with its suns) and optionally a sun, drawn by both
+# from cameras of the grid (captured views at integer U,V, quad centres at halves) and
+# compared (subject PSNR, player/compare.mjs).
 #   scripts/player-vs-frf.sh FIELD OUT_DIR [U,V[,SUN_AZ,SUN_EL,SUN_E]] ...
 set -euo pipefail
 field=$1; out=$2; shift 2
@@ -10,7 +11,8 @@ mkdir -p "$out"
 # EXPORT_ARGS: more options of the export (e.g. --mesh-voxel 0.01).
 # shellcheck disable=SC2086
 "$frf" export "$field" --poses 0 ${EXPORT_ARGS:-} --out "$out/walker.glb" >/dev/null
-"$frf" env-sh sky --out "$out/sky.json" >/dev/null
+# LIGHT: a light file of `frf env-sh` (its suns too, `--suns`) instead of the sky's L2.
+if [ -n "${LIGHT:-}" ]; then cp "$LIGHT" "$out/sky.json"; else "$frf" env-sh sky --out "$out/sky.json" >/dev/null; fi
 for case in "$@"; do
   IFS=, read -r u v az el e <<< "$case"
   name="${u}_${v}${az:+_sun_${az}_${el}_${e}}"

@@ -174,7 +174,8 @@ impl EnvMap {
     /// The map with a distant disc of light added (a sun: unit `direction` toward it,
     /// angular `radius` in radians, `∫ L dω` over it `illuminance`): its illuminance spread
     /// over the texels whose centres the disc covers (the nearest texel when it covers
-    /// none), so that the map's `∫ L dω` grows by exactly the disc's.
+    /// none), so that the map's `∫ L dω` grows by exactly the disc's. Its other texels are
+    /// kept as they are, negative ones too.
     pub fn with_disc(&self, direction: Vec3, radius: f32, illuminance: Rgb) -> Result<Self> {
         let (w, h) = self.image().size();
         let at = self.texel_of(direction);
@@ -203,7 +204,17 @@ impl EnvMap {
             let p = radiance.get(x, y);
             radiance.set(x, y, [p[0] + add[0], p[1] + add[1], p[2] + add[2]]);
         }
-        Ok(EnvMap::from_image(radiance)?.rotated(self.yaw()))
+        self.with_image(radiance)
+    }
+
+    /// This map with its texels replaced by `radiance` (of its size), its yaw kept and its
+    /// negative texels kept as they are: a signed map (an L2 light's, with its negative
+    /// lobes) stays the light a player relights by, not that light clamped. What
+    /// [`EnvMap::with_disc`] and [`crate::sun::Sun::extract`] make of a map.
+    pub fn with_image(&self, radiance: RgbImage) -> Result<Self> {
+        let mut out = EnvMap::signed(radiance)?;
+        out.clamped_texels = self.clamped_texels;
+        Ok(out.rotated(self.yaw()))
     }
 
     /// The projection of the map (its yaw included) onto the L2 basis ([`crate::sh`]):

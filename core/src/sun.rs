@@ -193,10 +193,7 @@ impl Sun {
             // (No more than a map may carry, which rounding could pass.)
             e.map(|c| c.min(crate::env::MAX_TOTAL_LIGHT) as f32),
         )?;
-        Ok(Some((
-            sun,
-            EnvMap::from_image(radiance)?.rotated(env.yaw()),
-        )))
+        Ok(Some((sun, env.with_image(radiance)?)))
     }
 
     /// What a sun below the horizon does (`None` above it), for a note to the user: under

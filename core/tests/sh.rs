@@ -414,3 +414,29 @@ fn a_light_files_suns_round_trip_and_are_painted_into_its_map() {
         assert!(e.contains(want) && e.contains("light.json"), "{e}");
     }
 }
+
+/// A sun painted into a signed map (an L2 light's, its negative lobes kept) and taken out
+/// again leaves its other texels as they were, negative ones too: frf relights the light a
+/// player relights, not that light clamped (clamped, a light file's sun rendered 15 dB
+/// from the player's frame).
+#[test]
+fn a_sun_painted_into_a_signed_map_and_taken_out_keeps_its_negative_texels() {
+    use frf_core::env::EnvMap;
+    use frf_core::image::Image;
+    let (w, h) = (64, 32);
+    let radiance = Image::from_fn(w, h, |x, _| if x < 8 { [-0.2; 3] } else { [0.5; 3] });
+    let map = EnvMap::signed(radiance).unwrap();
+    let lit = map
+        .with_disc(glam::Vec3::new(0.3, 0.8, 0.2).normalize(), 0.005, [20.0; 3])
+        .unwrap();
+    let (sun, rest) = frf_core::sun::Sun::extract(&lit).unwrap().unwrap();
+    assert!(
+        (sun.illuminance()[0] - 20.0).abs() < 0.5,
+        "{:?}",
+        sun.illuminance()
+    );
+    for (name, m) in [("lit", &lit), ("rest", &rest)] {
+        let negative = m.image().pixels().iter().filter(|p| p[0] < 0.0).count();
+        assert_eq!(negative, 8 * h, "{name}: {negative} negative texels");
+    }
+}

@@ -20,7 +20,7 @@ import {
   GROUND_SHADOW_LAYER_FRAGMENT,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
-import { conditionTable, conditionTexture, sunViews, INVOLVED, MAX_CONDITIONS, NEAREST } from './sun.js';
+import { conditionTable, conditionTexture, sunViews, INVOLVED, MAX_CONDITIONS, MAX_SUNS, NEAREST } from './sun.js';
 import { subjectBounds, flowReachM, pixelBox, unionBox } from './footprint.js';
 
 /** The sun's map of the hull, texels a side. */
@@ -83,7 +83,6 @@ export function cameraUniforms(u, camera) {
 }
 
 /** A light: nine RGB radiance coefficients (three.js order) and an optional sun. */
-export const NO_SUN = { direction: [0, 1, 0], illuminance: [0, 0, 0] };
 
 export class FrfPlayer {
   /** `renderer`: a THREE.WebGLRenderer (WebGL 2). */
@@ -91,7 +90,7 @@ export class FrfPlayer {
     this.renderer = renderer;
     this.poses = new Map();
     this.sh = Array.from({ length: 9 }, () => [0, 0, 0]);
-    this.sun = NO_SUN;
+    this.suns = [];
     this.lightVersion = 0;
     // With `measure`, each part of a frame is waited for and timed into `partsMs` (ms,
     // summed until reset): what a frame costs by part, at the price of the waits.
@@ -105,18 +104,21 @@ export class FrfPlayer {
         uLayer: { value: 0 }, uCompact: { value: 0 },
         uScale: { value: [] }, uOffset: { value: [] }, uSh: { value: [] },
         uAlbedoScale: { value: new THREE.Vector3() }, uColourScale: { value: new THREE.Vector3() },
-        uSunDir: { value: new THREE.Vector3() }, uSunE: { value: new THREE.Vector3() }, uHasNormals: { value: 0 },
+        uSunCount: { value: 0 }, uSunDirs: { value: vectors(MAX_SUNS) }, uSunEs: { value: vectors(MAX_SUNS) }, uHasNormals: { value: 0 },
         uViewHull: { value: null }, uViewCentre: { value: new THREE.Vector3() }, uViewAxes: { value: new THREE.Matrix3() },
-        uViewK: { value: new THREE.Vector4() }, uSunMap: { value: null }, uSunAxisX: { value: new THREE.Vector3() },
-        uSunAxisY: { value: new THREE.Vector3() }, uSunBox: { value: new THREE.Vector4() }, uSunOffset: { value: -1 },
+        uViewK: { value: new THREE.Vector4() }, uSunMaps: { value: null }, uSunAxesX: { value: vectors(MAX_SUNS) },
+        uSunAxesY: { value: vectors(MAX_SUNS) }, uSunBoxes: { value: Array.from({ length: MAX_SUNS }, () => new THREE.Vector4()) },
+        uSunOffset: { value: -1 },
         uBasisSun: { value: 0 }, uBasis: { value: null }, uConditions: { value: null }, uBasisColumns: { value: 1 },
         uConditionCount: { value: 0 }, uLightsPer: { value: 0 },
         uBasisScale: { value: Array.from({ length: MAX_CONDITIONS }, () => new THREE.Vector3()) },
         uBasisOffset: { value: Array.from({ length: MAX_CONDITIONS }, () => new THREE.Vector3()) },
-        uDomeFromSubject: { value: new THREE.Matrix3() }, uSunDome: { value: new THREE.Vector3() },
-        uInvolved: { value: new Array(INVOLVED).fill(0) }, uInvolvedCount: { value: 0 }, uNearestCount: { value: 0 },
-        uNearestW: { value: [0, 0] }, uHeldPlace: { value: [0, 0, 0, 0] }, uHeldW: { value: [0, 0, 0, 0] },
-        uCompactness: { value: 0 }, uRegion: { value: 0 },
+        uDomeFromSubject: { value: new THREE.Matrix3() }, uSunDomes: { value: vectors(MAX_SUNS) },
+        uInvolved: { value: new Array(INVOLVED * MAX_SUNS).fill(0) }, uInvolvedCount: { value: new Array(MAX_SUNS).fill(0) },
+        uNearestCount: { value: new Array(MAX_SUNS).fill(0) }, uNearestW: { value: new Array(NEAREST * MAX_SUNS).fill(0) },
+        uHeldPlace: { value: new Array(2 * NEAREST * MAX_SUNS).fill(0) }, uHeldW: { value: new Array(2 * NEAREST * MAX_SUNS).fill(0) },
+        uCompactness: { value: new Array(MAX_SUNS).fill(0) }, uRegion: { value: new Array(MAX_SUNS).fill(0) },
+        uSunLum: { value: new Array(MAX_SUNS).fill(0) },
       },
       depthTest: false, depthWrite: false,
     });
@@ -232,9 +234,9 @@ export class FrfPlayer {
   /**
    * The L2 light (9 RGB radiance coefficients) and suns: none, one or a list of
    * { direction, illuminance RGB, diameter_deg (0.53 where not given) }. The brightest
-   * above the horizon is relit sharply (by the basis as frf relights it where the export
-   * holds its images, else by albedo and normal); the others join the L2 light, and a
-   * note says so. A sun at or below the horizon lights the walker as frf lights it, from
+   * MAX_SUNS (4, as frf) above the horizon are relit sharply (by the basis as frf relights
+   * them where the export holds its images, else by albedo and normal); any others join
+   * the L2 light, and a note says so. A sun at or below the horizon lights the walker as frf lights it, from
    * below and softly (through its floor conditions there): its L2 projection joins the
    * light, with no sharp shading or shadow, and a note says so.
    */
@@ -266,9 +268,9 @@ export class FrfPlayer {
     if (below.length > 0) note('the sun is below the horizon: it lights the walker from below as its L2 light, softly, with no sharp shading or shadow (as frf lights it through the floor conditions)');
     const lum = (s) => 0.2126 * s.illuminance[0] + 0.7152 * s.illuminance[1] + 0.0722 * s.illuminance[2];
     const above = checked.filter((s) => s.direction[1] > 0).sort((a, b) => lum(b) - lum(a));
-    this.sun = above[0] ?? NO_SUN;
-    above.slice(1).forEach(intoL2);
-    if (above.length > 1) note(`${above.length} suns: the brightest is relit sharply, the other ${above.length - 1} join the L2 light (frf relights up to 4 sharply)`);
+    this.suns = above.slice(0, MAX_SUNS);
+    above.slice(MAX_SUNS).forEach(intoL2);
+    if (above.length > MAX_SUNS) note(`${above.length} suns: the brightest ${MAX_SUNS} are relit sharply, the other ${above.length - MAX_SUNS} join the L2 light (as frf)`);
     this.lightVersion++;
   }
 
@@ -595,7 +597,7 @@ export class FrfPlayer {
 
   /** Whether the sun is relit as frf relights it: a sun, and the export's basis images. */
   #basisSun() {
-    return Boolean(this.ext.basis) && this.sun.illuminance.some((e) => e > 0);
+    return Boolean(this.ext.basis) && this.suns.length > 0;
   }
 
   /**
@@ -666,39 +668,51 @@ export class FrfPlayer {
     return [...reached];
   }
 
-  /** Sets the pre-lit pass' sun-by-the-basis uniforms for the light, and returns the views' suns. */
+  /**
+   * Sets the pre-lit pass' suns-by-the-basis uniforms for the light, and returns each
+   * sun's views (`[sun][view]`).
+   */
   #basisSunUniforms(pose, u) {
     u.uBasisSun.value = this.#basisSun() ? 1 : 0;
     if (!u.uBasisSun.value) return null;
     const { columns, conditions } = this.ext.basis;
     this.conditionTable ??= conditionTable(conditions);
     this.conditionTexture?.texture.dispose();
-    this.conditionTexture = conditionTexture(this.conditionTable, this.sun.illuminance);
+    this.conditionTexture = conditionTexture(this.conditionTable, this.suns.map((s) => s.illuminance));
     u.uBasis.value = pose.basis;
     u.uConditions.value = this.conditionTexture.texture;
     u.uBasisColumns.value = columns;
     u.uConditionCount.value = conditions.length;
     u.uLightsPer.value = this.conditionTexture.lights;
-    const radius = (this.sun.diameter_deg * Math.PI) / 360;
-    return sunViews(this.conditionTable, this.sun.direction, radius, pose.record.views.map((v) => v.turntable_deg));
+    const turntables = pose.record.views.map((v) => v.turntable_deg);
+    this.suns.forEach((sun, s) => {
+      const e = sun.illuminance;
+      u.uSunLum.value[s] = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
+    });
+    return this.suns.map((sun) => sunViews(this.conditionTable, sun.direction, (sun.diameter_deg * Math.PI) / 360, turntables));
   }
 
-  /** Sets view `v`'s sun (of `#basisSunUniforms`) in the pre-lit pass' uniforms. */
-  static #viewSun(u, v, sun) {
+  /** Sets view `v`'s suns (`suns[s]` sun s's view, of `#basisSunUniforms`) in the pre-lit pass' uniforms. */
+  static #viewSuns(u, v, suns) {
     v.basis.scale.forEach((c, k) => u.uBasisScale.value[k].set(...c));
     v.basis.offset.forEach((c, k) => u.uBasisOffset.value[k].set(...c));
     const t = (v.turntable_deg * Math.PI) / 180;
     const [c, s] = [Math.cos(t), Math.sin(t)];
     u.uDomeFromSubject.value.set(c, 0, s, 0, 1, 0, -s, 0, c);
-    u.uSunDome.value.set(...sun.direction);
-    u.uInvolved.value = Array.from({ length: INVOLVED }, (_, j) => sun.involved[j] ?? 0);
-    u.uInvolvedCount.value = sun.involved.length;
-    u.uNearestCount.value = sun.nearest.length;
-    u.uNearestW.value = Array.from({ length: NEAREST }, (_, j) => sun.nearest[j]?.[1] ?? 0);
-    u.uHeldPlace.value = Array.from({ length: 2 * NEAREST }, (_, j) => sun.heldAt[j >> 1]?.[j & 1]?.[0] ?? 0);
-    u.uHeldW.value = Array.from({ length: 2 * NEAREST }, (_, j) => sun.heldAt[j >> 1]?.[j & 1]?.[1] ?? 0);
-    u.uCompactness.value = sun.compactness;
-    u.uRegion.value = sun.region;
+    suns.forEach((sun, k) => {
+      u.uSunDomes.value[k].set(...sun.direction);
+      for (let j = 0; j < INVOLVED; j++) u.uInvolved.value[INVOLVED * k + j] = sun.involved[j] ?? 0;
+      u.uInvolvedCount.value[k] = sun.involved.length;
+      u.uNearestCount.value[k] = sun.nearest.length;
+      for (let j = 0; j < NEAREST; j++) u.uNearestW.value[NEAREST * k + j] = sun.nearest[j]?.[1] ?? 0;
+      for (let j = 0; j < 2 * NEAREST; j++) {
+        const held = sun.heldAt[j >> 1]?.[j & 1];
+        u.uHeldPlace.value[2 * NEAREST * k + j] = held?.[0] ?? 0;
+        u.uHeldW.value[2 * NEAREST * k + j] = held?.[1] ?? 0;
+      }
+      u.uCompactness.value[k] = sun.compactness;
+      u.uRegion.value[k] = sun.region;
+    });
   }
 
   #relight(pose) {
@@ -710,19 +724,27 @@ export class FrfPlayer {
     u.uAlbedo.value = pose.albedo;
     u.uCompact.value = compact ? 1 : 0;
     u.uSh.value = this.sh.map((c) => new THREE.Vector3(...c));
-    u.uSunDir.value.set(...this.sun.direction);
-    u.uSunE.value.set(...this.sun.illuminance);
+    u.uSunCount.value = this.suns.length;
+    this.suns.forEach((sun, s) => {
+      u.uSunDirs.value[s].set(...sun.direction);
+      u.uSunEs.value[s].set(...sun.illuminance);
+    });
     u.uViewHull.value = pose.viewHull.texture;
-    const shadows = this.sun.illuminance.some((e) => e > 0) && pose.geometry.hasHull;
+    const shadows = this.suns.length > 0 && pose.geometry.hasHull;
     u.uSunOffset.value = shadows ? pose.shadowOffset : -1;
-    if (shadows) this.#sunMap(pose, u);
+    this.sunTargets ??= new THREE.WebGLArrayRenderTarget(SUN_MAP_SIZE, SUN_MAP_SIZE, MAX_SUNS, {
+      type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
+      minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+    });
+    u.uSunMaps.value = this.sunTargets.texture;
+    if (shadows) this.suns.forEach((sun, s) => this.#sunMap(pose, u, s));
     if (pose.groundShadow) this.#relightGroundShadow(pose);
     const suns = this.#basisSunUniforms(pose, u);
     const saved = this.renderer.getRenderTarget();
     pose.record.views.forEach((v, i) => {
       // A view not decoded (no camera's rays reach it yet) is relit once it is.
       if (!pose.decoded[i]) return;
-      if (suns) FrfPlayer.#viewSun(u, v, suns[i]);
+      if (suns) FrfPlayer.#viewSuns(u, v, suns.map((views) => views[i]));
       const camera = pose.geometry.cameras[v.u * this.grid.rows + v.v];
       const [r, d, f] = camera.axes;
       u.uViewCentre.value.set(...camera.centre);
@@ -952,9 +974,9 @@ export class FrfPlayer {
     this.renderer.setRenderTarget(saved);
   }
 
-  /** The sun's map of the pose's hull (`SunDepth` of frf), and its uniforms in `u`. */
-  #sunMap(pose, u) {
-    const l = this.sun.direction;
+  /** Sun `s`'s map of the pose's hull (`SunDepth` of frf) into layer `s` of the suns' maps, and its uniforms in `u`. */
+  #sunMap(pose, u, s) {
+    const l = this.suns[s].direction;
     const axisX = new THREE.Vector3(...l).cross(Math.abs(l[1]) < 0.9 ? new THREE.Vector3(0, 1, 0) : new THREE.Vector3(1, 0, 0)).normalize();
     const axisY = new THREE.Vector3(...l).cross(axisX).normalize();
     const p = pose.mesh.positions;
@@ -972,10 +994,6 @@ export class FrfPlayer {
     }
     const margin = 0.05;
     const box = new THREE.Vector4(lo[0] - margin, lo[1] - margin, hi[0] + margin, hi[1] + margin);
-    this.sunTarget ??= new THREE.WebGLRenderTarget(SUN_MAP_SIZE, SUN_MAP_SIZE, {
-      type: THREE.FloatType, format: THREE.RedFormat, depthBuffer: true,
-      minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
-    });
     const m = this.sunMapMaterial.uniforms;
     m.uSunDir.value.copy(sun);
     m.uSunAxisX.value.copy(axisX);
@@ -983,7 +1001,7 @@ export class FrfPlayer {
     m.uSunBox.value.copy(box);
     m.uReach.value.set(lo[2] - margin, hi[2] + margin);
     const saved = this.renderer.getRenderTarget();
-    this.renderer.setRenderTarget(this.sunTarget);
+    this.renderer.setRenderTarget(this.sunTargets, s);
     this.renderer.setClearColor(0x000000, 0);
     this.renderer.clear(true, true, false);
     const mesh = new THREE.Mesh(pose.hull.mesh.geometry, this.sunMapMaterial);
@@ -992,10 +1010,9 @@ export class FrfPlayer {
     scene.add(mesh);
     this.renderer.render(scene, this.camera);
     this.renderer.setRenderTarget(saved);
-    u.uSunMap.value = this.sunTarget.texture;
-    u.uSunAxisX.value.copy(axisX);
-    u.uSunAxisY.value.copy(axisY);
-    u.uSunBox.value.copy(box);
+    u.uSunAxesX.value[s].copy(axisX);
+    u.uSunAxesY.value[s].copy(axisY);
+    u.uSunBoxes.value[s].copy(box);
   }
 
   /** Hull target `k` of a frame's size (two: the poses either side of an instant). */
@@ -1011,6 +1028,11 @@ export class FrfPlayer {
     }
     return this.hullTargets[k];
   }
+}
+
+/** `count` zero vectors (a uniform array's value). */
+function vectors(count) {
+  return Array.from({ length: count }, () => new THREE.Vector3());
 }
 
 /** `target` if it is `width` x `height`, else a float RGBA target of that size (the old one disposed). */

@@ -13,11 +13,15 @@ in vec3 position;
 void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }
 `;
 
-/** The pre-lit pass: one view's texels (layer uLayer) relit. */
+/**
+ * The pre-lit pass: one view's texels (layer uLayer) relit by the L2 light and up to
+ * MAX_SUNS (4) suns, each relit sharply.
+ */
 export const PRELIT_FRAGMENT = /* glsl */ `
 precision highp float;
 precision highp int;
 precision highp sampler2DArray;
+#define MAX_SUNS 4
 uniform sampler2DArray uAtlas;    // R8: layer 3 * view + channel (compact: 1 per view)
 uniform sampler2DArray uAlpha;    // R8
 uniform sampler2DArray uNormals;  // RGBA8: n = 2 rgb - 1, a = 0 where none
@@ -29,29 +33,31 @@ uniform vec3 uOffset[9];
 uniform vec3 uSh[9];              // the light's radiance coefficients (three.js order)
 uniform vec3 uAlbedoScale;
 uniform vec3 uColourScale;
-uniform vec3 uSunDir;             // toward the sun, subject frame
-uniform vec3 uSunE;               // its illuminance; 0: no sun
+uniform int uSunCount;            // suns relit sharply (0: none)
+uniform vec3 uSunDirs[MAX_SUNS];  // toward each sun, subject frame
+uniform vec3 uSunEs[MAX_SUNS];    // their illuminance
 uniform int uHasNormals;
-// The sun's shadow (frf's SunLight::sunlit): each texel's point on the hull (its ray's
+// A sun's shadow (frf's SunLight::sunlit): each texel's point on the hull (its ray's
 // distance + 1 in uViewHull, 0: the ray misses the hull, lit), moved uSunOffset toward the
-// sun, is shaded where the hull reaches farther toward the sun along its line (uSunMap:
-// the largest l . p of the hull + 100 per texel across the sun, 0 where none).
+// sun, is shaded where the hull reaches farther toward the sun along its line (layer s
+// of uSunMaps: the largest l . p of the hull + 100 per texel across sun s, 0 where none).
 uniform sampler2DArray uViewHull;
 uniform vec3 uViewCentre;
 uniform mat3 uViewAxes;
 uniform vec4 uViewK;
-uniform sampler2D uSunMap;
-uniform vec3 uSunAxisX;
-uniform vec3 uSunAxisY;
-uniform vec4 uSunBox;             // lo x, lo y, hi x, hi y along the axes
+uniform sampler2DArray uSunMaps;
+uniform vec3 uSunAxesX[MAX_SUNS];
+uniform vec3 uSunAxesY[MAX_SUNS];
+uniform vec4 uSunBoxes[MAX_SUNS]; // lo x, lo y, hi x, hi y along the axes
 uniform float uSunOffset;         // metres; < 0: no shadows
-// The sun relit as frf relights it (uBasisSun 1: the export holds the basis images;
+// The suns relit as frf relights them (uBasisSun 1: the export holds the basis images;
 // player/src/sun.js makes these, sun_light.rs derives them): the basis' tiles (R8, layer
 // 3 * view + channel, uBasisColumns tiles a row, value offset + scale * code), the
-// conditions' table (column k: row 0 its cone, row 1 the sun's light per unit of its,
-// rows 2.. its lights), and the view's sun: its direction in the view's dome, the
-// conditions the trust reads (the nearest first), each nearest's held-out predictors
-// (places among them), how compact the sun is, and the condition whose region holds it.
+// conditions' table (column k: row 0 its cone, row 1 + s sun s's light per unit of its,
+// rows 1 + MAX_SUNS.. its lights), and per sun at the view: its direction in the view's
+// dome, the conditions the trust reads (the nearest first, 6 a sun), each nearest's
+// held-out predictors (places among them), how compact it is, the condition whose region
+// holds it, and its luminance (its weight among the suns' trusts).
 uniform int uBasisSun;
 uniform sampler2DArray uBasis;
 uniform highp sampler2D uConditions;
@@ -61,40 +67,42 @@ uniform int uLightsPer;
 uniform vec3 uBasisScale[32];
 uniform vec3 uBasisOffset[32];
 uniform mat3 uDomeFromSubject;
-uniform vec3 uSunDome;
-uniform int uInvolved[6];
-uniform int uInvolvedCount;
-uniform int uNearestCount;
-uniform float uNearestW[2];
-uniform int uHeldPlace[4];
-uniform float uHeldW[4];
-uniform float uCompactness;
-uniform int uRegion;
+uniform vec3 uSunDomes[MAX_SUNS];
+uniform int uInvolved[6 * MAX_SUNS];
+uniform int uInvolvedCount[MAX_SUNS];
+uniform int uNearestCount[MAX_SUNS];
+uniform float uNearestW[2 * MAX_SUNS];
+uniform int uHeldPlace[4 * MAX_SUNS];
+uniform float uHeldW[4 * MAX_SUNS];
+uniform float uCompactness[MAX_SUNS];
+uniform int uRegion[MAX_SUNS];
+uniform float uSunLum[MAX_SUNS];
 out vec4 outColor;
 
-bool sunlit(ivec2 p) {
+bool sunlit(ivec2 p, int s) {
   if (uSunOffset < 0.0) return true;
   float t = texelFetch(uViewHull, ivec3(p, uLayer), 0).r - 1.0;
   if (t < 0.0) return true;
   vec3 dc = vec3((float(p.x) - uViewK.z) / uViewK.x, (float(p.y) - uViewK.w) / uViewK.y, 1.0);
   vec3 surface = uViewCentre + normalize(uViewAxes * dc) * t;
-  vec3 q = surface + uSunDir * uSunOffset;
-  vec2 size = vec2(textureSize(uSunMap, 0));
-  vec2 m = (vec2(dot(uSunAxisX, q), dot(uSunAxisY, q)) - uSunBox.xy) / (uSunBox.zw - uSunBox.xy) * size;
+  vec3 q = surface + uSunDirs[s] * uSunOffset;
+  vec2 size = vec2(textureSize(uSunMaps, 0).xy);
+  vec4 box = uSunBoxes[s];
+  vec2 m = (vec2(dot(uSunAxesX[s], q), dot(uSunAxesY[s], q)) - box.xy) / (box.zw - box.xy) * size;
   if (any(lessThan(m, vec2(0.0))) || any(greaterThanEqual(m, size))) return true;
-  float reach = texelFetch(uSunMap, ivec2(m), 0).r;
+  float reach = texelFetch(uSunMaps, ivec3(ivec2(m), s), 0).r;
   if (reach == 0.0) return true;
-  return !(reach - 100.0 > dot(uSunDir, q));
+  return !(reach - 100.0 > dot(uSunDirs[s], q));
 }
 
-// Condition k's image at texel p, per unit of its light, times the sun's light
+// Condition k's image at texel p, per unit of its light, times sun s's light
 // (SunLight::sunned).
-vec3 sunned(ivec2 p, ivec2 size, int k) {
+vec3 sunned(ivec2 p, ivec2 size, int k, int s) {
   ivec2 a = p + ivec2((k % uBasisColumns) * size.x, (k / uBasisColumns) * size.y);
   vec3 code = vec3(texelFetch(uBasis, ivec3(a, 3 * uLayer), 0).r,
                    texelFetch(uBasis, ivec3(a, 3 * uLayer + 1), 0).r,
                    texelFetch(uBasis, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
-  return (uBasisOffset[k] + uBasisScale[k] * code) * texelFetch(uConditions, ivec2(k, 1), 0).rgb;
+  return (uBasisOffset[k] + uBasisScale[k] * code) * texelFetch(uConditions, ivec2(k, 1 + s), 0).rgb;
 }
 
 // Condition k's shading of a unit normal n (dome frame), per unit of its light: n . m
@@ -106,7 +114,7 @@ float shading(int k, vec3 n) {
   if (d <= -cone.w) return 0.0;
   float s = 0.0;
   for (int j = 0; j < uLightsPer; j++) {
-    vec4 l = texelFetch(uConditions, ivec2(k, 2 + j), 0);
+    vec4 l = texelFetch(uConditions, ivec2(k, 1 + MAX_SUNS + j), 0);
     s += l.w * max(dot(n, l.xyz), 0.0);
   }
   return s;
@@ -114,58 +122,52 @@ float shading(int k, vec3 n) {
 
 float lum(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
-// The sun at texel p as frf relights it (suns_texel of one sun): the basis' sun (the
-// image of the condition whose region holds it), moved toward the normals' (the nearest
-// conditions' images times the ratio of the normal's shading under the sun to theirs,
-// where the hull does not hide the sun) by the trust: the sun's compactness times a
-// smooth step down as the texel's leave-one-out error goes from 2 to 5 (TRUST_ERROR).
-vec3 basisSun(ivec2 p, ivec2 size, bool hasNormal, vec3 n) {
-  vec3 basis = sunned(p, size, uRegion);
-  if (!hasNormal || uCompactness <= 0.0) return basis;
+// How far sun s's normals' relighting is trusted at texel p (SunLight::trust): its
+// compactness times a smooth step down as the texel's leave-one-out error goes from 2 to
+// 5 (TRUST_ERROR); and in lit, what the normals relight it to (relight_texel: the nearest
+// conditions' images by the ratio of the normal's shading under the sun to theirs, or,
+// where they barely reach the normal, the fit's shading scaled by every image's ratio).
+float sunTrust(ivec2 p, ivec2 size, vec3 n, int s, out vec3 lit) {
+  lit = vec3(0.0);
   float lums[6];
   float shades[6];
   vec3 photos[6];
   for (int j = 0; j < 6; j++) {
-    if (j >= uInvolvedCount) break;
-    photos[j] = sunned(p, size, uInvolved[j]);
+    if (j >= uInvolvedCount[s]) break;
+    int k = uInvolved[6 * s + j];
+    photos[j] = sunned(p, size, k, s);
     lums[j] = lum(photos[j]);
-    shades[j] = shading(uInvolved[j], n);
+    shades[j] = shading(k, n);
   }
   float error = 0.0;
   float plain = 0.0;
+  vec3 interpolatedRgb = vec3(0.0);
+  float shadedRgb = 0.0;
   for (int j = 0; j < 2; j++) {
-    if (j >= uNearestCount) break;
+    if (j >= uNearestCount[s]) break;
+    float w = uNearestW[2 * s + j];
+    interpolatedRgb += w * photos[j];
+    shadedRgb += w * shades[j];
     float shaded = 0.0;
     float interpolated = 0.0;
     for (int m = 0; m < 2; m++) {
-      float w = uHeldW[2 * j + m];
-      if (w == 0.0) continue;
-      shaded += w * shades[uHeldPlace[2 * j + m]];
-      interpolated += w * lums[uHeldPlace[2 * j + m]];
+      float wm = uHeldW[4 * s + 2 * j + m];
+      if (wm == 0.0) continue;
+      int place = uHeldPlace[4 * s + 2 * j + m];
+      shaded += wm * shades[place];
+      interpolated += wm * lums[place];
     }
     float wanted = shades[j];
     float predicted = wanted <= 0.0 ? 0.0
       : (shaded >= 0.3 * wanted ? interpolated * wanted / shaded : interpolated);
-    error += uNearestW[j] * abs(predicted - lums[j]);
-    plain += uNearestW[j] * abs(interpolated - lums[j]);
+    error += w * abs(predicted - lums[j]);
+    plain += w * abs(interpolated - lums[j]);
   }
   float e = plain > 0.0 ? error / plain : (error > 0.0 ? 1e30 : 0.0);
-  float t = uCompactness * (1.0 - smoothstep(2.0, 5.0, e));
-  if (t <= 0.0) return basis;
-  // relight_texel: the nearest images by the ratio of shadings, or, where they barely
-  // reach the normal, the fit's shading scaled by every image's ratio to it.
-  float wanted = max(dot(n, uSunDome), 0.0);
-  vec3 s = vec3(0.0);
+  float wanted = max(dot(n, uSunDomes[s]), 0.0);
   if (wanted > 0.0) {
-    vec3 interpolated = vec3(0.0);
-    float shaded = 0.0;
-    for (int j = 0; j < 2; j++) {
-      if (j >= uNearestCount) break;
-      interpolated += uNearestW[j] * photos[j];
-      shaded += uNearestW[j] * shades[j];
-    }
-    if (shaded >= 0.3 * wanted) {
-      s = interpolated * wanted / shaded;
+    if (shadedRgb >= 0.3 * wanted) {
+      lit = interpolatedRgb * wanted / shadedRgb;
     } else {
       vec3 num = vec3(0.0);
       float den = 0.0;
@@ -173,15 +175,38 @@ vec3 basisSun(ivec2 p, ivec2 size, bool hasNormal, vec3 n) {
         if (k >= uConditionCount) break;
         float m = shading(k, n);
         if (m > 0.0) {
-          num += sunned(p, size, k) * m;
+          num += sunned(p, size, k, s) * m;
           den += m * m;
         }
       }
-      if (den > 0.0) s = wanted * num / den;
+      if (den > 0.0) lit = wanted * num / den;
     }
   }
-  vec3 lit = (any(notEqual(s, vec3(0.0))) && sunlit(p)) ? s : vec3(0.0);
-  return basis + t * (lit - basis);
+  return uCompactness[s] <= 0.0 ? 0.0 : uCompactness[s] * (1.0 - smoothstep(2.0, 5.0, e));
+}
+
+// The suns at texel p as frf relights them (suns_texel): their basis' light (each sun's
+// condition image), moved toward the normals' by the suns' trust weighted by their
+// luminance; a sun counts where the hull does not hide it.
+vec3 basisSuns(ivec2 p, ivec2 size, bool hasNormal, vec3 n) {
+  vec3 basis = vec3(0.0);
+  for (int s = 0; s < MAX_SUNS; s++) {
+    if (s >= uSunCount) break;
+    basis += sunned(p, size, uRegion[s], s);
+  }
+  if (!hasNormal) return basis;
+  float trusted = 0.0;
+  float total = 0.0;
+  vec3 lit = vec3(0.0);
+  for (int s = 0; s < MAX_SUNS; s++) {
+    if (s >= uSunCount) break;
+    vec3 sunLit;
+    trusted += uSunLum[s] * sunTrust(p, size, n, s, sunLit);
+    total += uSunLum[s];
+    if (any(notEqual(sunLit, vec3(0.0))) && sunlit(p, s)) lit += sunLit;
+  }
+  float t = total > 0.0 ? trusted / total : 0.0;
+  return t <= 0.0 ? basis : basis + t * (lit - basis);
 }
 
 void main() {
@@ -207,14 +232,18 @@ void main() {
       }
       rgb += uSh[i] * t;
     }
-    if (uBasisSun == 1) {
+    if (uSunCount > 0) {
       vec4 n = uHasNormals == 1 ? texelFetch(uNormals, ivec3(p, uLayer), 0) : vec4(0.0);
-      rgb += basisSun(p, size, n.a > 0.0, normalize(uDomeFromSubject * (n.rgb * 2.0 - 1.0)));
-    } else if (uHasNormals == 1 && any(greaterThan(uSunE, vec3(0.0)))) {
-      vec4 n = texelFetch(uNormals, ivec3(p, uLayer), 0);
-      if (n.a > 0.0 && sunlit(p)) {
+      if (uBasisSun == 1) {
+        rgb += basisSuns(p, size, n.a > 0.0, normalize(uDomeFromSubject * (n.rgb * 2.0 - 1.0)));
+      } else if (n.a > 0.0) {
         vec3 albedo = texelFetch(uAlbedo, ivec3(p, 2 * uLayer), 0).rgb * 255.0 * uAlbedoScale;
-        rgb += albedo * max(dot(normalize(n.rgb * 2.0 - 1.0), uSunDir), 0.0) * uSunE;
+        vec3 normal = normalize(n.rgb * 2.0 - 1.0);
+        for (int s = 0; s < MAX_SUNS; s++) {
+          if (s >= uSunCount) break;
+          float facing = max(dot(normal, uSunDirs[s]), 0.0);
+          if (facing > 0.0 && sunlit(p, s)) rgb += albedo * facing * uSunEs[s];
+        }
       }
     }
   }

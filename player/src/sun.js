@@ -15,8 +15,10 @@ export const NEAREST = 2;
 const WEIGHT_POWER = 2;
 /** The most conditions a sun's trust reads at a view: its nearest and those predicting each. */
 export const INVOLVED = NEAREST * (1 + NEAREST);
-/** The most conditions and lights a condition the pre-lit pass takes. */
+/** The most conditions the pre-lit pass takes. */
 export const MAX_CONDITIONS = 32;
+/** The most suns relit sharply (frf's `MAX_SUNS`); more join the L2 light. */
+export const MAX_SUNS = 4;
 
 const luminance = (c) => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 const unit = (v) => {
@@ -117,20 +119,24 @@ export function sunViews(table, direction, radius, turntablesDeg) {
 
 /**
  * The table as a float texture the pre-lit pass reads (`uConditions`): column `k` per
- * condition; row 0 its cone (m, bound; bound 1e30 for an infinite one), row 1 the sun's
- * light per unit of the condition's (`illuminance / delivered`, 0 where it delivers none),
- * rows 2.. its lights (unit direction, share; share 0 beyond its count).
+ * condition; row 0 its cone (m, bound; bound 1e30 for an infinite one), row 1 + s sun
+ * s's light per unit of the condition's (`illuminance / delivered`, 0 where it delivers
+ * none; `illuminances` one RGB a sun, up to MAX_SUNS), rows 1 + MAX_SUNS.. its lights
+ * (unit direction, share; share 0 beyond its count).
  */
-export function conditionTexture(table, illuminance) {
-  const rows = 2 + Math.max(...table.map((c) => c.lights.length));
+export function conditionTexture(table, illuminances) {
+  const first = 1 + MAX_SUNS;
+  const rows = first + Math.max(...table.map((c) => c.lights.length));
   const data = new Float32Array(table.length * rows * 4);
   const set = (k, row, v) => data.set(v, (row * table.length + k) * 4);
   table.forEach((c, k) => {
     set(k, 0, [...c.cone[0], Number.isFinite(c.cone[1]) ? c.cone[1] : 1e30]);
-    set(k, 1, [...[0, 1, 2].map((i) => (c.delivered[i] > 0 ? illuminance[i] / c.delivered[i] : 0)), 0]);
-    c.lights.forEach(([l, share], j) => set(k, 2 + j, [...l, share]));
+    illuminances.slice(0, MAX_SUNS).forEach((e, s) => {
+      set(k, 1 + s, [...[0, 1, 2].map((i) => (c.delivered[i] > 0 ? e[i] / c.delivered[i] : 0)), 0]);
+    });
+    c.lights.forEach(([l, share], j) => set(k, first + j, [...l, share]));
   });
   const texture = new THREE.DataTexture(data, table.length, rows, THREE.RGBAFormat, THREE.FloatType);
   texture.needsUpdate = true;
-  return { texture, lights: rows - 2 };
+  return { texture, lights: rows - first };
 }

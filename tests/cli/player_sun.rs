@@ -3,7 +3,8 @@
 //! sky's L2 light and frf's default sun (E = 10) from the front, behind and the side; the
 //! player carries the sun by the nearest conditions' images with frf's trust, and the
 //! same field exported without them (the sun by albedo and normal, the negative control)
-//! misses. Damaged basis images are refused by name.
+//! misses; the sky's own sun found in its map, and two suns at once. Damaged basis images
+//! and a light file's bad sun are refused by name.
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
@@ -74,17 +75,26 @@ fn the_player_relights_a_sun_by_the_basis_as_frf_does() {
     let found = dir.path().join("sky-suns.json");
     let o = frf(&["env-sh", "sky", "--suns", "--out", found.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    for (u, v) in [(3.0, 1.0), (20.0, 0.0)] {
+    // Two suns at once, from either side (a light file's suns, as `frf env-sh --suns`
+    // writes them): both relit sharply, their trusts weighted by their luminance.
+    let mut light: Value = serde_json::from_slice(&std::fs::read(&sh).unwrap()).unwrap();
+    light["suns"] = serde_json::json!([
+        {"direction": [0.66, 0.64, 0.38], "diameter_deg": 0.53, "illuminance": [6.0, 6.0, 6.0]},
+        {"direction": [-0.75, 0.5, -0.43], "diameter_deg": 0.53, "illuminance": [4.0, 3.5, 3.0]}
+    ]);
+    let two = dir.path().join("two-suns.json");
+    std::fs::write(&two, light.to_string()).unwrap();
+    for (u, v, light) in [(3.0, 1.0, &found), (20.0, 0.0, &found), (11.5, 1.5, &two)] {
         let shot = grid_camera(&document, u, v);
         let case = dir.path().join(format!("found-{u}-{v}"));
         std::fs::create_dir_all(&case).unwrap();
-        let reference = frf_frame(&f.field, &found, &shot, "64x90", None, &case);
+        let reference = frf_frame(&f.field, light, &shot, "64x90", None, &case);
         let out = case.join("player.png");
-        let o = screenshot(&basis, &found, &shot, "64x90", None, &out);
+        let o = screenshot(&basis, light, &shot, "64x90", None, &out);
         assert!(o.status.success(), "{}", stderr(&o));
         let psnr = subject_psnr(&reference, &out);
-        eprintln!("({u}, {v}), the sky's found sun: {psnr:.2} dB");
-        assert!(psnr >= 30.0, "({u}, {v}), found sun: {psnr:.2} dB");
+        eprintln!("({u}, {v}), the suns of {light:?}: {psnr:.2} dB");
+        assert!(psnr >= 30.0, "({u}, {v}), {light:?}: {psnr:.2} dB");
     }
 }
 
