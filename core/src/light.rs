@@ -9,6 +9,31 @@ use crate::image::Rgb;
 /// The widest sun taken, degrees: wider is an area light, not a sun.
 pub const MAX_SUN_DIAMETER_DEG: f32 = 20.0;
 
+/// What is wrong with a sun's values, if anything (`sun_fault`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SunFault {
+    /// The direction is not finite, or zero.
+    Direction,
+    /// The angular diameter is not within (0, [`MAX_SUN_DIAMETER_DEG`]] degrees.
+    Diameter,
+    /// The illuminance is not finite, is negative, or beyond [`MAX_TOTAL_LIGHT`].
+    Illuminance,
+}
+
+/// The first of a sun's values that a sun cannot have (`None`: it can be one), as
+/// `frf_core::sun::Sun::new` and a light file's suns (`frf_core::sh`) check them.
+pub fn sun_fault(direction: Vec3, diameter_deg: f32, illuminance: Rgb) -> Option<SunFault> {
+    if !direction.is_finite() || direction.abs().max_element() <= 0.0 {
+        return Some(SunFault::Direction);
+    }
+    if !(diameter_deg > 0.0 && diameter_deg <= MAX_SUN_DIAMETER_DEG) {
+        return Some(SunFault::Diameter);
+    }
+    // (In f32, as the light is held: a sun of 1e30 is at the bound, not beyond it.)
+    let light = |c: &f32| c.is_finite() && *c >= 0.0 && *c <= MAX_TOTAL_LIGHT as f32;
+    (!illuminance.iter().all(light)).then_some(SunFault::Illuminance)
+}
+
 /// The largest total light (`∫ L dω`, any channel) a loaded map or light may carry: far
 /// above any real scene (the sun's is about 1e5 in units of sky radiance), far below
 /// f32's 3.4e38, so that relit sums and exposures stay finite.

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{CoreError, Result};
 use crate::image::Rgb;
-use crate::light::{MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT};
+use crate::light::{MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT, SunFault, sun_fault};
 
 /// Coefficients per channel of an L2 light.
 pub const SH_COUNT: usize = 9;
@@ -376,26 +376,19 @@ impl ShLight {
             ));
         }
         for (k, sun) in file.suns.iter().enumerate() {
-            let d = Vec3::from(sun.direction);
-            if !d.is_finite() || d.abs().max_element() <= 0.0 {
-                return bad(format!(
-                    "sun {k}'s direction {:?} is not a direction",
-                    sun.direction
-                ));
-            }
-            if !(sun.diameter_deg > 0.0 && sun.diameter_deg <= MAX_SUN_DIAMETER_DEG) {
-                return bad(format!(
-                    "sun {k}'s diameter {}° is not within (0, {MAX_SUN_DIAMETER_DEG}]°",
+            let (d, e) = (sun.direction, sun.illuminance);
+            let problem = match sun_fault(Vec3::from(d), sun.diameter_deg, e) {
+                None => continue,
+                Some(SunFault::Direction) => format!("direction {d:?} is not a direction"),
+                Some(SunFault::Diameter) => format!(
+                    "diameter {}° is not within (0, {MAX_SUN_DIAMETER_DEG}]°",
                     sun.diameter_deg
-                ));
-            }
-            let light = |c: &f32| c.is_finite() && *c >= 0.0 && f64::from(*c) <= MAX_TOTAL_LIGHT;
-            if !sun.illuminance.iter().all(light) {
-                return bad(format!(
-                    "sun {k}'s illuminance {:?} is not a finite, non-negative light",
-                    sun.illuminance
-                ));
-            }
+                ),
+                Some(SunFault::Illuminance) => {
+                    format!("illuminance {e:?} is not a finite, non-negative light")
+                }
+            };
+            return bad(format!("sun {k}'s {problem}"));
         }
         Ok((Self { coefficients }, file.suns))
     }

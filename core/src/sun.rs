@@ -11,6 +11,7 @@ use glam::Vec3;
 use crate::env::EnvMap;
 use crate::error::{CoreError, Result};
 use crate::image::Rgb;
+use crate::light::{SunFault, sun_fault};
 
 /// The widest sun taken, degrees: wider is an area light, not a sun.
 pub const MAX_DIAMETER_DEG: f32 = crate::light::MAX_SUN_DIAMETER_DEG;
@@ -38,33 +39,25 @@ impl Sun {
     /// angular diameter `diameter_deg` and illuminance `illuminance` (per channel): values
     /// outside what a sun can be are refused naming them.
     pub fn new(direction: Vec3, diameter_deg: f32, illuminance: Rgb) -> Result<Self> {
+        if let Some(fault) = sun_fault(direction, diameter_deg, illuminance) {
+            let (what, problem) = match fault {
+                SunFault::Direction => ("sun direction", format!("{direction} is not a direction")),
+                SunFault::Diameter => (
+                    "sun angular diameter",
+                    format!("{diameter_deg}° is not within (0, {MAX_DIAMETER_DEG}]°"),
+                ),
+                SunFault::Illuminance => (
+                    "sun illuminance",
+                    format!("{illuminance:?} is not a finite, non-negative light"),
+                ),
+            };
+            return Err(CoreError::invalid(what, problem));
+        }
         // Any finite, non-zero vector names a direction, however short or long: it is
         // scaled to its largest component before it is normalised, so that neither its
         // length's square underflows (a sun found in a dim map) nor overflows (one of
         // 1e20) in 32-bit floats.
-        let longest = direction.abs().max_element();
-        if !direction.is_finite() || longest <= 0.0 {
-            return Err(CoreError::invalid(
-                "sun direction",
-                format!("{direction} is not a direction"),
-            ));
-        }
-        let direction = (direction / longest).normalize();
-        if !(diameter_deg > 0.0 && diameter_deg <= MAX_DIAMETER_DEG) {
-            return Err(CoreError::invalid(
-                "sun angular diameter",
-                format!("{diameter_deg}° is not within (0, {MAX_DIAMETER_DEG}]°"),
-            ));
-        }
-        if illuminance
-            .iter()
-            .any(|c| !c.is_finite() || *c < 0.0 || *c > crate::env::MAX_TOTAL_LIGHT as f32)
-        {
-            return Err(CoreError::invalid(
-                "sun illuminance",
-                format!("{illuminance:?} is not a finite, non-negative light"),
-            ));
-        }
+        let direction = (direction / direction.abs().max_element()).normalize();
         Ok(Self {
             direction,
             diameter: diameter_deg.to_radians(),
@@ -194,6 +187,22 @@ impl Sun {
             e.map(|c| c.min(crate::env::MAX_TOTAL_LIGHT) as f32),
         )?;
         Ok(Some((sun, env.with_image(radiance)?)))
+    }
+
+    /// Up to `most` suns of `env`, brightest first, each found in what the last left
+    /// ([`Sun::extract`]), and the map less them (`None` when it holds none): what a
+    /// relighting takes out of a map and relights by the normals.
+    pub fn extract_all(env: &EnvMap, most: usize) -> Result<(Vec<Sun>, Option<EnvMap>)> {
+        let mut suns = Vec::new();
+        let mut rest: Option<EnvMap> = None;
+        while suns.len() < most {
+            let Some((found, less)) = Sun::extract(rest.as_ref().unwrap_or(env))? else {
+                break;
+            };
+            suns.push(found);
+            rest = Some(less);
+        }
+        Ok((suns, rest))
     }
 
     /// What a sun below the horizon does (`None` above it), for a note to the user: under

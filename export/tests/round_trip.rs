@@ -5,13 +5,46 @@
 
 #![allow(clippy::unwrap_used)] // tests: a failed unwrap is a failed test
 
+use std::path::Path;
+
 use frf_core::env::SH_MAP_HEIGHT;
+use frf_core::image::{GrayImage, RgbImage};
 use frf_core::sh::ShLight;
 use frf_export::read::Export;
-use frf_export::{ExportOptions, Tier, ViewSelection, export};
+use frf_export::{ExportOptions, ExportReport, Tier, ViewSelection, export};
 use frf_reflectance::FieldFile;
 use frf_reflectance::project::FloorModel;
 use frf_reflectance::relight::relight;
+use tempfile::TempDir;
+
+/// `field` exported with `options` into a new directory, read back, and opened: the
+/// directory (kept while the test runs), the report, the export and the field.
+fn exported(field: &Path, options: &ExportOptions) -> (TempDir, ExportReport, Export, FieldFile) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("walker.glb");
+    let report = export(field, &out, options).unwrap();
+    let glb = Export::open(&out).unwrap();
+    (dir, report, glb, FieldFile::open(field).unwrap())
+}
+
+/// PSNR of `got` against `want` (its brightest channel the peak) over the texels `alpha`
+/// covers by more than half, and the samples it read (three a texel).
+fn matte_psnr(want: &RgbImage, got: &RgbImage, alpha: &GrayImage) -> (f64, usize) {
+    let (mut se, mut n, mut peak) = (0.0f64, 0usize, 0.0f32);
+    for ((w, g), &a) in want.pixels().iter().zip(got.pixels()).zip(alpha.pixels()) {
+        if a > 0.5 {
+            for c in 0..3 {
+                se += ((w[c] - g[c]) as f64).powi(2);
+                peak = peak.max(w[c]);
+            }
+            n += 3;
+        }
+    }
+    (
+        10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10(),
+        n,
+    )
+}
 
 /// The built-in sky's L2 light.
 fn light() -> ShLight {
@@ -56,18 +89,8 @@ fn relights_as_frf(tier: Tier, floor_db: f64) {
         let want = relight(&field.basis(0, u, v).unwrap(), &a).unwrap();
         let got = glb.relight(0, u, v, &light).unwrap();
         let alpha = glb.alpha(0, u, v).unwrap();
-        let (mut se, mut n, mut peak) = (0.0f64, 0usize, 0.0f32);
-        for ((w, g), &al) in want.pixels().iter().zip(got.pixels()).zip(alpha.pixels()) {
-            if al > 0.5 {
-                for c in 0..3 {
-                    se += ((w[c] - g[c]) as f64).powi(2);
-                    peak = peak.max(w[c]);
-                }
-                n += 3;
-            }
-        }
+        let (psnr, n) = matte_psnr(&want, &got, &alpha);
         assert!(n > 300, "view {u},{v}: {n} samples");
-        let psnr = 10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10();
         eprintln!("{tier:?} view {u},{v}: exported transfer against frf's relighting {psnr:.2} dB");
         assert!(psnr > floor_db, "{tier:?} view {u},{v}: {psnr:.2} dB");
     }
@@ -297,15 +320,11 @@ fn a_field_without_normals_exports_without_them_and_says_so() {
 #[test]
 fn flows_are_the_fields_within_a_code_and_extended_beyond_the_subject() {
     let f = frf_testkit::tiny_field();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("walker.glb");
     let options = ExportOptions {
         views: ViewSelection::List(vec![(5, 1)]),
         ..ExportOptions::default()
     };
-    export(&f.field, &out, &options).unwrap();
-    let glb = Export::open(&out).unwrap();
-    let field = FieldFile::open(&f.field).unwrap();
+    let (_dir, _, glb, field) = exported(&f.field, &options);
     let view = glb.view(0, 5, 1).unwrap();
     let index = view.flows["right"];
     let png = image::load_from_memory(glb.image_bytes(index).unwrap())
@@ -345,15 +364,11 @@ fn flows_are_the_fields_within_a_code_and_extended_beyond_the_subject() {
 #[test]
 fn motion_and_ground_shadows_are_the_fields_within_a_code() {
     let f = frf_testkit::tiny_two_poses();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("walker.glb");
     let options = ExportOptions {
         views: ViewSelection::List(vec![(5, 1)]),
         ..ExportOptions::default()
     };
-    export(&f.field, &out, &options).unwrap();
-    let glb = Export::open(&out).unwrap();
-    let field = FieldFile::open(&f.field).unwrap();
+    let (_dir, _, glb, field) = exported(&f.field, &options);
     let h = field.header();
     let ext = &glb.document["extensions"]["FRF_flowed_reflectance_field"];
     assert_eq!(
@@ -430,23 +445,19 @@ fn motion_and_ground_shadows_are_the_fields_within_a_code() {
 #[test]
 fn basis_images_are_the_fields_within_the_jpegs_error() {
     let f = frf_testkit::tiny_field();
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("walker.glb");
     let views = ViewSelection::List(vec![(3, 1)]);
     let options = ExportOptions {
         views: views.clone(),
         basis: true,
         ..ExportOptions::default()
     };
-    let report = export(&f.field, &out, &options).unwrap();
+    let (dir, report, glb, field) = exported(&f.field, &options);
     let basis_bytes = report.section_bytes[8].1;
     let transfer_bytes = report.section_bytes[0].1;
     assert!(
         basis_bytes > transfer_bytes,
         "{basis_bytes} vs {transfer_bytes}"
     );
-    let glb = Export::open(&out).unwrap();
-    let field = FieldFile::open(&f.field).unwrap();
     assert_eq!(
         glb.field().basis.as_ref().unwrap().conditions,
         field.header().conditions
@@ -455,17 +466,7 @@ fn basis_images_are_the_fields_within_the_jpegs_error() {
     let alpha = glb.alpha(0, 3, 1).unwrap();
     assert_eq!(got.len(), want.len());
     for (k, (g, w)) in got.iter().zip(&want).enumerate() {
-        let (mut se, mut n, mut peak) = (0.0f64, 0usize, 0.0f32);
-        for ((g, w), &a) in g.pixels().iter().zip(w.pixels()).zip(alpha.pixels()) {
-            if a > 0.5 {
-                for c in 0..3 {
-                    se += ((g[c] - w[c]) as f64).powi(2);
-                    peak = peak.max(w[c]);
-                }
-                n += 3;
-            }
-        }
-        let psnr = 10.0 * (peak as f64 * peak as f64 / (se / n as f64)).log10();
+        let (psnr, n) = matte_psnr(w, g, &alpha);
         assert!(
             n > 300 && psnr > 40.0,
             "condition {k}: {psnr:.2} dB over {n}"

@@ -9,7 +9,7 @@
 // layers are redone when the light changes.
 import * as THREE from 'three';
 import { parseGlb, poseMesh, BadFile } from './glb.js';
-import { MAX_TOTAL_LIGHT } from './sh.js';
+import { MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT } from './sh.js';
 import { png, greyJpeg, expect } from './images.js';
 import {
   poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
@@ -20,7 +20,7 @@ import {
   GROUND_SHADOW_LAYER_FRAGMENT,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
-import { conditionTable, conditionTexture, sunViews, INVOLVED, MAX_CONDITIONS, MAX_SUNS, NEAREST } from './sun.js';
+import { conditionTable, conditionTexture, luminance, sunViews, INVOLVED, MAX_CONDITIONS, MAX_SUNS, NEAREST } from './sun.js';
 import { subjectBounds, flowReachM, pixelBox, unionBox } from './footprint.js';
 
 /** The sun's map of the hull, texels a side. */
@@ -81,8 +81,6 @@ export function cameraUniforms(u, camera) {
   u.uK.value.set(camera.k.fx, camera.k.fy, camera.k.cx, camera.k.cy);
   u.uHeight.value = camera.height;
 }
-
-/** A light: nine RGB radiance coefficients (three.js order) and an optional sun. */
 
 export class FrfPlayer {
   /** `renderer`: a THREE.WebGLRenderer (WebGL 2). */
@@ -252,7 +250,7 @@ export class FrfPlayer {
       const d = new THREE.Vector3(...sun.direction);
       if (!(d.length() > 0) || !Number.isFinite(d.length())) throw new Error('a sun\'s direction is a non-zero vector');
       const diameter = sun.diameter_deg ?? 0.53;
-      if (!(diameter > 0 && diameter <= 180)) throw new Error('a sun\'s angular diameter is above 0 and at most 180 degrees');
+      if (!(diameter > 0 && diameter <= MAX_SUN_DIAMETER_DEG)) throw new Error(`a sun's angular diameter is above 0 and at most ${MAX_SUN_DIAMETER_DEG} degrees`);
       return { direction: d.normalize().toArray(), illuminance: [...e], diameter_deg: diameter };
     }).filter((s) => s.illuminance.some((v) => v > 0));
     this.sh = sh.map((c) => [...c]);
@@ -266,8 +264,7 @@ export class FrfPlayer {
     const below = checked.filter((s) => s.direction[1] <= 0);
     below.forEach(intoL2);
     if (below.length > 0) note('the sun is below the horizon: it lights the walker from below as its L2 light, softly, with no sharp shading or shadow (as frf lights it through the floor conditions)');
-    const lum = (s) => 0.2126 * s.illuminance[0] + 0.7152 * s.illuminance[1] + 0.0722 * s.illuminance[2];
-    const above = checked.filter((s) => s.direction[1] > 0).sort((a, b) => lum(b) - lum(a));
+    const above = checked.filter((s) => s.direction[1] > 0).sort((a, b) => luminance(b.illuminance) - luminance(a.illuminance));
     this.suns = above.slice(0, MAX_SUNS);
     above.slice(MAX_SUNS).forEach(intoL2);
     if (above.length > MAX_SUNS) note(`${above.length} suns: the brightest ${MAX_SUNS} are relit sharply, the other ${above.length - MAX_SUNS} join the L2 light (as frf)`);
@@ -685,10 +682,7 @@ export class FrfPlayer {
     u.uConditionCount.value = conditions.length;
     u.uLightsPer.value = this.conditionTexture.lights;
     const turntables = pose.record.views.map((v) => v.turntable_deg);
-    this.suns.forEach((sun, s) => {
-      const e = sun.illuminance;
-      u.uSunLum.value[s] = 0.2126 * e[0] + 0.7152 * e[1] + 0.0722 * e[2];
-    });
+    this.suns.forEach((sun, s) => { u.uSunLum.value[s] = luminance(sun.illuminance); });
     return this.suns.map((sun) => sunViews(this.conditionTable, sun.direction, (sun.diameter_deg * Math.PI) / 360, turntables));
   }
 

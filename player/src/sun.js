@@ -20,7 +20,8 @@ export const MAX_CONDITIONS = 32;
 /** The most suns relit sharply (frf's `MAX_SUNS`); more join the L2 light. */
 export const MAX_SUNS = 4;
 
-const luminance = (c) => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+/** The luminance of an RGB light (frf's `luminance`). */
+export const luminance = (c) => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 const unit = (v) => {
   const l = Math.hypot(...v);
   return l > 0 ? v.map((x) => x / l) : [0, 0, 0];

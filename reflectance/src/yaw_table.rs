@@ -189,15 +189,7 @@ impl YawTable {
         if let Some(made) = self.less_suns.get() {
             return Ok(made.as_ref());
         }
-        let mut suns = Vec::new();
-        let mut rest: Option<EnvMap> = None;
-        while suns.len() < MAX_SUNS {
-            let Some((found, less)) = Sun::extract(rest.as_ref().unwrap_or(&self.map))? else {
-                break;
-            };
-            suns.push(found);
-            rest = Some(less);
-        }
+        let (suns, rest) = Sun::extract_all(&self.map, MAX_SUNS)?;
         let made = rest.map(|r| (suns, Samples::new(PreparedMap::new(&r, self.floor))));
         // (Another thread may have found the same suns meanwhile.)
         Ok(self.less_suns.get_or_init(|| made).as_ref())

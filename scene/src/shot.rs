@@ -757,13 +757,8 @@ impl<'a, R: ReadAt> Shot<'a, R> {
         if let Some(shade) = self.envs.get(&key) {
             return Ok(shade.clone());
         }
-        let mut shade = e;
-        for _ in 0..frf_reflectance::sun_light::MAX_SUNS {
-            match frf_core::sun::Sun::extract(&shade)? {
-                Some((_, less)) => shade = less,
-                None => break,
-            }
-        }
+        let most = frf_reflectance::sun_light::MAX_SUNS;
+        let shade = frf_core::sun::Sun::extract_all(&e, most)?.1.unwrap_or(e);
         self.envs.insert(key, shade.clone());
         Ok(shade)
     }

@@ -96,20 +96,15 @@ pub fn run(args: EnvShArgs) -> CliResult {
 /// The map's suns (up to [`MAX_SUNS`], each found in what the last left, as frf's
 /// relighting finds them) and the map less them.
 fn found_suns(env: EnvMap) -> CliResult<(EnvMap, Vec<ShSun>)> {
-    let mut rest = env;
-    let mut suns = Vec::new();
-    while suns.len() < MAX_SUNS {
-        let Some((sun, less)) = Sun::extract(&rest)? else {
-            break;
-        };
-        suns.push(ShSun {
+    let (suns, rest) = Sun::extract_all(&env, MAX_SUNS)?;
+    let suns = (suns.iter())
+        .map(|sun| ShSun {
             direction: sun.direction().to_array(),
             diameter_deg: 2.0 * sun.radius().to_degrees(),
             illuminance: sun.illuminance(),
-        });
-        rest = less;
-    }
-    Ok((rest, suns))
+        })
+        .collect();
+    Ok((rest.unwrap_or(env), suns))
 }
 
 /// `Σ c_i² / ∫ L² dω` of the luminance: 1 for a light that is L2 already.
