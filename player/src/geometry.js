@@ -173,11 +173,32 @@ export function poseGeometry(grid, cameraRecords, hullPositions) {
   return { cameras, quads, frames, frameRows, axis, hasHull: hullPositions.length > 0 };
 }
 
-/** Quads as RGBA32F texels, 5 per quad: p00+u, e1+v, e2+wall, e3+wallGamma, normal. */
+/** RGBA32F texels a quad: its corners and normal, then its plane and edges' tests. */
+export const QUAD_TEXELS = 10;
+
+/** How far outside its unit square (bilinear units) a point still meets a quad (frf's `EDGE_SLACK`). */
+const EDGE_SLACK = 1e-4;
+
+/**
+ * Quads as RGBA32F texels, `QUAD_TEXELS` a quad: p00+u, e1+v, e2+wall, e3+wallGamma,
+ * normal; then its plane (n, n . p00) and, per edge i of the corner cycle p00, p10,
+ * p11, p01, the test (m, k) with m = n x edge: a point p of the plane is inside the
+ * quad where m . p >= k on every edge (the slack of frf's `EDGE_SLACK` added, scaled
+ * by the edges' lengths).
+ */
 export function quadTexels(quads) {
-  const out = new Float32Array(quads.length * 5 * 4);
+  const out = new Float32Array(quads.length * QUAD_TEXELS * 4);
   quads.forEach((q, i) => {
-    out.set([...q.p00, q.u, ...q.e1, q.v, ...q.e2, q.wall, ...q.e3, q.wallGamma, ...q.normal, 0], i * 20);
+    const n = q.normal;
+    const p10 = add(q.p00, q.e1);
+    const p01 = add(q.p00, q.e2);
+    const corners = [q.p00, p10, add(p10, add(q.e2, q.e3)), p01];
+    const slack = EDGE_SLACK * length(q.e1) * length(q.e2);
+    const edges = corners.flatMap((c, j) => {
+      const m = cross(n, sub(corners[(j + 1) % 4], c));
+      return [...m, dot(c, m) - slack];
+    });
+    out.set([...q.p00, q.u, ...q.e1, q.v, ...q.e2, q.wall, ...q.e3, q.wallGamma, ...n, 0, ...n, dot(n, q.p00), ...edges], i * QUAD_TEXELS * 4);
   });
   return out;
 }

@@ -12,7 +12,7 @@ import { parseGlb, poseMesh, BadFile } from './glb.js';
 import { MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT } from './sh.js';
 import { png, greyJpeg, expect } from './images.js';
 import {
-  poseGeometry, quadTexels, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
+  poseGeometry, quadTexels, QUAD_TEXELS, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
 } from './geometry.js';
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
@@ -345,7 +345,7 @@ export class FrfPlayer {
       albedo: arrayTexture(data.albedo, w, h, 2 * n, THREE.RGBAFormat, THREE.UnsignedByteType),
       flows: arrayTexture(data.flows, w, h, Math.max(flowCount, 1), THREE.RGFormat, THREE.FloatType),
       views: dataTexture(viewTable, 2, columns * rows),
-      quads: dataTexture(quadTexels(geometry.quads), 5, geometry.quads.length),
+      quads: dataTexture(quadTexels(geometry.quads), QUAD_TEXELS, geometry.quads.length),
       frames: dataTexture(frameTexels(geometry.frames), FRAME_TEXELS, geometry.frames.length),
       index: columnIndex(geometry.quads, rows + 1, geometry.cameras, rows),
       prelit: new THREE.WebGLArrayRenderTarget(w, h, n, {

@@ -331,6 +331,7 @@ const float SETTLED_PX = 0.01;
 const float SETTLE_PX = 2.0;
 const float SETTLE_FLOOR = 1e-3;
 const float BIG = 3.4e38;
+const int NONE = 1 << 30;
 
 float cross2(vec2 m, vec2 n) { return m.x * n.y - m.y * n.x; }
 bool finite(float x) { return abs(x) <= BIG; }
@@ -400,24 +401,34 @@ uniform int uSpans;
 uniform int uQuadsPerSpan;
 const float TAU = 6.2831855;
 
-// Offers the hit of the ray on quad i: the smallest t is kept (of equal ones the
-// first quad's), and whether any lies ahead.
-void offer(int i, vec3 origin, vec3 dir, inout Hit best, inout int bestIndex, inout bool anyAhead) {
-  vec4 t0 = quadTexel(i, 0), t1 = quadTexel(i, 1), t2 = quadTexel(i, 2), t3 = quadTexel(i, 3), t4 = quadTexel(i, 4);
-  vec3 normal = t4.xyz;
-  float denom = dot(normal, dir);
-  if (abs(denom) < 1e-9) return;
-  float t = dot(normal, t0.xyz - origin) / denom;
-  vec3 p = origin + dir * t;
-  vec3 r = inverseBilinear(p, t0.xyz, t1.xyz, t2.xyz, t3.xyz, normal);
-  if (r.z == 0.0 || outside(r.xy) > 1e-4) return;
-  if (t >= 0.0) anyAhead = true;
-  if (t < best.t || (t == best.t && i < bestIndex)) {
-    int wall = int(t2.w);
-    float gamma = wall != 0 ? t3.w : clamp(r.y, 0.0, 1.0);
-    best = Hit(int(t0.w), int(t1.w), clamp(r.x, 0.0, 1.0), gamma, p, t, wall);
+// Offers quad i: where the ray meets its plane, kept when inside the quad (its four
+// edges' tests, geometry.js quadTexels: frf's EDGE_SLACK as a band along the edges)
+// and nearer than the best so far (of equal ones the first quad's); and whether any
+// lies ahead. Its bilinear coordinates are solved once, for the quad kept (hitOn).
+void offer(int i, vec3 origin, vec3 dir, inout float bestT, inout int bestIndex, inout bool anyAhead) {
+  vec4 plane = quadTexel(i, 5);
+  float denom = dot(plane.xyz, dir);
+  float t = (plane.w - dot(plane.xyz, origin)) / denom;
+  vec4 p = vec4(origin + dir * t, -1.0);
+  vec4 s = vec4(dot(quadTexel(i, 6), p), dot(quadTexel(i, 7), p), dot(quadTexel(i, 8), p), dot(quadTexel(i, 9), p));
+  bool inside = abs(denom) >= 1e-9 && min(min(s.x, s.y), min(s.z, s.w)) >= 0.0;
+  if (inside && t >= 0.0) anyAhead = true;
+  if (inside && (t < bestT || (t == bestT && i < bestIndex))) {
+    bestT = t;
     bestIndex = i;
   }
+}
+
+// The ray's hit on quad i (frf's): its column and row, its bilinear coordinates (the
+// wall's gamma above and below the grid) and point.
+Hit hitOn(int i, vec3 origin, vec3 dir) {
+  vec4 t0 = quadTexel(i, 0), t1 = quadTexel(i, 1), t2 = quadTexel(i, 2), t3 = quadTexel(i, 3), t4 = quadTexel(i, 4);
+  float t = dot(t4.xyz, t0.xyz - origin) / dot(t4.xyz, dir);
+  vec3 p = origin + dir * t;
+  vec3 r = inverseBilinear(p, t0.xyz, t1.xyz, t2.xyz, t3.xyz, t4.xyz);
+  int wall = int(t2.w);
+  float gamma = wall != 0 ? t3.w : clamp(r.y, 0.0, 1.0);
+  return Hit(int(t0.w), int(t1.w), clamp(r.x, 0.0, 1.0), gamma, p, t, wall);
 }
 
 float turn(vec2 s, vec2 e) { return atan(cross2(s, e), dot(s, e)); }
@@ -428,7 +439,7 @@ float columnAzimuth(vec2 v) {
 vec2 spanRange(int u) { return texelFetch(uRanges, ivec2(u, 0), 0).xy; }
 
 // Offers the quads of every span whose range meets the azimuths swept from start to end.
-void walkSpans(vec2 start, vec2 end, vec3 origin, vec3 dir, inout Hit best, inout int bestIndex, inout bool anyAhead) {
+void walkSpans(vec2 start, vec2 end, vec3 origin, vec3 dir, inout float bestT, inout int bestIndex, inout bool anyAhead) {
   float sweep = uColOrientation * turn(start, end);
   float a = columnAzimuth(start);
   float len = sweep;
@@ -444,10 +455,10 @@ void walkSpans(vec2 start, vec2 end, vec3 origin, vec3 dir, inout Hit best, inou
     if (spanRange(mid).y < a) lo = mid + 1; else hi = mid;
   }
   for (int u = lo; u < uSpans && spanRange(u).x <= b; u++) {
-    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, best, bestIndex, anyAhead);
+    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, bestT, bestIndex, anyAhead);
   }
   for (int u = 0; u < uSpans && spanRange(u).x + TAU <= b; u++) {
-    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, best, bestIndex, anyAhead);
+    for (int k = 0; k < uQuadsPerSpan; k++) offer(u * uQuadsPerSpan + k, origin, dir, bestT, bestIndex, anyAhead);
   }
 }
 
@@ -455,17 +466,17 @@ void walkSpans(vec2 start, vec2 end, vec3 origin, vec3 dir, inout Hit best, inou
 // (clamped = 3). Only the spans the ray's line can reach are tested (every quad without
 // the index), as frf does.
 Hit intersect(vec3 origin, vec3 dir) {
-  Hit best = Hit(0, 0, 0.0, 0.0, vec3(0.0), BIG, 3);
-  int bestIndex = 1 << 30;
+  float bestT = BIG;
+  int bestIndex = NONE;
   bool anyAhead = false;
   if (uIndexed == 0) {
-    for (int i = 0; i < uQuadCount; i++) offer(i, origin, dir, best, bestIndex, anyAhead);
+    for (int i = 0; i < uQuadCount; i++) offer(i, origin, dir, bestT, bestIndex, anyAhead);
   } else {
     vec2 o = origin.xz - uColAxis;
     float m = max(abs(dir.x), abs(dir.z));
     if (m == 0.0) {
       float r = length(o);
-      if (r >= uRMin && r <= uRMax) walkSpans(o, o, origin, dir, best, bestIndex, anyAhead);
+      if (r >= uRMin && r <= uRMax) walkSpans(o, o, origin, dir, bestT, bestIndex, anyAhead);
     } else {
       vec2 d = normalize(dir.xz / m);
       vec2 across = vec2(-d.y, d.x);
@@ -474,17 +485,17 @@ Hit intersect(vec3 origin, vec3 dir) {
         vec2 foot = across * h;
         float outer = sqrt(uRMax * uRMax - h * h);
         if (abs(h) >= uRMin) {
-          walkSpans(foot - d * outer, foot + d * outer, origin, dir, best, bestIndex, anyAhead);
+          walkSpans(foot - d * outer, foot + d * outer, origin, dir, bestT, bestIndex, anyAhead);
         } else {
           float inner = sqrt(uRMin * uRMin - h * h);
-          walkSpans(foot - d * outer, foot - d * inner, origin, dir, best, bestIndex, anyAhead);
-          walkSpans(foot + d * inner, foot + d * outer, origin, dir, best, bestIndex, anyAhead);
+          walkSpans(foot - d * outer, foot - d * inner, origin, dir, bestT, bestIndex, anyAhead);
+          walkSpans(foot + d * inner, foot + d * outer, origin, dir, bestT, bestIndex, anyAhead);
         }
       }
     }
   }
-  if (!anyAhead) best.clamped = 3;
-  return best;
+  if (bestIndex == NONE || !anyAhead) return Hit(0, 0, 0.0, 0.0, vec3(0.0), BIG, 3);
+  return hitOn(bestIndex, origin, dir);
 }
 
 vec4 bilinearWeights(float beta, float gamma) {
