@@ -4,7 +4,7 @@
 //   node player/screenshot.mjs --glb F [--pose N | --time SECONDS [--interpolate flow|nearest]] \
 //     --camera X,Y,Z --look-at X,Y,Z --fov DEG --size WxH --sh SH.json [--sun AZ,EL[,DIAM[,E]]] \
 //     --out OUT.png [--time-frames K] [--box X,Y,Z,SX,SY,SZ,R,G,B ...] [--no-depth]
-//     [--shadow-out SHADOW.png] [--all-views] [--json]
+//     [--shadow-out SHADOW.png] [--all-views] [--mask VIEW_PX|none] [--json]
 //
 // `--pose N` draws a pose; `--time SECONDS` an instant of the walk (from pose 0's, looping
 // every cycle), between two poses morphed in time by their motion as frf does (`flow`), or
@@ -20,6 +20,8 @@
 // given), lighting by the normals (below the horizon, softly through the L2 light); the
 // light file's own suns (`frf env-sh --suns`) light it too. Only the views the camera's
 // rays reach are decoded (`views_decoded` in the JSON); `--all-views` decodes every view.
+// The passes shade only the walker's mask, its hull grown by `--mask` of its views'
+// pixels (8 when not given; `none`: every pixel of the walker's box, as frf).
 // `--time-frames K` times K frames after the first (ms per frame). Chromium is found at
 // $CHROMIUM, else /usr/bin/chromium (scripts/setup.sh installs it).
 import { readFile, writeFile, rename, stat, unlink } from 'node:fs/promises';
@@ -72,6 +74,12 @@ function parse(argv) {
       case '--box': o.boxes.push(numbers(flag, value(), 9)); break;
       case '--no-depth': o.depth = false; break;
       case '--all-views': o.allViews = true; break;
+      case '--mask': {
+        const v = value();
+        o.mask = v === 'none' ? null : numbers(flag, v, 1)[0];
+        if (o.mask !== null && !(o.mask >= 0 && o.mask <= 1000)) fail(`--mask ${v}: expected views' pixels from 0 to 1000, or none`);
+        break;
+      }
       case '--shadow-out': o.shadowOut = value(); break;
       default: fail(`unknown flag ${flag}`);
     }
@@ -147,7 +155,7 @@ try {
     glbUrl: '/job/walker.glb', glbName: basename(o.glb), shText, shName: basename(o.sh),
     pose: o.pose, time: o.time, interpolate: o.interpolate, camera: o.camera, lookAt: o.lookAt, fov: o.fov, width: o.width, height: o.height,
     sun: o.sun ?? null, timedFrames: o.timeFrames, boxes: o.boxes, depth: o.depth, shadowLayer: Boolean(o.shadowOut),
-    allViews: Boolean(o.allViews),
+    allViews: Boolean(o.allViews), mask: o.mask,
   });
 } catch (e) {
   if (interrupted) await new Promise(() => {});
@@ -179,6 +187,6 @@ if (o.shadowOut) {
 const report = {
   out: o.out, pose: result.at.before, between: result.at.s > 0 ? { after: result.at.after, s: result.at.s } : null, width: o.width, height: o.height,
   ms_per_frame: result.msPerFrame, frame_parts_ms: result.partsMs, timed_frames: o.timeFrames, load_ms: result.loadMs, load_parts_ms: result.loadParts,
-  gl_renderer: result.renderer, notes: result.notes, views_decoded: result.viewsDecoded,
+  gl_renderer: result.renderer, notes: result.notes, views_decoded: result.viewsDecoded, mask: result.mask, shaded_pixels: result.shadedPixels,
 };
 console.log(o.json ? JSON.stringify(report) : `wrote ${o.out} (${o.width}x${o.height}, pose ${result.at.before}${result.at.s > 0 ? ` to ${result.at.after} at ${result.at.s.toFixed(3)}` : ''}${result.msPerFrame ? `, ${result.msPerFrame.toFixed(1)} ms per frame on ${result.renderer}` : ''})`);

@@ -40,9 +40,14 @@ export function subjectBounds(positions, margin) {
  * bilinear footprint, at the median pixels per metre of the views' `cameras`.
  */
 export function flowReachM(maxFlowPx, cameras) {
+  return (maxFlowPx * Math.SQRT2 + 1) * viewPixelM(cameras);
+}
+
+/** A view's pixel at the subject's axis, in metres: at the median pixels per metre of `cameras`. */
+export function viewPixelM(cameras) {
   const ppm = cameras.map(pixelsPerMetre).sort((a, b) => a - b);
   const median = ppm[Math.floor(ppm.length / 2)] ?? 0;
-  return (maxFlowPx * Math.SQRT2 + 1) / median;
+  return 1 / median;
 }
 
 /**

@@ -57,6 +57,7 @@ window.frfRender = async (job) => {
   canvas.height = job.height;
   const renderer = new THREE.WebGLRenderer({ canvas, antialias: false, alpha: true, preserveDrawingBuffer: true });
   const player = new FrfPlayer(renderer);
+  if (job.mask !== undefined) player.maskViewPx = job.mask;
   const response = await fetch(job.glbUrl);
   if (!response.ok) throw new Error(`${job.glbName}: ${response.status} ${response.statusText}`);
   const bytes = new Uint8Array(await response.arrayBuffer());
@@ -154,6 +155,8 @@ window.frfRender = async (job) => {
   const parts = player.poses.get(at.before);
   const loadParts = { ...parts.loadMs, relight: parts.relightMs };
   const viewsDecoded = player.viewsDecoded();
-  return { rgba: base64(out), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER), viewsDecoded };
+  const m = parts.mask;
+  const mask = m ? { view_px: m.viewPx, margin_m: m.marginM, voxel_m: m.voxelM, voxels: m.centres.length / 3 } : null;
+  return { rgba: base64(out), shadow, msPerFrame, partsMs, loadMs, loadParts, at, notes: player.notes, renderer: gl.getParameter(gl.RENDERER), viewsDecoded, mask, shadedPixels: player.drawn?.shadedPixels ?? 0 };
 };
 window.frfReady = true;

@@ -17,11 +17,12 @@ import {
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
   SUN_MAP_VERTEX, SUN_MAP_FRAGMENT, TIME_MORPH_FRAGMENT, GROUND_SHADOW_RELIGHT_FRAGMENT,
-  GROUND_SHADOW_LAYER_FRAGMENT,
+  GROUND_SHADOW_LAYER_FRAGMENT, TILE_VERTEX,
 } from './shaders.js';
 import { instantOf, motionToImage } from './time.js';
 import { conditionTable, conditionTexture, luminance, sunViews, INVOLVED, MAX_CONDITIONS, MAX_SUNS, NEAREST } from './sun.js';
-import { subjectBounds, flowReachM, pixelBox, unionBox } from './footprint.js';
+import { subjectBounds, flowReachM, viewPixelM, pixelBox, unionBox } from './footprint.js';
+import { maskVoxels, maskTiles, TILE_PX } from './mask.js';
 
 /** The sun's map of the hull, texels a side. */
 const SUN_MAP_SIZE = 512;
@@ -31,6 +32,14 @@ const SUN_MAP_SIZE = 512;
  * its hull grid's height, which the export gives as `sun_shadow_offset_m`).
  */
 const SHADOW_OFFSET_PER_HEIGHT = 0.17;
+
+/**
+ * The walker's mask (mask.js) grows its hull by this many of its views' pixels (at the
+ * subject) and its mesh's voxel: what the views' soft edges, the cycles' disagreement
+ * the hull's carving leaves out and the flows' errors put outside the hull. Chosen on
+ * the small preset's two-pose oracle field (docs/export.md, "The walker's mask").
+ */
+export const MASK_VIEW_PX = 8;
 
 const NEIGHBOURS = ['right', 'left', 'up', 'down'];
 /** The steps in time a view's motion is stored toward (`motion_to`'s keys). */
@@ -122,7 +131,7 @@ export class FrfPlayer {
     });
     this.prelitScene = fullscreen(this.prelitMaterial);
     this.frameMaterial = new THREE.RawShaderMaterial({
-      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: FRAME_FRAGMENT,
+      glslVersion: THREE.GLSL3, vertexShader: TILE_VERTEX, fragmentShader: FRAME_FRAGMENT,
       uniforms: {
         uEye: { value: new THREE.Vector3() }, uAxes: { value: new THREE.Matrix3() }, uK: { value: new THREE.Vector4() },
         uHeight: { value: 0 }, uQuads: { value: null }, uQuadCount: { value: 0 }, uFrames: { value: null },
@@ -135,7 +144,7 @@ export class FrfPlayer {
       },
       depthTest: false, depthWrite: false, transparent: false, blending: THREE.NoBlending,
     });
-    this.frameScene = fullscreen(this.frameMaterial);
+    this.frameScene = tiled(this.frameMaterial);
     this.sunMapMaterial = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: SUN_MAP_VERTEX, fragmentShader: SUN_MAP_FRAGMENT,
       uniforms: {
@@ -151,14 +160,18 @@ export class FrfPlayer {
     });
     this.groundScene = fullscreen(this.groundMaterial);
     this.timeMaterial = new THREE.RawShaderMaterial({
-      glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: TIME_MORPH_FRAGMENT,
+      glslVersion: THREE.GLSL3, vertexShader: TILE_VERTEX, fragmentShader: TIME_MORPH_FRAGMENT,
       uniforms: {
         uBefore: { value: null }, uAfter: { value: null }, uBeforeMotion: { value: null }, uAfterMotion: { value: null },
         uToImage: { value: new THREE.Matrix2() }, uS: { value: 0 }, uHeight: { value: 0 },
       },
       depthTest: false, depthWrite: false, transparent: false, blending: THREE.NoBlending,
     });
-    this.timeScene = fullscreen(this.timeMaterial);
+    this.timeScene = tiled(this.timeMaterial);
+    // The mask's margin in views' pixels (MASK_VIEW_PX), or null: no mask (every pixel
+    // of the walker's box shaded, as frf).
+    this.maskViewPx = MASK_VIEW_PX;
+    this.pointSizes = renderer.getContext().getParameter(renderer.getContext().ALIASED_POINT_SIZE_RANGE);
     this.hullMaterial = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: HULL_VERTEX, fragmentShader: HULL_FRAGMENT,
       uniforms: { uViewProjection: { value: new THREE.Matrix4() }, uEye: { value: new THREE.Vector3() } },
@@ -388,8 +401,9 @@ export class FrfPlayer {
     // flows' reach, which the export states (else every view is decoded to find it). The
     // frame passes shade only the pixels that see it.
     if (!Number.isFinite(record.max_flow_px)) await this.#decodeViews(pose, views.map((_, i) => i));
-    const reach = flowReachM(record.max_flow_px ?? pose.maxFlow, views.map((v) => geometry.cameras[v.u * rows + v.v]));
-    pose.bounds = subjectBounds(mesh.positions, reach);
+    const viewCameras = views.map((v) => geometry.cameras[v.u * rows + v.v]);
+    pose.bounds = subjectBounds(mesh.positions, flowReachM(record.max_flow_px ?? pose.maxFlow, viewCameras));
+    pose.viewPixelM = viewPixelM(viewCameras);
     return pose;
   }
 
@@ -581,6 +595,45 @@ export class FrfPlayer {
     return true;
   }
 
+  /**
+   * The pose's mask (mask.js) for the current margin (`maskViewPx` of its views' pixels),
+   * made when first drawn; null with the mask off.
+   */
+  #mask(pose) {
+    if (this.maskViewPx === null) return null;
+    if (pose.mask?.viewPx !== this.maskViewPx) {
+      const t = performance.now();
+      const marginM = this.maskViewPx * pose.viewPixelM;
+      pose.mask = { viewPx: this.maskViewPx, ...maskVoxels(pose.mesh.positions, pose.mesh.indices, marginM) };
+      pose.loadMs.mask = performance.now() - t;
+    }
+    return pose.mask;
+  }
+
+  /**
+   * Has `scene` (a pass of `tiled`) cover the tiles of `box` where `camera` sees the
+   * masks of `poses`, or the whole box: with the mask off, a camera amid a mask, or
+   * point sprites too small for a tile. Returns how many pixels it covers.
+   */
+  #tile(scene, poses, camera, box) {
+    const masks = poses.map((pose) => this.#mask(pose));
+    const [points, whole] = scene.children;
+    const tiles = !masks.includes(null) && this.pointSizes[1] >= TILE_PX ? maskTiles(masks, camera, box) : null;
+    points.visible = Boolean(tiles);
+    whole.visible = !tiles;
+    const [g, xy] = tiles ? [points.geometry, tiles.centres] : [whole.geometry, boxTriangles(box, camera)];
+    let a = g.getAttribute('position');
+    if (!a || a.array.length < xy.length) {
+      a = new THREE.BufferAttribute(new Float32Array(Math.max(xy.length, 12)), 2);
+      a.setUsage(THREE.DynamicDrawUsage);
+      g.setAttribute('position', a);
+    }
+    a.array.set(xy);
+    a.needsUpdate = true;
+    g.setDrawRange(0, xy.length / 2);
+    return tiles ? tiles.pixels : (box.x1 - box.x0) * (box.y1 - box.y0);
+  }
+
   #hullMesh(mesh) {
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(mesh.positions, 3));
@@ -642,6 +695,7 @@ export class FrfPlayer {
       this.quadTarget = sized(this.quadTarget, camera.width, camera.height);
       const target = this.quadTarget;
       this.#clearBoxed([hull, target], box);
+      this.#tile(this.frameScene, [pose], camera, box);
       this.#drawHull(pose, camera, hull, 0, true);
       this.#frame(pose, camera, pose.prelit.texture, hull, target, null, true);
       this.#unboxed([hull, target]);
@@ -768,10 +822,11 @@ export class FrfPlayer {
   draw(number, camera, target) {
     const pose = this.#prepared(number);
     const hull = this.#hullTarget(camera.width, camera.height, 0);
-    this.drawn = { camera, hulls: [hull], axis: pose.geometry.axis };
+    this.drawn = { camera, hulls: [hull], axis: pose.geometry.axis, shadedPixels: 0 };
     const box = pixelBox(pose.bounds, camera);
     this.#clearBoxed([hull, target], box);
     if (box) {
+      this.drawn.shadedPixels = this.#part('mask', null, () => this.#tile(this.frameScene, [pose], camera, box));
       this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
       this.#part('frame', target, () => this.#frame(pose, camera, pose.prelit.texture, hull, target));
     }
@@ -822,7 +877,7 @@ export class FrfPlayer {
     const [before, after] = [this.#prepared(at.before), this.#prepared(at.after)];
     const t = this.#timeTargets(camera.width, camera.height);
     const hulls = [0, 1].map((k) => this.#hullTarget(camera.width, camera.height, k));
-    this.drawn = { camera, hulls, axis: before.geometry.axis };
+    this.drawn = { camera, hulls, axis: before.geometry.axis, shadedPixels: 0 };
     const box = unionBox(pixelBox(before.bounds, camera), pixelBox(after.bounds, camera));
     const targets = [...t, ...hulls, target];
     this.#clearBoxed(targets, box);
@@ -832,6 +887,7 @@ export class FrfPlayer {
     }
     // Each pose's colour and its motion toward the other in one frame pass (two outputs).
     for (const [pose, step, both, hull] of [[before, 'next', t[0], hulls[0]], [after, 'prev', t[1], hulls[1]]]) {
+      this.drawn.shadedPixels += this.#part('mask', null, () => this.#tile(this.frameScene, [pose], camera, box));
       this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
       this.#part('frame', both, () => this.#frame(pose, camera, pose.prelit.texture, hull, both, pose.motion[step]));
     }
@@ -843,6 +899,7 @@ export class FrfPlayer {
     u.uS.value = at.s;
     u.uHeight.value = camera.height;
     const saved = this.renderer.getRenderTarget();
+    this.#part('mask', null, () => this.#tile(this.timeScene, [before, after], camera, box));
     this.renderer.setRenderTarget(target);
     this.#part('time morph', target, () => this.renderer.render(this.timeScene, this.camera));
     this.renderer.setRenderTarget(saved);
@@ -880,12 +937,12 @@ export class FrfPlayer {
    * in Chromium, nor does a read of another target on SwiftShader).
    */
   #part(name, target, draw) {
-    if (!this.measure || !target) return draw();
+    if (!this.measure) return draw();
     const pixel = new Float32Array(4);
-    this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
+    if (target) this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
     const t0 = performance.now();
     const out = draw();
-    this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
+    if (target) this.renderer.readRenderTargetPixels(target, 0, 0, 1, 1, pixel);
     this.partsMs[name] = (this.partsMs[name] ?? 0) + performance.now() - t0;
     return out;
   }
@@ -1037,6 +1094,29 @@ function sized(target, width, height) {
     type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
     minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
   });
+}
+
+/**
+ * A pass (`material`) drawn where `#tile` says: as point sprites, a mask's tiles (no
+ * diagonal splits a tile: two triangles would shade the pixels along it twice), or as
+ * two triangles, a whole box.
+ */
+function tiled(material) {
+  material.uniforms.uPointSize = { value: TILE_PX };
+  const scene = new THREE.Scene();
+  for (const kind of [THREE.Points, THREE.Mesh]) {
+    const object = new kind(new THREE.BufferGeometry(), material);
+    object.frustumCulled = false;
+    scene.add(object);
+  }
+  return scene;
+}
+
+/** The pixel box `box` (rows down) of `camera`'s frame as two triangles in clip space (rows bottom up). */
+function boxTriangles(box, camera) {
+  const [xa, xb] = [(2 * box.x0) / camera.width - 1, (2 * box.x1) / camera.width - 1];
+  const [ya, yb] = [1 - (2 * box.y0) / camera.height, 1 - (2 * box.y1) / camera.height];
+  return new Float32Array([xa, yb, xb, yb, xb, ya, xa, yb, xb, ya, xa, ya]);
 }
 
 /** The height of a mesh's positions' box. */

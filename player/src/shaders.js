@@ -274,6 +274,19 @@ uniform vec3 uEye;
 out vec4 outColor;
 void main() { outColor = vec4(length(vWorld - uEye) + 1.0, 0.0, 0.0, 1.0); }
 `;
+/**
+ * A pass drawn as tiles of the frame (player.js `#tile`): point sprites uPointSize
+ * across at their centres, or triangles' corners, in clip space.
+ */
+export const TILE_VERTEX = /* glsl */ `
+precision highp float;
+in vec2 position;
+uniform float uPointSize;
+void main() {
+  gl_Position = vec4(position, 0.0, 1.0);
+  gl_PointSize = uPointSize;
+}
+`;
 export const SUN_MAP_VERTEX = /* glsl */ `
 precision highp float;
 in vec3 position;

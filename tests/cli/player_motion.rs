@@ -16,10 +16,10 @@ use crate::common::{frf, stderr};
 use crate::player::{Shot, grid_camera_of, list, player, staged_field, subject_psnr};
 
 /// The instant half-way between poses 0 and 3 of a 30-pose, one-second cycle.
-const HALF_WAY_S: f64 = 0.05;
+pub(crate) const HALF_WAY_S: f64 = 0.05;
 
 /// `node player/screenshot.mjs` of `shot` at instant `time` (seconds), with `extra` flags.
-fn screenshot_at(
+pub(crate) fn screenshot_at(
     glb: &Path,
     sh: &Path,
     shot: &Shot,
@@ -81,14 +81,14 @@ fn frf_at(field: &Path, sh: &Path, shot: &Shot, time: f64, dir: &Path) -> PathBu
 
 /// The two-pose walker, made once for the module's tests: a directory holding the field,
 /// its export and the sky's light.
-struct TwoPoses {
-    dir: tempfile::TempDir,
-    field: PathBuf,
-    glb: PathBuf,
-    sh: PathBuf,
+pub(crate) struct TwoPoses {
+    pub(crate) dir: tempfile::TempDir,
+    pub(crate) field: PathBuf,
+    pub(crate) glb: PathBuf,
+    pub(crate) sh: PathBuf,
 }
 
-fn two_poses() -> &'static TwoPoses {
+pub(crate) fn two_poses() -> &'static TwoPoses {
     static FIXTURE: std::sync::OnceLock<TwoPoses> = std::sync::OnceLock::new();
     FIXTURE.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap();
