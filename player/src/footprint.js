@@ -2,7 +2,7 @@
 // round its hull mesh's box grown by the reach of its flows, and the box of pixels where
 // a camera sees it. The player's passes shade only that box: outside it no ray can show
 // the walker, which is transparent there.
-import { project } from './geometry.js';
+import { positionsBox, project } from './geometry.js';
 
 /** Where on the subject's axis pixels per metre are measured (metres up: mid-body). */
 const AXIS_POINT_M = 1.0;
@@ -19,14 +19,7 @@ export function pixelsPerMetre(camera) {
  * (a hull mesh's, xyz flat) grown by `margin` metres on every side.
  */
 export function subjectBounds(positions, margin) {
-  const lo = [Infinity, Infinity, Infinity];
-  const hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < positions.length; i += 3) {
-    for (let a = 0; a < 3; a++) {
-      lo[a] = Math.min(lo[a], positions[i + a]);
-      hi[a] = Math.max(hi[a], positions[i + a]);
-    }
-  }
+  const [lo, hi] = positionsBox(positions);
   return {
     axis: [(lo[0] + hi[0]) / 2, (lo[2] + hi[2]) / 2],
     radius: Math.hypot((hi[0] - lo[0]) / 2, (hi[2] - lo[2]) / 2) + margin,

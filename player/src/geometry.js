@@ -17,6 +17,19 @@ export const normalizeOrZero = (a) => {
   return l > 0 ? scale(a, 1 / l) : [0, 0, 0];
 };
 
+/** The box `[lo, hi]` of `positions` (xyz flat); infinite bounds the wrong way round when empty. */
+export function positionsBox(positions) {
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < positions.length; i += 3) {
+    for (let a = 0; a < 3; a++) {
+      lo[a] = Math.min(lo[a], positions[i + a]);
+      hi[a] = Math.max(hi[a], positions[i + a]);
+    }
+  }
+  return [lo, hi];
+}
+
 /** A camera's projection of subject-frame point `q` (pixels, centres at integers), or null behind it (frf's `Camera::project`). */
 export function project(camera, q) {
   const [r, d, f] = camera.axes;
@@ -161,14 +174,7 @@ export function poseGeometry(grid, cameraRecords, hullPositions) {
     const top = rows > 1 ? v + 1 : v;
     frames.push(quadFrame([at(u, v), at(u + 1, v), at(u, top), at(u + 1, top)]));
   }
-  let lo = [Infinity, Infinity, Infinity];
-  let hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < hullPositions.length; i += 3) {
-    for (let a = 0; a < 3; a++) {
-      lo[a] = Math.min(lo[a], hullPositions[i + a]);
-      hi[a] = Math.max(hi[a], hullPositions[i + a]);
-    }
-  }
+  const [lo, hi] = positionsBox(hullPositions);
   const axis = hullPositions.length ? [(lo[0] + hi[0]) / 2, (lo[2] + hi[2]) / 2] : [0, 0];
   return { cameras, quads, frames, frameRows, axis, hasHull: hullPositions.length > 0 };
 }

@@ -9,7 +9,7 @@
 // the margin (a box of voxels: at least the margin in every direction), and the voxels
 // on its boundary kept: their projections hold every point within the margin of the
 // hull's silhouette.
-import { dot, sub } from './geometry.js';
+import { dot, positionsBox, sub } from './geometry.js';
 
 /** Pixels a side of a mask's tile. */
 export const TILE_PX = 8;
@@ -30,14 +30,7 @@ export function maskVoxels(positions, indices, marginM) {
   if (!(marginM >= 0) || !Number.isFinite(marginM)) throw new Error(`mask margin ${marginM} m: expected a finite length >= 0`);
   const empty = { centres: new Float32Array(0), voxelM: 0, marginM };
   if (!positions.length || !indices.length) return empty;
-  const lo = [Infinity, Infinity, Infinity];
-  const hi = [-Infinity, -Infinity, -Infinity];
-  for (let i = 0; i < positions.length; i += 3) {
-    for (let a = 0; a < 3; a++) {
-      lo[a] = Math.min(lo[a], positions[i + a]);
-      hi[a] = Math.max(hi[a], positions[i + a]);
-    }
-  }
+  const [lo, hi] = positionsBox(positions);
   let voxel = Math.max(marginM / VOXELS_PER_MARGIN, MIN_VOXEL_M);
   const cells = (v) => [0, 1, 2].map((a) => Math.ceil((hi[a] - lo[a] + 2 * marginM) / v) + 5);
   while (cells(voxel).reduce((p, n) => p * n, 1) > MAX_CELLS) voxel *= 1.25;

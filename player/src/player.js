@@ -12,7 +12,7 @@ import { parseGlb, poseMesh, BadFile } from './glb.js';
 import { MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT } from './sh.js';
 import { png, greyJpeg, expect } from './images.js';
 import {
-  poseGeometry, quadTexels, QUAD_TEXELS, frameTexels, FRAME_TEXELS, lookAt, columnIndex,
+  poseGeometry, quadTexels, QUAD_TEXELS, frameTexels, FRAME_TEXELS, lookAt, columnIndex, positionsBox,
 } from './geometry.js';
 import {
   FULLSCREEN_VERTEX, PRELIT_FRAGMENT, HULL_VERTEX, HULL_FRAGMENT, FRAME_FRAGMENT,
@@ -1119,15 +1119,10 @@ function boxTriangles(box, camera) {
   return new Float32Array([xa, yb, xb, yb, xb, ya, xa, yb, xb, ya, xa, ya]);
 }
 
-/** The height of a mesh's positions' box. */
+/** The height of a mesh's positions' box (0: none). */
 function meshHeight(positions) {
-  let lo = Infinity;
-  let hi = -Infinity;
-  for (let i = 1; i < positions.length; i += 3) {
-    lo = Math.min(lo, positions[i]);
-    hi = Math.max(hi, positions[i]);
-  }
-  return positions.length ? hi - lo : 0;
+  const [lo, hi] = positionsBox(positions);
+  return positions.length ? hi[1] - lo[1] : 0;
 }
 
 /**
