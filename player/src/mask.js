@@ -132,14 +132,15 @@ function boundary(solid, [nx, ny, nz], origin, voxel) {
 
 /**
  * The tiles (`TILE_PX` a side, on the frame's grid) of `box` (a pixel box, rows down)
- * where `camera` sees `masks`' voxels (each voxel's bounding sphere, and a pixel's
- * bilinear footprint beyond): `{ centres, pixels }`, the centres of point sprites
+ * where `camera` sees `mask`'s voxels (each voxel's bounding sphere, and a pixel's
+ * bilinear footprint beyond): `{ covered, centres, pixels }`, the tiles marked (a
+ * frame's grid of them, rows down), the centres of point sprites
  * `TILE_PX` across in clip space (xy pairs; the target's rows bottom up; a tile the
  * frame's edge cuts is moved in, so that its centre, which decides whether a point is
  * drawn, lies in the frame) and how many of the box's pixels they cover. Null where a
  * voxel is near or behind the camera: the whole box is needed.
  */
-export function maskTiles(masks, camera, box) {
+export function maskTiles(mask, camera, box) {
   const { width: w, height: h } = camera;
   const [cols, rows] = [Math.ceil(w / TILE_PX), Math.ceil(h / TILE_PX)];
   const [tx0, ty0] = [Math.floor(box.x0 / TILE_PX), Math.floor(box.y0 / TILE_PX)];
@@ -147,36 +148,47 @@ export function maskTiles(masks, camera, box) {
   const covered = new Uint8Array(cols * rows);
   const [r, d, f] = camera.axes;
   const { fx, fy, cx, cy } = camera.k;
-  for (const mask of masks) {
-    const c = mask.centres;
-    const radius = (mask.voxelM * Math.sqrt(3)) / 2;
-    for (let i = 0; i < c.length; i += 3) {
-      const v = sub([c[i], c[i + 1], c[i + 2]], camera.centre);
-      const z = dot(f, v);
-      if (z < radius + 1e-3) return null;
-      // A point e from the centre moves its pixel by at most f |e| sqrt(1 + tan^2) / (z - |e|)
-      // along each axis (tan: the centre's off the axis).
-      const tx = dot(r, v) / z;
-      const ty = dot(d, v) / z;
-      const px = fx * tx + cx;
-      const py = fy * ty + cy;
-      const rx = (Math.abs(fx) * radius * Math.sqrt(1 + tx * tx)) / (z - radius) + 1;
-      const ry = (Math.abs(fy) * radius * Math.sqrt(1 + ty * ty)) / (z - radius) + 1;
-      const [a0, a1] = [Math.max(Math.floor((px - rx) / TILE_PX), tx0), Math.min(Math.floor((px + rx) / TILE_PX), tx1 - 1)];
-      const [b0, b1] = [Math.max(Math.floor((py - ry) / TILE_PX), ty0), Math.min(Math.floor((py + ry) / TILE_PX), ty1 - 1)];
-      for (let b = b0; b <= b1; b++) for (let a = a0; a <= a1; a++) covered[b * cols + a] = 1;
-    }
+  const c = mask.centres;
+  const radius = (mask.voxelM * Math.sqrt(3)) / 2;
+  for (let i = 0; i < c.length; i += 3) {
+    const v = sub([c[i], c[i + 1], c[i + 2]], camera.centre);
+    const z = dot(f, v);
+    if (z < radius + 1e-3) return null;
+    // A point e from the centre moves its pixel by at most f |e| sqrt(1 + tan^2) / (z - |e|)
+    // along each axis (tan: the centre's off the axis).
+    const tx = dot(r, v) / z;
+    const ty = dot(d, v) / z;
+    const px = fx * tx + cx;
+    const py = fy * ty + cy;
+    const rx = (Math.abs(fx) * radius * Math.sqrt(1 + tx * tx)) / (z - radius) + 1;
+    const ry = (Math.abs(fy) * radius * Math.sqrt(1 + ty * ty)) / (z - radius) + 1;
+    const [a0, a1] = [Math.max(Math.floor((px - rx) / TILE_PX), tx0), Math.min(Math.floor((px + rx) / TILE_PX), tx1 - 1)];
+    const [b0, b1] = [Math.max(Math.floor((py - ry) / TILE_PX), ty0), Math.min(Math.floor((py + ry) / TILE_PX), ty1 - 1)];
+    for (let b = b0; b <= b1; b++) for (let a = a0; a <= a1; a++) covered[b * cols + a] = 1;
   }
+  return tilesOf(covered, camera, box);
+}
+
+/** The tiles either of two `maskTiles` of the same camera and box holds (null: either is the whole box). */
+export function unionTiles(a, b, camera, box) {
+  if (!a || !b) return null;
+  return tilesOf(a.covered.map((t, i) => t | b.covered[i]), camera, box);
+}
+
+/** The point sprites of the tiles `covered` marks in `box`, and the box's pixels they cover. */
+function tilesOf(covered, camera, box) {
+  const { width: w, height: h } = camera;
+  const cols = Math.ceil(w / TILE_PX);
   const out = [];
   let pixels = 0;
   const centre = (t, size) => Math.min((t + 0.5) * TILE_PX, size - TILE_PX / 2);
   const inBox = (t, lo, hi) => Math.max(Math.min((t + 1) * TILE_PX, hi) - Math.max(t * TILE_PX, lo), 0);
-  for (let b = ty0; b < ty1; b++) {
-    for (let a = tx0; a < tx1; a++) {
+  for (let b = Math.floor(box.y0 / TILE_PX); b < Math.ceil(box.y1 / TILE_PX); b++) {
+    for (let a = Math.floor(box.x0 / TILE_PX); a < Math.ceil(box.x1 / TILE_PX); a++) {
       if (!covered[b * cols + a]) continue;
       out.push((2 * centre(a, w)) / w - 1, 1 - (2 * centre(b, h)) / h);
       pixels += inBox(a, box.x0, box.x1) * inBox(b, box.y0, box.y1);
     }
   }
-  return { centres: new Float32Array(out), pixels };
+  return { covered, centres: new Float32Array(out), pixels };
 }

@@ -22,7 +22,7 @@ import {
 import { instantOf, motionToImage } from './time.js';
 import { conditionTable, conditionTexture, luminance, sunViews, INVOLVED, MAX_CONDITIONS, MAX_SUNS, NEAREST } from './sun.js';
 import { subjectBounds, flowReachM, viewPixelM, pixelBox, unionBox } from './footprint.js';
-import { maskVoxels, maskTiles, TILE_PX } from './mask.js';
+import { maskVoxels, maskTiles, unionTiles, TILE_PX } from './mask.js';
 
 /** The sun's map of the hull, texels a side. */
 const SUN_MAP_SIZE = 512;
@@ -35,9 +35,9 @@ const SHADOW_OFFSET_PER_HEIGHT = 0.17;
 
 /**
  * The walker's mask (mask.js) grows its hull by this many of its views' pixels (at the
- * subject) and its mesh's voxel: what the views' soft edges, the cycles' disagreement
- * the hull's carving leaves out and the flows' errors put outside the hull. Chosen on
- * the small preset's two-pose oracle field (docs/export.md, "The walker's mask").
+ * subject): what the views' soft edges, the cycles' disagreement the hull's carving
+ * leaves out and the flows' errors put outside the hull. Chosen on the small preset's
+ * two-pose oracle field (docs/export.md, "The walker's mask").
  */
 export const MASK_VIEW_PX = 8;
 
@@ -611,14 +611,21 @@ export class FrfPlayer {
   }
 
   /**
-   * Has `scene` (a pass of `tiled`) cover the tiles of `box` where `camera` sees the
-   * masks of `poses`, or the whole box: with the mask off, a camera amid a mask, or
-   * point sprites too small for a tile. Returns how many pixels it covers.
+   * The tiles of `box` where `camera` sees `pose`'s mask (mask.js `maskTiles`), or null
+   * for the whole box: with the mask off, a camera amid the mask, or point sprites too
+   * small for a tile.
    */
-  #tile(scene, poses, camera, box) {
-    const masks = poses.map((pose) => this.#mask(pose));
+  #tilesOf(pose, camera, box) {
+    const mask = this.#mask(pose);
+    return mask && this.pointSizes[1] >= TILE_PX ? maskTiles(mask, camera, box) : null;
+  }
+
+  /**
+   * Has `scene` (a pass of `tiled`) cover `tiles` (of `#tilesOf`), or the whole `box`
+   * where they are null. Returns how many pixels it covers.
+   */
+  #tile(scene, tiles, camera, box) {
     const [points, whole] = scene.children;
-    const tiles = !masks.includes(null) && this.pointSizes[1] >= TILE_PX ? maskTiles(masks, camera, box) : null;
     points.visible = Boolean(tiles);
     whole.visible = !tiles;
     const [g, xy] = tiles ? [points.geometry, tiles.centres] : [whole.geometry, boxTriangles(box, camera)];
@@ -695,7 +702,7 @@ export class FrfPlayer {
       this.quadTarget = sized(this.quadTarget, camera.width, camera.height);
       const target = this.quadTarget;
       this.#clearBoxed([hull, target], box);
-      this.#tile(this.frameScene, [pose], camera, box);
+      this.#tile(this.frameScene, this.#tilesOf(pose, camera, box), camera, box);
       this.#drawHull(pose, camera, hull, 0, true);
       this.#frame(pose, camera, pose.prelit.texture, hull, target, null, true);
       this.#unboxed([hull, target]);
@@ -826,7 +833,7 @@ export class FrfPlayer {
     const box = pixelBox(pose.bounds, camera);
     this.#clearBoxed([hull, target], box);
     if (box) {
-      this.drawn.shadedPixels = this.#part('mask', null, () => this.#tile(this.frameScene, [pose], camera, box));
+      this.drawn.shadedPixels = this.#part('mask', null, () => this.#tile(this.frameScene, this.#tilesOf(pose, camera, box), camera, box));
       this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
       this.#part('frame', target, () => this.#frame(pose, camera, pose.prelit.texture, hull, target));
     }
@@ -885,9 +892,11 @@ export class FrfPlayer {
       this.#unboxed(targets);
       return;
     }
-    // Each pose's colour and its motion toward the other in one frame pass (two outputs).
-    for (const [pose, step, both, hull] of [[before, 'next', t[0], hulls[0]], [after, 'prev', t[1], hulls[1]]]) {
-      this.drawn.shadedPixels += this.#part('mask', null, () => this.#tile(this.frameScene, [pose], camera, box));
+    // Each pose's colour and its motion toward the other in one frame pass (two outputs),
+    // over its mask's tiles; the morph in time over either's.
+    const tiles = this.#part('mask', null, () => [before, after].map((pose) => this.#tilesOf(pose, camera, box)));
+    for (const [pose, step, both, hull, k] of [[before, 'next', t[0], hulls[0], 0], [after, 'prev', t[1], hulls[1], 1]]) {
+      this.drawn.shadedPixels += this.#part('mask', null, () => this.#tile(this.frameScene, tiles[k], camera, box));
       this.#part('hull', hull, () => this.#drawHull(pose, camera, hull, 0, true));
       this.#part('frame', both, () => this.#frame(pose, camera, pose.prelit.texture, hull, both, pose.motion[step]));
     }
@@ -899,7 +908,7 @@ export class FrfPlayer {
     u.uS.value = at.s;
     u.uHeight.value = camera.height;
     const saved = this.renderer.getRenderTarget();
-    this.#part('mask', null, () => this.#tile(this.timeScene, [before, after], camera, box));
+    this.#part('mask', null, () => this.#tile(this.timeScene, unionTiles(...tiles, camera, box), camera, box));
     this.renderer.setRenderTarget(target);
     this.#part('time morph', target, () => this.renderer.render(this.timeScene, this.camera));
     this.renderer.setRenderTarget(saved);

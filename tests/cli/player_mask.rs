@@ -70,8 +70,8 @@ for (const [eye, margin] of [[[0.3, 1.2, 3.0], 0.08], [[0.5, 3.0, 1.5], 0.08], [
     }
     return set;
   };
-  const grown = held(m.maskTiles([m.maskVoxels(positions, indices, margin)], camera, box));
-  const bare = held(m.maskTiles([m.maskVoxels(positions, indices, 0)], camera, box));
+  const grown = held(m.maskTiles(m.maskVoxels(positions, indices, margin), camera, box));
+  const bare = held(m.maskTiles(m.maskVoxels(positions, indices, 0), camera, box));
   let near = 0, missed = 0, missedBare = 0;
   for (let y = 0; y < H; y++) {
     for (let x = 0; x < W; x++) {
@@ -100,7 +100,7 @@ for (const [eye, margin] of [[[0.3, 1.2, 3.0], 0.08], [[0.5, 3.0, 1.5], 0.08], [
   const boxed = (b.x1 - b.x0) * (b.y1 - b.y0);
   out.push({ eye, margin, near, missed, missedBare, held: grown.size, boxed });
 }
-const inside = m.maskTiles([m.maskVoxels(positions, indices, 0.1)], g.lookAt([0.1, 1.2, 0.25], [0, 1.2, -1], 1, 16, 16), { x0: 0, y0: 0, x1: 16, y1: 16 });
+const inside = m.maskTiles(m.maskVoxels(positions, indices, 0.1), g.lookAt([0.1, 1.2, 0.25], [0, 1.2, -1], 1, 16, 16), { x0: 0, y0: 0, x1: 16, y1: 16 });
 let refused = '';
 try { m.maskVoxels(positions, indices, NaN); } catch (e) { refused = e.message; }
 console.log(JSON.stringify({ out, inside, refused, empty: m.maskVoxels([], [], 0.1).centres.length }));
