@@ -139,6 +139,10 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
         .unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(|e| CoreError::io(parent, e))?;
     let lock_path = parent.join(format!(".{name}.lock"));
+    // Held from before the lock file exists until the claim is listed live: an interrupt
+    // in between waits for the listing in `abandon_live_claims`, which then removes the
+    // file (an interrupt there once left the lock file behind).
+    let mut live = LIVE.lock().unwrap_or_else(|e| e.into_inner());
     let lock = loop {
         let file = OpenOptions::new()
             .create(true)
@@ -166,11 +170,8 @@ pub fn claim_output(path: &Path) -> Result<OutputClaim> {
     let _ = std::fs::write(&lock_path, format!("{}\n", std::process::id()));
     let prefix = format!("{name}.");
     let removed = remove_temporaries(parent, &prefix);
-    LIVE.lock().unwrap_or_else(|e| e.into_inner()).push((
-        lock_path.clone(),
-        parent.to_path_buf(),
-        prefix,
-    ));
+    live.push((lock_path.clone(), parent.to_path_buf(), prefix));
+    drop(live);
     Ok(OutputClaim {
         lock_path,
         lock: Some(lock),
