@@ -9,7 +9,7 @@ import { fileURLToPath } from 'node:url';
 const root = dirname(fileURLToPath(import.meta.url));
 const TYPES = {
   '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json',
-  '.glb': 'model/gltf-binary', '.css': 'text/css', '.png': 'image/png',
+  '.glb': 'model/gltf-binary', '.css': 'text/css', '.png': 'image/png', '.wasm': 'application/wasm',
 };
 
 /** Serves the player on `port` (0: any free one); `extra` maps URL paths to files. */

@@ -27,6 +27,14 @@ for (const path of paths) {
   }
   const issues = report.issues;
   const errors = issues.messages.filter((m) => m.severity === 0);
+  // Warnings by code, and the images they point at (a check can say which are expected).
+  const warningCodes = {};
+  const warnedImages = new Set();
+  for (const m of issues.messages.filter((w) => w.severity === 1)) {
+    warningCodes[m.code] = (warningCodes[m.code] ?? 0) + 1;
+    const image = /^\/images\/(\d+)/.exec(m.pointer ?? '');
+    if (image) warnedImages.add(Number(image[1]));
+  }
   console.log(JSON.stringify({
     file: path,
     errors: issues.numErrors,
@@ -35,6 +43,8 @@ for (const path of paths) {
     hints: issues.numHints,
     truncated: Boolean(issues.truncated),
     first_errors: errors.slice(0, 5).map((m) => `${m.code} ${m.pointer ?? ''}: ${m.message}`),
+    warning_codes: warningCodes,
+    warned_images: [...warnedImages].sort((x, y) => x - y),
   }));
   if (issues.numErrors > 0 || issues.truncated) failed = true;
 }

@@ -21,10 +21,11 @@ pub mod error;
 pub mod format;
 pub mod glb;
 pub mod hull_mesh;
+pub mod ktx2;
 pub mod model;
 pub mod read;
 pub mod view_maps;
 mod write;
 
 pub use error::{ExportError, Result};
-pub use write::{ExportOptions, ExportReport, Tier, ViewSelection, export};
+pub use write::{AtlasError, ExportOptions, ExportReport, Textures, Tier, ViewSelection, export};

@@ -107,9 +107,21 @@ impl Export {
                 "view {u},{v} has {images} transfer atlases, expected 3 or 1"
             )));
         }
-        let atlas = self.grey_atlases(&t.images, &format!("transfer atlas of view {u},{v}"))?;
+        // Three grey atlases, one KTX2 of the three, or one of either (the compact tier).
+        let channels = match t.colour {
+            Some(_) => 1,
+            None => 3,
+        };
+        let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS) as u32;
+        let grid = self.extension.grid;
+        let tiles = (ATLAS_COLUMNS as u32 * grid.width, rows * grid.height);
+        let atlas = self.grey_atlases(
+            &t.images,
+            (channels, tiles),
+            &format!("transfer atlas of view {u},{v}"),
+        )?;
         // The compact tier: one grey atlas and a colour per texel.
-        let colour = match (&t.colour, images) {
+        let colour = match (&t.colour, atlas.len()) {
             (Some(c), 1) => {
                 let png = image::load_from_memory(self.image_bytes(c.image)?)
                     .map_err(|e| self.bad(format!("the transfer colour of view {u},{v}: {e}")))?
@@ -122,7 +134,6 @@ impl Export {
             _ => None,
         };
         let (scale, offset) = (t.scale, t.offset);
-        let rows = SH_COUNT.div_ceil(ATLAS_COLUMNS) as u32;
         let (w, h) = (
             atlas[0].width() / ATLAS_COLUMNS as u32,
             atlas[0].height() / rows,
@@ -146,8 +157,39 @@ impl Export {
         }))
     }
 
-    /// Grey atlases `images` decoded, checked to be of one size (`what` names them).
-    fn grey_atlases(&self, images: &[usize], what: &str) -> Result<Vec<image::GrayImage>> {
+    /// Whether image `index` is a KTX2 image (its channels in R, G and B).
+    fn is_ktx2(&self, index: usize) -> bool {
+        self.document["images"][index]["mimeType"] == "image/ktx2"
+    }
+
+    /// Grey atlases `images` decoded, checked to be of one size (`what` names them): grey
+    /// JPEGs, or one KTX2 image's R, G and B (its first `channels`; cropped to
+    /// `tiles_size`, the atlas before its padding to whole blocks).
+    fn grey_atlases(
+        &self,
+        images: &[usize],
+        (channels, tiles_size): (usize, (u32, u32)),
+        what: &str,
+    ) -> Result<Vec<image::GrayImage>> {
+        if let [index] = images
+            && self.is_ktx2(*index)
+        {
+            let (w, h, rgba) = crate::ktx2::read(self.image_bytes(*index)?)
+                .map_err(|e| self.bad(format!("the {what}: {e}")))?;
+            let (tw, th) = tiles_size;
+            if (w as u32) < tw || (h as u32) < th {
+                return Err(self.bad(format!(
+                    "the {what} is {w}x{h}, smaller than its tiles' {tw}x{th}"
+                )));
+            }
+            return Ok((0..channels)
+                .map(|c| {
+                    image::GrayImage::from_fn(tw, th, |x, y| {
+                        image::Luma([rgba[4 * (y as usize * w + x as usize) + c]])
+                    })
+                })
+                .collect());
+        }
         let atlas = (images.iter().enumerate())
             .map(|(c, &index)| {
                 image::load_from_memory(self.image_bytes(index)?)
@@ -173,16 +215,23 @@ impl Export {
             )));
         };
         let count = basis.conditions.len();
-        if b.images.len() != 3 || b.scale.len() != count || b.offset.len() != count {
+        let atlases = match b.images.as_slice() {
+            [one] if self.is_ktx2(*one) => 1,
+            _ => 3,
+        };
+        if b.images.len() != atlases || b.scale.len() != count || b.offset.len() != count {
             return Err(self.bad(format!(
-                "view {u},{v}'s basis: {} atlases and {} scales for {count} conditions, expected 3 and {count}",
+                "view {u},{v}'s basis: {} atlases and {} scales for {count} conditions, expected 3 (or one KTX2) and {count}",
                 b.images.len(),
                 b.scale.len()
             )));
         }
         let columns = basis.columns.max(1);
-        let atlas = self.grey_atlases(&b.images, &format!("basis atlas of view {u},{v}"))?;
         let rows = count.div_ceil(columns) as u32;
+        let grid = self.extension.grid;
+        let tiles = (columns as u32 * grid.width, rows * grid.height);
+        let what = format!("basis atlas of view {u},{v}");
+        let atlas = self.grey_atlases(&b.images, (3, tiles), &what)?;
         let (w, h) = (atlas[0].width() / columns as u32, atlas[0].height() / rows);
         Ok((0..count)
             .map(|k| {

@@ -25,7 +25,8 @@ use crate::model::{
     TierName, Transfer, ViewRecord, Walk,
 };
 use crate::view_maps::{
-    alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png, tile_atlas, transfer_atlas,
+    AtlasFormat, CodeError, alpha_png, flow_png, motion_png, normals_png, scaled_rgb_png,
+    tile_atlas, transfer_atlas,
 };
 
 /// Which views of each pose are exported.
@@ -60,6 +61,30 @@ impl std::str::FromStr for Tier {
             "full" => Ok(Tier::Full),
             "compact" => Ok(Tier::Compact),
             other => Err(format!("{other:?}: expected full or compact")),
+        }
+    }
+}
+
+/// How the transfer's (and the basis') atlases are stored (`frf export --textures`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Textures {
+    /// Grey JPEGs, one a channel: the smallest files, decoded to texels by a player.
+    Jpeg,
+    /// One GPU-compressed KTX2 image of UASTC blocks (zstd) a view: a player transcodes
+    /// it to its GPU's block format and keeps it compressed there (8 bits a texel for the
+    /// three channels, against 24 decoded).
+    Ktx2,
+}
+
+/// `jpeg` or `ktx2` (`frf export --textures`).
+impl std::str::FromStr for Textures {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "jpeg" => Ok(Textures::Jpeg),
+            "ktx2" => Ok(Textures::Ktx2),
+            other => Err(format!("{other:?}: expected jpeg or ktx2")),
         }
     }
 }
@@ -115,7 +140,11 @@ pub struct ExportOptions {
     pub views: ViewSelection,
     /// Voxel side of the hull meshes, metres (never finer than the hull's own).
     pub mesh_voxel_m: f32,
-    /// JPEG quality of the transfer atlases (and the basis').
+    /// How the transfer atlases are stored.
+    pub textures: Textures,
+    /// How the basis atlases are stored (with [`ExportOptions::basis`]).
+    pub basis_textures: Textures,
+    /// JPEG quality of the transfer atlases (and the basis'), [`Textures::Jpeg`].
     pub jpeg_quality: u8,
     /// Whether the views' basis images go too (what frf relights a sun by).
     pub basis: bool,
@@ -128,6 +157,8 @@ impl Default for ExportOptions {
             poses: None,
             views: ViewSelection::All,
             mesh_voxel_m: 0.02,
+            textures: Textures::Jpeg,
+            basis_textures: Textures::Jpeg,
             jpeg_quality: 95,
             basis: false,
         }
@@ -150,8 +181,47 @@ pub struct ExportReport {
     pub section_bytes: [(String, u64); SECTIONS],
     /// Wall seconds.
     pub seconds: f64,
+    /// The atlases' codes as a reader decodes them against those encoded, by atlas
+    /// (`transfer`, `basis`), all views pooled.
+    pub atlas_error: Vec<AtlasError>,
     /// What the export lacks that a player may expect (a field without normals).
     pub notes: Vec<String>,
+}
+
+/// The error of one kind of atlas, all views pooled ([`crate::view_maps::CodeError`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct AtlasError {
+    /// `transfer` or `basis`.
+    pub atlas: &'static str,
+    /// The images' media type.
+    pub mime: &'static str,
+    /// Root mean square error, codes (a 255th of a tile's range).
+    pub rms_codes: f64,
+    /// Peak signal to noise ratio over the 255 codes, dB.
+    pub psnr_db: f64,
+    /// The largest error, codes.
+    pub largest_codes: u8,
+    /// The worst view's PSNR, dB.
+    pub worst_view_psnr_db: f64,
+}
+
+impl AtlasError {
+    fn of(atlas: &'static str, mime: &'static str, errors: &[CodeError]) -> Self {
+        let mut all = CodeError::default();
+        errors.iter().for_each(|e| all.add(e));
+        let worst = errors
+            .iter()
+            .map(CodeError::psnr_db)
+            .fold(f64::INFINITY, f64::min);
+        Self {
+            atlas,
+            mime,
+            rms_codes: all.rms(),
+            psnr_db: all.psnr_db(),
+            largest_codes: all.largest,
+            worst_view_psnr_db: worst,
+        }
+    }
 }
 
 /// The sections of an export's bytes ([`ExportReport::section_bytes`]).
@@ -191,6 +261,8 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let mut pose_records = Vec::new();
     let mut triangles = 0;
     let mut exported_views = 0;
+    let (mut transfer_errors, mut basis_errors) = (Vec::new(), Vec::new());
+    let mut mimes = ("", "");
     for &pose in &poses {
         let record = header.pose(pose)?.clone();
         let hull = field.hull(pose)?.ok_or_else(|| {
@@ -264,6 +336,14 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             })
             .collect::<Result<_>>()?;
         let max_flow_px = encoded.iter().map(|e| e.max_flow_px).fold(0.0f32, f32::max);
+        for e in &encoded {
+            mimes = (e.atlas.mime, mimes.1);
+            transfer_errors.push(e.atlas.error);
+            if let Some(b) = &e.basis {
+                basis_errors.push(b.error);
+                mimes.1 = b.mime;
+            }
+        }
         let views: Vec<ViewRecord> = encoded
             .into_iter()
             .map(|e| add_view(&mut glb, &mut sizes, pose, e))
@@ -291,9 +371,17 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let nodes_of: Vec<usize> = pose_records.iter().map(|p| p.node).collect();
     let animation = pose_animation(&mut glb, &poses, &header, &nodes_of);
     let extension = extension_of(&field, field_path, options, pose_records)?;
+    // KTX2 images are glTF's by KHR_texture_basisu (which lists image/ktx2 among the
+    // media types).
+    let mut extensions_used = vec![EXTENSION];
+    if options.textures == Textures::Ktx2
+        || (options.basis && options.basis_textures == Textures::Ktx2)
+    {
+        extensions_used.push("KHR_texture_basisu");
+    }
     let document = json!({
         "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
-        "extensionsUsed": [EXTENSION],
+        "extensionsUsed": extensions_used,
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": nodes,
@@ -322,6 +410,14 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         triangles,
         section_bytes: std::array::from_fn(|i| (names[i].to_string(), sizes[i])),
         seconds: started.elapsed().as_secs_f64(),
+        atlas_error: [
+            ("transfer", mimes.0, &transfer_errors),
+            ("basis", mimes.1, &basis_errors),
+        ]
+        .into_iter()
+        .filter(|(_, _, e)| !e.is_empty())
+        .map(|(atlas, mime, e)| AtlasError::of(atlas, mime, e))
+        .collect(),
         notes,
     })
 }
@@ -474,14 +570,22 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; SECTIONS], pose: u32, e: ViewOut) -
     let name = |what: &str| format!("pose {pose} view {},{} {what}", e.u, e.v);
     let before = glb.binary_bytes();
     let rgb = ["red", "green", "blue"];
-    let atlas: Vec<usize> = (0..e.atlas.jpeg.len())
-        .map(|c| {
-            glb.image(
-                &e.atlas.jpeg[c],
-                "image/jpeg",
-                name(&format!("transfer {}", rgb[c])),
-            )
-        })
+    // One grey JPEG a channel, or one KTX2 image of them all.
+    let channel_names = |what: &str, mime: &str, count: usize| -> Vec<String> {
+        match mime {
+            "image/jpeg" => (rgb.iter().take(count))
+                .map(|c| format!("{what} {c}"))
+                .collect(),
+            _ => vec![what.to_string()],
+        }
+    };
+    let atlas: Vec<usize> = (e.atlas.images.iter())
+        .zip(channel_names(
+            "transfer",
+            e.atlas.mime,
+            e.atlas.images.len(),
+        ))
+        .map(|(bytes, what)| glb.image(bytes, e.atlas.mime, name(&what)))
         .collect();
     let colour = e.colour.as_ref().map(|(png, scale)| ScaledImage {
         image: glb.image(png, "image/png", name("transfer colour")),
@@ -523,8 +627,9 @@ fn add_view(glb: &mut Glb, sizes: &mut [u64; SECTIONS], pose: u32, e: ViewOut) -
     sizes[6] += (glb.binary_bytes() - before) as u64;
     let before = glb.binary_bytes();
     let basis = e.basis.map(|b| BasisImages {
-        images: (b.jpeg.iter().zip(rgb))
-            .map(|(jpeg, c)| glb.image(jpeg, "image/jpeg", name(&format!("basis {c}"))))
+        images: (b.images.iter())
+            .zip(channel_names("basis", b.mime, b.images.len()))
+            .map(|(bytes, what)| glb.image(bytes, b.mime, name(&what)))
             .collect(),
         scale: b.scale,
         offset: b.offset,
@@ -602,9 +707,13 @@ fn encode_view(
             }
         })
         .collect();
-    let quality = options.jpeg_quality;
+    let format_of = |t: Textures| match t {
+        Textures::Jpeg => AtlasFormat::Jpeg(options.jpeg_quality),
+        Textures::Ktx2 => AtlasFormat::Ktx2,
+    };
+    let format = format_of(options.textures);
     let (atlas, colour) = match options.tier {
-        Tier::Full => (transfer_atlas(&transfer, &alpha, quality, 3)?, None),
+        Tier::Full => (transfer_atlas(&transfer, &alpha, format, 3)?, None),
         Tier::Compact => {
             let lum = |c: Rgb| frf_core::image::luminance(c);
             let grey: Vec<[Rgb; SH_COUNT]> = transfer
@@ -623,7 +732,7 @@ fn encode_view(
                 })
                 .collect();
             (
-                transfer_atlas(&grey, &alpha, quality, 1)?,
+                transfer_atlas(&grey, &alpha, format, 1)?,
                 Some(scaled_rgb_png(&colour, w, h)?),
             )
         }
@@ -664,7 +773,8 @@ fn encode_view(
                 true => basis[k].pixels()[p],
                 false => [0.0; 3],
             };
-            tile_atlas(tile, (basis.len(), BASIS_COLUMNS), &alpha, quality, 3)
+            let format = format_of(options.basis_textures);
+            tile_atlas(tile, (basis.len(), BASIS_COLUMNS), &alpha, format, 3)
         })
         .transpose()?;
     Ok(ViewOut {

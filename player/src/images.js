@@ -1,6 +1,9 @@
 // Decoding the export's images into texel arrays: PNGs by fast-png (it keeps the flows'
 // 16 bits, which a canvas would cut to 8), JPEGs by the browser (grey atlases; no colour
-// conversion, no premultiplication; WebCodecs' ImageDecoder where it has it).
+// conversion, no premultiplication; WebCodecs' ImageDecoder where it has it), and KTX2
+// atlases transcoded by three's KTX2Loader to the GPU's own block format (kept
+// compressed: never decoded to texels here).
+import * as THREE from 'three';
 import { decode as decodePng } from 'fast-png';
 import { BadFile, imageBytes } from './glb.js';
 
@@ -67,6 +70,34 @@ async function greyJpegByCanvas(glb, bytes, mime, what) {
   for (let i = 0; i < data.length; i++) data[i] = rgba[4 * i];
   bitmap.close();
   return { width: canvas.width, height: canvas.height, data };
+}
+
+/** `n` rounded up to whole 4 x 4 blocks (a KTX2 atlas' padded size). */
+export const blocks4 = (n) => Math.ceil(n / 4) * 4;
+
+/**
+ * A KTX2 atlas (UASTC blocks, `frf export --textures ktx2`) transcoded by `loader` (a
+ * KTX2Loader set up for the renderer) to a block format the GPU samples (BC7, ASTC, ETC2:
+ * whichever it has), or to RGBA8 texels where it has none: { width, height, format, type,
+ * compressed, data } of its one level.
+ */
+export async function ktx2Atlas(glb, index, what, loader) {
+  const { bytes, mime } = imageBytes(glb, index);
+  if (mime !== 'image/ktx2') throw new BadFile(glb.name, `${what}: ${mime}, expected image/ktx2`);
+  let texture;
+  try {
+    // The loader hands the buffer to its worker: a copy of the image's bytes.
+    texture = await new Promise((ok, fail) => loader.parse(bytes.slice().buffer, ok, fail));
+  } catch (e) {
+    throw new BadFile(glb.name, `${what}: the KTX2 image does not transcode (${e?.message ?? e})`);
+  }
+  const level = texture.mipmaps?.[0];
+  texture.dispose();
+  if (!level || texture.isCompressedArrayTexture) throw new BadFile(glb.name, `${what}: not one 2D level`);
+  return {
+    width: level.width, height: level.height, format: texture.format, type: texture.type,
+    compressed: texture.format !== THREE.RGBAFormat, data: level.data,
+  };
 }
 
 /** Checks an image's size and channels against what the extension says it is. */

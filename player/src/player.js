@@ -8,9 +8,10 @@
 // section 4.7). A pose's textures are made when it is first shown and kept; the pre-lit
 // layers are redone when the light changes.
 import * as THREE from 'three';
-import { parseGlb, poseMesh, BadFile } from './glb.js';
+import { KTX2Loader } from 'three/addons/loaders/KTX2Loader.js';
+import { parseGlb, poseMesh, BadFile, imageBytes } from './glb.js';
 import { MAX_SUN_DIAMETER_DEG, MAX_TOTAL_LIGHT } from './sh.js';
-import { png, greyJpeg, expect } from './images.js';
+import { png, greyJpeg, ktx2Atlas, blocks4, expect } from './images.js';
 import {
   poseGeometry, quadTexels, QUAD_TEXELS, frameTexels, FRAME_TEXELS, lookAt, columnIndex, positionsBox,
 } from './geometry.js';
@@ -58,6 +59,27 @@ function arrayTexture(data, width, height, depth, format, type) {
   t.unpackAlignment = 1;
   t.needsUpdate = true;
   return t;
+}
+
+/** Where three's Basis Universal transcoder lives (the KTX2 atlases'). */
+const TRANSCODER_PATH = new URL('../node_modules/three/examples/jsm/libs/basis/', import.meta.url).href;
+
+/**
+ * An array texture of `depth` layers of a transcoded KTX2 atlas' size and format
+ * (`level`, of `ktx2Atlas`): compressed where the GPU took a block format, else RGBA8.
+ * Its layers' bytes are `data`, `layerBytes` a layer.
+ */
+function packedArrayTexture(level, depth) {
+  const { width, height, format, type, compressed } = level;
+  const data = new Uint8Array(level.data.length * depth);
+  const texture = compressed
+    ? new THREE.CompressedArrayTexture([{ data, width, height }], width, height, depth, format, type)
+    : arrayTexture(data, width, height, depth, THREE.RGBAFormat, THREE.UnsignedByteType);
+  texture.minFilter = THREE.NearestFilter;
+  texture.magFilter = THREE.NearestFilter;
+  texture.generateMipmaps = false;
+  texture.needsUpdate = true;
+  return { texture, data, layerBytes: level.data.length, format };
 }
 
 function dataTexture(data, width, height) {
@@ -108,7 +130,7 @@ export class FrfPlayer {
       glslVersion: THREE.GLSL3, vertexShader: FULLSCREEN_VERTEX, fragmentShader: PRELIT_FRAGMENT,
       uniforms: {
         uAtlas: { value: null }, uAlpha: { value: null }, uNormals: { value: null }, uAlbedo: { value: null },
-        uLayer: { value: 0 }, uCompact: { value: 0 },
+        uLayer: { value: 0 }, uCompact: { value: 0 }, uAtlasPacked: { value: 0 }, uBasisPacked: { value: 0 },
         uScale: { value: [] }, uOffset: { value: [] }, uSh: { value: [] },
         uAlbedoScale: { value: new THREE.Vector3() }, uColourScale: { value: new THREE.Vector3() },
         uSunCount: { value: 0 }, uSunDirs: { value: vectors(MAX_SUNS) }, uSunEs: { value: vectors(MAX_SUNS) }, uHasNormals: { value: 0 },
@@ -184,6 +206,8 @@ export class FrfPlayer {
     this.glb = parseGlb(bytes, name);
     this.ext = this.glb.ext;
     this.grid = this.ext.grid;
+    // Whether the basis atlases are KTX2 (known at the first decoded).
+    this.basisPacked = undefined;
     this.notes = [];
     if (this.ext.poses.some((p) => p.views.some((v) => v.normals === null || v.normals === undefined))) {
       this.notes.push(`${name} holds no fitted normals for some views: a sun lights only the SH part there`);
@@ -227,8 +251,10 @@ export class FrfPlayer {
     for (const p of this.ext.poses) {
       for (const v of p.views) {
         const b = v.basis;
-        if (!b || b.scale?.length !== count || b.offset?.length !== count || b.images?.length !== 3) {
-          throw new BadFile(name, `pose ${p.pose} view ${v.u},${v.v}: its basis holds no three atlases and ${count} scales and offsets, as the export's ${count} conditions ask`);
+        // Three grey JPEGs, or one KTX2 image of the three channels.
+        const atlases = b?.images?.length === 1 && imageBytes(this.glb, b.images[0]).mime === 'image/ktx2' ? 1 : 3;
+        if (!b || b.scale?.length !== count || b.offset?.length !== count || b.images?.length !== atlases) {
+          throw new BadFile(name, `pose ${p.pose} view ${v.u},${v.v}: its basis holds no three atlases (or one KTX2) and ${count} scales and offsets, as the export's ${count} conditions ask`);
         }
       }
     }
@@ -326,8 +352,11 @@ export class FrfPlayer {
     const mesh = poseMesh(glb, record);
     const geometry = poseGeometry(this.grid, record.cameras, mesh.positions);
     const channels = compact ? 1 : 3;
+    // A KTX2 atlas holds a view's channels in one image (layer): it is made at the first
+    // view transcoded, of the GPU's block format.
+    const packed = imageBytes(glb, views[0].transfer.images[0]).mime === 'image/ktx2';
     const data = {
-      atlas: new Uint8Array(9 * w * h * channels * n),
+      atlas: packed ? null : new Uint8Array(9 * w * h * channels * n),
       alpha: new Uint8Array(w * h * n),
       normals: new Uint8Array(4 * w * h * n),
       albedo: new Uint8Array(4 * w * h * 2 * n),
@@ -350,9 +379,9 @@ export class FrfPlayer {
     const motion = this.#motionTextures(record);
     const groundShadow = this.#groundShadowMaps(record);
     const pose = {
-      record, geometry, n, motion, groundShadow, data, flowLayers,
+      record, geometry, n, motion, groundShadow, data, flowLayers, packed,
       decoded: new Array(n).fill(false),
-      atlas: arrayTexture(data.atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
+      atlas: packed ? null : arrayTexture(data.atlas, 3 * w, 3 * h, n * channels, THREE.RedFormat, THREE.UnsignedByteType),
       alpha: arrayTexture(data.alpha, w, h, n, THREE.RedFormat, THREE.UnsignedByteType),
       normals: arrayTexture(data.normals, w, h, n, THREE.RGBAFormat, THREE.UnsignedByteType),
       albedo: arrayTexture(data.albedo, w, h, 2 * n, THREE.RGBAFormat, THREE.UnsignedByteType),
@@ -378,7 +407,7 @@ export class FrfPlayer {
       lightVersion: -1,
       hasNormals: views.map((v) => v.normals !== null && v.normals !== undefined),
       dispose() {
-        for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t.dispose();
+        for (const t of [this.atlas, this.alpha, this.normals, this.albedo, this.flows, this.views, this.quads, this.frames]) t?.dispose();
         for (const t of Object.values(this.motion)) t.dispose();
         this.groundShadow?.maps.dispose();
         this.groundShadow?.relit.dispose();
@@ -396,7 +425,7 @@ export class FrfPlayer {
     }
     // What loading took, by part (ms; the GPU's work as it was issued; the views' images
     // and hulls are added as `#decodeViews` decodes them).
-    pose.loadMs = { jpeg: 0, png: 0, motion: performance.now() - started, hull: 0 };
+    pose.loadMs = { atlases: 0, png: 0, motion: performance.now() - started, hull: 0 };
     // Where the walker can show (frf's SubjectBounds::of_pose): the hull grown by the
     // flows' reach, which the export states (else every view is decoded to find it). The
     // frame passes shade only the pixels that see it.
@@ -422,7 +451,10 @@ export class FrfPlayer {
     const todo = [...new Set(which)].filter((i) => !pose.decoded[i]).sort((a, b) => a - b);
     if (todo.length === 0) return;
     const started = performance.now();
-    await Promise.all(todo.flatMap((i) => Array.from({ length: channels }, (_, c) => {
+    if (pose.packed) {
+      const what = (i) => `pose ${record.pose} view ${record.views[i].u},${record.views[i].v} transfer`;
+      await this.#packedInto(pose, 'atlas', todo, (i) => record.views[i].transfer.images[0], [3 * w, 3 * h], what);
+    } else await Promise.all(todo.flatMap((i) => Array.from({ length: channels }, (_, c) => {
       const v = record.views[i];
       const what = `pose ${record.pose} view ${v.u},${v.v} transfer`;
       return greyJpeg(glb, v.transfer.images[c], what).then((img) => {
@@ -483,7 +515,7 @@ export class FrfPlayer {
     pose.loadMs.hull += performance.now() - decodedPng;
     // Relit again (the new views' colour), and their basis images decoded with a sun.
     pose.lightVersion = -1;
-    pose.loadMs.jpeg += decodedJpeg - started;
+    pose.loadMs.atlases += decodedJpeg - started;
     pose.loadMs.png += decodedPng - decodedJpeg;
   }
 
@@ -652,6 +684,28 @@ export class FrfPlayer {
     return { mesh: m, scene };
   }
 
+  /**
+   * Transcodes views `todo`'s KTX2 atlases (image `imageOf(view)`, `size` texels before
+   * their padding to whole blocks) into one layer a view of `pose[key]`, an array texture
+   * made at the first of them (every view's of one format).
+   */
+  async #packedInto(pose, key, todo, imageOf, [width, height], what) {
+    this.ktx2Loader ??= new KTX2Loader().setTranscoderPath(TRANSCODER_PATH).detectSupport(this.renderer);
+    const levels = await Promise.all(todo.map((i) => ktx2Atlas(this.glb, imageOf(i), what(i), this.ktx2Loader)));
+    levels.forEach((level, k) => {
+      const i = todo[k];
+      expect(this.glb, level, blocks4(width), blocks4(height), null, `${what(i)} atlas`);
+      const store = (pose.packedStores ??= {});
+      store[key] ??= packedArrayTexture(level, pose.record.views.length);
+      pose[key] = store[key].texture;
+      if (level.format !== store[key].format || level.data.length !== store[key].layerBytes) {
+        throw new BadFile(this.glb.name, `${what(i)} atlas: transcoded to another format or size than its pose's other views`);
+      }
+      store[key].data.set(level.data, i * store[key].layerBytes);
+    });
+    if (pose[key]) pose[key].needsUpdate = true;
+  }
+
   /** Whether the sun is relit as frf relights it: a sun, and the export's basis images. */
   #basisSun() {
     return Boolean(this.ext.basis) && this.suns.length > 0;
@@ -667,12 +721,19 @@ export class FrfPlayer {
     const [aw, ah] = [columns * w, Math.ceil(conditions.length / columns) * h];
     const { record } = pose;
     const n = record.views.length;
-    if (!pose.basis) {
-      pose.basisDecoded = new Array(n).fill(false);
+    this.basisPacked ??= imageBytes(this.glb, record.views[0].basis.images[0]).mime === 'image/ktx2';
+    pose.basisDecoded ??= new Array(n).fill(false);
+    if (!pose.basis && !this.basisPacked) {
       pose.basis = arrayTexture(new Uint8Array(aw * ah * 3 * n), aw, ah, 3 * n, THREE.RedFormat, THREE.UnsignedByteType);
     }
     const todo = record.views.map((_, i) => i).filter((i) => pose.decoded[i] && !pose.basisDecoded[i]);
     if (todo.length === 0) return;
+    if (this.basisPacked) {
+      const what = (i) => `pose ${record.pose} view ${record.views[i].u},${record.views[i].v} basis`;
+      await this.#packedInto(pose, 'basis', todo, (i) => record.views[i].basis.images[0], [aw, ah], what);
+      todo.forEach((i) => { pose.basisDecoded[i] = true; });
+      return;
+    }
     const data = pose.basis.image.data;
     await Promise.all(todo.flatMap((i) => [0, 1, 2].map(async (c) => {
       const v = record.views[i];
@@ -738,6 +799,7 @@ export class FrfPlayer {
     this.conditionTexture?.texture.dispose();
     this.conditionTexture = conditionTexture(this.conditionTable, this.suns.map((s) => s.illuminance));
     u.uBasis.value = pose.basis;
+    u.uBasisPacked.value = this.basisPacked ? 1 : 0;
     u.uConditions.value = this.conditionTexture.texture;
     u.uBasisColumns.value = columns;
     u.uConditionCount.value = conditions.length;
@@ -778,6 +840,7 @@ export class FrfPlayer {
     u.uNormals.value = pose.normals;
     u.uAlbedo.value = pose.albedo;
     u.uCompact.value = compact ? 1 : 0;
+    u.uAtlasPacked.value = pose.packed ? 1 : 0;
     u.uSh.value = this.sh.map((c) => new THREE.Vector3(...c));
     u.uSunCount.value = this.suns.length;
     this.suns.forEach((sun, s) => {

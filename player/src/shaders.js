@@ -22,7 +22,9 @@ precision highp float;
 precision highp int;
 precision highp sampler2DArray;
 #define MAX_SUNS 4
-uniform sampler2DArray uAtlas;    // R8: layer 3 * view + channel (compact: 1 per view)
+uniform sampler2DArray uAtlas;    // R8: layer 3 * view + channel (compact: 1 per view); packed: RGB, layer view
+uniform int uAtlasPacked;         // 1: a KTX2 atlas, a view's channels in one layer's RGB
+uniform int uBasisPacked;         // 1: the basis likewise
 uniform sampler2DArray uAlpha;    // R8
 uniform sampler2DArray uNormals;  // RGBA8: n = 2 rgb - 1, a = 0 where none
 uniform sampler2DArray uAlbedo;   // RGBA8 (rgb) of the albedo, and of the compact colour
@@ -99,9 +101,10 @@ bool sunlit(ivec2 p, int s) {
 // (SunLight::sunned).
 vec3 sunned(ivec2 p, ivec2 size, int k, int s) {
   ivec2 a = p + ivec2((k % uBasisColumns) * size.x, (k / uBasisColumns) * size.y);
-  vec3 code = vec3(texelFetch(uBasis, ivec3(a, 3 * uLayer), 0).r,
-                   texelFetch(uBasis, ivec3(a, 3 * uLayer + 1), 0).r,
-                   texelFetch(uBasis, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
+  vec3 code = uBasisPacked == 1 ? texelFetch(uBasis, ivec3(a, uLayer), 0).rgb * 255.0
+    : vec3(texelFetch(uBasis, ivec3(a, 3 * uLayer), 0).r,
+           texelFetch(uBasis, ivec3(a, 3 * uLayer + 1), 0).r,
+           texelFetch(uBasis, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
   return (uBasisOffset[k] + uBasisScale[k] * code) * texelFetch(uConditions, ivec2(k, 1 + s), 0).rgb;
 }
 
@@ -225,9 +228,10 @@ void main() {
         vec3 colour = texelFetch(uAlbedo, ivec3(p, 2 * uLayer + 1), 0).rgb * 255.0 * uColourScale;
         t = (uOffset[i].x + uScale[i].x * code) * colour;
       } else {
-        vec3 code = vec3(texelFetch(uAtlas, ivec3(a, 3 * uLayer), 0).r,
-                         texelFetch(uAtlas, ivec3(a, 3 * uLayer + 1), 0).r,
-                         texelFetch(uAtlas, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
+        vec3 code = uAtlasPacked == 1 ? texelFetch(uAtlas, ivec3(a, uLayer), 0).rgb * 255.0
+          : vec3(texelFetch(uAtlas, ivec3(a, 3 * uLayer), 0).r,
+                 texelFetch(uAtlas, ivec3(a, 3 * uLayer + 1), 0).r,
+                 texelFetch(uAtlas, ivec3(a, 3 * uLayer + 2), 0).r) * 255.0;
         t = uOffset[i] + uScale[i] * code;
       }
       rgb += uSh[i] * t;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use frf_export::{ExportOptions, Tier, ViewSelection};
+use frf_export::{ExportOptions, Textures, Tier, ViewSelection};
 
 use crate::CliResult;
 use crate::cmd::args::{
@@ -35,7 +35,15 @@ pub struct ExportArgs {
     /// grey coefficients and a colour: a third of the transfer's bytes).
     #[arg(long, default_value = "full", value_parser = <Tier as std::str::FromStr>::from_str, conflicts_with = "sprites")]
     tier: Tier,
-    /// JPEG quality of the SH transfer atlases (and the basis').
+    /// How the SH transfer atlases are stored: `jpeg` (grey JPEGs, one a
+    /// channel: the smallest file) or `ktx2` (one GPU-compressed KTX2 image of UASTC
+    /// blocks a view, which a player keeps compressed on its GPU).
+    #[arg(long, default_value = "jpeg", value_parser = <Textures as std::str::FromStr>::from_str, conflicts_with = "sprites")]
+    textures: Textures,
+    /// How the basis atlases are stored (`--basis`): `jpeg` or `ktx2`, as `--textures`.
+    #[arg(long, default_value = "jpeg", value_parser = <Textures as std::str::FromStr>::from_str, requires = "basis", conflicts_with = "sprites")]
+    basis_textures: Textures,
+    /// JPEG quality of the SH transfer atlases (and the basis'), `--textures jpeg`.
     #[arg(long, default_value_t = 95, conflicts_with = "sprites")]
     jpeg_quality: u8,
     /// Also write each view's basis images (one per lighting condition, about three
@@ -112,6 +120,8 @@ pub fn run(args: ExportArgs) -> CliResult {
         poses,
         views: args.views,
         mesh_voxel_m: args.mesh_voxel,
+        textures: args.textures,
+        basis_textures: args.basis_textures,
         jpeg_quality: args.jpeg_quality,
         basis: args.basis,
     };
@@ -131,6 +141,12 @@ pub fn run(args: ExportArgs) -> CliResult {
         println!("  {name:<9} {:>8.2} MB", *bytes as f64 / 1e6);
     }
     println!("  hull meshes: {} triangles", report.triangles);
+    for e in &report.atlas_error {
+        println!(
+            "  {} atlases ({}) as a reader decodes them: {:.2} codes RMS ({:.1} dB PSNR, the worst view's {:.1}), at most {} codes off",
+            e.atlas, e.mime, e.rms_codes, e.psnr_db, e.worst_view_psnr_db, e.largest_codes
+        );
+    }
     for note in &report.notes {
         eprintln!("note: {note}");
     }

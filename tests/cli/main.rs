@@ -12,6 +12,7 @@ mod interrupt;
 mod olat;
 mod outputs;
 mod player;
+mod player_ktx2;
 mod player_mask;
 mod player_motion;
 mod player_scene;
