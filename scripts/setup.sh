@@ -10,6 +10,8 @@
 #   fast-png, puppeteer-core and the Khronos glTF validator), for the export's and the
 #   player's tests;
 # - Debian's Chromium, the real browser the player's tests drive headless (software GL);
+# - a C++ compiler, for the Basis Universal encoder the export's KTX2 atlases are made by
+#   (built from source by the basis-universal crate);
 # - the rustfmt and clippy components, for the checks in .ci/run.
 set -euo pipefail
 
@@ -17,6 +19,7 @@ packages=(mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool libxcursor1 libxi6 l
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
 command -v chromium >/dev/null 2>&1 || packages+=(chromium)
+command -v c++ >/dev/null 2>&1 || packages+=(g++)
 missing=()
 for p in "${packages[@]}"; do
   dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")

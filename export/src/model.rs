@@ -165,7 +165,7 @@ pub struct ViewRecord {
 /// `offset + scale × code` per condition and channel.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BasisImages {
-    /// The atlases (images' indices): red, green, blue.
+    /// The atlases (images' indices): red, green, blue; or one KTX2 image of the three.
     pub images: Vec<usize>,
     /// Per condition and channel: a code's step.
     pub scale: Vec<Rgb>,
@@ -186,7 +186,8 @@ pub struct MotionImage {
 /// A view's SH transfer: per coefficient and channel, `offset + scale × code`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Transfer {
-    /// The atlases (images' indices): three (red, green, blue) or one (grey, compact).
+    /// The atlases (images' indices): three (red, green, blue) or one (grey, compact)
+    /// JPEGs, or one KTX2 image of them (R, G, B; compact R).
     pub images: Vec<usize>,
     /// Per coefficient and channel: a code's step.
     pub scale: [Rgb; SH_COUNT],
