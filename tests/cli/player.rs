@@ -591,41 +591,32 @@ fn the_player_says_what_it_cannot_draw() {
 }
 
 /// A walker of two poses that differ (issue 59: the player's test exported one pose and
-/// could not see a wrong one): the player draws pose 6 as frf renders it, and pose 0
+/// could not see a wrong one): the player draws pose 3 as frf renders it, and pose 0
 /// drawn in its place (a player showing the wrong pose) misses by far.
 #[test]
 fn the_player_draws_the_pose_asked_for() {
+    // The tiny preset's poses 0 and 3, exported (the fixture the walk's tests share).
+    let fixture = crate::player_motion::two_poses();
+    let (field, glb, sh) = (&fixture.field, &fixture.glb, &fixture.sh);
     let dir = tempfile::tempdir().unwrap();
-    let field = staged_field(dir.path(), "0,6", &[]);
-    let glb = dir.path().join("two.glb");
-    let o = frf(&[
-        "export",
-        field.to_str().unwrap(),
-        "--out",
-        glb.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let sh = dir.path().join("sky.json");
-    let o = frf(&["env-sh", "sky", "--out", sh.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let document = frf_export::read::Export::open(&glb).unwrap().document;
-    // A captured view of pose 6 (the export's second).
+    let document = frf_export::read::Export::open(glb).unwrap().document;
+    // A captured view of pose 3 (the export's second).
     let shot = grid_camera_of(&document, 1, 3.0, 1.0);
-    let reference = frf_frame_pose(&field, &sh, &shot, ("64x90", None), dir.path(), Some(6));
+    let reference = frf_frame_pose(field, sh, &shot, ("64x90", None), dir.path(), Some(3));
     let score = |pose: u32| {
         let out = dir.path().join(format!("player{pose}.png"));
-        let o = screenshot_pose(&glb, &sh, &shot, ("64x90", None), &out, pose);
+        let o = screenshot_pose(glb, sh, &shot, ("64x90", None), &out, pose);
         assert!(o.status.success(), "{}", stderr(&o));
         let report: Value = serde_json::from_slice(&o.stdout).unwrap();
         assert_eq!(report["pose"], pose);
         subject_psnr(&reference, &out)
     };
-    let (right, wrong) = (score(6), score(0));
-    eprintln!("pose 6 against frf's pose 6: {right:.2} dB; pose 0 in its place {wrong:.2} dB");
+    let (right, wrong) = (score(3), score(0));
+    eprintln!("pose 3 against frf's pose 3: {right:.2} dB; pose 0 in its place {wrong:.2} dB");
     assert!(right >= 35.0, "{right:.2} dB");
     assert!(
         wrong < right - 5.0,
-        "pose 0 {wrong:.2} dB against pose 6 {right:.2}"
+        "pose 0 {wrong:.2} dB against pose 3 {right:.2}"
     );
 }
 
