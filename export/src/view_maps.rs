@@ -28,6 +28,16 @@ pub enum AtlasFormat {
     Ktx2,
 }
 
+impl AtlasFormat {
+    /// The media type of its images.
+    pub fn mime(self) -> &'static str {
+        match self {
+            AtlasFormat::Jpeg(_) => "image/jpeg",
+            AtlasFormat::Ktx2 => "image/ktx2",
+        }
+    }
+}
+
 /// A view's tiles (the SH transfer's nine coefficients, or the basis' images) as atlases
 /// and how to read their codes back.
 #[derive(Debug, Clone)]
@@ -150,9 +160,27 @@ pub fn tile_atlas(
             }
         }
     }
+    let (images, error) = encode_codes(&codes, &seen, (aw, ah), format)?;
+    Ok(Atlas {
+        images,
+        mime: format.mime(),
+        scale,
+        offset,
+        error,
+    })
+}
+
+/// An atlas' channels (`codes`, each `aw x ah`) encoded as `format`, and the error of what
+/// a reader decodes over the texels `seen`.
+fn encode_codes(
+    codes: &[Vec<u8>],
+    seen: &[bool],
+    (aw, ah): (usize, usize),
+    format: AtlasFormat,
+) -> Result<(Vec<Vec<u8>>, CodeError)> {
     let mut error = CodeError::default();
     let mut compare = |codes: &[u8], decoded: &mut dyn Iterator<Item = u8>| {
-        for ((&a, b), &s) in codes.iter().zip(decoded).zip(&seen) {
+        for ((&a, b), &s) in codes.iter().zip(decoded).zip(seen) {
             if s {
                 let d = a.abs_diff(b);
                 error.squared += f64::from(d).powi(2);
@@ -161,10 +189,10 @@ pub fn tile_atlas(
             }
         }
     };
-    let (images, mime) = match format {
+    let images = match format {
         AtlasFormat::Jpeg(quality) => {
-            let mut images = Vec::with_capacity(channels);
-            for channel in &codes {
+            let mut images = Vec::with_capacity(codes.len());
+            for channel in codes {
                 let mut jpeg = Vec::new();
                 JpegEncoder::new_with_quality(&mut jpeg, quality)
                     .write_image(channel, aw as u32, ah as u32, ExtendedColorType::L8)
@@ -175,7 +203,7 @@ pub fn tile_atlas(
                 compare(channel, &mut decoded.into_raw().into_iter());
                 images.push(jpeg);
             }
-            (images, "image/jpeg")
+            images
         }
         AtlasFormat::Ktx2 => {
             // The atlas padded to whole blocks (code 0, as the texels the view does not
@@ -187,26 +215,20 @@ pub fn tile_atlas(
                 for x in 0..aw {
                     let o = 4 * (y * pw + x);
                     for c in 0..3 {
-                        rgba[o + c] = codes[c.min(channels - 1)][y * aw + x];
+                        rgba[o + c] = codes[c.min(codes.len() - 1)][y * aw + x];
                     }
                     rgba[o + 3] = 255;
                 }
             }
-            let e = crate::ktx2::encode(&rgba, pw, ph, channels == 1)?;
+            let e = crate::ktx2::encode(&rgba, pw, ph, codes.len() == 1)?;
             for (c, channel) in codes.iter().enumerate() {
                 let mut decoded = (0..aw * ah).map(|t| e.decoded[4 * ((t / aw) * pw + t % aw) + c]);
                 compare(channel, &mut decoded);
             }
-            (vec![e.ktx2], "image/ktx2")
+            vec![e.ktx2]
         }
     };
-    Ok(Atlas {
-        images,
-        mime,
-        scale,
-        offset,
-        error,
-    })
+    Ok((images, error))
 }
 
 fn png(bytes: &[u8], w: usize, h: usize, kind: ExtendedColorType) -> Result<Vec<u8>> {

@@ -150,6 +150,21 @@ pub struct ExportOptions {
     pub basis: bool,
 }
 
+impl ExportOptions {
+    /// How atlases stored as `textures` are encoded.
+    fn atlas_format(&self, textures: Textures) -> AtlasFormat {
+        match textures {
+            Textures::Jpeg => AtlasFormat::Jpeg(self.jpeg_quality),
+            Textures::Ktx2 => AtlasFormat::Ktx2,
+        }
+    }
+
+    /// Whether the export holds KTX2 images.
+    fn writes_ktx2(&self) -> bool {
+        self.textures == Textures::Ktx2 || (self.basis && self.basis_textures == Textures::Ktx2)
+    }
+}
+
 impl Default for ExportOptions {
     fn default() -> Self {
         Self {
@@ -262,7 +277,6 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let mut triangles = 0;
     let mut exported_views = 0;
     let (mut transfer_errors, mut basis_errors) = (Vec::new(), Vec::new());
-    let mut mimes = ("", "");
     for &pose in &poses {
         let record = header.pose(pose)?.clone();
         let hull = field.hull(pose)?.ok_or_else(|| {
@@ -271,21 +285,8 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             ))
         })?;
         let mesh = hull_mesh(&hull, options.mesh_voxel_m, pose)?;
-        let before = glb.binary_bytes();
-        let positions = glb.vec3(&mesh.positions);
-        let indices = glb.indices(&mesh.indices);
-        sizes[5] += (glb.binary_bytes() - before) as u64;
         triangles += mesh.indices.len() / 3;
-        meshes.push(json!({
-            "name": format!("hull of pose {pose}"),
-            "primitives": [{"attributes": {"POSITION": positions}, "indices": indices, "material": 0}]
-        }));
-        nodes.push(json!({"name": format!("pose {pose}"), "mesh": meshes.len() - 1}));
-        let node = nodes.len() - 1;
-        nodes[0]["children"]
-            .as_array_mut()
-            .expect("an array")
-            .push(json!(node));
+        let node = add_hull(&mut glb, &mut sizes, (&mut nodes, &mut meshes), &mesh, pose);
 
         let ground_shadow = match field.shadows(pose)? {
             Some(maps) => {
@@ -336,14 +337,8 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
             })
             .collect::<Result<_>>()?;
         let max_flow_px = encoded.iter().map(|e| e.max_flow_px).fold(0.0f32, f32::max);
-        for e in &encoded {
-            mimes = (e.atlas.mime, mimes.1);
-            transfer_errors.push(e.atlas.error);
-            if let Some(b) = &e.basis {
-                basis_errors.push(b.error);
-                mimes.1 = b.mime;
-            }
-        }
+        transfer_errors.extend(encoded.iter().map(|e| e.atlas.error));
+        basis_errors.extend(encoded.iter().filter_map(|e| Some(e.basis.as_ref()?.error)));
         let views: Vec<ViewRecord> = encoded
             .into_iter()
             .map(|e| add_view(&mut glb, &mut sizes, pose, e))
@@ -371,25 +366,7 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
     let nodes_of: Vec<usize> = pose_records.iter().map(|p| p.node).collect();
     let animation = pose_animation(&mut glb, &poses, &header, &nodes_of);
     let extension = extension_of(&field, field_path, options, pose_records)?;
-    // KTX2 images are glTF's by KHR_texture_basisu (which lists image/ktx2 among the
-    // media types).
-    let mut extensions_used = vec![EXTENSION];
-    if options.textures == Textures::Ktx2
-        || (options.basis && options.basis_textures == Textures::Ktx2)
-    {
-        extensions_used.push("KHR_texture_basisu");
-    }
-    let document = json!({
-        "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
-        "extensionsUsed": extensions_used,
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "materials": [{"name": "hull", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
-        "animations": [animation],
-        "extensions": {EXTENSION: extension},
-    });
+    let document = document_of(options, (nodes, meshes), animation, extension);
     let bytes = glb.finish(document);
     frf_core::atomic::write_bytes_atomic(out, &bytes)?;
     let names = [
@@ -411,15 +388,68 @@ pub fn export(field_path: &Path, out: &Path, options: &ExportOptions) -> Result<
         section_bytes: std::array::from_fn(|i| (names[i].to_string(), sizes[i])),
         seconds: started.elapsed().as_secs_f64(),
         atlas_error: [
-            ("transfer", mimes.0, &transfer_errors),
-            ("basis", mimes.1, &basis_errors),
+            ("transfer", options.textures, transfer_errors),
+            ("basis", options.basis_textures, basis_errors),
         ]
         .into_iter()
         .filter(|(_, _, e)| !e.is_empty())
-        .map(|(atlas, mime, e)| AtlasError::of(atlas, mime, e))
+        .map(|(atlas, t, e)| AtlasError::of(atlas, options.atlas_format(t).mime(), &e))
         .collect(),
         notes,
     })
+}
+
+/// The glTF document of the walker: its nodes and hull meshes, the poses' animation and
+/// the extension.
+fn document_of(
+    options: &ExportOptions,
+    (nodes, meshes): (Vec<Value>, Vec<Value>),
+    animation: Value,
+    extension: Value,
+) -> Value {
+    // KTX2 images are glTF's by KHR_texture_basisu (which lists image/ktx2 among the
+    // media types).
+    let extensions_used = match options.writes_ktx2() {
+        true => vec![EXTENSION, "KHR_texture_basisu"],
+        false => vec![EXTENSION],
+    };
+    json!({
+        "asset": {"version": "2.0", "generator": format!("frf {}", env!("CARGO_PKG_VERSION"))},
+        "extensionsUsed": extensions_used,
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": [{"name": "hull", "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.6, 0.6, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.9}}],
+        "animations": [animation],
+        "extensions": {EXTENSION: extension},
+    })
+}
+
+/// Adds pose `pose`'s hull mesh to `glb` (its bytes counted in `sizes`), as a mesh and a
+/// node under the walker's: the node's index.
+fn add_hull(
+    glb: &mut Glb,
+    sizes: &mut [u64; SECTIONS],
+    (nodes, meshes): (&mut Vec<Value>, &mut Vec<Value>),
+    mesh: &crate::hull_mesh::Mesh,
+    pose: u32,
+) -> usize {
+    let before = glb.binary_bytes();
+    let positions = glb.vec3(&mesh.positions);
+    let indices = glb.indices(&mesh.indices);
+    sizes[5] += (glb.binary_bytes() - before) as u64;
+    meshes.push(json!({
+        "name": format!("hull of pose {pose}"),
+        "primitives": [{"attributes": {"POSITION": positions}, "indices": indices, "material": 0}]
+    }));
+    nodes.push(json!({"name": format!("pose {pose}"), "mesh": meshes.len() - 1}));
+    let node = nodes.len() - 1;
+    nodes[0]["children"]
+        .as_array_mut()
+        .expect("an array")
+        .push(json!(node));
+    node
 }
 
 /// The ground-shadow basis' patch and each map's SH weights (frf's ground coefficients
@@ -707,11 +737,7 @@ fn encode_view(
             }
         })
         .collect();
-    let format_of = |t: Textures| match t {
-        Textures::Jpeg => AtlasFormat::Jpeg(options.jpeg_quality),
-        Textures::Ktx2 => AtlasFormat::Ktx2,
-    };
-    let format = format_of(options.textures);
+    let format = options.atlas_format(options.textures);
     let (atlas, colour) = match options.tier {
         Tier::Full => (transfer_atlas(&transfer, &alpha, format, 3)?, None),
         Tier::Compact => {
@@ -773,7 +799,7 @@ fn encode_view(
                 true => basis[k].pixels()[p],
                 false => [0.0; 3],
             };
-            let format = format_of(options.basis_textures);
+            let format = options.atlas_format(options.basis_textures);
             tile_atlas(tile, (basis.len(), BASIS_COLUMNS), &alpha, format, 3)
         })
         .transpose()?;
