@@ -692,10 +692,10 @@ export class FrfPlayer {
   async #packedInto(pose, key, todo, imageOf, [width, height], what) {
     this.ktx2Loader ??= new KTX2Loader().setTranscoderPath(TRANSCODER_PATH).detectSupport(this.renderer);
     const levels = await Promise.all(todo.map((i) => ktx2Atlas(this.glb, imageOf(i), what(i), this.ktx2Loader)));
+    const store = (pose.packedStores ??= {});
     levels.forEach((level, k) => {
       const i = todo[k];
       expect(this.glb, level, blocks4(width), blocks4(height), null, `${what(i)} atlas`);
-      const store = (pose.packedStores ??= {});
       store[key] ??= packedArrayTexture(level, pose.record.views.length);
       pose[key] = store[key].texture;
       if (level.format !== store[key].format || level.data.length !== store[key].layerBytes) {
